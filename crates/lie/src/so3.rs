@@ -1,0 +1,226 @@
+//! SO(3): rotations of 3-space.
+
+use crate::{Error, Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+use std::ops::Mul;
+
+/// Below this angle the closed forms lose precision and Taylor series are used.
+pub(crate) const SMALL_ANGLE: f64 = 1e-4;
+
+/// Largest `‖RᵀR − I‖_F` that [`SO3::from_matrix`] re-orthonormalises rather than refuses.
+pub const ORTHONORMALITY_TOLERANCE: f64 = 1e-3;
+
+/// A rotation, stored as its orthonormal matrix. Serialised as a unit quaternion `[w, x, y, z]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(into = "[f64; 4]", try_from = "[f64; 4]")]
+pub struct SO3 {
+    matrix: Matrix3,
+}
+
+/// `sin θ / θ`, `(1 − cos θ) / θ²` and `(θ − sin θ) / θ³`, with series near 0.
+pub(crate) fn rotation_coefficients(theta: f64) -> (f64, f64, f64) {
+    if theta < SMALL_ANGLE {
+        let t2 = theta * theta;
+        (1.0 - t2 / 6.0 + t2 * t2 / 120.0, 0.5 - t2 / 24.0 + t2 * t2 / 720.0, 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0)
+    } else {
+        let (s, c) = theta.sin_cos();
+        (s / theta, (1.0 - c) / (theta * theta), (theta - s) / (theta * theta * theta))
+    }
+}
+
+impl SO3 {
+    /// The identity rotation.
+    pub fn identity() -> Self {
+        Self { matrix: Matrix3::identity() }
+    }
+
+    /// The skew-symmetric matrix `ω^` with `ω^ x = ω × x`.
+    pub fn hat(w: &Vector3) -> Matrix3 {
+        Matrix3::new(0.0, -w.z, w.y, w.z, 0.0, -w.x, -w.y, w.x, 0.0)
+    }
+
+    /// The inverse of [`SO3::hat`] (reads the skew-symmetric part).
+    pub fn vee(m: &Matrix3) -> Vector3 {
+        Vector3::new(m[(2, 1)] - m[(1, 2)], m[(0, 2)] - m[(2, 0)], m[(1, 0)] - m[(0, 1)]) * 0.5
+    }
+
+    /// Rodrigues' formula `exp(ω^) = I + (sin θ/θ) ω^ + ((1 − cos θ)/θ²) ω^²`.
+    pub fn exp(w: &Vector3) -> Self {
+        let (a, b, _) = rotation_coefficients(w.norm());
+        let k = Self::hat(w);
+        Self { matrix: Matrix3::identity() + k * a + k * k * b }
+    }
+
+    /// The rotation vector `ω` with `exp(ω^) = R`, `|ω| ≤ π`.
+    ///
+    /// Near θ = π the skew part of R vanishes, so the axis is read from the symmetric part
+    /// `(R + Rᵀ)/2 − cos θ I = (1 − cos θ) a aᵀ` instead, its sign from the skew part.
+    pub fn log(&self) -> Vector3 {
+        let r = &self.matrix;
+        let skew = Vector3::new(r[(2, 1)] - r[(1, 2)], r[(0, 2)] - r[(2, 0)], r[(1, 0)] - r[(0, 1)]);
+        let cos = ((r.trace() - 1.0) * 0.5).clamp(-1.0, 1.0);
+        let sin = 0.5 * skew.norm();
+        let theta = sin.atan2(cos);
+        if theta < SMALL_ANGLE {
+            return skew * (0.5 * (1.0 + theta * theta / 6.0));
+        }
+        if theta < PI - 1e-2 {
+            return skew * (theta / (2.0 * sin));
+        }
+        let symmetric = (r + r.transpose()) * 0.5;
+        let k = (0..3).max_by(|&i, &j| symmetric[(i, i)].total_cmp(&symmetric[(j, j)])).unwrap_or(0);
+        let one_minus_cos = 1.0 - cos;
+        let mut axis = Vector3::zeros();
+        axis[k] = ((symmetric[(k, k)] - cos) / one_minus_cos).max(0.0).sqrt();
+        for j in 0..3 {
+            if j != k {
+                axis[j] = symmetric[(j, k)] / (one_minus_cos * axis[k]);
+            }
+        }
+        let axis = axis.normalize();
+        if axis.dot(&skew) < 0.0 { -axis * theta } else { axis * theta }
+    }
+
+    /// The rotation matrix.
+    pub fn matrix(&self) -> Matrix3 {
+        self.matrix
+    }
+
+    /// Wraps a matrix the caller knows to be a rotation, without checking.
+    pub fn from_matrix_unchecked(matrix: Matrix3) -> Self {
+        Self { matrix }
+    }
+
+    /// Re-orthonormalises a nearly-rotation matrix (the nearest rotation in the Frobenius norm,
+    /// by SVD) and refuses one far from a rotation.
+    pub fn from_matrix(matrix: Matrix3) -> Result<Self, Error> {
+        let deviation = (matrix.transpose() * matrix - Matrix3::identity()).norm();
+        let determinant = matrix.determinant();
+        if !(deviation <= ORTHONORMALITY_TOLERANCE && determinant > 0.0) {
+            return Err(Error::NotARotation { deviation, determinant });
+        }
+        let svd = matrix.svd(true, true);
+        match (svd.u, svd.v_t) {
+            (Some(u), Some(v_t)) => Ok(Self { matrix: u * v_t }),
+            _ => Err(Error::NotARotation { deviation, determinant }),
+        }
+    }
+
+    /// The inverse (transpose).
+    pub fn inverse(&self) -> Self {
+        Self { matrix: self.matrix.transpose() }
+    }
+
+    /// `self · other`.
+    pub fn compose(&self, other: &Self) -> Self {
+        Self { matrix: self.matrix * other.matrix }
+    }
+
+    /// Rotates a vector.
+    pub fn act(&self, x: &Vector3) -> Vector3 {
+        self.matrix * x
+    }
+
+    /// Same as [`SO3::exp`].
+    pub fn from_rotation_vector(w: &Vector3) -> Self {
+        Self::exp(w)
+    }
+
+    /// Same as [`SO3::log`].
+    pub fn to_rotation_vector(&self) -> Vector3 {
+        self.log()
+    }
+
+    /// From a quaternion `w + xi + yj + zk`; normalised, refused when its norm is off by more than
+    /// 1e-3.
+    pub fn from_quaternion(w: f64, x: f64, y: f64, z: f64) -> Result<Self, Error> {
+        let norm = (w * w + x * x + y * y + z * z).sqrt();
+        if norm.is_nan() || (norm - 1.0).abs() > 1e-3 {
+            return Err(Error::NotAUnitQuaternion { norm });
+        }
+        let (w, x, y, z) = (w / norm, x / norm, y / norm, z / norm);
+        Ok(Self {
+            matrix: Matrix3::new(
+                1.0 - 2.0 * (y * y + z * z),
+                2.0 * (x * y - w * z),
+                2.0 * (x * z + w * y),
+                2.0 * (x * y + w * z),
+                1.0 - 2.0 * (x * x + z * z),
+                2.0 * (y * z - w * x),
+                2.0 * (x * z - w * y),
+                2.0 * (y * z + w * x),
+                1.0 - 2.0 * (x * x + y * y),
+            ),
+        })
+    }
+
+    /// The unit quaternion `[w, x, y, z]` with `w ≥ 0` (Shepperd's method: the largest of the four
+    /// candidates is computed first, for precision).
+    pub fn to_quaternion(&self) -> [f64; 4] {
+        let m = &self.matrix;
+        let trace = m.trace();
+        let candidates = [trace, m[(0, 0)], m[(1, 1)], m[(2, 2)]];
+        let largest = (0..4).max_by(|&i, &j| candidates[i].total_cmp(&candidates[j])).unwrap_or(0);
+        let q = match largest {
+            0 => {
+                let s = (1.0 + trace).sqrt() * 2.0;
+                [0.25 * s, (m[(2, 1)] - m[(1, 2)]) / s, (m[(0, 2)] - m[(2, 0)]) / s, (m[(1, 0)] - m[(0, 1)]) / s]
+            }
+            1 => {
+                let s = (1.0 + m[(0, 0)] - m[(1, 1)] - m[(2, 2)]).sqrt() * 2.0;
+                [(m[(2, 1)] - m[(1, 2)]) / s, 0.25 * s, (m[(0, 1)] + m[(1, 0)]) / s, (m[(0, 2)] + m[(2, 0)]) / s]
+            }
+            2 => {
+                let s = (1.0 - m[(0, 0)] + m[(1, 1)] - m[(2, 2)]).sqrt() * 2.0;
+                [(m[(0, 2)] - m[(2, 0)]) / s, (m[(0, 1)] + m[(1, 0)]) / s, 0.25 * s, (m[(1, 2)] + m[(2, 1)]) / s]
+            }
+            _ => {
+                let s = (1.0 - m[(0, 0)] - m[(1, 1)] + m[(2, 2)]).sqrt() * 2.0;
+                [(m[(1, 0)] - m[(0, 1)]) / s, (m[(0, 2)] + m[(2, 0)]) / s, (m[(1, 2)] + m[(2, 1)]) / s, 0.25 * s]
+            }
+        };
+        let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let sign = if q[0] < 0.0 { -1.0 } else { 1.0 };
+        q.map(|v| v * sign / norm)
+    }
+
+    /// From roll, pitch, yaw (radians): `R = Rz(yaw) · Ry(pitch) · Rx(roll)`.
+    pub fn from_rpy(roll: f64, pitch: f64, yaw: f64) -> Self {
+        Self::exp(&(Vector3::z() * yaw)) * Self::exp(&(Vector3::y() * pitch)) * Self::exp(&(Vector3::x() * roll))
+    }
+
+    /// `[roll, pitch, yaw]` with `R = Rz(yaw) Ry(pitch) Rx(roll)`, pitch in `[−π/2, π/2]`.
+    pub fn to_rpy(&self) -> [f64; 3] {
+        let m = &self.matrix;
+        let pitch = (-m[(2, 0)]).clamp(-1.0, 1.0).asin();
+        if m[(2, 0)].abs() > 1.0 - 1e-12 {
+            // Gimbal lock: only roll − yaw (or roll + yaw) is defined; put it all in roll.
+            let roll = (-m[(1, 2)]).atan2(m[(1, 1)]);
+            return [roll, pitch, 0.0];
+        }
+        [m[(2, 1)].atan2(m[(2, 2)]), pitch, m[(1, 0)].atan2(m[(0, 0)])]
+    }
+}
+
+impl Mul for SO3 {
+    type Output = SO3;
+
+    fn mul(self, rhs: SO3) -> SO3 {
+        self.compose(&rhs)
+    }
+}
+
+impl From<SO3> for [f64; 4] {
+    fn from(r: SO3) -> Self {
+        r.to_quaternion()
+    }
+}
+
+impl TryFrom<[f64; 4]> for SO3 {
+    type Error = Error;
+
+    fn try_from(q: [f64; 4]) -> Result<Self, Error> {
+        SO3::from_quaternion(q[0], q[1], q[2], q[3])
+    }
+}

@@ -1,0 +1,53 @@
+//! Identification of the local POE parameters from measurements (paper Section III-A-2).
+
+mod options;
+mod redundancy;
+mod registration;
+mod report;
+mod residual;
+mod solver;
+
+pub use options::{IdentificationOptions, Observation, ParameterMask, Solver, Target};
+pub use redundancy::Redundancy;
+pub use registration::register;
+pub use report::{IdentificationReport, IterationRecord};
+pub use residual::ResidualStats;
+pub use solver::{Identification, identify};
+
+use crate::{Error, LocalPoe};
+
+/// Which parameters a calibration identifies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scope {
+    /// Only the base placement and the tools (12 parameters per tool pair, 9 with position-only
+    /// data): the paper's base-tool baseline.
+    BaseTool,
+    /// Every local transform: the paper's POE calibration.
+    Full,
+}
+
+/// Calibrates a nominal model from measurements with no initial guess: closed-form registration
+/// of the measurement frame and tool offsets, a base-tool identification, then (for
+/// [`Scope::Full`]) the full local POE identification. The report is the last stage's.
+pub fn calibrate(
+    nominal: &LocalPoe,
+    observations: &[Observation],
+    scope: Scope,
+    options: &IdentificationOptions,
+) -> Result<Identification, Error> {
+    let registered = register(nominal, observations)?;
+    let base_tool_mask = ParameterMask::base_tool(registered.layout());
+    let base_tool = identify(&registered, observations, &base_tool_mask, options)?;
+    match scope {
+        Scope::BaseTool => Ok(base_tool),
+        Scope::Full => {
+            let mask = ParameterMask::all(base_tool.model.layout());
+            identify(&base_tool.model, observations, &mask, options)
+        }
+    }
+}
+
+/// Error statistics of a model on observations (no identification).
+pub fn evaluate(model: &LocalPoe, observations: &[Observation]) -> Result<ResidualStats, Error> {
+    residual::residuals(model, observations, &IdentificationOptions::default()).map(|(_, s)| s)
+}
