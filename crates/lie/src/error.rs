@@ -23,6 +23,11 @@ pub enum Error {
         /// The last row found.
         last_row: [f64; 4],
     },
+    /// A 4×4 matrix whose translation column holds a NaN or an infinity.
+    NonFiniteTranslation {
+        /// The translation found.
+        translation: [f64; 3],
+    },
 }
 
 impl fmt::Display for Error {
@@ -36,6 +41,9 @@ impl fmt::Display for Error {
             }
             Error::NotRigid { last_row } => {
                 write!(f, "last row of a rigid transform must be [0, 0, 0, 1], found {last_row:?}")
+            }
+            Error::NonFiniteTranslation { translation } => {
+                write!(f, "translation of a rigid transform must be finite, found {translation:?}")
             }
         }
     }

@@ -26,6 +26,7 @@
 //! ```
 #![deny(missing_docs)]
 
+mod coefficients;
 mod error;
 mod jacobians;
 mod se3;

@@ -75,16 +75,21 @@ impl SE3 {
         m
     }
 
-    /// From a homogeneous 4×4 matrix: the last row must be `[0, 0, 0, 1]` (to 1e-9) and the
-    /// rotation block nearly orthonormal (it is re-orthonormalised).
+    /// From a homogeneous 4×4 matrix: the last row must be `[0, 0, 0, 1]` (to 1e-9), the
+    /// translation finite and the rotation block nearly orthonormal (it is re-orthonormalised, see
+    /// [`SO3::from_matrix`]).
     pub fn from_matrix(m: &Matrix4) -> Result<Self, Error> {
         let last_row = [m[(3, 0)], m[(3, 1)], m[(3, 2)], m[(3, 3)]];
         let expected = [0.0, 0.0, 0.0, 1.0];
         if last_row.iter().zip(expected).any(|(a, b)| (a - b).abs().is_nan() || (a - b).abs() > 1e-9) {
             return Err(Error::NotRigid { last_row });
         }
+        let translation = Vector3::new(m[(0, 3)], m[(1, 3)], m[(2, 3)]);
+        if !translation.iter().all(|x| x.is_finite()) {
+            return Err(Error::NonFiniteTranslation { translation: translation.into() });
+        }
         let rotation = SO3::from_matrix(m.fixed_view::<3, 3>(0, 0).into_owned())?;
-        Ok(Self { rotation, translation: Vector3::new(m[(0, 3)], m[(1, 3)], m[(2, 3)]) })
+        Ok(Self { rotation, translation })
     }
 
     /// The adjoint `Ad(T) = [[R, t^ R], [0, R]]` in `(v, ω)` order: `Ad(T) ξ = vee(T ξ^ T⁻¹)`.

@@ -1,12 +1,17 @@
 //! SO(3): rotations of 3-space.
 
+use crate::coefficients::{one_minus_cos_over_angle2, sin_over_angle};
 use crate::{Error, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::PI;
+use std::f64::consts::FRAC_PI_2;
 use std::ops::Mul;
 
-/// Below this angle the closed forms lose precision and Taylor series are used.
-pub(crate) const SMALL_ANGLE: f64 = 1e-4;
+/// Below this angle `log` reads the rotation vector from the skew part by a series in θ.
+const SMALL_ANGLE: f64 = 1e-4;
+
+/// Above this angle `log` reads the rotation axis from the symmetric part of R: the errors of the
+/// two readings, `~ε / sin θ` and `~ε / (1 − cos θ)`, cross at π/2.
+const SYMMETRIC_BRANCH_ANGLE: f64 = FRAC_PI_2;
 
 /// Largest `‖RᵀR − I‖_F` that [`SO3::from_matrix`] re-orthonormalises rather than refuses.
 pub const ORTHONORMALITY_TOLERANCE: f64 = 1e-3;
@@ -16,17 +21,6 @@ pub const ORTHONORMALITY_TOLERANCE: f64 = 1e-3;
 #[serde(into = "[f64; 4]", try_from = "[f64; 4]")]
 pub struct SO3 {
     matrix: Matrix3,
-}
-
-/// `sin θ / θ`, `(1 − cos θ) / θ²` and `(θ − sin θ) / θ³`, with series near 0.
-pub(crate) fn rotation_coefficients(theta: f64) -> (f64, f64, f64) {
-    if theta < SMALL_ANGLE {
-        let t2 = theta * theta;
-        (1.0 - t2 / 6.0 + t2 * t2 / 120.0, 0.5 - t2 / 24.0 + t2 * t2 / 720.0, 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0)
-    } else {
-        let (s, c) = theta.sin_cos();
-        (s / theta, (1.0 - c) / (theta * theta), (theta - s) / (theta * theta * theta))
-    }
 }
 
 impl SO3 {
@@ -47,15 +41,18 @@ impl SO3 {
 
     /// Rodrigues' formula `exp(ω^) = I + (sin θ/θ) ω^ + ((1 − cos θ)/θ²) ω^²`.
     pub fn exp(w: &Vector3) -> Self {
-        let (a, b, _) = rotation_coefficients(w.norm());
+        let theta = w.norm();
         let k = Self::hat(w);
-        Self { matrix: Matrix3::identity() + k * a + k * k * b }
+        Self { matrix: Matrix3::identity() + k * sin_over_angle(theta) + k * k * one_minus_cos_over_angle2(theta) }
     }
 
-    /// The rotation vector `ω` with `exp(ω^) = R`, `|ω| ≤ π`.
+    /// The rotation vector `ω` with `exp(ω^) = R`, `|ω| ≤ π`; at exactly π either of `±π a`.
     ///
-    /// Near θ = π the skew part of R vanishes, so the axis is read from the symmetric part
-    /// `(R + Rᵀ)/2 − cos θ I = (1 − cos θ) a aᵀ` instead, its sign from the skew part.
+    /// The angle is `atan2(sin θ, cos θ)`, both read from R, precise at every angle. The axis read
+    /// from the skew part `R − Rᵀ = 2 sin θ a^` carries a relative error `~ε / sin θ`, which grows
+    /// without bound towards π; above [`SYMMETRIC_BRANCH_ANGLE`] the axis is therefore read from the
+    /// symmetric part `(R + Rᵀ)/2 − cos θ I = (1 − cos θ) a aᵀ` (error `~ε / (1 − cos θ)`, at most
+    /// `ε` there), its sign from the skew part.
     pub fn log(&self) -> Vector3 {
         let r = &self.matrix;
         let skew = Vector3::new(r[(2, 1)] - r[(1, 2)], r[(0, 2)] - r[(2, 0)], r[(1, 0)] - r[(0, 1)]);
@@ -63,21 +60,18 @@ impl SO3 {
         let sin = 0.5 * skew.norm();
         let theta = sin.atan2(cos);
         if theta < SMALL_ANGLE {
+            // θ / (2 sin θ) = ½ (1 + θ²/6 + O(θ⁴)).
             return skew * (0.5 * (1.0 + theta * theta / 6.0));
         }
-        if theta < PI - 1e-2 {
+        if theta < SYMMETRIC_BRANCH_ANGLE {
             return skew * (theta / (2.0 * sin));
         }
+        // The column of (1 − cos θ) a aᵀ with the largest diagonal entry (a_k² ≥ 1/3) is a_k a,
+        // well away from zero.
         let symmetric = (r + r.transpose()) * 0.5;
         let k = (0..3).max_by(|&i, &j| symmetric[(i, i)].total_cmp(&symmetric[(j, j)])).unwrap_or(0);
-        let one_minus_cos = 1.0 - cos;
-        let mut axis = Vector3::zeros();
-        axis[k] = ((symmetric[(k, k)] - cos) / one_minus_cos).max(0.0).sqrt();
-        for j in 0..3 {
-            if j != k {
-                axis[j] = symmetric[(j, k)] / (one_minus_cos * axis[k]);
-            }
-        }
+        let mut axis = symmetric.column(k).into_owned();
+        axis[k] -= cos;
         let axis = axis.normalize();
         if axis.dot(&skew) < 0.0 { -axis * theta } else { axis * theta }
     }
@@ -190,16 +184,23 @@ impl SO3 {
         Self::exp(&(Vector3::z() * yaw)) * Self::exp(&(Vector3::y() * pitch)) * Self::exp(&(Vector3::x() * roll))
     }
 
-    /// `[roll, pitch, yaw]` with `R = Rz(yaw) Ry(pitch) Rx(roll)`, pitch in `[−π/2, π/2]`.
+    /// `[roll, pitch, yaw]` with `R = Rz(yaw) Ry(pitch) Rx(roll)`, pitch in `[−π/2, π/2]`, roll and
+    /// yaw in `[−π, π]`. At gimbal lock (pitch = ±π/2 exactly) yaw is 0 and roll takes the free angle.
+    ///
+    /// Yaw is read first, then removed, and roll and pitch are read from `Rz(−yaw) R = Ry(pitch)
+    /// Rx(roll)` (M. Day, *Extracting Euler angles from a rotation matrix*, Insomniac Games, 2012):
+    /// every angle comes from a well-conditioned `atan2`, so the angles reproduce R to rounding even
+    /// within 1e-6 of gimbal lock, where `asin(−R₂₀)` and a lock threshold would lose half the digits.
     pub fn to_rpy(&self) -> [f64; 3] {
         let m = &self.matrix;
-        let pitch = (-m[(2, 0)]).clamp(-1.0, 1.0).asin();
-        if m[(2, 0)].abs() > 1.0 - 1e-12 {
-            // Gimbal lock: only roll − yaw (or roll + yaw) is defined; put it all in roll.
-            let roll = (-m[(1, 2)]).atan2(m[(1, 1)]);
-            return [roll, pitch, 0.0];
-        }
-        [m[(2, 1)].atan2(m[(2, 2)]), pitch, m[(1, 0)].atan2(m[(0, 0)])]
+        // At exact lock both are ±0, and atan2(±0, −0) = ±π: pin yaw to 0 instead.
+        let yaw = if m[(1, 0)] == 0.0 && m[(0, 0)] == 0.0 { 0.0 } else { m[(1, 0)].atan2(m[(0, 0)]) };
+        let (s, c) = yaw.sin_cos();
+        // Rows 0 and 1 of Rz(−yaw) R: [[cos p, sin p sin r, sin p cos r], [0, cos r, −sin r]].
+        let cos_pitch = c * m[(0, 0)] + s * m[(1, 0)];
+        let pitch = (-m[(2, 0)]).atan2(cos_pitch);
+        let roll = (s * m[(0, 2)] - c * m[(1, 2)]).atan2(c * m[(1, 1)] - s * m[(0, 1)]);
+        [roll, pitch, yaw]
     }
 }
 
