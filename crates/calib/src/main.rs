@@ -1,12 +1,54 @@
-//! `calib`: the command-line tool.
+//! `calib`: the command-line tool. `main` only parses and dispatches; each subcommand lives in a
+//! file of its own and prints through its own functions.
 
-use clap::Parser;
+mod eval;
+mod fit;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
 
 /// Make industrial robots accurate: fit, evaluate and diagnose kinematic calibrations.
 #[derive(Debug, Parser)]
 #[command(name = "calib", version, about, arg_required_else_help = true)]
-struct Cli {}
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
 
-fn main() {
-    let _cli = Cli::parse();
+#[derive(Debug, Subcommand)]
+enum Command {
+    Fit(fit::Args),
+    Eval(eval::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(
+                e.kind(),
+                ErrorKind::DisplayHelp
+                    | ErrorKind::DisplayVersion
+                    | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            ) {
+                e.exit();
+            }
+            // The SPEC asks for one clear line on stderr: clap's first line says what is wrong.
+            let rendered = e.render().to_string();
+            eprintln!("{}", rendered.lines().next().unwrap_or("error: invalid arguments"));
+            return ExitCode::from(2);
+        }
+    };
+    let result = match cli.command {
+        Command::Fit(args) => fit::run(&args),
+        Command::Eval(args) => eval::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }

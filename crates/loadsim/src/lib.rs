@@ -2,3 +2,7 @@
 //! compliance (the paper's ref. [15]), backlash, gear periodic error, thermal growth, drift and
 //! tracker noise.
 #![deny(missing_docs)]
+
+mod dynamics;
+
+pub use dynamics::{LinkInertia, RobotDynamics};

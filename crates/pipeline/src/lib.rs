@@ -1,3 +1,27 @@
-//! The two-step calibration of the paper: geometric identification of a local POE model, then a
-//! Gaussian process on the remaining pose error. Also the measurement CSV and robot RON readers.
+//! The two-step calibration of the paper (Jing, Tao, Yang, Shimada): geometric identification of a
+//! local POE model, then a Gaussian process on the remaining pose error. Also the readers and
+//! writers of the files the SPEC fixes: the measurement CSV, the robot RON, the model RON.
+//!
+//! This is the only library crate that touches files, and only through functions that take a
+//! path or a reader from the caller.
 #![deny(missing_docs)]
+
+mod calibrated;
+mod error;
+mod fit;
+pub mod geometric;
+mod measurements;
+mod method;
+mod metrics;
+mod model_file;
+mod robot;
+mod ron_position;
+
+pub use calibrated::{CalibratedModel, PredictedPose, pose_error};
+pub use error::Error;
+pub use fit::{Evaluation, FitOptions, FitReport, evaluate, fit, tool_indices};
+pub use measurements::{Measurement, MeasurementSet, parse_measurements, read_measurements};
+pub use method::{Method, UnknownMethod};
+pub use metrics::{ErrorSummary, PoseError};
+pub use model_file::{SCHEMA_VERSION, parse_model, read_model, write_model};
+pub use robot::{FlangeDescription, JointDescription, JointType, RobotDescription};

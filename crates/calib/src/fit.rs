@@ -1,0 +1,70 @@
+//! `calib fit`: fit a calibration method to measurements and write the model.
+
+use pipeline::{ErrorSummary, FitOptions, Method, RobotDescription};
+use std::path::PathBuf;
+
+/// Fit a calibrated model to measurements.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Robot description (RON), e.g. fixtures/robots/irb4400.ron.
+    #[arg(long)]
+    robot: PathBuf,
+    /// Measurements (SPEC CSV).
+    #[arg(long)]
+    data: PathBuf,
+    /// Calibration method: base-tool, poe, poe-gp or poe-gp-load.
+    #[arg(long)]
+    method: Method,
+    /// Where to write the calibrated model (RON).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    let robot = RobotDescription::read(&args.robot)?;
+    let data = pipeline::read_measurements(&args.data, Some(robot.joint_count()))?;
+    let (model, report) = pipeline::fit(&robot, &data, args.method, &FitOptions::default())?;
+    pipeline::write_model(&args.out, &model)?;
+
+    let kind = if data.full_pose { "full pose" } else { "position only" };
+    let tools = data.tools.iter().filter(|t| !t.is_empty()).count().max(1);
+    println!(
+        "{} on {} ({} rows, {kind}, {tools} tool{}) for {}",
+        args.method,
+        args.data.display(),
+        data.rows.len(),
+        if tools == 1 { "" } else { "s" },
+        robot.name
+    );
+    if !data.ignored_columns.is_empty() {
+        println!("  ignored columns: {}", data.ignored_columns.join(", "));
+    }
+    print_errors("training error before (nominal, registered)", &report.before);
+    print_errors("training error after", &report.after);
+    let id = &report.identification;
+    println!(
+        "  identifiable: {} of {} free parameters, condition number {:.3e}",
+        id.rank, id.free_parameters, id.condition_number
+    );
+    for direction in &id.unidentifiable {
+        println!("    unidentifiable: {direction}");
+    }
+    println!(
+        "  iterations: {}{}",
+        id.iteration_count(),
+        if id.converged { " (converged)" } else { " (iteration limit reached)" }
+    );
+    println!("  wrote {}", args.out.display());
+    Ok(())
+}
+
+fn print_errors(label: &str, summary: &ErrorSummary) {
+    print!(
+        "  {label}: mean {:.4} mm, rms {:.4} mm, max {:.4} mm",
+        summary.mean_position_error_mm, summary.rms_position_error_mm, summary.max_position_error_mm
+    );
+    match summary.mean_rotation_error_mrad {
+        Some(rotation) => println!(", rotation mean {rotation:.4} mrad"),
+        None => println!(),
+    }
+}

@@ -1,0 +1,72 @@
+//! A calibrated model: the identified kinematics, the optional GP compensation, and prediction.
+
+use crate::{Error, Measurement, Method, PoseError};
+use lie::SE3;
+use poe::LocalPoe;
+use serde::{Deserialize, Serialize};
+
+/// What `calib fit` produces and `calib eval` / `calib predict` use.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CalibratedModel {
+    /// Version of this file layout ([`crate::SCHEMA_VERSION`]).
+    pub schema_version: u32,
+    /// Name of the robot description the fit started from.
+    pub robot: String,
+    /// The method that produced the model.
+    pub method: Method,
+    /// Whether the model was fitted on full-pose data (otherwise orientation is not calibrated).
+    pub full_pose: bool,
+    /// Tool identifiers, in the order of the kinematic model's tools.
+    pub tools: Vec<String>,
+    /// The identified local POE model; its reference frame is the tracker frame.
+    pub kinematics: LocalPoe,
+}
+
+/// A predicted tool pose and, where a GP is part of the model, its standard deviation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PredictedPose {
+    /// `tracker_from_tool`.
+    pub pose: SE3,
+    /// GP standard deviation of the six pose-error components `(v, ω)` (metres, radians).
+    pub std: Option<[f64; 6]>,
+}
+
+impl CalibratedModel {
+    /// Number of joints of the robot.
+    pub fn joint_count(&self) -> usize {
+        self.kinematics.joint_count()
+    }
+
+    /// Index of a tool by its identifier. A set without a `tool` column uses the model's first
+    /// tool; an identifier the model was not fitted with is refused.
+    pub fn tool_index(&self, name: &str, file: &str, line: u64, column: usize) -> Result<usize, Error> {
+        if name.is_empty() && !self.tools.is_empty() {
+            return Ok(0);
+        }
+        self.tools.iter().position(|t| t == name).ok_or_else(|| Error::UnknownTool {
+            file: file.to_owned(),
+            line,
+            column,
+            tool: name.to_owned(),
+            known: self.tools.clone(),
+        })
+    }
+
+    /// Predicts the tool pose of rows of a measurement set, with the GP placed before the POE
+    /// model as in the paper's Eq. 9: `T = exp(ĝ(q, m)) · T_POE(q)`.
+    pub fn predict(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<PredictedPose>, Error> {
+        let mut poses = Vec::with_capacity(rows.len());
+        for (row, &tool) in rows.iter().zip(tools) {
+            poses.push(PredictedPose { pose: self.kinematics.forward(&row.q, tool)?, std: None });
+        }
+        Ok(poses)
+    }
+}
+
+/// The error of a prediction against a measured row.
+pub fn pose_error(predicted: &SE3, row: &Measurement) -> PoseError {
+    PoseError {
+        position_mm: (row.position - predicted.translation()).norm() * 1e3,
+        rotation_mrad: row.orientation.map(|measured| (measured * predicted.rotation().inverse()).log().norm() * 1e3),
+    }
+}

@@ -1,0 +1,46 @@
+//! Step 1 of the paper: the geometric calibration (`base-tool` and `poe`).
+
+use crate::{Error, MeasurementSet};
+use lie::SE3;
+use poe::LocalPoe;
+use poe::identify::{IdentificationOptions, IdentificationReport, Observation, Scope, Target};
+
+/// The measurements as identification observations (SI units, tracker frame).
+pub fn observations(data: &MeasurementSet) -> Vec<Observation> {
+    data.rows
+        .iter()
+        .map(|row| Observation {
+            q: row.q.clone(),
+            tool: row.tool,
+            target: match row.orientation {
+                Some(rotation) => Target::Pose(SE3::new(rotation, row.position)),
+                None => Target::Point(row.position),
+            },
+        })
+        .collect()
+}
+
+/// The result of the geometric step.
+#[derive(Debug, Clone)]
+pub struct GeometricFit {
+    /// The identified kinematics, reference frame = tracker.
+    pub model: LocalPoe,
+    /// The nominal model registered into the tracker frame (the "before" of the report).
+    pub registered: LocalPoe,
+    /// How the identification went.
+    pub report: IdentificationReport,
+}
+
+/// Fits the kinematics to the data: closed-form registration, then the base-tool or the full
+/// local POE identification.
+pub fn fit_geometry(
+    nominal: &LocalPoe,
+    data: &MeasurementSet,
+    scope: Scope,
+    options: &IdentificationOptions,
+) -> Result<GeometricFit, Error> {
+    let observations = observations(data);
+    let registered = poe::identify::register(nominal, &observations)?;
+    let identification = poe::identify::calibrate(nominal, &observations, scope, options)?;
+    Ok(GeometricFit { model: identification.model, registered, report: identification.report })
+}

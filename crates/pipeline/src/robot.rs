@@ -1,0 +1,219 @@
+//! The robot description file (SPEC "Robot description (RON)"): nominal zero-configuration joint
+//! axes, limits, the flange, and optionally a nominal tool and the load model's data.
+
+use crate::Error;
+use crate::ron_position::{field_position, ron_options};
+use lie::{Matrix3, SE3, SO3, Vector3};
+use poe::{JointAxis, JointKind, LocalPoe};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Whether a joint turns or slides, as written in the file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum JointType {
+    /// Rotation about the axis; limits in degrees.
+    Revolute,
+    /// Translation along the axis; limits in metres.
+    Prismatic,
+}
+
+/// One joint at the zero configuration, base frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointDescription {
+    /// Revolute or prismatic.
+    pub kind: JointType,
+    /// Unit direction of the axis.
+    pub axis: [f64; 3],
+    /// A point on the axis, metres.
+    pub point: [f64; 3],
+    /// Limits of a revolute joint, degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limits_deg: Option<(f64, f64)>,
+    /// Limits of a prismatic joint, metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limits_m: Option<(f64, f64)>,
+}
+
+/// The flange at the zero configuration: its origin and two of its axes, base frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlangeDescription {
+    /// Origin, metres.
+    pub position: [f64; 3],
+    /// Its x axis (unit, perpendicular to `z_axis`).
+    pub x_axis: [f64; 3],
+    /// Its z axis, usually out of the wrist (unit).
+    pub z_axis: [f64; 3],
+}
+
+/// A robot description as read from `fixtures/robots/<name>.ron`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename = "Robot", deny_unknown_fields)]
+pub struct RobotDescription {
+    /// Human-readable name.
+    pub name: String,
+    /// The joints, base first.
+    pub joints: Vec<JointDescription>,
+    /// The flange at the zero configuration.
+    pub flange: FlangeDescription,
+    /// Nominal tool point in the flange frame, metres (the measured point's design position).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool: Option<[f64; 3]>,
+    /// Link masses, centres of mass and joint stiffness, for the load model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dynamics: Option<loadsim::RobotDynamics>,
+}
+
+/// Largest deviation from 1 of an axis norm, or from 0 of the flange axes' dot product.
+const UNIT_TOLERANCE: f64 = 1e-6;
+
+impl RobotDescription {
+    /// Reads and validates a robot description file.
+    pub fn read(path: &Path) -> Result<Self, Error> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+        Self::parse(&text, &file)
+    }
+
+    /// Parses and validates a robot description; `file` names it in errors.
+    pub fn parse(text: &str, file: &str) -> Result<Self, Error> {
+        let robot: RobotDescription = ron_options().from_str(text).map_err(|e| Error::RonFormat {
+            file: file.to_owned(),
+            line: e.span.start.line,
+            column: e.span.start.col,
+            message: e.code.to_string(),
+        })?;
+        robot.validate(text, file)?;
+        Ok(robot)
+    }
+
+    fn validate(&self, text: &str, file: &str) -> Result<(), Error> {
+        let at = |field: &str, index: usize, message: String| {
+            let (line, column) = field_position(text, field, index);
+            Error::RonFormat { file: file.to_owned(), line, column, message }
+        };
+        if self.joints.is_empty() {
+            return Err(at("joints", 0, "a robot needs at least one joint".into()));
+        }
+        let (mut deg_index, mut m_index) = (0, 0);
+        for (i, joint) in self.joints.iter().enumerate() {
+            let norm = Vector3::from(joint.axis).norm();
+            if (norm - 1.0).abs() > UNIT_TOLERANCE {
+                return Err(at("axis", i, format!("joint {}: axis has norm {norm}, expected 1", i + 1)));
+            }
+            if !joint.axis.iter().chain(&joint.point).all(|v| v.is_finite()) {
+                return Err(at("axis", i, format!("joint {}: axis or point is not finite", i + 1)));
+            }
+            let (limits, field, index) = match joint.kind {
+                JointType::Revolute => (joint.limits_deg, "limits_deg", &mut deg_index),
+                JointType::Prismatic => (joint.limits_m, "limits_m", &mut m_index),
+            };
+            let other = match joint.kind {
+                JointType::Revolute => joint.limits_m.map(|_| "limits_m"),
+                JointType::Prismatic => joint.limits_deg.map(|_| "limits_deg"),
+            };
+            if let Some(other) = other {
+                return Err(at("kind", i, format!("joint {}: {other} does not fit a {:?} joint", i + 1, joint.kind)));
+            }
+            match limits {
+                None => return Err(at("kind", i, format!("joint {}: {field} is required", i + 1))),
+                Some((lo, hi)) if !(lo.is_finite() && hi.is_finite() && lo < hi) => {
+                    return Err(at(
+                        field,
+                        *index,
+                        format!("joint {}: limits ({lo}, {hi}) must be finite and increasing", i + 1),
+                    ));
+                }
+                Some(_) => *index += 1,
+            }
+        }
+        let x = Vector3::from(self.flange.x_axis);
+        let z = Vector3::from(self.flange.z_axis);
+        for (name, axis) in [("x_axis", x), ("z_axis", z)] {
+            if (axis.norm() - 1.0).abs() > UNIT_TOLERANCE {
+                return Err(at(name, 0, format!("flange {name} has norm {}, expected 1", axis.norm())));
+            }
+        }
+        if x.dot(&z).abs() > UNIT_TOLERANCE {
+            return Err(at("x_axis", 0, format!("flange x_axis and z_axis are not perpendicular (dot {})", x.dot(&z))));
+        }
+        if let Some(dynamics) = &self.dynamics {
+            let n = self.joints.len();
+            if dynamics.links.len() != n {
+                return Err(at("links", 0, format!("{} links given, the robot has {n} joints", dynamics.links.len())));
+            }
+            if dynamics.stiffness_nm_per_rad.len() != n {
+                return Err(at(
+                    "stiffness_nm_per_rad",
+                    0,
+                    format!("{} stiffness values given, the robot has {n} joints", dynamics.stiffness_nm_per_rad.len()),
+                ));
+            }
+            if let Some(k) = dynamics.stiffness_nm_per_rad.iter().position(|k| !(k.is_finite() && *k > 0.0)) {
+                return Err(at("stiffness_nm_per_rad", 0, format!("joint {}: stiffness must be positive", k + 1)));
+            }
+            if let Some(k) = dynamics.links.iter().position(|l| !(l.mass_kg.is_finite() && l.mass_kg >= 0.0)) {
+                return Err(at("mass_kg", k, format!("link {}: mass must be finite and not negative", k + 1)));
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of joints.
+    pub fn joint_count(&self) -> usize {
+        self.joints.len()
+    }
+
+    /// Joint limits in SI units (radians or metres), base first.
+    pub fn limits(&self) -> Vec<(f64, f64)> {
+        self.joints
+            .iter()
+            .map(|j| match (j.kind, j.limits_deg, j.limits_m) {
+                (JointType::Revolute, Some((lo, hi)), _) => (lo.to_radians(), hi.to_radians()),
+                (JointType::Prismatic, _, Some(limits)) => limits,
+                _ => (f64::NEG_INFINITY, f64::INFINITY),
+            })
+            .collect()
+    }
+
+    /// The zero-configuration `base_from_flange` pose.
+    pub fn base_from_flange_zero(&self) -> SE3 {
+        let x = Vector3::from(self.flange.x_axis).normalize();
+        let z = Vector3::from(self.flange.z_axis).normalize();
+        let rotation = SO3::from_matrix_unchecked(Matrix3::from_columns(&[x, z.cross(&x), z]));
+        SE3::new(rotation, Vector3::from(self.flange.position))
+    }
+
+    /// The zero-configuration joint axes as the kinematics crate takes them.
+    pub fn joint_axes(&self) -> Vec<JointAxis> {
+        self.joints
+            .iter()
+            .map(|joint| JointAxis {
+                kind: match joint.kind {
+                    JointType::Revolute => JointKind::Revolute,
+                    JointType::Prismatic => JointKind::Prismatic,
+                },
+                direction: Vector3::from(joint.axis).normalize(),
+                point: Vector3::from(joint.point),
+            })
+            .collect()
+    }
+
+    /// The nominal local POE model in the base frame, with one tool: the flange, or the nominal
+    /// tool point if the description has one.
+    pub fn nominal_model(&self) -> Result<LocalPoe, Error> {
+        let mut model = LocalPoe::from_zero_configuration(&self.joint_axes(), self.base_from_flange_zero())?;
+        if let Some(tool) = self.tool {
+            let flange = model.tools()[0];
+            model.set_tools(vec![flange * SE3::from_translation(Vector3::from(tool))]);
+        }
+        Ok(model)
+    }
+
+    /// The robot described by the file at `path`'s content, as RON text (for writing fixtures).
+    pub fn to_ron(&self) -> String {
+        ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default().struct_names(true))
+            .unwrap_or_else(|e| format!("// cannot serialise robot: {e}"))
+    }
+}

@@ -1,0 +1,141 @@
+//! Every bad measurement file the SPEC lists is refused with its file, line and column.
+
+use pipeline::{Error, parse_measurements};
+
+fn refuse(text: &str, joints: Option<usize>) -> (Error, String) {
+    let error = parse_measurements(text.as_bytes(), "cell.csv", joints).expect_err("the file must be refused");
+    let message = error.to_string();
+    (error, message)
+}
+
+const HEADER2: &str = "q1_rad,q2_rad,x_mm,y_mm,z_mm";
+
+#[test]
+fn an_empty_file_is_refused() {
+    let (error, message) = refuse("", None);
+    assert!(matches!(error, Error::EmptyFile { .. }), "{message}");
+    assert_eq!(message, "cell.csv:1:1: the file has no header or no data row");
+}
+
+#[test]
+fn a_header_without_rows_is_refused() {
+    let (error, message) = refuse(&format!("{HEADER2}\n"), Some(2));
+    assert!(matches!(error, Error::EmptyFile { .. }), "{message}");
+}
+
+#[test]
+fn a_missing_position_column_is_refused_at_the_end_of_the_header() {
+    let (error, message) = refuse("q1_rad,q2_rad,x_mm,z_mm\n0,0,1,2\n", Some(2));
+    assert!(matches!(error, Error::MissingColumn { line: 1, column: 5, ref name, .. } if name == "y_mm"), "{message}");
+    assert_eq!(message, "cell.csv:1:5: missing required column 'y_mm'");
+}
+
+#[test]
+fn a_gap_in_the_joint_columns_is_refused() {
+    let (error, message) = refuse("q1_rad,q3_rad,x_mm,y_mm,z_mm\n0,0,1,2,3\n", None);
+    assert!(matches!(error, Error::MissingColumn { ref name, .. } if name == "q2_rad"), "{message}");
+}
+
+#[test]
+fn a_partial_quaternion_is_refused() {
+    let (error, message) = refuse(&format!("{HEADER2},qw,qx,qy\n0,0,1,2,3,1,0,0\n"), Some(2));
+    assert!(matches!(error, Error::MissingColumn { ref name, .. } if name == "qz"), "{message}");
+}
+
+#[test]
+fn a_duplicate_header_is_refused_at_its_second_occurrence() {
+    let (error, message) = refuse("q1_rad,q2_rad,x_mm,y_mm,z_mm,y_mm\n0,0,1,2,3,4\n", Some(2));
+    assert!(matches!(error, Error::DuplicateColumn { line: 1, column: 6, .. }), "{message}");
+    assert_eq!(message, "cell.csv:1:6: column 'y_mm' appears more than once");
+}
+
+#[test]
+fn one_quantity_in_two_units_is_a_duplicate() {
+    let (error, message) = refuse("q1_rad,q1_deg,x_mm,y_mm,z_mm\n0,0,1,2,3\n", None);
+    assert!(matches!(error, Error::DuplicateColumn { column: 2, .. }), "{message}");
+    let (error, message) = refuse("q1_rad,x_mm,x_m,y_mm,z_mm\n0,0,1,2,3\n", None);
+    assert!(matches!(error, Error::DuplicateColumn { column: 3, .. }), "{message}");
+}
+
+#[test]
+fn a_non_number_is_refused_at_its_cell() {
+    let (error, message) = refuse(&format!("{HEADER2}\n0,0,1,2,3\n0,0.5,1,abc,3\n"), Some(2));
+    assert!(matches!(error, Error::NotANumber { line: 3, column: 4, .. }), "{message}");
+    assert_eq!(message, "cell.csv:3:4: column 'y_mm': 'abc' is not a finite number");
+}
+
+#[test]
+fn nan_and_infinity_are_refused() {
+    for bad in ["NaN", "nan", "inf", "-Infinity", ""] {
+        let (error, message) = refuse(&format!("{HEADER2}\n0,{bad},1,2,3\n"), Some(2));
+        assert!(matches!(error, Error::NotANumber { line: 2, column: 2, .. }), "{bad}: {message}");
+    }
+}
+
+#[test]
+fn a_bad_optional_column_is_refused_too() {
+    let (error, message) = refuse(&format!("{HEADER2},payload_kg,temp_c\n0,0,1,2,3,five,20\n"), Some(2));
+    assert!(matches!(error, Error::NotANumber { column: 6, .. }), "{message}");
+}
+
+#[test]
+fn a_joint_count_that_does_not_match_the_robot_is_refused() {
+    let (error, message) = refuse(&format!("{HEADER2}\n0,0,1,2,3\n"), Some(6));
+    assert!(matches!(error, Error::JointCountMismatch { found: 2, expected: 6, line: 1, .. }), "{message}");
+    assert_eq!(message, "cell.csv:1:6: 2 joint columns, the robot has 6 joints");
+    let (error, message) = refuse("q1_rad,q2_rad,q3_rad,x_mm,y_mm,z_mm\n0,0,0,1,2,3\n", Some(2));
+    assert!(matches!(error, Error::JointCountMismatch { column: 3, .. }), "{message}");
+}
+
+#[test]
+fn a_quaternion_off_unit_norm_is_refused() {
+    let (error, message) =
+        refuse(&format!("{HEADER2},qw,qx,qy,qz\n0,0,1,2,3,1,0,0,0\n0,0,1,2,3,1.01,0,0,0\n"), Some(2));
+    assert!(matches!(error, Error::QuaternionNorm { line: 3, column: 6, .. }), "{message}");
+    assert!(message.starts_with("cell.csv:3:6: quaternion"), "{message}");
+}
+
+#[test]
+fn a_row_with_a_missing_field_is_refused_at_its_line() {
+    let (error, message) = refuse(&format!("{HEADER2}\n0,0,1,2,3\n0,0,1,2\n"), Some(2));
+    assert!(matches!(error, Error::CsvSyntax { line: 3, .. }), "{message}");
+}
+
+#[test]
+fn a_good_file_is_read_in_si_units_with_its_extras() {
+    let text = "tool,q2_deg,q1_rad,x_m,y_mm,z_mm,qw,qx,qy,qz,payload_kg,temp_c,t_s,operator\n\
+                A,90,0.5,1.5,2000,3,1,0,0,0,2.5,21.5,10,ann\n\
+                B,0,0,0,0,0,0,1,0,0,0,22,20,bob\n\
+                A,0,0,0,0,0,0,0,1,0,0,22,30,bob\n";
+    let set = parse_measurements(text.as_bytes(), "good.csv", Some(2)).unwrap();
+    assert_eq!(set.rows.len(), 3);
+    assert!(set.full_pose);
+    assert_eq!(set.tools, vec!["A".to_owned(), "B".to_owned()]);
+    assert_eq!(set.rows.iter().map(|r| r.tool).collect::<Vec<_>>(), vec![0, 1, 0]);
+    let first = &set.rows[0];
+    assert_eq!(first.line, 2);
+    assert!((first.q[1] - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    assert_eq!(first.q[0], 0.5);
+    assert!((first.position - lie::Vector3::new(1.5, 2.0, 0.003)).norm() < 1e-15);
+    assert_eq!((first.payload_kg, first.temp_c, first.t_s), (2.5, Some(21.5), Some(10.0)));
+    assert_eq!(set.ignored_columns, vec!["operator".to_owned()]);
+}
+
+#[test]
+fn written_sets_read_back_unchanged() {
+    let text = "q1_rad,q2_rad,x_mm,y_mm,z_mm,qw,qx,qy,qz,payload_kg,tool,temp_c,t_s\n\
+                0.1,-0.2,1000.5,-3.25,7,0.8,0.6,0,0,1.5,T1,20,0\n\
+                0.3,0.4,999,3,-7,0,0,0.6,0.8,0,T2,21,60\n";
+    let set = parse_measurements(text.as_bytes(), "a.csv", Some(2)).unwrap();
+    let mut buffer = Vec::new();
+    set.write_csv(&mut buffer).unwrap();
+    let again = parse_measurements(buffer.as_slice(), "a.csv", Some(2)).unwrap();
+    assert_eq!(again.tools, set.tools);
+    for (a, b) in set.rows.iter().zip(&again.rows) {
+        assert_eq!(a.q, b.q);
+        assert!((a.position - b.position).norm() < 1e-15);
+        let (ra, rb) = (a.orientation.unwrap(), b.orientation.unwrap());
+        assert!((ra.matrix() - rb.matrix()).norm() < 1e-15);
+        assert_eq!((a.payload_kg, a.temp_c, a.t_s, a.tool), (b.payload_kg, b.temp_c, b.t_s, b.tool));
+    }
+}

@@ -1,0 +1,125 @@
+//! The robot description files: the committed fixtures, and the bad inputs refused.
+
+use pipeline::{Error, RobotDescription};
+use poe::{DhConvention, DhRow, JointKind, LocalPoe};
+use std::f64::consts::FRAC_PI_2;
+use std::path::PathBuf;
+
+fn fixture(name: &str) -> RobotDescription {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name);
+    RobotDescription::read(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn every_fixture_robot_reads_and_builds_its_model() {
+    for (name, joints) in [("irb4400.ron", 6), ("ur10.ron", 6), ("iiwa7.ron", 7)] {
+        let robot = fixture(name);
+        assert_eq!(robot.joint_count(), joints, "{name}");
+        let model = robot.nominal_model().unwrap();
+        let zero = model.forward(&vec![0.0; joints], 0).unwrap();
+        assert!((zero.to_matrix() - robot.base_from_flange_zero().to_matrix()).norm() < 1e-12, "{name}");
+    }
+}
+
+#[test]
+fn ur10_fixture_matches_the_published_dh_table() {
+    let d = [0.1273, 0.0, 0.0, 0.163941, 0.1157, 0.0922];
+    let a = [0.0, -0.612, -0.5723, 0.0, 0.0, 0.0];
+    let alpha = [FRAC_PI_2, 0.0, 0.0, FRAC_PI_2, -FRAC_PI_2, 0.0];
+    let rows: Vec<DhRow> =
+        (0..6).map(|i| DhRow { kind: JointKind::Revolute, a: a[i], alpha: alpha[i], d: d[i], theta: 0.0 }).collect();
+    let dh = LocalPoe::from_dh(&rows, DhConvention::Standard);
+    let fixture = fixture("ur10.ron").nominal_model().unwrap();
+    let qs = [[0.0; 6], [0.3, -1.2, 0.8, 2.0, -0.5, 1.1], [-2.5, 0.4, -2.9, -1.0, 3.0, -0.2]];
+    for q in qs {
+        let a = dh.forward(&q, 0).unwrap();
+        let b = fixture.forward(&q, 0).unwrap();
+        assert!((a.to_matrix() - b.to_matrix()).norm() < 1e-9, "q = {q:?}");
+    }
+}
+
+#[test]
+fn irb4400_positive_joint_two_tilts_the_arm_forward() {
+    let model = fixture("irb4400.ron").nominal_model().unwrap();
+    let up = model.forward(&[0.0; 6], 0).unwrap().translation();
+    let tilted = model.forward(&[0.0, 0.3, 0.0, 0.0, 0.0, 0.0], 0).unwrap().translation();
+    assert!(tilted.x > up.x && tilted.z < up.z);
+}
+
+const GOOD: &str = r#"// a two-joint robot
+Robot(
+    name: "two",
+    joints: [
+        (kind: Revolute, axis: (0.0, 0.0, 1.0), point: (0.0, 0.0, 0.0), limits_deg: (-90.0, 90.0)),
+        (kind: Prismatic, axis: (1.0, 0.0, 0.0), point: (0.0, 0.0, 1.0), limits_m: (0.0, 0.5)),
+    ],
+    flange: (position: (1.0, 0.0, 1.0), x_axis: (1.0, 0.0, 0.0), z_axis: (0.0, 0.0, 1.0)),
+    tool: (0.0, 0.0, 0.1),
+)
+"#;
+
+fn refuse(text: &str) -> (usize, usize, String) {
+    match RobotDescription::parse(text, "robot.ron") {
+        Err(Error::RonFormat { line, column, message, .. }) => (line, column, message),
+        other => panic!("expected a RON error, got {other:?}"),
+    }
+}
+
+#[test]
+fn a_good_description_reads_with_si_limits_and_its_tool() {
+    let robot = RobotDescription::parse(GOOD, "robot.ron").unwrap();
+    assert_eq!(robot.limits()[1], (0.0, 0.5));
+    assert!((robot.limits()[0].1 - FRAC_PI_2).abs() < 1e-15);
+    let model = robot.nominal_model().unwrap();
+    let tool = model.forward(&[0.0, 0.2], 0).unwrap().translation();
+    assert!((tool - lie::Vector3::new(1.2, 0.0, 1.1)).norm() < 1e-12, "{tool}");
+}
+
+#[test]
+fn a_syntax_error_is_refused_at_its_line_and_column() {
+    let (line, column, message) = refuse(&GOOD.replace("point: (0.0, 0.0, 1.0)", "point: (0.0, 0.0 1.0)"));
+    assert_eq!(line, 6, "{message}");
+    assert!(column > 40, "{column}: {message}");
+}
+
+#[test]
+fn an_unknown_field_is_refused() {
+    let (line, _, message) = refuse(&GOOD.replace("tool:", "toll:"));
+    assert_eq!(line, 9, "{message}");
+    assert!(message.contains("toll"), "{message}");
+}
+
+#[test]
+fn a_non_unit_axis_is_refused_at_that_axis() {
+    let (line, column, message) = refuse(&GOOD.replace("axis: (1.0, 0.0, 0.0)", "axis: (2.0, 0.0, 0.0)"));
+    assert_eq!((line, column), (6, 27), "{message}");
+    assert!(message.contains("joint 2: axis has norm 2"), "{message}");
+}
+
+#[test]
+fn limits_of_the_wrong_unit_or_order_are_refused() {
+    let (line, _, message) = refuse(&GOOD.replace("limits_m: (0.0, 0.5)", "limits_deg: (0.0, 0.5)"));
+    assert_eq!(line, 6, "{message}");
+    assert!(message.contains("limits_deg does not fit"), "{message}");
+    let (line, column, message) = refuse(&GOOD.replace("(-90.0, 90.0)", "(90.0, -90.0)"));
+    assert_eq!((line, column), (5, 73), "{message}");
+    assert!(message.contains("increasing"), "{message}");
+}
+
+#[test]
+fn flange_axes_that_are_not_perpendicular_are_refused() {
+    let (line, _, message) = refuse(&GOOD.replace("x_axis: (1.0, 0.0, 0.0)", "x_axis: (0.0, 0.0, 1.0)"));
+    assert_eq!(line, 8, "{message}");
+    assert!(message.contains("perpendicular"), "{message}");
+}
+
+#[test]
+fn dynamics_of_the_wrong_length_are_refused() {
+    let text = GOOD.replace(
+        "    tool: (0.0, 0.0, 0.1),\n",
+        "    dynamics: (links: [(mass_kg: 1.0, com_m: (0.0, 0.0, 0.5))], stiffness_nm_per_rad: [1e5, 1e5]),\n",
+    );
+    let (line, _, message) = refuse(&text);
+    assert_eq!(line, 9, "{message}");
+    assert!(message.contains("1 links given"), "{message}");
+}
