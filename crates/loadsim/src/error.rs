@@ -1,0 +1,104 @@
+//! The errors of the `loadsim` crate.
+
+use std::fmt;
+
+/// What can go wrong when configuring or running a simulation.
+#[non_exhaustive]
+#[derive(Debug, Clone, PartialEq)]
+pub enum Error {
+    /// The kinematic model refused the request (wrong joint count, unknown tool).
+    Kinematics {
+        /// The error of the `poe` crate.
+        source: poe::Error,
+    },
+    /// A list that needs one entry per joint (or per link) has the wrong length.
+    LengthMismatch {
+        /// Which list, e.g. `"stiffness_nm_per_rad"`.
+        field: &'static str,
+        /// Entries given.
+        given: usize,
+        /// Entries needed.
+        expected: usize,
+    },
+    /// A joint index refers to no joint of the robot.
+    UnknownJoint {
+        /// Which setting carried it, e.g. `"backlash"`.
+        field: &'static str,
+        /// The 0-based index given.
+        joint_index: usize,
+        /// The robot's joint count.
+        joint_count: usize,
+    },
+    /// A number is out of its physical range (negative stiffness, NaN, …).
+    InvalidParameter {
+        /// Which parameter.
+        field: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// An effect needs the robot's masses and stiffness, but the robot description has none.
+    MissingDynamics {
+        /// The effect that needs them.
+        effect: &'static str,
+    },
+    /// A joint range is empty once the margin is taken off both ends.
+    EmptyJointRange {
+        /// 0-based joint index.
+        joint_index: usize,
+        /// Lower limit, rad.
+        lower_rad: f64,
+        /// Upper limit, rad.
+        upper_rad: f64,
+        /// Margin taken off each end, rad.
+        margin_rad: f64,
+    },
+    /// The generator rejected too many candidate poses as near-singular.
+    SamplingExhausted {
+        /// Poses accepted before giving up.
+        accepted: usize,
+        /// Candidates drawn.
+        attempts: usize,
+    },
+}
+
+impl From<poe::Error> for Error {
+    fn from(source: poe::Error) -> Self {
+        Error::Kinematics { source }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Kinematics { source } => write!(f, "kinematic model: {source}"),
+            Error::LengthMismatch { field, given, expected } => {
+                write!(f, "{field} has {given} entries, {expected} expected")
+            }
+            Error::UnknownJoint { field, joint_index, joint_count } => {
+                write!(f, "{field} names joint {} but the robot has {joint_count} joints", joint_index + 1)
+            }
+            Error::InvalidParameter { field, value } => write!(f, "{field} = {value} is out of range"),
+            Error::MissingDynamics { effect } => {
+                write!(f, "{effect} needs link masses and joint stiffness, but the robot has no `dynamics`")
+            }
+            Error::EmptyJointRange { joint_index, lower_rad, upper_rad, margin_rad } => write!(
+                f,
+                "joint {} range [{lower_rad}, {upper_rad}] rad is empty after a margin of {margin_rad} rad",
+                joint_index + 1
+            ),
+            Error::SamplingExhausted { accepted, attempts } => write!(
+                f,
+                "only {accepted} poses accepted after {attempts} candidates: the singularity threshold is too strict"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Error::Kinematics { source } => Some(source),
+            _ => None,
+        }
+    }
+}
