@@ -1,13 +1,35 @@
 //! `cargo xtask`: the paper's experiments and project automation. `main` only dispatches; each
 //! command lives in a file of its own.
 
-use clap::Parser;
+mod convert_ur10;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
 
 /// Project automation for the calib workspace.
 #[derive(Debug, Parser)]
 #[command(name = "cargo xtask", arg_required_else_help = true)]
-struct Cli {}
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
 
-fn main() {
-    let _cli = Cli::parse();
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Convert the IPA UR10 tracker dataset to SPEC measurement CSV.
+    ConvertUr10(convert_ur10::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::ConvertUr10(args) => convert_ur10::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }

@@ -1,0 +1,153 @@
+//! `cargo xtask convert-ur10`: the IPA UR10 tracker dataset (Landgraf et al., CASE 2021, MIT
+//! licence; <https://ieeexplore.ieee.org/document/9551684>) as SPEC measurement CSV.
+//!
+//! The dataset is not part of this repository: point `--input` at a copy (by default
+//! `../shared/data/ipa-ur10` beside the project). Its measurement files are `;`-separated with a
+//! decimal comma; joints in radians (UR's DH zero), the T-Mac position in millimetres and its
+//! orientation as `rx, ry, rz` in degrees, and the cell temperature.
+
+use lie::{SO3, Vector3};
+use pipeline::{Measurement, MeasurementSet};
+use std::path::{Path, PathBuf};
+
+/// Convert the IPA UR10 dataset (Leica AT960 + T-Mac on a UR10) to SPEC CSV.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Folder of the dataset (holding Series_A … Series_D).
+    #[arg(long, default_value = "../shared/data/ipa-ur10")]
+    input: PathBuf,
+    /// Which series: A (grid), B (joint configurations), C (random poses), D (ISO cubes).
+    #[arg(long, default_value = "C")]
+    series: String,
+    /// Keep the T-Mac orientation (full-pose data); otherwise position only.
+    #[arg(long)]
+    full_pose: bool,
+    /// Write all rows here.
+    #[arg(long, conflicts_with_all = ["train", "test"])]
+    out: Option<PathBuf>,
+    /// Write the first half of the rows (in measurement order) here…
+    #[arg(long, requires = "test")]
+    train: Option<PathBuf>,
+    /// …and the second half here.
+    #[arg(long, requires = "train")]
+    test: Option<PathBuf>,
+}
+
+const SERIES: [(&str, &str); 4] = [
+    ("A", "Series_A/measurements_grid.csv"),
+    ("B", "Series_B/measurements_joint_configurations.csv"),
+    ("C", "Series_C/measurements_random_poses.csv"),
+    ("D", "Series_D/measurements_iso_cubes.csv"),
+];
+
+const JOINTS: [&str; 6] =
+    ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"];
+
+fn number(text: &str, file: &Path, line: usize, column: usize) -> Result<f64, String> {
+    let value: f64 = text
+        .trim()
+        .replace(',', ".")
+        .parse()
+        .map_err(|_| format!("{}:{line}:{column}: '{text}' is not a number", file.display()))?;
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(format!("{}:{line}:{column}: '{text}' is not finite", file.display()))
+    }
+}
+
+/// The tracker's orientation angles as a rotation: `R = Rx(rx) · Ry(ry) · Rz(rz)` (intrinsic
+/// x-y'-z''), the convention that makes the T-Mac a rigid body on the flange in this dataset
+/// (checked by `cargo xtask convert-ur10 --full-pose` followed by a `poe` fit: the orientation
+/// residual is at the tracker's noise level only with this order).
+fn rotation(rx: f64, ry: f64, rz: f64) -> SO3 {
+    SO3::exp(&(Vector3::x() * rx.to_radians()))
+        * SO3::exp(&(Vector3::y() * ry.to_radians()))
+        * SO3::exp(&(Vector3::z() * rz.to_radians()))
+}
+
+/// `YYYYMMDDhhmmss` as seconds since the first row's day; `None` when the stamp lost its digits
+/// (Series B and C store it as `2,02011E+13`).
+fn seconds(stamp: &str) -> Option<f64> {
+    let s = stamp.trim();
+    if s.len() != 14 || !s.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    let part = |a: usize, b: usize| s[a..b].parse::<f64>().ok();
+    Some(part(6, 8)? * 86400.0 + part(8, 10)? * 3600.0 + part(10, 12)? * 60.0 + part(12, 14)?)
+}
+
+/// Reads one series as measurements.
+pub fn read_series(input: &Path, series: &str, full_pose: bool) -> Result<MeasurementSet, String> {
+    let relative = SERIES
+        .iter()
+        .find(|(name, _)| name.eq_ignore_ascii_case(series))
+        .map(|(_, path)| *path)
+        .ok_or_else(|| format!("unknown series '{series}': expected A, B, C or D"))?;
+    let file = input.join(relative);
+    let text = std::fs::read_to_string(&file).map_err(|e| {
+        format!("{}: {e} (get the dataset of Landgraf et al., CASE 2021, and pass --input)", file.display())
+    })?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(';').map(str::trim).collect();
+    let column = |name: &str| {
+        header.iter().position(|h| *h == name).ok_or_else(|| format!("{}:1: no column '{name}'", file.display()))
+    };
+    let joints: Vec<usize> = JOINTS.iter().map(|j| column(j)).collect::<Result<_, _>>()?;
+    let position = [column("measurement_x")?, column("measurement_y")?, column("measurement_z")?];
+    let angles = [column("measurement_rx")?, column("measurement_ry")?, column("measurement_rz")?];
+    let temperature = column("measurement_temperature")?;
+    let stamp = column("Timestamp")?;
+    let mut rows = Vec::new();
+    for (index, raw) in lines.enumerate() {
+        let line = index + 2;
+        if raw.trim().is_empty() {
+            continue;
+        }
+        let cells: Vec<&str> = raw.split(';').collect();
+        let cell =
+            |c: usize| -> Result<f64, String> { number(cells.get(c).copied().unwrap_or(""), &file, line, c + 1) };
+        let q = joints.iter().map(|&c| cell(c)).collect::<Result<Vec<_>, _>>()?;
+        let p = Vector3::new(cell(position[0])?, cell(position[1])?, cell(position[2])?) * 1e-3;
+        let orientation =
+            if full_pose { Some(rotation(cell(angles[0])?, cell(angles[1])?, cell(angles[2])?)) } else { None };
+        rows.push(Measurement {
+            line: line as u64,
+            q,
+            position: p,
+            orientation,
+            payload_kg: 0.0,
+            tool: 0,
+            temp_c: Some(cell(temperature)?),
+            t_s: cells.get(stamp).and_then(|s| seconds(s)),
+            torques_nm: None,
+        });
+    }
+    // A time column only when every stamp survived.
+    if rows.iter().any(|r| r.t_s.is_none()) {
+        rows.iter_mut().for_each(|r| r.t_s = None);
+    } else if let Some(t0) = rows.first().and_then(|r| r.t_s) {
+        rows.iter_mut().for_each(|r| r.t_s = r.t_s.map(|t| t - t0));
+    }
+    Ok(MeasurementSet::from_rows(&file.display().to_string(), rows, vec![]))
+}
+
+fn write(set: &MeasurementSet, path: &Path) -> Result<(), String> {
+    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    set.write_csv(std::io::BufWriter::new(file)).map_err(|e| format!("{}: {e}", path.display()))?;
+    println!("wrote {} rows to {}", set.rows.len(), path.display());
+    Ok(())
+}
+
+pub fn run(args: &Args) -> Result<(), String> {
+    let set = read_series(&args.input, &args.series, args.full_pose)?;
+    match (&args.out, &args.train, &args.test) {
+        (Some(out), _, _) => write(&set, out),
+        (None, Some(train), Some(test)) => {
+            let half = set.rows.len() / 2;
+            write(&set.subset(&(0..half).collect::<Vec<_>>()), train)?;
+            write(&set.subset(&(half..set.rows.len()).collect::<Vec<_>>()), test)
+        }
+        _ => Err("give --out FILE, or --train FILE and --test FILE".into()),
+    }
+}
