@@ -1,7 +1,5 @@
-//! Left and right Jacobians of SO(3) and SE(3) and their inverses.
-//!
-//! Convention (left): `exp(ξ + δ) ≈ exp(J_l(ξ) δ) · exp(ξ)`; (right): `exp(ξ + δ) ≈ exp(ξ) · exp(J_r(ξ) δ)`;
-//! `J_r(ξ) = J_l(−ξ)`.
+//! Left and right Jacobians of SO(3) and SE(3) and their inverses, in the convention of the crate
+//! doc.
 
 use crate::coefficients::{
     angle_minus_sin_over_angle3, inverse_jacobian_coefficient, one_minus_cos_over_angle2, q_coefficient_2,

@@ -2,15 +2,27 @@
 //! `f64` types on nalgebra's fixed-size matrices.
 //!
 //! # Conventions
-//! - A tangent vector of SE(3) (a [`Twist`]) is ordered `(v, ω)`: translation first, rotation
-//!   second.
-//! - Perturbations are on the **left**: `T' = exp(δ^) · T`, and the error between two poses is
-//!   `log(T' · T⁻¹)^∨` (the paper's `y_i`).
-//! - Jacobians: the left Jacobian satisfies `exp(ξ + δ) ≈ exp(J_l(ξ) δ) · exp(ξ)`, the right one
-//!   `exp(ξ + δ) ≈ exp(ξ) · exp(J_r(ξ) δ)`, and `J_r(ξ) = J_l(−ξ)`.
-//! - The adjoint moves a twist between frames: `Ad(T) ξ = (T ξ^ T⁻¹)^∨`, so that
-//!   `T · exp(ξ) = exp(Ad(T) ξ) · T`.
-//! - A transform named `a_from_b` maps coordinates in frame `b` into frame `a`.
+//! Stated once here, for the whole crate (and checked by `tests/conventions.rs`).
+//!
+//! - **Tangent order.** A tangent vector of SE(3) (a [`Twist`]) is ordered `(v, ω)`: translation
+//!   first, rotation second, in vectors, in Jacobian rows and columns and in adjoints.
+//! - **Perturbation side: left.** A pose is perturbed as `T' = exp(δ^) · T`, and the error between
+//!   two poses is `log(T' · T⁻¹)^∨` (the paper's `y_i`): δ is expressed in the frame that `T` maps
+//!   into (for `base_from_tool`, the base frame).
+//! - **Jacobians.** Consequently the derivative of a map `f` between groups is
+//!   `Df(T) = ∂ log(f(exp(δ^) T) · f(T)⁻¹)^∨ / ∂δ` at `δ = 0`, and of a map into a vector space
+//!   `∂ f(exp(δ^) T) / ∂δ`. With this convention:
+//!   - `∂ exp(ξ) / ∂ξ = J_l(ξ)`, the **left Jacobian**: `exp(ξ + δ) ≈ exp(J_l(ξ) δ) · exp(ξ)`;
+//!   - `∂ log(T) / ∂T = J_l⁻¹(log T)`: `log(exp(δ) · T) ≈ log T + J_l⁻¹(log T) δ`;
+//!   - the **right Jacobian** serves right perturbations: `exp(ξ + δ) ≈ exp(ξ) · exp(J_r(ξ) δ)`,
+//!     with `J_r(ξ) = J_l(−ξ)` and `J_l(ξ) = Ad(exp ξ) · J_r(ξ)`;
+//!   - `∂(T · U)/∂T = I`, `∂(T · U)/∂U = Ad(T)`, `∂ T⁻¹/∂T = −Ad(T⁻¹)`;
+//!   - for the action on a point, `∂ (T x) / ∂δ = [I, −(T x)^]` (3×6, `(v, ω)` columns).
+//!
+//!   The same holds for SO(3) with `ω` alone, `Ad(R) = R` and `∂(R x)/∂δ = −(R x)^`.
+//! - **Adjoint.** `Ad(T) ξ = (T ξ^ T⁻¹)^∨`, so that `T · exp(ξ) = exp(Ad(T) ξ) · T`; and
+//!   `ad(ξ) η = [ξ^, η^]^∨`, with `Ad(exp ξ) = exp(ad ξ)`.
+//! - **Names.** A transform named `a_from_b` maps coordinates in frame `b` into frame `a`.
 //!
 //! ```
 //! use lie::{SE3, Twist, Vector3};
@@ -18,7 +30,7 @@
 //! let xi = Twist::new(Vector3::new(0.1, -0.2, 0.3), Vector3::new(0.4, 0.1, -0.2));
 //! let t = xi.exp();
 //! assert!((t.log().to_vector() - xi.to_vector()).norm() < 1e-12);
-//! // Left perturbation moved through the adjoint.
+//! // A right perturbation moved to the left through the adjoint.
 //! let d = Twist::new(Vector3::new(0.01, 0.0, 0.0), Vector3::new(0.0, 0.02, 0.0));
 //! let lhs = t * d.exp();
 //! let rhs = SE3::exp(&Twist::from_vector(&(t.adjoint() * d.to_vector()))) * t;

@@ -50,9 +50,9 @@ impl SO3 {
     ///
     /// The angle is `atan2(sin θ, cos θ)`, both read from R, precise at every angle. The axis read
     /// from the skew part `R − Rᵀ = 2 sin θ a^` carries a relative error `~ε / sin θ`, which grows
-    /// without bound towards π; above [`SYMMETRIC_BRANCH_ANGLE`] the axis is therefore read from the
-    /// symmetric part `(R + Rᵀ)/2 − cos θ I = (1 − cos θ) a aᵀ` (error `~ε / (1 − cos θ)`, at most
-    /// `ε` there), its sign from the skew part.
+    /// without bound towards π; above π/2 the axis is therefore read from the symmetric part
+    /// `(R + Rᵀ)/2 − cos θ I = (1 − cos θ) a aᵀ` (error `~ε / (1 − cos θ)`, at most `ε` there), its
+    /// sign from the skew part.
     pub fn log(&self) -> Vector3 {
         let r = &self.matrix;
         let skew = Vector3::new(r[(2, 1)] - r[(1, 2)], r[(0, 2)] - r[(2, 0)], r[(1, 0)] - r[(0, 1)]);

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{max_diff, se3, so3, vector3};
+use common::{fixed_twists, max_diff, se3, so3, vector3};
 use lie::{Matrix3, SE3, SO3};
 use proptest::prelude::*;
 
@@ -103,4 +103,22 @@ fn se3_pure_translation_moves_points_without_rotating() {
     let t = SE3::from_translation(lie::Vector3::new(1.0, -2.0, 3.0));
     assert_eq!(t.rotation().matrix(), Matrix3::identity());
     assert_eq!(t.transform_point(&lie::Vector3::new(0.5, 0.5, 0.5)), lie::Vector3::new(1.5, -1.5, 3.5));
+}
+
+#[test]
+fn se3_group_axioms_hold_on_the_fixed_hard_examples() {
+    // Sophus style: every triple of the fixed examples (identity, tiny angles, branch switches, π − 1e-6).
+    let examples: Vec<SE3> = fixed_twists().iter().map(|xi| xi.exp()).collect();
+    let identity = SE3::identity().to_matrix();
+    for a in &examples {
+        assert!(max_diff(&(*a * a.inverse()).to_matrix(), &identity) < TOL);
+        assert!(max_diff(&(a.inverse() * *a).to_matrix(), &identity) < TOL);
+        for b in &examples {
+            let lhs = (*a * *b).inverse().to_matrix();
+            assert!(max_diff(&lhs, &(b.inverse() * a.inverse()).to_matrix()) < TOL);
+            for c in examples.iter().step_by(5) {
+                assert!(max_diff(&((*a * *b) * *c).to_matrix(), &(*a * (*b * *c)).to_matrix()) < TOL);
+            }
+        }
+    }
 }

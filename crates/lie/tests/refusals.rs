@@ -80,11 +80,11 @@ proptest! {
     }
 
     #[test]
-    fn so3_from_matrix_returns_the_nearest_rotation(r in so3(), s in vector3(3e-4), t in vector3(3e-4)) {
+    fn so3_from_matrix_returns_the_nearest_rotation(r in so3(), s in vector3(1e-4), t in vector3(1e-4)) {
         // R (I + S) with S small and symmetric has polar factor R: R is the nearest rotation.
+        // ‖S‖_F ≤ 3e-4, so the deviation ≈ 2‖S‖_F stays within tolerance.
         let symmetric = Matrix3::new(s.x, t.z, t.y, t.z, s.y, t.x, t.y, t.x, s.z);
         let m = r.matrix() * (Matrix3::identity() + symmetric);
-        prop_assume!(deviation(&m) <= ORTHONORMALITY_TOLERANCE);
         prop_assert!(max_diff(&SO3::from_matrix(m).unwrap().matrix(), &r.matrix()) < 1e-14);
     }
 }

@@ -107,8 +107,8 @@ proptest! {
     fn se3_jacobians_times_their_inverses_are_identity(xi in twist(MAX_ANGLE)) {
         let left = SE3::left_jacobian(&xi) * SE3::left_jacobian_inverse(&xi);
         let right = SE3::right_jacobian_inverse(&xi) * SE3::right_jacobian(&xi);
-        prop_assert!(max_diff(&left, &Matrix6::identity()) < 1e-12);
-        prop_assert!(max_diff(&right, &Matrix6::identity()) < 1e-12);
+        prop_assert!(max_diff(&left, &Matrix6::identity()) < 1e-13);
+        prop_assert!(max_diff(&right, &Matrix6::identity()) < 1e-13);
     }
 
     #[test]

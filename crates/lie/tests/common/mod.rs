@@ -1,7 +1,7 @@
 //! Strategies, reference computations and fixed examples shared by the `lie` tests.
 #![allow(dead_code)]
 
-use lie::{Matrix3, Matrix4, Matrix6, SE3, SO3, Twist, Vector3, Vector6};
+use lie::{Matrix3, Matrix6, SE3, SO3, Twist, Vector3, Vector6};
 use nalgebra::SMatrix;
 use proptest::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -148,11 +148,6 @@ pub fn jacobian_points() -> [(&'static str, Twist); 3] {
         ("tiny", Twist::new(Vector3::new(3e-9, -7e-9, 2e-9), Vector3::new(-4e-9, 6e-9, 5e-9))),
         ("random", Twist::new(Vector3::new(0.42, -1.1, 0.73), Vector3::new(0.61, -0.29, 1.37))),
     ]
-}
-
-/// The homogeneous matrix `ξ^` of a 6-vector.
-pub fn hat6(x: &Vector6) -> Matrix4 {
-    Twist::from_vector(x).hat()
 }
 
 /// Rz(angle), written out (an independent reference for the RPY convention).
