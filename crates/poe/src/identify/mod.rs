@@ -1,5 +1,6 @@
 //! Identification of the local POE parameters from measurements (paper Section III-A-2).
 
+mod correction;
 mod options;
 mod redundancy;
 mod registration;
@@ -7,12 +8,13 @@ mod report;
 mod residual;
 mod solver;
 
+pub use correction::PoseCorrection;
 pub use options::{IdentificationOptions, Observation, ParameterMask, Solver, Target};
 pub use redundancy::Redundancy;
 pub use registration::register;
 pub use report::{IdentificationReport, IterationRecord};
 pub use residual::ResidualStats;
-pub use solver::{Identification, identify};
+pub use solver::{Identification, identify, identify_with_correction};
 
 use crate::{Error, LocalPoe};
 
@@ -49,5 +51,5 @@ pub fn calibrate(
 
 /// Error statistics of a model on observations (no identification).
 pub fn evaluate(model: &LocalPoe, observations: &[Observation]) -> Result<ResidualStats, Error> {
-    residual::residuals(model, observations, &IdentificationOptions::default()).map(|(_, s)| s)
+    residual::residuals(model, observations, None, &IdentificationOptions::default()).map(|(_, s)| s)
 }

@@ -1,5 +1,6 @@
 //! Iterative linearised least squares (paper Section III-A-2) and Levenberg–Marquardt.
 
+use super::correction::{Corrected, PoseCorrection};
 use super::redundancy::find_redundancies;
 use super::residual::{ResidualStats, linearise, residuals};
 use super::{IdentificationOptions, IdentificationReport, IterationRecord, Observation, ParameterMask, Solver};
@@ -12,6 +13,8 @@ use faer::{Mat, Side};
 pub struct Identification {
     /// The identified model.
     pub model: LocalPoe,
+    /// The identified correction parameters (empty without a [`PoseCorrection`]).
+    pub correction: Vec<f64>,
     /// Iterations, identifiability and the unidentifiable directions.
     pub report: IdentificationReport,
 }
@@ -68,6 +71,10 @@ fn damped_step(normal: &Mat<f64>, gradient: &[f64], lambda: f64) -> Option<Vec<f
     Some((0..p).map(|i| x[(i, 0)]).collect())
 }
 
+fn with<'a>(correction: Option<&'a dyn PoseCorrection>, theta: &'a [f64]) -> Option<Corrected<'a>> {
+    correction.map(|correction| Corrected { correction, theta })
+}
+
 fn scatter(free: &[usize], step: &[f64], length: usize) -> Vec<f64> {
     let mut full = vec![0.0; length];
     for (&index, &value) in free.iter().zip(step) {
@@ -89,6 +96,20 @@ pub fn identify(
     mask: &ParameterMask,
     options: &IdentificationOptions,
 ) -> Result<Identification, Error> {
+    identify_with_correction(initial, observations, mask, None, options)
+}
+
+/// [`identify`], with the parameters of a [`PoseCorrection`] identified jointly with the free
+/// kinematic ones (starting from zero). The pseudo-inverse drops directions the correction shares
+/// with the kinematics, so a correction partly absorbed by the geometry is harmless.
+pub fn identify_with_correction(
+    initial: &LocalPoe,
+    observations: &[Observation],
+    mask: &ParameterMask,
+    correction: Option<&dyn PoseCorrection>,
+    options: &IdentificationOptions,
+) -> Result<Identification, Error> {
+    let mut theta = vec![0.0; correction.map_or(0, |c| c.parameter_count())];
     let layout = initial.layout();
     if mask.flags().len() != layout.len() {
         return Err(Error::MaskLength { given: mask.flags().len(), expected: layout.len() });
@@ -99,7 +120,7 @@ pub fn identify(
         return Err(Error::TooFewObservations { rows: observations.len(), needed: free.len().div_ceil(6) });
     }
     let mut model = initial.clone();
-    let (a, mut y, stats) = linearise(&model, observations, &free, options)?;
+    let (a, mut y, stats) = linearise(&model, observations, &free, with(correction, &theta), options)?;
     let mut a = a;
     let mut iterations = vec![record(stats, 0.0)];
     let mut current = cost(&y);
@@ -113,9 +134,8 @@ pub fn identify(
             }
             Solver::LevenbergMarquardt => {
                 let normal = a.transpose() * &a;
-                let gradient: Vec<f64> =
-                    (0..free.len()).map(|j| (0..y.len()).map(|i| a[(i, j)] * y[i]).sum()).collect();
-                damped_step(&normal, &gradient, lambda).unwrap_or_else(|| vec![0.0; free.len()])
+                let gradient: Vec<f64> = (0..a.ncols()).map(|j| (0..y.len()).map(|i| a[(i, j)] * y[i]).sum()).collect();
+                damped_step(&normal, &gradient, lambda).unwrap_or_else(|| vec![0.0; a.ncols()])
             }
         };
         // Line search by halving: Gauss–Newton can overshoot far from the solution.
@@ -124,11 +144,12 @@ pub fn identify(
         for _ in 0..12 {
             let scaled: Vec<f64> = step.iter().map(|s| s * scale).collect();
             let mut trial = model.clone();
-            trial.apply_update(&scatter(&free, &scaled, layout.len()));
-            let (trial_y, _) = residuals(&trial, observations, options)?;
+            trial.apply_update(&scatter(&free, &scaled[..free.len()], layout.len()));
+            let trial_theta: Vec<f64> = theta.iter().zip(&scaled[free.len()..]).map(|(t, s)| t + s).collect();
+            let (trial_y, _) = residuals(&trial, observations, with(correction, &trial_theta), options)?;
             let trial_cost = cost(&trial_y);
             if trial_cost.is_finite() && trial_cost <= current {
-                accepted = Some((trial, trial_cost, scaled));
+                accepted = Some((trial, trial_theta, trial_cost, scaled));
                 break;
             }
             match options.solver {
@@ -136,7 +157,7 @@ pub fn identify(
                 Solver::LevenbergMarquardt => break,
             }
         }
-        let Some((trial, trial_cost, scaled)) = accepted else {
+        let Some((trial, trial_theta, trial_cost, scaled)) = accepted else {
             if options.solver == Solver::LevenbergMarquardt && lambda < 1e12 {
                 lambda *= 10.0;
                 continue;
@@ -146,9 +167,10 @@ pub fn identify(
         };
         let decrease = (current - trial_cost) / current.max(f64::MIN_POSITIVE);
         model = trial;
+        theta = trial_theta;
         current = trial_cost;
         lambda = (lambda / 10.0).max(1e-12);
-        let (next_a, next_y, next_stats) = linearise(&model, observations, &free, options)?;
+        let (next_a, next_y, next_stats) = linearise(&model, observations, &free, with(correction, &theta), options)?;
         a = next_a;
         y = next_y;
         let step_norm = scaled.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -170,13 +192,14 @@ pub fn identify(
         Some(&smin) => smax / smin,
         None => f64::INFINITY,
     };
-    let unidentifiable = find_redundancies(&model, observations, mask, free.len() - rank);
+    let unidentifiable = find_redundancies(&model, observations, mask, a.ncols().saturating_sub(rank));
     Ok(Identification {
         model,
+        correction: theta,
         report: IdentificationReport {
             iterations,
             converged,
-            free_parameters: free.len(),
+            free_parameters: a.ncols(),
             rank,
             singular_values: d.singular_values,
             condition_number,
