@@ -1,0 +1,117 @@
+//! Cholesky factorisation of a kernel matrix on faer with explicit parallelism, with jitter
+//! escalation when a pivot is not positive, and the solves built on it.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt;
+use faer::linalg::triangular_solve;
+use faer::{Mat, MatMut, Par};
+use serde::{Deserialize, Serialize};
+
+use crate::Error;
+use crate::config::JitterConfig;
+
+/// `K + jitter·I = L Lᵀ` (the jitter is recorded by the caller in a [`JitterOutcome`]).
+#[derive(Debug, Clone)]
+pub(crate) struct Factor {
+    /// Lower-triangular factor; the strict upper triangle is zero.
+    l: Mat<f64>,
+}
+
+/// What the jitter escalation did, for the fit report.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct JitterOutcome {
+    /// Absolute jitter added to the diagonal of the kernel matrix (normalised output units²).
+    pub added: f64,
+    /// Failed attempts before the one that succeeded.
+    pub failed_attempts: usize,
+}
+
+/// Factors the lower triangle of `a` in place; on failure returns the index of the first pivot that
+/// was not positive.
+pub(crate) fn factor_in_place(mut a: Mat<f64>, par: Par) -> Result<Mat<f64>, usize> {
+    let n = a.nrows();
+    let mut mem = MemBuffer::new(llt::factor::cholesky_in_place_scratch::<f64>(n, par, Default::default()));
+    let stack = MemStack::new(&mut mem);
+    match llt::factor::cholesky_in_place(a.as_mut(), Default::default(), par, stack, Default::default()) {
+        Ok(_) => {
+            for j in 1..n {
+                for i in 0..j {
+                    a[(i, j)] = 0.0;
+                }
+            }
+            Ok(a)
+        }
+        Err(llt::factor::LltError::NonPositivePivot { index }) => Err(index),
+    }
+}
+
+impl Factor {
+    /// Factors `k` (lower triangle read) as it is, then with growing jitter on the diagonal until
+    /// it succeeds or [`JitterConfig::max_attempts`] is exhausted.
+    pub(crate) fn with_jitter(k: &Mat<f64>, config: &JitterConfig, par: Par) -> Result<(Self, JitterOutcome), Error> {
+        let n = k.nrows();
+        let mut pivot = match factor_in_place(k.clone(), par) {
+            Ok(l) => return Ok((Self { l }, JitterOutcome { added: 0.0, failed_attempts: 0 })),
+            Err(pivot) => pivot,
+        };
+        let mean_diagonal = (0..n).map(|i| k[(i, i)].abs()).sum::<f64>() / n.max(1) as f64;
+        let base = if mean_diagonal.is_finite() && mean_diagonal > 0.0 { mean_diagonal } else { 1.0 };
+        let mut jitter = config.initial_relative * base;
+        let mut tried = 0.0;
+        for attempt in 1..=config.max_attempts {
+            match Self::with_fixed_jitter(k, jitter, par) {
+                Ok(factor) => return Ok((factor, JitterOutcome { added: jitter, failed_attempts: attempt })),
+                Err(Error::CholeskyFailed { pivot: p, .. }) => pivot = p,
+                Err(other) => return Err(other),
+            }
+            tried = jitter;
+            jitter *= config.growth;
+        }
+        Err(Error::CholeskyFailed { size: n, pivot, jitter_tried: tried })
+    }
+
+    /// Factors `k + jitter·I` once (used to rebuild a stored model with its recorded jitter).
+    pub(crate) fn with_fixed_jitter(k: &Mat<f64>, jitter: f64, par: Par) -> Result<Self, Error> {
+        let n = k.nrows();
+        let mut a = k.clone();
+        for i in 0..n {
+            a[(i, i)] += jitter;
+        }
+        factor_in_place(a, par).map(|l| Self { l }).map_err(|pivot| Error::CholeskyFailed {
+            size: n,
+            pivot,
+            jitter_tried: jitter,
+        })
+    }
+
+    /// Wraps an existing factor.
+    pub(crate) fn from_lower(l: Mat<f64>) -> Self {
+        Self { l }
+    }
+
+    /// `rhs ← L⁻¹ rhs`.
+    pub(crate) fn solve_lower_in_place(&self, rhs: MatMut<'_, f64>, par: Par) {
+        triangular_solve::solve_lower_triangular_in_place(self.l.as_ref(), rhs, par);
+    }
+
+    /// `rhs ← (L Lᵀ)⁻¹ rhs` (R&W Algorithm 2.1, line 3).
+    pub(crate) fn solve_in_place(&self, mut rhs: MatMut<'_, f64>, par: Par) {
+        triangular_solve::solve_lower_triangular_in_place(self.l.as_ref(), rhs.as_mut(), par);
+        triangular_solve::solve_upper_triangular_in_place(self.l.transpose(), rhs, par);
+    }
+
+    /// `ln |L Lᵀ| = 2 Σ ln Lᵢᵢ`.
+    pub(crate) fn log_determinant(&self) -> f64 {
+        2.0 * (0..self.l.nrows()).map(|i| self.l[(i, i)].ln()).sum::<f64>()
+    }
+
+    /// Lower triangle of `(L Lᵀ)⁻¹` (the strict upper triangle is not meaningful).
+    pub(crate) fn inverse_lower(&self, par: Par) -> Mat<f64> {
+        let n = self.l.nrows();
+        let mut out = Mat::zeros(n, n);
+        let mut mem = MemBuffer::new(llt::inverse::inverse_scratch::<f64>(n, par));
+        let stack = MemStack::new(&mut mem);
+        llt::inverse::inverse(out.as_mut(), self.l.as_ref(), par, stack);
+        out
+    }
+}

@@ -1,0 +1,154 @@
+//! Configuration of a fit: named fields, `Default`, serde, validated once by [`GpConfig::validate`].
+
+use serde::{Deserialize, Serialize};
+
+use crate::Error;
+use crate::kernel::{Bounds, KernelChoice};
+
+/// How several outputs (e.g. the six components of a twist) are modelled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum OutputMode {
+    /// Each output has its own hyperparameters and its own factorisation.
+    #[default]
+    Independent,
+    /// All outputs share one set of hyperparameters (fitted on the sum of their log marginal
+    /// likelihoods) and one Cholesky factorisation.
+    Shared,
+}
+
+/// Whether kernel matrices, factorisations and restarts run on the rayon pool.
+///
+/// Either way the result is the same to the last bit: parallel loops write disjoint entries and
+/// partial sums are combined in a fixed order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Parallelism {
+    /// One thread.
+    Sequential,
+    /// The global rayon pool.
+    #[default]
+    Rayon,
+}
+
+impl Parallelism {
+    /// The faer equivalent.
+    pub fn faer(self) -> faer::Par {
+        match self {
+            Self::Sequential => faer::Par::Seq,
+            Self::Rayon => faer::Par::rayon(0),
+        }
+    }
+}
+
+/// Diagonal jitter added when a Cholesky factorisation fails.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct JitterConfig {
+    /// First jitter tried, relative to the mean of the kernel matrix's diagonal.
+    pub initial_relative: f64,
+    /// Factor by which the jitter grows after each failure.
+    pub growth: f64,
+    /// Attempts with jitter after the first attempt without.
+    pub max_attempts: usize,
+}
+
+impl Default for JitterConfig {
+    fn default() -> Self {
+        // 1e-10 … 1e-4 of the signal scale: the last is still far below any noise a tracker sees.
+        Self { initial_relative: 1e-10, growth: 10.0, max_attempts: 7 }
+    }
+}
+
+/// Hyperparameter search: bounded L-BFGS in log space from several starting points.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct OptimiserConfig {
+    /// Random starting points drawn (log-uniformly in the bounds) in addition to the default start.
+    pub restarts: usize,
+    /// Seed of the starting points; start `i` uses its own stream, so the draw does not depend on
+    /// the order in which threads run.
+    pub seed: u64,
+    /// Iterations per start.
+    pub max_iterations: usize,
+    /// L-BFGS memory (number of correction pairs kept).
+    pub memory: usize,
+    /// Stop when the largest projected-gradient component of the negative log marginal likelihood
+    /// falls below this.
+    pub gradient_tolerance: f64,
+    /// Stop when the relative decrease of the negative log marginal likelihood in one iteration
+    /// falls below this.
+    pub function_tolerance: f64,
+}
+
+impl Default for OptimiserConfig {
+    fn default() -> Self {
+        Self {
+            restarts: 3,
+            seed: 0,
+            max_iterations: 200,
+            memory: 10,
+            gradient_tolerance: 1e-5,
+            // scipy's L-BFGS-B default factr = 1e7 times machine epsilon.
+            function_tolerance: 1e7 * f64::EPSILON,
+        }
+    }
+}
+
+/// Everything that decides an exact GP fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct GpConfig {
+    /// Covariance family.
+    pub kernel: KernelChoice,
+    /// Search box in natural units for standardised inputs and normalised outputs; `None` takes
+    /// [`crate::Kernel::default_bounds`].
+    pub bounds: Option<Bounds>,
+    /// One set of hyperparameters per output, or one shared.
+    pub outputs: OutputMode,
+    /// Subtract the mean and divide by the standard deviation of each input.
+    pub standardise_inputs: bool,
+    /// Subtract the mean and divide by the standard deviation of each output.
+    pub normalise_outputs: bool,
+    /// Hyperparameter search.
+    pub optimiser: OptimiserConfig,
+    /// Jitter escalation.
+    pub jitter: JitterConfig,
+    /// Serial or rayon.
+    pub parallelism: Parallelism,
+}
+
+impl Default for GpConfig {
+    fn default() -> Self {
+        Self {
+            kernel: KernelChoice::default(),
+            bounds: None,
+            outputs: OutputMode::default(),
+            standardise_inputs: true,
+            normalise_outputs: true,
+            optimiser: OptimiserConfig::default(),
+            jitter: JitterConfig::default(),
+            parallelism: Parallelism::default(),
+        }
+    }
+}
+
+impl GpConfig {
+    /// Refuses numbers that would make the fit meaningless (bounds are checked against the kernel
+    /// when the fit starts).
+    pub fn validate(&self) -> Result<(), Error> {
+        let o = &self.optimiser;
+        let j = &self.jitter;
+        let checks: [(&'static str, f64, bool); 5] = [
+            ("optimiser.memory", o.memory as f64, o.memory >= 1),
+            ("optimiser.gradient_tolerance", o.gradient_tolerance, o.gradient_tolerance >= 0.0),
+            ("optimiser.function_tolerance", o.function_tolerance, o.function_tolerance >= 0.0),
+            ("jitter.initial_relative", j.initial_relative, j.initial_relative > 0.0 && j.initial_relative.is_finite()),
+            ("jitter.growth", j.growth, j.growth > 1.0 && j.growth.is_finite()),
+        ];
+        for (field, value, ok) in checks {
+            if !ok {
+                return Err(Error::InvalidConfig { field, value });
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,339 @@
+//! The exact GP model: fitting (hyperparameter search, factorisation with jitter) and the stored
+//! form it is serialised to.
+
+use faer::{Mat, MatRef};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::Error;
+use crate::cholesky::{Factor, JitterOutcome};
+use crate::config::{GpConfig, OutputMode, Parallelism};
+use crate::gram::training_covariance;
+use crate::kernel::{Evaluator, Kernel};
+use crate::lml::check_finite_outputs;
+use crate::optimise::{OptimisationReport, fit_hyperparameters};
+use crate::points::Points;
+use crate::scaling::{InputStandardiser, OutputNormaliser};
+
+/// An exact Gaussian process fitted to `n` points with `d` inputs and `m` outputs.
+///
+/// Inputs are standardised and outputs normalised as the [`GpConfig`] said; the maps are stored and
+/// applied again in [`ExactGp::predict`]. Serialises (serde) to its training data, the scaling maps
+/// and the fit report; the factorisation is rebuilt, with the recorded jitter, when it is read back.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(try_from = "StoredExactGp", into = "StoredExactGp")]
+pub struct ExactGp {
+    pub(crate) inputs: InputStandardiser,
+    pub(crate) outputs: OutputNormaliser,
+    /// Standardised training inputs.
+    pub(crate) x: Points,
+    /// Normalised training outputs, `n × m`.
+    pub(crate) y: Mat<f64>,
+    pub(crate) components: Vec<Component>,
+    pub(crate) parallelism: Parallelism,
+    pub(crate) report: FitReport,
+}
+
+/// One kernel with its factorisation and the outputs it serves.
+#[derive(Debug, Clone)]
+pub(crate) struct Component {
+    pub(crate) kernel: Kernel,
+    pub(crate) outputs: Vec<usize>,
+    pub(crate) evaluator: Evaluator,
+    /// Training inputs prepared for `evaluator`.
+    pub(crate) prepared: Points,
+    pub(crate) factor: Factor,
+    /// `(K + σn² I + jitter I)⁻¹ y` for each served output (R&W Algorithm 2.1, line 3).
+    pub(crate) alpha: Mat<f64>,
+}
+
+/// What the fit did, per kernel.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitReport {
+    /// One entry per kernel: one per output ([`OutputMode::Independent`]) or one for all
+    /// ([`OutputMode::Shared`]).
+    pub components: Vec<ComponentReport>,
+}
+
+/// The fit of one kernel.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ComponentReport {
+    /// Output columns this kernel models.
+    pub outputs: Vec<usize>,
+    /// Hyperparameters, for standardised inputs and normalised outputs.
+    pub kernel: Kernel,
+    /// Log marginal likelihood of the normalised outputs it serves, summed over them, with the
+    /// jitter (if any) included in the covariance.
+    pub log_marginal_likelihood: f64,
+    /// Jitter added to make the final factorisation succeed.
+    pub jitter: JitterOutcome,
+    /// The hyperparameter search (`None` when the hyperparameters were given).
+    pub optimisation: Option<OptimisationReport>,
+}
+
+enum Hyperparameters<'a> {
+    Optimise(&'a Kernel),
+    Fixed(&'a [Kernel]),
+}
+
+impl ExactGp {
+    /// Fits the model: inputs `x` (n × d), outputs `y` (n × m), hyperparameters found by maximising
+    /// the log marginal likelihood from the default start of `config.kernel`.
+    pub fn fit(x: MatRef<'_, f64>, y: MatRef<'_, f64>, config: &GpConfig) -> Result<Self, Error> {
+        let start = Kernel::start(config.kernel, x.ncols());
+        Self::fit_impl(x, y, Hyperparameters::Optimise(&start), config)
+    }
+
+    /// As [`ExactGp::fit`] but the search starts from `start` (its family replaces `config.kernel`).
+    pub fn fit_from(x: MatRef<'_, f64>, y: MatRef<'_, f64>, start: &Kernel, config: &GpConfig) -> Result<Self, Error> {
+        Self::fit_impl(x, y, Hyperparameters::Optimise(start), config)
+    }
+
+    /// Fits with given hyperparameters, no search: one kernel for all outputs, or one per output
+    /// ([`OutputMode::Independent`] only). Hyperparameters are for the standardised inputs and
+    /// normalised outputs when the config asks for those maps.
+    pub fn fit_fixed(
+        x: MatRef<'_, f64>,
+        y: MatRef<'_, f64>,
+        kernels: &[Kernel],
+        config: &GpConfig,
+    ) -> Result<Self, Error> {
+        let valid = kernels.len() == 1 || (config.outputs == OutputMode::Independent && kernels.len() == y.ncols());
+        if !valid {
+            return Err(Error::InvalidConfig { field: "kernels", value: kernels.len() as f64 });
+        }
+        Self::fit_impl(x, y, Hyperparameters::Fixed(kernels), config)
+    }
+
+    fn fit_impl(
+        x: MatRef<'_, f64>,
+        y: MatRef<'_, f64>,
+        how: Hyperparameters<'_>,
+        config: &GpConfig,
+    ) -> Result<Self, Error> {
+        config.validate()?;
+        let raw = validate_training_data(x, y)?;
+        let (n, m) = (y.nrows(), y.ncols());
+        let inputs = if config.standardise_inputs {
+            InputStandardiser::fit(&raw)
+        } else {
+            InputStandardiser::identity(x.ncols())
+        };
+        let outputs = if config.normalise_outputs { OutputNormaliser::fit(y) } else { OutputNormaliser::identity(m) };
+        let xs = inputs.apply_points(&raw);
+        let yn = outputs.normalise(y);
+        let groups: Vec<Vec<usize>> = match config.outputs {
+            OutputMode::Independent => (0..m).map(|j| vec![j]).collect(),
+            OutputMode::Shared => vec![(0..m).collect()],
+        };
+        let fit_group = |(g, cols): (usize, &Vec<usize>)| -> Result<(Component, ComponentReport), Error> {
+            let yg = Mat::from_fn(n, cols.len(), |i, c| yn[(i, cols[c])]);
+            let (kernel, optimisation) = match &how {
+                Hyperparameters::Fixed(kernels) => (kernels[g.min(kernels.len() - 1)].clone(), None),
+                Hyperparameters::Optimise(start) => {
+                    start.validate(xs.dim())?;
+                    let bounds = config.bounds.clone().unwrap_or_else(|| start.default_bounds());
+                    let o =
+                        fit_hyperparameters(start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism)?;
+                    (o.kernel, Some(o.report))
+                }
+            };
+            kernel.validate(xs.dim())?;
+            let (component, jitter) =
+                Component::build(kernel.clone(), cols.clone(), &xs, yg.as_ref(), None, config, config.parallelism)?;
+            let lml = component.log_marginal_likelihood(yg.as_ref());
+            let report =
+                ComponentReport { outputs: cols.clone(), kernel, log_marginal_likelihood: lml, jitter, optimisation };
+            Ok((component, report))
+        };
+        let fitted: Vec<_> = match config.parallelism {
+            Parallelism::Sequential => groups.iter().enumerate().map(fit_group).collect(),
+            Parallelism::Rayon => groups.par_iter().enumerate().map(fit_group).collect(),
+        };
+        let (components, reports): (Vec<_>, Vec<_>) =
+            fitted.into_iter().collect::<Result<Vec<_>, _>>()?.into_iter().unzip();
+        Ok(Self {
+            inputs,
+            outputs,
+            x: xs,
+            y: yn,
+            components,
+            parallelism: config.parallelism,
+            report: FitReport { components: reports },
+        })
+    }
+
+    /// What the fit did: hyperparameters, likelihoods, jitter and search per kernel.
+    pub fn report(&self) -> &FitReport {
+        &self.report
+    }
+
+    /// The kernel that models output `output` (for standardised inputs and normalised outputs).
+    pub fn kernel_for_output(&self, output: usize) -> Option<&Kernel> {
+        self.components.iter().find(|c| c.outputs.contains(&output)).map(|c| &c.kernel)
+    }
+
+    /// Total log marginal likelihood of the normalised outputs, summed over kernels.
+    pub fn log_marginal_likelihood(&self) -> f64 {
+        self.report.components.iter().map(|c| c.log_marginal_likelihood).sum()
+    }
+
+    /// Number of training points.
+    pub fn training_len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// Number of inputs `d`.
+    pub fn input_dim(&self) -> usize {
+        self.x.dim()
+    }
+
+    /// Number of outputs `m`.
+    pub fn output_count(&self) -> usize {
+        self.y.ncols()
+    }
+
+    /// The input standardisation applied before the kernel.
+    pub fn input_standardiser(&self) -> &InputStandardiser {
+        &self.inputs
+    }
+
+    /// The output normalisation undone after prediction.
+    pub fn output_normaliser(&self) -> &OutputNormaliser {
+        &self.outputs
+    }
+}
+
+/// Rows agree, at least one point, one input and one output, everything finite.
+pub(crate) fn validate_training_data(x: MatRef<'_, f64>, y: MatRef<'_, f64>) -> Result<Points, Error> {
+    if x.nrows() != y.nrows() {
+        return Err(Error::RowCountMismatch { input_rows: x.nrows(), output_rows: y.nrows() });
+    }
+    if x.nrows() == 0 {
+        return Err(Error::TooFewPoints { rows: 0, required: 1 });
+    }
+    if x.ncols() == 0 {
+        return Err(Error::NoInputDimensions);
+    }
+    if y.ncols() == 0 {
+        return Err(Error::NoOutputs);
+    }
+    check_finite_outputs(y)?;
+    Points::from_rows(x)
+}
+
+impl Component {
+    /// Factors the kernel matrix (with jitter escalation, or with exactly `fixed_jitter`) and solves
+    /// for the weights.
+    pub(crate) fn build(
+        kernel: Kernel,
+        outputs: Vec<usize>,
+        x: &Points,
+        y: MatRef<'_, f64>,
+        fixed_jitter: Option<f64>,
+        config: &GpConfig,
+        parallelism: Parallelism,
+    ) -> Result<(Self, JitterOutcome), Error> {
+        let par = parallelism.faer();
+        let (evaluator, prepared) = kernel.prepare(x);
+        let k = training_covariance(&evaluator, &prepared, kernel.noise_variance(), parallelism);
+        let (factor, jitter) = match fixed_jitter {
+            None => Factor::with_jitter(&k, &config.jitter, par)?,
+            Some(j) => (Factor::with_fixed_jitter(&k, j, par)?, JitterOutcome { added: j, failed_attempts: 0 }),
+        };
+        let mut alpha = y.to_owned();
+        factor.solve_in_place(alpha.as_mut(), par);
+        Ok((Self { kernel, outputs, evaluator, prepared, factor, alpha }, jitter))
+    }
+
+    /// R&W Eq. 2.30 summed over the served outputs, from the stored factor and weights.
+    fn log_marginal_likelihood(&self, y: MatRef<'_, f64>) -> f64 {
+        let (n, m) = (y.nrows(), y.ncols());
+        let fit: f64 = (0..m).map(|c| (0..n).map(|i| y[(i, c)] * self.alpha[(i, c)]).sum::<f64>()).sum();
+        -0.5 * fit
+            - 0.5 * m as f64 * self.factor.log_determinant()
+            - 0.5 * (n * m) as f64 * (2.0 * std::f64::consts::PI).ln()
+    }
+}
+
+/// The serialised form: data, maps and report; the factorisation is rebuilt on reading.
+#[derive(Serialize, Deserialize)]
+struct StoredExactGp {
+    inputs: InputStandardiser,
+    outputs: OutputNormaliser,
+    /// Standardised training inputs, one row per point.
+    training_inputs: Vec<Vec<f64>>,
+    /// Normalised training outputs, one row per point.
+    training_outputs: Vec<Vec<f64>>,
+    parallelism: Parallelism,
+    report: FitReport,
+}
+
+impl From<ExactGp> for StoredExactGp {
+    fn from(gp: ExactGp) -> Self {
+        let training_inputs = (0..gp.x.len()).map(|i| gp.x.row(i).to_vec()).collect();
+        let training_outputs = (0..gp.y.nrows()).map(|i| (0..gp.y.ncols()).map(|j| gp.y[(i, j)]).collect()).collect();
+        Self {
+            inputs: gp.inputs,
+            outputs: gp.outputs,
+            training_inputs,
+            training_outputs,
+            parallelism: gp.parallelism,
+            report: gp.report,
+        }
+    }
+}
+
+impl TryFrom<StoredExactGp> for ExactGp {
+    type Error = Error;
+
+    fn try_from(s: StoredExactGp) -> Result<Self, Error> {
+        let n = s.training_inputs.len();
+        let d = s.inputs.mean.len();
+        let m = s.outputs.mean.len();
+        if s.training_outputs.len() != n {
+            return Err(Error::RowCountMismatch { input_rows: n, output_rows: s.training_outputs.len() });
+        }
+        let x = Mat::from_fn(n, d, |i, j| s.training_inputs[i].get(j).copied().unwrap_or(f64::NAN));
+        let y = Mat::from_fn(n, m, |i, j| s.training_outputs[i].get(j).copied().unwrap_or(f64::NAN));
+        let points = validate_training_data(x.as_ref(), y.as_ref())?;
+        // Every output must be served by exactly one kernel, or prediction would leave it empty.
+        let mut served = vec![0usize; m];
+        for c in &s.report.components {
+            for &j in &c.outputs {
+                if j >= m {
+                    return Err(Error::InputDimensionMismatch { expected: m, found: j + 1 });
+                }
+                served[j] += 1;
+            }
+        }
+        if let Some(j) = served.iter().position(|&k| k != 1) {
+            return Err(Error::InvalidConfig { field: "report.components.outputs", value: j as f64 });
+        }
+        let config = GpConfig::default();
+        let mut components = Vec::with_capacity(s.report.components.len());
+        for c in &s.report.components {
+            c.kernel.validate(d)?;
+            let yc = Mat::from_fn(n, c.outputs.len(), |i, k| y[(i, c.outputs[k])]);
+            let (component, _) = Component::build(
+                c.kernel.clone(),
+                c.outputs.clone(),
+                &points,
+                yc.as_ref(),
+                Some(c.jitter.added),
+                &config,
+                s.parallelism,
+            )?;
+            components.push(component);
+        }
+        Ok(Self {
+            inputs: s.inputs,
+            outputs: s.outputs,
+            x: points,
+            y,
+            components,
+            parallelism: s.parallelism,
+            report: s.report,
+        })
+    }
+}
