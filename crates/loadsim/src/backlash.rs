@@ -55,5 +55,16 @@ impl Backlash {
 /// The joint-space regressor of backlash: `sign(τ_j)` per joint (0 where the torque is exactly 0),
 /// so that `δq_j = b_j · sign(τ_j)`.
 pub fn backlash_joint_regressor(torque: &[f64]) -> Vec<f64> {
-    torque.iter().map(|&t| if t > 0.0 { 1.0 } else if t < 0.0 { -1.0 } else { 0.0 }).collect()
+    torque
+        .iter()
+        .map(|&t| {
+            if t > 0.0 {
+                1.0
+            } else if t < 0.0 {
+                -1.0
+            } else {
+                0.0
+            }
+        })
+        .collect()
 }

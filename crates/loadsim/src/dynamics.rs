@@ -77,7 +77,9 @@ impl RobotDynamics {
     pub fn inertial_parameters(&self) -> DVector<f64> {
         DVector::from_iterator(
             4 * self.links.len(),
-            self.links.iter().flat_map(|l| [l.mass_kg, l.mass_kg * l.com_m[0], l.mass_kg * l.com_m[1], l.mass_kg * l.com_m[2]]),
+            self.links
+                .iter()
+                .flat_map(|l| [l.mass_kg, l.mass_kg * l.com_m[0], l.mass_kg * l.com_m[1], l.mass_kg * l.com_m[2]]),
         )
     }
 

@@ -2,7 +2,7 @@
 //! measured tool pose.
 
 use crate::{
-    BaseDrift, Backlash, Error, JointBacklash, JointCompliance, PeriodicError, PoseContext, SimulatedCell,
+    Backlash, BaseDrift, Error, JointBacklash, JointCompliance, PeriodicError, PoseContext, SimulatedCell,
     ThermalGrowth, TrackerNoise, compliance::compliance_deflection, gravity::static_torque, periodic::Harmonic,
 };
 use lie::SE3;
@@ -102,7 +102,9 @@ impl Effects {
         Self {
             compliance: Some(JointCompliance::default()),
             backlash: Some(Backlash {
-                joints: (0..joint_count).map(|joint_index| JointBacklash { joint_index, half_band_rad: half_band }).collect(),
+                joints: (0..joint_count)
+                    .map(|joint_index| JointBacklash { joint_index, half_band_rad: half_band })
+                    .collect(),
             }),
             periodic: Some(PeriodicError { harmonics }),
             thermal: Some(ThermalGrowth::default()),

@@ -136,7 +136,7 @@ pub fn sample_configurations(
     }
     let bounds: Vec<(f64, f64)> = ranges.iter().map(|r| (r.lower_rad + margin, r.upper_rad - margin)).collect();
     for (joint_index, (r, (lo, hi))) in ranges.iter().zip(&bounds).enumerate() {
-        if !(lo < hi) {
+        if lo.partial_cmp(hi) != Some(std::cmp::Ordering::Less) {
             return Err(Error::EmptyJointRange {
                 joint_index,
                 lower_rad: r.lower_rad,
@@ -196,4 +196,10 @@ pub fn generate(
             Ok(Sample { q, tracker_from_tool, payload_kg, temp_c: context.temp_c, t_s })
         })
         .collect()
+}
+
+impl From<(f64, f64)> for JointRange {
+    fn from((lower_rad, upper_rad): (f64, f64)) -> Self {
+        Self { lower_rad, upper_rad }
+    }
 }

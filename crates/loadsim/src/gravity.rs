@@ -101,7 +101,8 @@ pub fn gravity_torque(
     let mut torque = payload_gravity_torque(model, q, tool, payload, &g)?;
     for (j, s) in twists.iter().enumerate() {
         // Joint j moves links j, j+1, …: the links before it do not move with it.
-        torque[j] += centres.iter().zip(&dynamics.links).skip(j).map(|(c, l)| l.mass_kg * g.dot(&point_rate(s, c))).sum::<f64>();
+        torque[j] +=
+            centres.iter().zip(&dynamics.links).skip(j).map(|(c, l)| l.mass_kg * g.dot(&point_rate(s, c))).sum::<f64>();
     }
     Ok(torque)
 }

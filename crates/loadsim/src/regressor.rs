@@ -78,7 +78,10 @@ pub fn compliance_regressor(model: &LocalPoe, q: &[f64], torque: &[f64]) -> Resu
         .into_iter()
         .zip(torque)
         .enumerate()
-        .map(|(joint_index, (s, t))| RegressorColumn { parameter: EffectParameter::Compliance { joint_index }, twist: s * *t })
+        .map(|(joint_index, (s, t))| RegressorColumn {
+            parameter: EffectParameter::Compliance { joint_index },
+            twist: s * *t,
+        })
         .collect())
 }
 
@@ -89,7 +92,10 @@ pub fn backlash_regressor(model: &LocalPoe, q: &[f64], torque: &[f64]) -> Result
         .into_iter()
         .zip(backlash_joint_regressor(torque))
         .enumerate()
-        .map(|(joint_index, (s, sign))| RegressorColumn { parameter: EffectParameter::Backlash { joint_index }, twist: s * sign })
+        .map(|(joint_index, (s, sign))| RegressorColumn {
+            parameter: EffectParameter::Backlash { joint_index },
+            twist: s * sign,
+        })
         .collect())
 }
 
@@ -126,7 +132,8 @@ pub fn thermal_regressor(
     model.forward(q, tool)?;
     let frames = model.frames(q)?;
     let before = std::iter::once(lie::SE3::identity()).chain(frames.iter().copied());
-    let transforms = model.joints().iter().map(|j| j.previous_from_joint_zero).chain(std::iter::once(model.tools()[tool]));
+    let transforms =
+        model.joints().iter().map(|j| j.previous_from_joint_zero).chain(std::iter::once(model.tools()[tool]));
     Ok(before
         .zip(transforms)
         .enumerate()

@@ -1,0 +1,12 @@
+//! Properties of the load model, the effects, their regressors and the dataset generator.
+// Joint-indexed loops read like the formulas they check.
+#![allow(clippy::needless_range_loop)]
+
+mod deflection;
+mod effects_alone;
+mod fixture;
+mod generator;
+mod gravity;
+mod refusals;
+mod regressors;
+mod robot;

@@ -1,0 +1,153 @@
+//! Each effect's regressor against its forward model: the pose error the forward model produces
+//! is, to first order (exactly for thermal growth and drift), the regressor columns times the
+//! parameters.
+
+use crate::robot::{irb4400, pose_error, random_q, with_tool};
+use lie::{SE3, SO3, Twist, Vector3, Vector6};
+use loadsim::{
+    Backlash, BaseDrift, Effects, Harmonic, JointCompliance, Payload, PeriodicError, PoseContext, RegressorColumn,
+    RobotDynamics, SimulatedCell, ThermalGrowth, backlash_regressor, compliance_regressor, drift_regressor,
+    periodic_regressor, static_torque, thermal_regressor,
+};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+fn combine(columns: &[RegressorColumn], parameters: &[f64]) -> Vector6 {
+    columns.iter().zip(parameters).fold(Vector6::zeros(), |sum, (c, p)| sum + c.twist * *p)
+}
+
+/// Forward-model pose error of `effects` against the plain geometric model, base frame.
+fn forward_error(cell: &SimulatedCell, effects: &Effects, q: &[f64], context: &PoseContext) -> Vector6 {
+    let measured = effects.true_pose(cell, q, context).unwrap();
+    pose_error(&measured, &(cell.tracker_from_base * cell.robot.forward(q, cell.tool).unwrap()))
+}
+
+fn stiff(dynamics: &RobotDynamics, factor: f64) -> RobotDynamics {
+    RobotDynamics {
+        stiffness_nm_per_rad: dynamics.stiffness_nm_per_rad.iter().map(|k| k * factor).collect(),
+        ..dynamics.clone()
+    }
+}
+
+#[test]
+fn compliance_regressor_predicts_the_compliance_pose_error() {
+    let robot = irb4400();
+    let model = with_tool(&robot.model, 0.2);
+    // 100× stiffer than the fixture so that the second-order remainder is 1e-5 of the effect.
+    let dynamics = stiff(&robot.dynamics, 100.0);
+    let cell = SimulatedCell::new(model.clone(), Some(dynamics.clone()));
+    let effects = Effects { compliance: Some(JointCompliance::default()), ..Effects::default() };
+    let mut rng = ChaCha8Rng::seed_from_u64(20);
+    for _ in 0..20 {
+        let q = random_q(&robot.ranges, &mut rng);
+        let context = PoseContext { payload: Payload::at_tool(rng.random_range(0.0..60.0)), ..PoseContext::default() };
+        let torque = static_torque(&model, &dynamics, &q, 0, &context.payload).unwrap();
+        let columns = compliance_regressor(&model, &q, &torque).unwrap();
+        let c: Vec<f64> = dynamics.stiffness_nm_per_rad.iter().map(|k| 1.0 / k).collect();
+        let predicted = combine(&columns, &c);
+        let actual = forward_error(&cell, &effects, &q, &context);
+        assert!((predicted - actual).norm() < 1e-3 * actual.norm(), "{predicted:?} vs {actual:?}");
+    }
+}
+
+#[test]
+fn backlash_regressor_predicts_the_backlash_pose_error() {
+    let robot = irb4400();
+    let cell = SimulatedCell::new(robot.model.clone(), Some(robot.dynamics.clone()));
+    let half_bands = [3e-6, 5e-6, 4e-6, 8e-6, 6e-6, 7e-6];
+    let backlash = Backlash {
+        joints: half_bands
+            .iter()
+            .enumerate()
+            .map(|(joint_index, &half_band_rad)| loadsim::JointBacklash { joint_index, half_band_rad })
+            .collect(),
+    };
+    let effects = Effects { backlash: Some(backlash), ..Effects::default() };
+    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    for _ in 0..20 {
+        let q = random_q(&robot.ranges, &mut rng);
+        let context = PoseContext::default();
+        let torque = static_torque(&robot.model, &robot.dynamics, &q, 0, &context.payload).unwrap();
+        let predicted = combine(&backlash_regressor(&robot.model, &q, &torque).unwrap(), &half_bands);
+        let actual = forward_error(&cell, &effects, &q, &context);
+        assert!((predicted - actual).norm() < 1e-3 * actual.norm(), "{predicted:?} vs {actual:?}");
+    }
+}
+
+#[test]
+fn periodic_regressor_predicts_the_gear_error_pose_error_per_harmonic() {
+    let robot = irb4400();
+    let cell = SimulatedCell::new(robot.model.clone(), None);
+    let harmonics = vec![
+        Harmonic { joint_index: 1, order: 1.0, amplitude_rad: 2e-5, phase_rad: 0.4 },
+        Harmonic { joint_index: 1, order: 3.0, amplitude_rad: 1e-5, phase_rad: -1.1 },
+        Harmonic { joint_index: 4, order: 2.0, amplitude_rad: 3e-5, phase_rad: 2.0 },
+    ];
+    let effects = Effects { periodic: Some(PeriodicError { harmonics: harmonics.clone() }), ..Effects::default() };
+    let mut rng = ChaCha8Rng::seed_from_u64(22);
+    for _ in 0..20 {
+        let q = random_q(&robot.ranges, &mut rng);
+        let mut predicted = Vector6::zeros();
+        for h in &harmonics {
+            let columns = periodic_regressor(&robot.model, &q, h.joint_index, h.order).unwrap();
+            predicted += combine(&columns, &h.cos_sin_coefficients());
+        }
+        let actual = forward_error(&cell, &effects, &q, &PoseContext::default());
+        assert!((predicted - actual).norm() < 1e-3 * actual.norm(), "{predicted:?} vs {actual:?}");
+    }
+}
+
+#[test]
+fn thermal_regressor_is_exact_per_link() {
+    let robot = irb4400();
+    let model = with_tool(&robot.model, 0.2);
+    let cell = SimulatedCell::new(model.clone(), None);
+    let alphas = vec![11e-6, 12e-6, 23e-6, 13e-6, 17e-6, 9e-6, 20e-6];
+    let thermal = ThermalGrowth { reference_temp_c: 20.0, expansion_per_k: 0.0, link_expansion_per_k: alphas.clone() };
+    let effects = Effects { thermal: Some(thermal), ..Effects::default() };
+    let mut rng = ChaCha8Rng::seed_from_u64(23);
+    for _ in 0..20 {
+        let q = random_q(&robot.ranges, &mut rng);
+        let context = PoseContext { temp_c: rng.random_range(5.0..40.0), ..PoseContext::default() };
+        let columns = thermal_regressor(&model, &q, 0, context.temp_c - 20.0).unwrap();
+        assert_eq!(columns.len(), 7);
+        let predicted = combine(&columns, &alphas);
+        // Exactly linear: the pose error is a pure translation and the log of a pure translation
+        // is that translation.
+        let actual = forward_error(&cell, &effects, &q, &context);
+        assert!((predicted - actual).norm() < 1e-12, "{predicted:?} vs {actual:?}");
+    }
+}
+
+#[test]
+fn drift_regressor_is_exact_in_the_tracker_frame() {
+    let robot = irb4400();
+    let mut cell = SimulatedCell::new(robot.model.clone(), None);
+    cell.tracker_from_base = SE3::new(SO3::from_rpy(0.1, -0.2, 2.5), Vector3::new(3.0, -1.0, 0.4));
+    let drift = BaseDrift { twist_per_s: [3e-9, -1e-9, 2e-9, 1e-9, -2e-9, 4e-9] };
+    let effects = Effects { drift: Some(drift), ..Effects::default() };
+    let q = [0.2, 0.3, -0.1, 0.5, 0.6, -0.7];
+    for t_s in [0.0, 600.0, 7200.0, 36000.0] {
+        let predicted = combine(&drift_regressor(t_s), &drift.twist_per_s);
+        let actual = forward_error(&cell, &effects, &q, &PoseContext { t_s, ..PoseContext::default() });
+        assert!((predicted - actual).norm() < 1e-12, "t {t_s}: {predicted:?} vs {actual:?}");
+        assert!((Twist::from_vector(&predicted).exp().to_matrix() - drift.motion_at(t_s).to_matrix()).norm() < 1e-15);
+    }
+}
+
+#[test]
+fn joint_regressors_scale_with_the_spatial_twist_of_their_joint() {
+    // A regressor column of joint j is parallel to the joint's spatial twist.
+    let robot = irb4400();
+    let q = [0.2, 0.3, -0.1, 0.5, 0.6, -0.7];
+    let twists = robot.model.spatial_twists(&q).unwrap();
+    let torque = [1.0, -2.0, 3.0, -4.0, 5.0, -6.0];
+    for (j, column) in compliance_regressor(&robot.model, &q, &torque).unwrap().iter().enumerate() {
+        assert!((column.twist - twists[j].to_vector() * torque[j]).norm() < 1e-15);
+    }
+    for (j, column) in backlash_regressor(&robot.model, &q, &torque).unwrap().iter().enumerate() {
+        assert!((column.twist - twists[j].to_vector() * torque[j].signum()).norm() < 1e-15);
+    }
+    let zero = backlash_regressor(&robot.model, &q, &[0.0; 6]).unwrap();
+    assert!(zero.iter().all(|c| c.twist == Vector6::zeros()), "no torque, no side of the play");
+}
