@@ -16,20 +16,17 @@ fn horner(x: f64, coefficients: &[f64]) -> f64 {
     coefficients.iter().rev().fold(0.0, |sum, c| sum * x + c)
 }
 
-/// `sin θ / θ`.
-pub(crate) fn sin_over_angle(theta: f64) -> f64 {
+/// `(sin θ / θ, (1 − cos θ) / θ²)`, the coefficients of Rodrigues' formula, from one `sin_cos` of
+/// θ/2: `sin θ = 2 sin(θ/2) cos(θ/2)` and `1 − cos θ = 2 sin²(θ/2)`, which does not cancel.
+pub(crate) fn rodrigues_coefficients(theta: f64) -> (f64, f64) {
     if theta < TINY_ANGLE {
         let t2 = theta * theta;
-        1.0 - t2 / 6.0 + t2 * t2 / 120.0
+        (1.0 - t2 / 6.0 + t2 * t2 / 120.0, 0.5 - t2 / 24.0 + t2 * t2 / 720.0)
     } else {
-        theta.sin() / theta
+        let (s, c) = (0.5 * theta).sin_cos();
+        let s_over = s / theta;
+        (2.0 * s_over * c, 2.0 * s_over * s_over)
     }
-}
-
-/// `(1 − cos θ) / θ²`, computed as `½ (sin(θ/2) / (θ/2))²`, which does not cancel.
-pub(crate) fn one_minus_cos_over_angle2(theta: f64) -> f64 {
-    let s = sin_over_angle(0.5 * theta);
-    0.5 * s * s
 }
 
 /// `(θ − sin θ) / θ³ = Σ_{k≥0} (−1)^k θ^{2k} / (2k + 3)!`.
@@ -102,7 +99,8 @@ pub(crate) fn inverse_jacobian_coefficient(theta: f64) -> f64 {
         1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30_240.0
     } else {
         let half = 0.5 * theta;
-        (1.0 - half * half.cos() / half.sin()) / (theta * theta)
+        let (s, c) = half.sin_cos();
+        (1.0 - half * c / s) / (theta * theta)
     }
 }
 
@@ -127,11 +125,10 @@ mod tests {
         }
     }
 
-    /// Near 0 the series gives the limits `1/6`, `1/24`, `1/120` exactly.
+    /// Near 0 the series give the limits exactly.
     #[test]
     fn coefficients_at_zero_are_their_limits() {
-        assert_eq!(sin_over_angle(0.0), 1.0);
-        assert_eq!(one_minus_cos_over_angle2(0.0), 0.5);
+        assert_eq!(rodrigues_coefficients(0.0), (1.0, 0.5));
         assert_eq!(angle_minus_sin_over_angle3(0.0), 1.0 / 6.0);
         assert_eq!(q_coefficient_2(0.0), 1.0 / 24.0);
         assert_eq!(q_coefficient_3(0.0), 1.0 / 120.0);

@@ -2,8 +2,7 @@
 //! doc.
 
 use crate::coefficients::{
-    angle_minus_sin_over_angle3, inverse_jacobian_coefficient, one_minus_cos_over_angle2, q_coefficient_2,
-    q_coefficient_3,
+    angle_minus_sin_over_angle3, inverse_jacobian_coefficient, q_coefficient_2, q_coefficient_3, rodrigues_coefficients,
 };
 use crate::{Matrix3, Matrix6, SE3, SO3, Twist, Vector3};
 
@@ -13,7 +12,8 @@ impl SO3 {
     pub fn left_jacobian(w: &Vector3) -> Matrix3 {
         let theta = w.norm();
         let k = SO3::hat(w);
-        Matrix3::identity() + k * one_minus_cos_over_angle2(theta) + k * k * angle_minus_sin_over_angle3(theta)
+        let (_, b) = rodrigues_coefficients(theta);
+        Matrix3::identity() + k * b + k * k * angle_minus_sin_over_angle3(theta)
     }
 
     /// `J_r(ω) = J_l(−ω)`.

@@ -1,6 +1,7 @@
 //! SE(3): rigid transforms.
 
-use crate::{Error, Matrix4, Matrix6, SO3, Twist, Vector3};
+use crate::coefficients::{angle_minus_sin_over_angle3, inverse_jacobian_coefficient, rodrigues_coefficients};
+use crate::{Error, Matrix3, Matrix4, Matrix6, SO3, Twist, Vector3};
 use serde::{Deserialize, Serialize};
 use std::ops::Mul;
 
@@ -39,13 +40,23 @@ impl SE3 {
 
     /// `exp(ξ^) = [[exp(ω^), J_l(ω) v], [0, 1]]`, with `J_l` the left Jacobian of SO(3).
     pub fn exp(xi: &Twist) -> Self {
-        Self { rotation: SO3::exp(&xi.w), translation: SO3::left_jacobian(&xi.w) * xi.v }
+        let theta = xi.w.norm();
+        let (a, b) = rodrigues_coefficients(theta);
+        let c = angle_minus_sin_over_angle3(theta);
+        let k = SO3::hat(&xi.w);
+        let rotation = SO3::from_matrix_unchecked(Matrix3::identity() + k * a + k * k * b);
+        // J_l(ω) v = v + b ω × v + c ω × (ω × v), without forming J_l.
+        let wv = xi.w.cross(&xi.v);
+        Self { rotation, translation: xi.v + wv * b + xi.w.cross(&wv) * c }
     }
 
     /// The twist `ξ` with `exp(ξ^) = T`, `|ω| ≤ π`.
     pub fn log(&self) -> Twist {
         let w = self.rotation.log();
-        Twist::new(SO3::left_jacobian_inverse(&w) * self.translation, w)
+        // J_l⁻¹(ω) t = t − ½ ω × t + d ω × (ω × t), without forming J_l⁻¹.
+        let t = self.translation;
+        let wt = w.cross(&t);
+        Twist::new(t - wt * 0.5 + w.cross(&wt) * inverse_jacobian_coefficient(w.norm()), w)
     }
 
     /// The inverse transform.

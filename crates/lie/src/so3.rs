@@ -1,6 +1,6 @@
 //! SO(3): rotations of 3-space.
 
-use crate::coefficients::{one_minus_cos_over_angle2, sin_over_angle};
+use crate::coefficients::rodrigues_coefficients;
 use crate::{Error, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_2;
@@ -41,9 +41,9 @@ impl SO3 {
 
     /// Rodrigues' formula `exp(ω^) = I + (sin θ/θ) ω^ + ((1 − cos θ)/θ²) ω^²`.
     pub fn exp(w: &Vector3) -> Self {
-        let theta = w.norm();
+        let (a, b) = rodrigues_coefficients(w.norm());
         let k = Self::hat(w);
-        Self { matrix: Matrix3::identity() + k * sin_over_angle(theta) + k * k * one_minus_cos_over_angle2(theta) }
+        Self { matrix: Matrix3::identity() + k * a + k * k * b }
     }
 
     /// The rotation vector `ω` with `exp(ω^) = R`, `|ω| ≤ π`; at exactly π either of `±π a`.
