@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 /// A robot in a measurement cell: its true geometry (reference frame = robot base, z up), its
 /// masses and stiffness if known, where the tracker sees the base from, and which tool is measured.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SimulatedCell {
     /// The true kinematic model, base reference frame.
     pub robot: LocalPoe,

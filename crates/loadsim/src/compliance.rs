@@ -1,6 +1,6 @@
 //! Joint compliance: each joint transmission is a torsion spring, so the static torque turns the
 //! link by `δq = C τ`, `C = diag(1/k_i)` (the lumped joint-stiffness model of Salisbury 1980 and
-//! Tao, Yang & Tomizuka 2013, the paper's ref. [15]; links taken as rigid, which Dumas et al.,
+//! Tao, Yang & Tomizuka 2013, the paper's ref. \[15\]; links taken as rigid, which Dumas et al.,
 //! *Robotica* 2011, found adequate for 6R industrial arms).
 
 use crate::{Error, Payload, RobotDynamics, gravity::payload_gravity_torque, gravity::static_torque};

@@ -6,7 +6,7 @@
 //!
 //! `∂c/∂q_j = v_j + ω_j × c` for the joint's spatial twist `(v_j, ω_j)` (Lynch & Park, *Modern
 //! Robotics*, 2017, §5.1), so `τ_j = Σ_{k ≥ j} m_k gᵀ (v_j + ω_j × c_k) = Σ_k J_{c,k}ᵀ m_k g`
-//! (the load model of Tao, Yang & Tomizuka 2013, the paper's ref. [15]).
+//! (the load model of Tao, Yang & Tomizuka 2013, the paper's ref. \[15\]).
 
 use crate::{Error, RobotDynamics};
 use lie::{SE3, Twist, Vector3};

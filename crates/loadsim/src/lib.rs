@@ -1,5 +1,5 @@
 //! Non-geometric error models of a serial robot: payload and gravity deflection through joint
-//! compliance (the paper's ref. [15], Tao, Yang & Tomizuka 2013), a joint-2 spring balancer,
+//! compliance (the paper's ref. \[15\], Tao, Yang & Tomizuka 2013), a joint-2 spring balancer,
 //! backlash, gear periodic error, thermal growth, base drift and tracker noise; and a seeded
 //! dataset generator.
 //!
