@@ -65,4 +65,13 @@ impl Points {
             self.data.chunks_exact(self.dim).flat_map(|row| row.iter().zip(factor).map(|(x, f)| x * f)).collect();
         Self { dim: self.dim, data }
     }
+
+    /// The points at `indices`, in that order.
+    pub(crate) fn select(&self, indices: &[usize]) -> Self {
+        let mut data = Vec::with_capacity(indices.len() * self.dim);
+        for &i in indices {
+            data.extend_from_slice(self.row(i));
+        }
+        Self { dim: self.dim, data }
+    }
 }
