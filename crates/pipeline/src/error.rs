@@ -127,6 +127,11 @@ pub enum Error {
         /// The underlying error.
         source: poe::Error,
     },
+    /// The load and effect models refused their input.
+    Load {
+        /// The underlying error.
+        source: loadsim::Error,
+    },
     /// Too few rows for what was asked.
     TooFewRows {
         /// The file.
@@ -170,6 +175,7 @@ impl fmt::Display for Error {
                 write!(f, "{file}:1:1: model file has schema version {found}, this calib reads version {supported}")
             }
             Error::Kinematics { source } => write!(f, "{source}"),
+            Error::Load { source } => write!(f, "load model: {source}"),
             Error::TooFewRows { file, rows, needed } => {
                 write!(f, "{file}: {rows} measurement rows, at least {needed} needed")
             }
@@ -182,6 +188,7 @@ impl std::error::Error for Error {
         match self {
             Error::Io { source, .. } => Some(source),
             Error::Kinematics { source } => Some(source),
+            Error::Load { source } => Some(source),
             _ => None,
         }
     }
@@ -190,5 +197,11 @@ impl std::error::Error for Error {
 impl From<poe::Error> for Error {
     fn from(source: poe::Error) -> Self {
         Error::Kinematics { source }
+    }
+}
+
+impl From<loadsim::Error> for Error {
+    fn from(source: loadsim::Error) -> Self {
+        Error::Load { source }
     }
 }

@@ -7,6 +7,7 @@
 #![deny(missing_docs)]
 
 mod calibrated;
+pub mod diagnose;
 mod error;
 mod fit;
 pub mod geometric;

@@ -1,0 +1,176 @@
+//! The linearised problem the diagnosis scores candidates on: at the geometric solution fitted to
+//! all rows, each measured pose gives weighted residual rows `y_i` and kinematic Jacobian rows
+//! `A_i`; a candidate effect adds columns `C_i`. One Gauss–Newton step from that solution on the
+//! training rows, `[A C]⁺ y`, predicts the held-out rows. The residuals are millimetres against
+//! metres of lever, so the step is the converged refit to first order.
+
+use crate::{Error, MeasurementSet};
+use faer::Mat;
+use lie::{SO3, Vector3, Vector6};
+use poe::{LocalPoe, RowKind};
+
+/// Weights that make position and orientation rows comparable.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Weights {
+    /// Position noise, m (per axis).
+    pub position_m: f64,
+    /// Orientation noise, rad (per axis).
+    pub rotation_rad: f64,
+}
+
+/// The rows of every measurement at the geometric solution.
+#[derive(Debug, Clone)]
+pub(crate) struct Design {
+    /// Rows per measurement: 3 (position only) or 6 (full pose).
+    pub rows_per_pose: usize,
+    /// Weighted residuals `measured − predicted`, `rows_per_pose` per measurement.
+    pub y: Vec<f64>,
+    /// Weighted kinematic Jacobian, one row per residual, all 6(n + tools) parameters.
+    pub kinematic: Mat<f64>,
+    /// Predicted tool points, reference frame, one per measurement.
+    pub points: Vec<Vector3>,
+    /// The weights.
+    pub weights: Weights,
+}
+
+impl Design {
+    /// Linearises `model` at every measurement of `data` (tool indices already the model's).
+    pub(crate) fn new(model: &LocalPoe, data: &MeasurementSet, weights: Weights) -> Result<Self, Error> {
+        let rows_per_pose = if data.full_pose { 6 } else { 3 };
+        let kind = if data.full_pose { RowKind::PointAndRotation } else { RowKind::Position };
+        let columns = model.layout().len();
+        let total = rows_per_pose * data.rows.len();
+        let mut kinematic = Mat::<f64>::zeros(total, columns);
+        let mut y = vec![0.0; total];
+        let mut points = Vec::with_capacity(data.rows.len());
+        let mut buffer = vec![0.0; rows_per_pose * columns];
+        for (i, row) in data.rows.iter().enumerate() {
+            let pose = model.identification_jacobian(&row.q, row.tool, kind, &mut buffer)?;
+            let base = i * rows_per_pose;
+            let d = row.position - pose.translation();
+            for r in 0..3 {
+                y[base + r] = d[r] / weights.position_m;
+            }
+            if let Some(measured) = row.orientation {
+                let w = (measured * pose.rotation().inverse()).log();
+                for r in 0..3 {
+                    y[base + 3 + r] = w[r] / weights.rotation_rad;
+                }
+            }
+            for r in 0..rows_per_pose {
+                let weight = if r < 3 { weights.position_m } else { weights.rotation_rad };
+                for c in 0..columns {
+                    kinematic[(base + r, c)] = buffer[r * columns + c] / weight;
+                }
+            }
+            points.push(pose.translation());
+        }
+        Ok(Self { rows_per_pose, y, kinematic, points, weights })
+    }
+
+    /// Number of measurements.
+    pub(crate) fn poses(&self) -> usize {
+        self.points.len()
+    }
+
+    /// The weighted residual rows of a left twist `c` at measurement `i`: the point moves by
+    /// `v + ω × p`, the orientation by `ω`.
+    pub(crate) fn twist_rows(&self, i: usize, twist: &Vector6, out: &mut [f64]) {
+        let p = self.points[i];
+        let w = Vector3::new(twist[3], twist[4], twist[5]);
+        let v = Vector3::new(twist[0], twist[1], twist[2]) - SO3::hat(&p) * w;
+        for r in 0..3 {
+            out[r] = v[r] / self.weights.position_m;
+        }
+        if self.rows_per_pose == 6 {
+            for r in 0..3 {
+                out[3 + r] = w[r] / self.weights.rotation_rad;
+            }
+        }
+    }
+
+    /// The coefficients of the `extra` columns fitted together with the kinematic ones on every
+    /// measurement (one linear step, as in [`Design::cross_validate`]).
+    pub(crate) fn fit_all(&self, extra: &[Vec<f64>]) -> Vec<f64> {
+        let (beta, scale) = self.solve(extra, &(0..self.poses()).collect::<Vec<_>>());
+        let kinematic_columns = self.kinematic.ncols();
+        (0..extra.len()).map(|l| beta[kinematic_columns + l] * scale[kinematic_columns + l]).collect()
+    }
+
+    fn value(&self, extra: &[Vec<f64>], row: usize, c: usize) -> f64 {
+        let kinematic_columns = self.kinematic.ncols();
+        if c < kinematic_columns { self.kinematic[(row, c)] } else { extra[c - kinematic_columns][row] }
+    }
+
+    /// Least squares on the rows of `train`: the coefficients of the scaled columns and the
+    /// column scales (unit norm on the training rows, so that the rank decision does not depend
+    /// on the columns' units: torques in N·m against lever arms in metres).
+    fn solve(&self, extra: &[Vec<f64>], train: &[usize]) -> (Vec<f64>, Vec<f64>) {
+        let k = self.rows_per_pose;
+        let columns = self.kinematic.ncols() + extra.len();
+        let rows = || train.iter().flat_map(move |&i| (0..k).map(move |r| i * k + r));
+        let scale: Vec<f64> = (0..columns)
+            .map(|c| {
+                let norm = rows().map(|row| self.value(extra, row, c).powi(2)).sum::<f64>().sqrt();
+                if norm > 0.0 { 1.0 / norm } else { 0.0 }
+            })
+            .collect();
+        let a = Mat::<f64>::from_fn(train.len() * k, columns, |row, c| {
+            let (i, r) = (train[row / k], row % k);
+            self.value(extra, i * k + r, c) * scale[c]
+        });
+        let b: Vec<f64> = rows().map(|row| self.y[row]).collect();
+        (pseudo_inverse_solve(&a, &b), scale)
+    }
+
+    /// Held-out residuals of every measurement by K-fold cross-validation of one linear step
+    /// with the kinematic columns and `extra` columns (one `Vec` of weighted rows per column,
+    /// `rows_per_pose × poses` long). Returns the unweighted held-out position residual (m) and,
+    /// for full-pose data, the orientation residual (rad), per measurement.
+    pub(crate) fn cross_validate(&self, extra: &[Vec<f64>], folds: &[usize], fold_count: usize) -> Vec<Vector6> {
+        let k = self.rows_per_pose;
+        let columns = self.kinematic.ncols() + extra.len();
+        let mut out = vec![Vector6::zeros(); self.poses()];
+        for fold in 0..fold_count {
+            let train: Vec<usize> = (0..self.poses()).filter(|&i| folds[i] != fold).collect();
+            let test: Vec<usize> = (0..self.poses()).filter(|&i| folds[i] == fold).collect();
+            if train.is_empty() || test.is_empty() {
+                continue;
+            }
+            let (beta, scale) = self.solve(extra, &train);
+            for &i in &test {
+                let mut residual = Vector6::zeros();
+                for r in 0..k {
+                    let row = i * k + r;
+                    let predicted: f64 = (0..columns).map(|c| self.value(extra, row, c) * scale[c] * beta[c]).sum();
+                    let weight = if r < 3 { self.weights.position_m } else { self.weights.rotation_rad };
+                    residual[r] = (self.y[row] - predicted) * weight;
+                }
+                out[i] = residual;
+            }
+        }
+        out
+    }
+}
+
+/// `x = A⁺ b` through the thin SVD, dropping directions below `1e-10 σ_max` (the kinematic
+/// model's unidentifiable directions and any a candidate shares with it).
+fn pseudo_inverse_solve(a: &Mat<f64>, b: &[f64]) -> Vec<f64> {
+    let mut x = vec![0.0; a.ncols()];
+    let Ok(svd) = a.thin_svd() else {
+        return x;
+    };
+    let s = svd.S().column_vector();
+    let (u, v) = (svd.U(), svd.V());
+    let threshold = 1e-10 * (0..s.nrows()).map(|i| s[i]).fold(0.0, f64::max);
+    for k in 0..s.nrows() {
+        if s[k] <= threshold {
+            continue;
+        }
+        let utb: f64 = (0..b.len()).map(|i| u[(i, k)] * b[i]).sum::<f64>() / s[k];
+        for (j, xj) in x.iter_mut().enumerate() {
+            *xj += v[(j, k)] * utb;
+        }
+    }
+    x
+}
