@@ -20,6 +20,9 @@ pub struct CalibratedModel {
     pub tools: Vec<String>,
     /// The identified local POE model; its reference frame is the tracker frame.
     pub kinematics: LocalPoe,
+    /// The GP compensation of the residual (methods `poe-gp`, `poe-gp-load`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compensation: Option<crate::Compensation>,
 }
 
 /// A predicted tool pose and, where a GP is part of the model, its standard deviation.
@@ -57,9 +60,19 @@ impl CalibratedModel {
     pub fn predict(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<PredictedPose>, Error> {
         let mut poses = Vec::with_capacity(rows.len());
         for (row, &tool) in rows.iter().zip(tools) {
-            poses.push(PredictedPose { pose: self.kinematics.forward(&row.q, tool)?, std: None });
+            poses.push(self.kinematics.forward(&row.q, tool)?);
         }
-        Ok(poses)
+        match &self.compensation {
+            None => Ok(poses.into_iter().map(|pose| PredictedPose { pose, std: None }).collect()),
+            Some(compensation) => {
+                let corrections = compensation.predict(rows, &poses)?;
+                Ok(poses
+                    .into_iter()
+                    .zip(corrections)
+                    .map(|(pose, (g, std))| PredictedPose { pose: g * pose, std: Some(std) })
+                    .collect())
+            }
+        }
     }
 }
 

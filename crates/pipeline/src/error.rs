@@ -132,6 +132,11 @@ pub enum Error {
         /// The underlying error.
         source: loadsim::Error,
     },
+    /// The Gaussian process failed.
+    Gp {
+        /// The underlying error.
+        source: gp::Error,
+    },
     /// Too few rows for what was asked.
     TooFewRows {
         /// The file.
@@ -176,6 +181,7 @@ impl fmt::Display for Error {
             }
             Error::Kinematics { source } => write!(f, "{source}"),
             Error::Load { source } => write!(f, "load model: {source}"),
+            Error::Gp { source } => write!(f, "Gaussian process: {source}"),
             Error::TooFewRows { file, rows, needed } => {
                 write!(f, "{file}: {rows} measurement rows, at least {needed} needed")
             }
@@ -189,6 +195,7 @@ impl std::error::Error for Error {
             Error::Io { source, .. } => Some(source),
             Error::Kinematics { source } => Some(source),
             Error::Load { source } => Some(source),
+            Error::Gp { source } => Some(source),
             _ => None,
         }
     }
@@ -203,5 +210,11 @@ impl From<poe::Error> for Error {
 impl From<loadsim::Error> for Error {
     fn from(source: loadsim::Error) -> Self {
         Error::Load { source }
+    }
+}
+
+impl From<gp::Error> for Error {
+    fn from(source: gp::Error) -> Self {
+        Error::Gp { source }
     }
 }

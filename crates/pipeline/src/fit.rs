@@ -2,8 +2,8 @@
 
 use crate::geometric::fit_geometry;
 use crate::{
-    CalibratedModel, Error, ErrorSummary, MeasurementSet, Method, PoseError, RobotDescription, SCHEMA_VERSION,
-    pose_error,
+    CalibratedModel, Compensation, CompensationOptions, CompensationReport, Error, ErrorSummary, MeasurementSet,
+    Method, PoseError, RobotDescription, SCHEMA_VERSION, pose_error,
 };
 use poe::identify::{IdentificationOptions, IdentificationReport, Scope};
 use serde::{Deserialize, Serialize};
@@ -14,6 +14,8 @@ use serde::{Deserialize, Serialize};
 pub struct FitOptions {
     /// The geometric identification.
     pub identification: IdentificationOptions,
+    /// The Gaussian-process compensation (methods `poe-gp`, `poe-gp-load`).
+    pub compensation: CompensationOptions,
 }
 
 /// What a fit reports besides the model.
@@ -27,6 +29,8 @@ pub struct FitReport {
     pub after: ErrorSummary,
     /// The geometric identification's report.
     pub identification: IdentificationReport,
+    /// The GP stage's report, for the GP methods.
+    pub compensation: Option<CompensationReport>,
 }
 
 /// Per-row errors and their summary.
@@ -38,7 +42,8 @@ pub struct Evaluation {
     pub summary: ErrorSummary,
 }
 
-/// Fits `method` to `data` for `robot` (paper Section III-A).
+/// Fits `method` to `data` for `robot` (paper Section III: step 1, then step 2 for the GP
+/// methods, trained on the error the identified model leaves on the same rows, Eq. 8).
 pub fn fit(
     robot: &RobotDescription,
     data: &MeasurementSet,
@@ -57,18 +62,26 @@ pub fn fit(
     let nominal = robot.nominal_model()?;
     let scope = if method == Method::BaseTool { Scope::BaseTool } else { Scope::Full };
     let geometry = fit_geometry(&nominal, data, scope, &options.identification)?;
-    let model = CalibratedModel {
+    let mut model = CalibratedModel {
         schema_version: SCHEMA_VERSION,
         robot: robot.name.clone(),
         method,
         full_pose: data.full_pose,
         tools: data.tools.clone(),
         kinematics: geometry.model,
+        compensation: None,
     };
-    let registered = CalibratedModel { kinematics: geometry.registered, ..model.clone() };
+    let mut compensation = None;
+    if method.uses_gp() {
+        let with_payload = method == Method::PoeGpLoad;
+        let (fitted, report) = Compensation::fit(&model.kinematics, data, with_payload, &options.compensation)?;
+        model.compensation = Some(fitted);
+        compensation = Some(report);
+    }
+    let registered = CalibratedModel { kinematics: geometry.registered, compensation: None, ..model.clone() };
     let before = evaluate(&registered, data)?.summary;
     let after = evaluate(&model, data)?.summary;
-    Ok((model, FitReport { method, before, after, identification: geometry.report }))
+    Ok((model, FitReport { method, before, after, identification: geometry.report, compensation }))
 }
 
 /// Evaluates a fitted model on measurements.

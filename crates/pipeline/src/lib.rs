@@ -7,6 +7,7 @@
 #![deny(missing_docs)]
 
 mod calibrated;
+mod compensation;
 pub mod diagnose;
 mod error;
 mod fit;
@@ -17,8 +18,10 @@ mod metrics;
 mod model_file;
 mod robot;
 mod ron_position;
+pub mod simulated;
 
 pub use calibrated::{CalibratedModel, PredictedPose, pose_error};
+pub use compensation::{Compensation, CompensationOptions, CompensationReport, ResidualFrame};
 pub use error::Error;
 pub use fit::{Evaluation, FitOptions, FitReport, evaluate, fit, tool_indices};
 pub use measurements::{Measurement, MeasurementSet, parse_measurements, read_measurements};

@@ -1,0 +1,145 @@
+//! Step 2 of the paper (Section III-B): a Gaussian process on the pose error the geometric model
+//! leaves, with the joint values (and the payload) as inputs, placed before the POE model
+//! (Eq. 9): `T = G(q, m) · T_POE(q)`.
+
+use crate::{Error, Measurement, MeasurementSet};
+use faer::Mat;
+use lie::{SE3, Twist, Vector3, Vector6};
+use poe::LocalPoe;
+use serde::{Deserialize, Serialize};
+
+/// Where the error twist of Eq. 8 is expressed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ResidualFrame {
+    /// At the tool point: `ε = log(P⁻¹ T' T⁻¹ P)^∨` with `P` the translation to the modelled tool
+    /// point, and `G = P exp(ĝ) P⁻¹`. The same twist as Eq. 8 seen from the tool, so that its `v`
+    /// part is the position error and does not carry the orientation error times the lever arm
+    /// to the tracker (metres): each GP output then sees one physical error.
+    #[default]
+    ToolPoint,
+    /// In the tracker frame, exactly the paper's Eq. 8: `ε = log(T' T⁻¹)^∨`, `G = exp(ĝ)`.
+    Tracker,
+}
+
+/// Options of the GP stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct CompensationOptions {
+    /// The Gaussian process.
+    pub gp: gp::GpConfig,
+    /// Where the error twist is expressed.
+    pub residual_frame: ResidualFrame,
+}
+
+impl Default for CompensationOptions {
+    fn default() -> Self {
+        Self {
+            gp: gp::GpConfig { kernel: gp::KernelChoice::SquaredExponentialArd, ..gp::GpConfig::default() },
+            residual_frame: ResidualFrame::default(),
+        }
+    }
+}
+
+/// A fitted GP compensation, stored in the model file.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Compensation {
+    /// Whether the payload is an input (method `poe-gp-load`, Eq. 12).
+    pub with_payload: bool,
+    /// Six outputs (a twist) for full-pose data, three (the position error) otherwise.
+    pub full_pose: bool,
+    /// Where the error twist is expressed.
+    pub residual_frame: ResidualFrame,
+    /// The GP: inputs `(q_1 … q_n[, m])`, outputs the error components.
+    pub gp: gp::ExactGp,
+}
+
+/// What the GP stage reports.
+#[derive(Debug, Clone)]
+pub struct CompensationReport {
+    /// The GP's own report (hyperparameters, log marginal likelihood, jitter).
+    pub gp: gp::FitReport,
+}
+
+fn inputs(rows: &[Measurement], with_payload: bool) -> Mat<f64> {
+    let n = rows.first().map_or(0, |r| r.q.len());
+    let d = n + usize::from(with_payload);
+    Mat::from_fn(rows.len(), d, |i, c| if c < n { rows[i].q[c] } else { rows[i].payload_kg })
+}
+
+/// The error of one row against the model's pose, as the GP's output vector.
+fn error_vector(model_pose: &SE3, row: &Measurement, frame: ResidualFrame) -> Vector6 {
+    match row.orientation {
+        None => {
+            let d = row.position - model_pose.translation();
+            Vector6::new(d.x, d.y, d.z, 0.0, 0.0, 0.0)
+        }
+        Some(rotation) => {
+            let measured = SE3::new(rotation, row.position);
+            let error = measured * model_pose.inverse();
+            match frame {
+                ResidualFrame::Tracker => error.log().to_vector(),
+                ResidualFrame::ToolPoint => {
+                    let p = SE3::from_translation(model_pose.translation());
+                    (p.inverse() * error * p).log().to_vector()
+                }
+            }
+        }
+    }
+}
+
+impl Compensation {
+    /// Fits the GP to the error `kinematics` leaves on `data` (tool indices are the model's).
+    pub fn fit(
+        kinematics: &LocalPoe,
+        data: &MeasurementSet,
+        with_payload: bool,
+        options: &CompensationOptions,
+    ) -> Result<(Self, CompensationReport), Error> {
+        let outputs = if data.full_pose { 6 } else { 3 };
+        let mut y = Mat::<f64>::zeros(data.rows.len(), outputs);
+        for (i, row) in data.rows.iter().enumerate() {
+            let pose = kinematics.forward(&row.q, row.tool)?;
+            let e = error_vector(&pose, row, options.residual_frame);
+            for c in 0..outputs {
+                y[(i, c)] = e[c];
+            }
+        }
+        let x = inputs(&data.rows, with_payload);
+        let gp = gp::ExactGp::fit(x.as_ref(), y.as_ref(), &options.gp)?;
+        let report = CompensationReport { gp: gp.report().clone() };
+        Ok((Self { with_payload, full_pose: data.full_pose, residual_frame: options.residual_frame, gp }, report))
+    }
+
+    /// The correction of every row: `G(q, m)` to put before the model pose, and the GP's standard
+    /// deviation of each error component `(v, ω)` (m, rad; zeros where not modelled).
+    pub fn predict(&self, rows: &[Measurement], model_poses: &[SE3]) -> Result<Vec<(SE3, [f64; 6])>, Error> {
+        let prediction = self.gp.predict(inputs(rows, self.with_payload).as_ref())?;
+        let outputs = prediction.mean.ncols();
+        Ok(model_poses
+            .iter()
+            .enumerate()
+            .map(|(i, pose)| {
+                let mut g = Vector6::zeros();
+                let mut std = [0.0; 6];
+                for c in 0..outputs {
+                    g[c] = prediction.mean[(i, c)];
+                    std[c] = prediction.variance[(i, c)].max(0.0).sqrt();
+                }
+                let correction = if !self.full_pose {
+                    SE3::from_translation(Vector3::new(g[0], g[1], g[2]))
+                } else {
+                    let exp = Twist::from_vector(&g).exp();
+                    match self.residual_frame {
+                        ResidualFrame::Tracker => exp,
+                        ResidualFrame::ToolPoint => {
+                            let p = SE3::from_translation(pose.translation());
+                            p * exp * p.inverse()
+                        }
+                    }
+                };
+                (correction, std)
+            })
+            .collect())
+    }
+}
