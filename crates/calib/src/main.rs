@@ -1,8 +1,10 @@
 //! `calib`: the command-line tool. `main` only parses and dispatches; each subcommand lives in a
 //! file of its own and prints through its own functions.
 
+mod diagnose;
 mod eval;
 mod fit;
+mod predict;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -19,6 +21,8 @@ struct Cli {
 enum Command {
     Fit(fit::Args),
     Eval(eval::Args),
+    Predict(predict::Args),
+    Diagnose(diagnose::Args),
 }
 
 fn main() -> ExitCode {
@@ -43,6 +47,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Fit(args) => fit::run(&args),
         Command::Eval(args) => eval::run(&args),
+        Command::Predict(args) => predict::run(&args),
+        Command::Diagnose(args) => diagnose::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

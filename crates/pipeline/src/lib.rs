@@ -24,7 +24,7 @@ pub use calibrated::{CalibratedModel, PredictedPose, pose_error};
 pub use compensation::{Compensation, CompensationOptions, CompensationReport, ResidualFrame};
 pub use error::Error;
 pub use fit::{Evaluation, FitOptions, FitReport, evaluate, fit, tool_indices};
-pub use measurements::{Measurement, MeasurementSet, parse_measurements, read_measurements};
+pub use measurements::{Measurement, MeasurementSet, parse_measurements, read_configurations, read_measurements};
 pub use method::{Method, UnknownMethod};
 pub use metrics::{ErrorSummary, PoseError};
 pub use model_file::{SCHEMA_VERSION, parse_model, read_model, write_model};

@@ -46,6 +46,8 @@ pub struct MeasurementSet {
     pub rows: Vec<Measurement>,
     /// Columns found but not used, by name.
     pub ignored_columns: Vec<String>,
+    /// Whether the rows carry measured positions ([`read_configurations`] may read sets without).
+    pub positions_measured: bool,
 }
 
 /// How a cell's number is turned into SI.
@@ -136,7 +138,13 @@ impl Layout {
         Ok(layout)
     }
 
-    fn check(&self, header_len: usize, file: &str, expected_joints: Option<usize>) -> Result<(), Error> {
+    fn check(
+        &self,
+        header_len: usize,
+        file: &str,
+        expected_joints: Option<usize>,
+        positions: bool,
+    ) -> Result<(), Error> {
         let missing =
             |name: String| Error::MissingColumn { file: file.to_owned(), line: 1, column: header_len + 1, name };
         let found = self.joints.len();
@@ -156,8 +164,9 @@ impl Layout {
         if let Some(k) = self.joints.iter().position(Option::is_none) {
             return Err(missing(format!("q{}_rad", k + 1)));
         }
+        let any_position = self.position.iter().any(Option::is_some);
         for (axis, slot) in ["x_mm", "y_mm", "z_mm"].iter().zip(&self.position) {
-            if slot.is_none() {
+            if slot.is_none() && (positions || any_position) {
                 return Err(missing((*axis).into()));
             }
         }
@@ -186,6 +195,24 @@ pub fn parse_measurements<R: Read>(
     file: &str,
     expected_joints: Option<usize>,
 ) -> Result<MeasurementSet, Error> {
+    parse(reader, file, expected_joints, true)
+}
+
+/// Reads joint configurations to predict poses for: the measurement CSV in which the position
+/// columns may be left out (then [`MeasurementSet::positions_measured`] is false and every
+/// position is zero). Every other rule of the format holds.
+pub fn read_configurations(path: &Path, expected_joints: Option<usize>) -> Result<MeasurementSet, Error> {
+    let file = path.display().to_string();
+    let reader = std::fs::File::open(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+    parse(reader, &file, expected_joints, false)
+}
+
+fn parse<R: Read>(
+    reader: R,
+    file: &str,
+    expected_joints: Option<usize>,
+    positions_required: bool,
+) -> Result<MeasurementSet, Error> {
     let mut csv = csv::ReaderBuilder::new().has_headers(true).trim(csv::Trim::All).from_reader(reader);
     let syntax = |e: csv::Error| {
         let line = e.position().map_or(1, |p| p.line());
@@ -202,7 +229,8 @@ pub fn parse_measurements<R: Read>(
         return Err(Error::EmptyFile { file: file.to_owned() });
     }
     let layout = Layout::from_header(&header, file)?;
-    layout.check(header.len(), file, expected_joints)?;
+    layout.check(header.len(), file, expected_joints, positions_required)?;
+    let positions_measured = layout.position.iter().all(Option::is_some);
     let full_pose = layout.quaternion[0].is_some();
     let mut tools: Vec<String> = Vec::new();
     let mut rows = Vec::new();
@@ -226,7 +254,7 @@ pub fn parse_measurements<R: Read>(
             slots.iter().flatten().map(|&c| number(c)).collect()
         };
         let q = all(&layout.joints)?;
-        let p = all(&layout.position)?;
+        let p = if positions_measured { all(&layout.position)? } else { vec![0.0; 3] };
         let orientation = if full_pose {
             let quaternion = all(&layout.quaternion)?;
             let norm = quaternion.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -275,6 +303,7 @@ pub fn parse_measurements<R: Read>(
         tool_column: layout.tool.map(|i| i + 1),
         rows,
         ignored_columns: layout.ignored,
+        positions_measured,
     })
 }
 
@@ -292,6 +321,7 @@ impl MeasurementSet {
             tool_column: None,
             rows,
             ignored_columns: vec![],
+            positions_measured: true,
         }
     }
 
@@ -309,6 +339,7 @@ impl MeasurementSet {
             tool_column: self.tool_column,
             rows: Vec::new(),
             ignored_columns: self.ignored_columns.clone(),
+            positions_measured: self.positions_measured,
         }
     }
 

@@ -16,12 +16,13 @@ mod regions;
 mod report;
 mod selection;
 mod statistics;
+mod structure;
 mod svg;
 
 pub use candidates::{CandidateOptions, Effect};
 pub use noise::{NoiseFloor, NoiseSource};
 pub use regions::{PoseDiagnosis, Region};
-pub use report::{CandidateScore, SelectedEffect, Verdict};
+pub use report::{CandidateScore, Remaining, SelectedEffect, Verdict};
 pub use selection::SelectionOptions;
 
 use crate::geometric::{fit_geometry, observations};
@@ -47,6 +48,11 @@ pub struct DiagnoseOptions {
     pub candidates: CandidateOptions,
     /// How strict the selection is.
     pub selection: SelectionOptions,
+    /// Look for structure no candidate explains with a cross-validated GP on the final residual
+    /// (the `unknown` verdict). It costs a few GP fits.
+    pub check_structure: bool,
+    /// The GP must lower the held-out error by at least this fraction to count as structure.
+    pub structure_min_gain: f64,
 }
 
 impl Default for DiagnoseOptions {
@@ -57,6 +63,8 @@ impl Default for DiagnoseOptions {
             noise_mm: None,
             candidates: CandidateOptions::default(),
             selection: SelectionOptions::default(),
+            check_structure: true,
+            structure_min_gain: 0.1,
         }
     }
 }
@@ -82,6 +90,8 @@ pub struct Diagnosis {
     pub selected: Vec<SelectedEffect>,
     /// The critical paired t value a candidate had to pass.
     pub critical_t: f64,
+    /// What a GP on the final residual still finds, if that was checked.
+    pub remaining: Option<Remaining>,
     /// The noise floor.
     pub noise: NoiseFloor,
     /// The held-out error by region.
@@ -136,12 +146,22 @@ pub fn diagnose(
     let selection = selection::select(&design, &candidates, &fold, folds, &options.selection);
 
     let after = selection.steps.last().map_or(&selection.baseline, |s| &s.result);
-    let noise = match options.noise_mm {
-        Some(sigma) => NoiseFloor::from_sigma(sigma, NoiseSource::Given),
-        None => match noise::from_repeats(data) {
-            Some(sigma) => NoiseFloor::from_sigma(sigma, NoiseSource::Repeats),
-            None => report::residual_noise(after, data)?,
-        },
+    let structure =
+        if options.check_structure { Some(structure::residual_structure(after, data, &fold, folds)?) } else { None };
+    let remaining = structure.as_ref().map(|s| {
+        let critical = statistics::normal_quantile(1.0 - options.selection.significance);
+        let gain = 1.0 - s.after_gp_m / after.mean_error().max(f64::MIN_POSITIVE);
+        Remaining {
+            heldout_after_gp_mm: s.after_gp_m * 1e3,
+            t: s.t,
+            significant: s.t > critical && gain >= options.structure_min_gain,
+        }
+    });
+    let noise = match (options.noise_mm, noise::from_repeats(data), &structure) {
+        (Some(sigma), _, _) => NoiseFloor::from_sigma(sigma, NoiseSource::Given),
+        (None, Some(sigma), _) => NoiseFloor::from_sigma(sigma, NoiseSource::Repeats),
+        (None, None, Some(s)) => NoiseFloor::from_sigma(s.sigma_m * 1e3, NoiseSource::ResidualGp),
+        (None, None, None) => report::residual_noise(after),
     };
 
     // Base-frame axes for the breakdown: tracker_from_base = calibrated · nominal⁻¹ at q = 0.
@@ -174,5 +194,5 @@ pub fn diagnose(
             }
         })
         .collect();
-    Ok(report::assemble(robot, data, &candidates, &selection, noise, regions::regions(&poses), poses))
+    Ok(report::assemble(robot, data, &candidates, &selection, remaining, noise, poses))
 }

@@ -18,6 +18,9 @@ pub enum NoiseSource {
     /// The held-out residual of the final model, per axis: an upper bound, since structure that no
     /// candidate explains counts as noise.
     HeldOutResidual,
+    /// What a cross-validated GP leaves of the final model's held-out residual, per axis: the
+    /// noise if the GP caught all structure, an upper bound otherwise.
+    ResidualGp,
 }
 
 /// The noise level and the floor it sets.

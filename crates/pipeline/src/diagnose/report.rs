@@ -6,7 +6,7 @@ use super::noise::{NoiseFloor, NoiseSource};
 use super::regions::{PoseDiagnosis, Region};
 use super::selection::{CrossValidated, Selection};
 use super::{Diagnosis, svg};
-use crate::{Error, MeasurementSet, RobotDescription};
+use crate::{MeasurementSet, RobotDescription};
 use serde::{Deserialize, Serialize};
 
 /// The SPEC's `verdict`: the effect that explains the residual and the joints it involves.
@@ -50,11 +50,22 @@ pub struct SelectedEffect {
     pub t: f64,
 }
 
-/// The per-axis RMS of the held-out residual, as a noise level.
-pub(crate) fn residual_noise(result: &CrossValidated, _data: &MeasurementSet) -> Result<NoiseFloor, Error> {
+/// What a GP on the final held-out residual still finds.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Remaining {
+    /// Cross-validated mean position error once the GP's prediction of the residual is removed, mm.
+    pub heldout_after_gp_mm: f64,
+    /// Paired t statistic of the GP's gain.
+    pub t: f64,
+    /// Whether the gain is significant and large enough to call the residual structured.
+    pub significant: bool,
+}
+
+/// The per-axis RMS of the held-out residual, as a noise level (an upper bound).
+pub(crate) fn residual_noise(result: &CrossValidated) -> NoiseFloor {
     let n = result.residuals.len().max(1) as f64;
     let sum: f64 = result.residuals.iter().map(|r| r.fixed_rows::<3>(0).norm_squared()).sum();
-    Ok(NoiseFloor::from_sigma((sum / (3.0 * n)).sqrt() * 1e3, NoiseSource::HeldOutResidual))
+    NoiseFloor::from_sigma((sum / (3.0 * n)).sqrt() * 1e3, NoiseSource::HeldOutResidual)
 }
 
 pub(crate) fn assemble(
@@ -62,10 +73,11 @@ pub(crate) fn assemble(
     data: &MeasurementSet,
     candidates: &[Candidate],
     selection: &Selection,
+    remaining: Option<Remaining>,
     noise: NoiseFloor,
-    regions: Vec<Region>,
     poses: Vec<PoseDiagnosis>,
 ) -> Diagnosis {
+    let regions = super::regions::regions(&poses);
     let mut scores: Vec<CandidateScore> = candidates
         .iter()
         .zip(&selection.single)
@@ -93,6 +105,7 @@ pub(crate) fn assemble(
         })
         .collect();
     let verdict = match selected.first() {
+        None if remaining.is_some_and(|r| r.significant) => Verdict { effect: Effect::Unknown, joints: vec![] },
         None => Verdict { effect: Effect::None, joints: vec![] },
         Some(first) => {
             let mut joints: Vec<usize> =
@@ -113,6 +126,7 @@ pub(crate) fn assemble(
         candidates: scores,
         selected,
         critical_t: selection.critical_t,
+        remaining,
         noise,
         regions,
         poses,
@@ -136,6 +150,7 @@ fn noise_source(source: NoiseSource) -> &'static str {
         NoiseSource::Given => "given",
         NoiseSource::Repeats => "from repeated poses",
         NoiseSource::HeldOutResidual => "upper bound from the held-out residual",
+        NoiseSource::ResidualGp => "what a GP leaves of the held-out residual",
     }
 }
 
@@ -164,6 +179,7 @@ impl Diagnosis {
         out.push_str(&format!("{}: {} poses, {kind}\n", self.robot, self.n));
         let verdict = match self.verdict.effect {
             Effect::None => "none: nothing beats the noise floor significantly".to_owned(),
+            Effect::Unknown => "unknown: structure is left that no candidate explains".to_owned(),
             _ => describe(self.verdict.effect, &self.verdict.joints, None),
         };
         out.push_str(&format!("  verdict:        {verdict}\n"));
@@ -184,6 +200,12 @@ impl Diagnosis {
                 describe(s.effect, &s.joints, s.harmonic),
                 s.heldout_after_mm,
                 s.t
+            ));
+        }
+        if let Some(r) = self.remaining.filter(|r| r.significant) {
+            out.push_str(&format!(
+                "  left:           a GP on the residual still lowers it to {:.4} mm (t = {:.1}): something is unmodelled\n",
+                r.heldout_after_gp_mm, r.t
             ));
         }
         let runners: Vec<String> = self

@@ -1,0 +1,61 @@
+//! `calib predict`: the compensated pose of every row of a joint file, with the GP's standard
+//! deviation where the model has a GP.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Predict the tool pose (tracker frame) for joint configurations, as CSV on stdout.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Calibrated model (RON, from `calib fit`).
+    #[arg(long)]
+    model: PathBuf,
+    /// Joint configurations: the measurement CSV; the position columns may be left out.
+    #[arg(long)]
+    data: PathBuf,
+}
+
+pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    let model = pipeline::read_model(&args.model)?;
+    let data = pipeline::read_configurations(&args.data, Some(model.joint_count()))?;
+    let tools = pipeline::tool_indices(&model, &data)?;
+    let predictions = model.predict(&data.rows, &tools)?;
+    let stdout = std::io::stdout();
+    let mut out = csv::Writer::from_writer(stdout.lock());
+    let gp = model.compensation.is_some();
+    let mut header: Vec<&str> = vec!["line", "x_mm", "y_mm", "z_mm"];
+    if model.full_pose {
+        header.extend(["qw", "qx", "qy", "qz"]);
+    }
+    if gp {
+        header.extend(["std_x_mm", "std_y_mm", "std_z_mm"]);
+        if model.full_pose {
+            header.extend(["std_rx_mrad", "std_ry_mrad", "std_rz_mrad"]);
+        }
+    }
+    if data.positions_measured {
+        header.push("error_mm");
+    }
+    out.write_record(&header)?;
+    for (row, prediction) in data.rows.iter().zip(&predictions) {
+        let p = prediction.pose.translation() * 1e3;
+        let mut record =
+            vec![row.line.to_string(), format!("{:.6}", p.x), format!("{:.6}", p.y), format!("{:.6}", p.z)];
+        if model.full_pose {
+            record.extend(prediction.pose.rotation().to_quaternion().iter().map(|v| format!("{v:.9}")));
+        }
+        if let Some(std) = prediction.std {
+            record.extend(std[..3].iter().map(|s| format!("{:.6}", s * 1e3)));
+            if model.full_pose {
+                record.extend(std[3..].iter().map(|s| format!("{:.6}", s * 1e3)));
+            }
+        }
+        if data.positions_measured {
+            record.push(format!("{:.6}", (row.position - prediction.pose.translation()).norm() * 1e3));
+        }
+        out.write_record(&record)?;
+    }
+    out.flush()?;
+    std::io::stdout().flush()?;
+    Ok(())
+}
