@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 use crate::Error;
 use crate::cholesky::{Factor, factor_in_place};
 use crate::config::Parallelism;
-use crate::gram::{contract_gradient, training_covariance};
+use crate::gram::{contract_gradient, training_covariance, training_covariance_with_cache};
 use crate::kernel::Kernel;
 use crate::points::Points;
 
@@ -67,7 +67,11 @@ pub(crate) fn evaluate(
     let (n, m) = (y.nrows(), y.ncols());
     let (evaluator, prepared) = kernel.prepare(x);
     let noise = kernel.noise_variance();
-    let k = training_covariance(&evaluator, &prepared, noise, parallelism);
+    let (k, cache) = if with_gradient {
+        training_covariance_with_cache(&evaluator, &prepared, noise, parallelism)
+    } else {
+        (training_covariance(&evaluator, &prepared, noise, parallelism), Mat::zeros(0, 0))
+    };
     let factor = factor_in_place(k, par).map(Factor::from_lower).map_err(|pivot| Error::CholeskyFailed {
         size: n,
         pivot,
@@ -89,7 +93,15 @@ pub(crate) fn evaluate(
         }
         // W = A Aᵀ − m K⁻¹; only the lower triangle is read by the contraction.
         matmul(w.as_mut(), Accum::Add, alpha.as_ref(), alpha.transpose(), 1.0, par);
-        contract_gradient(&evaluator, &prepared, w.as_ref(), noise, kernel.parameter_count() - 1, parallelism)
+        contract_gradient(
+            &evaluator,
+            &prepared,
+            w.as_ref(),
+            cache.as_ref(),
+            noise,
+            kernel.parameter_count() - 1,
+            parallelism,
+        )
     } else {
         Vec::new()
     };

@@ -33,23 +33,29 @@ impl Matern52Ard {
         signal_variance * (1.0 + SQRT_5 * r + 5.0 / 3.0 * r2) * (-SQRT_5 * r).exp()
     }
 
-    /// `k` and its derivatives on inputs already divided by their length scales.
+    /// `k` and the exponential `e^{−√5 r}` on inputs already divided by their length scales.
+    #[inline]
+    pub(crate) fn value_and_exponential(signal_variance: f64, a: &[f64], b: &[f64]) -> (f64, f64) {
+        let r2 = super::squared_distance(a, b);
+        let r = r2.sqrt();
+        let e = (-SQRT_5 * r).exp();
+        (signal_variance * (1.0 + SQRT_5 * r + 5.0 / 3.0 * r2) * e, e)
+    }
+
+    /// Derivatives given `e = e^{−√5 r}`, on inputs already divided by their length scales.
     ///
     /// `dk/dr = −(5/3) σf² r (1 + √5 r) e^{−√5 r}` and `∂r/∂ln ℓᵢ = −(Δᵢ/ℓᵢ)²/r`, so
     /// `∂k/∂ln ℓᵢ = (5/3) σf² (1 + √5 r) e^{−√5 r} (Δᵢ/ℓᵢ)²`: the `r` cancels and the derivative is
     /// smooth at `r = 0`. `∂k/∂ln σf² = k`.
     #[inline]
-    pub(crate) fn value_and_gradient_scaled(signal_variance: f64, a: &[f64], b: &[f64], gradient: &mut [f64]) -> f64 {
+    pub(crate) fn gradient_from_exponential(signal_variance: f64, a: &[f64], b: &[f64], e: f64, gradient: &mut [f64]) {
         let r2 = super::squared_distance(a, b);
         let r = r2.sqrt();
-        let e = (-SQRT_5 * r).exp();
-        let k = signal_variance * (1.0 + SQRT_5 * r + 5.0 / 3.0 * r2) * e;
+        gradient[0] = signal_variance * (1.0 + SQRT_5 * r + 5.0 / 3.0 * r2) * e;
         let common = 5.0 / 3.0 * signal_variance * (1.0 + SQRT_5 * r) * e;
-        gradient[0] = k;
         for ((g, x), y) in gradient[1..].iter_mut().zip(a).zip(b) {
             let d = x - y;
             *g = common * d * d;
         }
-        k
     }
 }

@@ -211,11 +211,11 @@ impl Kernel {
         match self {
             Self::Quadratic(k) => (Evaluator::Quadratic(*k), None),
             Self::SquaredExponentialArd(k) => (
-                Evaluator::SquaredExponential { signal_variance: k.signal_variance },
+                Evaluator::SquaredExponential(SquaredExponentialScaled { signal_variance: k.signal_variance }),
                 Some(k.length_scales.iter().map(|l| 1.0 / l).collect()),
             ),
             Self::Matern52Ard(k) => (
-                Evaluator::Matern52 { signal_variance: k.signal_variance },
+                Evaluator::Matern52(Matern52Scaled { signal_variance: k.signal_variance }),
                 Some(k.length_scales.iter().map(|l| 1.0 / l).collect()),
             ),
         }
@@ -255,33 +255,110 @@ impl Bounds {
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Evaluator {
     Quadratic(QuadraticKernel),
-    SquaredExponential { signal_variance: f64 },
-    Matern52 { signal_variance: f64 },
+    SquaredExponential(SquaredExponentialScaled),
+    Matern52(Matern52Scaled),
 }
+
+/// The squared exponential on inputs already divided by their length scales.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SquaredExponentialScaled {
+    pub(crate) signal_variance: f64,
+}
+
+/// The Matérn 5/2 on inputs already divided by their length scales.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Matern52Scaled {
+    pub(crate) signal_variance: f64,
+}
+
+/// One covariance function on prepared inputs, monomorphised into the Gram-matrix loops.
+///
+/// The likelihood gradient needs, for every pair, the kernel's gradient; `value_and_cache` returns
+/// with the value the one number (the exponential factor) that makes the gradient cheap, so the
+/// contraction pass does no `exp` of its own.
+pub(crate) trait PairKernel: Sync {
+    /// `k(a, b)` without noise.
+    fn value(&self, a: &[f64], b: &[f64]) -> f64;
+    /// `k(a, b)` and the cached factor for [`PairKernel::gradient_from_cache`].
+    fn value_and_cache(&self, a: &[f64], b: &[f64]) -> (f64, f64);
+    /// `∂k/∂ln p` for every kernel log-parameter (noise excluded), from the cached factor.
+    fn gradient_from_cache(&self, a: &[f64], b: &[f64], cache: f64, gradient: &mut [f64]);
+}
+
+impl PairKernel for QuadraticKernel {
+    #[inline]
+    fn value(&self, a: &[f64], b: &[f64]) -> f64 {
+        QuadraticKernel::value(self, a, b)
+    }
+    #[inline]
+    fn value_and_cache(&self, a: &[f64], b: &[f64]) -> (f64, f64) {
+        self.value_and_exponential(a, b)
+    }
+    #[inline]
+    fn gradient_from_cache(&self, a: &[f64], b: &[f64], cache: f64, gradient: &mut [f64]) {
+        self.gradient_from_exponential(a, b, cache, gradient);
+    }
+}
+
+impl PairKernel for SquaredExponentialScaled {
+    #[inline]
+    fn value(&self, a: &[f64], b: &[f64]) -> f64 {
+        SquaredExponentialArd::value_scaled(self.signal_variance, a, b)
+    }
+    #[inline]
+    fn value_and_cache(&self, a: &[f64], b: &[f64]) -> (f64, f64) {
+        let k = self.value(a, b);
+        (k, k)
+    }
+    #[inline]
+    fn gradient_from_cache(&self, a: &[f64], b: &[f64], cache: f64, gradient: &mut [f64]) {
+        SquaredExponentialArd::gradient_from_value(cache, a, b, gradient);
+    }
+}
+
+impl PairKernel for Matern52Scaled {
+    #[inline]
+    fn value(&self, a: &[f64], b: &[f64]) -> f64 {
+        Matern52Ard::value_scaled(self.signal_variance, a, b)
+    }
+    #[inline]
+    fn value_and_cache(&self, a: &[f64], b: &[f64]) -> (f64, f64) {
+        Matern52Ard::value_and_exponential(self.signal_variance, a, b)
+    }
+    #[inline]
+    fn gradient_from_cache(&self, a: &[f64], b: &[f64], cache: f64, gradient: &mut [f64]) {
+        Matern52Ard::gradient_from_exponential(self.signal_variance, a, b, cache, gradient);
+    }
+}
+
+/// Runs `$body` with `$k` bound to the concrete [`PairKernel`] inside `$evaluator`, so that the
+/// loops in `$body` are compiled once per kernel with no dispatch per pair.
+macro_rules! with_pair_kernel {
+    ($evaluator:expr, $k:ident => $body:expr) => {
+        match $evaluator {
+            $crate::kernel::Evaluator::Quadratic($k) => $body,
+            $crate::kernel::Evaluator::SquaredExponential($k) => $body,
+            $crate::kernel::Evaluator::Matern52($k) => $body,
+        }
+    };
+}
+pub(crate) use with_pair_kernel;
 
 impl Evaluator {
     /// `k(a, b)` without noise.
     #[inline]
     pub(crate) fn value(&self, a: &[f64], b: &[f64]) -> f64 {
-        match self {
-            Self::Quadratic(k) => k.value(a, b),
-            Self::SquaredExponential { signal_variance } => SquaredExponentialArd::value_scaled(*signal_variance, a, b),
-            Self::Matern52 { signal_variance } => Matern52Ard::value_scaled(*signal_variance, a, b),
-        }
+        with_pair_kernel!(self, k => k.value(a, b))
     }
 
     /// `k(a, b)` without noise and its gradient in the kernel's log-parameters (noise excluded).
     #[inline]
     pub(crate) fn value_and_gradient(&self, a: &[f64], b: &[f64], gradient: &mut [f64]) -> f64 {
-        match self {
-            Self::Quadratic(k) => k.value_and_gradient(a, b, gradient),
-            Self::SquaredExponential { signal_variance } => {
-                SquaredExponentialArd::value_and_gradient_scaled(*signal_variance, a, b, gradient)
-            }
-            Self::Matern52 { signal_variance } => {
-                Matern52Ard::value_and_gradient_scaled(*signal_variance, a, b, gradient)
-            }
-        }
+        with_pair_kernel!(self, k => {
+            let (value, cache) = k.value_and_cache(a, b);
+            k.gradient_from_cache(a, b, cache, gradient);
+            value
+        })
     }
 }
 

@@ -40,19 +40,23 @@ impl QuadraticKernel {
         self.theta0 * (-0.5 * self.theta1 * r2).exp() + self.theta2 + self.theta3 * dot
     }
 
-    /// `k(a, b)` and its derivatives with respect to `ln θ0 … ln θ3`, written into `gradient[..4]`.
-    ///
-    /// `∂k/∂ln θ = θ ∂k/∂θ`: `θ0 e`, `−θ0 e θ1 r²/2`, `θ2`, `θ3 xᵀx'` with `e = exp(−θ1 r²/2)`.
+    /// `k(a, b)` without noise and its exponential part `θ0 exp(−θ1 r²/2)`.
     #[inline]
-    pub(crate) fn value_and_gradient(&self, a: &[f64], b: &[f64], gradient: &mut [f64]) -> f64 {
+    pub(crate) fn value_and_exponential(&self, a: &[f64], b: &[f64]) -> (f64, f64) {
         let (r2, dot) = squared_distance_and_dot(a, b);
         let exponential = self.theta0 * (-0.5 * self.theta1 * r2).exp();
-        let linear = self.theta3 * dot;
+        (exponential + self.theta2 + self.theta3 * dot, exponential)
+    }
+
+    /// Derivatives with respect to `ln θ0 … ln θ3` into `gradient[..4]`, given the exponential part
+    /// `E = θ0 exp(−θ1 r²/2)`: `∂k/∂ln θ = θ ∂k/∂θ` gives `E`, `−E θ1 r²/2`, `θ2`, `θ3 xᵀx'`.
+    #[inline]
+    pub(crate) fn gradient_from_exponential(&self, a: &[f64], b: &[f64], exponential: f64, gradient: &mut [f64]) {
+        let (r2, dot) = squared_distance_and_dot(a, b);
         gradient[0] = exponential;
         gradient[1] = -0.5 * exponential * self.theta1 * r2;
         gradient[2] = self.theta2;
-        gradient[3] = linear;
-        exponential + self.theta2 + linear
+        gradient[3] = self.theta3 * dot;
     }
 
     /// Natural-scale parameters in log-parameter order (noise last).

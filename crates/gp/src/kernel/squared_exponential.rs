@@ -28,17 +28,14 @@ impl SquaredExponentialArd {
         signal_variance * (-0.5 * super::squared_distance(a, b)).exp()
     }
 
-    /// `k` and its derivatives on inputs already divided by their length scales.
-    ///
+    /// Derivatives from the value `k` on inputs already divided by their length scales:
     /// `∂k/∂ln σf² = k` and `∂k/∂ln ℓᵢ = k (Δᵢ/ℓᵢ)²` (R&W Eq. 5.2 differentiated).
     #[inline]
-    pub(crate) fn value_and_gradient_scaled(signal_variance: f64, a: &[f64], b: &[f64], gradient: &mut [f64]) -> f64 {
-        let k = Self::value_scaled(signal_variance, a, b);
+    pub(crate) fn gradient_from_value(k: f64, a: &[f64], b: &[f64], gradient: &mut [f64]) {
         gradient[0] = k;
         for ((g, x), y) in gradient[1..].iter_mut().zip(a).zip(b) {
             let d = x - y;
             *g = k * d * d;
         }
-        k
     }
 }
