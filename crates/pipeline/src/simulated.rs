@@ -1,0 +1,248 @@
+//! Simulated tracker campaigns, shared by `calib simulate` and the experiments of `cargo xtask`:
+//! a "true" robot made by perturbing the nominal one, a tracker placed in the cell, and the
+//! samples of [`loadsim::generate`] as a [`MeasurementSet`].
+//!
+//! The loadsim types a caller needs to configure a campaign are re-exported here, so that the
+//! `calib` binary depends on this crate alone.
+
+use crate::ron_position::{field_position, ron_options};
+use crate::{Error, Measurement, MeasurementSet, RobotDescription};
+use lie::{SE3, SO3, Twist, Vector3};
+use poe::LocalPoe;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use ron::Value;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+pub use loadsim::{Effects, GeneratorConfig, JointCompliance, JointRange, Sample, SimulatedCell, TrackerNoise};
+
+/// How far the true robot is from its nominal model: every constant transform of the local POE
+/// model (one per joint, and the tool) is moved by `exp(ξ̂)` with each component of `ξ = (v, ω)`
+/// uniform in ±`translation_m`, ±`rotation_rad`; the tool sits `tool_m` out along the flange's z.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Perturbation {
+    /// Largest offset of each translation component, m.
+    pub translation_m: f64,
+    /// Largest offset of each rotation-vector component, rad.
+    pub rotation_rad: f64,
+    /// Nominal tool length along the flange's z axis, m.
+    pub tool_m: f64,
+}
+
+impl Default for Perturbation {
+    /// 1 mm and 1 mrad per component, a 0.2 m tool. Machining and assembly tolerances of a
+    /// 1-tonne arm's castings leave link lengths and axis alignments off by tenths of a millimetre
+    /// to a millimetre and by tenths of a milliradian to a milliradian; an uncalibrated arm of this
+    /// size then misses by one to a few millimetres, the range tracker studies report before
+    /// calibration (e.g. Nubiola & Bonev 2013, ABB IRB 1600: 0.97 mm mean, 2.2 mm max).
+    fn default() -> Self {
+        Self { translation_m: 1e-3, rotation_rad: 1e-3, tool_m: 0.2 }
+    }
+}
+
+/// A random twist with translation and rotation components uniform in ±`translation`, ±`rotation`.
+pub fn random_twist<R: Rng + ?Sized>(rng: &mut R, translation: f64, rotation: f64) -> Twist {
+    let mut v = || Vector3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+    let (a, b) = (v(), v());
+    Twist::new(a * translation, b * rotation)
+}
+
+/// The nominal arm of `robot` perturbed as `perturbation` says: joints in order, then the tool.
+pub fn perturbed_robot<R: Rng + ?Sized>(
+    robot: &RobotDescription,
+    perturbation: &Perturbation,
+    rng: &mut R,
+) -> Result<LocalPoe, Error> {
+    let Perturbation { translation_m, rotation_rad, tool_m } = *perturbation;
+    let mut model = robot.nominal_model()?;
+    for joint in model.joints_mut() {
+        joint.previous_from_joint_zero =
+            random_twist(rng, translation_m, rotation_rad).exp() * joint.previous_from_joint_zero;
+    }
+    let tool = model.tools()[0] * SE3::from_translation(Vector3::new(0.0, 0.0, tool_m));
+    model.set_tools(vec![random_twist(rng, translation_m, rotation_rad).exp() * tool]);
+    Ok(model)
+}
+
+/// `tracker_from_base` for a tracker 3–5 m from the base on a random bearing, within ±0.5 m of
+/// the base's height, turned about the vertical and levelled (as a tracker stands on its tripod).
+pub fn tracker_placement<R: Rng + ?Sized>(rng: &mut R) -> SE3 {
+    let distance = rng.random_range(3.0..5.0);
+    let bearing: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+    let turn = SO3::exp(&Vector3::new(0.0, 0.0, rng.random_range(-3.1..3.1)));
+    let tracker_in_base = Vector3::new(distance * bearing.cos(), distance * bearing.sin(), rng.random_range(-0.5..0.5));
+    SE3::new(turn, tracker_in_base).inverse()
+}
+
+/// A cell for `robot` drawn from `seed`: the perturbed arm (with the robot file's masses and
+/// stiffness), then the tracker placement, from one ChaCha8 stream.
+pub fn simulated_cell(
+    robot: &RobotDescription,
+    perturbation: &Perturbation,
+    seed: u64,
+) -> Result<SimulatedCell, Error> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let geometry = perturbed_robot(robot, perturbation, &mut rng)?;
+    let mut cell = SimulatedCell::new(geometry, robot.dynamics.clone());
+    cell.tracker_from_base = tracker_placement(&mut rng);
+    Ok(cell)
+}
+
+/// The robot's joint ranges as the generator takes them.
+pub fn joint_ranges(robot: &RobotDescription) -> Vec<JointRange> {
+    robot.limits().into_iter().map(|(lower_rad, upper_rad)| JointRange { lower_rad, upper_rad }).collect()
+}
+
+/// The effects of the paper's simulation (Section IV-A): the load model of its ref. \[15\] (joint
+/// compliance under the arm's weight and the payload) and tracker noise (Leica AT901 with T-Mac).
+pub fn paper_effects() -> Effects {
+    Effects {
+        compliance: Some(JointCompliance::default()),
+        tracker_noise: Some(TrackerNoise::default()),
+        ..Effects::default()
+    }
+}
+
+/// Simulated samples as a measurement set named `source` (lines numbered as in a CSV written
+/// from it; position only unless `full_pose`).
+pub fn measurement_set(source: &str, samples: Vec<Sample>, full_pose: bool) -> MeasurementSet {
+    let rows = samples
+        .into_iter()
+        .enumerate()
+        .map(|(i, s)| Measurement {
+            line: i as u64 + 2,
+            q: s.q,
+            position: s.tracker_from_tool.translation(),
+            orientation: full_pose.then(|| s.tracker_from_tool.rotation()),
+            payload_kg: s.payload_kg,
+            tool: 0,
+            temp_c: Some(s.temp_c),
+            t_s: Some(s.t_s),
+            torques_nm: None,
+        })
+        .collect();
+    MeasurementSet::from_rows(source, rows, vec![])
+}
+
+/// A simulated dataset: [`loadsim::generate`] then [`measurement_set`].
+pub fn simulate(
+    cell: &SimulatedCell,
+    effects: &Effects,
+    ranges: &[JointRange],
+    config: &GeneratorConfig,
+    full_pose: bool,
+) -> Result<MeasurementSet, Error> {
+    let samples = loadsim::generate(cell, effects, ranges, config)?;
+    Ok(measurement_set("simulated", samples, full_pose))
+}
+
+/// Reads an [`Effects`] RON file (fields left out are off; `Some(..)` may be omitted).
+pub fn read_effects(path: &Path) -> Result<Effects, Error> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+    parse_effects(&text, &file)
+}
+
+/// Parses an [`Effects`] RON text; `file` names it in errors. A field name that no effect has is
+/// refused at its line: serde would skip it, and a misspelt effect would silently stay off.
+pub fn parse_effects(text: &str, file: &str) -> Result<Effects, Error> {
+    let at =
+        |line: usize, column: usize, message: String| Error::RonFormat { file: file.to_owned(), line, column, message };
+    let syntax = |e: ron::error::SpannedError| at(e.span.start.line, e.span.start.col, e.code.to_string());
+    let effects: Effects = ron_options().from_str(text).map_err(syntax)?;
+    let given: Value = ron_options().from_str(text).map_err(syntax)?;
+    // The parsed effects written back hold every field they know, switched on or not.
+    let known = ron::to_string(&effects)
+        .ok()
+        .and_then(|written| ron::from_str::<Value>(&written).ok())
+        .ok_or_else(|| at(1, 1, "the effects do not write back as RON".into()))?;
+    match unknown_field(&given, &known) {
+        Some(name) => {
+            let (line, column) = field_position(text, &name, 0);
+            Err(at(line, column, format!("unknown field `{name}`")))
+        }
+        None => Ok(effects),
+    }
+}
+
+/// The first field name in `given` that `known` lacks, at any depth.
+fn unknown_field(given: &Value, known: &Value) -> Option<String> {
+    fn unwrap(value: &Value) -> &Value {
+        match value {
+            Value::Option(Some(inner)) => unwrap(inner),
+            other => other,
+        }
+    }
+    match (unwrap(given), unwrap(known)) {
+        (Value::Map(given), Value::Map(known)) => given.iter().find_map(|(key, value)| match known.get(key) {
+            Some(inner) => unknown_field(value, inner),
+            None => Some(match key {
+                Value::String(name) => name.clone(),
+                other => format!("{other:?}"),
+            }),
+        }),
+        (Value::Seq(given), Value::Seq(known)) => given.iter().zip(known).find_map(|(a, b)| unknown_field(a, b)),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn irb4400() -> RobotDescription {
+        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron");
+        RobotDescription::read(&path).unwrap()
+    }
+
+    #[test]
+    fn a_seeded_cell_is_reproducible_and_off_nominal_by_the_perturbation() {
+        let robot = irb4400();
+        let perturbation = Perturbation::default();
+        let a = simulated_cell(&robot, &perturbation, 7).unwrap();
+        assert_eq!(a, simulated_cell(&robot, &perturbation, 7).unwrap());
+        assert_ne!(a, simulated_cell(&robot, &perturbation, 8).unwrap());
+        let nominal = robot.nominal_model().unwrap();
+        for (true_joint, nominal_joint) in a.robot.joints().iter().zip(nominal.joints()) {
+            let offset = (true_joint.previous_from_joint_zero * nominal_joint.previous_from_joint_zero.inverse()).log();
+            let v = offset.to_vector();
+            assert!(v.iter().all(|c| c.abs() <= 1.8e-3), "{v:?}");
+        }
+        let distance = a.tracker_from_base.inverse().translation().norm();
+        assert!((3.0..5.1).contains(&distance), "{distance}");
+    }
+
+    #[test]
+    fn simulated_rows_carry_payload_and_orientation_only_for_full_pose() {
+        let robot = irb4400();
+        let cell = simulated_cell(&robot, &Perturbation::default(), 1).unwrap();
+        let config = GeneratorConfig { sample_count: 5, ..GeneratorConfig::default() };
+        for full_pose in [false, true] {
+            let set = simulate(&cell, &paper_effects(), &joint_ranges(&robot), &config, full_pose).unwrap();
+            assert_eq!(set.rows.len(), 5);
+            assert_eq!(set.full_pose, full_pose);
+            assert!(set.rows.iter().all(|r| config.payloads_kg.contains(&r.payload_kg)));
+        }
+    }
+
+    #[test]
+    fn an_effects_file_with_a_typo_is_refused_at_its_line() {
+        let good = parse_effects("(compliance: (payload_only: true), tracker_noise: ())", "e.ron").unwrap();
+        assert_eq!(good.compliance, Some(JointCompliance { payload_only: true, ..JointCompliance::default() }));
+        assert_eq!(good.tracker_noise, Some(TrackerNoise::default()));
+        for (text, line) in [
+            ("(\n  complaince: (),\n)", 2),
+            ("(\n  compliance: (),\n  tracker_noise: (\n    radial_sigma: 1e-5),\n)", 4),
+            ("(\n  compliance: (payload_only: maybe),\n)", 2),
+        ] {
+            match parse_effects(text, "e.ron") {
+                Err(Error::RonFormat { file, line: at, .. }) => {
+                    assert_eq!((file.as_str(), at), ("e.ron", line), "{text}")
+                }
+                other => panic!("{text}: {other:?}"),
+            }
+        }
+    }
+}
