@@ -68,9 +68,10 @@ pub(crate) fn evaluate(
     let (evaluator, prepared) = kernel.prepare(x);
     let noise = kernel.noise_variance();
     let (k, cache) = if with_gradient {
-        training_covariance_with_cache(&evaluator, &prepared, noise, parallelism)
+        let (k, cache) = training_covariance_with_cache(&evaluator, &prepared, noise, parallelism);
+        (k, Some(cache))
     } else {
-        (training_covariance(&evaluator, &prepared, noise, parallelism), Mat::zeros(0, 0))
+        (training_covariance(&evaluator, &prepared, noise, parallelism), None)
     };
     let factor = factor_in_place(k, par).map(Factor::from_lower).map_err(|pivot| Error::CholeskyFailed {
         size: n,
@@ -83,7 +84,7 @@ pub(crate) fn evaluate(
     let value = -0.5 * data_fit
         - 0.5 * m as f64 * factor.log_determinant()
         - 0.5 * (n * m) as f64 * (2.0 * std::f64::consts::PI).ln();
-    let gradient = if with_gradient {
+    let gradient = if let Some(cache) = cache {
         let mut w: Mat<f64> = factor.inverse_lower(par);
         let scale = -(m as f64);
         for j in 0..n {
@@ -93,15 +94,7 @@ pub(crate) fn evaluate(
         }
         // W = A Aᵀ − m K⁻¹; only the lower triangle is read by the contraction.
         matmul(w.as_mut(), Accum::Add, alpha.as_ref(), alpha.transpose(), 1.0, par);
-        contract_gradient(
-            &evaluator,
-            &prepared,
-            w.as_ref(),
-            cache.as_ref(),
-            noise,
-            kernel.parameter_count() - 1,
-            parallelism,
-        )
+        contract_gradient(&evaluator, &prepared, w.as_ref(), &cache, noise, kernel.parameter_count() - 1, parallelism)
     } else {
         Vec::new()
     };

@@ -271,63 +271,75 @@ pub(crate) struct Matern52Scaled {
     pub(crate) signal_variance: f64,
 }
 
-/// One covariance function on prepared inputs, monomorphised into the Gram-matrix loops.
+/// One covariance function on prepared inputs, as a function of the pair's squared distance `r²`
+/// and inner product `xᵀx'` (both come from one matrix product, see `gram`), monomorphised into
+/// the Gram-matrix loops.
 ///
-/// The likelihood gradient needs, for every pair, the kernel's gradient; `value_and_cache` returns
-/// with the value the one number (the exponential factor) that makes the gradient cheap, so the
-/// contraction pass does no `exp` of its own.
+/// The likelihood gradient needs every pair's kernel gradient; `value_and_cache` returns with the
+/// value the one number (the exponential factor) that makes the gradient free of `exp`.
 pub(crate) trait PairKernel: Sync {
-    /// `k(a, b)` without noise.
-    fn value(&self, a: &[f64], b: &[f64]) -> f64;
-    /// `k(a, b)` and the cached factor for [`PairKernel::gradient_from_cache`].
-    fn value_and_cache(&self, a: &[f64], b: &[f64]) -> (f64, f64);
-    /// `∂k/∂ln p` for every kernel log-parameter (noise excluded), from the cached factor.
-    fn gradient_from_cache(&self, a: &[f64], b: &[f64], cache: f64, gradient: &mut [f64]);
+    /// Log-parameters differentiated pair by pair (first in the log-parameter order); any further
+    /// ones, up to the noise, are ARD length scales.
+    const SCALARS: usize;
+    /// `k` without noise.
+    fn value(&self, r2: f64, dot: f64) -> f64;
+    /// `k` without noise and the cached factor for [`PairKernel::gradient_from_cache`].
+    fn value_and_cache(&self, r2: f64, dot: f64) -> (f64, f64);
+    /// `∂k/∂ln p` for the first [`PairKernel::SCALARS`] log-parameters, written to `scalars`; returns
+    /// the length-scale weight `m` with `∂k/∂ln ℓᵢ = m (Δᵢ/ℓᵢ)²` (0 without length scales).
+    fn gradient_from_cache(&self, r2: f64, dot: f64, cache: f64, scalars: &mut [f64]) -> f64;
 }
 
 impl PairKernel for QuadraticKernel {
+    const SCALARS: usize = quadratic::PARAMETERS;
     #[inline]
-    fn value(&self, a: &[f64], b: &[f64]) -> f64 {
-        QuadraticKernel::value(self, a, b)
+    fn value(&self, r2: f64, dot: f64) -> f64 {
+        self.value_from(r2, dot)
     }
     #[inline]
-    fn value_and_cache(&self, a: &[f64], b: &[f64]) -> (f64, f64) {
-        self.value_and_exponential(a, b)
+    fn value_and_cache(&self, r2: f64, dot: f64) -> (f64, f64) {
+        self.value_and_exponential(r2, dot)
     }
     #[inline]
-    fn gradient_from_cache(&self, a: &[f64], b: &[f64], cache: f64, gradient: &mut [f64]) {
-        self.gradient_from_exponential(a, b, cache, gradient);
+    fn gradient_from_cache(&self, r2: f64, dot: f64, cache: f64, scalars: &mut [f64]) -> f64 {
+        self.gradient_from_exponential(r2, dot, cache, scalars);
+        0.0
     }
 }
 
 impl PairKernel for SquaredExponentialScaled {
+    const SCALARS: usize = 1;
     #[inline]
-    fn value(&self, a: &[f64], b: &[f64]) -> f64 {
-        SquaredExponentialArd::value_scaled(self.signal_variance, a, b)
+    fn value(&self, r2: f64, _dot: f64) -> f64 {
+        SquaredExponentialArd::value_scaled(self.signal_variance, r2)
     }
     #[inline]
-    fn value_and_cache(&self, a: &[f64], b: &[f64]) -> (f64, f64) {
-        let k = self.value(a, b);
+    fn value_and_cache(&self, r2: f64, dot: f64) -> (f64, f64) {
+        let k = self.value(r2, dot);
         (k, k)
     }
     #[inline]
-    fn gradient_from_cache(&self, a: &[f64], b: &[f64], cache: f64, gradient: &mut [f64]) {
-        SquaredExponentialArd::gradient_from_value(cache, a, b, gradient);
+    fn gradient_from_cache(&self, _r2: f64, _dot: f64, cache: f64, scalars: &mut [f64]) -> f64 {
+        scalars[0] = cache;
+        cache
     }
 }
 
 impl PairKernel for Matern52Scaled {
+    const SCALARS: usize = 1;
     #[inline]
-    fn value(&self, a: &[f64], b: &[f64]) -> f64 {
-        Matern52Ard::value_scaled(self.signal_variance, a, b)
+    fn value(&self, r2: f64, _dot: f64) -> f64 {
+        Matern52Ard::value_and_exponential(self.signal_variance, r2).0
     }
     #[inline]
-    fn value_and_cache(&self, a: &[f64], b: &[f64]) -> (f64, f64) {
-        Matern52Ard::value_and_exponential(self.signal_variance, a, b)
+    fn value_and_cache(&self, r2: f64, _dot: f64) -> (f64, f64) {
+        Matern52Ard::value_and_exponential(self.signal_variance, r2)
     }
     #[inline]
-    fn gradient_from_cache(&self, a: &[f64], b: &[f64], cache: f64, gradient: &mut [f64]) {
-        Matern52Ard::gradient_from_exponential(self.signal_variance, a, b, cache, gradient);
+    fn gradient_from_cache(&self, r2: f64, _dot: f64, cache: f64, scalars: &mut [f64]) -> f64 {
+        let (k, weight) = Matern52Ard::value_and_weight(self.signal_variance, r2, cache);
+        scalars[0] = k;
+        weight
     }
 }
 
@@ -344,21 +356,41 @@ macro_rules! with_pair_kernel {
 }
 pub(crate) use with_pair_kernel;
 
+/// `‖a − b‖²` and `aᵀb`.
+#[inline]
+fn distance_and_dot(a: &[f64], b: &[f64]) -> (f64, f64) {
+    a.iter().zip(b).fold((0.0, 0.0), |(r2, dot), (x, y)| (r2 + (x - y) * (x - y), dot + x * y))
+}
+
 impl Evaluator {
-    /// `k(a, b)` without noise.
+    /// `k(a, b)` without noise, on prepared points.
     #[inline]
     pub(crate) fn value(&self, a: &[f64], b: &[f64]) -> f64 {
-        with_pair_kernel!(self, k => k.value(a, b))
+        let (r2, dot) = distance_and_dot(a, b);
+        with_pair_kernel!(self, k => k.value(r2, dot))
     }
 
-    /// `k(a, b)` without noise and its gradient in the kernel's log-parameters (noise excluded).
-    #[inline]
+    /// `k(a, b)` without noise and its gradient in the kernel's log-parameters (noise excluded),
+    /// on prepared points.
     pub(crate) fn value_and_gradient(&self, a: &[f64], b: &[f64], gradient: &mut [f64]) -> f64 {
+        let (r2, dot) = distance_and_dot(a, b);
         with_pair_kernel!(self, k => {
-            let (value, cache) = k.value_and_cache(a, b);
-            k.gradient_from_cache(a, b, cache, gradient);
+            let (value, cache) = k.value_and_cache(r2, dot);
+            let scalars = k.gradient_from_cache(r2, dot, cache, gradient);
+            fill_length_scale_gradient(scalars, a, b, gradient, k_scalars(k));
             value
         })
+    }
+}
+
+fn k_scalars<K: PairKernel>(_: &K) -> usize {
+    K::SCALARS
+}
+
+/// `∂k/∂ln ℓᵢ = m (Δᵢ/ℓᵢ)²` into `gradient[scalars..]` (prepared points are already divided by ℓ).
+fn fill_length_scale_gradient(m: f64, a: &[f64], b: &[f64], gradient: &mut [f64], scalars: usize) {
+    for ((g, x), y) in gradient[scalars..].iter_mut().zip(a).zip(b) {
+        *g = m * (x - y) * (x - y);
     }
 }
 

@@ -33,26 +33,23 @@ impl Default for QuadraticKernel {
 pub(crate) const PARAMETERS: usize = 4;
 
 impl QuadraticKernel {
-    /// `k(a, b)` without noise (Eq. 5).
+    /// `k` without noise (Eq. 5) from `r² = ‖x − x'‖²` and `xᵀx'`.
     #[inline]
-    pub(crate) fn value(&self, a: &[f64], b: &[f64]) -> f64 {
-        let (r2, dot) = squared_distance_and_dot(a, b);
+    pub(crate) fn value_from(&self, r2: f64, dot: f64) -> f64 {
         self.theta0 * (-0.5 * self.theta1 * r2).exp() + self.theta2 + self.theta3 * dot
     }
 
-    /// `k(a, b)` without noise and its exponential part `θ0 exp(−θ1 r²/2)`.
+    /// `k` without noise and its exponential part `E = θ0 exp(−θ1 r²/2)`.
     #[inline]
-    pub(crate) fn value_and_exponential(&self, a: &[f64], b: &[f64]) -> (f64, f64) {
-        let (r2, dot) = squared_distance_and_dot(a, b);
+    pub(crate) fn value_and_exponential(&self, r2: f64, dot: f64) -> (f64, f64) {
         let exponential = self.theta0 * (-0.5 * self.theta1 * r2).exp();
         (exponential + self.theta2 + self.theta3 * dot, exponential)
     }
 
-    /// Derivatives with respect to `ln θ0 … ln θ3` into `gradient[..4]`, given the exponential part
-    /// `E = θ0 exp(−θ1 r²/2)`: `∂k/∂ln θ = θ ∂k/∂θ` gives `E`, `−E θ1 r²/2`, `θ2`, `θ3 xᵀx'`.
+    /// Derivatives with respect to `ln θ0 … ln θ3` into `gradient[..4]`, given `E`:
+    /// `∂k/∂ln θ = θ ∂k/∂θ` gives `E`, `−E θ1 r²/2`, `θ2`, `θ3 xᵀx'`.
     #[inline]
-    pub(crate) fn gradient_from_exponential(&self, a: &[f64], b: &[f64], exponential: f64, gradient: &mut [f64]) {
-        let (r2, dot) = squared_distance_and_dot(a, b);
+    pub(crate) fn gradient_from_exponential(&self, r2: f64, dot: f64, exponential: f64, gradient: &mut [f64]) {
         gradient[0] = exponential;
         gradient[1] = -0.5 * exponential * self.theta1 * r2;
         gradient[2] = self.theta2;
@@ -75,16 +72,4 @@ impl QuadraticKernel {
         // the noise may go down to 1e-9 so that nearly noiseless data can be interpolated.
         ([1e-3, 1e-4, 1e-6, 1e-6, 1e-9], [1e2, 1e2, 1e2, 1e2, 1e1])
     }
-}
-
-#[inline]
-fn squared_distance_and_dot(a: &[f64], b: &[f64]) -> (f64, f64) {
-    let mut r2 = 0.0;
-    let mut dot = 0.0;
-    for (x, y) in a.iter().zip(b) {
-        let d = x - y;
-        r2 += d * d;
-        dot += x * y;
-    }
-    (r2, dot)
 }

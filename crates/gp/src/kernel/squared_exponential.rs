@@ -22,20 +22,11 @@ impl SquaredExponentialArd {
         Self { signal_variance: 1.0, length_scales: vec![1.0; dim], noise_variance: 0.01 }
     }
 
-    /// `k` on inputs already divided by their length scales: `σf² exp(−r²/2)`.
+    /// `σf² exp(−r²/2)` with `r²` the squared distance of inputs already divided by their
+    /// length scales (R&W Eq. 5.2). Its derivatives: `∂k/∂ln σf² = k` and
+    /// `∂k/∂ln ℓᵢ = k (Δᵢ/ℓᵢ)²`, i.e. the length-scale weight is `k` itself.
     #[inline]
-    pub(crate) fn value_scaled(signal_variance: f64, a: &[f64], b: &[f64]) -> f64 {
-        signal_variance * (-0.5 * super::squared_distance(a, b)).exp()
-    }
-
-    /// Derivatives from the value `k` on inputs already divided by their length scales:
-    /// `∂k/∂ln σf² = k` and `∂k/∂ln ℓᵢ = k (Δᵢ/ℓᵢ)²` (R&W Eq. 5.2 differentiated).
-    #[inline]
-    pub(crate) fn gradient_from_value(k: f64, a: &[f64], b: &[f64], gradient: &mut [f64]) {
-        gradient[0] = k;
-        for ((g, x), y) in gradient[1..].iter_mut().zip(a).zip(b) {
-            let d = x - y;
-            *g = k * d * d;
-        }
+    pub(crate) fn value_scaled(signal_variance: f64, r2: f64) -> f64 {
+        signal_variance * (-0.5 * r2).exp()
     }
 }
