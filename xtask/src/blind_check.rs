@@ -168,7 +168,8 @@ fn run_case(robot: &RobotDescription, index: usize, seed: u64, rows: usize) -> R
         let mut positions = data.clone();
         positions.full_pose = false;
         positions.rows.iter_mut().for_each(|r| r.orientation = None);
-        let (_, report) = pipeline::fit(robot, &positions, Method::Poe, &FitOptions::default()).map_err(|e| e.to_string())?;
+        let (_, report) =
+            pipeline::fit(robot, &positions, Method::Poe, &FitOptions::default()).map_err(|e| e.to_string())?;
         Ok(report.after.mean_position_error_mm)
     };
     let mut effects = Effects::default();
@@ -177,22 +178,14 @@ fn run_case(robot: &RobotDescription, index: usize, seed: u64, rows: usize) -> R
         // Scale the reference effect so that what a geometric fit leaves of it is the target.
         let (reference, dynamics) = effect_at(robot, truth, &joints, harmonic, phase, 1.0);
         cell.dynamics = dynamics;
-        let clean = simulate(&cell, &reference, &ranges, &config, full_pose)?;
-        let (_, report) =
-            pipeline::fit(robot, &clean, Method::Poe, &FitOptions::default()).map_err(|e| e.to_string())?;
-        let left = report.after.mean_position_error_mm;
+        let left = left_after_fit(&simulate(&cell, &reference, &ranges, &config, false)?)?;
         if left <= 0.0 {
             return Err(format!("case {index}: {truth:?} leaves nothing after a geometric fit"));
         }
         let scale = target_mm / left;
         let (scaled, dynamics) = effect_at(robot, truth, &joints, harmonic, phase, scale);
         cell.dynamics = dynamics;
-        let check = simulate(&cell, &scaled, &ranges, &config, full_pose)?;
-        magnitude_mm = pipeline::fit(robot, &check, Method::Poe, &FitOptions::default())
-            .map_err(|e| e.to_string())?
-            .1
-            .after
-            .mean_position_error_mm;
+        magnitude_mm = left_after_fit(&simulate(&cell, &scaled, &ranges, &config, false)?)?;
         effects = scaled;
     }
     let data = simulate(&cell, &with_noise(&effects), &ranges, &config, full_pose)?;

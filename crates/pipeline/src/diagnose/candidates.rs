@@ -89,6 +89,53 @@ fn sign(x: f64) -> f64 {
     }
 }
 
+/// The side of the backlash band each pose is on, learnt from the data: the sign of the joint's
+/// torque `τ = Y(q) π` with `π` unknown. It starts from the joint's fitted compliance deflection
+/// (proportional to the torque), then alternates: given the signs, fit the band and flip every pose
+/// whose residual the other side explains better; given the flipped signs, refit `π` by least
+/// squares on them (a linear classifier over the torque regressors), so that the sign stays a
+/// function of the torque and does not merely follow the noise.
+fn learnt_torque_sign(
+    design: &Design,
+    scalars: &[Vec<f64>],
+    compliance_columns: &[Vec<f64>],
+    column_of: &dyn Fn(&[f64]) -> Vec<f64>,
+) -> Vec<f64> {
+    let poses = design.poses();
+    let k = design.rows_per_pose;
+    let torque = |theta: &[f64]| -> Vec<f64> {
+        (0..poses).map(|i| scalars.iter().zip(theta).map(|(s, t)| s[i] * t).sum()).collect()
+    };
+    let mut signs: Vec<f64> = torque(&design.fit_all(compliance_columns)).into_iter().map(sign).collect();
+    for _ in 0..5 {
+        let column = column_of(&signs);
+        let (band, residual) = design.fit_all_residual(std::slice::from_ref(&column));
+        let b = band[0];
+        let flipped: Vec<f64> = (0..poses)
+            .map(|i| {
+                let rows = i * k..(i + 1) * k;
+                let now: f64 = residual[rows.clone()].iter().map(|r| r * r).sum();
+                // Flipping the side moves the prediction by −2 b s_i c_i.
+                let other: f64 = rows.map(|row| (residual[row] + 2.0 * b * column[row]).powi(2)).sum();
+                if other < now { -signs[i] } else { signs[i] }
+            })
+            .collect();
+        let y = nalgebra::DMatrix::from_fn(poses, scalars.len(), |i, l| scalars[l][i]);
+        let norms: Vec<f64> = (0..scalars.len()).map(|l| y.column(l).norm().max(f64::MIN_POSITIVE)).collect();
+        let scaled = nalgebra::DMatrix::from_fn(poses, scalars.len(), |i, l| y[(i, l)] / norms[l]);
+        let Ok(pi) = scaled.svd(true, true).solve(&nalgebra::DVector::from_vec(flipped), 1e-10) else {
+            break;
+        };
+        let pi: Vec<f64> = pi.iter().zip(&norms).map(|(p, n)| p / n).collect();
+        let next: Vec<f64> = torque(&pi).into_iter().map(sign).collect();
+        if next == signs {
+            break;
+        }
+        signs = next;
+    }
+    signs
+}
+
 /// Which candidates to build.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -167,10 +214,8 @@ pub(crate) fn build_candidates(
             });
         }
         if !columns.is_empty() {
-            let theta = design.fit_all(&columns);
-            let deflection: Vec<f64> =
-                (0..poses).map(|i| scalars.iter().zip(&theta).map(|(s, t)| s[i] * t).sum()).collect();
-            let learnt = joint_column(j, &|i| sign(deflection[i]));
+            let signs = learnt_torque_sign(design, &scalars, &columns, &|s: &[f64]| joint_column(j, &|i| s[i]));
+            let learnt = joint_column(j, &|i| signs[i]);
             if nonzero(&learnt) {
                 candidates.push(Candidate {
                     effect: Effect::Backlash,

@@ -97,6 +97,17 @@ impl Design {
         (0..extra.len()).map(|l| beta[kinematic_columns + l] * scale[kinematic_columns + l]).collect()
     }
 
+    /// [`Design::fit_all`] with the weighted residual rows it leaves.
+    pub(crate) fn fit_all_residual(&self, extra: &[Vec<f64>]) -> (Vec<f64>, Vec<f64>) {
+        let (beta, scale) = self.solve(extra, &(0..self.poses()).collect::<Vec<_>>());
+        let columns = beta.len();
+        let residual = (0..self.y.len())
+            .map(|row| self.y[row] - (0..columns).map(|c| self.value(extra, row, c) * scale[c] * beta[c]).sum::<f64>())
+            .collect();
+        let kinematic_columns = self.kinematic.ncols();
+        ((0..extra.len()).map(|l| beta[kinematic_columns + l] * scale[kinematic_columns + l]).collect(), residual)
+    }
+
     fn value(&self, extra: &[Vec<f64>], row: usize, c: usize) -> f64 {
         let kinematic_columns = self.kinematic.ncols();
         if c < kinematic_columns { self.kinematic[(row, c)] } else { extra[c - kinematic_columns][row] }
