@@ -296,6 +296,8 @@ impl TryFrom<StoredExactGp> for ExactGp {
         }
         let x = Mat::from_fn(n, d, |i, j| s.training_inputs[i].get(j).copied().unwrap_or(f64::NAN));
         let y = Mat::from_fn(n, m, |i, j| s.training_outputs[i].get(j).copied().unwrap_or(f64::NAN));
+        s.inputs.check(d)?;
+        s.outputs.check(m)?;
         let points = validate_training_data(x.as_ref(), y.as_ref())?;
         // Every output must be served by exactly one kernel, or prediction would leave it empty.
         let mut served = vec![0usize; m];

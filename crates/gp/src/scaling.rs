@@ -49,7 +49,27 @@ fn column_moments(n: usize, cols: usize, at: impl Fn(usize, usize) -> f64) -> (V
     (mean, scale)
 }
 
+/// `mean` and `scale` have `len` entries, means finite, scales finite and positive (a stored model
+/// read back from a file is checked with this).
+fn check_map(mean: &[f64], scale: &[f64], len: usize, field: &'static str) -> Result<(), Error> {
+    if mean.len() != len || scale.len() != len {
+        return Err(Error::InvalidConfig { field, value: mean.len().max(scale.len()) as f64 });
+    }
+    if let Some(&bad) = mean.iter().find(|v| !v.is_finite()) {
+        return Err(Error::InvalidConfig { field, value: bad });
+    }
+    if let Some(&bad) = scale.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
+        return Err(Error::InvalidConfig { field, value: bad });
+    }
+    Ok(())
+}
+
 impl InputStandardiser {
+    /// Refuses a map that does not have `dim` finite entries with positive scales.
+    pub(crate) fn check(&self, dim: usize) -> Result<(), Error> {
+        check_map(&self.mean, &self.scale, dim, "inputs")
+    }
+
     /// The identity map for `dim` inputs.
     pub fn identity(dim: usize) -> Self {
         Self { mean: vec![0.0; dim], scale: vec![1.0; dim] }
@@ -82,6 +102,11 @@ impl InputStandardiser {
 }
 
 impl OutputNormaliser {
+    /// Refuses a map that does not have `outputs` finite entries with positive scales.
+    pub(crate) fn check(&self, outputs: usize) -> Result<(), Error> {
+        check_map(&self.mean, &self.scale, outputs, "outputs")
+    }
+
     /// The identity map for `outputs` columns.
     pub fn identity(outputs: usize) -> Self {
         Self { mean: vec![0.0; outputs], scale: vec![1.0; outputs] }

@@ -381,6 +381,8 @@ impl TryFrom<StoredSparseGp> for SparseGp {
         let y = Mat::from_fn(n, m, |i, j| s.training_outputs[i].get(j).copied().unwrap_or(f64::NAN));
         let nu = s.inducing_inputs.len();
         let zm = Mat::from_fn(nu, d, |i, j| s.inducing_inputs[i].get(j).copied().unwrap_or(f64::NAN));
+        s.inputs.check(d)?;
+        s.outputs.check(m)?;
         let points = validate_training_data(x.as_ref(), y.as_ref())?;
         let inducing = Points::from_rows(zm.as_ref())?;
         if nu == 0 || nu > n {

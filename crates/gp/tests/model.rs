@@ -120,6 +120,11 @@ fn a_stored_model_with_an_inconsistent_report_is_refused() {
     let broken = text.replacen("outputs:[0]", "outputs:[3]", 1);
     assert_ne!(broken, text, "the stored form names the outputs of each kernel");
     assert!(ron::from_str::<ExactGp>(&broken).is_err());
+    // A zero input scale would divide by zero at prediction.
+    let start = text.find("scale:[").expect("the stored form has the input scales") + "scale:[".len();
+    let end = start + text[start..].find([',', ']']).expect("a number");
+    let zero_scale = format!("{}0.0{}", &text[..start], &text[end..]);
+    assert!(matches!(ron::from_str::<ExactGp>(&zero_scale), Err(e) if e.to_string().contains("inputs")));
 }
 
 #[test]
