@@ -1,6 +1,7 @@
 //! `cargo xtask`: the paper's experiments and project automation. `main` only dispatches; each
 //! command lives in a file of its own.
 
+mod bench_gp;
 mod blind_check;
 mod convert_ur10;
 mod simulation;
@@ -18,6 +19,8 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Time the gp crate (fit, predict, Cholesky vs peak, sparse vs exact, scikit-learn); print a markdown table.
+    BenchGp(bench_gp::Args),
     /// Convert the IPA UR10 tracker dataset to SPEC measurement CSV.
     ConvertUr10(convert_ur10::Args),
     /// Diagnose simulated datasets with a hidden effect, without the truth; print the confusion matrix.
@@ -27,6 +30,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
+        Command::BenchGp(args) => bench_gp::run(args),
         Command::ConvertUr10(args) => convert_ur10::run(args),
         Command::BlindCheck(args) => blind_check::run(args),
     };
