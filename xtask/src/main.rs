@@ -3,7 +3,11 @@
 
 mod bench_gp;
 mod blind_check;
+mod box_plot;
 mod convert_ur10;
+mod reproduce_sim;
+mod reproduce_sim_params;
+mod reproduce_sim_report;
 mod simulation;
 
 use clap::{Parser, Subcommand};
@@ -19,6 +23,8 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// The paper's simulation study (Fig. 1, Table I): writes docs/results/reproduce-sim.md and its box plot.
+    ReproduceSim(reproduce_sim::Args),
     /// Time the gp crate (fit, predict, Cholesky vs peak, sparse vs exact, scikit-learn); print a markdown table.
     BenchGp(bench_gp::Args),
     /// Convert the IPA UR10 tracker dataset to SPEC measurement CSV.
@@ -30,6 +36,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
+        Command::ReproduceSim(args) => reproduce_sim::run(args),
         Command::BenchGp(args) => bench_gp::run(args),
         Command::ConvertUr10(args) => convert_ur10::run(args),
         Command::BlindCheck(args) => blind_check::run(args),

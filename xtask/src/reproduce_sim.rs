@@ -1,0 +1,338 @@
+//! `cargo xtask reproduce-sim`: the paper's simulation study (Jing et al., Section IV-A, Fig. 1 and
+//! Table I) end to end.
+//!
+//! An ABB IRB 4400 whose every local frame is slightly off its nominal (the "true" robot) carries
+//! payloads of 1, 2.5, 3.5, 5 and 7.5 kg, drawn per pose, and bends under them and its own weight
+//! through its joint compliance (the paper's load model, ref. \[15\]); a Leica-like tracker with a
+//! 6-DOF probe measures the tool. On 300 training poses the four methods are cross-validated over
+//! 10 folds (Fig. 1); then each is fitted on all 300 and tested on three independent sets of 100
+//! poses (Table I). The report and the box plot go to `--out`, the numbers to `--json`.
+
+use crate::box_plot::{BoxGroup, box_plot};
+use crate::reproduce_sim_report::{Magnitudes, Outcome, Params, Seeds, Setup, Sizes, VariantResult, json, markdown};
+use gp::{KernelChoice, OutputMode, Parallelism};
+use indicatif::{ProgressBar, ProgressStyle};
+use loadsim::{Effects, GeneratorConfig, JointCompliance, RobotDynamics, SimulatedCell};
+use pipeline::simulated::{Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
+use pipeline::{CompensationOptions, FitOptions, MeasurementSet, Method, ResidualFrame, RobotDescription};
+use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Reproduce the paper's simulation study (Fig. 1, Table I).
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Fewer poses and folds (for CI; a few seconds).
+    #[arg(long)]
+    quick: bool,
+    /// Also write the results as one JSON object here (SPEC "Experiment output").
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Directory for the markdown report and its box plot [default: docs/results].
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Seed of the whole study (robot, tracker, datasets, folds).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Joint stiffness: the fixture's (physical) or softer joints (paper-like).
+    #[arg(long, value_enum, default_value_t = Preset::Physical)]
+    preset: Preset,
+    /// Robot description with a dynamics block [default: fixtures/robots/irb4400.ron].
+    #[arg(long)]
+    robot: Option<PathBuf>,
+}
+
+/// How stiff the simulated joints are, and what loads them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Preset {
+    /// The robot file's stiffness (engineering estimates of an arm of this class), loaded by the
+    /// arm's own weight, its balancer and the payload.
+    Physical,
+    /// Every joint [`PAPER_LIKE_SOFTENING`] times softer than the robot file's, loaded by the payload
+    /// alone. Not a physical robot: see [`PAPER_LIKE_SOFTENING`].
+    PaperLike,
+}
+
+/// How much softer the paper-like preset makes every joint. The paper's Table I has POE leave
+/// 0.81–0.90 mm and POE+GP 0.62–0.71 mm, which the payload input takes down to 0.23–0.25 mm: the
+/// error left after POE is mostly the payload's, and of the order of a millimetre. With the
+/// fixture's stiffness the payload moves the tool by about 0.1 mm and the arm's own weight by
+/// about 1 mm (physical preset); softening every joint tenfold under the arm's weight as well
+/// leaves POE 5 mm, another regime than the paper's. So the paper-like preset lets the payload
+/// alone load joints ten times softer (a round factor; 20 overshoots, POE then leaves 1.2–1.5 mm).
+pub const PAPER_LIKE_SOFTENING: f64 = 10.0;
+
+impl Preset {
+    /// The name used on the command line and in the reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Physical => "physical",
+            Preset::PaperLike => "paper-like",
+        }
+    }
+
+    /// The factor the robot file's stiffness is divided by.
+    pub fn softening(self) -> f64 {
+        match self {
+            Preset::Physical => 1.0,
+            Preset::PaperLike => PAPER_LIKE_SOFTENING,
+        }
+    }
+
+    /// The simulated effects: compliance (under everything, or the payload alone) and tracker noise.
+    pub fn effects(self) -> Effects {
+        let payload_only = self == Preset::PaperLike;
+        Effects { compliance: Some(JointCompliance { payload_only, ..JointCompliance::default() }), ..paper_effects() }
+    }
+}
+
+/// One row of the comparison: a method with its fit options.
+#[derive(Debug, Clone)]
+pub struct Variant {
+    /// Key in the JSON (`base-tool`, …) and, for the paper-faithful rows, in `paper_faithful`.
+    pub key: &'static str,
+    /// Label in the table and the plot.
+    pub label: &'static str,
+    /// The method.
+    pub method: Method,
+    /// Its options.
+    pub options: FitOptions,
+    /// Whether this is one of the paper-faithful extra rows (Eq. 5 kernel, Eq. 8 frame).
+    pub paper_faithful: bool,
+}
+
+/// The four methods with the project's defaults, then POE+GP with and without the payload as the
+/// paper wrote them: its Eq. 5 kernel on the error twist of its Eq. 8 (tracker frame), one kernel
+/// for the six components (Eq. 11 predicts every component with the same `K`, as scikit-learn's
+/// regressor does with a multi-column target).
+///
+/// Two departures from the defaults, for the 60 s budget, neither changing the result: one random
+/// restart of the hyperparameter search instead of three (on the physical preset the table is the
+/// same to the micrometre with three), and each GP fitted on one thread, since the fits themselves
+/// run in parallel.
+fn variants() -> Vec<Variant> {
+    let mut ours = FitOptions::default();
+    ours.compensation.gp.optimiser.restarts = 1;
+    ours.compensation.gp.parallelism = Parallelism::Sequential;
+    let paper = FitOptions {
+        compensation: CompensationOptions {
+            gp: gp::GpConfig {
+                kernel: KernelChoice::Quadratic,
+                outputs: OutputMode::Shared,
+                ..ours.compensation.gp.clone()
+            },
+            residual_frame: ResidualFrame::Tracker,
+        },
+        ..ours.clone()
+    };
+    let row = |key, label, method, options: &FitOptions, paper_faithful| Variant {
+        key,
+        label,
+        method,
+        options: options.clone(),
+        paper_faithful,
+    };
+    vec![
+        row("base-tool", "Base-tool", Method::BaseTool, &ours, false),
+        row("poe", "POE", Method::Poe, &ours, false),
+        row("poe-gp", "POE + GP", Method::PoeGp, &ours, false),
+        row("poe-gp-load", "POE + GP with loading", Method::PoeGpLoad, &ours, false),
+        row("poe-gp", "POE + GP (Eq. 5, Eq. 8)", Method::PoeGp, &paper, true),
+        row("poe-gp-load", "POE + GP with loading (Eq. 5, Eq. 8)", Method::PoeGpLoad, &paper, true),
+    ]
+}
+
+/// The workspace root, so that the defaults work from any directory.
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf)
+}
+
+/// The robot with the preset's stiffness.
+fn robot_for(robot: &RobotDescription, preset: Preset, file: &Path) -> Result<RobotDescription, String> {
+    let mut dynamics: RobotDynamics = robot.dynamics.clone().ok_or_else(|| {
+        format!("{}: the load model needs the robot's masses and stiffness (a dynamics block)", file.display())
+    })?;
+    for k in &mut dynamics.stiffness_nm_per_rad {
+        *k /= preset.softening();
+    }
+    Ok(RobotDescription { dynamics: Some(dynamics), ..robot.clone() })
+}
+
+/// The seeds of every random draw, all from the study's seed.
+fn seeds(seed: u64) -> Seeds {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    Seeds {
+        study: seed,
+        cell: rng.random(),
+        training: rng.random(),
+        tests: [rng.random(), rng.random(), rng.random()],
+        folds: rng.random(),
+    }
+}
+
+/// Mean displacement of the measured tool point between two simulations of the same poses, mm.
+fn mean_shift_mm(a: &MeasurementSet, b: &MeasurementSet) -> f64 {
+    a.rows.iter().zip(&b.rows).map(|(x, y)| (x.position - y.position).norm()).sum::<f64>() * 1e3
+        / a.rows.len().max(1) as f64
+}
+
+/// How large the simulated effects are on the training poses: the compliance as simulated, the
+/// payload's share, and the tracker noise.
+fn magnitudes(
+    cell: &SimulatedCell,
+    effects: &Effects,
+    ranges: &[loadsim::JointRange],
+    config: &GeneratorConfig,
+    full_pose: bool,
+) -> Result<Magnitudes, String> {
+    let run = |effects: &Effects| simulate(cell, effects, ranges, config, full_pose).map_err(|e| e.to_string());
+    let rigid = run(&Effects::default())?;
+    let bent = run(&Effects { compliance: effects.compliance, ..Effects::default() })?;
+    let payload_only = JointCompliance { payload_only: true, ..JointCompliance::default() };
+    let payload = run(&Effects { compliance: Some(payload_only), ..Effects::default() })?;
+    let noisy = run(&Effects { tracker_noise: effects.tracker_noise, ..Effects::default() })?;
+    Ok(Magnitudes {
+        compliance_mm: mean_shift_mm(&rigid, &bent),
+        payload_mm: mean_shift_mm(&rigid, &payload),
+        noise_mm: mean_shift_mm(&rigid, &noisy),
+    })
+}
+
+/// Mean position error (mm) of `variant` fitted on `train`, on each of `tests`; and its training error.
+fn fit_and_test(
+    robot: &RobotDescription,
+    variant: &Variant,
+    train: &MeasurementSet,
+    tests: &[&MeasurementSet],
+) -> Result<(f64, Vec<f64>), String> {
+    let (model, report) = pipeline::fit(robot, train, variant.method, &variant.options)
+        .map_err(|e| format!("{} on {} rows: {e}", variant.label, train.rows.len()))?;
+    let errors = tests
+        .iter()
+        .map(|test| {
+            pipeline::evaluate(&model, test).map(|e| e.summary.mean_position_error_mm).map_err(|e| e.to_string())
+        })
+        .collect::<Result<Vec<f64>, String>>()?;
+    Ok((report.after.mean_position_error_mm, errors))
+}
+
+pub fn run(args: &Args) -> Result<(), String> {
+    let started = Instant::now();
+    let root = workspace_root();
+    let robot_file = args.robot.clone().unwrap_or_else(|| root.join("fixtures/robots/irb4400.ron"));
+    let out_dir = args.out.clone().unwrap_or_else(|| root.join("docs/results"));
+    let nominal = RobotDescription::read(&robot_file).map_err(|e| e.to_string())?;
+    let robot = robot_for(&nominal, args.preset, &robot_file)?;
+    let sizes = if args.quick { Sizes::QUICK } else { Sizes::PAPER };
+    let seeds = seeds(args.seed);
+    let perturbation = Perturbation::default();
+    let full_pose = true;
+    let effects = args.preset.effects();
+
+    // The truth: a perturbed arm with the preset's stiffness; the tracker placed at random.
+    let cell = simulated_cell(&robot, &perturbation, seeds.cell).map_err(|e| e.to_string())?;
+    let ranges = joint_ranges(&robot);
+    let generator = |sample_count, seed| GeneratorConfig { sample_count, seed, ..GeneratorConfig::default() };
+    let dataset =
+        |count, seed| simulate(&cell, &effects, &ranges, &generator(count, seed), full_pose).map_err(|e| e.to_string());
+    let train = dataset(sizes.training, seeds.training)?;
+    let tests = seeds.tests.iter().map(|&s| dataset(sizes.test, s)).collect::<Result<Vec<_>, String>>()?;
+    let magnitudes = magnitudes(&cell, &effects, &ranges, &generator(sizes.training, seeds.training), full_pose)?;
+
+    // Fold k holds the k-th of `folds` nearly equal slices of a seeded shuffle of the rows.
+    let mut order: Vec<usize> = (0..train.rows.len()).collect();
+    order.shuffle(&mut ChaCha8Rng::seed_from_u64(seeds.folds));
+    let folds: Vec<(MeasurementSet, MeasurementSet)> = (0..sizes.folds)
+        .map(|k| {
+            let (start, end) = (k * order.len() / sizes.folds, (k + 1) * order.len() / sizes.folds);
+            let held: Vec<usize> = order[start..end].to_vec();
+            let kept: Vec<usize> = order[..start].iter().chain(&order[end..]).copied().collect();
+            (train.subset(&kept), train.subset(&held))
+        })
+        .collect();
+
+    let variants = variants();
+    let bar = ProgressBar::new(((sizes.folds + 1) * variants.len()) as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} fits {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_message(format!("reproduce-sim ({}, {} folds + test sets)", args.preset.name(), sizes.folds));
+    // Every (variant, fold) fit is independent: run them on the rayon pool; results come back in
+    // order, and each is the same whichever thread ran it.
+    let jobs: Vec<(usize, Option<usize>)> =
+        (0..variants.len()).flat_map(|v| (0..sizes.folds).map(Some).chain([None]).map(move |f| (v, f))).collect();
+    let test_refs: Vec<&MeasurementSet> = tests.iter().collect();
+    let results: Vec<(f64, Vec<f64>)> = jobs
+        .par_iter()
+        .map(|&(v, fold)| {
+            let result = match fold {
+                Some(k) => fit_and_test(&robot, &variants[v], &folds[k].0, &[&folds[k].1]),
+                None => fit_and_test(&robot, &variants[v], &train, &test_refs),
+            };
+            bar.inc(1);
+            result
+        })
+        .collect::<Result<_, String>>()?;
+    bar.finish_and_clear();
+
+    let per_variant = sizes.folds + 1;
+    let outcome = Outcome {
+        variants: variants
+            .iter()
+            .enumerate()
+            .map(|(v, variant)| {
+                let mine = &results[v * per_variant..(v + 1) * per_variant];
+                VariantResult {
+                    key: variant.key,
+                    label: variant.label,
+                    paper_faithful: variant.paper_faithful,
+                    cv: mine[..sizes.folds].iter().map(|(_, e)| e[0]).collect(),
+                    test: mine[sizes.folds].1.clone(),
+                    training: mine[sizes.folds].0,
+                }
+            })
+            .collect(),
+        magnitudes,
+        seconds: started.elapsed().as_secs_f64(),
+    };
+    let params = Params::new(&Setup {
+        robot_file: robot_file.strip_prefix(&root).unwrap_or(&robot_file),
+        robot: &robot,
+        preset: args.preset,
+        quick: args.quick,
+        sizes,
+        seeds,
+        cell: &cell,
+        perturbation,
+        effects: &effects,
+        generator: &generator(sizes.training, seeds.training),
+        full_pose,
+        variants: &variants,
+    })?;
+
+    std::fs::create_dir_all(&out_dir).map_err(|e| format!("{}: {e}", out_dir.display()))?;
+    let stem = match args.preset {
+        Preset::Physical => "reproduce-sim".to_owned(),
+        preset => format!("reproduce-sim-{}", preset.name()),
+    };
+    let svg_name = format!("{stem}-cv.svg");
+    let groups: Vec<BoxGroup> =
+        outcome.variants.iter().map(|v| BoxGroup { label: v.short_label(), values: v.cv.clone() }).collect();
+    let title = format!("{}-fold cross-validation, simulated IRB 4400 ({} preset)", sizes.folds, args.preset.name());
+    let svg = box_plot(&title, "mean position error per fold (mm, log scale)", &groups, true);
+    let write = |path: PathBuf, text: &str| std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()));
+    write(out_dir.join(&svg_name), &svg)?;
+    write(out_dir.join(format!("{stem}.md")), &markdown(&params, &outcome, &svg_name))?;
+    if let Some(path) = &args.json {
+        write(path.clone(), &json(&params, &outcome))?;
+    }
+    println!("{}", crate::reproduce_sim_report::summary(&params, &outcome));
+    println!("wrote {} and {}", out_dir.join(format!("{stem}.md")).display(), out_dir.join(&svg_name).display());
+    Ok(())
+}
