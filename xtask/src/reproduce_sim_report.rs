@@ -328,7 +328,7 @@ pub fn markdown(params: &Params, outcome: &Outcome, svg_name: &str) -> String {
     );
     let _ = writeln!(
         out,
-        "Written by `{command}` ({:.1} s). Jing, Tao, Yang, Shimada, Section IV-A: a perturbed {} carries \
+        "Written by `{command}` ({:.1} s wall clock). Jing, Tao, Yang, Shimada, Section IV-A: a perturbed {} carries \
 payloads of {} kg drawn per pose and bends under them through its joint compliance; a Leica-like tracker \
 with a 6-DOF probe measures the tool. {} training poses are cross-validated over {} folds (the paper's \
 Fig. 1); each method is then fitted on all of them and tested on three independent sets of {} poses \
@@ -340,6 +340,14 @@ Fig. 1); each method is then fitted on all of them and tested on three independe
         params.sizes.folds,
         params.sizes.test
     );
+    if params.preset == Preset::Physical {
+        let _ = writeln!(
+            out,
+            "This is the physical preset: the fixture's stiffness and masses. `--preset paper-like` \
+(`reproduce-sim-paper-like.md`) softens the joints until the payload's effect has the size the paper's \
+Table I implies, and says so.\n"
+        );
+    }
     if params.preset == Preset::PaperLike {
         let _ = writeln!(
             out,
@@ -426,7 +434,8 @@ fn reading(params: &Params, outcome: &Outcome) -> String {
     let _ = writeln!(
         out,
         "- **Base-tool** leaves {bt:.2} mm (paper {:.2} mm, means over the three test sets). This row measures the \
-kinematic perturbation, which the paper does not state; ours is ±{} mm / ±{} mrad per component.",
+kinematic perturbation, its size (which the paper does not state; ours is ±{} mm / ±{} mrad per component) \
+and its draw (seeded).",
         paper_mean("base-tool"),
         p.translation_m * 1e3,
         p.rotation_rad * 1e3

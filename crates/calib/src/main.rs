@@ -5,6 +5,7 @@ mod diagnose;
 mod eval;
 mod fit;
 mod predict;
+mod simulate;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -23,6 +24,7 @@ enum Command {
     Eval(eval::Args),
     Predict(predict::Args),
     Diagnose(diagnose::Args),
+    Simulate(simulate::Args),
 }
 
 fn main() -> ExitCode {
@@ -49,6 +51,7 @@ fn main() -> ExitCode {
         Command::Eval(args) => eval::run(&args),
         Command::Predict(args) => predict::run(&args),
         Command::Diagnose(args) => diagnose::run(&args),
+        Command::Simulate(args) => simulate::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

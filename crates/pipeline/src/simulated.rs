@@ -76,14 +76,19 @@ pub fn tracker_placement<R: Rng + ?Sized>(rng: &mut R) -> SE3 {
     SE3::new(turn, tracker_in_base).inverse()
 }
 
+/// The ChaCha8 stream of a seed that [`simulated_cell`] draws from: loadsim's generator uses
+/// streams 0–2, so one seed can give both the cell and its dataset without shared draws.
+const CELL_STREAM: u64 = 3;
+
 /// A cell for `robot` drawn from `seed`: the perturbed arm (with the robot file's masses and
-/// stiffness), then the tracker placement, from one ChaCha8 stream.
+/// stiffness), then the tracker placement, from one ChaCha8 stream ([`CELL_STREAM`]).
 pub fn simulated_cell(
     robot: &RobotDescription,
     perturbation: &Perturbation,
     seed: u64,
 ) -> Result<SimulatedCell, Error> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(CELL_STREAM);
     let geometry = perturbed_robot(robot, perturbation, &mut rng)?;
     let mut cell = SimulatedCell::new(geometry, robot.dynamics.clone());
     cell.tracker_from_base = tracker_placement(&mut rng);

@@ -1,0 +1,125 @@
+//! `calib simulate` through the binary: its CSV feeds `calib fit` and `calib eval`, and bad input
+//! gets one line on stderr and a non-zero exit.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn calib(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_calib")).args(args).output().expect("the calib binary runs")
+}
+
+fn irb4400() -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron").display().to_string()
+}
+
+fn text(path: &Path) -> String {
+    path.display().to_string()
+}
+
+fn succeeds(args: &[&str]) -> String {
+    let out = calib(args);
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Splits a CSV into its first `head` data rows and the rest, both with the header.
+fn split_csv(path: &Path, head: usize, first: &Path, rest: &Path) {
+    let content = std::fs::read_to_string(path).unwrap();
+    let mut lines = content.lines();
+    let header = lines.next().unwrap();
+    let rows: Vec<&str> = lines.collect();
+    let write = |to: &Path, part: &[&str]| std::fs::write(to, format!("{header}\n{}\n", part.join("\n"))).unwrap();
+    write(first, &rows[..head]);
+    write(rest, &rows[head..]);
+}
+
+/// `calib eval --json`'s mean position error, mm.
+fn held_out_mm(model: &Path, data: &Path) -> f64 {
+    let json: serde_json::Value =
+        serde_json::from_str(&succeeds(&["eval", "--model", &text(model), "--data", &text(data), "--json"]))
+            .expect("eval prints JSON");
+    json["mean_position_error_mm"].as_f64().expect("a mean position error")
+}
+
+#[test]
+fn simulated_data_round_trips_through_fit_and_eval_and_poe_beats_base_tool() {
+    let dir = tempfile::tempdir().unwrap();
+    let (all, train, test) = (dir.path().join("all.csv"), dir.path().join("train.csv"), dir.path().join("test.csv"));
+    let robot = irb4400();
+    succeeds(&["simulate", "--robot", &robot, "--out", &text(&all), "--rows", "160", "--seed", "3", "--full-pose"]);
+    let header = std::fs::read_to_string(&all).unwrap().lines().next().unwrap().to_owned();
+    for column in ["q6_rad", "x_mm", "qw", "payload_kg"] {
+        assert!(header.split(',').any(|c| c == column), "{column} missing from {header}");
+    }
+    split_csv(&all, 120, &train, &test);
+    let mut errors = Vec::new();
+    for method in ["base-tool", "poe"] {
+        let model = dir.path().join(format!("{method}.ron"));
+        succeeds(&["fit", "--robot", &robot, "--data", &text(&train), "--method", method, "--out", &text(&model)]);
+        errors.push(held_out_mm(&model, &test));
+    }
+    let (base_tool, poe) = (errors[0], errors[1]);
+    // ±1 mm / 1 mrad per frame leaves millimetres after base-tool; POE leaves the compliance, < 1 mm.
+    assert!(base_tool > 1.0, "base-tool {base_tool} mm");
+    assert!(poe < 0.5 * base_tool && poe < 1.0, "POE {poe} mm, base-tool {base_tool} mm");
+}
+
+#[test]
+fn without_compliance_poe_leaves_only_the_tracker_noise() {
+    let dir = tempfile::tempdir().unwrap();
+    let [effects, all, train, test] =
+        ["effects.ron", "all.csv", "train.csv", "test.csv"].map(|name| dir.path().join(name));
+    std::fs::write(&effects, "// tracker noise alone\n(tracker_noise: ())\n").unwrap();
+    let robot = irb4400();
+    let out = succeeds(&[
+        "simulate",
+        "--robot",
+        &robot,
+        "--out",
+        &text(&all),
+        "--rows",
+        "100",
+        "--effects",
+        &text(&effects),
+        "--payloads",
+        "0,10",
+    ]);
+    assert!(out.contains("effects: tracker_noise"), "{out}");
+    let payloads: Vec<String> = std::fs::read_to_string(&all)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(9).unwrap().to_owned())
+        .collect();
+    assert!(payloads.iter().all(|p| p == "0.0" || p == "10.0"), "{payloads:?}");
+    split_csv(&all, 80, &train, &test);
+    let model = dir.path().join("poe.ron");
+    succeeds(&["fit", "--robot", &robot, "--data", &text(&train), "--method", "poe", "--out", &text(&model)]);
+    // The AT901-like noise is about 0.03 mm at these distances: a rigid robot is fitted to it.
+    let error = held_out_mm(&model, &test);
+    assert!(error < 0.1, "{error} mm");
+}
+
+/// Exit status non-zero and exactly one line on stderr, containing `needle`.
+fn refused(args: &[&str], needle: &str) {
+    let out = calib(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
+    assert!(stderr.contains(needle), "{args:?}: {stderr}");
+}
+
+#[test]
+fn bad_arguments_and_files_are_refused_with_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = text(&dir.path().join("out.csv"));
+    let robot = irb4400();
+    refused(&["simulate", "--robot", &robot, "--out", &out, "--rows", "many"], "many");
+    refused(&["simulate", "--robot", &robot, "--out", &out, "--rows", "0"], "--rows");
+    refused(&["simulate", "--robot", &robot, "--out", &out, "--payloads", "1,-2"], "payloads");
+    refused(&["simulate", "--robot", "no/such/robot.ron", "--out", &out], "no/such/robot.ron");
+    let effects = dir.path().join("effects.ron");
+    std::fs::write(&effects, "(\n  compliance: (),\n  tracker_nosie: (),\n)\n").unwrap();
+    refused(&["simulate", "--robot", &robot, "--out", &out, "--effects", &text(&effects)], "tracker_nosie");
+    assert!(!Path::new(&out).exists(), "nothing is written when the input is refused");
+}
