@@ -9,6 +9,7 @@ mod reproduce_sim;
 mod reproduce_sim_params;
 mod reproduce_sim_report;
 mod simulation;
+mod ur10;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -31,6 +32,8 @@ enum Command {
     ConvertUr10(convert_ur10::Args),
     /// Diagnose simulated datasets with a hidden effect, without the truth; print the confusion matrix.
     BlindCheck(blind_check::Args),
+    /// Every method and the diagnosis on the real UR10 tracker data (Landgraf et al., CASE 2021).
+    Ur10(ur10::Args),
 }
 
 fn main() -> ExitCode {
@@ -40,6 +43,7 @@ fn main() -> ExitCode {
         Command::BenchGp(args) => bench_gp::run(args),
         Command::ConvertUr10(args) => convert_ur10::run(args),
         Command::BlindCheck(args) => blind_check::run(args),
+        Command::Ur10(args) => ur10::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -34,8 +34,13 @@ pub struct CompensationOptions {
 
 impl Default for CompensationOptions {
     fn default() -> Self {
+        // ARD squared exponential rather than the paper's Eq. 5 kernel, and one random restart
+        // besides the default start: on the UR10 data (series C, 1386 training poses, position
+        // only) the paper's kernel left 0.307 mm held-out against 0.205 mm, and three restarts
+        // found the same optimum as one in 2.2x the time (176 s against 79 s).
+        let optimiser = gp::OptimiserConfig { restarts: 1, ..gp::OptimiserConfig::default() };
         Self {
-            gp: gp::GpConfig { kernel: gp::KernelChoice::SquaredExponentialArd, ..gp::GpConfig::default() },
+            gp: gp::GpConfig { kernel: gp::KernelChoice::SquaredExponentialArd, optimiser, ..gp::GpConfig::default() },
             residual_frame: ResidualFrame::default(),
         }
     }
