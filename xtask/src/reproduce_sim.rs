@@ -10,6 +10,7 @@
 
 use crate::box_plot::{BoxGroup, box_plot};
 use crate::reproduce_sim_report::{Magnitudes, Outcome, Params, Seeds, Setup, Sizes, VariantResult, json, markdown};
+use crate::simulation::mean_distance_mm;
 use gp::{KernelChoice, OutputMode, Parallelism};
 use indicatif::{ProgressBar, ProgressStyle};
 use loadsim::{Effects, GeneratorConfig, JointCompliance, RobotDynamics, SimulatedCell};
@@ -175,12 +176,6 @@ fn seeds(seed: u64) -> Seeds {
     }
 }
 
-/// Mean displacement of the measured tool point between two simulations of the same poses, mm.
-fn mean_shift_mm(a: &MeasurementSet, b: &MeasurementSet) -> f64 {
-    a.rows.iter().zip(&b.rows).map(|(x, y)| (x.position - y.position).norm()).sum::<f64>() * 1e3
-        / a.rows.len().max(1) as f64
-}
-
 /// How large the simulated effects are on the training poses: the compliance as simulated, the
 /// payload's share, and the tracker noise.
 fn magnitudes(
@@ -197,9 +192,9 @@ fn magnitudes(
     let payload = run(&Effects { compliance: Some(payload_only), ..Effects::default() })?;
     let noisy = run(&Effects { tracker_noise: effects.tracker_noise, ..Effects::default() })?;
     Ok(Magnitudes {
-        compliance_mm: mean_shift_mm(&rigid, &bent),
-        payload_mm: mean_shift_mm(&rigid, &payload),
-        noise_mm: mean_shift_mm(&rigid, &noisy),
+        compliance_mm: mean_distance_mm(&rigid, &bent),
+        payload_mm: mean_distance_mm(&rigid, &payload),
+        noise_mm: mean_distance_mm(&rigid, &noisy),
     })
 }
 
