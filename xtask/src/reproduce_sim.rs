@@ -9,7 +9,8 @@
 //! poses (Table I). The report and the box plot go to `--out`, the numbers to `--json`.
 
 use crate::box_plot::{BoxGroup, box_plot};
-use crate::reproduce_sim_report::{Magnitudes, Outcome, Params, Seeds, Setup, Sizes, VariantResult, json, markdown};
+use crate::reproduce_sim_params::{Params, Seeds, Setup, Sizes};
+use crate::reproduce_sim_report::{Magnitudes, Outcome, VariantResult, json, markdown};
 use crate::simulation::mean_distance_mm;
 use gp::{KernelChoice, OutputMode, Parallelism};
 use indicatif::{ProgressBar, ProgressStyle};

@@ -1,9 +1,152 @@
-//! The report's account of every simulation parameter with its source, and of what differs from
-//! the paper.
+//! Every parameter of the simulation study (the JSON's `params`), and the report's account of
+//! each with its source and of what differs from the paper.
 
-use crate::reproduce_sim::{PAPER_LIKE_SOFTENING, Preset};
-use crate::reproduce_sim_report::{Params, list};
+use crate::reproduce_sim::{PAPER_LIKE_SOFTENING, Preset, Variant};
+use crate::reproduce_sim_report::list;
+use loadsim::{Effects, GeneratorConfig, RobotDynamics, SimulatedCell};
+use pipeline::simulated::Perturbation;
+use pipeline::{FitOptions, RobotDescription};
+use serde::Serialize;
+use std::collections::BTreeMap;
 use std::fmt::Write;
+use std::path::Path;
+
+/// How many poses and folds.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Sizes {
+    /// Training poses.
+    pub training: usize,
+    /// Cross-validation folds.
+    pub folds: usize,
+    /// Poses per test set (there are three).
+    pub test: usize,
+}
+
+impl Sizes {
+    /// The paper's study: 300 training poses, 10 folds, three test sets of 100.
+    pub const PAPER: Sizes = Sizes { training: 300, folds: 10, test: 100 };
+    /// For CI: the same pipeline on a fifth of the poses.
+    pub const QUICK: Sizes = Sizes { training: 60, folds: 3, test: 20 };
+}
+
+/// Every seed, drawn from the study's seed.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Seeds {
+    /// The `--seed` given.
+    pub study: u64,
+    /// The true robot's perturbation and the tracker placement.
+    pub cell: u64,
+    /// The training poses, payloads and noise.
+    pub training: u64,
+    /// The three test sets.
+    pub tests: [u64; 3],
+    /// The shuffle that assigns training poses to folds.
+    pub folds: u64,
+}
+
+/// Where the tracker stands.
+#[derive(Debug, Clone, Serialize)]
+pub struct TrackerPlacement {
+    /// Distance from the robot base, m.
+    pub distance_m: f64,
+    /// `tracker_from_base` translation, m.
+    pub translation_m: [f64; 3],
+    /// `tracker_from_base` rotation vector, rad.
+    pub rotation_vector_rad: [f64; 3],
+}
+
+/// Every parameter of the simulation, as written to the JSON's `params`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Params {
+    /// Stiffness preset.
+    pub preset: Preset,
+    /// Factor the robot file's stiffness was divided by.
+    pub stiffness_softening: f64,
+    /// Whether this was the reduced `--quick` run.
+    pub quick: bool,
+    /// The robot file.
+    pub robot_file: String,
+    /// Its name.
+    pub robot_name: String,
+    /// Seeds.
+    pub seeds: Seeds,
+    /// Poses and folds.
+    pub sizes: Sizes,
+    /// Full-pose (6-DOF) measurements.
+    pub full_pose: bool,
+    /// The true robot's offsets from nominal.
+    pub perturbation: Perturbation,
+    /// The tracker.
+    pub tracker: TrackerPlacement,
+    /// Masses, centres of mass, stiffness (after the preset) and balancer.
+    pub dynamics: RobotDynamics,
+    /// The simulated effects.
+    pub effects: Effects,
+    /// The training set's generator (the test sets differ only in seed and count).
+    pub generator: GeneratorConfig,
+    /// Fit options per variant (`paper:` prefix for the paper-faithful rows).
+    pub fit_options: BTreeMap<String, FitOptions>,
+}
+
+/// What the study needs to describe itself.
+#[derive(Debug)]
+pub struct Setup<'a> {
+    /// The robot file.
+    pub robot_file: &'a Path,
+    /// The robot with the preset's stiffness.
+    pub robot: &'a RobotDescription,
+    /// The preset.
+    pub preset: Preset,
+    /// `--quick`.
+    pub quick: bool,
+    /// Poses and folds.
+    pub sizes: Sizes,
+    /// Seeds.
+    pub seeds: Seeds,
+    /// The truth.
+    pub cell: &'a SimulatedCell,
+    /// The perturbation the truth was drawn with.
+    pub perturbation: Perturbation,
+    /// The effects.
+    pub effects: &'a Effects,
+    /// The training generator.
+    pub generator: &'a GeneratorConfig,
+    /// Full pose.
+    pub full_pose: bool,
+    /// The rows compared.
+    pub variants: &'a [Variant],
+}
+
+impl Params {
+    /// The parameters of a study.
+    pub fn new(s: &Setup<'_>) -> Result<Self, String> {
+        let base_in_tracker = s.cell.tracker_from_base;
+        Ok(Params {
+            preset: s.preset,
+            stiffness_softening: s.preset.softening(),
+            quick: s.quick,
+            robot_file: s.robot_file.display().to_string(),
+            robot_name: s.robot.name.clone(),
+            seeds: s.seeds,
+            sizes: s.sizes,
+            full_pose: s.full_pose,
+            perturbation: s.perturbation,
+            tracker: TrackerPlacement {
+                distance_m: base_in_tracker.translation().norm(),
+                translation_m: base_in_tracker.translation().into(),
+                rotation_vector_rad: base_in_tracker.rotation().log().into(),
+            },
+            dynamics: s.robot.dynamics.clone().ok_or("the robot has no dynamics block")?,
+            effects: s.effects.clone(),
+            generator: s.generator.clone(),
+            fit_options: s
+                .variants
+                .iter()
+                .map(|v| (format!("{}{}", if v.paper_faithful { "paper:" } else { "" }, v.key), v.options.clone()))
+                .collect(),
+        })
+    }
+}
 
 fn round(values: impl IntoIterator<Item = f64>, scale: f64, digits: usize) -> String {
     values.into_iter().map(|v| format!("{:.digits$}", v * scale)).collect::<Vec<_>>().join(", ")
