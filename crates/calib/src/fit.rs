@@ -18,12 +18,17 @@ pub struct Args {
     /// Where to write the calibrated model (RON).
     #[arg(long)]
     out: PathBuf,
+    /// Also identify joint compliance with the geometry, through gravity-torque regressors (no
+    /// masses needed; uses the payload column). Beyond the paper; applied before any GP.
+    #[arg(long)]
+    joint_compliance: bool,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let robot = RobotDescription::read(&args.robot)?;
     let data = pipeline::read_measurements(&args.data, Some(robot.joint_count()))?;
-    let (model, report) = pipeline::fit(&robot, &data, args.method, &FitOptions::default())?;
+    let options = FitOptions { joint_compliance: args.joint_compliance, ..FitOptions::default() };
+    let (model, report) = pipeline::fit(&robot, &data, args.method, &options)?;
     pipeline::write_model(&args.out, &model)?;
 
     let kind = if data.full_pose { "full pose" } else { "position only" };
@@ -46,6 +51,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         "  identifiable: {} of {} free parameters, condition number {:.3e}",
         id.rank, id.free_parameters, id.condition_number
     );
+    if let Some(compliance) = &model.joint_compliance {
+        println!("  joint compliance: {} torque-regressor terms identified with the geometry", compliance.terms.len());
+    }
     for direction in &id.unidentifiable {
         println!("    unidentifiable: {direction}");
     }

@@ -20,6 +20,10 @@ pub struct CalibratedModel {
     pub tools: Vec<String>,
     /// The identified local POE model; its reference frame is the tracker frame.
     pub kinematics: LocalPoe,
+    /// Joint compliance identified with the geometry (`calib fit --joint-compliance`), applied
+    /// before the GP.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint_compliance: Option<crate::ComplianceModel>,
     /// The GP compensation of the residual (methods `poe-gp`, `poe-gp-load`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compensation: Option<crate::Compensation>,
@@ -55,13 +59,26 @@ impl CalibratedModel {
         })
     }
 
+    /// The poses of the kinematics, with the joint compliance if the model has it, before any GP.
+    pub fn geometric_poses(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<SE3>, Error> {
+        let mut poses = Vec::with_capacity(rows.len());
+        for (row, &tool) in rows.iter().zip(tools) {
+            let pose = self.kinematics.forward(&row.q, tool)?;
+            poses.push(match &self.joint_compliance {
+                Some(compliance) => {
+                    let row = Measurement { tool, ..row.clone() };
+                    compliance.apply(&self.kinematics, &row, pose)?
+                }
+                None => pose,
+            });
+        }
+        Ok(poses)
+    }
+
     /// Predicts the tool pose of rows of a measurement set, with the GP placed before the POE
     /// model as in the paper's Eq. 9: `T = exp(ĝ(q, m)) · T_POE(q)`.
     pub fn predict(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<PredictedPose>, Error> {
-        let mut poses = Vec::with_capacity(rows.len());
-        for (row, &tool) in rows.iter().zip(tools) {
-            poses.push(self.kinematics.forward(&row.q, tool)?);
-        }
+        let poses = self.geometric_poses(rows, tools)?;
         match &self.compensation {
             None => Ok(poses.into_iter().map(|pose| PredictedPose { pose, std: None }).collect()),
             Some(compensation) => {

@@ -5,7 +5,6 @@
 use crate::{Error, Measurement, MeasurementSet};
 use faer::Mat;
 use lie::{SE3, Twist, Vector3, Vector6};
-use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
 
 /// Where the error twist of Eq. 8 is expressed.
@@ -94,18 +93,17 @@ fn error_vector(model_pose: &SE3, row: &Measurement, frame: ResidualFrame) -> Ve
 }
 
 impl Compensation {
-    /// Fits the GP to the error `kinematics` leaves on `data` (tool indices are the model's).
+    /// Fits the GP to the error that the model poses `poses` (one per row) leave on `data`.
     pub fn fit(
-        kinematics: &LocalPoe,
+        poses: &[SE3],
         data: &MeasurementSet,
         with_payload: bool,
         options: &CompensationOptions,
     ) -> Result<(Self, CompensationReport), Error> {
         let outputs = if data.full_pose { 6 } else { 3 };
         let mut y = Mat::<f64>::zeros(data.rows.len(), outputs);
-        for (i, row) in data.rows.iter().enumerate() {
-            let pose = kinematics.forward(&row.q, row.tool)?;
-            let e = error_vector(&pose, row, options.residual_frame);
+        for (i, (row, pose)) in data.rows.iter().zip(poses).enumerate() {
+            let e = error_vector(pose, row, options.residual_frame);
             for c in 0..outputs {
                 y[(i, c)] = e[c];
             }

@@ -79,3 +79,26 @@ fn with_a_load_effect_poe_gp_load_beats_poe_gp_which_beats_poe() {
         assert!(load < 0.9 * gp, "poe-gp-load {load} mm should beat poe-gp {gp} mm by 10 %");
     }
 }
+
+#[test]
+fn identified_joint_compliance_leaves_little_more_than_the_noise() {
+    let robot = irb4400();
+    for (seed, full_pose) in [(13, true), (14, false)] {
+        let all = loaded_data(&robot, 400, full_pose, seed);
+        let train = all.subset(&(0..250).collect::<Vec<_>>());
+        let test = all.subset(&(250..400).collect::<Vec<_>>());
+        let error = |method, joint_compliance| {
+            let options = FitOptions { joint_compliance, ..FitOptions::default() };
+            let (model, _) = pipeline::fit(&robot, &train, method, &options).unwrap();
+            pipeline::evaluate(&model, &test).unwrap().summary.mean_position_error_mm
+        };
+        let load = error(Method::PoeGpLoad, false);
+        let compliance = error(Method::Poe, true);
+        eprintln!(
+            "seed {seed} full pose {full_pose}: poe-gp-load {load:.4} mm, poe + joint compliance {compliance:.4} mm"
+        );
+        // The Leica-like noise alone leaves about 0.03 mm.
+        assert!(compliance < 0.06, "poe with joint compliance left {compliance} mm");
+        assert!(compliance < 0.5 * load, "joint compliance {compliance} mm against poe-gp-load {load} mm");
+    }
+}
