@@ -66,7 +66,7 @@ pub enum Preset {
 /// fixture's stiffness the payload moves the tool by about 0.1 mm and the arm's own weight by
 /// about 1 mm (physical preset); softening every joint tenfold under the arm's weight as well
 /// leaves POE 5 mm, another regime than the paper's. So the paper-like preset lets the payload
-/// alone load joints ten times softer (a round factor; 20 overshoots, POE then leaves 1.2–1.5 mm).
+/// alone load joints ten times softer (a round factor; 20 overshoots: POE then leaves over 1 mm).
 pub const PAPER_LIKE_SOFTENING: f64 = 10.0;
 
 impl Preset {

@@ -253,16 +253,19 @@ about 0.1 mm, too little for the paper's gains; see `reproduce-sim.md` for the p
     }
     let m = &outcome.magnitudes;
     let loaded_by = match params.effects.compliance {
-        Some(c) if c.payload_only => "the payload alone, as simulated here",
-        _ => "the arm's weight, the balancer and the payload together",
+        Some(c) if c.payload_only => "under the payload alone, as simulated here".to_owned(),
+        _ => format!(
+            "under the arm's weight, the balancer and the payload together; the payload's share alone would be {:.3} mm",
+            m.payload_mm
+        ),
     };
     let _ = writeln!(
         out,
         "\n## What the methods are up against\n\nOn the training poses the joint compliance moves the tool point by \
-{:.3} mm on average ({loaded_by}); the payload's share alone would be {:.3} mm; the tracker noise moves it by \
-{:.4} mm. A geometric model absorbs the part of the sag that is a fixed function of the joint angles near the \
-mean payload; what varies with the payload can only be learnt with the payload as an input.\n",
-        m.compliance_mm, m.payload_mm, m.noise_mm
+{:.3} mm on average ({loaded_by}); the tracker noise moves it by {:.4} mm. A geometric model absorbs the part of \
+the sag that is a fixed function of the joint angles near the mean payload; what varies with the payload can only \
+be learnt with the payload as an input.\n",
+        m.compliance_mm, m.noise_mm
     );
     out.push_str(&reading(params, outcome));
     out.push_str(&crate::reproduce_sim_params::parameters_section(params));
