@@ -106,6 +106,8 @@ pub struct Variant {
     pub options: FitOptions,
     /// Whether this is one of the paper-faithful extra rows (Eq. 5 kernel, Eq. 8 frame).
     pub paper_faithful: bool,
+    /// Whether this row goes beyond the paper (not one of its four methods).
+    pub beyond: bool,
 }
 
 /// The four methods with the project's defaults, then POE+GP with and without the payload as the
@@ -138,7 +140,12 @@ fn variants() -> Vec<Variant> {
         method,
         options: options.clone(),
         paper_faithful,
+        beyond: false,
     };
+    // Beyond the paper: joint compliance identified with the geometry through gravity-torque
+    // regressors (no masses), alone and followed by the GP with the payload.
+    let compliance = FitOptions { joint_compliance: true, ..ours.clone() };
+    let beyond = |key, label, method| Variant { beyond: true, ..row(key, label, method, &compliance, false) };
     vec![
         row("base-tool", "Base-tool", Method::BaseTool, &ours, false),
         row("poe", "POE", Method::Poe, &ours, false),
@@ -146,6 +153,12 @@ fn variants() -> Vec<Variant> {
         row("poe-gp-load", "POE + GP with loading", Method::PoeGpLoad, &ours, false),
         row("poe-gp", "POE + GP (Eq. 5, Eq. 8)", Method::PoeGp, &paper, true),
         row("poe-gp-load", "POE + GP with loading (Eq. 5, Eq. 8)", Method::PoeGpLoad, &paper, true),
+        beyond("poe-compliance", "POE + joint compliance (beyond the paper)", Method::Poe),
+        beyond(
+            "poe-compliance-gp-load",
+            "POE + joint compliance + GP with loading (beyond the paper)",
+            Method::PoeGpLoad,
+        ),
     ]
 }
 
@@ -288,6 +301,7 @@ pub fn run(args: &Args) -> Result<(), String> {
                     key: variant.key,
                     label: variant.label,
                     paper_faithful: variant.paper_faithful,
+                    beyond: variant.beyond,
                     cv: mine[..sizes.folds].iter().map(|(_, e)| e[0]).collect(),
                     test: mine[sizes.folds].1.clone(),
                     training: mine[sizes.folds].0,
