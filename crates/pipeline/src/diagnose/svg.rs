@@ -29,7 +29,12 @@ pub(crate) fn ticks(low: f64, high: f64) -> Vec<f64> {
     let span = (high - low).abs().max(1e-12);
     let raw = span / 5.0;
     let magnitude = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 2.5, 5.0, 10.0].iter().map(|m| m * magnitude).find(|s| *s >= raw).unwrap_or(10.0 * magnitude);
+    // The round step nearest to a fifth of the span (in ratio), so that 4 to 8 ticks show.
+    let step = [1.0, 2.0, 2.5, 5.0, 10.0]
+        .iter()
+        .map(|m| m * magnitude)
+        .min_by(|a, b| (a / raw).ln().abs().total_cmp(&(b / raw).ln().abs()))
+        .unwrap_or(magnitude);
     let first = (low / step).ceil() * step;
     (0..).map(|k| first + k as f64 * step).take_while(|t| *t <= high + 1e-9 * step).collect()
 }
@@ -132,8 +137,10 @@ mod tests {
     #[test]
     fn ticks_are_round_and_cover_the_range() {
         assert_eq!(ticks(0.0, 1.0), vec![0.0, 0.2, 0.4, 0.6000000000000001, 0.8, 1.0]);
-        let t = ticks(-173.0, 161.0);
-        assert!(t.first().unwrap() >= &-173.0 && t.last().unwrap() <= &161.0 && t.len() >= 4, "{t:?}");
+        for (low, high) in [(-173.0, 161.0), (0.0, 0.037), (20.0, 23.5), (0.0, 9000.0)] {
+            let t = ticks(low, high);
+            assert!(t[0] >= low && *t.last().unwrap() <= high && (4..=8).contains(&t.len()), "{low}..{high}: {t:?}");
+        }
     }
 
     #[test]
