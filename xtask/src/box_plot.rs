@@ -1,10 +1,10 @@
 //! A hand-written SVG box plot (the paper's Fig. 1 kind): one box per group, Tukey whiskers,
 //! outliers as circles, every value drawn as a dot beside its box.
 //!
-//! Hand-written for the reason `pipeline::diagnose`'s charts are: `plotters` lays text out with a
-//! system font library a clean CI machine may lack, and a box plot needs only rectangles, lines and
-//! `<text>` that the viewer lays out itself.
+//! Drawn on the frame `pipeline::chart` shares with the diagnosis's plots (hand-written SVG; see
+//! there for why not `plotters`).
 
+use pipeline::chart::{Canvas, escape, linear_ticks};
 use std::fmt::Write;
 
 /// One box: its label under the axis and the values it summarises.
@@ -60,17 +60,10 @@ impl BoxStatistics {
     }
 }
 
-const WIDTH: f64 = 720.0;
-const HEIGHT: f64 = 460.0;
-const LEFT: f64 = 70.0;
-const RIGHT: f64 = 20.0;
-const TOP: f64 = 40.0;
-const BOTTOM: f64 = 60.0;
+const CANVAS: Canvas = Canvas { width: 720.0, height: 460.0, left: 70.0, right: 20.0, top: 40.0, bottom: 60.0 };
+const LEFT: f64 = CANVAS.left;
+const TOP: f64 = CANVAS.top;
 const COLOURS: [&str; 6] = ["#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860"];
-
-fn escape(text: &str) -> String {
-    text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
-}
 
 /// Tick values of a log axis over `[low, high]`: 1, 2 and 5 times the powers of ten inside.
 fn log_ticks(low: f64, high: f64) -> Vec<f64> {
@@ -94,19 +87,6 @@ fn step_above(v: f64) -> f64 {
     [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * decade).find(|s| *s >= v * (1.0 - 1e-9)).unwrap_or(10.0 * decade)
 }
 
-/// Round tick values of a linear axis from 0 to `high`, about five.
-fn linear_ticks(high: f64) -> Vec<f64> {
-    let raw = high / 5.0;
-    let magnitude = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 2.5, 5.0, 10.0].iter().map(|m| m * magnitude).find(|s| *s >= raw).unwrap_or(10.0 * magnitude);
-    (0..).map(|k| k as f64 * step).take_while(|t| *t <= high * (1.0 + 1e-9)).collect()
-}
-
-fn format_tick(t: f64) -> String {
-    let text = format!("{t:.4}");
-    text.trim_end_matches('0').trim_end_matches('.').to_owned()
-}
-
 /// A box plot of `groups`. The y axis is logarithmic when `log` (so that boxes an order of
 /// magnitude apart are all readable), else linear from zero.
 pub fn box_plot(title: &str, y_label: &str, groups: &[BoxGroup], log: bool) -> String {
@@ -118,39 +98,16 @@ pub fn box_plot(title: &str, y_label: &str, groups: &[BoxGroup], log: bool) -> S
         (false, true) => (0.0, high * 1.08),
         (_, false) => (if log { 0.1 } else { 0.0 }, 1.0),
     };
-    let (pw, ph) = (WIDTH - LEFT - RIGHT, HEIGHT - TOP - BOTTOM);
+    let (pw, ph) = (CANVAS.plot_width(), CANVAS.plot_height());
     let sy = |y: f64| {
         let fraction = if log { (y.log10() - y0.log10()) / (y1.log10() - y0.log10()) } else { (y - y0) / (y1 - y0) };
         TOP + ph - fraction * ph
     };
     let slot = pw / groups.len().max(1) as f64;
-    let mut out = String::new();
-    let _ = write!(
-        out,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{HEIGHT}" viewBox="0 0 {WIDTH} {HEIGHT}" font-family="sans-serif" font-size="12">"#
-    );
-    let _ = write!(out, r#"<rect width="100%" height="100%" fill="white"/>"#);
-    let _ =
-        write!(out, r#"<text x="{}" y="22" text-anchor="middle" font-size="15">{}</text>"#, WIDTH / 2.0, escape(title));
-    let ticks = if log { log_ticks(y0, y1) } else { linear_ticks(y1) };
-    for t in ticks {
-        let y = sy(t);
-        let _ = write!(out, r##"<line x1="{LEFT}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#e4e4e4"/>"##, LEFT + pw);
-        let _ = write!(
-            out,
-            r#"<text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>"#,
-            LEFT - 6.0,
-            y + 4.0,
-            format_tick(t)
-        );
-    }
-    let _ = write!(out, r##"<rect x="{LEFT}" y="{TOP}" width="{pw}" height="{ph}" fill="none" stroke="#444444"/>"##);
-    let _ = write!(
-        out,
-        r#"<text transform="translate(18 {:.1}) rotate(-90)" text-anchor="middle">{}</text>"#,
-        TOP + ph / 2.0,
-        escape(y_label)
-    );
+    let mut out = CANVAS.open(title);
+    let ticks = if log { log_ticks(y0, y1) } else { linear_ticks(0.0, y1) };
+    CANVAS.y_grid(&mut out, &ticks, &sy);
+    CANVAS.frame(&mut out, y_label);
     for (k, group) in groups.iter().enumerate() {
         let colour = COLOURS[k % COLOURS.len()];
         let centre = LEFT + slot * (k as f64 + 0.5);

@@ -10,15 +10,22 @@ use lie::{SO3, Vector3};
 use pipeline::{Measurement, MeasurementSet};
 use std::path::{Path, PathBuf};
 
-/// Convert the IPA UR10 dataset (Leica AT960 + T-Mac on a UR10) to SPEC CSV.
+/// Where the IPA UR10 dataset is and which series to read.
 #[derive(Debug, clap::Args)]
-pub struct Args {
+pub struct Dataset {
     /// Folder of the dataset (holding Series_A … Series_D).
     #[arg(long, default_value = "../shared/data/ipa-ur10")]
-    input: PathBuf,
+    pub input: PathBuf,
     /// Which series: A (grid), B (joint configurations), C (random poses), D (ISO cubes).
     #[arg(long, default_value = "C")]
-    series: String,
+    pub series: String,
+}
+
+/// Convert the IPA UR10 dataset (a Leica laser tracker with a T-Mac on a UR10) to SPEC CSV.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    dataset: Dataset,
     /// Keep the T-Mac orientation (full-pose data); otherwise position only.
     #[arg(long)]
     full_pose: bool,
@@ -140,7 +147,7 @@ fn write(set: &MeasurementSet, path: &Path) -> Result<(), String> {
 }
 
 pub fn run(args: &Args) -> Result<(), String> {
-    let set = read_series(&args.input, &args.series, args.full_pose)?;
+    let set = read_series(&args.dataset.input, &args.dataset.series, args.full_pose)?;
     match (&args.out, &args.train, &args.test) {
         (Some(out), _, _) => write(&set, out),
         (None, Some(train), Some(test)) => {

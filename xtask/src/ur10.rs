@@ -2,7 +2,7 @@
 //! al. (CASE 2021): train on the first half of a series (in measurement order), test on the second.
 //! Writes `ur10.md` and the diagnosis report into `--out`.
 
-use crate::convert_ur10::read_series;
+use crate::convert_ur10::{Dataset, read_series};
 use indicatif::{ProgressBar, ProgressStyle};
 use pipeline::diagnose::{DiagnoseOptions, diagnose};
 use pipeline::{CompensationOptions, FitOptions, MeasurementSet, Method, ResidualFrame, RobotDescription};
@@ -13,12 +13,8 @@ use std::time::Instant;
 /// Fit and evaluate every method, and diagnose, on the IPA UR10 data set.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Folder of the dataset (holding Series_A … Series_D).
-    #[arg(long, default_value = "../shared/data/ipa-ur10")]
-    input: PathBuf,
-    /// Which series.
-    #[arg(long, default_value = "C")]
-    series: String,
+    #[command(flatten)]
+    dataset: Dataset,
     /// Robot description.
     #[arg(long, default_value = "fixtures/robots/ur10.ron")]
     robot: PathBuf,
@@ -67,7 +63,7 @@ pub fn run(args: &Args) -> Result<(), String> {
     let mut rows = Vec::new();
     let mut sizes = (0, 0);
     for (label, full_pose) in [("position", false), ("full pose", true)] {
-        let set = read_series(&args.input, &args.series, full_pose)?;
+        let set = read_series(&args.dataset.input, &args.dataset.series, full_pose)?;
         let (train, test) = halves(&set);
         sizes = (train.rows.len(), test.rows.len());
         for (name, method, options) in &variants {
@@ -89,7 +85,7 @@ pub fn run(args: &Args) -> Result<(), String> {
         }
     }
     bar.set_message("diagnose");
-    let set = read_series(&args.input, &args.series, false)?;
+    let set = read_series(&args.dataset.input, &args.dataset.series, false)?;
     let (train, _) = halves(&set);
     let start = Instant::now();
     let diagnosis = diagnose(&robot, &train, &DiagnoseOptions::default()).map_err(|e| e.to_string())?;
@@ -114,7 +110,7 @@ pub fn run(args: &Args) -> Result<(), String> {
          this repository): a UR10 measured with a Leica laser tracker and a T-Mac at random poses, no payload variation. \
          Train on the first half of the rows in measurement order ({} poses), test on the second ({} poses). \
          Orientation from the tracker's rx, ry, rz as R = Rx Ry Rz. Produced by `cargo xtask ur10`.\n",
-        args.series, sizes.0, sizes.1
+        args.dataset.series, sizes.0, sizes.1
     );
     let _ = writeln!(md, "| data | method | mean (mm) | RMS (mm) | max (mm) | rotation mean (mrad) | fit time (s) |");
     let _ = writeln!(md, "| --- | --- | ---: | ---: | ---: | ---: | ---: |");

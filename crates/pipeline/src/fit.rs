@@ -54,15 +54,7 @@ pub fn fit(
     method: Method,
     options: &FitOptions,
 ) -> Result<(CalibratedModel, FitReport), Error> {
-    if data.joint_count != robot.joint_count() {
-        return Err(Error::JointCountMismatch {
-            file: data.source.clone(),
-            line: 1,
-            column: 1,
-            found: data.joint_count,
-            expected: robot.joint_count(),
-        });
-    }
+    data.check_joint_count(robot.joint_count())?;
     let nominal = robot.nominal_model()?;
     let scope = if method == Method::BaseTool { Scope::BaseTool } else { Scope::Full };
     let geometry = fit_geometry(&nominal, data, scope, &options.identification)?;
@@ -130,15 +122,7 @@ pub fn evaluate(model: &CalibratedModel, data: &MeasurementSet) -> Result<Evalua
 
 /// The model's tool index of every row of `data`, matched by tool identifier.
 pub fn tool_indices(model: &CalibratedModel, data: &MeasurementSet) -> Result<Vec<usize>, Error> {
-    if data.joint_count != model.joint_count() {
-        return Err(Error::JointCountMismatch {
-            file: data.source.clone(),
-            line: 1,
-            column: 1,
-            found: data.joint_count,
-            expected: model.joint_count(),
-        });
-    }
+    data.check_joint_count(model.joint_count())?;
     let column = data.tool_column.unwrap_or(1);
     data.rows
         .iter()

@@ -7,6 +7,7 @@
 #![deny(missing_docs)]
 
 mod calibrated;
+pub mod chart;
 mod compensation;
 pub mod diagnose;
 mod error;

@@ -325,6 +325,20 @@ impl MeasurementSet {
         }
     }
 
+    /// Refuses a set whose joint columns do not match a robot's `joints`.
+    pub fn check_joint_count(&self, joints: usize) -> Result<(), Error> {
+        if self.joint_count == joints {
+            return Ok(());
+        }
+        Err(Error::JointCountMismatch {
+            file: self.source.clone(),
+            line: 1,
+            column: 1,
+            found: self.joint_count,
+            expected: joints,
+        })
+    }
+
     /// The rows at `indices`, as a set of their own (same tools).
     pub fn subset(&self, indices: &[usize]) -> Self {
         Self { rows: indices.iter().map(|&i| self.rows[i].clone()).collect(), ..self.clone_empty() }

@@ -1,11 +1,11 @@
 //! `diagnose` on simulated data whose hidden effect it is not told.
 
-use lie::{SE3, SO3, Twist, Vector3};
-use loadsim::{Effects, GeneratorConfig, Harmonic, JointRange, PeriodicError, SimulatedCell, TrackerNoise};
+use loadsim::{Harmonic, PeriodicError};
 use pipeline::diagnose::{DiagnoseOptions, Effect, diagnose};
-use pipeline::{Measurement, MeasurementSet, RobotDescription};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+use pipeline::simulated::{
+    Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell,
+};
+use pipeline::{MeasurementSet, RobotDescription};
 use std::path::PathBuf;
 
 fn irb4400() -> RobotDescription {
@@ -14,37 +14,10 @@ fn irb4400() -> RobotDescription {
 }
 
 fn simulated(robot: &RobotDescription, effects: &Effects, full_pose: bool, seed: u64) -> MeasurementSet {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut truth = robot.nominal_model().unwrap();
-    for joint in truth.joints_mut() {
-        let mut v =
-            || Vector3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
-        let (a, b) = (v(), v());
-        joint.previous_from_joint_zero = Twist::new(a * 0.001, b * 0.001).exp() * joint.previous_from_joint_zero;
-    }
-    truth.set_tools(vec![truth.tools()[0] * SE3::from_translation(Vector3::new(0.0, 0.0, 0.2))]);
-    let mut cell = SimulatedCell::new(truth, robot.dynamics.clone());
-    cell.tracker_from_base = SE3::new(SO3::exp(&Vector3::new(0.0, 0.0, -1.0)), Vector3::new(-3.0, 2.0, 0.2));
-    let ranges: Vec<JointRange> =
-        robot.limits().into_iter().map(|(lower_rad, upper_rad)| JointRange { lower_rad, upper_rad }).collect();
+    let cell = simulated_cell(robot, &Perturbation::default(), seed).unwrap();
     let config = GeneratorConfig { sample_count: 250, seed, ..GeneratorConfig::default() };
     let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..effects.clone() };
-    let rows = loadsim::generate(&cell, &effects, &ranges, &config)
-        .unwrap()
-        .into_iter()
-        .map(|s| Measurement {
-            line: 0,
-            q: s.q,
-            position: s.tracker_from_tool.translation(),
-            orientation: full_pose.then(|| s.tracker_from_tool.rotation()),
-            payload_kg: s.payload_kg,
-            tool: 0,
-            temp_c: Some(s.temp_c),
-            t_s: Some(s.t_s),
-            torques_nm: None,
-        })
-        .collect();
-    MeasurementSet::from_rows("simulated", rows, vec![])
+    simulate(&cell, &effects, &joint_ranges(robot), &config, full_pose).unwrap()
 }
 
 /// The robot as the diagnosis gets it: no masses, no stiffness.

@@ -1,10 +1,7 @@
 //! The GP methods on simulated data with a load effect: the paper's ordering on held-out rows.
 
-use lie::{SE3, SO3, Twist, Vector3};
-use loadsim::{Effects, GeneratorConfig, JointCompliance, JointRange, SimulatedCell, TrackerNoise};
-use pipeline::{FitOptions, Measurement, MeasurementSet, Method, RobotDescription};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+use pipeline::simulated::{GeneratorConfig, Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
+use pipeline::{FitOptions, MeasurementSet, Method, RobotDescription};
 use std::path::PathBuf;
 
 fn irb4400() -> RobotDescription {
@@ -16,50 +13,14 @@ fn irb4400() -> RobotDescription {
 /// The payloads span the robot's rating (0 to 60 kg), where the load effect is of the same order
 /// as the self-weight one.
 fn loaded_data(robot: &RobotDescription, rows: usize, full_pose: bool, seed: u64) -> MeasurementSet {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut truth = robot.nominal_model().unwrap();
-    let mut twist = |t: f64, r: f64| {
-        let mut v =
-            || Vector3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
-        let (a, b) = (v(), v());
-        Twist::new(a * t, b * r).exp()
-    };
-    for joint in truth.joints_mut() {
-        joint.previous_from_joint_zero = twist(0.001, 0.001) * joint.previous_from_joint_zero;
-    }
-    let tool = truth.tools()[0] * SE3::from_translation(Vector3::new(0.0, 0.0, 0.2));
-    truth.set_tools(vec![tool]);
-    let mut cell = SimulatedCell::new(truth, robot.dynamics.clone());
-    cell.tracker_from_base = SE3::new(SO3::exp(&Vector3::new(0.0, 0.0, 2.0)), Vector3::new(3.5, 1.0, -0.3));
-    let effects = Effects {
-        compliance: Some(JointCompliance::default()),
-        tracker_noise: Some(TrackerNoise::default()),
-        ..Effects::default()
-    };
-    let ranges: Vec<JointRange> =
-        robot.limits().into_iter().map(|(lower_rad, upper_rad)| JointRange { lower_rad, upper_rad }).collect();
+    let cell = simulated_cell(robot, &Perturbation::default(), seed).unwrap();
     let config = GeneratorConfig {
         sample_count: rows,
         seed,
         payloads_kg: vec![0.0, 15.0, 30.0, 45.0, 60.0],
         ..GeneratorConfig::default()
     };
-    let samples = loadsim::generate(&cell, &effects, &ranges, &config).unwrap();
-    let rows = samples
-        .into_iter()
-        .map(|s| Measurement {
-            line: 0,
-            q: s.q,
-            position: s.tracker_from_tool.translation(),
-            orientation: full_pose.then(|| s.tracker_from_tool.rotation()),
-            payload_kg: s.payload_kg,
-            tool: 0,
-            temp_c: None,
-            t_s: None,
-            torques_nm: None,
-        })
-        .collect();
-    MeasurementSet::from_rows("simulated", rows, vec![])
+    simulate(&cell, &paper_effects(), &joint_ranges(robot), &config, full_pose).unwrap()
 }
 
 #[test]

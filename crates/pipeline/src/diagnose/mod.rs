@@ -117,15 +117,7 @@ pub fn diagnose(
     data: &MeasurementSet,
     options: &DiagnoseOptions,
 ) -> Result<Diagnosis, Error> {
-    if data.joint_count != robot.joint_count() {
-        return Err(Error::JointCountMismatch {
-            file: data.source.clone(),
-            line: 1,
-            column: 1,
-            found: data.joint_count,
-            expected: robot.joint_count(),
-        });
-    }
+    data.check_joint_count(robot.joint_count())?;
     let folds = options.folds.max(2);
     let needed = folds * 10;
     if data.rows.len() < needed {
