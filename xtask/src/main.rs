@@ -2,6 +2,7 @@
 //! command lives in a file of its own.
 
 mod bench_gp;
+mod bench_identify;
 mod blind_check;
 mod box_plot;
 mod convert_ur10;
@@ -28,6 +29,8 @@ enum Command {
     ReproduceSim(reproduce_sim::Args),
     /// Time the gp crate (fit, predict, Cholesky vs peak, sparse vs exact, scikit-learn); print a markdown table.
     BenchGp(bench_gp::Args),
+    /// Time the local POE identification against SciPy's least_squares on the same data; print a table.
+    BenchIdentify(bench_identify::Args),
     /// Convert the IPA UR10 tracker dataset to SPEC measurement CSV.
     ConvertUr10(convert_ur10::Args),
     /// Diagnose simulated datasets with a hidden effect, without the truth; print the confusion matrix.
@@ -41,6 +44,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::ReproduceSim(args) => reproduce_sim::run(args),
         Command::BenchGp(args) => bench_gp::run(args),
+        Command::BenchIdentify(args) => bench_identify::run(args),
         Command::ConvertUr10(args) => convert_ur10::run(args),
         Command::BlindCheck(args) => blind_check::run(args),
         Command::Ur10(args) => ur10::run(args),

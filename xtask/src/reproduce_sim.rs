@@ -163,7 +163,7 @@ fn variants() -> Vec<Variant> {
 }
 
 /// The workspace root, so that the defaults work from any directory.
-fn workspace_root() -> PathBuf {
+pub(crate) fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf)
 }
 
