@@ -40,6 +40,10 @@ pub struct Args {
     /// Also write the table as markdown here.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Fail (non-zero exit) when the top-1 rate is below this fraction, or when more than a tenth
+    /// of the `none` cases raise an alarm: the acceptance the diagnosis must meet (CI uses 0.8).
+    #[arg(long)]
+    require_top1: Option<f64>,
 }
 
 const EFFECTS: [Effect; 6] =
@@ -322,6 +326,18 @@ pub fn run(args: &Args) -> Result<(), String> {
             args.robot.display()
         );
         std::fs::write(path, body).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    if let Some(required) = args.require_top1 {
+        let right = cases.iter().filter(|c| c.verdict == c.truth).count();
+        let nones: Vec<&Case> = cases.iter().filter(|c| c.truth == Effect::None).collect();
+        let alarms = nones.iter().filter(|c| c.verdict != Effect::None).count();
+        let rate = right as f64 / cases.len().max(1) as f64;
+        if rate < required {
+            return Err(format!("top-1 {right}/{} is below the required {required}", cases.len()));
+        }
+        if alarms as f64 > 0.1 * nones.len() as f64 {
+            return Err(format!("{alarms} false alarms in {} none cases, more than one in ten", nones.len()));
+        }
     }
     Ok(())
 }
