@@ -57,11 +57,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     for direction in &id.unidentifiable {
         println!("    unidentifiable: {direction}");
     }
-    println!(
-        "  iterations: {}{}",
-        id.iteration_count(),
-        if id.converged { " (converged)" } else { " (iteration limit reached)" }
-    );
+    println!("  iterations: {} ({})", id.iteration_count(), id.termination);
     println!("  wrote {}", args.out.display());
     Ok(())
 }

@@ -34,12 +34,38 @@ pub enum Error {
         /// Number of parameters.
         expected: usize,
     },
-    /// Fewer observations than needed to determine the free parameters.
+    /// Fewer residual rows than free parameters: the data cannot determine them.
     TooFewObservations {
-        /// Rows given.
+        /// Measurements given.
+        observations: usize,
+        /// Residual rows they give (3 per position, 6 per pose).
         rows: usize,
-        /// Rows needed at least.
+        /// Parameters the identification would have to determine.
+        parameters: usize,
+    },
+    /// Fewer measurements than the closed-form registration has unknowns.
+    TooFewForRegistration {
+        /// Measurements given.
+        observations: usize,
+        /// Unknowns of the linear registration (13, and 9 more per extra tool).
         needed: usize,
+    },
+    /// An option is out of its range.
+    InvalidOption {
+        /// The field of the options struct.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// What it must be.
+        expected: &'static str,
+    },
+    /// A linear solve failed (a factorisation that did not converge or a matrix that is not
+    /// positive definite even with the damping).
+    LinearSolveFailed {
+        /// The iteration at which it failed.
+        iteration: usize,
+        /// Which decomposition.
+        decomposition: &'static str,
     },
     /// The observations mix full-pose and position-only rows, which the registration cannot use.
     MixedObservations,
@@ -74,8 +100,19 @@ impl fmt::Display for Error {
             Error::MaskLength { given, expected } => {
                 write!(f, "parameter mask has {given} entries, the model has {expected} parameters")
             }
-            Error::TooFewObservations { rows, needed } => {
-                write!(f, "{rows} measurement rows, at least {needed} needed")
+            Error::TooFewObservations { observations, rows, parameters } => write!(
+                f,
+                "{observations} measurements give {rows} residual rows, fewer than the {parameters} free parameters \
+                 they must determine: measure more poses or fit fewer parameters"
+            ),
+            Error::TooFewForRegistration { observations, needed } => {
+                write!(f, "{observations} measurements, the registration of the tracker needs at least {needed}")
+            }
+            Error::InvalidOption { name, value, expected } => {
+                write!(f, "option {name} = {value}: expected {expected}")
+            }
+            Error::LinearSolveFailed { iteration, decomposition } => {
+                write!(f, "the {decomposition} of iteration {iteration} failed")
             }
             Error::MixedObservations => {
                 write!(f, "full-pose and position-only rows cannot be mixed")

@@ -169,6 +169,6 @@ fn registration_refuses_too_few_rows() {
         Observation { q: vec![0.0; 6], tool: 0, target: Target::Point(Vector3::new(gaussian(&mut rng), 0.0, 0.0)) };
     assert!(matches!(
         calibrate(&nominal, &[observation], Scope::Full, &IdentificationOptions::default()),
-        Err(poe::Error::TooFewObservations { .. })
+        Err(poe::Error::TooFewForRegistration { observations: 1, needed: 13 })
     ));
 }

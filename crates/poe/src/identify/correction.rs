@@ -18,6 +18,13 @@ pub trait PoseCorrection: Sync {
     /// The twists `c_l` of observation `index` under `model`, one per parameter, written into
     /// `out` (length [`PoseCorrection::parameter_count`]).
     fn twists(&self, model: &LocalPoe, index: usize, out: &mut [Vector6]);
+
+    /// Prior standard deviation of parameter `parameter` about zero, used by Levenberg–Marquardt
+    /// ([`crate::identify::Solver::LevenbergMarquardt`]); `f64::INFINITY` (the default) for none.
+    fn prior_sigma(&self, parameter: usize) -> f64 {
+        let _ = parameter;
+        f64::INFINITY
+    }
 }
 
 /// A correction together with its current parameter values.
@@ -28,12 +35,22 @@ pub(crate) struct Corrected<'a> {
 }
 
 impl Corrected<'_> {
-    /// `exp((Σ θ_l c_l)^) · pose` and the twists used (for the Jacobian's extra columns).
+    /// `exp((Σ θ_l c_l)^) · pose`, with `twists` set to the derivative of that pose with respect to
+    /// each `θ_l` as a left twist: `J_l(ξ) c_l`, `ξ = Σ θ_l c_l` (exact, for the Jacobian's extra
+    /// columns).
     pub(crate) fn apply(&self, model: &LocalPoe, index: usize, pose: SE3, twists: &mut Vec<Vector6>) -> SE3 {
         twists.clear();
         twists.resize(self.theta.len(), Vector6::zeros());
         self.correction.twists(model, index, twists);
         let total: Vector6 = twists.iter().zip(self.theta).map(|(c, t)| c * *t).sum();
-        if total == Vector6::zeros() { pose } else { Twist::from_vector(&total).exp() * pose }
+        if total == Vector6::zeros() {
+            return pose;
+        }
+        let xi = Twist::from_vector(&total);
+        let jacobian = SE3::left_jacobian(&xi);
+        for twist in twists.iter_mut() {
+            *twist = jacobian * *twist;
+        }
+        xi.exp() * pose
     }
 }

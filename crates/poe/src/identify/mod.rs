@@ -1,12 +1,15 @@
 //! Identification of the local POE parameters from measurements (paper Section III-A-2).
 
 mod correction;
+mod levenberg;
+mod normal;
 mod options;
 mod redundancy;
 mod registration;
 mod report;
 mod residual;
 mod solver;
+mod termination;
 
 pub use correction::PoseCorrection;
 pub use options::{IdentificationOptions, Observation, ParameterMask, Solver, Target};
@@ -15,6 +18,7 @@ pub use registration::register;
 pub use report::{IdentificationReport, IterationRecord};
 pub use residual::ResidualStats;
 pub use solver::{Identification, identify, identify_with_correction};
+pub use termination::Termination;
 
 use crate::{Error, LocalPoe};
 

@@ -1,6 +1,6 @@
 //! What the identification is told: observations, solver choice, weights and masks.
 
-use crate::{Block, ParameterLayout};
+use crate::{Block, Error, ParameterLayout};
 use lie::{SE3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -36,22 +36,46 @@ pub enum Solver {
 }
 
 /// Options of the identification. Weights are the expected measurement noise: each residual is
-/// divided by its sigma, so metres and radians become comparable.
+/// divided by its sigma, so metres and radians become comparable. Every tuning constant of the
+/// solvers is a field here; [`IdentificationOptions::validate`] checks them once, before any work.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct IdentificationOptions {
     /// The linear solver of each iteration.
     pub solver: Solver,
     /// At most this many iterations.
     pub max_iterations: usize,
-    /// Stop when the weighted cost decreases by less than this fraction in one iteration.
-    pub tolerance: f64,
+    /// Converged when an accepted step lowers the weighted cost by less than this fraction.
+    #[serde(alias = "tolerance")]
+    pub cost_tolerance: f64,
+    /// Converged when a step is shorter than this, relative to the parameters' deviation from the
+    /// start (plus this, so that a start at zero can converge).
+    pub step_tolerance: f64,
+    /// Converged when every column of the weighted Jacobian is this close to orthogonal to the
+    /// residual: `max_j |a_jᵀ y| / (‖a_j‖ ‖y‖) ≤ gradient_tolerance` (MINPACK's `gtol`).
+    pub gradient_tolerance: f64,
+    /// Halvings of a pseudo-inverse step before the line search gives up.
+    pub line_search_halvings: usize,
+    /// Levenberg–Marquardt's first damping, relative to the diagonal of the normal matrix.
+    pub initial_damping: f64,
+    /// Smallest damping Levenberg–Marquardt lowers to.
+    pub min_damping: f64,
+    /// Largest damping: beyond it no step lowers the cost and the solver stops.
+    pub max_damping: f64,
     /// Noise of a position residual, metres.
     pub position_sigma_m: f64,
     /// Noise of an orientation residual, radians.
     pub rotation_sigma_rad: f64,
-    /// Relative singular-value threshold below which a direction counts as unidentifiable.
+    /// Relative singular-value threshold: the pseudo-inverse drops directions below
+    /// `rcond · σ_max`, and the report counts them as unidentifiable.
     pub rcond: f64,
+    /// Levenberg–Marquardt only: prior standard deviation of the local frames' translations about
+    /// the start, metres. Directions the data does not excite stay at the start instead of
+    /// drifting on noise; `f64::INFINITY` for none.
+    pub prior_translation_m: f64,
+    /// Levenberg–Marquardt only: prior standard deviation of the local frames' rotations about the
+    /// start, radians.
+    pub prior_rotation_rad: f64,
 }
 
 impl Default for IdentificationOptions {
@@ -59,11 +83,70 @@ impl Default for IdentificationOptions {
         Self {
             solver: Solver::PseudoInverse,
             max_iterations: 50,
-            tolerance: 1e-10,
+            cost_tolerance: 1e-10,
+            // Far below any parameter change that moves a tool point by a micrometre.
+            step_tolerance: 1e-12,
+            // SciPy's `least_squares` default `gtol`.
+            gradient_tolerance: 1e-8,
+            // The halvings the paper's iteration always had: a step shrunk 4096 times is noise.
+            line_search_halvings: 12,
+            // Marquardt's and Nielsen's customary start (Madsen, Nielsen, Tingleff, "Methods for
+            // non-linear least squares problems", 2004, §3.2: τ = 1e-3 when the start is good,
+            // as after the registration and the base-tool step).
+            initial_damping: 1e-3,
+            min_damping: 1e-12,
+            // Beyond 1e12 times the diagonal the step is below the rounding of the parameters.
+            max_damping: 1e12,
             position_sigma_m: 1e-4,
             rotation_sigma_rad: 1e-4,
             rcond: 1e-9,
+            // No prior: the plain least-squares solution (callers that want a maximum a
+            // posteriori fit set it, as `pipeline` does for non-geometric effects).
+            prior_translation_m: f64::INFINITY,
+            prior_rotation_rad: f64::INFINITY,
         }
+    }
+}
+
+impl IdentificationOptions {
+    /// Checks every field once: tolerances and sigmas positive and finite, damping bounds ordered.
+    pub fn validate(&self) -> Result<(), Error> {
+        let invalid = |name: &'static str, value: f64, expected: &'static str| {
+            Err(Error::InvalidOption { name, value, expected })
+        };
+        let positive = [
+            ("cost_tolerance", self.cost_tolerance),
+            ("step_tolerance", self.step_tolerance),
+            ("gradient_tolerance", self.gradient_tolerance),
+            ("initial_damping", self.initial_damping),
+            ("min_damping", self.min_damping),
+            ("max_damping", self.max_damping),
+            ("position_sigma_m", self.position_sigma_m),
+            ("rotation_sigma_rad", self.rotation_sigma_rad),
+            ("rcond", self.rcond),
+        ];
+        for (name, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return invalid(name, value, "a finite number above 0");
+            }
+        }
+        for (name, value) in
+            [("prior_translation_m", self.prior_translation_m), ("prior_rotation_rad", self.prior_rotation_rad)]
+        {
+            if value.is_nan() || value <= 0.0 {
+                return invalid(name, value, "a number above 0 (inf for no prior)");
+            }
+        }
+        if self.rcond >= 1.0 {
+            return invalid("rcond", self.rcond, "below 1");
+        }
+        if self.max_iterations == 0 {
+            return invalid("max_iterations", 0.0, "at least 1");
+        }
+        if !(self.min_damping <= self.initial_damping && self.initial_damping <= self.max_damping) {
+            return invalid("initial_damping", self.initial_damping, "between min_damping and max_damping");
+        }
+        Ok(())
     }
 }
 

@@ -34,7 +34,7 @@ pub fn register(nominal: &LocalPoe, observations: &[Observation]) -> Result<Loca
     let tool_count = observations.iter().map(|o| o.tool + 1).max().unwrap_or(1);
     let unknowns = 4 + 9 * tool_count;
     if observations.len() < unknowns {
-        return Err(Error::TooFewObservations { rows: observations.len(), needed: unknowns });
+        return Err(Error::TooFewForRegistration { observations: observations.len(), needed: unknowns });
     }
     let flanges: Vec<SE3> = observations.iter().map(|o| nominal.forward(&o.q, 0)).collect::<Result<_, _>>()?;
     let points: Vec<Vector3> = observations

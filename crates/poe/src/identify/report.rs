@@ -1,6 +1,6 @@
 //! What an identification reports.
 
-use super::Redundancy;
+use super::{Redundancy, Termination};
 
 /// The errors after one iteration (index 0: before the first).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -11,6 +11,9 @@ pub struct IterationRecord {
     pub rms_rotation_rad: Option<f64>,
     /// Norm of the parameter update taken to reach this iteration.
     pub step_norm: f64,
+    /// The weighted cost (squared residual in noise units, plus the prior's term where there is
+    /// one) after this iteration.
+    pub cost: f64,
 }
 
 /// How an identification went and what the data could and could not determine.
@@ -18,10 +21,18 @@ pub struct IterationRecord {
 pub struct IdentificationReport {
     /// Errors per iteration, the initial model first.
     pub iterations: Vec<IterationRecord>,
-    /// Whether the cost stopped decreasing before the iteration limit.
+    /// Whether a convergence criterion was met ([`Termination::converged`]).
     pub converged: bool,
+    /// Why the iterations ended.
+    pub termination: Termination,
+    /// The weighted cost at the end.
+    pub final_cost: f64,
+    /// `max_j |a_jᵀ y| / (‖a_j‖ ‖y‖)` at the end: 0 at an exact stationary point.
+    pub gradient_cosine: f64,
     /// Number of parameters the identification was allowed to change.
     pub free_parameters: usize,
+    /// Number of residual rows.
+    pub residual_rows: usize,
     /// Rank of the weighted identification Jacobian: the number of identifiable parameters.
     pub rank: usize,
     /// Singular values of the weighted identification Jacobian at the solution, descending.
@@ -30,11 +41,20 @@ pub struct IdentificationReport {
     pub condition_number: f64,
     /// The directions the data cannot determine, in words.
     pub unidentifiable: Vec<Redundancy>,
+    /// Correction parameters (indices into the correction's θ) that the data barely determines:
+    /// their posterior standard deviation is more than half their prior's, so the prior holds
+    /// them near their start (Levenberg–Marquardt with a prior only).
+    pub held_at_prior: Vec<usize>,
 }
 
 impl IdentificationReport {
     /// Number of iterations taken (not counting the initial evaluation).
     pub fn iteration_count(&self) -> usize {
         self.iterations.len().saturating_sub(1)
+    }
+
+    /// Residual rows per identifiable parameter: below about 3 a fit follows the noise.
+    pub fn redundancy(&self) -> f64 {
+        self.residual_rows as f64 / self.rank.max(1) as f64
     }
 }

@@ -1,12 +1,15 @@
-//! Iterative linearised least squares (paper Section III-A-2) and Levenberg–Marquardt.
+//! The identification loop: the paper's iterative linearised least squares with a pseudo-inverse
+//! (Section III-A-2), or Levenberg–Marquardt with a prior (`levenberg.rs`). Both stop only on a
+//! stated criterion and say which ([`Termination`]).
 
 use super::correction::{Corrected, PoseCorrection};
+use super::levenberg::levenberg_marquardt;
 use super::redundancy::find_redundancies;
 use super::residual::{ResidualStats, linearise, residuals};
 use super::{IdentificationOptions, IdentificationReport, IterationRecord, Observation, ParameterMask, Solver};
+use super::{Termination, normal};
 use crate::{Error, LocalPoe};
-use faer::prelude::Solve;
-use faer::{Mat, Side};
+use faer::Mat;
 
 /// The result of an identification: the identified model and how it got there.
 #[derive(Debug, Clone)]
@@ -19,72 +22,74 @@ pub struct Identification {
     pub report: IdentificationReport,
 }
 
-fn cost(y: &[f64]) -> f64 {
+pub(super) fn cost(y: &[f64]) -> f64 {
     y.iter().map(|v| v * v).sum()
 }
 
-/// Singular value decomposition of the weighted Jacobian, as plain vectors.
-struct Decomposition {
-    singular_values: Vec<f64>,
-    u: Mat<f64>,
-    v: Mat<f64>,
+/// The problem being solved: what is free, what is observed, how rows are weighted.
+pub(super) struct Problem<'a> {
+    pub observations: &'a [Observation],
+    pub free: Vec<usize>,
+    pub correction: Option<&'a dyn PoseCorrection>,
+    pub options: &'a IdentificationOptions,
 }
 
-fn decompose(a: &Mat<f64>, iterations: usize, residual: f64) -> Result<Decomposition, Error> {
-    let svd = a.thin_svd().map_err(|_| Error::NotConverged { iterations, residual })?;
-    let s = svd.S().column_vector();
-    Ok(Decomposition {
-        singular_values: (0..s.nrows()).map(|i| s[i]).collect(),
-        u: svd.U().to_owned(),
-        v: svd.V().to_owned(),
-    })
+/// A point of the parameter space: the model, the correction's θ, and the accumulated steps
+/// (the deviation from the start that a prior penalises).
+#[derive(Clone)]
+pub(super) struct State {
+    pub model: LocalPoe,
+    pub theta: Vec<f64>,
+    pub deviation: Vec<f64>,
 }
 
-/// `x = A⁺ y` with the directions below `rcond · σ_max` dropped (the paper's pseudo-inverse).
-fn pseudo_inverse_step(d: &Decomposition, y: &[f64], rcond: f64) -> Vec<f64> {
-    let threshold = rcond * d.singular_values.first().copied().unwrap_or(0.0);
-    let mut x = vec![0.0; d.v.nrows()];
-    for (k, &sigma) in d.singular_values.iter().enumerate() {
-        if sigma <= threshold || sigma == 0.0 {
-            continue;
+impl Problem<'_> {
+    pub(super) fn parameter_count(&self) -> usize {
+        self.free.len() + self.correction.map_or(0, |c| c.parameter_count())
+    }
+
+    fn corrected<'b>(&'b self, theta: &'b [f64]) -> Option<Corrected<'b>> {
+        self.correction.map(|correction| Corrected { correction, theta })
+    }
+
+    /// The state after a step of every parameter (free kinematic ones first).
+    pub(super) fn step(&self, state: &State, step: &[f64]) -> State {
+        let layout = state.model.layout();
+        let mut full = vec![0.0; layout.len()];
+        for (&index, &value) in self.free.iter().zip(step) {
+            full[index] = value;
         }
-        let uty: f64 = (0..y.len()).map(|i| d.u[(i, k)] * y[i]).sum();
-        let scale = uty / sigma;
-        for (j, xj) in x.iter_mut().enumerate() {
-            *xj += scale * d.v[(j, k)];
-        }
+        let mut model = state.model.clone();
+        model.apply_update(&full);
+        let theta = state.theta.iter().zip(&step[self.free.len()..]).map(|(t, s)| t + s).collect();
+        let deviation = state.deviation.iter().zip(step).map(|(d, s)| d + s).collect();
+        State { model, theta, deviation }
     }
-    x
-}
 
-/// Solves `(AᵀA + λ diag(AᵀA)) x = Aᵀy`.
-fn damped_step(normal: &Mat<f64>, gradient: &[f64], lambda: f64) -> Option<Vec<f64>> {
-    let p = normal.nrows();
-    let mut damped = normal.clone();
-    for i in 0..p {
-        // A column that no row sees keeps a unit floor so that the system stays definite.
-        damped[(i, i)] += lambda * normal[(i, i)].max(1e-12) + 1e-12;
+    /// The weighted residual of a state and its errors.
+    pub(super) fn residuals(&self, state: &State) -> Result<(Vec<f64>, ResidualStats), Error> {
+        residuals(&state.model, self.observations, self.corrected(&state.theta), self.options)
     }
-    let llt = damped.llt(Side::Lower).ok()?;
-    let rhs = Mat::<f64>::from_fn(p, 1, |i, _| gradient[i]);
-    let x = llt.solve(rhs);
-    Some((0..p).map(|i| x[(i, 0)]).collect())
-}
 
-fn with<'a>(correction: Option<&'a dyn PoseCorrection>, theta: &'a [f64]) -> Option<Corrected<'a>> {
-    correction.map(|correction| Corrected { correction, theta })
-}
-
-fn scatter(free: &[usize], step: &[f64], length: usize) -> Vec<f64> {
-    let mut full = vec![0.0; length];
-    for (&index, &value) in free.iter().zip(step) {
-        full[index] = value;
+    /// The weighted Jacobian (free columns, then the correction's), residual and errors.
+    pub(super) fn linearise(&self, state: &State) -> Result<(Mat<f64>, Vec<f64>, ResidualStats), Error> {
+        linearise(&state.model, self.observations, &self.free, self.corrected(&state.theta), self.options)
     }
-    full
 }
 
-fn record(stats: ResidualStats, step_norm: f64) -> IterationRecord {
-    IterationRecord { rms_position_m: stats.rms_position_m, rms_rotation_rad: stats.rms_rotation_rad, step_norm }
+pub(super) fn record(stats: ResidualStats, step_norm: f64, cost: f64) -> IterationRecord {
+    IterationRecord { rms_position_m: stats.rms_position_m, rms_rotation_rad: stats.rms_rotation_rad, step_norm, cost }
+}
+
+/// What a solver returns to [`identify_with_correction`].
+pub(super) struct Solved {
+    pub state: State,
+    pub a: Mat<f64>,
+    pub iterations: Vec<IterationRecord>,
+    pub termination: Termination,
+    pub final_cost: f64,
+    pub gradient_cosine: f64,
+    pub held_at_prior: Vec<usize>,
 }
 
 /// Identifies the free parameters of `initial` from `observations` by iterating
@@ -100,8 +105,10 @@ pub fn identify(
 }
 
 /// [`identify`], with the parameters of a [`PoseCorrection`] identified jointly with the free
-/// kinematic ones (starting from zero). The pseudo-inverse drops directions the correction shares
-/// with the kinematics, so a correction partly absorbed by the geometry is harmless.
+/// kinematic ones (starting from zero).
+///
+/// Refuses data with fewer residual rows than free parameters. The report says which criterion
+/// ended the iterations; `converged` is true only when one of the convergence criteria was met.
 pub fn identify_with_correction(
     initial: &LocalPoe,
     observations: &[Observation],
@@ -109,101 +116,111 @@ pub fn identify_with_correction(
     correction: Option<&dyn PoseCorrection>,
     options: &IdentificationOptions,
 ) -> Result<Identification, Error> {
-    let mut theta = vec![0.0; correction.map_or(0, |c| c.parameter_count())];
+    options.validate()?;
     let layout = initial.layout();
     if mask.flags().len() != layout.len() {
         return Err(Error::MaskLength { given: mask.flags().len(), expected: layout.len() });
     }
-    let free = mask.free_indices();
+    let problem = Problem { observations, free: mask.free_indices(), correction, options };
     let rows = super::residual::row_count(observations);
-    if rows < free.len().min(6) {
-        return Err(Error::TooFewObservations { rows: observations.len(), needed: free.len().div_ceil(6) });
+    let parameters = problem.parameter_count();
+    if rows < parameters {
+        return Err(Error::TooFewObservations { observations: observations.len(), rows, parameters });
     }
-    let mut model = initial.clone();
-    let (a, mut y, stats) = linearise(&model, observations, &free, with(correction, &theta), options)?;
-    let mut a = a;
-    let mut iterations = vec![record(stats, 0.0)];
-    let mut current = cost(&y);
-    let mut lambda = 1e-3;
-    let mut converged = false;
-    for iteration in 1..=options.max_iterations {
-        let step = match options.solver {
-            Solver::PseudoInverse => {
-                let d = decompose(&a, iteration, stats.rms_position_m)?;
-                pseudo_inverse_step(&d, &y, options.rcond)
-            }
-            Solver::LevenbergMarquardt => {
-                let normal = a.transpose() * &a;
-                let gradient: Vec<f64> = (0..a.ncols()).map(|j| (0..y.len()).map(|i| a[(i, j)] * y[i]).sum()).collect();
-                damped_step(&normal, &gradient, lambda).unwrap_or_else(|| vec![0.0; a.ncols()])
-            }
-        };
-        // Line search by halving: Gauss–Newton can overshoot far from the solution.
-        let mut scale = 1.0;
-        let mut accepted = None;
-        for _ in 0..12 {
-            let scaled: Vec<f64> = step.iter().map(|s| s * scale).collect();
-            let mut trial = model.clone();
-            trial.apply_update(&scatter(&free, &scaled[..free.len()], layout.len()));
-            let trial_theta: Vec<f64> = theta.iter().zip(&scaled[free.len()..]).map(|(t, s)| t + s).collect();
-            let (trial_y, _) = residuals(&trial, observations, with(correction, &trial_theta), options)?;
-            let trial_cost = cost(&trial_y);
-            if trial_cost.is_finite() && trial_cost <= current {
-                accepted = Some((trial, trial_theta, trial_cost, scaled));
-                break;
-            }
-            match options.solver {
-                Solver::PseudoInverse => scale *= 0.5,
-                Solver::LevenbergMarquardt => break,
-            }
-        }
-        let Some((trial, trial_theta, trial_cost, scaled)) = accepted else {
-            if options.solver == Solver::LevenbergMarquardt && lambda < 1e12 {
-                lambda *= 10.0;
-                continue;
-            }
-            converged = true;
-            break;
-        };
-        let decrease = (current - trial_cost) / current.max(f64::MIN_POSITIVE);
-        model = trial;
-        theta = trial_theta;
-        current = trial_cost;
-        lambda = (lambda / 10.0).max(1e-12);
-        let (next_a, next_y, next_stats) = linearise(&model, observations, &free, with(correction, &theta), options)?;
-        a = next_a;
-        y = next_y;
-        let step_norm = scaled.iter().map(|v| v * v).sum::<f64>().sqrt();
-        iterations.push(record(next_stats, step_norm));
-        if !current.is_finite() {
-            return Err(Error::NotConverged { iterations: iteration, residual: next_stats.rms_position_m });
-        }
-        if decrease < options.tolerance || step_norm < 1e-14 {
-            converged = true;
-            break;
-        }
-    }
-    let last = iterations.last().map_or(f64::NAN, |r| r.rms_position_m);
-    let d = decompose(&a, iterations.len(), last)?;
-    let smax = d.singular_values.first().copied().unwrap_or(0.0);
-    let kept: Vec<f64> = d.singular_values.iter().copied().filter(|&s| s > options.rcond * smax && s > 0.0).collect();
+    let start = State {
+        model: initial.clone(),
+        theta: vec![0.0; correction.map_or(0, |c| c.parameter_count())],
+        deviation: vec![0.0; parameters],
+    };
+    let solved = match options.solver {
+        Solver::PseudoInverse => gauss_newton(&problem, start)?,
+        Solver::LevenbergMarquardt => levenberg_marquardt(&problem, start)?,
+    };
+    let svd = normal::Decomposition::new(&solved.a, solved.iterations.len())?;
+    let smax = svd.singular_values.first().copied().unwrap_or(0.0);
+    let kept: Vec<f64> = svd.singular_values.iter().copied().filter(|&s| s > options.rcond * smax && s > 0.0).collect();
     let rank = kept.len();
     let condition_number = match kept.last() {
         Some(&smin) => smax / smin,
         None => f64::INFINITY,
     };
-    let unidentifiable = find_redundancies(&model, observations, mask, a.ncols().saturating_sub(rank));
+    let unidentifiable =
+        find_redundancies(&solved.state.model, observations, mask, solved.a.ncols().saturating_sub(rank));
     Ok(Identification {
-        model,
-        correction: theta,
+        model: solved.state.model,
+        correction: solved.state.theta,
         report: IdentificationReport {
-            iterations,
-            converged,
-            free_parameters: a.ncols(),
+            iterations: solved.iterations,
+            converged: solved.termination.converged(),
+            termination: solved.termination,
+            final_cost: solved.final_cost,
+            gradient_cosine: solved.gradient_cosine,
+            free_parameters: parameters,
+            residual_rows: rows,
             rank,
-            singular_values: d.singular_values,
+            singular_values: svd.singular_values,
             condition_number,
             unidentifiable,
+            held_at_prior: solved.held_at_prior,
         },
     })
+}
+
+/// The paper's iteration: `x = A⁺ y` with the directions below `rcond · σ_max` dropped, each step
+/// halved until it lowers the cost (Gauss–Newton can overshoot far from the solution).
+fn gauss_newton(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
+    let options = problem.options;
+    let mut state = start;
+    let (mut a, mut y, stats) = problem.linearise(&state)?;
+    let mut current = cost(&y);
+    let mut iterations = vec![record(stats, 0.0, current)];
+    let mut termination = Termination::IterationLimit { iterations: options.max_iterations };
+    for iteration in 1..=options.max_iterations {
+        let decomposition = normal::Decomposition::new(&a, iteration)?;
+        let step = decomposition.pseudo_inverse_solve(&y, options.rcond);
+        let mut accepted = None;
+        let mut scale = 1.0;
+        for _ in 0..=options.line_search_halvings {
+            let scaled: Vec<f64> = step.iter().map(|s| s * scale).collect();
+            let trial = problem.step(&state, &scaled);
+            let (trial_y, _) = problem.residuals(&trial)?;
+            let trial_cost = cost(&trial_y);
+            if trial_cost.is_finite() && trial_cost <= current {
+                accepted = Some((trial, trial_cost, scaled));
+                break;
+            }
+            scale *= 0.5;
+        }
+        let Some((trial, trial_cost, scaled)) = accepted else {
+            let gradient_cosine = normal::gradient_cosine(&a, &y, &[], &[]);
+            termination = if gradient_cosine <= options.gradient_tolerance {
+                Termination::GradientTolerance { gradient_cosine }
+            } else {
+                Termination::LineSearchFailed { gradient_cosine }
+            };
+            break;
+        };
+        let relative_decrease = (current - trial_cost) / current.max(f64::MIN_POSITIVE);
+        state = trial;
+        current = trial_cost;
+        let (next_a, next_y, next_stats) = problem.linearise(&state)?;
+        a = next_a;
+        y = next_y;
+        let step_norm = scaled.iter().map(|v| v * v).sum::<f64>().sqrt();
+        iterations.push(record(next_stats, step_norm, current));
+        if !current.is_finite() {
+            return Err(Error::NotConverged { iterations: iteration, residual: next_stats.rms_position_m });
+        }
+        if relative_decrease < options.cost_tolerance {
+            termination = Termination::CostTolerance { relative_decrease };
+            break;
+        }
+        let deviation = state.deviation.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if step_norm <= options.step_tolerance * (deviation + options.step_tolerance) {
+            termination = Termination::StepTolerance { step_norm };
+            break;
+        }
+    }
+    let gradient_cosine = normal::gradient_cosine(&a, &y, &[], &[]);
+    Ok(Solved { state, a, iterations, termination, final_cost: current, gradient_cosine, held_at_prior: Vec::new() })
 }
