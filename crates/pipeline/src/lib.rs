@@ -19,6 +19,7 @@ mod method;
 mod metrics;
 mod model_file;
 mod robot;
+mod robot_dh;
 mod ron_position;
 pub mod simulated;
 
@@ -32,3 +33,4 @@ pub use method::{Method, UnknownMethod};
 pub use metrics::{ErrorSummary, PoseError};
 pub use model_file::{SCHEMA_VERSION, parse_model, read_model, write_model};
 pub use robot::{FlangeDescription, JointDescription, JointType, RobotDescription};
+pub use robot_dh::{DhTable, DhTableRow};

@@ -1,7 +1,9 @@
 //! The robot description file (SPEC "Robot description (RON)"): nominal zero-configuration joint
-//! axes, limits, the flange, and optionally a nominal tool and the load model's data.
+//! axes (or a DH table, `robot_dh.rs`), limits, the flange, and optionally a nominal tool and the
+//! load model's data.
 
 use crate::Error;
+use crate::robot_dh::DhTable;
 use crate::ron_position::{field_position, ron_options};
 use lie::{Matrix3, SE3, SO3, Vector3};
 use poe::{JointAxis, JointKind, LocalPoe};
@@ -65,6 +67,48 @@ pub struct RobotDescription {
     pub dynamics: Option<loadsim::RobotDynamics>,
 }
 
+/// The robot file as written: the kinematics as zero-configuration axes (`joints` and `flange`) or
+/// as a DH table (`dh`, and a `flange` only where it is not the last DH frame).
+#[derive(Deserialize)]
+#[serde(rename = "Robot", deny_unknown_fields)]
+struct RobotFile {
+    name: String,
+    #[serde(default)]
+    joints: Option<Vec<JointDescription>>,
+    #[serde(default)]
+    dh: Option<DhTable>,
+    #[serde(default)]
+    flange: Option<FlangeDescription>,
+    #[serde(default)]
+    tool: Option<[f64; 3]>,
+    #[serde(default)]
+    dynamics: Option<loadsim::RobotDynamics>,
+}
+
+impl RobotFile {
+    fn into_description(self, text: &str, file: &str) -> Result<RobotDescription, Error> {
+        let at = |field: &str, message: &str| {
+            let (line, column) = field_position(text, field, 0);
+            Error::RonFormat { file: file.to_owned(), line, column, message: message.to_owned() }
+        };
+        let (joints, flange) = match (self.joints, self.dh) {
+            (Some(_), Some(_)) => return Err(at("dh", "give the kinematics as `joints` or as a `dh` table, not both")),
+            (None, None) => {
+                return Err(at("name", "no kinematics: give `joints` (zero-configuration axes) or a `dh` table"));
+            }
+            (Some(joints), None) => match self.flange {
+                Some(flange) => (joints, flange),
+                None => return Err(at("joints", "`flange` is required with `joints`")),
+            },
+            (None, Some(table)) => {
+                let (joints, last_frame) = table.zero_configuration(text, file)?;
+                (joints, self.flange.unwrap_or(last_frame))
+            }
+        };
+        Ok(RobotDescription { name: self.name, joints, flange, tool: self.tool, dynamics: self.dynamics })
+    }
+}
+
 /// Largest deviation from 1 of an axis norm, or from 0 of the flange axes' dot product.
 const UNIT_TOLERANCE: f64 = 1e-6;
 
@@ -76,14 +120,16 @@ impl RobotDescription {
         Self::parse(&text, &file)
     }
 
-    /// Parses and validates a robot description; `file` names it in errors.
+    /// Parses and validates a robot description; `file` names it in errors. The kinematics may be
+    /// zero-configuration axes or a DH table (turned into axes, see [`DhTable`]).
     pub fn parse(text: &str, file: &str) -> Result<Self, Error> {
-        let robot: RobotDescription = ron_options().from_str(text).map_err(|e| Error::RonFormat {
+        let form: RobotFile = ron_options().from_str(text).map_err(|e| Error::RonFormat {
             file: file.to_owned(),
             line: e.span.start.line,
             column: e.span.start.col,
             message: e.code.to_string(),
         })?;
+        let robot = form.into_description(text, file)?;
         robot.validate(text, file)?;
         Ok(robot)
     }
