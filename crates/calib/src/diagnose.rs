@@ -1,7 +1,7 @@
 //! `calib diagnose`: where the geometric model misses, which effect explains it, how far it shrinks.
 
-use pipeline::RobotDescription;
 use pipeline::diagnose::{DiagnoseOptions, diagnose};
+use pipeline::{ReadOptions, RobotDescription};
 use std::path::PathBuf;
 
 /// Diagnose what a geometric calibration leaves: where, which effect, how far it shrinks.
@@ -37,7 +37,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let robot = RobotDescription::read(&args.robot)?;
-    let data = pipeline::read_measurements(&args.data, Some(robot.joint_count()))?;
+    let data = pipeline::read_measurements(&args.data, &ReadOptions::for_joints(robot.joint_kinds()))?;
     let options =
         DiagnoseOptions { folds: args.folds, seed: args.seed, noise_mm: args.noise_mm, ..DiagnoseOptions::default() };
     let diagnosis = diagnose(&robot, &data, &options)?;
@@ -53,7 +53,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         std::fs::write(&path, diagnosis.markdown(&names)).map_err(|e| format!("{}: {e}", path.display()))?;
     }
     if args.json {
-        println!("{}", diagnosis.to_json());
+        println!("{}", json_text(diagnosis.to_json())?);
     } else {
         print!("{}", diagnosis.summary());
         if let Some(folder) = &args.report {
@@ -61,4 +61,22 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     Ok(())
+}
+
+/// The diagnosis's JSON text. `Diagnosis::to_json` gives `null` when serialisation failed: that is
+/// an error with a non-zero exit, never a `null` printed as if it were the answer.
+fn json_text(value: serde_json::Value) -> Result<String, String> {
+    match value {
+        serde_json::Value::Null => Err("the diagnosis could not be written as JSON".into()),
+        value => Ok(value.to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_diagnosis_that_did_not_serialise_is_an_error_not_null() {
+        assert!(super::json_text(serde_json::Value::Null).is_err());
+        assert_eq!(super::json_text(serde_json::json!({"n": 1})).unwrap(), r#"{"n":1}"#);
+    }
 }

@@ -18,7 +18,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let model = pipeline::read_model(&args.model)?;
-    let data = pipeline::read_measurements(&args.data, Some(model.joint_count()))?;
+    let data = pipeline::read_measurements(&args.data, &pipeline::ReadOptions::for_joints(model.joint_kinds()))?;
     let evaluation = pipeline::evaluate(&model, &data)?;
     let s = &evaluation.summary;
     if args.json {

@@ -1,6 +1,6 @@
 //! `calib fit`: fit a calibration method to measurements and write the model.
 
-use pipeline::{ErrorSummary, FitOptions, Method, RobotDescription};
+use pipeline::{ErrorSummary, FitOptions, Method, ReadOptions, RobotDescription};
 use std::path::PathBuf;
 
 /// Fit a calibrated model to measurements.
@@ -26,7 +26,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let robot = RobotDescription::read(&args.robot)?;
-    let data = pipeline::read_measurements(&args.data, Some(robot.joint_count()))?;
+    let data = pipeline::read_measurements(&args.data, &ReadOptions::for_joints(robot.joint_kinds()))?;
     let options = FitOptions { joint_compliance: args.joint_compliance, ..FitOptions::default() };
     let (model, report) = pipeline::fit(&robot, &data, args.method, &options)?;
     pipeline::write_model(&args.out, &model)?;

@@ -17,7 +17,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let model = pipeline::read_model(&args.model)?;
-    let data = pipeline::read_configurations(&args.data, Some(model.joint_count()))?;
+    let data = pipeline::read_configurations(&args.data, &pipeline::ReadOptions::for_joints(model.joint_kinds()))?;
     let tools = pipeline::tool_indices(&model, &data)?;
     let predictions = model.predict(&data.rows, &tools)?;
     let stdout = std::io::stdout();

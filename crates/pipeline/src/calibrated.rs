@@ -44,12 +44,15 @@ impl CalibratedModel {
         self.kinematics.joint_count()
     }
 
-    /// Index of a tool by its identifier. A set without a `tool` column uses the model's first
-    /// tool; an identifier the model was not fitted with is refused.
+    /// The kinds of the joints, base first.
+    pub fn joint_kinds(&self) -> Vec<poe::JointKind> {
+        self.kinematics.joints().iter().map(|j| j.kind).collect()
+    }
+
+    /// Index of a tool by its identifier. `""` is the default tool (a blank `tool` cell, or a
+    /// file without the column), matched like any other name, as in the fit (SPEC v2); an
+    /// identifier the model was not fitted with is refused.
     pub fn tool_index(&self, name: &str, file: &str, line: u64, column: usize) -> Result<usize, Error> {
-        if name.is_empty() && !self.tools.is_empty() {
-            return Ok(0);
-        }
         self.tools.iter().position(|t| t == name).ok_or_else(|| Error::UnknownTool {
             file: file.to_owned(),
             line,

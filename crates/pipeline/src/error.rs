@@ -1,6 +1,7 @@
 //! The errors of the `pipeline` crate. Every error about a user's file names the file, and where
 //! it can, the line and the column.
 
+use crate::{ColumnMapFault, DecimalFault};
 use std::fmt;
 
 /// What can go wrong reading inputs, fitting or evaluating.
@@ -29,6 +30,133 @@ pub enum Error {
         column: usize,
         /// What the CSV reader said.
         message: String,
+    },
+    /// A row with another number of fields than the header.
+    FieldCount {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: u64,
+        /// 1-based column: the first field one of the two lacks.
+        column: usize,
+        /// Fields in the row.
+        found: u64,
+        /// Fields in the header.
+        expected: u64,
+        /// The file's field separator.
+        delimiter: char,
+    },
+    /// Bytes that are not UTF-8 text.
+    InvalidUtf8 {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: u64,
+        /// 1-based column (the field, in a CSV file; the character, in a RON file).
+        column: usize,
+    },
+    /// A number whose decimal mark does not fit the file.
+    DecimalMark {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: u64,
+        /// 1-based column.
+        column: usize,
+        /// The column's name.
+        name: String,
+        /// The cell's text.
+        text: String,
+        /// What is wrong with it.
+        fault: DecimalFault,
+    },
+    /// A negative `payload_kg`.
+    NegativePayload {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: u64,
+        /// 1-based column.
+        column: usize,
+        /// The value, kg.
+        value: f64,
+    },
+    /// A joint column whose unit does not fit its joint: an angle on a prismatic joint, a
+    /// length on a revolute one.
+    JointUnit {
+        /// The file.
+        file: String,
+        /// The header line (1).
+        line: u64,
+        /// 1-based column.
+        column: usize,
+        /// 1-based joint.
+        joint: usize,
+        /// The robot's kind of that joint.
+        kind: poe::JointKind,
+    },
+    /// A per-joint column (`tau<k>_nm`) for a joint the data does not have.
+    ColumnBeyondJoints {
+        /// The file.
+        file: String,
+        /// The header line (1).
+        line: u64,
+        /// 1-based column.
+        column: usize,
+        /// The column's name.
+        name: String,
+        /// The joint it names (1-based).
+        index: usize,
+        /// The data's joint count.
+        joints: usize,
+    },
+    /// The orientation given both as a quaternion and as Euler angles.
+    OrientationTwice {
+        /// The file.
+        file: String,
+        /// The header line (1).
+        line: u64,
+        /// 1-based column of the later of the two.
+        column: usize,
+        /// Its name.
+        name: String,
+        /// The name of the earlier one.
+        other: String,
+    },
+    /// A column map names a header the file does not have.
+    MappedHeaderMissing {
+        /// The file.
+        file: String,
+        /// The header line (1).
+        line: u64,
+        /// Where the header ends (its field count + 1).
+        column: usize,
+        /// The SPEC name it was to give.
+        target: String,
+        /// The header named.
+        header: String,
+    },
+    /// A `--columns` argument that does not parse.
+    ColumnMap {
+        /// 1-based character of the argument where the faulty item starts.
+        column: usize,
+        /// The faulty item.
+        text: String,
+        /// What is wrong with it.
+        fault: ColumnMapFault,
+    },
+    /// A value in a RON file (robot or model) that must be a finite number and is not.
+    NotFinite {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// The field, e.g. `flange.position` or `links[2].com_m`.
+        field: String,
+        /// The value found.
+        value: f64,
     },
     /// A required column is absent.
     MissingColumn {
@@ -154,6 +282,48 @@ impl fmt::Display for Error {
             Error::Io { path, source } => write!(f, "{path}: {source}"),
             Error::EmptyFile { file } => write!(f, "{file}:1:1: the file has no header or no data row"),
             Error::CsvSyntax { file, line, column, message } => write!(f, "{file}:{line}:{column}: {message}"),
+            Error::FieldCount { file, line, column, found, expected, delimiter } => {
+                write!(f, "{file}:{line}:{column}: row has {found} fields, the header has {expected}")?;
+                if *delimiter == ',' && found > expected {
+                    write!(
+                        f,
+                        " (decimal commas in a ','-separated file? tracker exports with decimal commas separate fields with ';')"
+                    )?;
+                }
+                Ok(())
+            }
+            Error::InvalidUtf8 { file, line, column } => write!(f, "{file}:{line}:{column}: the text is not UTF-8"),
+            Error::DecimalMark { file, line, column, name, text, fault } => {
+                write!(f, "{file}:{line}:{column}: column '{name}': '{text}' {fault}")
+            }
+            Error::NegativePayload { file, line, column, value } => {
+                write!(f, "{file}:{line}:{column}: column 'payload_kg': {value} kg, a payload cannot be negative")
+            }
+            Error::JointUnit { file, line, column, joint, kind } => match kind {
+                poe::JointKind::Prismatic => write!(
+                    f,
+                    "{file}:{line}:{column}: joint {joint} is prismatic: its column is q{joint}_m or q{joint}_mm, not an angle"
+                ),
+                poe::JointKind::Revolute => write!(
+                    f,
+                    "{file}:{line}:{column}: joint {joint} is revolute: its column is q{joint}_rad or q{joint}_deg, not a length"
+                ),
+            },
+            Error::ColumnBeyondJoints { file, line, column, name, index, joints } => {
+                write!(f, "{file}:{line}:{column}: column '{name}' is for joint {index}, the data has {joints} joints")
+            }
+            Error::OrientationTwice { file, line, column, name, other } => write!(
+                f,
+                "{file}:{line}:{column}: column '{name}': the orientation is already given by '{other}'; give a quaternion (qw, qx, qy, qz) or Euler angles (rx, ry, rz), not both"
+            ),
+            Error::MappedHeaderMissing { file, line, column, target, header } => write!(
+                f,
+                "{file}:{line}:{column}: --columns maps {target} to the header '{header}', which the file does not have"
+            ),
+            Error::ColumnMap { column, text, fault } => write!(f, "--columns:1:{column}: '{text}' {fault}"),
+            Error::NotFinite { file, line, column, field, value } => {
+                write!(f, "{file}:{line}:{column}: {field} is {value}, a finite number is needed")
+            }
             Error::MissingColumn { file, line, column, name } => {
                 write!(f, "{file}:{line}:{column}: missing required column '{name}'")
             }
@@ -170,11 +340,21 @@ impl fmt::Display for Error {
                 f,
                 "{file}:{line}:{column}: quaternion (qw, qx, qy, qz) has norm {norm:.6}, expected 1 within 1e-3"
             ),
-            Error::UnknownTool { file, line, column, tool, known } => write!(
-                f,
-                "{file}:{line}:{column}: tool '{tool}' is not in the model (it knows {})",
-                if known.is_empty() { "none".to_owned() } else { known.join(", ") }
-            ),
+            Error::UnknownTool { file, line, column, tool, known } => {
+                let known: Vec<String> = known
+                    .iter()
+                    .map(|t| if t.is_empty() { "the default tool".to_owned() } else { format!("'{t}'") })
+                    .collect();
+                let known = if known.is_empty() { "none".to_owned() } else { known.join(", ") };
+                if tool.is_empty() {
+                    write!(
+                        f,
+                        "{file}:{line}:{column}: a row without a tool name is the default tool, which the model was not fitted with (it knows {known}); name the tool in a 'tool' column"
+                    )
+                } else {
+                    write!(f, "{file}:{line}:{column}: tool '{tool}' is not in the model (it knows {known})")
+                }
+            }
             Error::RonFormat { file, line, column, message } => write!(f, "{file}:{line}:{column}: {message}"),
             Error::SchemaVersion { file, found, supported } => {
                 write!(f, "{file}:1:1: model file has schema version {found}, this calib reads version {supported}")

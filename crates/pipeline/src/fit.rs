@@ -54,7 +54,7 @@ pub fn fit(
     method: Method,
     options: &FitOptions,
 ) -> Result<(CalibratedModel, FitReport), Error> {
-    data.check_joint_count(robot.joint_count())?;
+    data.check_joints(&robot.joint_kinds())?;
     let nominal = robot.nominal_model()?;
     let scope = if method == Method::BaseTool { Scope::BaseTool } else { Scope::Full };
     let geometry = fit_geometry(&nominal, data, scope, &options.identification)?;
@@ -122,7 +122,7 @@ pub fn evaluate(model: &CalibratedModel, data: &MeasurementSet) -> Result<Evalua
 
 /// The model's tool index of every row of `data`, matched by tool identifier.
 pub fn tool_indices(model: &CalibratedModel, data: &MeasurementSet) -> Result<Vec<usize>, Error> {
-    data.check_joint_count(model.joint_count())?;
+    data.check_joints(&model.joint_kinds())?;
     let column = data.tool_column.unwrap_or(1);
     data.rows
         .iter()

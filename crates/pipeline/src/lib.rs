@@ -28,7 +28,10 @@ pub use compensation::{Compensation, CompensationOptions, CompensationReport, Re
 pub use error::Error;
 pub use fit::{Evaluation, FitOptions, FitReport, evaluate, fit, tool_indices};
 pub use load_model::{ComplianceModel, ComplianceTerm};
-pub use measurements::{Measurement, MeasurementSet, parse_measurements, read_configurations, read_measurements};
+pub use measurements::{
+    ColumnMap, ColumnMapFault, Decimal, DecimalFault, Delimiter, Dialect, FileFormat, JointColumn, Measurement,
+    MeasurementSet, ReadOptions, parse_measurements, read_configurations, read_measurements,
+};
 pub use method::{Method, UnknownMethod};
 pub use metrics::{ErrorSummary, PoseError};
 pub use model_file::{SCHEMA_VERSION, parse_model, read_model, write_model};

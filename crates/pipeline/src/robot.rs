@@ -211,6 +211,11 @@ impl RobotDescription {
         self.joints.len()
     }
 
+    /// The kinds of the joints, base first.
+    pub fn joint_kinds(&self) -> Vec<JointKind> {
+        self.joint_axes().iter().map(|axis| axis.kind).collect()
+    }
+
     /// Joint limits in SI units (radians or metres), base first.
     pub fn limits(&self) -> Vec<(f64, f64)> {
         self.joints

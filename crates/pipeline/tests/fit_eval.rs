@@ -1,7 +1,9 @@
 //! `fit` then `evaluate` on synthetic tracker data made here, through the files users write.
 
 use lie::{SE3, SO3, Twist, Vector3};
-use pipeline::{Error, FitOptions, Measurement, MeasurementSet, Method, RobotDescription, parse_measurements};
+use pipeline::{
+    Error, FitOptions, Measurement, MeasurementSet, Method, ReadOptions, RobotDescription, parse_measurements,
+};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
@@ -55,7 +57,7 @@ fn synthetic(robot: &RobotDescription, rows: usize, tools: &[&str], full_pose: b
 fn through_csv(set: &MeasurementSet) -> MeasurementSet {
     let mut buffer = Vec::new();
     set.write_csv(&mut buffer).unwrap();
-    parse_measurements(buffer.as_slice(), "data.csv", Some(set.joint_count)).unwrap()
+    parse_measurements(buffer.as_slice(), "data.csv", &ReadOptions::default()).unwrap()
 }
 
 #[test]
@@ -125,7 +127,65 @@ fn model_files_of_another_schema_or_broken_are_refused_with_a_position() {
 fn a_data_file_for_another_robot_is_refused() {
     let robot = irb4400();
     let text = "q1_rad,q2_rad,x_mm,y_mm,z_mm\n0,0,1,2,3\n";
-    let set = parse_measurements(text.as_bytes(), "two.csv", None).unwrap();
+    let set = parse_measurements(text.as_bytes(), "two.csv", &ReadOptions::default()).unwrap();
     let error = pipeline::fit(&robot, &set, Method::Poe, &FitOptions::default()).unwrap_err();
     assert!(matches!(error, Error::JointCountMismatch { found: 2, expected: 6, .. }), "{error}");
+}
+
+#[test]
+fn a_blank_tool_is_the_default_tool_in_the_fit_its_report_and_the_evaluation() {
+    let robot = irb4400();
+    // Rows alternate between tool "A" and a blank cell, 0.3 m and 1 rad apart.
+    let all = through_csv(&synthetic(&robot, 160, &["A", ""], true, 10));
+    assert_eq!(all.tools, vec!["A".to_owned(), String::new()]);
+    let train = all.subset(&(0..100).collect::<Vec<_>>());
+    let (model, report) = pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default()).unwrap();
+    // The fit's own "after" report once sent the blank rows to tool "A": hundreds of mm.
+    assert!(report.after.max_position_error_mm < 1e-6, "{:?}", report.after);
+    let test = all.subset(&(100..160).collect::<Vec<_>>());
+    let evaluation = pipeline::evaluate(&model, &test).unwrap();
+    assert!(evaluation.summary.max_position_error_mm < 1e-6, "{:?}", evaluation.summary);
+
+    // A file without a tool column is the default tool too: the blank rows alone, written
+    // without the column, evaluate the same.
+    let blank_rows: Vec<usize> = (100..160).filter(|&i| all.rows[i].tool == 1).collect();
+    let mut blank = all.subset(&blank_rows);
+    blank.tools = vec![String::new()];
+    blank.rows.iter_mut().for_each(|r| r.tool = 0);
+    let blank = through_csv(&blank);
+    assert_eq!(blank.tool_column, None);
+    let evaluation = pipeline::evaluate(&model, &blank).unwrap();
+    assert!(evaluation.summary.max_position_error_mm < 1e-6, "{:?}", evaluation.summary);
+}
+
+#[test]
+fn the_default_tool_is_refused_by_a_model_fitted_only_with_named_tools() {
+    let robot = irb4400();
+    let train = through_csv(&synthetic(&robot, 60, &["A", "B"], true, 11));
+    let (model, _) = pipeline::fit(&robot, &train, Method::BaseTool, &FitOptions::default()).unwrap();
+    let unnamed = through_csv(&synthetic(&robot, 10, &[""], true, 12));
+    let error = pipeline::evaluate(&model, &unnamed).unwrap_err();
+    assert!(matches!(error, Error::UnknownTool { line: 2, ref tool, .. } if tool.is_empty()), "{error}");
+    assert_eq!(
+        error.to_string(),
+        "data.csv:2:1: a row without a tool name is the default tool, which the model was not fitted with \
+         (it knows 'A', 'B'); name the tool in a 'tool' column"
+    );
+}
+
+#[test]
+fn a_joint_unit_that_does_not_fit_the_robot_is_refused_by_the_fit() {
+    let robot = RobotDescription::parse(
+        "Robot(name: \"two\", joints: [\
+         (kind: Revolute, axis: (0.0, 0.0, 1.0), point: (0.0, 0.0, 0.0), limits_deg: (-90.0, 90.0)),\
+         (kind: Prismatic, axis: (1.0, 0.0, 0.0), point: (0.0, 0.0, 1.0), limits_m: (0.0, 0.5))],\
+         flange: (position: (1.0, 0.0, 1.0), x_axis: (1.0, 0.0, 0.0), z_axis: (0.0, 0.0, 1.0)))",
+        "two.ron",
+    )
+    .unwrap();
+    let set =
+        parse_measurements("q1_rad,q2_deg,x_mm,y_mm,z_mm\n0,0,1,2,3\n".as_bytes(), "two.csv", &ReadOptions::default())
+            .unwrap();
+    let error = pipeline::fit(&robot, &set, Method::Poe, &FitOptions::default()).unwrap_err();
+    assert!(matches!(error, Error::JointUnit { column: 2, joint: 2, .. }), "{error}");
 }
