@@ -158,6 +158,39 @@ pub enum Error {
         /// The value found.
         value: f64,
     },
+    /// A model file whose parts do not fit together: a count that differs from what another
+    /// part needs (an edited or corrupt file).
+    ModelCount {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// The field, e.g. `compensation.gp`.
+        field: String,
+        /// What is counted, e.g. `inputs`.
+        what: &'static str,
+        /// The count found.
+        found: usize,
+        /// The count the rest of the model needs.
+        expected: usize,
+    },
+    /// A model file with an index out of its range.
+    ModelIndex {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// The field, e.g. `joint_compliance.terms[3].joint`.
+        field: String,
+        /// The index found.
+        index: usize,
+        /// The index must be below this.
+        limit: usize,
+    },
     /// A required column is absent.
     MissingColumn {
         /// The file.
@@ -323,6 +356,12 @@ impl fmt::Display for Error {
             Error::ColumnMap { column, text, fault } => write!(f, "--columns:1:{column}: '{text}' {fault}"),
             Error::NotFinite { file, line, column, field, value } => {
                 write!(f, "{file}:{line}:{column}: {field} is {value}, a finite number is needed")
+            }
+            Error::ModelCount { file, line, column, field, what, found, expected } => {
+                write!(f, "{file}:{line}:{column}: {field} has {found} {what}, the rest of the model needs {expected}")
+            }
+            Error::ModelIndex { file, line, column, field, index, limit } => {
+                write!(f, "{file}:{line}:{column}: {field} is {index}, it must be below {limit}")
             }
             Error::MissingColumn { file, line, column, name } => {
                 write!(f, "{file}:{line}:{column}: missing required column '{name}'")

@@ -35,12 +35,12 @@ pub fn write_model(path: &Path, model: &CalibratedModel) -> Result<(), Error> {
 
 /// Reads a calibrated model, refusing a file of another schema version.
 pub fn read_model(path: &Path) -> Result<CalibratedModel, Error> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: file.clone(), source })?;
-    parse_model(&text, &file)
+    let text = crate::ron_position::read_text(path)?;
+    parse_model(&text, &path.display().to_string())
 }
 
-/// Parses a calibrated model from RON text; `file` names it in errors.
+/// Parses a calibrated model from RON text and checks that its parts fit together
+/// ([`CalibratedModel::check`]); `file` names it in errors.
 pub fn parse_model(text: &str, file: &str) -> Result<CalibratedModel, Error> {
     #[derive(serde::Deserialize)]
     struct Version {
@@ -71,5 +71,7 @@ pub fn parse_model(text: &str, file: &str) -> Result<CalibratedModel, Error> {
             supported: SCHEMA_VERSION,
         });
     }
-    options.from_str(text).map_err(position_error)
+    let model: CalibratedModel = options.from_str(text).map_err(position_error)?;
+    model.check(text, file)?;
+    Ok(model)
 }

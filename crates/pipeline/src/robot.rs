@@ -115,9 +115,8 @@ const UNIT_TOLERANCE: f64 = 1e-6;
 impl RobotDescription {
     /// Reads and validates a robot description file.
     pub fn read(path: &Path) -> Result<Self, Error> {
-        let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: file.clone(), source })?;
-        Self::parse(&text, &file)
+        let text = crate::ron_position::read_text(path)?;
+        Self::parse(&text, &path.display().to_string())
     }
 
     /// Parses and validates a robot description; `file` names it in errors. The kinematics may be
@@ -142,6 +141,7 @@ impl RobotDescription {
         if self.joints.is_empty() {
             return Err(at("joints", 0, "a robot needs at least one joint".into()));
         }
+        crate::robot_check::check_values(self, text, file)?;
         let (mut deg_index, mut m_index) = (0, 0);
         for (i, joint) in self.joints.iter().enumerate() {
             let norm = Vector3::from(joint.axis).norm();

@@ -1,6 +1,25 @@
 //! Positions of fields in RON text, so that a value refused after parsing (an axis that is not a
 //! unit vector, say) is reported at its line and column like a syntax error.
 
+/// The text of a RON file; bytes that are not UTF-8 are refused at their line and column (the
+/// standard library's message names neither).
+pub(crate) fn read_text(path: &std::path::Path) -> Result<String, crate::Error> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| crate::Error::Io { path: file.clone(), source })?;
+    text_of(bytes, &file)
+}
+
+/// `bytes` as text, or the position of the first byte that is not UTF-8.
+pub(crate) fn text_of(bytes: Vec<u8>, file: &str) -> Result<String, crate::Error> {
+    String::from_utf8(bytes).map_err(|e| {
+        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        let valid = std::str::from_utf8(valid).unwrap_or_default();
+        let line = valid.matches('\n').count() as u64 + 1;
+        let column = valid.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        crate::Error::InvalidUtf8 { file: file.to_owned(), line, column }
+    })
+}
+
 /// The RON options every file of ours is read with: `Some(..)` may be left out of optional fields.
 pub(crate) fn ron_options() -> ron::Options {
     ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
@@ -56,7 +75,13 @@ pub(crate) fn field_position(text: &str, field: &str, index: usize) -> (usize, u
 
 #[cfg(test)]
 mod tests {
-    use super::field_position;
+    use super::{field_position, text_of};
+
+    #[test]
+    fn bytes_that_are_not_utf8_are_placed_at_their_line_and_column() {
+        let error = text_of(b"(a: 1,\n  b: \"\xff\")".to_vec(), "r.ron").unwrap_err();
+        assert_eq!(error.to_string(), "r.ron:2:7: the text is not UTF-8");
+    }
 
     #[test]
     fn field_positions_skip_comments_strings_and_longer_names() {

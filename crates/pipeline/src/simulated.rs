@@ -145,9 +145,8 @@ pub fn simulate(
 
 /// Reads an [`Effects`] RON file (fields left out are off; `Some(..)` may be omitted).
 pub fn read_effects(path: &Path) -> Result<Effects, Error> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: file.clone(), source })?;
-    parse_effects(&text, &file)
+    let text = crate::ron_position::read_text(path)?;
+    parse_effects(&text, &path.display().to_string())
 }
 
 /// Parses an [`Effects`] RON text; `file` names it in errors. A field name that no effect has is

@@ -123,3 +123,75 @@ fn dynamics_of_the_wrong_length_are_refused() {
     assert_eq!(line, 9, "{message}");
     assert!(message.contains("1 links given"), "{message}");
 }
+
+/// The refusal of a value that must be finite: its field and where it is.
+fn refuse_not_finite(text: &str) -> (usize, usize, String, String) {
+    match RobotDescription::parse(text, "robot.ron") {
+        Err(e @ Error::NotFinite { .. }) => {
+            let message = e.to_string();
+            let Error::NotFinite { line, column, field, .. } = e else { unreachable!() };
+            (line, column, field, message)
+        }
+        other => panic!("expected a NotFinite error, got {other:?}"),
+    }
+}
+
+#[test]
+fn a_nan_flange_position_is_refused_at_the_flange_not_downstream() {
+    // Once accepted, then "refused" by the fit as "the poses are too alike to register the
+    // tracker: rank 0 of 13", which sent the user to the data file.
+    let (line, column, field, message) =
+        refuse_not_finite(&GOOD.replace("position: (1.0, 0.0, 1.0)", "position: (NaN, 0.0, 1.0)"));
+    assert_eq!((line, column, field.as_str()), (8, 14, "flange.position"), "{message}");
+    assert_eq!(message, "robot.ron:8:14: flange.position is NaN, a finite number is needed");
+    let (line, _, field, message) =
+        refuse_not_finite(&GOOD.replace("z_axis: (0.0, 0.0, 1.0)", "z_axis: (0.0, NaN, 1.0)"));
+    assert_eq!((line, field.as_str()), (8, "flange.z_axis"), "{message}");
+}
+
+#[test]
+fn an_infinite_tool_is_refused_at_the_tool() {
+    let (line, column, field, message) =
+        refuse_not_finite(&GOOD.replace("tool: (0.0, 0.0, 0.1)", "tool: (0.0, inf, 0.1)"));
+    assert_eq!((line, column, field.as_str()), (9, 5, "tool"), "{message}");
+}
+
+const DYNAMICS: &str = "    dynamics: (\n        links: [(mass_kg: 1.0, com_m: (0.0, 0.0, 0.5)), (mass_kg: 1.0, com_m: (0.5, 0.0, 1.0))],\n        stiffness_nm_per_rad: [1e5, 1e5],\n        gravity_m_per_s2: (0.0, 0.0, -9.81),\n        counterbalance: (joint_index: 0, anchor_radius_m: 0.3, attachment_radius_m: 0.2, angle_at_zero_rad: 0.0, force_at_zero_n: 100.0, stiffness_n_per_m: 1000.0),\n    ),\n";
+
+fn with_dynamics(edit: (&str, &str)) -> String {
+    GOOD.replace(
+        "    tool: (0.0, 0.0, 0.1),\n",
+        &format!("    tool: (0.0, 0.0, 0.1),\n{}", DYNAMICS.replace(edit.0, edit.1)),
+    )
+}
+
+#[test]
+fn good_dynamics_are_read() {
+    let robot = RobotDescription::parse(&with_dynamics(("", "")), "robot.ron").unwrap();
+    assert_eq!(robot.dynamics.unwrap().links.len(), 2);
+}
+
+#[test]
+fn non_finite_load_data_is_refused_at_its_field() {
+    let (line, _, field, message) =
+        refuse_not_finite(&with_dynamics(("com_m: (0.5, 0.0, 1.0)", "com_m: (0.5, NaN, 1.0)")));
+    assert_eq!((line, field.as_str()), (11, "links[1].com_m"), "{message}");
+    let (line, column, field, message) = refuse_not_finite(&with_dynamics((
+        "gravity_m_per_s2: (0.0, 0.0, -9.81)",
+        "gravity_m_per_s2: (0.0, 0.0, -inf)",
+    )));
+    assert_eq!((line, column, field.as_str()), (13, 9, "gravity_m_per_s2"), "{message}");
+    let (line, _, field, message) =
+        refuse_not_finite(&with_dynamics(("force_at_zero_n: 100.0", "force_at_zero_n: NaN")));
+    assert_eq!((line, field.as_str()), (14, "counterbalance.force_at_zero_n"), "{message}");
+}
+
+#[test]
+fn a_balancer_out_of_range_is_refused_at_its_field() {
+    let (line, column, message) = refuse(&with_dynamics(("anchor_radius_m: 0.3", "anchor_radius_m: -0.3")));
+    assert_eq!(line, 14, "{message}");
+    assert!(column > 40 && message.contains("anchor_radius_m = -0.3"), "{column}: {message}");
+    let (line, column, message) = refuse(&with_dynamics(("joint_index: 0", "joint_index: 5")));
+    assert_eq!((line, column), (14, 26), "{message}");
+    assert!(message.contains("names joint 6 but the robot has 2 joints"), "{message}");
+}

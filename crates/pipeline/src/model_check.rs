@@ -1,0 +1,144 @@
+//! The internal consistency of a calibrated model, checked once when its file is read: an edited or
+//! corrupt file is refused at the field at fault, never left to panic on an index (or to be
+//! silently truncated by a `zip`) in `eval` or `predict`. One function, so that each new part of a
+//! model adds its checks here.
+
+use crate::ron_position::field_position;
+use crate::{CalibratedModel, Error, Method};
+use lie::SE3;
+
+/// Where a field is in the file's text, and the error makers that use it.
+struct Located<'a> {
+    text: &'a str,
+    file: &'a str,
+}
+
+impl Located<'_> {
+    fn at(&self, field: &str, index: usize) -> (usize, usize) {
+        field_position(self.text, field, index)
+    }
+
+    fn count(&self, at: (&str, usize), field: String, what: &'static str, found: usize, expected: usize) -> Error {
+        let (line, column) = self.at(at.0, at.1);
+        Error::ModelCount { file: self.file.to_owned(), line, column, field, what, found, expected }
+    }
+
+    fn index(&self, at: (&str, usize), field: String, index: usize, limit: usize) -> Error {
+        let (line, column) = self.at(at.0, at.1);
+        Error::ModelIndex { file: self.file.to_owned(), line, column, field, index, limit }
+    }
+
+    fn not_finite(&self, at: (&str, usize), field: String, value: f64) -> Error {
+        let (line, column) = self.at(at.0, at.1);
+        Error::NotFinite { file: self.file.to_owned(), line, column, field, value }
+    }
+
+    fn part(&self, field: &str, message: String) -> Error {
+        let (line, column) = self.at(field, 0);
+        Error::RonFormat { file: self.file.to_owned(), line, column, message }
+    }
+}
+
+/// The first non-finite translation among `transforms`, with its position in the list.
+fn non_finite_translation(transforms: impl Iterator<Item = SE3>) -> Option<(usize, f64)> {
+    transforms.enumerate().find_map(|(k, t)| t.translation().iter().copied().find(|v| !v.is_finite()).map(|v| (k, v)))
+}
+
+impl CalibratedModel {
+    /// Checks that the parts of the model fit together: the kinematics' joint and tool counts,
+    /// the tool names, the compliance terms' indices and values, the GP's input and output
+    /// dimensions. `text` is the file the model was read from, `file` its name, for positions.
+    pub fn check(&self, text: &str, file: &str) -> Result<(), Error> {
+        let at = Located { text, file };
+        let n = self.kinematics.joint_count();
+        let tool_count = self.kinematics.tool_count();
+        if n == 0 {
+            return Err(at.count(("joints", 0), "kinematics.joints".into(), "joints", 0, 1));
+        }
+        // Translations appear in the file in this order: the joints', then the tools'.
+        let transforms = self.kinematics.joints().iter().map(|j| j.previous_from_joint_zero);
+        if let Some((k, value)) = non_finite_translation(transforms.chain(self.kinematics.tools().iter().copied())) {
+            let field = if k < n { format!("kinematics.joints[{k}]") } else { format!("kinematics.tools[{}]", k - n) };
+            return Err(at.not_finite(("translation", k), field, value));
+        }
+        if self.tools.len() != tool_count {
+            return Err(at.count(("tools", 0), "tools".into(), "tool names", self.tools.len(), tool_count));
+        }
+        if let Some(k) = (1..self.tools.len()).find(|&k| self.tools[..k].contains(&self.tools[k])) {
+            return Err(at.part("tools", format!("tools: the name '{}' is given twice", self.tools[k])));
+        }
+        if self.method.uses_gp() != self.compensation.is_some() {
+            let has = if self.compensation.is_some() { "has a" } else { "has no" };
+            return Err(at.part("method", format!("method {} but the model {has} GP compensation", self.method)));
+        }
+        if let Some(compliance) = &self.joint_compliance {
+            let base = &compliance.base_model;
+            if base.joint_count() != n {
+                let found = base.joint_count();
+                return Err(at.count(("base_model", 0), "joint_compliance.base_model".into(), "joints", found, n));
+            }
+            if base.tool_count() != tool_count {
+                let found = base.tool_count();
+                return Err(at.count(
+                    ("base_model", 0),
+                    "joint_compliance.base_model".into(),
+                    "tools",
+                    found,
+                    tool_count,
+                ));
+            }
+            let moved = base.joints().iter().map(|j| j.previous_from_joint_zero).chain(base.tools().iter().copied());
+            if let Some((_, value)) = non_finite_translation(moved) {
+                return Err(at.not_finite(("base_model", 0), "joint_compliance.base_model".into(), value));
+            }
+            if let Some(&g) = compliance.gravity_m_per_s2.iter().find(|g| !g.is_finite()) {
+                return Err(at.not_finite(("gravity_m_per_s2", 0), "joint_compliance.gravity_m_per_s2".into(), g));
+            }
+            // A regressor row holds 4 columns per link and the payload's: 4n + 1.
+            for (k, term) in compliance.terms.iter().enumerate() {
+                let field = |name: &str| format!("joint_compliance.terms[{k}].{name}");
+                if term.joint >= n {
+                    return Err(at.index(("joint", k), field("joint"), term.joint, n));
+                }
+                if term.column > 4 * n {
+                    return Err(at.index(("column", k), field("column"), term.column, 4 * n + 1));
+                }
+                if !(term.scale.is_finite() && term.scale > 0.0) {
+                    return Err(at.not_finite(("scale", k), field("scale"), term.scale));
+                }
+            }
+            if compliance.theta.len() != compliance.terms.len() {
+                let (found, expected) = (compliance.theta.len(), compliance.terms.len());
+                return Err(at.count(("theta", 0), "joint_compliance.theta".into(), "values", found, expected));
+            }
+            if let Some(&value) = compliance.theta.iter().find(|v| !v.is_finite()) {
+                return Err(at.not_finite(("theta", 0), "joint_compliance.theta".into(), value));
+            }
+        }
+        if let Some(compensation) = &self.compensation {
+            if compensation.with_payload != (self.method == Method::PoeGpLoad) {
+                let message =
+                    format!("compensation.with_payload is {} for method {}", compensation.with_payload, self.method);
+                return Err(at.part("with_payload", message));
+            }
+            if compensation.full_pose != self.full_pose {
+                let message = format!(
+                    "compensation.full_pose is {}, the model's full_pose {}",
+                    compensation.full_pose, self.full_pose
+                );
+                return Err(at.part("compensation", message));
+            }
+            let inputs = n + usize::from(compensation.with_payload);
+            if compensation.gp.input_dim() != inputs {
+                let found = compensation.gp.input_dim();
+                return Err(at.count(("gp", 0), "compensation.gp".into(), "inputs", found, inputs));
+            }
+            let outputs = if self.full_pose { 6 } else { 3 };
+            if compensation.gp.output_count() != outputs {
+                let found = compensation.gp.output_count();
+                return Err(at.count(("gp", 0), "compensation.gp".into(), "outputs", found, outputs));
+            }
+        }
+        Ok(())
+    }
+}

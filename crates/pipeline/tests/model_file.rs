@@ -1,0 +1,119 @@
+//! Model files whose parts do not fit together (edited by hand, or corrupt) are refused when read,
+//! at the field at fault; before, `eval` and `predict` panicked on an index or silently dropped
+//! compliance terms.
+
+use pipeline::simulated::{GeneratorConfig, Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
+use pipeline::{CalibratedModel, Error, FitOptions, Method, RobotDescription};
+use std::path::PathBuf;
+
+fn irb4400() -> RobotDescription {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron");
+    RobotDescription::read(&path).unwrap()
+}
+
+/// A `poe-gp-load` model with joint compliance (every part a model can have), and its file text.
+fn fitted(full_pose: bool) -> (CalibratedModel, String) {
+    let robot = irb4400();
+    let cell = simulated_cell(&robot, &Perturbation::default(), 3).unwrap();
+    let config = GeneratorConfig { sample_count: 60, seed: 3, ..GeneratorConfig::default() };
+    let data = simulate(&cell, &paper_effects(), &joint_ranges(&robot), &config, full_pose).unwrap();
+    let options = FitOptions { joint_compliance: true, ..FitOptions::default() };
+    let (model, _) = pipeline::fit(&robot, &data, Method::PoeGpLoad, &options).unwrap();
+    (model.clone(), text_of(&model))
+}
+
+fn text_of(model: &CalibratedModel) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.ron");
+    pipeline::write_model(&path, model).unwrap();
+    std::fs::read_to_string(&path).unwrap()
+}
+
+/// The refusal of `text`, checked to name the file and a line past the first.
+fn refused(text: &str) -> (Error, String) {
+    let error = pipeline::parse_model(text, "m.ron").expect_err("the model must be refused");
+    let message = error.to_string();
+    let line: usize = message.split(':').nth(1).and_then(|l| l.parse().ok()).unwrap_or(0);
+    assert!(message.starts_with("m.ron:") && line > 1, "{message}");
+    (error, message)
+}
+
+#[test]
+fn a_written_model_reads_back_and_passes_its_check() {
+    let (model, text) = fitted(false);
+    let again = pipeline::parse_model(&text, "m.ron").unwrap();
+    assert_eq!(again.tools, model.tools);
+    model.check(&text, "m.ron").unwrap();
+}
+
+#[test]
+fn a_compliance_term_of_a_joint_the_robot_lacks_is_refused() {
+    let (_, text) = fitted(false);
+    let (error, message) = refused(&text.replacen("joint: 1,", "joint: 9,", 1));
+    assert!(matches!(error, Error::ModelIndex { index: 9, limit: 6, .. }), "{message}");
+    assert!(message.contains("joint_compliance.terms[") && message.contains("].joint is 9, it must be below 6"));
+    let (error, message) = refused(&text.replacen("column: ", "column: 9999", 1));
+    assert!(matches!(error, Error::ModelIndex { limit: 25, .. }), "{message}");
+}
+
+#[test]
+fn compliance_values_that_do_not_match_their_terms_are_refused() {
+    let (mut model, _) = fitted(false);
+    let compliance = model.joint_compliance.as_mut().unwrap();
+    compliance.theta.pop();
+    let terms = compliance.terms.len();
+    let (error, message) = refused(&text_of(&model));
+    assert!(
+        matches!(error, Error::ModelCount { found, expected, .. } if found == terms - 1 && expected == terms),
+        "{message}"
+    );
+    assert!(message.contains("joint_compliance.theta has"), "{message}");
+}
+
+#[test]
+fn tool_names_that_do_not_match_the_kinematics_are_refused() {
+    let (mut model, _) = fitted(false);
+    model.tools.push("second".into());
+    let (error, message) = refused(&text_of(&model));
+    assert!(matches!(error, Error::ModelCount { found: 2, expected: 1, .. }), "{message}");
+    assert!(message.contains("tools has 2 tool names, the rest of the model needs 1"), "{message}");
+}
+
+#[test]
+fn a_gp_of_the_wrong_dimensions_is_refused() {
+    let (position_only, _) = fitted(false);
+    let (mut full_pose, _) = fitted(true);
+    // A full-pose model with the position-only GP: 3 outputs where 6 are needed.
+    full_pose.compensation = position_only.compensation.clone();
+    full_pose.compensation.as_mut().unwrap().full_pose = true;
+    let (error, message) = refused(&text_of(&full_pose));
+    assert!(matches!(error, Error::ModelCount { what: "outputs", found: 3, expected: 6, .. }), "{message}");
+    // The payload input dropped from the method but not from the GP.
+    let mut model = position_only.clone();
+    model.method = Method::PoeGp;
+    let (_, message) = refused(&text_of(&model));
+    assert!(message.contains("with_payload is true for method poe-gp"), "{message}");
+    let mut model = position_only;
+    model.compensation.as_mut().unwrap().with_payload = false;
+    model.method = Method::PoeGp;
+    let (error, message) = refused(&text_of(&model));
+    assert!(matches!(error, Error::ModelCount { what: "inputs", found: 7, expected: 6, .. }), "{message}");
+}
+
+#[test]
+fn a_gp_method_without_a_gp_is_refused() {
+    let (mut model, _) = fitted(false);
+    model.compensation = None;
+    let (_, message) = refused(&text_of(&model));
+    assert!(message.contains("method poe-gp-load but the model has no GP compensation"), "{message}");
+}
+
+#[test]
+fn a_non_finite_transform_is_refused_at_its_translation() {
+    let (_, text) = fitted(false);
+    let at = text.find("translation: (").unwrap() + "translation: (".len();
+    let end = at + text[at..].find(',').unwrap();
+    let edited = format!("{}NaN{}", &text[..at], &text[end..]);
+    let (error, message) = refused(&edited);
+    assert!(matches!(error, Error::NotFinite { ref field, .. } if field == "kinematics.joints[0]"), "{message}");
+}
