@@ -1,15 +1,14 @@
 //! `calib diagnose`: where the geometric model misses, which effect explains it, how far it shrinks.
 
 use pipeline::diagnose::{DiagnoseOptions, diagnose};
-use pipeline::{ReadOptions, RobotDescription};
+use pipeline::ReadOptions;
 use std::path::PathBuf;
 
 /// Diagnose what a geometric calibration leaves: where, which effect, how far it shrinks.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Robot description (RON).
-    #[arg(long)]
-    robot: PathBuf,
+    #[command(flatten)]
+    robot: crate::robot_args::RobotArgs,
     /// Measurements (SPEC CSV).
     #[arg(long)]
     data: PathBuf,
@@ -36,7 +35,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             return Err(format!("--noise-mm must be a positive number of millimetres, got {noise}").into());
         }
     }
-    let robot = RobotDescription::read(&args.robot)?;
+    let robot = args.robot.read()?;
     let data = pipeline::read_measurements(&args.data, &ReadOptions::for_joints(robot.joint_kinds()))?;
     let options =
         DiagnoseOptions { folds: args.folds, seed: args.seed, noise_mm: args.noise_mm, ..DiagnoseOptions::default() };

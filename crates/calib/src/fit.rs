@@ -1,14 +1,13 @@
 //! `calib fit`: fit a calibration method to measurements and write the model.
 
-use pipeline::{ErrorSummary, FitOptions, Method, ReadOptions, RobotDescription};
+use pipeline::{ErrorSummary, FitOptions, Method, ReadOptions};
 use std::path::PathBuf;
 
 /// Fit a calibrated model to measurements.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Robot description (RON), e.g. fixtures/robots/irb4400.ron.
-    #[arg(long)]
-    robot: PathBuf,
+    #[command(flatten)]
+    robot: crate::robot_args::RobotArgs,
     /// Measurements (SPEC CSV).
     #[arg(long)]
     data: PathBuf,
@@ -25,7 +24,7 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let robot = RobotDescription::read(&args.robot)?;
+    let robot = args.robot.read()?;
     let data = pipeline::read_measurements(&args.data, &ReadOptions::for_joints(robot.joint_kinds()))?;
     let options = FitOptions { joint_compliance: args.joint_compliance, ..FitOptions::default() };
     let (model, report) = pipeline::fit(&robot, &data, args.method, &options)?;

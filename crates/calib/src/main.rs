@@ -5,6 +5,7 @@ mod diagnose;
 mod eval;
 mod fit;
 mod predict;
+mod robot_args;
 mod simulate;
 
 use clap::{Parser, Subcommand};

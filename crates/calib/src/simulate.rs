@@ -1,8 +1,8 @@
 //! `calib simulate`: a simulated tracker campaign written as SPEC measurement CSV, to try the other
 //! subcommands without a robot, or to test a calibration on data whose truth is known.
 
+use pipeline::Error;
 use pipeline::simulated::{self, GeneratorConfig, Perturbation};
-use pipeline::{Error, RobotDescription};
 use std::path::PathBuf;
 
 /// Simulate tracker measurements of a robot whose kinematics are off its nominal.
@@ -12,9 +12,8 @@ use std::path::PathBuf;
 /// drawn from the seed.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Robot description (RON); the load effects need its dynamics block (masses, stiffness).
-    #[arg(long)]
-    robot: PathBuf,
+    #[command(flatten)]
+    robot: crate::robot_args::RobotArgs,
     /// Where to write the measurements (SPEC CSV).
     #[arg(long)]
     out: PathBuf,
@@ -37,7 +36,7 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let robot = RobotDescription::read(&args.robot)?;
+    let robot = args.robot.read()?;
     let effects = match &args.effects {
         Some(path) => simulated::read_effects(path)?,
         None => simulated::paper_effects(),

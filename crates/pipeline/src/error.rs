@@ -274,6 +274,17 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A URDF file that does not parse, or whose kinematic chain cannot be calibrated.
+    UrdfFormat {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
     /// A model file written by another schema version.
     SchemaVersion {
         /// The file.
@@ -394,7 +405,9 @@ impl fmt::Display for Error {
                     write!(f, "{file}:{line}:{column}: tool '{tool}' is not in the model (it knows {known})")
                 }
             }
-            Error::RonFormat { file, line, column, message } => write!(f, "{file}:{line}:{column}: {message}"),
+            Error::RonFormat { file, line, column, message } | Error::UrdfFormat { file, line, column, message } => {
+                write!(f, "{file}:{line}:{column}: {message}")
+            }
             Error::SchemaVersion { file, found, supported } => {
                 write!(f, "{file}:1:1: model file has schema version {found}, this calib reads version {supported}")
             }

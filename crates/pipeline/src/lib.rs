@@ -24,6 +24,8 @@ mod robot_check;
 mod robot_dh;
 mod ron_position;
 pub mod simulated;
+mod urdf_chain;
+mod xml_outline;
 
 pub use calibrated::{CalibratedModel, PredictedPose, pose_error};
 pub use compensation::{Compensation, CompensationOptions, CompensationReport, ResidualFrame};
@@ -39,3 +41,4 @@ pub use metrics::{ErrorSummary, PoseError};
 pub use model_file::{SCHEMA_VERSION, parse_model, read_model, write_model};
 pub use robot::{FlangeDescription, JointDescription, JointType, RobotDescription};
 pub use robot_dh::{DhTable, DhTableRow};
+pub use urdf_chain::{ChainEnds, ChainStep, StepMotion, UrdfChain, UrdfDocument};

@@ -5,6 +5,7 @@
 use crate::Error;
 use crate::robot_dh::DhTable;
 use crate::ron_position::{field_position, ron_options};
+use crate::urdf_chain::{ChainEnds, UrdfDocument};
 use lie::{Matrix3, SE3, SO3, Vector3};
 use poe::{JointAxis, JointKind, LocalPoe};
 use serde::{Deserialize, Serialize};
@@ -113,10 +114,30 @@ impl RobotFile {
 const UNIT_TOLERANCE: f64 = 1e-6;
 
 impl RobotDescription {
-    /// Reads and validates a robot description file.
+    /// Reads and validates a robot description file: RON, or a URDF (`.urdf`) whose chain runs
+    /// from its only root link to its only deepest leaf.
     pub fn read(path: &Path) -> Result<Self, Error> {
+        Self::read_with(path, &ChainEnds::default())
+    }
+
+    /// Reads a robot description file; for a URDF, the chain between the links `ends` names
+    /// (`--base-link`, `--tip-link`), which a RON file refuses.
+    pub fn read_with(path: &Path, ends: &ChainEnds) -> Result<Self, Error> {
+        let file = path.display().to_string();
+        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("urdf")) {
+            return Ok(UrdfDocument::read(path)?.chain(ends)?.description());
+        }
+        if *ends != ChainEnds::default() {
+            return Err(Error::RonFormat {
+                file,
+                line: 1,
+                column: 1,
+                message: "--base-link and --tip-link choose the chain of a URDF (.urdf), not of a RON robot file"
+                    .into(),
+            });
+        }
         let text = crate::ron_position::read_text(path)?;
-        Self::parse(&text, &path.display().to_string())
+        Self::parse(&text, &file)
     }
 
     /// Parses and validates a robot description; `file` names it in errors. The kinematics may be

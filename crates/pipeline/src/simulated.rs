@@ -95,9 +95,18 @@ pub fn simulated_cell(
     Ok(cell)
 }
 
-/// The robot's joint ranges as the generator takes them.
+/// The robot's joint ranges as the generator takes them. A joint without limits (a URDF's
+/// continuous joint) is sampled over one turn, ±π, which reaches every pose it can take.
 pub fn joint_ranges(robot: &RobotDescription) -> Vec<JointRange> {
-    robot.limits().into_iter().map(|(lower_rad, upper_rad)| JointRange { lower_rad, upper_rad }).collect()
+    let bounded = |limit: f64, turn: f64| if limit.is_finite() { limit } else { turn };
+    robot
+        .limits()
+        .into_iter()
+        .map(|(lower, upper)| JointRange {
+            lower_rad: bounded(lower, -std::f64::consts::PI),
+            upper_rad: bounded(upper, std::f64::consts::PI),
+        })
+        .collect()
 }
 
 /// The effects of the paper's simulation (Section IV-A): the load model of its ref. \[15\] (joint

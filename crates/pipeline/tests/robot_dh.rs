@@ -1,48 +1,7 @@
-//! DH tables in the robot RON: the fixtures against their axes form, a table against poe's own
-//! DH construction, and every refusal at its line and column.
+//! DH tables in the robot RON: a flange given with a table, and every refusal at its line and
+//! column (the forward kinematics of every form are in `robot_forms.rs`).
 
 use pipeline::{Error, RobotDescription};
-use poe::{DhConvention, DhRow, JointKind, LocalPoe};
-use std::path::PathBuf;
-
-fn fixture(name: &str) -> RobotDescription {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name);
-    RobotDescription::read(&path).unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// Configurations spread over the joint ranges, the same for every form of a robot.
-fn configurations(n: usize) -> Vec<Vec<f64>> {
-    let mut qs = vec![vec![0.0; n]];
-    for k in 1..8 {
-        qs.push((0..n).map(|j| ((k * 7 + j * 3) as f64 * 0.61).sin() * 2.7).collect());
-    }
-    qs
-}
-
-fn largest_difference_m(a: &LocalPoe, b: &LocalPoe) -> f64 {
-    configurations(a.joint_count())
-        .iter()
-        .map(|q| {
-            let (ta, tb) = (a.forward(q, 0).unwrap(), b.forward(q, 0).unwrap());
-            // Position of the flange and of points 1 m out along its axes: orientation in metres.
-            [lie::Vector3::zeros(), lie::Vector3::x(), lie::Vector3::y(), lie::Vector3::z()]
-                .iter()
-                .map(|p| (ta.transform_point(p) - tb.transform_point(p)).norm())
-                .fold(0.0, f64::max)
-        })
-        .fold(0.0, f64::max)
-}
-
-#[test]
-fn dh_fixtures_have_the_forward_kinematics_of_their_axes_form() {
-    for (dh, axes) in [("ur10_dh.ron", "ur10.ron"), ("iiwa7_dh.ron", "iiwa7.ron")] {
-        let (a, b) = (fixture(dh), fixture(axes));
-        assert_eq!(a.name, b.name);
-        assert_eq!(a.limits(), b.limits(), "{dh}");
-        let difference = largest_difference_m(&a.nominal_model().unwrap(), &b.nominal_model().unwrap());
-        assert!(difference < 1e-9, "{dh}: {difference:e} m");
-    }
-}
 
 const TABLE: &str = r#"Robot(
     name: "three",
@@ -56,22 +15,6 @@ const TABLE: &str = r#"Robot(
     ),
 )
 "#;
-
-#[test]
-fn a_table_in_either_convention_moves_like_poes_dh_model() {
-    let rows = [
-        DhRow { kind: JointKind::Revolute, a: 0.1, alpha: 90f64.to_radians(), d: 0.3, theta: 10f64.to_radians() },
-        DhRow { kind: JointKind::Prismatic, a: 0.4, alpha: -0.3, d: 0.05, theta: 0.2 },
-        DhRow { kind: JointKind::Revolute, a: -0.2, alpha: -45f64.to_radians(), d: 0.1, theta: -30f64.to_radians() },
-    ];
-    for (name, convention) in [("Standard", DhConvention::Standard), ("Modified", DhConvention::Modified)] {
-        let robot = RobotDescription::parse(&TABLE.replace("CONVENTION", name), "three.ron").unwrap();
-        let expected = LocalPoe::from_dh(&rows, convention);
-        let difference = largest_difference_m(&robot.nominal_model().unwrap(), &expected);
-        assert!(difference < 1e-12, "{name}: {difference:e} m");
-        assert_eq!(robot.limits()[1], (0.0, 0.5));
-    }
-}
 
 #[test]
 fn a_flange_given_with_a_table_replaces_the_last_dh_frame() {

@@ -1,0 +1,452 @@
+//! A URDF as a robot description (SPEC version 2, `--robot arm.urdf`): the kinematic chain from a
+//! base link to a tip link, fixed joints folded in, turned exactly into zero-configuration axes.
+//!
+//! The file is parsed by `urdf-rs`; its [`xml_outline`](crate::xml_outline) gives every refusal
+//! its line and column. The base link defaults to the one root link; the tip to the leaf with the
+//! most movable joints on the way down from the base (or from the link the base hangs from by
+//! fixed joints); several such leaves are ambiguous and need `--tip-link`. The chain may run up
+//! through fixed joints (a base link below the root, such as the ROS-Industrial `base` frame),
+//! never through a movable joint backwards.
+
+use crate::xml_outline::{Element, Position, outline};
+use crate::{Error, FlangeDescription, JointDescription, JointType, RobotDescription};
+use lie::{SE3, SO3, Vector3};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Which links the chain runs between; `None` picks the only candidate or refuses.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct ChainEnds {
+    /// The link whose frame is the robot's base frame (`--base-link`).
+    pub base_link: Option<String>,
+    /// The link whose frame is the flange (`--tip-link`).
+    pub tip_link: Option<String>,
+}
+
+/// How a step of the chain moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepMotion {
+    /// A fixed joint, folded into the neighbouring transforms.
+    Fixed,
+    /// A revolute joint with its limits (radians), or a continuous one (`None`).
+    Revolute {
+        /// Lower and upper limit, radians.
+        limits_rad: Option<(f64, f64)>,
+    },
+    /// A prismatic joint with its limits, metres.
+    Prismatic {
+        /// Lower and upper limit, metres.
+        limits_m: (f64, f64),
+    },
+}
+
+/// One joint on the chain, in the direction from the base link to the tip link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainStep {
+    /// The URDF joint's name.
+    pub joint: String,
+    /// The link the step leaves.
+    pub from_link: String,
+    /// The link the step reaches.
+    pub to_link: String,
+    /// Whether the step runs the joint from its child to its parent (fixed joints only).
+    pub reversed: bool,
+    /// Fixed, revolute or prismatic.
+    pub motion: StepMotion,
+    /// `from_link_from_to_link` at zero joint value.
+    pub from_to: SE3,
+    /// Unit axis of a movable joint in `to_link`'s frame.
+    pub axis: Vector3,
+}
+
+/// The chain between two links of a URDF.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UrdfChain {
+    /// The `<robot name>`.
+    pub robot_name: String,
+    /// The base link.
+    pub base_link: String,
+    /// The tip link.
+    pub tip_link: String,
+    /// The joints from the base link to the tip link.
+    pub steps: Vec<ChainStep>,
+}
+
+/// A parsed URDF with the positions of its elements.
+#[derive(Debug, Clone)]
+pub struct UrdfDocument {
+    file: String,
+    robot: urdf_rs::Robot,
+    outline: Element,
+}
+
+/// Largest allowed `|axis|` below which a joint axis counts as zero.
+const ZERO_AXIS: f64 = 1e-9;
+
+impl UrdfDocument {
+    /// Reads and checks a URDF file.
+    pub fn read(path: &Path) -> Result<Self, Error> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+        Self::parse(&text, &file)
+    }
+
+    /// Parses and checks a URDF; `file` names it in errors.
+    pub fn parse(text: &str, file: &str) -> Result<Self, Error> {
+        let at = |(line, column): Position, message: String| Error::UrdfFormat {
+            file: file.to_owned(),
+            line,
+            column,
+            message,
+        };
+        let root = outline(text).map_err(|e| at(e.position, e.message))?;
+        if root.name != "robot" {
+            return Err(at(root.position, format!("the root element is <{}>, a URDF's is <robot>", root.name)));
+        }
+        if let Some(xacro) = find(&root, &|e| {
+            e.name.starts_with("xacro:") || e.attributes.iter().any(|(n, _)| n.starts_with("xmlns:xacro"))
+        }) {
+            return Err(at(xacro.position, "a xacro file: expand it first (`xacro arm.urdf.xacro > arm.urdf`)".into()));
+        }
+        let robot = urdf_rs::read_from_string(text).map_err(|e| {
+            let message = e.to_string();
+            // urdf-rs quotes the offending value in brackets where it can; find it in the text.
+            let position = message
+                .split_once('[')
+                .and_then(|(_, rest)| rest.split_once(']'))
+                .and_then(|(quoted, _)| text.find(quoted))
+                .map_or(root.position, |offset| line_column(text, offset));
+            at(position, format!("URDF: {message}"))
+        })?;
+        let document = Self { file: file.to_owned(), robot, outline: root };
+        document.check_structure()?;
+        Ok(document)
+    }
+
+    /// The file name used in messages.
+    pub fn file(&self) -> &str {
+        &self.file
+    }
+
+    /// The parsed robot.
+    pub fn robot(&self) -> &urdf_rs::Robot {
+        &self.robot
+    }
+
+    /// The top-level element `<kind name="name">` of the outline.
+    pub(crate) fn element(&self, kind: &str, name: &str) -> Option<&Element> {
+        self.outline.children.iter().find(|e| e.name == kind && e.attribute("name") == Some(name))
+    }
+
+    /// An error at the element `<kind name="name">` (or at `<robot>` if there is none).
+    pub(crate) fn error_at(&self, kind: &str, name: &str, message: String) -> Error {
+        let (line, column) = self.element(kind, name).map_or(self.outline.position, |e| e.position);
+        Error::UrdfFormat { file: self.file.clone(), line, column, message }
+    }
+
+    fn check_structure(&self) -> Result<(), Error> {
+        for kind in ["link", "joint"] {
+            let mut seen: Vec<&str> = Vec::new();
+            for element in self.outline.children.iter().filter(|e| e.name == kind) {
+                let Some(name) = element.attribute("name") else {
+                    return Err(self.at(element.position, format!("<{kind}> has no name")));
+                };
+                if seen.contains(&name) {
+                    return Err(self.at(element.position, format!("a second {kind} named '{name}'")));
+                }
+                seen.push(name);
+            }
+        }
+        let mut parent_of: HashMap<&str, &str> = HashMap::new();
+        for (joint, element) in self.robot.joints.iter().zip(self.outline.children.iter().filter(|e| e.name == "joint"))
+        {
+            for link in [&joint.parent.link, &joint.child.link] {
+                if !self.robot.links.iter().any(|l| l.name == *link) {
+                    return Err(self.at(
+                        element.position,
+                        format!("joint '{}' names link '{link}', which is not defined", joint.name),
+                    ));
+                }
+            }
+            if let Some(other) = parent_of.insert(&joint.child.link, &joint.name) {
+                return Err(self.at(
+                    element.position,
+                    format!("link '{}' is the child of joints '{other}' and '{}'", joint.child.link, joint.name),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn at(&self, (line, column): Position, message: String) -> Error {
+        Error::UrdfFormat { file: self.file.clone(), line, column, message }
+    }
+
+    /// The joint of which `link` is the child.
+    fn parent_joint(&self, link: &str) -> Option<&urdf_rs::Joint> {
+        self.robot.joints.iter().find(|j| j.child.link == link)
+    }
+
+    fn link_exists(&self, link: &str, flag: &str) -> Result<(), Error> {
+        if self.robot.links.iter().any(|l| l.name == link) {
+            return Ok(());
+        }
+        let known: Vec<&str> = self.robot.links.iter().map(|l| l.name.as_str()).collect();
+        Err(self.at(self.outline.position, format!("{flag}: no link named '{link}' (links: {})", known.join(", "))))
+    }
+
+    /// The chain between the links `ends` names (or the only candidates).
+    pub fn chain(&self, ends: &ChainEnds) -> Result<UrdfChain, Error> {
+        let base = match &ends.base_link {
+            Some(base) => {
+                self.link_exists(base, "--base-link")?;
+                base.clone()
+            }
+            None => self.root_link()?,
+        };
+        let tip = match &ends.tip_link {
+            Some(tip) => {
+                self.link_exists(tip, "--tip-link")?;
+                tip.clone()
+            }
+            None => self.deepest_leaf(&self.fixed_top(&base), &base)?,
+        };
+        // Ancestors of each end, nearest first, as (link, joint above it).
+        let up = |from: &str| {
+            let mut path = vec![from.to_owned()];
+            while let Some(joint) = self.parent_joint(path.last().map_or("", String::as_str)) {
+                if path.contains(&joint.parent.link) {
+                    break;
+                }
+                path.push(joint.parent.link.clone());
+            }
+            path
+        };
+        let (from_base, from_tip) = (up(&base), up(&tip));
+        let Some(meet) = from_base.iter().position(|l| from_tip.contains(l)) else {
+            return Err(self.error_at("link", &tip, format!("no chain joins base link '{base}' and tip link '{tip}'")));
+        };
+        let down = from_tip.iter().position(|l| *l == from_base[meet]).unwrap_or(0);
+        let mut steps = Vec::new();
+        for link in &from_base[..meet] {
+            steps.push(self.step(link, true, &base, &tip)?);
+        }
+        for link in from_tip[..down].iter().rev() {
+            steps.push(self.step(link, false, &base, &tip)?);
+        }
+        if steps.iter().all(|s| s.motion == StepMotion::Fixed) {
+            return Err(self.error_at(
+                "link",
+                &tip,
+                format!("no movable joint between base link '{base}' and tip link '{tip}'"),
+            ));
+        }
+        Ok(UrdfChain { robot_name: self.robot.name.clone(), base_link: base, tip_link: tip, steps })
+    }
+
+    fn root_link(&self) -> Result<String, Error> {
+        let roots: Vec<&str> =
+            self.robot.links.iter().map(|l| l.name.as_str()).filter(|l| self.parent_joint(l).is_none()).collect();
+        match roots.as_slice() {
+            [root] => Ok((*root).to_owned()),
+            [] => Err(self.at(self.outline.position, "no root link: every link is a joint's child (a loop)".into())),
+            [_, second, ..] => Err(self.error_at(
+                "link",
+                second,
+                format!("several root links ({}): choose the base with --base-link", roots.join(", ")),
+            )),
+        }
+    }
+
+    /// The highest link reached from `link` up through fixed joints: the chain may start there.
+    fn fixed_top(&self, link: &str) -> String {
+        let mut top = link.to_owned();
+        let mut seen = vec![top.clone()];
+        while let Some(joint) = self.parent_joint(&top).filter(|j| j.joint_type == urdf_rs::JointType::Fixed) {
+            if seen.contains(&joint.parent.link) {
+                break;
+            }
+            top = joint.parent.link.clone();
+            seen.push(top.clone());
+        }
+        top
+    }
+
+    /// The leaf below `top` with the most movable joints on the way (`base` names the chain's
+    /// base in messages).
+    fn deepest_leaf(&self, top: &str, base: &str) -> Result<String, Error> {
+        let mut leaves: Vec<(String, usize)> = Vec::new();
+        let mut visited: Vec<String> = Vec::new();
+        let mut stack = vec![(top.to_owned(), 0usize)];
+        while let Some((link, movable)) = stack.pop() {
+            // A loop of joints (no root) would otherwise be walked for ever.
+            if visited.contains(&link) {
+                continue;
+            }
+            visited.push(link.clone());
+            let children: Vec<&urdf_rs::Joint> = self.robot.joints.iter().filter(|j| j.parent.link == link).collect();
+            if children.is_empty() {
+                leaves.push((link, movable));
+            }
+            for joint in children.into_iter().rev() {
+                let moves = usize::from(joint.joint_type != urdf_rs::JointType::Fixed);
+                stack.push((joint.child.link.clone(), movable + moves));
+            }
+        }
+        let most = leaves.iter().map(|(_, m)| *m).max().unwrap_or(0);
+        let best: Vec<&str> = leaves.iter().filter(|(_, m)| *m == most).map(|(l, _)| l.as_str()).collect();
+        match best.as_slice() {
+            _ if most == 0 => Err(self.error_at("link", base, format!("no movable joint below base link '{base}'"))),
+            [tip] => Ok((*tip).to_owned()),
+            _ => Err(self.error_at(
+                "link",
+                base,
+                format!(
+                    "ambiguous chain: leaves {} below base link '{base}' each have {most} movable joints; choose one with --tip-link",
+                    best.join(", ")
+                ),
+            )),
+        }
+    }
+
+    /// The step through the joint above `link`, forward (`link` is its child) or reversed.
+    fn step(&self, link: &str, reversed: bool, base: &str, tip: &str) -> Result<ChainStep, Error> {
+        let joint = self
+            .parent_joint(link)
+            .ok_or_else(|| self.error_at("link", link, format!("link '{link}' has no parent joint")))?;
+        let refuse =
+            |message: String| self.error_at("joint", &joint.name, format!("joint '{}': {message}", joint.name));
+        let numbers = joint.origin.xyz.iter().chain(joint.origin.rpy.iter());
+        if !numbers.chain(joint.axis.xyz.iter()).all(|v| v.is_finite()) {
+            return Err(refuse("origin and axis must be finite".into()));
+        }
+        let has_limit = self.element("joint", &joint.name).is_some_and(|e| e.child("limit").is_some());
+        let (lower, upper) = (joint.limit.lower, joint.limit.upper);
+        let limits = || -> Result<(f64, f64), String> {
+            if !has_limit {
+                return Err("a <limit lower=.. upper=..> is required".into());
+            }
+            if !(lower.is_finite() && upper.is_finite() && lower < upper) {
+                return Err(format!("limits lower {lower} upper {upper} must be finite and increasing"));
+            }
+            Ok((lower, upper))
+        };
+        use urdf_rs::JointType as T;
+        let motion = match joint.joint_type {
+            T::Fixed => StepMotion::Fixed,
+            T::Continuous => StepMotion::Revolute { limits_rad: None },
+            // URDF 1.2 leaves out limits to mean none: both infinite.
+            T::Revolute if has_limit && lower == f64::NEG_INFINITY && upper == f64::INFINITY => {
+                StepMotion::Revolute { limits_rad: None }
+            }
+            T::Revolute => StepMotion::Revolute { limits_rad: Some(limits().map_err(refuse)?) },
+            T::Prismatic => StepMotion::Prismatic { limits_m: limits().map_err(refuse)? },
+            ref other => {
+                return Err(refuse(format!(
+                    "{} joints cannot be calibrated (only revolute, continuous, prismatic and fixed); choose the chain's ends with --base-link/--tip-link",
+                    format!("{other:?}").to_lowercase()
+                )));
+            }
+        };
+        if motion != StepMotion::Fixed && joint.mimic.is_some() {
+            return Err(refuse("mimic joints cannot be calibrated".into()));
+        }
+        if motion != StepMotion::Fixed && reversed {
+            return Err(refuse(format!(
+                "the chain from '{base}' to '{tip}' runs through this movable joint from child to parent; choose a base link above it"
+            )));
+        }
+        let axis = Vector3::from(*joint.axis.xyz);
+        if motion != StepMotion::Fixed && axis.norm() < ZERO_AXIS {
+            return Err(refuse("the axis is zero".into()));
+        }
+        let [roll, pitch, yaw] = *joint.origin.rpy;
+        let origin = SE3::new(SO3::from_rpy(roll, pitch, yaw), Vector3::from(*joint.origin.xyz));
+        let (from_link, to_link) = if reversed {
+            (joint.child.link.clone(), joint.parent.link.clone())
+        } else {
+            (joint.parent.link.clone(), joint.child.link.clone())
+        };
+        Ok(ChainStep {
+            joint: joint.name.clone(),
+            from_link,
+            to_link,
+            reversed,
+            motion,
+            from_to: if reversed { origin.inverse() } else { origin },
+            axis: if motion == StepMotion::Fixed { Vector3::z() } else { axis.normalize() },
+        })
+    }
+}
+
+/// The first element, depth first, that `matches`.
+fn find<'a>(element: &'a Element, matches: &dyn Fn(&Element) -> bool) -> Option<&'a Element> {
+    if matches(element) {
+        return Some(element);
+    }
+    element.children.iter().find_map(|c| find(c, matches))
+}
+
+/// 1-based line and column of a byte offset.
+fn line_column(text: &str, offset: usize) -> Position {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+impl UrdfChain {
+    /// `base_from_link` at the zero configuration of every step's `to_link`, in chain order.
+    pub fn link_frames(&self) -> Vec<SE3> {
+        let mut frame = SE3::identity();
+        self.steps
+            .iter()
+            .map(|step| {
+                frame = frame * step.from_to;
+                frame
+            })
+            .collect()
+    }
+
+    /// Number of movable joints.
+    pub fn joint_count(&self) -> usize {
+        self.steps.iter().filter(|s| s.motion != StepMotion::Fixed).count()
+    }
+
+    /// The chain as a robot description: each movable joint's axis and a point on it (its child
+    /// link's origin) in the base link's frame at the zero configuration, the tip link as the flange.
+    pub fn description(&self) -> RobotDescription {
+        let frames = self.link_frames();
+        let mut joints = Vec::new();
+        for (step, frame) in self.steps.iter().zip(&frames) {
+            let (kind, limits_deg, limits_m) = match step.motion {
+                StepMotion::Fixed => continue,
+                StepMotion::Revolute { limits_rad } => {
+                    (JointType::Revolute, limits_rad.map(|(lo, hi)| (lo.to_degrees(), hi.to_degrees())), None)
+                }
+                StepMotion::Prismatic { limits_m } => (JointType::Prismatic, None, Some(limits_m)),
+            };
+            let axis = frame.rotation().act(&step.axis);
+            joints.push(JointDescription {
+                kind,
+                axis: axis.into(),
+                point: frame.translation().into(),
+                limits_deg,
+                limits_m,
+            });
+        }
+        let flange = frames.last().copied().unwrap_or_else(SE3::identity);
+        let rotation = flange.rotation().matrix();
+        RobotDescription {
+            name: self.robot_name.clone(),
+            joints,
+            flange: FlangeDescription {
+                position: flange.translation().into(),
+                x_axis: rotation.column(0).into_owned().into(),
+                z_axis: rotation.column(2).into_owned().into(),
+            },
+            tool: None,
+            dynamics: None,
+        }
+    }
+}
