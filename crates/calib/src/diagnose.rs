@@ -1,7 +1,7 @@
 //! `calib diagnose`: where the geometric model misses, which effect explains it, how far it shrinks.
 
-use pipeline::diagnose::{DiagnoseOptions, diagnose};
 use pipeline::ReadOptions;
+use pipeline::diagnose::{DiagnoseOptions, diagnose};
 use std::path::PathBuf;
 
 /// Diagnose what a geometric calibration leaves: where, which effect, how far it shrinks.
