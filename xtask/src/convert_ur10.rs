@@ -158,3 +158,35 @@ pub fn run(args: &Args) -> Result<(), String> {
         _ => Err("give --out FILE, or --train FILE and --test FILE".into()),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use pipeline::{ColumnMap, ReadOptions, parse_measurements};
+
+    /// The T-Mac angles of the first rows of series C, as the export writes them.
+    const ANGLES: [&str; 3] =
+        ["-90,179563;-20,112975;-90,157388", "-84,20352;-22,726835;-88,245609", "-89,065785;0,79839706;-89,749441"];
+
+    #[test]
+    fn the_readers_euler_columns_give_the_rotation_of_this_conversion() {
+        let mut text = String::from(
+            "q1_rad;measurement_x;measurement_y;measurement_z;measurement_rx;measurement_ry;measurement_rz\n",
+        );
+        for angles in ANGLES {
+            text.push_str(&format!("0;383,97123;-3240,7562;201,72621;{angles}\n"));
+        }
+        let columns: ColumnMap = "x_mm=measurement_x,y_mm=measurement_y,z_mm=measurement_z,\
+                                  rx_deg=measurement_rx,ry_deg=measurement_ry,rz_deg=measurement_rz"
+            .parse()
+            .unwrap();
+        let set =
+            parse_measurements(text.as_bytes(), "tmac.csv", &ReadOptions::default().with_columns(columns)).unwrap();
+        for (row, angles) in set.rows.iter().zip(ANGLES) {
+            let a: Vec<f64> = angles.split(';').map(|c| c.replace(',', ".").parse().unwrap()).collect();
+            let converted = super::rotation(a[0], a[1], a[2]).to_quaternion();
+            let read = row.orientation.unwrap().to_quaternion();
+            let difference = converted.iter().zip(&read).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+            assert!(difference < 1e-14, "{angles}: {converted:?} converted, {read:?} read");
+        }
+    }
+}

@@ -9,9 +9,12 @@ use std::path::PathBuf;
 pub struct Args {
     #[command(flatten)]
     robot: crate::robot_args::RobotArgs,
-    /// Measurements (SPEC CSV).
+    /// Measurements (SPEC CSV; `;` and decimal commas are detected).
     #[arg(long)]
     data: PathBuf,
+    /// Other headers mapped onto the SPEC's column names: NAME=HEADER,… (e.g. x_mm="X [mm]",qw=Q0).
+    #[arg(long)]
+    columns: Option<pipeline::ColumnMap>,
     /// Print one JSON object on stdout instead of the summary.
     #[arg(long)]
     json: bool,
@@ -36,7 +39,8 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let robot = args.robot.read()?;
-    let data = pipeline::read_measurements(&args.data, &ReadOptions::for_joints(robot.joint_kinds()))?;
+    let read = ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
+    let data = pipeline::read_measurements(&args.data, &read)?;
     let options =
         DiagnoseOptions { folds: args.folds, seed: args.seed, noise_mm: args.noise_mm, ..DiagnoseOptions::default() };
     let diagnosis = diagnose(&robot, &data, &options)?;
@@ -53,7 +57,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     if args.json {
         println!("{}", json_text(diagnosis.to_json())?);
+        eprintln!("{}", data.read_summary());
     } else {
+        println!("{}", data.read_summary());
         print!("{}", diagnosis.summary());
         if let Some(folder) = &args.report {
             println!("  report:         {}", folder.join("diagnosis.md").display());

@@ -1,5 +1,6 @@
 //! `calib eval`: the errors of a calibrated model on measurements.
 
+use pipeline::{ColumnMap, EvalReport, ReadOptions};
 use std::path::PathBuf;
 
 /// Evaluate a calibrated model on measurements.
@@ -8,9 +9,12 @@ pub struct Args {
     /// Calibrated model (RON, from `calib fit`).
     #[arg(long)]
     model: PathBuf,
-    /// Measurements (SPEC CSV).
+    /// Measurements (SPEC CSV; `;` and decimal commas are detected).
     #[arg(long)]
     data: PathBuf,
+    /// Other headers mapped onto the SPEC's column names: NAME=HEADER,… (e.g. x_mm="X [mm]",qw=Q0).
+    #[arg(long)]
+    columns: Option<ColumnMap>,
     /// Print one JSON object on stdout instead of a table.
     #[arg(long)]
     json: bool,
@@ -18,18 +22,16 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let model = pipeline::read_model(&args.model)?;
-    let data = pipeline::read_measurements(&args.data, &pipeline::ReadOptions::for_joints(model.joint_kinds()))?;
+    let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
+    let data = pipeline::read_measurements(&args.data, &options)?;
     let evaluation = pipeline::evaluate(&model, &data)?;
-    let s = &evaluation.summary;
     if args.json {
-        let mut value = serde_json::to_value(s)?;
-        if let Some(object) = value.as_object_mut() {
-            object.insert("method".into(), model.method.name().into());
-            object.insert("full_pose".into(), data.full_pose.into());
-        }
-        println!("{value}");
+        println!("{}", serde_json::to_string(&EvalReport::new(&model, &data, &evaluation))?);
+        eprintln!("{}", data.read_summary());
         return Ok(());
     }
+    let s = &evaluation.summary;
+    println!("{}", data.read_summary());
     println!("{} model of {} on {} ({} rows)", model.method, model.robot, args.data.display(), s.n);
     println!(
         "  position error: mean {:.4} mm, rms {:.4} mm, median {:.4} mm, max {:.4} mm",

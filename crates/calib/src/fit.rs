@@ -8,9 +8,12 @@ use std::path::PathBuf;
 pub struct Args {
     #[command(flatten)]
     robot: crate::robot_args::RobotArgs,
-    /// Measurements (SPEC CSV).
+    /// Measurements (SPEC CSV; `;` and decimal commas are detected).
     #[arg(long)]
     data: PathBuf,
+    /// Other headers mapped onto the SPEC's column names: NAME=HEADER,… (e.g. x_mm="X [mm]",qw=Q0).
+    #[arg(long)]
+    columns: Option<pipeline::ColumnMap>,
     /// Calibration method: base-tool, poe, poe-gp or poe-gp-load.
     #[arg(long)]
     method: Method,
@@ -25,7 +28,9 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let robot = args.robot.read()?;
-    let data = pipeline::read_measurements(&args.data, &ReadOptions::for_joints(robot.joint_kinds()))?;
+    let options = ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
+    let data = pipeline::read_measurements(&args.data, &options)?;
+    println!("{}", data.read_summary());
     let options = FitOptions { joint_compliance: args.joint_compliance, ..FitOptions::default() };
     let (model, report) = pipeline::fit(&robot, &data, args.method, &options)?;
     pipeline::write_model(&args.out, &model)?;
@@ -40,9 +45,6 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         if tools == 1 { "" } else { "s" },
         robot.name
     );
-    if !data.ignored_columns.is_empty() {
-        println!("  ignored columns: {}", data.ignored_columns.join(", "));
-    }
     print_errors("training error before (nominal, registered)", &report.before);
     print_errors("training error after", &report.after);
     let id = &report.identification;

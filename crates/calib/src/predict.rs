@@ -13,11 +13,16 @@ pub struct Args {
     /// Joint configurations: the measurement CSV; the position columns may be left out.
     #[arg(long)]
     data: PathBuf,
+    /// Other headers mapped onto the SPEC's column names: NAME=HEADER,… (e.g. x_mm="X [mm]",qw=Q0).
+    #[arg(long)]
+    columns: Option<pipeline::ColumnMap>,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let model = pipeline::read_model(&args.model)?;
-    let data = pipeline::read_configurations(&args.data, &pipeline::ReadOptions::for_joints(model.joint_kinds()))?;
+    let options =
+        pipeline::ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
+    let data = pipeline::read_configurations(&args.data, &options)?;
     let tools = pipeline::tool_indices(&model, &data)?;
     let predictions = model.predict(&data.rows, &tools)?;
     let stdout = std::io::stdout();
@@ -57,5 +62,6 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     out.flush()?;
     std::io::stdout().flush()?;
+    eprintln!("{}", data.read_summary());
     Ok(())
 }

@@ -144,3 +144,146 @@ fn every_error_is_one_line_with_a_non_zero_exit() {
     fails(&["frobnicate"]);
     assert!(!model.exists(), "no model is written when the fit fails");
 }
+
+fn simulated_full_pose(dir: &Path, rows: usize, seed: u64) -> PathBuf {
+    let path = dir.join(format!("full{seed}.csv"));
+    succeeds(&[
+        "simulate",
+        "--robot",
+        &fixture("irb4400.ron"),
+        "--out",
+        &text(&path),
+        "--rows",
+        &rows.to_string(),
+        "--seed",
+        &seed.to_string(),
+        "--full-pose",
+    ]);
+    path
+}
+
+fn fit_poe(data: &Path, out: &Path, extra: &[&str]) -> String {
+    let (robot, data, out) = (fixture("irb4400.ron"), text(data), text(out));
+    let mut args = vec!["fit", "--robot", &robot, "--data", &data, "--method", "poe", "--out", &out];
+    args.extend_from_slice(extra);
+    succeeds(&args)
+}
+
+#[test]
+fn eval_json_carries_every_key_the_spec_lists() {
+    let dir = tempfile::tempdir().unwrap();
+    for (data, full_pose) in [(simulated(dir.path(), 80, 31), false), (simulated_full_pose(dir.path(), 80, 32), true)] {
+        let model = dir.path().join("eval.ron");
+        fit_poe(&data, &model, &[]);
+        let out = succeeds(&["eval", "--model", &text(&model), "--data", &text(&data), "--json"]);
+        let json: serde_json::Value = serde_json::from_str(&out).expect("one JSON object");
+        assert_eq!(json["n"].as_u64(), Some(80), "{json}");
+        for key in ["mean_position_error_mm", "rms_position_error_mm", "max_position_error_mm"] {
+            assert!(json[key].as_f64().is_some_and(f64::is_finite), "{key} in {json}");
+        }
+        assert_eq!(json["mean_rotation_error_mrad"].as_f64().is_some(), full_pose, "{json}");
+        assert_eq!((json["method"].as_str(), json["full_pose"].as_bool()), (Some("poe"), Some(full_pose)));
+    }
+}
+
+/// `value` as a tracker export writes it: full precision, a decimal comma.
+fn comma(value: f64) -> String {
+    format!("{value:?}").replace('.', ",")
+}
+
+/// A SPEC full-pose file rewritten as a Leica/T-Mac export: `;` between fields, decimal commas,
+/// joints in degrees, the orientation as Euler angles (R = Rx·Ry·Rz), its own header names, and a
+/// time stamp that spreadsheet software has mangled.
+fn leica_export(spec: &str) -> String {
+    let mut lines = spec.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let at = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let mut out = vec![
+        "Timestamp;A1 [deg];A2 [deg];A3 [deg];A4 [deg];A5 [deg];A6 [deg];X [mm];Y [mm];Z [mm];\
+                        Rx [deg];Ry [deg];Rz [deg];Load [kg];Temperature [°C]"
+            .to_owned(),
+    ];
+    for line in lines {
+        let cells: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+        let mut row = vec!["2,02011E+13".to_owned()];
+        row.extend((1..=6).map(|k| comma(cells[at(&format!("q{k}_rad"))].to_degrees())));
+        row.extend(["x_mm", "y_mm", "z_mm"].map(|n| comma(cells[at(n)])));
+        let [w, x, y, z] = ["qw", "qx", "qy", "qz"].map(|n| cells[at(n)]);
+        let (r00, r01, r02) = (1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y));
+        let (r12, r22) = (2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y));
+        let euler = [(-r12).atan2(r22), r02.clamp(-1.0, 1.0).asin(), (-r01).atan2(r00)];
+        row.extend(euler.map(|a| comma(a.to_degrees())));
+        row.extend(["payload_kg", "temp_c"].map(|n| comma(cells[at(n)])));
+        out.push(row.join(";"));
+    }
+    out.join("\n") + "\n"
+}
+
+const LEICA_COLUMNS: &str = "q1_deg=A1 [deg],q2_deg=A2 [deg],q3_deg=A3 [deg],q4_deg=A4 [deg],q5_deg=A5 [deg],\
+                             q6_deg=A6 [deg],x_mm=X [mm],y_mm=Y [mm],z_mm=Z [mm],rx_deg=Rx [deg],ry_deg=Ry [deg],\
+                             rz_deg=Rz [deg],payload_kg=Load [kg],temp_c=\"Temperature [°C]\"";
+
+#[test]
+fn a_leica_style_export_fits_without_editing_to_the_same_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = simulated_full_pose(dir.path(), 150, 33);
+    let export = dir.path().join("leica.csv");
+    std::fs::write(&export, leica_export(&std::fs::read_to_string(&spec).unwrap())).unwrap();
+    let (from_spec, from_export) = (dir.path().join("spec.ron"), dir.path().join("leica.ron"));
+    fit_poe(&spec, &from_spec, &[]);
+    let out = fit_poe(&export, &from_export, &["--columns", LEICA_COLUMNS]);
+    assert!(
+        out.contains(
+            "leica.csv: 150 rows, ';'-separated, decimal comma; orientation from Euler angles (R = Rx·Ry·Rz); \
+             14 columns named by --columns; ignored columns: Timestamp"
+        ),
+        "{out}"
+    );
+    // Both models, evaluated on the SPEC file, give the same errors.
+    let eval = |model: &Path| -> serde_json::Value {
+        serde_json::from_str(&succeeds(&["eval", "--model", &text(model), "--data", &text(&spec), "--json"])).unwrap()
+    };
+    let (a, b) = (eval(&from_spec), eval(&from_export));
+    for key in ["mean_position_error_mm", "max_position_error_mm", "mean_rotation_error_mrad"] {
+        let (a, b) = (a[key].as_f64().unwrap(), b[key].as_f64().unwrap());
+        assert!((a - b).abs() < 1e-9, "{key}: {a} from the SPEC file, {b} from the export");
+    }
+    // And the export evaluates as it comes, too.
+    let out = succeeds(&["eval", "--model", &text(&from_spec), "--data", &text(&export), "--columns", LEICA_COLUMNS]);
+    assert!(out.contains("';'-separated, decimal comma"), "{out}");
+}
+
+#[test]
+fn a_bad_column_map_is_one_line_naming_where_it_is() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 30, 34);
+    let model = dir.path().join("m.ron");
+    let message = fails(&[
+        "fit",
+        "--robot",
+        &fixture("irb4400.ron"),
+        "--data",
+        &text(&data),
+        "--method",
+        "poe",
+        "--out",
+        &text(&model),
+        "--columns",
+        "x_mm=X,x_cm=Y",
+    ]);
+    assert!(message.contains("--columns:1:8: 'x_cm=Y' is not a SPEC column name"), "{message}");
+    let message = fails(&[
+        "fit",
+        "--robot",
+        &fixture("irb4400.ron"),
+        "--data",
+        &text(&data),
+        "--method",
+        "poe",
+        "--out",
+        &text(&model),
+        "--columns",
+        "x_mm=X [mm]",
+    ]);
+    assert!(message.contains(&format!("{}:1:", text(&data))) && message.contains("'X [mm]'"), "{message}");
+}

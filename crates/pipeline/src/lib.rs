@@ -11,6 +11,7 @@ pub mod chart;
 mod compensation;
 pub mod diagnose;
 mod error;
+mod eval_report;
 mod fit;
 pub mod geometric;
 mod load_model;
@@ -30,6 +31,7 @@ mod xml_outline;
 pub use calibrated::{CalibratedModel, PredictedPose, pose_error};
 pub use compensation::{Compensation, CompensationOptions, CompensationReport, ResidualFrame};
 pub use error::Error;
+pub use eval_report::EvalReport;
 pub use fit::{Evaluation, FitOptions, FitReport, evaluate, fit, tool_indices};
 pub use load_model::{ComplianceModel, ComplianceTerm};
 pub use measurements::{

@@ -2,11 +2,13 @@
 //! the name. Every refusal names the file, the line and the column.
 //!
 //! `layout` reads the header, `dialect` the numbers (`,`/`.` or a tracker's `;`/`,`),
-//! `column_map` the `--columns` renaming, `writer` writes a set back as SPEC CSV.
+//! `column_map` the `--columns` renaming, `row` the cells of one row, `writer` writes a set back
+//! as SPEC CSV.
 
 mod column_map;
 mod dialect;
 mod layout;
+mod row;
 mod writer;
 
 pub use column_map::{ColumnMap, ColumnMapFault};
@@ -16,6 +18,7 @@ use crate::Error;
 use layout::{Column, Expectation, Layout, OrientationColumns};
 use lie::{SO3, Vector3};
 use poe::JointKind;
+use row::{Row, syntax_error};
 use serde::Serialize;
 use std::fmt;
 use std::io::Read;
@@ -147,79 +150,6 @@ pub fn read_configurations(path: &Path, options: &ReadOptions) -> Result<Measure
     parse(reader, &file, options, false)
 }
 
-/// The CSV layer's refusal as ours, at its line and field.
-fn syntax_error(e: &csv::Error, file: &str, delimiter: Delimiter) -> Error {
-    let line = e.position().map_or(1, |p| p.line());
-    match e.kind() {
-        csv::ErrorKind::UnequalLengths { expected_len, len, .. } => Error::FieldCount {
-            file: file.to_owned(),
-            line,
-            column: (*expected_len).min(*len) as usize + 1,
-            found: *len,
-            expected: *expected_len,
-            delimiter: delimiter.byte() as char,
-        },
-        csv::ErrorKind::Utf8 { err, .. } => Error::InvalidUtf8 { file: file.to_owned(), line, column: err.field() + 1 },
-        _ => Error::CsvSyntax { file: file.to_owned(), line, column: 1, message: e.to_string() },
-    }
-}
-
-/// The cells of one row, read as the header's layout says.
-struct Row<'a> {
-    record: &'a csv::StringRecord,
-    line: u64,
-    file: &'a str,
-    names: &'a [String],
-    dialect: &'a mut Dialect,
-}
-
-impl Row<'_> {
-    fn number(&mut self, column: Column) -> Result<f64, Error> {
-        let text = self.record.get(column.index).unwrap_or("");
-        let at = |text: &str| {
-            (self.file.to_owned(), self.line, column.index + 1, self.names[column.index].clone(), text.to_owned())
-        };
-        match self.dialect.number(text) {
-            Ok(Some(value)) => Ok(value * column.scale),
-            Ok(None) => {
-                let (file, line, column, name, text) = at(text);
-                Err(Error::NotANumber { file, line, column, name, text })
-            }
-            Err(fault) => {
-                let (file, line, column, name, text) = at(text);
-                Err(Error::DecimalMark { file, line, column, name, text, fault })
-            }
-        }
-    }
-
-    fn numbers(&mut self, columns: &[Column]) -> Result<Vec<f64>, Error> {
-        columns.iter().map(|&c| self.number(c)).collect()
-    }
-
-    fn orientation(&mut self, columns: &OrientationColumns) -> Result<SO3, Error> {
-        match columns {
-            OrientationColumns::Quaternion(c) => {
-                let q = self.numbers(c)?;
-                SO3::from_quaternion(q[0], q[1], q[2], q[3]).map_err(|_| Error::QuaternionNorm {
-                    file: self.file.to_owned(),
-                    line: self.line,
-                    column: c[0].index + 1,
-                    norm: q.iter().map(|v| v * v).sum::<f64>().sqrt(),
-                })
-            }
-            OrientationColumns::Euler(c) => {
-                // R = Rx(rx) · Ry(ry) · Rz(rz), the order of Leica/T-Mac exports (SPEC v2); each
-                // angle is first brought into one turn, so that no finite angle makes a NaN.
-                let a = self.numbers(c)?;
-                let turn = |angle: f64| angle.rem_euclid(std::f64::consts::TAU);
-                Ok(SO3::exp(&(Vector3::x() * turn(a[0])))
-                    * SO3::exp(&(Vector3::y() * turn(a[1])))
-                    * SO3::exp(&(Vector3::z() * turn(a[2]))))
-            }
-        }
-    }
-}
-
 fn parse<R: Read>(
     mut reader: R,
     file: &str,
@@ -336,6 +266,16 @@ impl MeasurementSet {
             joint_columns: vec![],
             format: FileFormat::default(),
         }
+    }
+
+    /// One line saying what the reader found: rows, separators, orientation, mapped and ignored
+    /// columns (the CLI prints it).
+    pub fn read_summary(&self) -> String {
+        let mut line = format!("read {}: {} rows, {}", self.source, self.rows.len(), self.format);
+        if !self.ignored_columns.is_empty() {
+            line.push_str(&format!("; ignored columns: {}", self.ignored_columns.join(", ")));
+        }
+        line
     }
 
     /// Refuses a set whose joint columns do not match a robot's `joints`.
