@@ -11,6 +11,7 @@ mod reproduce_sim_params;
 mod reproduce_sim_report;
 mod simulation;
 mod ur10;
+mod urdf_check;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -37,6 +38,8 @@ enum Command {
     BlindCheck(blind_check::Args),
     /// Every method and the diagnosis on the real UR10 tracker data (Landgraf et al., CASE 2021).
     Ur10(ur10::Args),
+    /// The UR10 as RON, DH and URDF on the real tracker data; the calibrated URDF exported and read back.
+    UrdfCheck(urdf_check::Args),
 }
 
 fn main() -> ExitCode {
@@ -48,6 +51,7 @@ fn main() -> ExitCode {
         Command::ConvertUr10(args) => convert_ur10::run(args),
         Command::BlindCheck(args) => blind_check::run(args),
         Command::Ur10(args) => ur10::run(args),
+        Command::UrdfCheck(args) => urdf_check::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

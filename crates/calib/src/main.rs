@@ -3,6 +3,7 @@
 
 mod diagnose;
 mod eval;
+mod export;
 mod fit;
 mod predict;
 mod robot_args;
@@ -26,6 +27,7 @@ enum Command {
     Predict(predict::Args),
     Diagnose(diagnose::Args),
     Simulate(simulate::Args),
+    Export(export::Args),
 }
 
 fn main() -> ExitCode {
@@ -53,6 +55,7 @@ fn main() -> ExitCode {
         Command::Predict(args) => predict::run(&args),
         Command::Diagnose(args) => diagnose::run(&args),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Export(args) => export::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

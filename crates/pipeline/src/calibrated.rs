@@ -62,6 +62,24 @@ impl CalibratedModel {
         })
     }
 
+    /// The model without its non-geometric parts (joint compliance, the GP): the geometry alone,
+    /// which is what a URDF can hold (`calib export`).
+    pub fn geometry_only(&self) -> CalibratedModel {
+        CalibratedModel { joint_compliance: None, compensation: None, ..self.clone() }
+    }
+
+    /// The names of the parts besides the geometry, in the order they apply.
+    pub fn non_geometric_parts(&self) -> Vec<&'static str> {
+        let mut parts = Vec::new();
+        if self.joint_compliance.is_some() {
+            parts.push("joint_compliance");
+        }
+        if self.compensation.is_some() {
+            parts.push("gaussian_process");
+        }
+        parts
+    }
+
     /// The poses of the kinematics, with the joint compliance if the model has it, before any GP.
     pub fn geometric_poses(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<SE3>, Error> {
         let mut poses = Vec::with_capacity(rows.len());

@@ -285,6 +285,42 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A nominal robot description whose joints are not where a calibrated model has them, once
+    /// its base is placed by joint 1: not the description the model was fitted with.
+    NominalMismatch {
+        /// The description.
+        file: String,
+        /// 1-based joint that is furthest off.
+        joint: usize,
+        /// Distance of the model's joint frame origin from the description's axis, mm.
+        offset_mm: f64,
+        /// Angle between the two axes, mrad.
+        angle_mrad: f64,
+        /// The largest offset accepted, mm.
+        limit_mm: f64,
+        /// The largest angle accepted, mrad.
+        limit_mrad: f64,
+    },
+    /// A robot description with another number of joints than a calibrated model.
+    RobotJointCount {
+        /// The description.
+        file: String,
+        /// Its joints.
+        robot: usize,
+        /// The model's joints.
+        model: usize,
+    },
+    /// A model with parts a URDF cannot hold, exported without the training data that measure
+    /// the error left without them.
+    ExportNeedsData {
+        /// The parts.
+        parts: Vec<String>,
+    },
+    /// A prismatic joint exported without the limits a URDF requires (no nominal description).
+    PrismaticWithoutLimits {
+        /// 1-based joint.
+        joint: usize,
+    },
     /// A model file written by another schema version.
     SchemaVersion {
         /// The file.
@@ -408,6 +444,25 @@ impl fmt::Display for Error {
             Error::RonFormat { file, line, column, message } | Error::UrdfFormat { file, line, column, message } => {
                 write!(f, "{file}:{line}:{column}: {message}")
             }
+            Error::NominalMismatch { file, joint, offset_mm, angle_mrad, limit_mm, limit_mrad } => write!(
+                f,
+                "{file}: joint {joint} of this robot is {offset_mm:.1} mm and {angle_mrad:.1} mrad from the model's (at most {limit_mm} mm and {limit_mrad} mrad expected): give the robot description the model was fitted with"
+            ),
+            Error::RobotJointCount { file, robot, model } => {
+                write!(
+                    f,
+                    "{file}: the robot has {robot} joints, the model {model}: not the robot the model was fitted for"
+                )
+            }
+            Error::ExportNeedsData { parts } => write!(
+                f,
+                "the model has {} that a URDF cannot hold: give its training data (--data) to measure the error left without them",
+                parts.join(" and ")
+            ),
+            Error::PrismaticWithoutLimits { joint } => write!(
+                f,
+                "joint {joint} is prismatic and a URDF needs its limits: give the robot description (--robot or --like)"
+            ),
             Error::SchemaVersion { file, found, supported } => {
                 write!(f, "{file}:1:1: model file has schema version {found}, this calib reads version {supported}")
             }

@@ -6,6 +6,7 @@
 //! path or a reader from the caller.
 #![deny(missing_docs)]
 
+mod base_frame;
 mod calibrated;
 pub mod chart;
 mod compensation;
@@ -26,8 +27,11 @@ mod robot_dh;
 mod ron_position;
 pub mod simulated;
 mod urdf_chain;
+mod urdf_export;
+mod urdf_like;
 mod xml_outline;
 
+pub use base_frame::{NominalTolerance, axis_changes, check_nominal, in_base_frame, tracker_from_base};
 pub use calibrated::{CalibratedModel, PredictedPose, pose_error};
 pub use compensation::{Compensation, CompensationOptions, CompensationReport, ResidualFrame};
 pub use error::Error;
@@ -44,3 +48,6 @@ pub use model_file::{SCHEMA_VERSION, parse_model, read_model, write_model};
 pub use robot::{FlangeDescription, JointDescription, JointType, RobotDescription};
 pub use robot_dh::{DhTable, DhTableRow};
 pub use urdf_chain::{ChainEnds, ChainStep, StepMotion, UrdfChain, UrdfDocument};
+pub use urdf_export::{
+    AxisChange, TrainingErrors, UrdfExport, UrdfExportReport, UrdfTemplate, export_urdf, write_urdf,
+};

@@ -76,6 +76,7 @@ pub struct UrdfChain {
 #[derive(Debug, Clone)]
 pub struct UrdfDocument {
     file: String,
+    text: String,
     robot: urdf_rs::Robot,
     outline: Element,
 }
@@ -118,7 +119,7 @@ impl UrdfDocument {
                 .map_or(root.position, |offset| line_column(text, offset));
             at(position, format!("URDF: {message}"))
         })?;
-        let document = Self { file: file.to_owned(), robot, outline: root };
+        let document = Self { file: file.to_owned(), text: text.to_owned(), robot, outline: root };
         document.check_structure()?;
         Ok(document)
     }
@@ -126,6 +127,16 @@ impl UrdfDocument {
     /// The file name used in messages.
     pub fn file(&self) -> &str {
         &self.file
+    }
+
+    /// The text as read.
+    pub(crate) fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// The root element `<robot>`.
+    pub(crate) fn root(&self) -> &Element {
+        &self.outline
     }
 
     /// The parsed robot.

@@ -1,0 +1,123 @@
+//! `calib export`: the calibrated geometry as a URDF for controllers, planners and simulators.
+
+use pipeline::{ChainEnds, NominalTolerance, ReadOptions, RobotDescription, UrdfDocument, UrdfTemplate};
+use std::path::PathBuf;
+
+/// Write a calibrated model's geometry as a URDF.
+///
+/// The URDF is in the robot's base frame (joint 1 where the nominal description puts it, as
+/// calibrated), with a fixed `tracker` link at the tracker frame and a fixed link per calibrated
+/// tool. What a URDF cannot hold (joint compliance, the GP) is reported with the error the model
+/// makes without it on the training data (--data).
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Calibrated model (RON, from `calib fit`).
+    #[arg(long)]
+    model: PathBuf,
+    /// Where to write the URDF.
+    #[arg(long)]
+    urdf: PathBuf,
+    /// Write into this URDF (of the robot the model was fitted with): its links, inertias, visuals
+    /// and limits are kept, the movable joints' origins become the calibrated ones.
+    #[arg(long, conflicts_with = "robot")]
+    like: Option<PathBuf>,
+    /// The nominal robot description the model was fitted with (RON or URDF): places the base
+    /// frame and gives the limits [default: the --like URDF; without either, the base is the
+    /// calibrated joint 1 frame and revolute joints are written as continuous].
+    #[arg(long)]
+    robot: Option<PathBuf>,
+    /// URDF only: the chain's base link in --like or --robot.
+    #[arg(long)]
+    base_link: Option<String>,
+    /// URDF only: the chain's tip link in --like or --robot.
+    #[arg(long)]
+    tip_link: Option<String>,
+    /// The training data (SPEC CSV): the error with and without what a URDF cannot hold. Required
+    /// for a model with joint compliance or a GP.
+    #[arg(long)]
+    data: Option<PathBuf>,
+    /// Print the report as one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    let model = pipeline::read_model(&args.model)?;
+    let ends = ChainEnds { base_link: args.base_link.clone(), tip_link: args.tip_link.clone() };
+    let training = match &args.data {
+        Some(path) => Some(pipeline::read_measurements(path, &ReadOptions::for_joints(model.joint_kinds()))?),
+        None => None,
+    };
+    let tolerance = NominalTolerance::default();
+    let export = match (&args.like, &args.robot) {
+        (Some(like), _) => {
+            let document = UrdfDocument::read(like)?;
+            let chain = document.chain(&ends)?;
+            pipeline::export_urdf(
+                &model,
+                UrdfTemplate::Like { document: &document, chain: &chain },
+                training.as_ref(),
+                &tolerance,
+            )?
+        }
+        (None, Some(robot)) => {
+            let description = RobotDescription::read_with(robot, &ends)?;
+            let file = robot.display().to_string();
+            let template = UrdfTemplate::Plain { nominal: Some((&description, &file)) };
+            pipeline::export_urdf(&model, template, training.as_ref(), &tolerance)?
+        }
+        (None, None) => {
+            if ends != ChainEnds::default() {
+                return Err(
+                    "--base-link and --tip-link choose the chain of --like or --robot, and neither is given".into()
+                );
+            }
+            pipeline::export_urdf(&model, UrdfTemplate::Plain { nominal: None }, training.as_ref(), &tolerance)?
+        }
+    };
+    pipeline::write_urdf(&args.urdf, &export)?;
+    let report = &export.report;
+    if args.json {
+        println!("{}", serde_json::to_string(report)?);
+        return Ok(());
+    }
+    println!(
+        "wrote {} ({}): base link {}, tracker link {}",
+        args.urdf.display(),
+        report.robot,
+        report.base_link,
+        report.tracker_link
+    );
+    println!("  base frame: {}", report.base_frame);
+    println!(
+        "  tool links: {}{}",
+        report.tool_links.join(", "),
+        if report.tool_orientation_calibrated {
+            ""
+        } else {
+            " (position-only data: their orientation is not calibrated)"
+        }
+    );
+    for change in &report.axis_changes {
+        println!(
+            "  {}: axis moved {:.3} mm, turned {:.3} mrad from the nominal",
+            change.joint, change.offset_mm, change.angle_mrad
+        );
+    }
+    if !report.not_in_urdf.is_empty() {
+        println!("  not in the URDF: {}", report.not_in_urdf.join(", "));
+    }
+    if let Some(errors) = &report.training_error {
+        println!(
+            "  training error ({} rows): model mean {:.4} mm, max {:.4} mm; URDF geometry mean {:.4} mm, max {:.4} mm",
+            errors.model.n,
+            errors.model.mean_position_error_mm,
+            errors.model.max_position_error_mm,
+            errors.urdf.mean_position_error_mm,
+            errors.urdf.max_position_error_mm
+        );
+    }
+    let tip = report.tool_links.first().map_or("tool", String::as_str);
+    println!("  read it back with: --robot {} --tip-link {tip}", args.urdf.display());
+    Ok(())
+}
