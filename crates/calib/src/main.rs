@@ -1,6 +1,7 @@
 //! `calib`: the command-line tool. `main` only parses and dispatches; each subcommand lives in a
 //! file of its own and prints through its own functions.
 
+mod compensate;
 mod diagnose;
 mod eval;
 mod export;
@@ -28,6 +29,7 @@ enum Command {
     Diagnose(diagnose::Args),
     Simulate(simulate::Args),
     Export(export::Args),
+    Compensate(compensate::Args),
 }
 
 fn main() -> ExitCode {
@@ -56,6 +58,7 @@ fn main() -> ExitCode {
         Command::Diagnose(args) => diagnose::run(&args),
         Command::Simulate(args) => simulate::run(&args),
         Command::Export(args) => export::run(&args),
+        Command::Compensate(args) => compensate::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -310,6 +310,33 @@ pub enum Error {
         /// The model's joints.
         model: usize,
     },
+    /// A targets file with an orientation that cannot be used: without a position, or for a model
+    /// fitted on positions only.
+    TargetOrientation {
+        /// The file.
+        file: String,
+        /// 1-based column of the orientation.
+        column: usize,
+        /// Whether the position columns are missing (otherwise the model has no orientation).
+        without_position: bool,
+    },
+    /// Targets whose meaning needs the robot description: joint targets (the nominal model) or
+    /// poses in the base frame.
+    TargetsNeedRobot {
+        /// The targets file.
+        file: String,
+        /// Whether the targets are poses (in the base frame) rather than joint targets.
+        poses: bool,
+    },
+    /// A robot description that a base-and-tool fit cannot lay onto the calibrated model.
+    RegistrationMismatch {
+        /// The description.
+        file: String,
+        /// RMS distance left, mm.
+        rms_mm: f64,
+        /// The largest accepted, mm.
+        limit_mm: f64,
+    },
     /// A model with parts a URDF cannot hold, exported without the training data that measure
     /// the error left without them.
     ExportNeedsData {
@@ -447,6 +474,25 @@ impl fmt::Display for Error {
             Error::NominalMismatch { file, joint, offset_mm, angle_mrad, limit_mm, limit_mrad } => write!(
                 f,
                 "{file}: joint {joint} of this robot is {offset_mm:.1} mm and {angle_mrad:.1} mrad from the model's (at most {limit_mm} mm and {limit_mrad} mrad expected): give the robot description the model was fitted with"
+            ),
+            Error::TargetOrientation { file, column, without_position: true } => write!(
+                f,
+                "{file}:1:{column}: an orientation without x_mm, y_mm, z_mm: give the whole pose, or joint targets alone"
+            ),
+            Error::TargetOrientation { file, column, without_position: false } => write!(
+                f,
+                "{file}:1:{column}: the model was fitted on positions only, its orientation is not calibrated: give position targets"
+            ),
+            Error::TargetsNeedRobot { file, poses: false } => write!(
+                f,
+                "{file}:1:1: joint targets are a program taught on the nominal model: give its robot description (--robot)"
+            ),
+            Error::TargetsNeedRobot { file, poses: true } => {
+                write!(f, "{file}:1:1: poses in the base frame need the robot description (--robot) to place the base")
+            }
+            Error::RegistrationMismatch { file, rms_mm, limit_mm } => write!(
+                f,
+                "{file}: this robot, placed on the model by base and tool, stays {rms_mm:.1} mm from it (at most {limit_mm} mm expected): give the robot description the model was fitted with"
             ),
             Error::RobotJointCount { file, robot, model } => {
                 write!(

@@ -15,6 +15,8 @@ mod error;
 mod eval_report;
 mod fit;
 pub mod geometric;
+mod inverse;
+mod joint_targets;
 mod load_model;
 mod measurements;
 mod method;
@@ -37,10 +39,16 @@ pub use compensation::{Compensation, CompensationOptions, CompensationReport, Re
 pub use error::Error;
 pub use eval_report::EvalReport;
 pub use fit::{Evaluation, FitOptions, FitReport, evaluate, fit, tool_indices};
+pub use inverse::{InverseOptions, PoseTarget, Solved, TargetStatus, solve_targets};
+pub use joint_targets::{
+    CompensateOptions, CompensationSummary, RegisteredNominal, TargetFile, TargetFrame, compensate, pose_targets,
+    read_targets, registered_nominal, write_compensated,
+};
 pub use load_model::{ComplianceModel, ComplianceTerm};
 pub use measurements::{
-    ColumnMap, ColumnMapFault, Decimal, DecimalFault, Delimiter, Dialect, FileFormat, JointColumn, Measurement,
-    MeasurementSet, ReadOptions, parse_measurements, read_configurations, read_measurements,
+    Cells, ColumnMap, ColumnMapFault, Decimal, DecimalFault, Delimiter, Dialect, FileFormat, JointColumn, Measurement,
+    MeasurementSet, ReadOptions, parse_measurements, read_configurations, read_configurations_with_cells,
+    read_measurements,
 };
 pub use method::{Method, UnknownMethod};
 pub use metrics::{ErrorSummary, PoseError};

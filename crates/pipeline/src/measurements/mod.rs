@@ -150,11 +150,40 @@ pub fn read_configurations(path: &Path, options: &ReadOptions) -> Result<Measure
     parse(reader, &file, options, false)
 }
 
+/// The cells of a file as written (trimmed), header and rows, beside its parsed rows: what a
+/// command that passes unused columns on needs (`calib compensate`).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Cells {
+    /// The header's names.
+    pub header: Vec<String>,
+    /// Each row's cells, in the order of [`MeasurementSet::rows`].
+    pub rows: Vec<Vec<String>>,
+}
+
+/// [`read_configurations`], with every cell as written.
+pub fn read_configurations_with_cells(path: &Path, options: &ReadOptions) -> Result<(MeasurementSet, Cells), Error> {
+    let file = path.display().to_string();
+    let reader = std::fs::File::open(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+    let mut cells = Cells::default();
+    let set = parse_keeping(reader, &file, options, false, Some(&mut cells))?;
+    Ok((set, cells))
+}
+
 fn parse<R: Read>(
+    reader: R,
+    file: &str,
+    options: &ReadOptions,
+    positions_required: bool,
+) -> Result<MeasurementSet, Error> {
+    parse_keeping(reader, file, options, positions_required, None)
+}
+
+fn parse_keeping<R: Read>(
     mut reader: R,
     file: &str,
     options: &ReadOptions,
     positions_required: bool,
+    mut cells: Option<&mut Cells>,
 ) -> Result<MeasurementSet, Error> {
     let mut bytes = Vec::new();
     reader.read_to_end(&mut bytes).map_err(|source| Error::Io { path: file.to_owned(), source })?;
@@ -177,6 +206,9 @@ fn parse<R: Read>(
         columns: &options.columns,
     };
     let layout = Layout::from_header(&header, &expect)?;
+    if let Some(cells) = cells.as_deref_mut() {
+        cells.header = header.iter().map(str::to_owned).collect();
+    }
     let joints: Vec<Column> = layout.joints.iter().map(|(c, _)| *c).collect();
     let mut tools: Vec<String> = Vec::new();
     let mut rows = Vec::new();
@@ -220,6 +252,9 @@ fn parse<R: Read>(
             }
         };
         rows.push(Measurement { line, q, position, orientation, payload_kg, tool, temp_c, t_s, torques_nm });
+        if let Some(cells) = cells.as_deref_mut() {
+            cells.rows.push(record.iter().map(str::to_owned).collect());
+        }
     }
     if rows.is_empty() {
         return Err(Error::EmptyFile { file: file.to_owned() });

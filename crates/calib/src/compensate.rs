@@ -1,0 +1,80 @@
+//! `calib compensate`: joint targets rewritten so that the calibrated robot reaches what they mean.
+
+use pipeline::{ChainEnds, CompensateOptions, RobotDescription, TargetFrame};
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Rewrite a program's joint targets so that the calibrated model reaches the intended poses.
+///
+/// TARGETS holds either joint columns alone (a program taught on the nominal model: the intended
+/// pose is where the nominal model, placed on the calibrated one by base and tool, puts the tool;
+/// needs --robot), or tool poses (x_mm … and optionally an orientation) with seed joint columns.
+/// The whole model counts: geometry, joint compliance and the GP, with each row's payload_kg.
+/// Output CSV on stdout: q1_rad … qN_rad (empty where refused), the input columns (joint columns
+/// as nominal_…), residual_mm, residual_mrad and status (ok, or why the row was refused).
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Calibrated model (RON, from `calib fit`).
+    #[arg(long)]
+    model: PathBuf,
+    /// The targets (SPEC CSV): joint columns, and for pose targets x_mm, y_mm, z_mm and optionally
+    /// qw, qx, qy, qz or rx_deg, ry_deg, rz_deg.
+    #[arg(long)]
+    targets: PathBuf,
+    /// The robot description the model was fitted with (RON or URDF): the nominal model of joint
+    /// targets, the base frame of --frame base, and the joint limits.
+    #[arg(long)]
+    robot: Option<PathBuf>,
+    /// URDF only: the chain's base link.
+    #[arg(long)]
+    base_link: Option<String>,
+    /// URDF only: the chain's tip link.
+    #[arg(long)]
+    tip_link: Option<String>,
+    /// Frame of pose targets: tracker or base.
+    #[arg(long, default_value = "tracker")]
+    frame: TargetFrame,
+    /// Map other headers onto the SPEC's names, e.g. `x_mm="X [mm]",qw=Q0`.
+    #[arg(long)]
+    columns: Option<pipeline::ColumnMap>,
+}
+
+pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    let model = pipeline::read_model(&args.model)?;
+    let ends = ChainEnds { base_link: args.base_link.clone(), tip_link: args.tip_link.clone() };
+    let robot = match &args.robot {
+        Some(path) => Some((RobotDescription::read_with(path, &ends)?, path.display().to_string())),
+        None if ends != ChainEnds::default() => return Err("--base-link and --tip-link need --robot".into()),
+        None => None,
+    };
+    let file = pipeline::read_targets(&args.targets, &model, args.columns.clone().unwrap_or_default())?;
+    let robot_ref = robot.as_ref().map(|(r, f)| (r, f.as_str()));
+    let (solved, summary) = pipeline::compensate(&model, &file, robot_ref, args.frame, &CompensateOptions::default())?;
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    pipeline::write_compensated(&mut out, &file, &solved)?;
+    out.flush()?;
+    eprintln!("{}", file.set.read_summary());
+    let refused = summary.rows - summary.ok;
+    let mut line = format!("compensated {} of {} targets", summary.ok, summary.rows);
+    if refused > 0 {
+        line.push_str(&format!(
+            "; refused {refused} (outside limits {}, no convergence {}, singular {}: see status)",
+            summary.outside_limits, summary.no_convergence, summary.singular
+        ));
+    }
+    if let Some(rms) = summary.registration_rms_mm {
+        line.push_str(&format!(
+            "; before compensation the model misses the intended poses by {:.4} mm mean (nominal placed by base and tool, RMS {rms:.4} mm)",
+            summary.before_mean_mm
+        ));
+    }
+    if !model.full_pose {
+        line.push_str("; position-only model: the tool point is compensated, not the orientation");
+    }
+    if robot.is_none() {
+        line.push_str("; no --robot: joint limits not checked");
+    }
+    eprintln!("{line}");
+    Ok(())
+}
