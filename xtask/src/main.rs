@@ -5,6 +5,7 @@ mod bench_gp;
 mod bench_identify;
 mod blind_check;
 mod box_plot;
+mod compensate_check;
 mod convert_ur10;
 mod reproduce_sim;
 mod reproduce_sim_params;
@@ -40,6 +41,8 @@ enum Command {
     Ur10(ur10::Args),
     /// The UR10 as RON, DH and URDF on the real tracker data; the calibrated URDF exported and read back.
     UrdfCheck(urdf_check::Args),
+    /// Compensated programs executed on the true simulated robot; 10,000 targets timed against SciPy.
+    CompensateCheck(compensate_check::Args),
 }
 
 fn main() -> ExitCode {
@@ -52,6 +55,7 @@ fn main() -> ExitCode {
         Command::BlindCheck(args) => blind_check::run(args),
         Command::Ur10(args) => ur10::run(args),
         Command::UrdfCheck(args) => urdf_check::run(args),
+        Command::CompensateCheck(args) => compensate_check::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
