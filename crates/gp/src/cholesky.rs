@@ -84,11 +84,6 @@ impl Factor {
         })
     }
 
-    /// Wraps an existing factor.
-    pub(crate) fn from_lower(l: Mat<f64>) -> Self {
-        Self { l }
-    }
-
     /// `rhs ← L⁻¹ rhs`.
     pub(crate) fn solve_lower_in_place(&self, rhs: MatMut<'_, f64>, par: Par) {
         triangular_solve::solve_lower_triangular_in_place(self.l.as_ref(), rhs, par);
@@ -103,15 +98,5 @@ impl Factor {
     /// `ln |L Lᵀ| = 2 Σ ln Lᵢᵢ`.
     pub(crate) fn log_determinant(&self) -> f64 {
         2.0 * (0..self.l.nrows()).map(|i| self.l[(i, i)].ln()).sum::<f64>()
-    }
-
-    /// Lower triangle of `(L Lᵀ)⁻¹` (the strict upper triangle is not meaningful).
-    pub(crate) fn inverse_lower(&self, par: Par) -> Mat<f64> {
-        let n = self.l.nrows();
-        let mut out = Mat::zeros(n, n);
-        let mut mem = MemBuffer::new(llt::inverse::inverse_scratch::<f64>(n, par));
-        let stack = MemStack::new(&mut mem);
-        llt::inverse::inverse(out.as_mut(), self.l.as_ref(), par, stack);
-        out
     }
 }

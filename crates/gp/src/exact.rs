@@ -9,7 +9,7 @@ use crate::Error;
 use crate::cholesky::{Factor, JitterOutcome};
 use crate::config::{GpConfig, OutputMode, Parallelism};
 use crate::gram::training_covariance;
-use crate::kernel::{Evaluator, Kernel};
+use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::lml::check_finite_outputs;
 use crate::optimise::{OptimisationReport, fit_hyperparameters};
 use crate::points::Points;
@@ -41,7 +41,7 @@ pub(crate) struct Component {
     pub(crate) outputs: Vec<usize>,
     pub(crate) evaluator: Evaluator,
     /// Training inputs prepared for `evaluator`.
-    pub(crate) prepared: Points,
+    pub(crate) prepared: Prepared,
     pub(crate) factor: Factor,
     /// `(K + σn² I + jitter I)⁻¹ y` for each served output (R&W Algorithm 2.1, line 3).
     pub(crate) alpha: Mat<f64>,

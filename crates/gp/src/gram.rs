@@ -1,9 +1,11 @@
 //! Kernel (Gram) matrices and the likelihood-gradient contraction, built on matrix products.
 //!
-//! Every kernel here is a function of `r² = ‖x − z‖²` and `xᵀz` on prepared inputs, so one faer
-//! product `X Zᵀ` gives both (`r² = ‖x‖² + ‖z‖² − 2 xᵀz`, clamped at 0 against round-off) and the
-//! kernel is applied entry by entry, columns in parallel. Likewise the length-scale gradients
-//! `½ Σᵢⱼ Mᵢⱼ (xᵢ_d − xⱼ_d)²` come from one product `M X` (see [`contract_gradient`]).
+//! The stationary term is a function of `r² = ‖x − z‖²` on inputs divided by their length
+//! scales; one faer product `X Zᵀ` gives every `r² = ‖x‖² + ‖z‖² − 2 xᵀz` (clamped at 0 against
+//! round-off, exactly 0 on the diagonal of a training matrix), and the kernel is applied entry by
+//! entry, columns in parallel. The linear term is itself a product, added by faer. Likewise the
+//! gradients in the length scales and slope weights come from products of the weight matrix with
+//! the inputs (see [`contract_gradient`]).
 //!
 //! Every entry is computed by exactly one closure call, whatever the thread that runs it, and
 //! reductions sum one partial vector per column in column order: with faer's products, which
@@ -11,14 +13,16 @@
 
 use faer::col::ColMut;
 use faer::linalg::matmul::matmul;
-use faer::reborrow::ReborrowMut;
+use faer::linalg::matmul::triangular::{self, BlockStructure};
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef};
 use rayon::prelude::*;
 
 use crate::config::Parallelism;
-use crate::kernel::{Evaluator, PairKernel, with_pair_kernel};
+use crate::kernel::{Evaluator, Expanded, Prepared};
 use crate::points::Points;
 
+/// Runs `f(j, column j)` over the columns, in parallel or not.
 fn for_each_column(mat: MatMut<'_, f64>, par: Parallelism, f: impl Fn(usize, ColMut<'_, f64>) + Sync + Send) {
     match par {
         Parallelism::Sequential => mat.col_iter_mut().enumerate().for_each(|(j, c)| f(j, c)),
@@ -26,26 +30,13 @@ fn for_each_column(mat: MatMut<'_, f64>, par: Parallelism, f: impl Fn(usize, Col
     }
 }
 
-/// Calls `f(i, &mut entry)` for rows `start..` of a column, through a slice when the column is
-/// contiguous (always, for an owned `Mat`) so the loop has no per-entry bounds checks.
+/// A column of an owned matrix as a slice (owned faer matrices store columns contiguously).
 #[inline]
-fn for_each_entry(mut col: ColMut<'_, f64>, start: usize, mut f: impl FnMut(usize, &mut f64)) {
-    match col.rb_mut().try_as_col_major_mut() {
-        Some(c) => c.as_slice_mut().iter_mut().enumerate().skip(start).for_each(|(i, v)| f(i, v)),
-        None => col.iter_mut().enumerate().skip(start).for_each(|(i, v)| f(i, v)),
-    }
+fn slice_mut(col: ColMut<'_, f64>) -> &mut [f64] {
+    col.try_as_col_major_mut().expect("columns of an owned matrix are contiguous").as_slice_mut()
 }
 
-/// Column `j` of `m` as a slice (copied when the column is not contiguous).
-#[inline]
-fn column(m: MatRef<'_, f64>, j: usize) -> std::borrow::Cow<'_, [f64]> {
-    match m.col(j).try_as_col_major() {
-        Some(c) => std::borrow::Cow::Borrowed(c.as_slice()),
-        None => std::borrow::Cow::Owned(m.col(j).iter().copied().collect()),
-    }
-}
-
-fn as_matrix(p: &Points) -> MatRef<'_, f64> {
+pub(crate) fn as_matrix(p: &Points) -> MatRef<'_, f64> {
     MatRef::from_row_major_slice(p.as_slice(), p.len(), p.dim())
 }
 
@@ -53,11 +44,20 @@ fn squared_norms(p: &Points) -> Vec<f64> {
     (0..p.len()).map(|i| p.row(i).iter().map(|v| v * v).sum()).collect()
 }
 
-/// `X Zᵀ`.
-fn inner_products(x: &Points, z: &Points, par: Parallelism) -> Mat<f64> {
-    let mut d = Mat::zeros(x.len(), z.len());
-    matmul(d.as_mut(), Accum::Replace, as_matrix(x), as_matrix(z).transpose(), 1.0, par.faer());
-    d
+/// The lower triangle (diagonal included) of `dst ← X Xᵀ`.
+fn lower_inner_products(dst: MatMut<'_, f64>, x: &Points, par: Parallelism) {
+    let xm = as_matrix(x);
+    triangular::matmul(
+        dst,
+        BlockStructure::TriangularLower,
+        Accum::Replace,
+        xm,
+        BlockStructure::Rectangular,
+        xm.transpose(),
+        BlockStructure::Rectangular,
+        1.0,
+        par.faer(),
+    );
 }
 
 /// `r²` from the squared norms and the inner product; exactly 0 on the diagonal of a training
@@ -67,172 +67,194 @@ fn squared_distance(sq_i: f64, sq_j: f64, dot: f64, same: bool) -> f64 {
     if same { 0.0 } else { (sq_i + sq_j - 2.0 * dot).max(0.0) }
 }
 
-/// Lower triangle, diagonal included, of `K(X, X) + σn² I` (R&W Eq. 2.21's `K + σn² I`).
-///
-/// The strict upper triangle is not meaningful: the Cholesky factorisation reads only the lower one.
-pub(crate) fn training_covariance(kernel: &Evaluator, x: &Points, noise_variance: f64, par: Parallelism) -> Mat<f64> {
-    let sq = squared_norms(x);
-    let mut k = inner_products(x, x, par);
-    with_pair_kernel!(kernel, pk => for_each_column(k.as_mut(), par, |j, col| {
-        for_each_entry(col, j, |i, v| *v = pk.value(squared_distance(sq[i], sq[j], *v, i == j), *v));
-    }));
-    for i in 0..x.len() {
-        k[(i, i)] += noise_variance;
-    }
-    k
-}
-
-/// What [`training_covariance_with_cache`] keeps for the gradient.
-pub(crate) struct GradientCache {
-    /// Per-pair factor from [`PairKernel::value_and_cache`] (lower triangle).
-    factor: Mat<f64>,
-    /// `X Xᵀ` (lower triangle).
-    inner: Mat<f64>,
-    /// `‖xᵢ‖²`.
-    squared_norms: Vec<f64>,
-}
-
-/// As [`training_covariance`], and what [`contract_gradient`] needs.
-pub(crate) fn training_covariance_with_cache(
+/// Lower triangle, diagonal included, of `K(X, X) + diagonal · I` written into `dst` (`n × n`);
+/// the strict upper triangle is left as it was (the Cholesky factorisation reads only the lower).
+pub(crate) fn fill_training_lower(
+    mut dst: MatMut<'_, f64>,
     kernel: &Evaluator,
-    x: &Points,
-    noise_variance: f64,
+    x: &Prepared,
+    diagonal: f64,
     par: Parallelism,
-) -> (Mat<f64>, GradientCache) {
-    let sq = squared_norms(x);
-    let inner = inner_products(x, x, par);
-    let mut k = inner.clone();
-    let mut factor = Mat::zeros(x.len(), x.len());
-    let fill = |j: usize, kc: ColMut<'_, f64>, fc: ColMut<'_, f64>| {
-        let mut caches = Vec::with_capacity(x.len() - j);
-        with_pair_kernel!(kernel, pk => for_each_entry(kc, j, |i, v| {
-            let (value, cache) = pk.value_and_cache(squared_distance(sq[i], sq[j], *v, i == j), *v);
-            *v = value;
-            caches.push(cache);
-        }));
-        let mut caches = caches.into_iter();
-        for_each_entry(fc, j, |_, c| *c = caches.next().unwrap_or(0.0));
-    };
-    match par {
-        Parallelism::Sequential => {
-            k.col_iter_mut().zip(factor.col_iter_mut()).enumerate().for_each(|(j, (kc, fc))| fill(j, kc, fc))
+) {
+    let sq = squared_norms(&x.stationary);
+    lower_inner_products(dst.rb_mut(), &x.stationary, par);
+    let (shape, signal, constant) = (kernel.shape, kernel.signal_variance, kernel.constant);
+    for_each_column(dst.rb_mut(), par, |j, col| {
+        for (i, v) in slice_mut(col).iter_mut().enumerate().skip(j) {
+            *v = shape.value(signal, squared_distance(sq[i], sq[j], *v, i == j)) + constant;
         }
-        Parallelism::Rayon => {
-            k.par_col_iter_mut().zip(factor.par_col_iter_mut()).enumerate().for_each(|(j, (kc, fc))| fill(j, kc, fc))
-        }
+    });
+    if let Some(l) = &x.linear {
+        let lm = as_matrix(l);
+        triangular::matmul(
+            dst.rb_mut(),
+            BlockStructure::TriangularLower,
+            Accum::Add,
+            lm,
+            BlockStructure::Rectangular,
+            lm.transpose(),
+            BlockStructure::Rectangular,
+            1.0,
+            par.faer(),
+        );
     }
     for i in 0..x.len() {
-        k[(i, i)] += noise_variance;
+        dst[(i, i)] += diagonal;
     }
-    (k, GradientCache { factor, inner, squared_norms: sq })
 }
 
-/// `K(X, Z)`, `|X|` rows by `|Z|` columns, without noise.
-pub(crate) fn cross_covariance(kernel: &Evaluator, x: &Points, z: &Points, par: Parallelism) -> Mat<f64> {
-    let (sx, sz) = (squared_norms(x), squared_norms(z));
-    let mut k = inner_products(x, z, par);
-    with_pair_kernel!(kernel, pk => for_each_column(k.as_mut(), par, |j, col| {
-        for_each_entry(col, 0, |i, v| *v = pk.value(squared_distance(sx[i], sz[j], *v, false), *v));
-    }));
+/// Lower triangle of `K(X, X) + diagonal · I` in a new matrix (R&W Eq. 2.21's `K + σn² I`).
+pub(crate) fn training_covariance(kernel: &Evaluator, x: &Prepared, diagonal: f64, par: Parallelism) -> Mat<f64> {
+    let mut k = Mat::zeros(x.len(), x.len());
+    fill_training_lower(k.as_mut(), kernel, x, diagonal, par);
     k
 }
 
-/// `k(z, z)` for every point, without noise.
-pub(crate) fn prior_variances(kernel: &Evaluator, z: &Points) -> Vec<f64> {
-    squared_norms(z).into_iter().map(|s| with_pair_kernel!(kernel, pk => pk.value(0.0, s))).collect()
+/// `K(X, Z)`, `|X|` rows by `|Z|` columns, without noise; `same` when `Z` is `X` (the diagonal
+/// then has `r² = 0` exactly).
+fn covariance(kernel: &Evaluator, x: &Prepared, z: &Prepared, same: bool, par: Parallelism) -> Mat<f64> {
+    let (sx, sz) = (squared_norms(&x.stationary), squared_norms(&z.stationary));
+    let mut k = Mat::zeros(x.len(), z.len());
+    matmul(k.as_mut(), Accum::Replace, as_matrix(&x.stationary), as_matrix(&z.stationary).transpose(), 1.0, par.faer());
+    let (shape, signal, constant) = (kernel.shape, kernel.signal_variance, kernel.constant);
+    for_each_column(k.as_mut(), par, |j, col| {
+        for (i, v) in slice_mut(col).iter_mut().enumerate() {
+            *v = shape.value(signal, squared_distance(sx[i], sz[j], *v, same && i == j)) + constant;
+        }
+    });
+    if let (Some(lx), Some(lz)) = (&x.linear, &z.linear) {
+        matmul(k.as_mut(), Accum::Add, as_matrix(lx), as_matrix(lz).transpose(), 1.0, par.faer());
+    }
+    k
+}
+
+/// `K(X, Z)` without noise.
+pub(crate) fn cross_covariance(kernel: &Evaluator, x: &Prepared, z: &Prepared, par: Parallelism) -> Mat<f64> {
+    covariance(kernel, x, z, false, par)
 }
 
 /// `K(Z, Z)` in full (both triangles), without noise.
-pub(crate) fn full_covariance(kernel: &Evaluator, z: &Points, par: Parallelism) -> Mat<f64> {
-    let sq = squared_norms(z);
-    let mut k = inner_products(z, z, par);
-    with_pair_kernel!(kernel, pk => for_each_column(k.as_mut(), par, |j, col| {
-        for_each_entry(col, 0, |i, v| *v = pk.value(squared_distance(sq[i], sq[j], *v, i == j), *v));
-    }));
-    k
+pub(crate) fn full_covariance(kernel: &Evaluator, z: &Prepared, par: Parallelism) -> Mat<f64> {
+    covariance(kernel, z, z, true, par)
 }
 
-/// `½ Σᵢₖ Wᵢₖ ∂Kᵢₖ/∂ln pⱼ` for every log-parameter `pⱼ` of the kernel and, last, of the noise.
+/// `k(z, z)` for every point, without noise.
+pub(crate) fn prior_variances(kernel: &Evaluator, z: &Prepared) -> Vec<f64> {
+    let linear = z.linear.as_ref().map(squared_norms).unwrap_or_else(|| vec![0.0; z.len()]);
+    linear.into_iter().map(|l| kernel.signal_variance + kernel.constant + l).collect()
+}
+
+/// `sym(A) R` where only the lower triangle of `A` is meaningful: `tril(A) R + stril(A)ᵀ R`.
+fn symmetric_product(a: MatRef<'_, f64>, r: MatRef<'_, f64>, par: Parallelism) -> Mat<f64> {
+    let mut out = Mat::zeros(a.nrows(), r.ncols());
+    triangular::matmul(
+        out.as_mut(),
+        BlockStructure::Rectangular,
+        Accum::Replace,
+        a,
+        BlockStructure::TriangularLower,
+        r,
+        BlockStructure::Rectangular,
+        1.0,
+        par.faer(),
+    );
+    triangular::matmul(
+        out.as_mut(),
+        BlockStructure::Rectangular,
+        Accum::Add,
+        a.transpose(),
+        BlockStructure::StrictTriangularUpper,
+        r,
+        BlockStructure::Rectangular,
+        1.0,
+        par.faer(),
+    );
+    out
+}
+
+/// `½ tr(W ∂K/∂θⱼ)` for every expanded log-parameter `θⱼ` (R&W Eq. 5.9), with
+/// `W = A Aᵀ − m K⁻¹`, `A = K⁻¹ Y` (`alpha`, `n × m`).
 ///
-/// This is R&W Eq. 5.9, `½ tr(W ∂K/∂θⱼ)`, with `W` symmetric and only its lower triangle read;
-/// the kernel derivatives are never stored as matrices. Parameters differentiated pair by pair are
-/// summed entry by entry. For a length scale, `∂Kᵢⱼ/∂ln ℓ_d = mᵢⱼ (xᵢ_d − xⱼ_d)²` on prepared
+/// On entry the lower triangle of `inverse` holds `K⁻¹`; on exit it holds `W`. `scratch` (`n × n`)
+/// is overwritten. The kernel derivatives are never stored as matrices: the scalar parameters are
+/// summed entry by entry; for a length scale, `∂Kᵢⱼ/∂ln ℓ_d = mᵢⱼ (xᵢ_d − xⱼ_d)²` on prepared
 /// inputs, so with `M = W ∘ m` and `s = M 1`:
-/// `½ Σᵢⱼ Mᵢⱼ (xᵢ_d − xⱼ_d)² = Σᵢ xᵢ_d (xᵢ_d sᵢ − (M X)ᵢ_d)`, one matrix product for all `d`.
+/// `½ Σᵢⱼ Mᵢⱼ (xᵢ_d − xⱼ_d)² = Σᵢ xᵢ_d (xᵢ_d sᵢ − (M X)ᵢ_d)`, one product for all `d`; for a
+/// slope weight, `∂Kᵢⱼ/∂ln w_d = lᵢ_d lⱼ_d` on inputs times `√w`, so the sum is `½ Σᵢ lᵢ_d (W L)ᵢ_d`.
 pub(crate) fn contract_gradient(
     kernel: &Evaluator,
-    x: &Points,
-    w: MatRef<'_, f64>,
-    cache: &GradientCache,
-    noise_variance: f64,
-    kernel_parameters: usize,
+    x: &Prepared,
+    mut inverse: MatMut<'_, f64>,
+    alpha: MatRef<'_, f64>,
+    mut scratch: MatMut<'_, f64>,
     par: Parallelism,
 ) -> Vec<f64> {
-    with_pair_kernel!(kernel, pk => contract(pk, x, w, cache, noise_variance, kernel_parameters, par))
-}
-
-fn contract<K: PairKernel>(
-    pk: &K,
-    x: &Points,
-    w: MatRef<'_, f64>,
-    cache: &GradientCache,
-    noise_variance: f64,
-    kernel_parameters: usize,
-    par: Parallelism,
-) -> Vec<f64> {
-    let (n, dim) = (x.len(), x.dim());
-    let scalars = K::SCALARS;
-    let ard = kernel_parameters > scalars;
-    let sq = &cache.squared_norms;
-    // M = W ∘ m, lower triangle, filled while the scalar sums are taken.
-    let mut m = if ard { Mat::zeros(n, n) } else { Mat::zeros(0, 0) };
-    let column_sums = |j: usize, mcol: Option<ColMut<'_, f64>>| {
-        let mut sum = vec![0.0; scalars + 1];
-        let mut g = vec![0.0; scalars];
-        let (wj, fj, dj) = (column(w, j), column(cache.factor.as_ref(), j), column(cache.inner.as_ref(), j));
-        let mut weights = Vec::with_capacity(if ard { n - j } else { 0 });
+    let (n, dim, m) = (x.len(), x.stationary.dim(), alpha.ncols());
+    let layout = Expanded { dim };
+    let sq = squared_norms(&x.stationary);
+    let alpha_rows: Vec<f64> = (0..n).flat_map(|i| (0..m).map(move |c| alpha[(i, c)])).collect();
+    lower_inner_products(scratch.rb_mut(), &x.stationary, par);
+    let (shape, signal) = (kernel.shape, kernel.signal_variance);
+    let scale = m as f64;
+    // Per column: Σ f Wᵢⱼ sᵢⱼ, Σ f Wᵢⱼ, ½ Wⱼⱼ, with f = ½ on the diagonal and 1 below it (each
+    // strict-lower entry stands for itself and its mirror).
+    let column = |j: usize, wc: ColMut<'_, f64>, mc: ColMut<'_, f64>| -> [f64; 3] {
+        let (wc, mc) = (slice_mut(wc), slice_mut(mc));
+        let aj = &alpha_rows[j * m..(j + 1) * m];
+        let mut sums = [0.0; 3];
         for i in j..n {
-            let r2 = squared_distance(sq[i], sq[j], dj[i], i == j);
-            let weight = pk.gradient_from_cache(r2, dj[i], fj[i], &mut g);
-            // Diagonal entry counts once, each strict-lower entry twice (for its mirror).
-            let wij = if i == j { 0.5 * wj[i] } else { wj[i] };
-            for (s, gp) in sum.iter_mut().zip(&g) {
-                *s += wij * gp;
-            }
-            if ard {
-                weights.push(wj[i] * weight);
-            }
+            let ai = &alpha_rows[i * m..(i + 1) * m];
+            let w = ai.iter().zip(aj).map(|(a, b)| a * b).sum::<f64>() - scale * wc[i];
+            wc[i] = w;
+            let r2 = squared_distance(sq[i], sq[j], mc[i], i == j);
+            let (value, weight) = shape.value_and_weight(signal, r2);
+            mc[i] = w * weight;
+            let f = if i == j { 0.5 } else { 1.0 };
+            sums[0] += f * w * value;
+            sums[1] += f * w;
         }
-        sum[scalars] = 0.5 * wj[j] * noise_variance;
-        if let Some(mcol) = mcol {
-            let mut weights = weights.into_iter();
-            for_each_entry(mcol, j, |_, v| *v = weights.next().unwrap_or(0.0));
-        }
-        sum
+        sums[2] = 0.5 * wc[j];
+        sums
     };
-    let partial: Vec<Vec<f64>> = match (par, ard) {
-        (Parallelism::Sequential, true) => m.col_iter_mut().enumerate().map(|(j, c)| column_sums(j, Some(c))).collect(),
-        (Parallelism::Rayon, true) => m.par_col_iter_mut().enumerate().map(|(j, c)| column_sums(j, Some(c))).collect(),
-        (Parallelism::Sequential, false) => (0..n).map(|j| column_sums(j, None)).collect(),
-        (Parallelism::Rayon, false) => (0..n).into_par_iter().map(|j| column_sums(j, None)).collect(),
+    let partial: Vec<[f64; 3]> = match par {
+        Parallelism::Sequential => inverse
+            .rb_mut()
+            .col_iter_mut()
+            .zip(scratch.rb_mut().col_iter_mut())
+            .enumerate()
+            .map(|(j, (w, mc))| column(j, w, mc))
+            .collect(),
+        Parallelism::Rayon => inverse
+            .rb_mut()
+            .par_col_iter_mut()
+            .zip(scratch.rb_mut().par_col_iter_mut())
+            .enumerate()
+            .map(|(j, (w, mc))| column(j, w, mc))
+            .collect(),
     };
-    let mut total = vec![0.0; kernel_parameters + 1];
+    let mut total = [0.0; 3];
     for p in &partial {
-        for (t, v) in total[..scalars].iter_mut().zip(p) {
+        for (t, v) in total.iter_mut().zip(p) {
             *t += v;
         }
-        total[kernel_parameters] += p[scalars];
     }
-    if ard {
-        // Mirror the lower triangle, then [M X | M 1] in one product.
-        let full = Mat::from_fn(n, n, |i, j| if i >= j { m[(i, j)] } else { m[(j, i)] });
-        drop(m);
-        let x1 = Mat::from_fn(n, dim + 1, |i, d| if d < dim { x.row(i)[d] } else { 1.0 });
-        let mut p = Mat::zeros(n, dim + 1);
-        matmul(p.as_mut(), Accum::Replace, full.as_ref(), x1.as_ref(), 1.0, par.faer());
+    let mut g = vec![0.0; layout.len()];
+    g[Expanded::SIGNAL] = total[0];
+    g[layout.constant()] = kernel.constant * total[1];
+    g[layout.noise()] = kernel.noise_variance * total[2];
+    // [M X | M 1] in one product.
+    let p = &x.stationary;
+    let x1 = Mat::from_fn(n, dim + 1, |i, d| if d < dim { p.row(i)[d] } else { 1.0 });
+    let q = symmetric_product(scratch.rb(), x1.as_ref(), par);
+    for d in 0..dim {
+        g[layout.length(d)] = (0..n).map(|i| x1[(i, d)] * (x1[(i, d)] * q[(i, dim)] - q[(i, d)])).sum();
+    }
+    if let Some(l) = &x.linear {
+        let lm = as_matrix(l);
+        let q = symmetric_product(inverse.rb(), lm, par);
         for d in 0..dim {
-            total[scalars + d] = (0..n).map(|i| x1[(i, d)] * (x1[(i, d)] * p[(i, dim)] - p[(i, d)])).sum();
+            g[layout.linear(d)] = 0.5 * (0..n).map(|i| lm[(i, d)] * q[(i, d)]).sum::<f64>();
         }
     }
-    total
+    g
 }

@@ -48,7 +48,9 @@ pub use config::{GpConfig, JitterConfig, OptimiserConfig, OutputMode, Parallelis
 pub use error::Error;
 pub use exact::{ComponentReport, ExactGp, FitReport};
 pub use inducing::InducingSelection;
-pub use kernel::{Bounds, Kernel, KernelChoice, Matern52Ard, QuadraticKernel, SquaredExponentialArd};
+pub use kernel::{
+    Bounds, CompositeKernel, Kernel, KernelChoice, Matern52Ard, QuadraticKernel, SquaredExponentialArd, StationaryShape,
+};
 pub use lml::{LogMarginalLikelihood, log_marginal_likelihood};
 pub use optimise::OptimisationReport;
 pub use predict::{PredictOptions, Prediction};

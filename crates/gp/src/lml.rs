@@ -3,15 +3,21 @@
 //! For `m` output columns sharing one kernel (independent given the kernel),
 //! `ln p(Y | X) = Σ_c [−½ y_cᵀ K⁻¹ y_c] − (m/2) ln |K| − (n m / 2) ln 2π` (R&W Eq. 2.30 summed over
 //! columns) and `∂/∂θⱼ = ½ tr((A Aᵀ − m K⁻¹) ∂K/∂θⱼ)` with `A = K⁻¹ Y` (R&W Eq. 5.9).
+//!
+//! One evaluation with the gradient costs `n³` flops: the Cholesky factor (`n³/3`), its inverse
+//! (`n³/3`) and `K⁻¹ = L⁻ᵀ L⁻¹` (`n³/3`, lower triangle only), all in two `n × n` buffers that a
+//! search reuses from one evaluation to the next ([`Workspace`]).
 
-use faer::linalg::matmul::matmul;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt;
+use faer::linalg::matmul::triangular::{self, BlockStructure};
+use faer::linalg::{triangular_inverse, triangular_solve};
 use faer::{Accum, Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
 use crate::Error;
-use crate::cholesky::{Factor, factor_in_place};
 use crate::config::Parallelism;
-use crate::gram::{contract_gradient, training_covariance, training_covariance_with_cache};
+use crate::gram::{contract_gradient, fill_training_lower};
 use crate::kernel::Kernel;
 use crate::points::Points;
 
@@ -41,7 +47,7 @@ pub fn log_marginal_likelihood(
     kernel.validate(x.ncols())?;
     let points = Points::from_rows(x)?;
     check_finite_outputs(y)?;
-    evaluate(kernel, &points, y, with_gradient, parallelism)
+    evaluate(&mut Workspace::default(), kernel, &points, y, with_gradient, parallelism)
 }
 
 pub(crate) fn check_finite_outputs(y: MatRef<'_, f64>) -> Result<(), Error> {
@@ -55,8 +61,33 @@ pub(crate) fn check_finite_outputs(y: MatRef<'_, f64>) -> Result<(), Error> {
     Ok(())
 }
 
+/// The two `n × n` buffers of an evaluation, kept between the evaluations of one search.
+#[derive(Debug)]
+pub(crate) struct Workspace {
+    factor: Mat<f64>,
+    inverse: Mat<f64>,
+}
+
+impl Default for Workspace {
+    fn default() -> Self {
+        Self { factor: Mat::new(), inverse: Mat::new() }
+    }
+}
+
+impl Workspace {
+    fn fit(&mut self, n: usize, with_gradient: bool) {
+        if self.factor.nrows() != n {
+            self.factor = Mat::zeros(n, n);
+        }
+        if with_gradient && self.inverse.nrows() != n {
+            self.inverse = Mat::zeros(n, n);
+        }
+    }
+}
+
 /// The work horse of [`log_marginal_likelihood`] on validated points.
 pub(crate) fn evaluate(
+    workspace: &mut Workspace,
     kernel: &Kernel,
     x: &Points,
     y: MatRef<'_, f64>,
@@ -65,38 +96,49 @@ pub(crate) fn evaluate(
 ) -> Result<LogMarginalLikelihood, Error> {
     let par = parallelism.faer();
     let (n, m) = (y.nrows(), y.ncols());
-    let (evaluator, prepared) = kernel.prepare(x);
-    let noise = kernel.noise_variance();
-    let (k, cache) = if with_gradient {
-        let (k, cache) = training_covariance_with_cache(&evaluator, &prepared, noise, parallelism);
-        (k, Some(cache))
-    } else {
-        (training_covariance(&evaluator, &prepared, noise, parallelism), None)
-    };
-    let factor = factor_in_place(k, par).map(Factor::from_lower).map_err(|pivot| Error::CholeskyFailed {
+    let terms = kernel.terms(x.dim());
+    let prepared = terms.prepare(x);
+    let evaluator = terms.evaluator;
+    workspace.fit(n, with_gradient);
+    let Workspace { factor, inverse } = workspace;
+    fill_training_lower(factor.as_mut(), &evaluator, &prepared, evaluator.noise_variance, parallelism);
+    let mut mem = MemBuffer::new(llt::factor::cholesky_in_place_scratch::<f64>(n, par, Default::default()));
+    llt::factor::cholesky_in_place(
+        factor.as_mut(),
+        Default::default(),
+        par,
+        MemStack::new(&mut mem),
+        Default::default(),
+    )
+    .map_err(|llt::factor::LltError::NonPositivePivot { index }| Error::CholeskyFailed {
         size: n,
-        pivot,
+        pivot: index,
         jitter_tried: 0.0,
     })?;
+    let log_determinant = 2.0 * (0..n).map(|i| factor[(i, i)].ln()).sum::<f64>();
     let mut alpha = y.to_owned();
-    factor.solve_in_place(alpha.as_mut(), par);
+    triangular_solve::solve_lower_triangular_in_place(factor.as_ref(), alpha.as_mut(), par);
+    triangular_solve::solve_upper_triangular_in_place(factor.transpose(), alpha.as_mut(), par);
     let data_fit: f64 = (0..m).map(|c| (0..n).map(|i| y[(i, c)] * alpha[(i, c)]).sum::<f64>()).sum();
-    let value = -0.5 * data_fit
-        - 0.5 * m as f64 * factor.log_determinant()
-        - 0.5 * (n * m) as f64 * (2.0 * std::f64::consts::PI).ln();
-    let gradient = if let Some(cache) = cache {
-        let mut w: Mat<f64> = factor.inverse_lower(par);
-        let scale = -(m as f64);
-        for j in 0..n {
-            for i in j..n {
-                w[(i, j)] *= scale;
-            }
-        }
-        // W = A Aᵀ − m K⁻¹; only the lower triangle is read by the contraction.
-        matmul(w.as_mut(), Accum::Add, alpha.as_ref(), alpha.transpose(), 1.0, par);
-        contract_gradient(&evaluator, &prepared, w.as_ref(), &cache, noise, kernel.parameter_count() - 1, parallelism)
-    } else {
-        Vec::new()
-    };
-    Ok(LogMarginalLikelihood { value, gradient })
+    let value =
+        -0.5 * data_fit - 0.5 * m as f64 * log_determinant - 0.5 * (n * m) as f64 * (2.0 * std::f64::consts::PI).ln();
+    if !with_gradient {
+        return Ok(LogMarginalLikelihood { value, gradient: Vec::new() });
+    }
+    // L⁻¹ into the second buffer, then the lower triangle of K⁻¹ = L⁻ᵀ L⁻¹ over the factor.
+    triangular_inverse::invert_lower_triangular(inverse.as_mut(), factor.as_ref(), par);
+    triangular::matmul(
+        factor.as_mut(),
+        BlockStructure::TriangularLower,
+        Accum::Replace,
+        inverse.transpose(),
+        BlockStructure::TriangularUpper,
+        inverse.as_ref(),
+        BlockStructure::TriangularLower,
+        1.0,
+        par,
+    );
+    let expanded =
+        contract_gradient(&evaluator, &prepared, factor.as_mut(), alpha.as_ref(), inverse.as_mut(), parallelism);
+    Ok(LogMarginalLikelihood { value, gradient: kernel.fold_gradient(&expanded, x.dim()) })
 }

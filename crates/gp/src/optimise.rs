@@ -12,7 +12,7 @@ use crate::Error;
 use crate::config::{OptimiserConfig, Parallelism};
 use crate::kernel::{Bounds, Kernel};
 use crate::lbfgsb::{self, Settings, Termination};
-use crate::lml::evaluate;
+use crate::lml::{Workspace, evaluate};
 use crate::points::Points;
 
 /// What the hyperparameter search did, for one kernel.
@@ -69,9 +69,10 @@ pub(crate) fn fit_hyperparameters(
         function_tolerance: config.function_tolerance,
     };
     let run = |p0: &Vec<f64>| {
+        let mut workspace = Workspace::default();
         let objective = |p: &[f64]| {
             let kernel = start.with_log_parameters(p).ok()?;
-            let lml = evaluate(&kernel, x, y, true, parallelism).ok()?;
+            let lml = evaluate(&mut workspace, &kernel, x, y, true, parallelism).ok()?;
             Some((-lml.value, lml.gradient.iter().map(|g| -g).collect()))
         };
         lbfgsb::minimise(objective, p0, &lower, &upper, &settings)

@@ -60,11 +60,7 @@ impl ExactGp {
         let mut variance = if options.variance { Mat::zeros(ns, m) } else { Mat::zeros(0, 0) };
         let mut covariance = if options.full_covariance { vec![Mat::zeros(0, 0); m] } else { Vec::new() };
         for c in &self.components {
-            let (_, scale) = c.kernel.evaluator();
-            let zp = match scale {
-                None => z.clone(),
-                Some(s) => z.scaled_columns(&s),
-            };
+            let (_, zp) = c.kernel.prepare(&z);
             // K(X, X*), n × n*.
             let mut ks = cross_covariance(&c.evaluator, &c.prepared, &zp, self.parallelism);
             // f̄* = K(X, X*)ᵀ α (R&W Eq. 2.25).

@@ -18,7 +18,7 @@ use crate::config::{GpConfig, OutputMode, Parallelism};
 use crate::exact::{ComponentReport, ExactGp, validate_training_data};
 use crate::gram::{cross_covariance, full_covariance, prior_variances, training_covariance};
 use crate::inducing::{InducingSelection, random_indices, select_inducing};
-use crate::kernel::{Evaluator, Kernel};
+use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::points::Points;
 use crate::predict::{PredictOptions, Prediction};
 use crate::scaling::{InputStandardiser, OutputNormaliser};
@@ -77,7 +77,7 @@ struct SparseComponent {
     outputs: Vec<usize>,
     evaluator: Evaluator,
     /// Inducing inputs prepared for `evaluator`.
-    inducing: Points,
+    inducing: Prepared,
     l_uu: Factor,
     l_b: Factor,
     /// `B⁻¹ A y / σ`, `m × k`: `μ* = A*ᵀ w`.

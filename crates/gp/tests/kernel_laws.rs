@@ -1,6 +1,6 @@
 //! Laws every covariance function obeys, on random parameters and points (proptest).
 
-use gp::{Kernel, Matern52Ard, QuadraticKernel, SquaredExponentialArd};
+use gp::{CompositeKernel, Kernel, Matern52Ard, QuadraticKernel, SquaredExponentialArd, StationaryShape};
 use proptest::prelude::*;
 
 const DIM: usize = 3;
@@ -23,7 +23,26 @@ fn kernel() -> impl Strategy<Value = Kernel> {
     let matern = (positive(), prop::collection::vec(positive(), DIM), positive()).prop_map(|(s, l, n)| {
         Kernel::Matern52Ard(Matern52Ard { signal_variance: s, length_scales: l, noise_variance: n })
     });
-    prop_oneof![quadratic, se, matern]
+    let shape = prop_oneof![Just(StationaryShape::SquaredExponential), Just(StationaryShape::Matern52)];
+    let composite = (
+        shape,
+        positive(),
+        prop::collection::vec(positive(), DIM),
+        prop::option::of(positive()),
+        prop::option::of(prop::collection::vec(positive(), DIM)),
+        positive(),
+    )
+        .prop_map(|(shape, s, l, c, w, n)| {
+            Kernel::Composite(CompositeKernel {
+                shape,
+                signal_variance: s,
+                length_scales: l,
+                constant: c,
+                linear_weights: w,
+                noise_variance: n,
+            })
+        });
+    prop_oneof![quadratic, se, matern, composite]
 }
 
 proptest! {

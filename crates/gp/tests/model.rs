@@ -6,7 +6,7 @@ use common::{rng, uniform_points};
 use faer::Mat;
 use gp::{
     Bounds, Error, ExactGp, GpConfig, Kernel, KernelChoice, OptimiserConfig, OutputMode, Parallelism,
-    SquaredExponentialArd,
+    SquaredExponentialArd, StationaryShape,
 };
 
 fn data(seed: u64, n: usize, d: usize, m: usize) -> (Mat<f64>, Mat<f64>) {
@@ -26,7 +26,8 @@ fn bits(m: &Mat<f64>) -> Vec<u64> {
 fn fit_and_prediction_are_bit_identical_serial_and_parallel() {
     let (x, y) = data(1, 120, 4, 3);
     let (xq, _) = data(2, 30, 4, 1);
-    for kernel in [KernelChoice::Quadratic, KernelChoice::SquaredExponentialArd, KernelChoice::Matern52Ard] {
+    let composite = KernelChoice::Composite { shape: StationaryShape::Matern52, constant: true, linear: true };
+    for kernel in [KernelChoice::Quadratic, KernelChoice::SquaredExponentialArd, KernelChoice::Matern52Ard, composite] {
         let mut results = Vec::new();
         for parallelism in [Parallelism::Sequential, Parallelism::Rayon] {
             let config = GpConfig { kernel, parallelism, ..GpConfig::default() };

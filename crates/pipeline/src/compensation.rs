@@ -92,6 +92,31 @@ fn error_vector(model_pose: &SE3, row: &Measurement, frame: ResidualFrame) -> Ve
     }
 }
 
+/// What the GP learns: its inputs `(q_1 … q_n[, m])` and the error the geometric model leaves
+/// (Eq. 8), one row per measurement.
+#[derive(Debug, Clone)]
+pub struct ResidualSet {
+    /// `n × (joints [+ 1])`: joint values, then the payload (kg) when it is an input.
+    pub inputs: Mat<f64>,
+    /// `n × 3` (position only: the position error, m) or `n × 6` (full pose: the error twist).
+    pub outputs: Mat<f64>,
+}
+
+impl ResidualSet {
+    /// The error that the model poses `poses` (one per row) leave on `data`, expressed in `frame`.
+    pub fn new(poses: &[SE3], data: &MeasurementSet, with_payload: bool, frame: ResidualFrame) -> Self {
+        let outputs = if data.full_pose { 6 } else { 3 };
+        let mut y = Mat::<f64>::zeros(data.rows.len(), outputs);
+        for (i, (row, pose)) in data.rows.iter().zip(poses).enumerate() {
+            let e = error_vector(pose, row, frame);
+            for c in 0..outputs {
+                y[(i, c)] = e[c];
+            }
+        }
+        Self { inputs: inputs(&data.rows, with_payload), outputs: y }
+    }
+}
+
 impl Compensation {
     /// Fits the GP to the error that the model poses `poses` (one per row) leave on `data`.
     pub fn fit(
@@ -100,15 +125,7 @@ impl Compensation {
         with_payload: bool,
         options: &CompensationOptions,
     ) -> Result<(Self, CompensationReport), Error> {
-        let outputs = if data.full_pose { 6 } else { 3 };
-        let mut y = Mat::<f64>::zeros(data.rows.len(), outputs);
-        for (i, (row, pose)) in data.rows.iter().zip(poses).enumerate() {
-            let e = error_vector(pose, row, options.residual_frame);
-            for c in 0..outputs {
-                y[(i, c)] = e[c];
-            }
-        }
-        let x = inputs(&data.rows, with_payload);
+        let ResidualSet { inputs: x, outputs: y } = ResidualSet::new(poses, data, with_payload, options.residual_frame);
         let gp = gp::ExactGp::fit(x.as_ref(), y.as_ref(), &options.gp)?;
         let report = CompensationReport { gp: gp.report().clone() };
         Ok((Self { with_payload, full_pose: data.full_pose, residual_frame: options.residual_frame, gp }, report))

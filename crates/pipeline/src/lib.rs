@@ -35,7 +35,7 @@ mod xml_outline;
 
 pub use base_frame::{NominalTolerance, axis_changes, check_nominal, in_base_frame, tracker_from_base};
 pub use calibrated::{CalibratedModel, PredictedPose, pose_error};
-pub use compensation::{Compensation, CompensationOptions, CompensationReport, ResidualFrame};
+pub use compensation::{Compensation, CompensationOptions, CompensationReport, ResidualFrame, ResidualSet};
 pub use error::Error;
 pub use eval_report::EvalReport;
 pub use fit::{Evaluation, FitOptions, FitReport, evaluate, fit, tool_indices};

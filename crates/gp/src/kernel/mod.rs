@@ -4,14 +4,24 @@
 //! Every parameter is positive and the optimiser works on `ln p`, so `∂k/∂ln p = p ∂k/∂p`. The
 //! noise variance is always the last log-parameter; it adds `σn² δᵢⱼ` to the training covariance
 //! only (same index, not same location, as scikit-learn's `WhiteKernel`).
+//!
+//! All kernels are evaluated through one expanded form (`terms.rs`): a stationary term, a
+//! constant and a linear term; each public kernel is a choice of which terms it has and which
+//! parameters it ties together.
 
+mod composite;
 mod matern52;
 mod quadratic;
+mod shape;
 mod squared_exponential;
+mod terms;
 
+pub use composite::CompositeKernel;
 pub use matern52::Matern52Ard;
 pub use quadratic::QuadraticKernel;
+pub use shape::StationaryShape;
 pub use squared_exponential::SquaredExponentialArd;
+pub(crate) use terms::{Evaluator, Expanded, Prepared, Terms};
 
 use serde::{Deserialize, Serialize};
 
@@ -28,6 +38,15 @@ pub enum KernelChoice {
     SquaredExponentialArd,
     /// ARD Matérn 5/2, see [`Matern52Ard`].
     Matern52Ard,
+    /// Eq. 5 with every term ARD and each optional, see [`CompositeKernel`].
+    Composite {
+        /// Family of the stationary term.
+        shape: StationaryShape,
+        /// With a constant term.
+        constant: bool,
+        /// With an ARD linear term.
+        linear: bool,
+    },
 }
 
 /// A covariance function with its hyperparameters, white noise included.
@@ -39,6 +58,8 @@ pub enum Kernel {
     SquaredExponentialArd(SquaredExponentialArd),
     /// ARD Matérn 5/2.
     Matern52Ard(Matern52Ard),
+    /// Constant + ARD linear + ARD stationary + noise.
+    Composite(CompositeKernel),
 }
 
 /// A box on the kernel's parameters, natural scale (not log), in log-parameter order.
@@ -50,6 +71,16 @@ pub struct Bounds {
     pub upper: Vec<f64>,
 }
 
+/// Search box of a signal variance on normalised outputs.
+const SIGNAL_BOUNDS: (f64, f64) = (1e-3, 1e2);
+/// Length scales from 1/100 to 1000 standard deviations of the input; beyond the upper end the
+/// input is irrelevant and the likelihood is flat.
+const LENGTH_BOUNDS: (f64, f64) = (1e-2, 1e3);
+/// A constant or a slope variance from negligible (1e-6 of the output variance) to 100 times it.
+const OFFSET_BOUNDS: (f64, f64) = (1e-6, 1e2);
+/// The noise may go down to 1e-9 so that nearly noiseless data can be interpolated.
+const NOISE_BOUNDS: (f64, f64) = (1e-9, 1e1);
+
 impl Kernel {
     /// The default starting point of `choice` for `dim` standardised inputs and normalised outputs.
     pub fn start(choice: KernelChoice, dim: usize) -> Self {
@@ -59,6 +90,9 @@ impl Kernel {
                 Self::SquaredExponentialArd(SquaredExponentialArd::isotropic_start(dim))
             }
             KernelChoice::Matern52Ard => Self::Matern52Ard(Matern52Ard::isotropic_start(dim)),
+            KernelChoice::Composite { shape, constant, linear } => {
+                Self::Composite(CompositeKernel::start(shape, dim, constant, linear))
+            }
         }
     }
 
@@ -68,6 +102,11 @@ impl Kernel {
             Self::Quadratic(_) => KernelChoice::Quadratic,
             Self::SquaredExponentialArd(_) => KernelChoice::SquaredExponentialArd,
             Self::Matern52Ard(_) => KernelChoice::Matern52Ard,
+            Self::Composite(k) => KernelChoice::Composite {
+                shape: k.shape,
+                constant: k.constant.is_some(),
+                linear: k.linear_weights.is_some(),
+            },
         }
     }
 
@@ -77,16 +116,13 @@ impl Kernel {
             Self::Quadratic(_) => None,
             Self::SquaredExponentialArd(k) => Some(k.length_scales.len()),
             Self::Matern52Ard(k) => Some(k.length_scales.len()),
+            Self::Composite(k) => Some(k.length_scales.len()),
         }
     }
 
     /// Number of log-parameters, noise included.
     pub fn parameter_count(&self) -> usize {
-        match self {
-            Self::Quadratic(_) => quadratic::PARAMETERS + 1,
-            Self::SquaredExponentialArd(k) => k.length_scales.len() + 2,
-            Self::Matern52Ard(k) => k.length_scales.len() + 2,
-        }
+        self.parameters().len()
     }
 
     /// The white-noise variance `σn²`.
@@ -95,6 +131,7 @@ impl Kernel {
             Self::Quadratic(k) => k.noise_variance,
             Self::SquaredExponentialArd(k) => k.noise_variance,
             Self::Matern52Ard(k) => k.noise_variance,
+            Self::Composite(k) => k.noise_variance,
         }
     }
 
@@ -108,6 +145,14 @@ impl Kernel {
                 p.push(*signal_variance);
                 p.extend_from_slice(length_scales);
                 p.push(*noise_variance);
+                p
+            }
+            Self::Composite(k) => {
+                let mut p = vec![k.signal_variance];
+                p.extend_from_slice(&k.length_scales);
+                p.extend(k.constant);
+                p.extend(k.linear_weights.iter().flatten());
+                p.push(k.noise_variance);
                 p
             }
         }
@@ -146,6 +191,23 @@ impl Kernel {
                 length_scales: parameters[1..n - 1].to_vec(),
                 noise_variance: parameters[n - 1],
             }),
+            Self::Composite(k) => {
+                let d = k.length_scales.len();
+                let mut rest = &parameters[1 + d..n - 1];
+                let constant = k.constant.map(|_| {
+                    let c = rest[0];
+                    rest = &rest[1..];
+                    c
+                });
+                Self::Composite(CompositeKernel {
+                    shape: k.shape,
+                    signal_variance: parameters[0],
+                    length_scales: parameters[1..1 + d].to_vec(),
+                    constant,
+                    linear_weights: k.linear_weights.as_ref().map(|_| rest.to_vec()),
+                    noise_variance: parameters[n - 1],
+                })
+            }
         })
     }
 
@@ -156,39 +218,108 @@ impl Kernel {
         {
             return Err(Error::InputDimensionMismatch { expected, found: dim });
         }
+        if let Self::Composite(CompositeKernel { linear_weights: Some(w), length_scales, .. }) = self
+            && w.len() != length_scales.len()
+        {
+            return Err(Error::InputDimensionMismatch { expected: length_scales.len(), found: w.len() });
+        }
         self.with_parameters(&self.parameters()).map(|_| ())
     }
 
     /// The default search box for this family, for standardised inputs and normalised outputs.
     pub fn default_bounds(&self) -> Bounds {
+        if let Self::Quadratic(_) = self {
+            let (lower, upper) = QuadraticKernel::default_bounds();
+            return Bounds { lower: lower.to_vec(), upper: upper.to_vec() };
+        }
+        let d = self.input_dim().unwrap_or(0);
+        let mut blocks = vec![(SIGNAL_BOUNDS, 1), (LENGTH_BOUNDS, d)];
+        if let Self::Composite(k) = self {
+            blocks.push((OFFSET_BOUNDS, usize::from(k.constant.is_some())));
+            blocks.push((OFFSET_BOUNDS, k.linear_weights.as_ref().map_or(0, Vec::len)));
+        }
+        blocks.push((NOISE_BOUNDS, 1));
+        let expand = |pick: fn((f64, f64)) -> f64| {
+            blocks.iter().flat_map(|&(b, count)| std::iter::repeat_n(pick(b), count)).collect::<Vec<f64>>()
+        };
+        Bounds { lower: expand(|b| b.0), upper: expand(|b| b.1) }
+    }
+
+    /// The expanded form of this kernel for `dim` inputs.
+    pub(crate) fn terms(&self, dim: usize) -> Terms {
+        let stationary = |shape, signal_variance, lengths: &[f64], noise_variance| Terms {
+            evaluator: Evaluator { shape, signal_variance, constant: 0.0, noise_variance },
+            inverse_length_scales: lengths.iter().map(|l| 1.0 / l).collect(),
+            linear_roots: None,
+        };
+        match self {
+            Self::Quadratic(k) => Terms {
+                evaluator: Evaluator {
+                    shape: StationaryShape::SquaredExponential,
+                    signal_variance: k.theta0,
+                    constant: k.theta2,
+                    noise_variance: k.noise_variance,
+                },
+                // θ1 = 1/ℓ² for every input, θ3 the weight of every input's slope.
+                inverse_length_scales: vec![k.theta1.sqrt(); dim],
+                linear_roots: Some(vec![k.theta3.sqrt(); dim]),
+            },
+            Self::SquaredExponentialArd(k) => {
+                stationary(StationaryShape::SquaredExponential, k.signal_variance, &k.length_scales, k.noise_variance)
+            }
+            Self::Matern52Ard(k) => {
+                stationary(StationaryShape::Matern52, k.signal_variance, &k.length_scales, k.noise_variance)
+            }
+            Self::Composite(k) => Terms {
+                evaluator: Evaluator {
+                    shape: k.shape,
+                    signal_variance: k.signal_variance,
+                    constant: k.constant.unwrap_or(0.0),
+                    noise_variance: k.noise_variance,
+                },
+                inverse_length_scales: k.length_scales.iter().map(|l| 1.0 / l).collect(),
+                linear_roots: k.linear_weights.as_ref().map(|w| w.iter().map(|v| v.sqrt()).collect()),
+            },
+        }
+    }
+
+    /// The evaluator and `points` prepared for it.
+    pub(crate) fn prepare(&self, points: &Points) -> (Evaluator, Prepared) {
+        let terms = self.terms(points.dim());
+        (terms.evaluator, terms.prepare(points))
+    }
+
+    /// The gradient in this kernel's log-parameters from the gradient in the expanded ones (chain
+    /// rule through the ties: Eq. 5's one length scale `ℓ = θ1^{−1/2}` and one slope weight).
+    pub(crate) fn fold_gradient(&self, expanded: &[f64], dim: usize) -> Vec<f64> {
+        let layout = Expanded { dim };
+        let lengths = (0..dim).map(|i| expanded[layout.length(i)]);
+        let mut g = vec![expanded[Expanded::SIGNAL]];
         match self {
             Self::Quadratic(_) => {
-                let (lower, upper) = QuadraticKernel::default_bounds();
-                Bounds { lower: lower.to_vec(), upper: upper.to_vec() }
+                // ln ℓ = −½ ln θ1, so ∂/∂ln θ1 = −½ Σᵢ ∂/∂ln ℓᵢ.
+                g.push(-0.5 * lengths.sum::<f64>());
+                g.push(expanded[layout.constant()]);
+                g.push((0..dim).map(|i| expanded[layout.linear(i)]).sum());
             }
-            Self::SquaredExponentialArd(SquaredExponentialArd { length_scales, .. })
-            | Self::Matern52Ard(Matern52Ard { length_scales, .. }) => {
-                // Length scales from 1/100 to 1000 standard deviations of the input; beyond the
-                // upper end the input is irrelevant and the likelihood is flat.
-                let d = length_scales.len();
-                let mut lower = vec![1e-3];
-                lower.extend(std::iter::repeat_n(1e-2, d));
-                lower.push(1e-9);
-                let mut upper = vec![1e2];
-                upper.extend(std::iter::repeat_n(1e3, d));
-                upper.push(1e1);
-                Bounds { lower, upper }
+            Self::SquaredExponentialArd(_) | Self::Matern52Ard(_) => g.extend(lengths),
+            Self::Composite(k) => {
+                g.extend(lengths);
+                if k.constant.is_some() {
+                    g.push(expanded[layout.constant()]);
+                }
+                if k.linear_weights.is_some() {
+                    g.extend((0..dim).map(|i| expanded[layout.linear(i)]));
+                }
             }
         }
+        g.push(expanded[layout.noise()]);
+        g
     }
 
     /// `k(a, b)` without the noise term.
     pub fn value(&self, a: &[f64], b: &[f64]) -> f64 {
-        let (evaluator, scale) = self.evaluator();
-        match scale {
-            None => evaluator.value(a, b),
-            Some(s) => evaluator.value(&scale_point(a, &s), &scale_point(b, &s)),
-        }
+        self.terms(a.len()).pair(a, b, None)
     }
 
     /// `k(a, b)` without noise, and `∂k/∂ln p` for every log-parameter but the noise, written into
@@ -198,37 +329,17 @@ impl Kernel {
         if gradient.len() != expected {
             return Err(Error::ParameterCountMismatch { expected, found: gradient.len() });
         }
-        let (evaluator, scale) = self.evaluator();
-        Ok(match scale {
-            None => evaluator.value_and_gradient(a, b, gradient),
-            Some(s) => evaluator.value_and_gradient(&scale_point(a, &s), &scale_point(b, &s), gradient),
-        })
-    }
-
-    /// The evaluator used in the hot loops, and the per-coordinate factor (`1/ℓ`) that inputs must
-    /// be multiplied by before it sees them (`None` for Eq. 5, which reads raw inputs).
-    pub(crate) fn evaluator(&self) -> (Evaluator, Option<Vec<f64>>) {
-        match self {
-            Self::Quadratic(k) => (Evaluator::Quadratic(*k), None),
-            Self::SquaredExponentialArd(k) => (
-                Evaluator::SquaredExponential(SquaredExponentialScaled { signal_variance: k.signal_variance }),
-                Some(k.length_scales.iter().map(|l| 1.0 / l).collect()),
-            ),
-            Self::Matern52Ard(k) => (
-                Evaluator::Matern52(Matern52Scaled { signal_variance: k.signal_variance }),
-                Some(k.length_scales.iter().map(|l| 1.0 / l).collect()),
-            ),
+        if let Some(dim) = self.input_dim()
+            && (a.len() != dim || b.len() != dim)
+        {
+            return Err(Error::InputDimensionMismatch { expected: dim, found: a.len().min(b.len()) });
         }
-    }
-
-    /// The evaluator and `points` prepared for it (divided by the length scales for ARD kernels).
-    pub(crate) fn prepare(&self, points: &Points) -> (Evaluator, Points) {
-        let (evaluator, scale) = self.evaluator();
-        let prepared = match scale {
-            None => points.clone(),
-            Some(s) => points.scaled_columns(&s),
-        };
-        (evaluator, prepared)
+        let dim = a.len();
+        let mut expanded = vec![0.0; Expanded { dim }.len()];
+        let value = self.terms(dim).pair(a, b, Some(&mut expanded));
+        let folded = self.fold_gradient(&expanded, dim);
+        gradient.copy_from_slice(&folded[..expected]);
+        Ok(value)
     }
 }
 
@@ -251,154 +362,8 @@ impl Bounds {
     }
 }
 
-/// A kernel ready for the inner loops: its inputs have been prepared by [`Kernel::prepare`].
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum Evaluator {
-    Quadratic(QuadraticKernel),
-    SquaredExponential(SquaredExponentialScaled),
-    Matern52(Matern52Scaled),
-}
-
-/// The squared exponential on inputs already divided by their length scales.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct SquaredExponentialScaled {
-    pub(crate) signal_variance: f64,
-}
-
-/// The Matérn 5/2 on inputs already divided by their length scales.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Matern52Scaled {
-    pub(crate) signal_variance: f64,
-}
-
-/// One covariance function on prepared inputs, as a function of the pair's squared distance `r²`
-/// and inner product `xᵀx'` (both come from one matrix product, see `gram`), monomorphised into
-/// the Gram-matrix loops.
-///
-/// The likelihood gradient needs every pair's kernel gradient; `value_and_cache` returns with the
-/// value the one number (the exponential factor) that makes the gradient free of `exp`.
-pub(crate) trait PairKernel: Sync {
-    /// Log-parameters differentiated pair by pair (first in the log-parameter order); any further
-    /// ones, up to the noise, are ARD length scales.
-    const SCALARS: usize;
-    /// `k` without noise.
-    fn value(&self, r2: f64, dot: f64) -> f64;
-    /// `k` without noise and the cached factor for [`PairKernel::gradient_from_cache`].
-    fn value_and_cache(&self, r2: f64, dot: f64) -> (f64, f64);
-    /// `∂k/∂ln p` for the first [`PairKernel::SCALARS`] log-parameters, written to `scalars`; returns
-    /// the length-scale weight `m` with `∂k/∂ln ℓᵢ = m (Δᵢ/ℓᵢ)²` (0 without length scales).
-    fn gradient_from_cache(&self, r2: f64, dot: f64, cache: f64, scalars: &mut [f64]) -> f64;
-}
-
-impl PairKernel for QuadraticKernel {
-    const SCALARS: usize = quadratic::PARAMETERS;
-    #[inline]
-    fn value(&self, r2: f64, dot: f64) -> f64 {
-        self.value_from(r2, dot)
-    }
-    #[inline]
-    fn value_and_cache(&self, r2: f64, dot: f64) -> (f64, f64) {
-        self.value_and_exponential(r2, dot)
-    }
-    #[inline]
-    fn gradient_from_cache(&self, r2: f64, dot: f64, cache: f64, scalars: &mut [f64]) -> f64 {
-        self.gradient_from_exponential(r2, dot, cache, scalars);
-        0.0
-    }
-}
-
-impl PairKernel for SquaredExponentialScaled {
-    const SCALARS: usize = 1;
-    #[inline]
-    fn value(&self, r2: f64, _dot: f64) -> f64 {
-        SquaredExponentialArd::value_scaled(self.signal_variance, r2)
-    }
-    #[inline]
-    fn value_and_cache(&self, r2: f64, dot: f64) -> (f64, f64) {
-        let k = self.value(r2, dot);
-        (k, k)
-    }
-    #[inline]
-    fn gradient_from_cache(&self, _r2: f64, _dot: f64, cache: f64, scalars: &mut [f64]) -> f64 {
-        scalars[0] = cache;
-        cache
-    }
-}
-
-impl PairKernel for Matern52Scaled {
-    const SCALARS: usize = 1;
-    #[inline]
-    fn value(&self, r2: f64, _dot: f64) -> f64 {
-        Matern52Ard::value_and_exponential(self.signal_variance, r2).0
-    }
-    #[inline]
-    fn value_and_cache(&self, r2: f64, _dot: f64) -> (f64, f64) {
-        Matern52Ard::value_and_exponential(self.signal_variance, r2)
-    }
-    #[inline]
-    fn gradient_from_cache(&self, r2: f64, _dot: f64, cache: f64, scalars: &mut [f64]) -> f64 {
-        let (k, weight) = Matern52Ard::value_and_weight(self.signal_variance, r2, cache);
-        scalars[0] = k;
-        weight
-    }
-}
-
-/// Runs `$body` with `$k` bound to the concrete [`PairKernel`] inside `$evaluator`, so that the
-/// loops in `$body` are compiled once per kernel with no dispatch per pair.
-macro_rules! with_pair_kernel {
-    ($evaluator:expr, $k:ident => $body:expr) => {
-        match $evaluator {
-            $crate::kernel::Evaluator::Quadratic($k) => $body,
-            $crate::kernel::Evaluator::SquaredExponential($k) => $body,
-            $crate::kernel::Evaluator::Matern52($k) => $body,
-        }
-    };
-}
-pub(crate) use with_pair_kernel;
-
-/// `‖a − b‖²` and `aᵀb`.
-#[inline]
-fn distance_and_dot(a: &[f64], b: &[f64]) -> (f64, f64) {
-    a.iter().zip(b).fold((0.0, 0.0), |(r2, dot), (x, y)| (r2 + (x - y) * (x - y), dot + x * y))
-}
-
-impl Evaluator {
-    /// `k(a, b)` without noise, on prepared points.
-    #[inline]
-    pub(crate) fn value(&self, a: &[f64], b: &[f64]) -> f64 {
-        let (r2, dot) = distance_and_dot(a, b);
-        with_pair_kernel!(self, k => k.value(r2, dot))
-    }
-
-    /// `k(a, b)` without noise and its gradient in the kernel's log-parameters (noise excluded),
-    /// on prepared points.
-    pub(crate) fn value_and_gradient(&self, a: &[f64], b: &[f64], gradient: &mut [f64]) -> f64 {
-        let (r2, dot) = distance_and_dot(a, b);
-        with_pair_kernel!(self, k => {
-            let (value, cache) = k.value_and_cache(r2, dot);
-            let scalars = k.gradient_from_cache(r2, dot, cache, gradient);
-            fill_length_scale_gradient(scalars, a, b, gradient, k_scalars(k));
-            value
-        })
-    }
-}
-
-fn k_scalars<K: PairKernel>(_: &K) -> usize {
-    K::SCALARS
-}
-
-/// `∂k/∂ln ℓᵢ = m (Δᵢ/ℓᵢ)²` into `gradient[scalars..]` (prepared points are already divided by ℓ).
-fn fill_length_scale_gradient(m: f64, a: &[f64], b: &[f64], gradient: &mut [f64], scalars: usize) {
-    for ((g, x), y) in gradient[scalars..].iter_mut().zip(a).zip(b) {
-        *g = m * (x - y) * (x - y);
-    }
-}
-
+/// `‖a − b‖²`.
 #[inline]
 pub(crate) fn squared_distance(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
-}
-
-fn scale_point(a: &[f64], scale: &[f64]) -> Vec<f64> {
-    a.iter().zip(scale).map(|(x, s)| x * s).collect()
 }

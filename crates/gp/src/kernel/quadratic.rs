@@ -33,29 +33,6 @@ impl Default for QuadraticKernel {
 pub(crate) const PARAMETERS: usize = 4;
 
 impl QuadraticKernel {
-    /// `k` without noise (Eq. 5) from `r² = ‖x − x'‖²` and `xᵀx'`.
-    #[inline]
-    pub(crate) fn value_from(&self, r2: f64, dot: f64) -> f64 {
-        self.theta0 * (-0.5 * self.theta1 * r2).exp() + self.theta2 + self.theta3 * dot
-    }
-
-    /// `k` without noise and its exponential part `E = θ0 exp(−θ1 r²/2)`.
-    #[inline]
-    pub(crate) fn value_and_exponential(&self, r2: f64, dot: f64) -> (f64, f64) {
-        let exponential = self.theta0 * (-0.5 * self.theta1 * r2).exp();
-        (exponential + self.theta2 + self.theta3 * dot, exponential)
-    }
-
-    /// Derivatives with respect to `ln θ0 … ln θ3` into `gradient[..4]`, given `E`:
-    /// `∂k/∂ln θ = θ ∂k/∂θ` gives `E`, `−E θ1 r²/2`, `θ2`, `θ3 xᵀx'`.
-    #[inline]
-    pub(crate) fn gradient_from_exponential(&self, r2: f64, dot: f64, exponential: f64, gradient: &mut [f64]) {
-        gradient[0] = exponential;
-        gradient[1] = -0.5 * exponential * self.theta1 * r2;
-        gradient[2] = self.theta2;
-        gradient[3] = self.theta3 * dot;
-    }
-
     /// Natural-scale parameters in log-parameter order (noise last).
     pub(crate) fn parameters(&self) -> [f64; PARAMETERS + 1] {
         [self.theta0, self.theta1, self.theta2, self.theta3, self.noise_variance]

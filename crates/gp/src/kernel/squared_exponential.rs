@@ -21,12 +21,4 @@ impl SquaredExponentialArd {
     pub fn isotropic_start(dim: usize) -> Self {
         Self { signal_variance: 1.0, length_scales: vec![1.0; dim], noise_variance: 0.01 }
     }
-
-    /// `σf² exp(−r²/2)` with `r²` the squared distance of inputs already divided by their
-    /// length scales (R&W Eq. 5.2). Its derivatives: `∂k/∂ln σf² = k` and
-    /// `∂k/∂ln ℓᵢ = k (Δᵢ/ℓᵢ)²`, i.e. the length-scale weight is `k` itself.
-    #[inline]
-    pub(crate) fn value_scaled(signal_variance: f64, r2: f64) -> f64 {
-        signal_variance * (-0.5 * r2).exp()
-    }
 }

@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use faer::Mat;
-use gp::{Kernel, Matern52Ard, QuadraticKernel, SquaredExponentialArd};
+use gp::{CompositeKernel, Kernel, Matern52Ard, QuadraticKernel, SquaredExponentialArd, StationaryShape};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
@@ -16,10 +16,24 @@ pub fn uniform_points(rng: &mut ChaCha8Rng, n: usize, d: usize, lo: f64, hi: f64
     Mat::from_fn(n, d, |_, _| rng.random_range(lo..hi))
 }
 
-/// One kernel of each family with random parameters (natural scale between 0.3 and 3).
+/// One kernel of each family, and the composite kernel with each shape and each choice of its
+/// optional terms, with random parameters (natural scale between 0.3 and 3).
 pub fn random_kernels(rng: &mut ChaCha8Rng, d: usize) -> Vec<Kernel> {
     let mut p = || rng.random_range(0.3f64.ln()..3.0f64.ln()).exp();
-    vec![
+    let mut composites = Vec::new();
+    for shape in [StationaryShape::SquaredExponential, StationaryShape::Matern52] {
+        for (constant, linear) in [(true, true), (true, false), (false, true)] {
+            composites.push(Kernel::Composite(CompositeKernel {
+                shape,
+                signal_variance: p(),
+                length_scales: (0..d).map(|_| p()).collect(),
+                constant: constant.then(&mut p),
+                linear_weights: linear.then(|| (0..d).map(|_| p()).collect()),
+                noise_variance: p(),
+            }));
+        }
+    }
+    let mut kernels = vec![
         Kernel::Quadratic(QuadraticKernel { theta0: p(), theta1: p(), theta2: p(), theta3: p(), noise_variance: p() }),
         Kernel::SquaredExponentialArd(SquaredExponentialArd {
             signal_variance: p(),
@@ -31,7 +45,9 @@ pub fn random_kernels(rng: &mut ChaCha8Rng, d: usize) -> Vec<Kernel> {
             length_scales: (0..d).map(|_| p()).collect(),
             noise_variance: p(),
         }),
-    ]
+    ];
+    kernels.extend(composites);
+    kernels
 }
 
 /// `m` independent draws `y ~ N(0, K(X, X) + σn² I)` (columns), by a Cholesky factor computed

@@ -10,6 +10,11 @@ Parameterisation (ours -> scikit-learn), all on standardised inputs and normalis
       -> C(th0) * RBF(l = 1/sqrt(th1)) + C(th2) + C(th3) * DotProduct(sigma_0 = 0, fixed) + White(sn2)
   SquaredExponentialArd: sf2, l_1..l_d, sn2 -> C(sf2) * RBF(l) + White(sn2)
   Matern52Ard:           sf2, l_1..l_d, sn2 -> C(sf2) * Matern(l, nu=2.5) + White(sn2)
+  Composite (SE or Matern 5/2, constant, ARD linear): sf2, l_1..l_d, c, w_1..w_d, sn2
+      -> C(sf2) * RBF(l * sqrt(w)) + C(c) + DotProduct(sigma_0 = 0, fixed) + White(sn2) on inputs
+         multiplied by sqrt(w) (scikit-learn has no ARD DotProduct; scaling the inputs makes one
+         at fixed hyperparameters). Its search has the isotropic slope only, C(s) * DotProduct,
+         a special case of ours, so our optimised likelihood must be at least scikit-learn's.
 Inputs are standardised here (mean, population std) exactly as `gp` does with
 `standardise_inputs = true`; outputs are normalised by scikit-learn's `normalize_y=True`, which
 matches `normalise_outputs = true`. `alpha = 0`: the only diagonal term is the WhiteKernel.
@@ -30,6 +35,10 @@ RESTARTS = 4
 # Default search boxes of `gp` (natural scale, in our parameter order), see `Kernel::default_bounds`.
 QUADRATIC_BOUNDS = ([1e-3, 1e-4, 1e-6, 1e-6, 1e-9], [1e2, 1e2, 1e2, 1e2, 1e1])
 ARD_BOUNDS = ([1e-3] + [1e-2] * DIM + [1e-9], [1e2] + [1e3] * DIM + [1e1])
+COMPOSITE_BOUNDS = (
+    [1e-3] + [1e-2] * DIM + [1e-6] + [1e-6] * DIM + [1e-9],
+    [1e2] + [1e3] * DIM + [1e2] + [1e2] * DIM + [1e1],
+)
 
 
 def data():
@@ -45,8 +54,28 @@ def data():
     return x[:N_TRAIN], y[:N_TRAIN], x[N_TRAIN:]
 
 
+def composite_parts(p):
+    sf2, ls, c, w, sn2 = p[0], np.array(p[1 : 1 + DIM]), p[1 + DIM], np.array(p[2 + DIM : 2 + 2 * DIM]), p[-1]
+    return sf2, ls, c, w, sn2
+
+
 def sk_kernel(family, p, lower, upper):
     """scikit-learn kernel for our natural parameters `p` and box (lower, upper)."""
+    if isinstance(family, dict):
+        shape = family["Composite"]["shape"]
+        sf2, ls, c, w, sn2 = composite_parts(p)
+        core = RBF(ls * np.sqrt(w), "fixed") if shape == "SquaredExponential" else Matern(ls * np.sqrt(w), "fixed", nu=2.5)
+        return C(sf2, "fixed") * core + C(c, "fixed") + DotProduct(sigma_0=0.0, sigma_0_bounds="fixed") + WhiteKernel(sn2, "fixed")
+    if isinstance(family, tuple):
+        sf2, ls, c, w, sn2 = composite_parts(p)
+        ls_bounds = list(zip(lower[1 : 1 + DIM], upper[1 : 1 + DIM]))
+        core = RBF(ls, ls_bounds) if family[1] == "SquaredExponential" else Matern(ls, ls_bounds, nu=2.5)
+        return (
+            C(sf2, (lower[0], upper[0])) * core
+            + C(c, (lower[1 + DIM], upper[1 + DIM]))
+            + C(float(np.mean(w)), (lower[2 + DIM], upper[2 + DIM])) * DotProduct(sigma_0=0.0, sigma_0_bounds="fixed")
+            + WhiteKernel(sn2, (lower[-1], upper[-1]))
+        )
     if family == "Quadratic":
         th0, th1, th2, th3, sn2 = p
         # th1 = 1/l^2, so th1 in [a, b] is l in [1/sqrt(b), 1/sqrt(a)].
@@ -67,6 +96,17 @@ def sk_kernel(family, p, lower, upper):
 
 def our_parameters(family, k):
     """Our natural parameters from a fitted scikit-learn kernel."""
+    if isinstance(family, dict):
+        # ((C0 * RBF + Cc) + Cs * Dot) + White: the isotropic slope as one weight per input.
+        c0_rbf, cc = k.k1.k1.k1, k.k1.k1.k2
+        slope = k.k1.k2.k1.constant_value
+        return (
+            [c0_rbf.k1.constant_value]
+            + list(np.atleast_1d(c0_rbf.k2.length_scale))
+            + [cc.constant_value]
+            + [slope] * DIM
+            + [k.k2.noise_level]
+        )
     if family == "Quadratic":
         # ((C0 * RBF + C2) + C3 * Dot) + White
         white = k.k2
@@ -87,11 +127,13 @@ def our_parameters(family, k):
 def case(family, outputs, fixed, bounds, xs, y, xs_test):
     lower, upper = bounds
     yc = y[:, outputs] if len(outputs) > 1 else y[:, outputs[0]]
+    # The composite's slope weights are applied by scaling the inputs (see the module doc).
+    root = np.sqrt(composite_parts(fixed)[3]) if isinstance(family, dict) else np.ones(DIM)
     gpr = GaussianProcessRegressor(sk_kernel(family, fixed, lower, upper), alpha=0.0, optimizer=None, normalize_y=True)
-    gpr.fit(xs, yc)
-    mean, std = gpr.predict(xs_test, return_std=True)
+    gpr.fit(xs * root, yc)
+    mean, std = gpr.predict(xs_test * root, return_std=True)
     opt = GaussianProcessRegressor(
-        sk_kernel(family, fixed, lower, upper),
+        sk_kernel(("search", family["Composite"]["shape"]) if isinstance(family, dict) else family, fixed, lower, upper),
         alpha=0.0,
         normalize_y=True,
         n_restarts_optimizer=RESTARTS,
@@ -125,6 +167,24 @@ def main():
         case("SquaredExponentialArd", [0], [1.2, 0.9, 1.7, 2.5, 0.01], ARD_BOUNDS, xs, y, xs_test),
         case("Matern52Ard", [1], [0.7, 1.1, 0.8, 3.0, 0.05], ARD_BOUNDS, xs, y, xs_test),
         case("SquaredExponentialArd", [0, 1], [1.0, 1.3, 1.1, 2.0, 0.03], ARD_BOUNDS, xs, y, xs_test),
+        case(
+            {"Composite": {"shape": "SquaredExponential", "constant": True, "linear": True}},
+            [0],
+            [1.1, 0.9, 1.5, 2.2, 0.2, 0.3, 0.05, 0.1, 0.02],
+            COMPOSITE_BOUNDS,
+            xs,
+            y,
+            xs_test,
+        ),
+        case(
+            {"Composite": {"shape": "Matern52", "constant": True, "linear": True}},
+            [0, 1],
+            [0.8, 1.2, 0.7, 2.8, 0.1, 0.2, 0.4, 0.03, 0.04],
+            COMPOSITE_BOUNDS,
+            xs,
+            y,
+            xs_test,
+        ),
     ]
     fixture = {
         "generator": "crates/gp/tests/sklearn/make_fixture.py",

@@ -1,0 +1,102 @@
+//! Every kernel of the crate as one sum of terms, for the inner loops:
+//! `σf² s(‖(x − x') ∘ ℓ⁻¹‖²) + σc² + Σᵢ wᵢ xᵢ x'ᵢ`, and the chain rule from the gradient in this
+//! expanded form back to each kernel's own log-parameters.
+//!
+//! The expanded log-parameters are, always in this order and whether or not the kernel has the
+//! term: `ln σf², ln ℓ₁ … ln ℓ_d, ln σc², ln w₁ … ln w_d, ln σn²` (`2d + 3` of them).
+
+use super::StationaryShape;
+use crate::points::Points;
+
+/// What the Gram-matrix loops need besides the prepared points.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Evaluator {
+    pub(crate) shape: StationaryShape,
+    pub(crate) signal_variance: f64,
+    /// `σc²`, 0 without a constant term.
+    pub(crate) constant: f64,
+    pub(crate) noise_variance: f64,
+}
+
+/// Inputs prepared for an [`Evaluator`]: divided by the length scales for the stationary term, and
+/// multiplied by `√wᵢ` for the linear term (so that it is a plain inner product).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Prepared {
+    pub(crate) stationary: Points,
+    pub(crate) linear: Option<Points>,
+}
+
+impl Prepared {
+    pub(crate) fn len(&self) -> usize {
+        self.stationary.len()
+    }
+}
+
+/// The expanded form of a kernel for `dim` inputs.
+#[derive(Debug, Clone)]
+pub(crate) struct Terms {
+    pub(crate) evaluator: Evaluator,
+    pub(crate) inverse_length_scales: Vec<f64>,
+    /// `√wᵢ`, `None` without a linear term.
+    pub(crate) linear_roots: Option<Vec<f64>>,
+}
+
+/// Index of each block in the expanded log-parameters for `dim` inputs.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Expanded {
+    pub(crate) dim: usize,
+}
+
+impl Expanded {
+    pub(crate) const SIGNAL: usize = 0;
+    pub(crate) fn length(self, i: usize) -> usize {
+        1 + i
+    }
+    pub(crate) fn constant(self) -> usize {
+        1 + self.dim
+    }
+    pub(crate) fn linear(self, i: usize) -> usize {
+        2 + self.dim + i
+    }
+    pub(crate) fn noise(self) -> usize {
+        2 + 2 * self.dim
+    }
+    pub(crate) fn len(self) -> usize {
+        3 + 2 * self.dim
+    }
+}
+
+impl Terms {
+    /// The inputs as the loops read them.
+    pub(crate) fn prepare(&self, points: &Points) -> Prepared {
+        Prepared {
+            stationary: points.scaled_columns(&self.inverse_length_scales),
+            linear: self.linear_roots.as_ref().map(|r| points.scaled_columns(r)),
+        }
+    }
+
+    /// `k(a, b)` without noise and, if `gradient` is given, `∂k/∂` every expanded log-parameter
+    /// (the noise entry is left 0), from raw points.
+    pub(crate) fn pair(&self, a: &[f64], b: &[f64], gradient: Option<&mut [f64]>) -> f64 {
+        let e = &self.evaluator;
+        let r2: f64 = a.iter().zip(b).zip(&self.inverse_length_scales).map(|((x, y), s)| ((x - y) * s).powi(2)).sum();
+        let (stationary, weight) = e.shape.value_and_weight(e.signal_variance, r2);
+        let linear: Vec<f64> = match &self.linear_roots {
+            Some(r) => a.iter().zip(b).zip(r).map(|((x, y), s)| x * s * y * s).collect(),
+            None => Vec::new(),
+        };
+        if let Some(g) = gradient {
+            let layout = Expanded { dim: a.len() };
+            g.iter_mut().for_each(|v| *v = 0.0);
+            g[Expanded::SIGNAL] = stationary;
+            for (i, ((x, y), s)) in a.iter().zip(b).zip(&self.inverse_length_scales).enumerate() {
+                g[layout.length(i)] = weight * ((x - y) * s).powi(2);
+            }
+            g[layout.constant()] = e.constant;
+            for (i, v) in linear.iter().enumerate() {
+                g[layout.linear(i)] = *v;
+            }
+        }
+        stationary + e.constant + linear.iter().sum::<f64>()
+    }
+}
