@@ -2,7 +2,7 @@
 //! subcommands without a robot, or to test a calibration on data whose truth is known.
 
 use pipeline::Error;
-use pipeline::simulated::{self, GeneratorConfig, Perturbation};
+use pipeline::simulated::{self, GeneratorConfig, Perturbation, Remount, TorqueSensorNoise};
 use std::path::PathBuf;
 
 /// Simulate tracker measurements of a robot whose kinematics are off its nominal.
@@ -10,6 +10,13 @@ use std::path::PathBuf;
 /// The true robot is the nominal one with every local frame (each joint and the tool) moved by up
 /// to 1 mm and 1 mrad per component, a 0.2 m tool, seen by a tracker placed 3–5 m away; all of it
 /// drawn from the seed.
+///
+/// Campaign shapes: `--moving-joints 1,2 --fixed-jitter-mrad 2` moves only joints 1 and 2 (the
+/// others at 0 within 2 mrad); `--runs` measures the payloads in consecutive runs, in the order
+/// given; `--tool-per-payload` also remounts the probe for each run (a different tool transform,
+/// up to 2 mm and 2 mrad per component off the first; a `tool` column); `--torques` writes the
+/// measured joint torques `tau1_nm … tauN_nm` (the drive torques holding gravity, payload and
+/// balancer, with sensor noise).
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
@@ -27,12 +34,31 @@ pub struct Args {
     #[arg(long)]
     full_pose: bool,
     /// Effects (RON, loadsim's `Effects`: compliance, backlash, periodic, thermal, drift,
-    /// tracker_noise; a field left out is off) [default: joint compliance and tracker noise].
+    /// tracker_noise, coupling; a field left out is off) [default: joint compliance and tracker noise].
     #[arg(long)]
     effects: Option<PathBuf>,
     /// Payloads, kg, one drawn per pose [default: the paper's 1,2.5,3.5,5,7.5].
     #[arg(long, value_delimiter = ',')]
     payloads: Option<Vec<f64>>,
+    /// Only these joints move (1-based, comma separated); the others sit at 0.
+    #[arg(long, value_delimiter = ',')]
+    moving_joints: Option<Vec<usize>>,
+    /// Joints that do not move are drawn within ± this of 0, mrad (with --moving-joints) [default: 0].
+    #[arg(long)]
+    fixed_jitter_mrad: Option<f64>,
+    /// Payload runs: the poses split into consecutive runs, one per payload in the order given.
+    #[arg(long)]
+    runs: bool,
+    /// One run per payload with the probe remounted for each: a tool per run (implies --runs).
+    #[arg(long)]
+    tool_per_payload: bool,
+    /// Write measured joint torques (needs the robot's dynamics block).
+    #[arg(long)]
+    torques: bool,
+    /// Standard deviation of the measured torques, N·m (with --torques) [default: 0.5, loadsim's
+    /// TorqueSensorNoise].
+    #[arg(long)]
+    torque_sigma_nm: Option<f64>,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
@@ -44,11 +70,15 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     if args.rows == 0 {
         return Err("--rows: at least one pose is needed".into());
     }
-    let defaults = GeneratorConfig::default();
-    let payloads_kg = args.payloads.clone().unwrap_or_else(|| defaults.payloads_kg.clone());
-    let config = GeneratorConfig { sample_count: args.rows, seed: args.seed, payloads_kg, ..defaults };
-    let cell = simulated::simulated_cell(&robot, &Perturbation::default(), args.seed)?;
-    let data = simulated::simulate(&cell, &effects, &simulated::joint_ranges(&robot), &config, args.full_pose)?;
+    let config = generator_config(args)?;
+    let (_, data) = simulated::simulate_campaign(
+        &robot,
+        &effects,
+        &Perturbation::default(),
+        &Remount::default(),
+        &config,
+        args.full_pose,
+    )?;
 
     let path = args.out.display().to_string();
     let io = |source: std::io::Error| Error::Io { path: path.clone(), source };
@@ -64,8 +94,76 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         if on.is_empty() { "none".to_owned() } else { on.join(", ") },
         args.seed
     );
+    for line in shape_lines(&config) {
+        println!("  {line}");
+    }
     println!("  wrote {}", args.out.display());
     Ok(())
+}
+
+/// The generator's configuration from the command line.
+fn generator_config(args: &Args) -> Result<GeneratorConfig, Box<dyn std::error::Error>> {
+    let defaults = GeneratorConfig::default();
+    let payloads_kg = args.payloads.clone().unwrap_or_else(|| defaults.payloads_kg.clone());
+    let mut moving_joints = Vec::new();
+    for &joint in args.moving_joints.iter().flatten() {
+        if joint == 0 {
+            return Err("--moving-joints: joints are numbered from 1".into());
+        }
+        moving_joints.push(joint - 1);
+    }
+    moving_joints.sort_unstable();
+    moving_joints.dedup();
+    if args.fixed_jitter_mrad.is_some() && moving_joints.is_empty() {
+        return Err("--fixed-jitter-mrad needs --moving-joints (only joints that do not move are held)".into());
+    }
+    let jitter = args.fixed_jitter_mrad.unwrap_or(0.0);
+    if !(jitter.is_finite() && jitter >= 0.0) {
+        return Err(format!("--fixed-jitter-mrad: {jitter} is not a non-negative number").into());
+    }
+    if args.torque_sigma_nm.is_some() && !args.torques {
+        return Err("--torque-sigma-nm needs --torques".into());
+    }
+    if let Some(sigma) = args.torque_sigma_nm.filter(|s| !(s.is_finite() && *s >= 0.0)) {
+        return Err(format!("--torque-sigma-nm: {sigma} is not a non-negative number").into());
+    }
+    let torque_sensor = args.torques.then(|| match args.torque_sigma_nm {
+        Some(sigma_nm) => TorqueSensorNoise { sigma_nm, ..TorqueSensorNoise::default() },
+        None => TorqueSensorNoise::default(),
+    });
+    Ok(GeneratorConfig {
+        sample_count: args.rows,
+        seed: args.seed,
+        payloads_kg,
+        moving_joints,
+        fixed_jitter_rad: jitter * 1e-3,
+        payload_runs: args.runs || args.tool_per_payload,
+        tool_per_run: args.tool_per_payload,
+        torque_sensor,
+        ..defaults
+    })
+}
+
+/// What the campaign's shape is, in words, where it is not the default.
+fn shape_lines(config: &GeneratorConfig) -> Vec<String> {
+    let mut lines = Vec::new();
+    if !config.moving_joints.is_empty() {
+        let joints: Vec<String> = config.moving_joints.iter().map(|j| (j + 1).to_string()).collect();
+        lines.push(format!(
+            "moving joints {}, the others at 0 within {} mrad",
+            joints.join(","),
+            config.fixed_jitter_rad * 1e3
+        ));
+    }
+    if config.runs() {
+        let kg: Vec<String> = config.payloads_kg.iter().map(|m| format!("{m} kg")).collect();
+        let tools = if config.tool_per_run { ", the probe remounted for each (one tool per run)" } else { "" };
+        lines.push(format!("payload runs: {}{tools}", kg.join(", ")));
+    }
+    if let Some(sensor) = &config.torque_sensor {
+        lines.push(format!("measured torques, sensor noise {} N·m", sensor.sigma_nm));
+    }
+    lines
 }
 
 /// The names of the effects that are on, as the RON file spells them.
@@ -77,6 +175,7 @@ fn effect_names(effects: &simulated::Effects) -> Vec<&'static str> {
         ("thermal", effects.thermal.is_some()),
         ("drift", effects.drift.is_some()),
         ("tracker_noise", effects.tracker_noise.is_some()),
+        ("coupling", effects.coupling.is_some()),
     ]
     .into_iter()
     .filter_map(|(name, on)| on.then_some(name))

@@ -123,3 +123,86 @@ fn bad_arguments_and_files_are_refused_with_one_line() {
     refused(&["simulate", "--robot", &robot, "--out", &out, "--effects", &text(&effects)], "tracker_nosie");
     assert!(!Path::new(&out).exists(), "nothing is written when the input is refused");
 }
+
+fn iiwa7() -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/iiwa7.ron").display().to_string()
+}
+
+/// The rows of a CSV as maps from header to cell.
+fn rows(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
+    let content = std::fs::read_to_string(path).unwrap();
+    let mut lines = content.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(str::to_owned).collect();
+    lines.map(|l| header.iter().cloned().zip(l.split(',').map(str::to_owned)).collect()).collect()
+}
+
+#[test]
+fn a_seven_axis_payload_run_campaign_writes_fixed_joints_a_tool_per_run_and_torques() {
+    let dir = tempfile::tempdir().unwrap();
+    let all = dir.path().join("all.csv");
+    let out = succeeds(&[
+        "simulate",
+        "--robot",
+        &iiwa7(),
+        "--out",
+        &text(&all),
+        "--rows",
+        "120",
+        "--seed",
+        "4",
+        "--full-pose",
+        "--moving-joints",
+        "1,2",
+        "--fixed-jitter-mrad",
+        "2",
+        "--payloads",
+        "0,1.25,2.5,5",
+        "--tool-per-payload",
+        "--torques",
+    ]);
+    assert!(out.contains("moving joints 1,2") && out.contains("one tool per run") && out.contains("torques"), "{out}");
+    let rows = rows(&all);
+    assert_eq!(rows.len(), 120);
+    let number = |row: &std::collections::HashMap<String, String>, column: &str| -> f64 {
+        row.get(column).unwrap_or_else(|| panic!("{column} missing")).parse().unwrap()
+    };
+    for row in &rows {
+        for j in 3..=7 {
+            assert!(number(row, &format!("q{j}_rad")).abs() <= 2e-3, "joint {j} is held at 0");
+        }
+        for j in 1..=7 {
+            number(row, &format!("tau{j}_nm"));
+        }
+    }
+    // Four consecutive runs of 30, one payload and one tool each, in the order given.
+    let runs: Vec<(String, f64)> = rows.iter().map(|r| (r["tool"].clone(), number(r, "payload_kg"))).collect();
+    for (k, kg) in [0.0, 1.25, 2.5, 5.0].iter().enumerate() {
+        let run = &runs[30 * k..30 * (k + 1)];
+        assert!(run.iter().all(|(tool, m)| *tool == format!("tool{}", k + 1) && m == kg), "run {k}: {run:?}");
+    }
+    // Joint 2 carries the arm's weight, joint 1 (vertical) none beyond the sensor noise.
+    let mean_abs = |j: usize| rows.iter().map(|r| number(r, &format!("tau{j}_nm")).abs()).sum::<f64>() / 120.0;
+    assert!(mean_abs(2) > 20.0 && mean_abs(1) < 1.0, "τ2 {} τ1 {}", mean_abs(2), mean_abs(1));
+    // The file reads back and fits, each run's tool its own.
+    let model = dir.path().join("poe.ron");
+    succeeds(&["fit", "--robot", &iiwa7(), "--data", &text(&all), "--method", "poe", "--out", &text(&model)]);
+    let fitted = std::fs::read_to_string(&model).unwrap();
+    assert!(["tool1", "tool2", "tool3", "tool4"].iter().all(|t| fitted.contains(t)), "the model keeps a tool per run");
+}
+
+#[test]
+fn campaign_shape_arguments_that_do_not_fit_are_refused_with_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = text(&dir.path().join("out.csv"));
+    let robot = iiwa7();
+    let base = ["simulate", "--robot", robot.as_str(), "--out", out.as_str()];
+    let with = |extra: &[&'static str]| -> Vec<&str> { base.iter().copied().chain(extra.iter().copied()).collect() };
+    refused(&with(&["--moving-joints", "0,2"]), "numbered from 1");
+    refused(&with(&["--moving-joints", "2,9"]), "joint 9");
+    refused(&with(&["--fixed-jitter-mrad", "2"]), "--moving-joints");
+    refused(&with(&["--moving-joints", "1,2", "--fixed-jitter-mrad=-1"]), "--fixed-jitter-mrad");
+    refused(&with(&["--torque-sigma-nm", "1"]), "--torques");
+    let bare = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/ur10.ron").display().to_string();
+    refused(&["simulate", "--robot", &bare, "--out", &out, "--torques"], "dynamics");
+    assert!(!Path::new(&out).exists(), "nothing is written when the input is refused");
+}

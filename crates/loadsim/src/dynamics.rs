@@ -7,6 +7,19 @@ use serde::{Deserialize, Serialize};
 /// Gravity in the base frame of a floor-mounted robot (base z up), m/s².
 pub const FLOOR_GRAVITY_M_PER_S2: [f64; 3] = [0.0, 0.0, -9.81];
 
+/// Gravity in the base frame of a robot whose base is tilted by `tilt_rad` from upright about the
+/// horizontal base axis at `azimuth_rad` from base x (towards base y), m/s²: 0 is a floor mount,
+/// π/2 a wall mount, π a ceiling mount. On a tilted base joint 1's axis is no longer vertical, so
+/// gravity loads it: this is how a joint-1 compliance or backlash becomes visible at all.
+pub fn tilted_base_gravity(tilt_rad: f64, azimuth_rad: f64) -> [f64; 3] {
+    let axis = lie::Vector3::new(azimuth_rad.cos(), azimuth_rad.sin(), 0.0);
+    // world_from_base turns the base by `tilt` about `axis`; gravity in the base frame is
+    // base_from_world · (0, 0, −g).
+    let base_from_world = lie::SO3::exp(&(axis * -tilt_rad));
+    let g = base_from_world.act(&lie::Vector3::from(FLOOR_GRAVITY_M_PER_S2));
+    [g.x, g.y, g.z]
+}
+
 fn floor_gravity() -> [f64; 3] {
     FLOOR_GRAVITY_M_PER_S2
 }

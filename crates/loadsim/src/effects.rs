@@ -2,8 +2,9 @@
 //! measured tool pose.
 
 use crate::{
-    Backlash, BaseDrift, Error, JointBacklash, JointCompliance, PeriodicError, PoseContext, SimulatedCell,
-    ThermalGrowth, TrackerNoise, compliance::compliance_deflection, gravity::static_torque, periodic::Harmonic,
+    Backlash, BaseDrift, Error, JointBacklash, JointCompliance, JointCoupling, PeriodicError, PoseContext,
+    SimulatedCell, ThermalGrowth, TrackerNoise, compliance::compliance_deflection, gravity::static_torque,
+    periodic::Harmonic,
 };
 use lie::SE3;
 use rand::Rng;
@@ -26,17 +27,20 @@ pub enum EffectKind {
     TimeDrift,
     /// Tracker measurement noise.
     TrackerNoise,
+    /// A joint error driven by other joints' angles; no candidate of the diagnosis models it.
+    Coupling,
 }
 
 impl EffectKind {
     /// Every kind, in a fixed order.
-    pub const ALL: [EffectKind; 6] = [
+    pub const ALL: [EffectKind; 7] = [
         EffectKind::JointCompliance,
         EffectKind::Backlash,
         EffectKind::GearPeriodic,
         EffectKind::Thermal,
         EffectKind::TimeDrift,
         EffectKind::TrackerNoise,
+        EffectKind::Coupling,
     ];
 }
 
@@ -57,6 +61,8 @@ pub struct Effects {
     pub drift: Option<BaseDrift>,
     /// Tracker noise.
     pub tracker_noise: Option<TrackerNoise>,
+    /// A joint error driven by other joints' angles (module [`JointCoupling`]).
+    pub coupling: Option<JointCoupling>,
 }
 
 /// The joint-space part of the forward model at one pose, each effect apart.
@@ -71,13 +77,15 @@ pub struct JointOffsets {
     pub backlash_rad: Vec<f64>,
     /// Periodic transmission error, rad.
     pub periodic_rad: Vec<f64>,
+    /// Coupled joint error, rad.
+    pub coupling_rad: Vec<f64>,
 }
 
 impl JointOffsets {
-    /// The sum of the three joint-space effects, rad.
+    /// The sum of the joint-space effects, rad.
     pub fn total(&self) -> Vec<f64> {
         (0..self.compliance_rad.len())
-            .map(|j| self.compliance_rad[j] + self.backlash_rad[j] + self.periodic_rad[j])
+            .map(|j| self.compliance_rad[j] + self.backlash_rad[j] + self.periodic_rad[j] + self.coupling_rad[j])
             .collect()
     }
 }
@@ -110,6 +118,7 @@ impl Effects {
             thermal: Some(ThermalGrowth::default()),
             drift: Some(BaseDrift::default()),
             tracker_noise: Some(TrackerNoise::default()),
+            coupling: None,
         }
     }
 
@@ -123,6 +132,7 @@ impl Effects {
             EffectKind::Thermal => alone.thermal = self.thermal.clone(),
             EffectKind::TimeDrift => alone.drift = self.drift,
             EffectKind::TrackerNoise => alone.tracker_noise = self.tracker_noise,
+            EffectKind::Coupling => alone.coupling = self.coupling.clone(),
         }
         alone
     }
@@ -136,6 +146,7 @@ impl Effects {
             EffectKind::Thermal => self.thermal.is_some(),
             EffectKind::TimeDrift => self.drift.is_some(),
             EffectKind::TrackerNoise => self.tracker_noise.is_some(),
+            EffectKind::Coupling => self.coupling.is_some(),
         }
     }
 
@@ -164,6 +175,9 @@ impl Effects {
         }
         if let Some(noise) = &self.tracker_noise {
             noise.validate()?;
+        }
+        if let Some(coupling) = &self.coupling {
+            coupling.validate(n)?;
         }
         Ok(())
     }
@@ -210,7 +224,11 @@ impl Effects {
             Some(periodic) => periodic.deflection(q),
             None => vec![0.0; n],
         };
-        Ok(JointOffsets { static_torque_nm, compliance_rad, backlash_rad, periodic_rad })
+        let coupling_rad = match &self.coupling {
+            Some(coupling) => coupling.deflection(q),
+            None => vec![0.0; n],
+        };
+        Ok(JointOffsets { static_torque_nm, compliance_rad, backlash_rad, periodic_rad, coupling_rad })
     }
 
     /// The true `tracker_from_tool` at commanded joints `q`, every active effect applied except the

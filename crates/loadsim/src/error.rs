@@ -52,6 +52,22 @@ pub enum Error {
         /// Margin taken off each end, rad.
         margin_rad: f64,
     },
+    /// A coupled joint error whose factor is the joint's own angle (that is a gear error).
+    SelfCoupling {
+        /// The 0-based joint index.
+        joint_index: usize,
+    },
+    /// A campaign setting that does not fit the cell or the other settings.
+    Campaign {
+        /// Which setting, e.g. `"tool_per_run"`.
+        field: &'static str,
+        /// What it needs, e.g. `"one tool per payload run"`.
+        needs: &'static str,
+        /// The count given.
+        given: usize,
+        /// The count needed.
+        expected: usize,
+    },
     /// The generator rejected too many candidate poses as near-singular.
     SamplingExhausted {
         /// Poses accepted before giving up.
@@ -86,6 +102,14 @@ impl fmt::Display for Error {
                 "joint {} range [{lower_rad}, {upper_rad}] rad is empty after a margin of {margin_rad} rad",
                 joint_index + 1
             ),
+            Error::SelfCoupling { joint_index } => write!(
+                f,
+                "coupling: joint {} is coupled to its own angle (a periodic error of its own angle is `periodic`)",
+                joint_index + 1
+            ),
+            Error::Campaign { field, needs, given, expected } => {
+                write!(f, "{field} needs {needs}: {given} given, {expected} needed")
+            }
             Error::SamplingExhausted { accepted, attempts } => write!(
                 f,
                 "only {accepted} poses accepted after {attempts} candidates: the singularity threshold is too strict"

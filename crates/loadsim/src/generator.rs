@@ -2,11 +2,17 @@
 //! singularities, a payload, a temperature and a time for each, and the measured pose after every
 //! active effect.
 //!
-//! Determinism: one seed, three independent ChaCha streams (configurations, payloads, tracker
-//! noise), so that switching the noise or changing the payload set leaves the configurations as
-//! they were.
+//! Beyond the paper's study, the shapes of real campaigns: only some joints moving (the others
+//! held at one value within a small jitter), payload runs (the poses split into consecutive runs,
+//! one per payload, each optionally measured with its own tool, the probe remounted between
+//! runs), and measured joint torques.
+//!
+//! Determinism: one seed, four independent ChaCha streams (configurations, payloads, tracker
+//! noise, torque noise; stream 3 is left to callers that draw a cell from the same seed), so that
+//! switching the noise or changing the payload set leaves the configurations as they were.
 
-use crate::{Effects, Error, Payload, PoseContext, SimulatedCell, singularity::smallest_singular_value};
+use crate::singularity::{smallest_singular_value, smallest_singular_value_of_joints};
+use crate::{Effects, Error, Payload, PoseContext, SimulatedCell, TorqueSensorNoise};
 use lie::SE3;
 use poe::LocalPoe;
 use rand::{Rng, SeedableRng};
@@ -74,6 +80,27 @@ pub struct GeneratorConfig {
     pub temperature: TemperatureProfile,
     /// Candidates drawn per accepted pose before giving up. Default 1000.
     pub max_attempts_per_sample: usize,
+    /// The joints that move, 0-based; empty (default): every joint. The others sit at
+    /// `fixed_at_rad` within `fixed_jitter_rad`, and only the moving joints' columns of the
+    /// tool-point Jacobian are checked for a singularity.
+    pub moving_joints: Vec<usize>,
+    /// Where each joint that does not move sits, rad: empty (default) or one entry per joint
+    /// (those of moving joints unused). Empty: 0, moved inside the joint's range less the margin
+    /// where 0 is not.
+    pub fixed_at_rad: Vec<f64>,
+    /// Each fixed joint is drawn uniformly within ± this of its value, rad (a joint held by its
+    /// controller reads back within a few encoder counts to milliradians). Default 0.
+    pub fixed_jitter_rad: f64,
+    /// Payload runs: the poses split into consecutive runs of sizes differing by at most one, one
+    /// per entry of `payloads_kg` in order, instead of a payload drawn per pose. Default false.
+    pub payload_runs: bool,
+    /// Measure run `r` with tool `r` of the cell's robot (the probe remounted between runs, so
+    /// each run has its own tool transform); implies `payload_runs`. The cell needs one tool per
+    /// payload. Default false: every pose with the cell's tool.
+    pub tool_per_run: bool,
+    /// Measured joint torques with each sample, with this noise; needs the robot's dynamics.
+    /// Default: none.
+    pub torque_sensor: Option<TorqueSensorNoise>,
 }
 
 impl Default for GeneratorConfig {
@@ -89,7 +116,30 @@ impl Default for GeneratorConfig {
             start_time_s: 0.0,
             temperature: TemperatureProfile::default(),
             max_attempts_per_sample: 1000,
+            moving_joints: Vec::new(),
+            fixed_at_rad: Vec::new(),
+            fixed_jitter_rad: 0.0,
+            payload_runs: false,
+            tool_per_run: false,
+            torque_sensor: None,
         }
+    }
+}
+
+impl GeneratorConfig {
+    /// Whether the poses come in payload runs (`payload_runs`, or implied by `tool_per_run`).
+    pub fn runs(&self) -> bool {
+        self.payload_runs || self.tool_per_run
+    }
+
+    /// The payload run of pose `index` (0 without runs).
+    pub fn run_of(&self, index: usize) -> usize {
+        if self.runs() && self.sample_count > 0 { index * self.payloads_kg.len() / self.sample_count } else { 0 }
+    }
+
+    /// Whether joint `j` moves.
+    fn moves(&self, j: usize) -> bool {
+        self.moving_joints.is_empty() || self.moving_joints.contains(&j)
     }
 }
 
@@ -106,11 +156,17 @@ pub struct Sample {
     pub temp_c: f64,
     /// Time, s.
     pub t_s: f64,
+    /// Index of the tool measured, in the cell's robot.
+    pub tool: usize,
+    /// Measured joint torques, the drive torques of the robot controller's convention
+    /// ([`TorqueSensorNoise`]), N·m; `None` unless the configuration asks for them.
+    pub torques_nm: Option<Vec<f64>>,
 }
 
 const CONFIGURATION_STREAM: u64 = 0;
 const PAYLOAD_STREAM: u64 = 1;
 const NOISE_STREAM: u64 = 2;
+const TORQUE_STREAM: u64 = 4;
 
 fn stream(seed: u64, id: u64) -> ChaCha8Rng {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -118,8 +174,9 @@ fn stream(seed: u64, id: u64) -> ChaCha8Rng {
     rng
 }
 
-/// `count` joint configurations drawn uniformly inside `ranges` less the margin, rejecting those
-/// whose tool-point Jacobian's smallest singular value is below the threshold.
+/// Joint configurations drawn uniformly inside `ranges` less the margin (the moving joints; the
+/// others at their fixed value within the jitter), rejecting those whose tool-point Jacobian
+/// (its moving joints' columns) has a smallest singular value below the threshold.
 pub fn sample_configurations(
     model: &LocalPoe,
     tool: usize,
@@ -145,6 +202,8 @@ pub fn sample_configurations(
             });
         }
     }
+    let fixed = fixed_values(config, &bounds)?;
+    let jitter = config.fixed_jitter_rad;
     let mut rng = stream(config.seed, CONFIGURATION_STREAM);
     let mut accepted = Vec::with_capacity(config.sample_count);
     let budget = config.sample_count.max(1).saturating_mul(config.max_attempts_per_sample);
@@ -154,17 +213,59 @@ pub fn sample_configurations(
             return Err(Error::SamplingExhausted { accepted: accepted.len(), attempts });
         }
         attempts += 1;
-        let q: Vec<f64> = bounds.iter().map(|&(lo, hi)| rng.random_range(lo..hi)).collect();
-        if smallest_singular_value(model, &q, tool)? >= config.min_singular_value {
+        let q: Vec<f64> = bounds
+            .iter()
+            .enumerate()
+            .map(|(j, &(lo, hi))| match fixed[j] {
+                None => rng.random_range(lo..hi),
+                Some(at) if jitter > 0.0 => (at + rng.random_range(-jitter..jitter)).clamp(lo, hi),
+                Some(at) => at,
+            })
+            .collect();
+        let smallest = if config.moving_joints.is_empty() {
+            smallest_singular_value(model, &q, tool)?
+        } else {
+            smallest_singular_value_of_joints(model, &q, tool, &config.moving_joints)?
+        };
+        if smallest >= config.min_singular_value {
             accepted.push(q);
         }
     }
     Ok(accepted)
 }
 
+/// Each joint's fixed value (`None` for a moving joint), checked against the configuration.
+fn fixed_values(config: &GeneratorConfig, bounds: &[(f64, f64)]) -> Result<Vec<Option<f64>>, Error> {
+    let n = bounds.len();
+    if let Some(&joint_index) = config.moving_joints.iter().find(|&&j| j >= n) {
+        return Err(Error::UnknownJoint { field: "moving_joints", joint_index, joint_count: n });
+    }
+    if !config.fixed_at_rad.is_empty() && config.fixed_at_rad.len() != n {
+        return Err(Error::LengthMismatch { field: "fixed_at_rad", given: config.fixed_at_rad.len(), expected: n });
+    }
+    let jitter = config.fixed_jitter_rad;
+    if !(jitter.is_finite() && jitter >= 0.0) {
+        return Err(Error::InvalidParameter { field: "fixed_jitter_rad", value: jitter });
+    }
+    (0..n)
+        .map(|j| {
+            if config.moves(j) {
+                return Ok(None);
+            }
+            let (lo, hi) = bounds[j];
+            match config.fixed_at_rad.get(j) {
+                Some(&at) if at.is_finite() && (lo..=hi).contains(&at) => Ok(Some(at)),
+                Some(&value) => Err(Error::InvalidParameter { field: "fixed_at_rad", value }),
+                None => Ok(Some(0f64.clamp(lo, hi))),
+            }
+        })
+        .collect()
+}
+
 /// The simulated dataset: configurations from [`sample_configurations`] on the cell's true model,
-/// a payload per pose drawn from the set, the time `start + i · seconds_per_pose` and the
-/// temperature profile at that time, and the measured pose from [`Effects::measured_pose`].
+/// a payload per pose drawn from the set (or one per run), the time `start + i · seconds_per_pose`
+/// and the temperature profile at that time, the measured pose from [`Effects::measured_pose`]
+/// with the cell's tool (or the run's), and the measured torques if asked for.
 pub fn generate(
     cell: &SimulatedCell,
     effects: &Effects,
@@ -178,22 +279,61 @@ pub fn generate(
     if let Some(&m) = config.payloads_kg.iter().find(|m| !(m.is_finite() && **m >= 0.0)) {
         return Err(Error::InvalidParameter { field: "payloads_kg", value: m });
     }
+    let runs = config.payloads_kg.len();
+    if config.tool_per_run && cell.robot.tool_count() < runs {
+        return Err(Error::Campaign {
+            field: "tool_per_run",
+            needs: "one tool of the cell per payload run",
+            given: cell.robot.tool_count(),
+            expected: runs,
+        });
+    }
+    if let Some(sensor) = &config.torque_sensor {
+        sensor.validate(cell.robot.joint_count())?;
+        cell.dynamics_for("measured torques")?;
+    }
+    // The cell as each run measures it: its own tool, or the cell's.
+    let cells: Vec<SimulatedCell> = (0..runs)
+        .map(|r| SimulatedCell { tool: if config.tool_per_run { r } else { cell.tool }, ..cell.clone() })
+        .collect();
     let configurations = sample_configurations(&cell.robot, cell.tool, ranges, config)?;
     let mut payload_rng = stream(config.seed, PAYLOAD_STREAM);
     let mut noise_rng = stream(config.seed, NOISE_STREAM);
+    let mut torque_rng = stream(config.seed, TORQUE_STREAM);
     configurations
         .into_iter()
         .enumerate()
         .map(|(i, q)| {
-            let payload_kg = config.payloads_kg[payload_rng.random_range(0..config.payloads_kg.len())];
+            let run = config.run_of(i);
+            let payload_kg = if config.runs() {
+                config.payloads_kg[run]
+            } else {
+                config.payloads_kg[payload_rng.random_range(0..runs)]
+            };
             let t_s = config.start_time_s + i as f64 * config.seconds_per_pose;
             let context = PoseContext {
                 payload: Payload { mass_kg: payload_kg, com_offset_m: config.payload_com_offset_m },
                 temp_c: config.temperature.at(t_s),
                 t_s,
             };
-            let tracker_from_tool = effects.measured_pose(cell, &q, &context, &mut noise_rng)?;
-            Ok(Sample { q, tracker_from_tool, payload_kg, temp_c: context.temp_c, t_s })
+            let run_cell = &cells[run];
+            let tracker_from_tool = effects.measured_pose(run_cell, &q, &context, &mut noise_rng)?;
+            let torques_nm = match &config.torque_sensor {
+                Some(sensor) => {
+                    let held = effects.joint_offsets(run_cell, &q, &context)?.static_torque_nm;
+                    Some(sensor.measure(&held, &mut torque_rng))
+                }
+                None => None,
+            };
+            Ok(Sample {
+                q,
+                tracker_from_tool,
+                payload_kg,
+                temp_c: context.temp_c,
+                t_s,
+                tool: run_cell.tool,
+                torques_nm,
+            })
         })
         .collect()
 }

@@ -1,7 +1,9 @@
 //! Non-geometric error models of a serial robot: payload and gravity deflection through joint
 //! compliance (the paper's ref. \[15\], Tao, Yang & Tomizuka 2013), a joint-2 spring balancer,
-//! backlash, gear periodic error, thermal growth, base drift and tracker noise; and a seeded
-//! dataset generator.
+//! backlash, gear periodic error, thermal growth, base drift, tracker noise, and a coupled joint
+//! error that no diagnosis candidate models; measured joint torques; and a seeded dataset
+//! generator that also draws the shapes of real campaigns (some joints fixed, payload runs with a
+//! tool each).
 //!
 //! Every effect is a forward model with named parameters, usable alone or combined through
 //! [`Effects`], and each has a *regressor*: the effect written as linear in its parameters
@@ -40,6 +42,7 @@ mod backlash;
 mod cell;
 mod compliance;
 mod counterbalance;
+mod coupling;
 mod drift;
 mod dynamics;
 mod effects;
@@ -51,14 +54,16 @@ mod periodic;
 mod regressor;
 mod singularity;
 mod thermal;
+mod torque_sensor;
 mod tracker_noise;
 
 pub use backlash::{Backlash, JointBacklash, backlash_joint_regressor};
 pub use cell::{PoseContext, SimulatedCell};
 pub use compliance::{JointCompliance, compliance_deflection, spring_torque};
 pub use counterbalance::Counterbalance;
+pub use coupling::{CouplingFactor, CouplingTerm, JointCoupling};
 pub use drift::BaseDrift;
-pub use dynamics::{FLOOR_GRAVITY_M_PER_S2, LinkInertia, RobotDynamics};
+pub use dynamics::{FLOOR_GRAVITY_M_PER_S2, LinkInertia, RobotDynamics, tilted_base_gravity};
 pub use effects::{EffectKind, Effects, JointOffsets};
 pub use error::Error;
 pub use generator::{GeneratorConfig, JointRange, Sample, TemperatureProfile, generate, sample_configurations};
@@ -72,6 +77,7 @@ pub use regressor::{
     EffectParameter, RegressorColumn, backlash_regressor, compliance_regressor, drift_regressor, periodic_regressor,
     thermal_regressor,
 };
-pub use singularity::{smallest_singular_value, tool_point_jacobian};
+pub use singularity::{smallest_singular_value, smallest_singular_value_of_joints, tool_point_jacobian};
 pub use thermal::ThermalGrowth;
+pub use torque_sensor::TorqueSensorNoise;
 pub use tracker_noise::TrackerNoise;

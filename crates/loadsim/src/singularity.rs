@@ -27,3 +27,21 @@ pub fn smallest_singular_value(model: &LocalPoe, q: &[f64], tool: usize) -> Resu
     let jacobian = tool_point_jacobian(model, q, tool)?;
     Ok(jacobian.singular_values().iter().copied().fold(f64::INFINITY, f64::min))
 }
+
+/// The smallest singular value of the columns of [`tool_point_jacobian`] that belong to `joints`
+/// (0-based), for a campaign that moves only those: a posture is singular for it when the joints
+/// that move cannot move the tool in as many directions as there are of them.
+pub fn smallest_singular_value_of_joints(
+    model: &LocalPoe,
+    q: &[f64],
+    tool: usize,
+    joints: &[usize],
+) -> Result<f64, Error> {
+    let jacobian = tool_point_jacobian(model, q, tool)?;
+    let n = jacobian.ncols();
+    if let Some(&joint_index) = joints.iter().find(|&&j| j >= n) {
+        return Err(Error::UnknownJoint { field: "moving_joints", joint_index, joint_count: n });
+    }
+    let columns = DMatrix::from_fn(6, joints.len(), |r, c| jacobian[(r, joints[c])]);
+    Ok(columns.singular_values().iter().copied().fold(f64::INFINITY, f64::min))
+}

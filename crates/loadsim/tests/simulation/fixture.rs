@@ -1,7 +1,7 @@
 //! The IRB 4400/60 load data in `fixtures/robots/irb4400.ron`: plausible, and what the comments
 //! claim.
 
-use crate::robot::{irb4400, random_q, with_tool};
+use crate::robot::{iiwa7, irb4400, random_q, with_tool};
 use loadsim::{Effects, JointCompliance, Payload, PoseContext, RobotDynamics, SimulatedCell, gravity_torque};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -12,6 +12,38 @@ fn irb4400_dynamics_parse_validate_and_weigh_about_seven_hundred_kilograms_movin
     robot.dynamics.validate(6).unwrap();
     assert_eq!(robot.dynamics.moving_mass_kg(), 680.0);
     assert_eq!(robot.dynamics.gravity_m_per_s2, [0.0, 0.0, -9.81]);
+}
+
+#[test]
+fn iiwa7_dynamics_parse_validate_and_weigh_what_the_toolbox_and_kukas_data_sheet_say() {
+    let robot = iiwa7();
+    robot.dynamics.validate(7).unwrap();
+    // 19.43 kg moving of KUKA's 23.9 kg arm: the fixed base keeps the rest.
+    assert!((robot.dynamics.moving_mass_kg() - 19.4348).abs() < 1e-9);
+    assert_eq!(robot.dynamics.counterbalance, None);
+    assert_eq!(robot.dynamics.gravity_m_per_s2, [0.0, 0.0, -9.81]);
+}
+
+#[test]
+fn iiwa7_joint_2_deflection_under_five_kilograms_is_reported() {
+    // A record of what the fixture implies, not a sourced bound: joints 1 and 2 moving, the arm
+    // straight beyond them, 5 kg at a 0.1 m tool; the tool displacement from joint 2's compliance.
+    let robot = iiwa7();
+    let mut dynamics = robot.dynamics.clone();
+    for (j, k) in dynamics.stiffness_nm_per_rad.iter_mut().enumerate() {
+        if j != 1 {
+            *k = 1e15;
+        }
+    }
+    let cell = SimulatedCell::new(with_tool(&robot.model, 0.1), Some(dynamics));
+    let effects = Effects { compliance: Some(JointCompliance::default()), ..Effects::default() };
+    let context = PoseContext { payload: Payload::at_tool(5.0), ..PoseContext::default() };
+    let q = [0.0, std::f64::consts::FRAC_PI_2, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let moved = effects.true_pose(&cell, &q, &context).unwrap().translation();
+    let nominal = cell.robot.forward(&q, 0).unwrap().translation();
+    let sag_mm = (moved - nominal).norm() * 1e3;
+    println!("iiwa 7, arm horizontal, 5 kg: joint 2 compliance moves the tool {sag_mm:.2} mm");
+    assert!((1.0..20.0).contains(&sag_mm));
 }
 
 #[test]

@@ -2,6 +2,8 @@
 // Joint-indexed loops read like the formulas they check.
 #![allow(clippy::needless_range_loop)]
 
+mod campaign;
+mod coupling;
 mod deflection;
 mod effects_alone;
 mod fixture;

@@ -1,4 +1,4 @@
-//! The robots the tests run on: the IRB 4400 fixture read with a mirror of the robot RON schema
+//! The robots the tests run on: the IRB 4400 and iiwa 7 fixtures read with a mirror of the robot RON schema
 //! (the reader proper lives in `pipeline`, which depends on this crate), and small helpers.
 
 use lie::{Matrix3, SE3, SO3, Vector3};
@@ -31,15 +31,25 @@ struct Robot {
     dynamics: Option<RobotDynamics>,
 }
 
-/// The IRB 4400/60 fixture: its nominal model (flange = tool 0), joint ranges and dynamics.
-pub struct Irb4400 {
+/// A robot fixture: its nominal model (flange = tool 0), joint ranges and dynamics.
+pub struct FixtureRobot {
     pub model: LocalPoe,
     pub ranges: Vec<JointRange>,
     pub dynamics: RobotDynamics,
 }
 
-pub fn irb4400() -> Irb4400 {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/robots/irb4400.ron");
+/// The IRB 4400/60 fixture.
+pub fn irb4400() -> FixtureRobot {
+    fixture("irb4400.ron")
+}
+
+/// The LBR iiwa 7 R800 fixture.
+pub fn iiwa7() -> FixtureRobot {
+    fixture("iiwa7.ron")
+}
+
+fn fixture(name: &str) -> FixtureRobot {
+    let path = format!("{}/../../fixtures/robots/{name}", env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(path).expect("fixture present");
     let robot: Robot = ron::from_str(&text).expect("fixture parses");
     let axes: Vec<JointAxis> = robot
@@ -53,14 +63,14 @@ pub fn irb4400() -> Irb4400 {
         SO3::from_matrix_unchecked(Matrix3::from_columns(&[x, z.cross(&x), z])),
         Vector3::from(robot.flange.position),
     );
-    Irb4400 {
+    FixtureRobot {
         model: LocalPoe::from_zero_configuration(&axes, flange).unwrap(),
         ranges: robot
             .joints
             .iter()
             .map(|j| JointRange { lower_rad: j.limits_deg.0.to_radians(), upper_rad: j.limits_deg.1.to_radians() })
             .collect(),
-        dynamics: robot.dynamics.expect("the IRB 4400 fixture carries dynamics"),
+        dynamics: robot.dynamics.expect("the fixture carries dynamics"),
     }
 }
 
