@@ -15,6 +15,7 @@ use crate::simulation::mean_distance_mm;
 use gp::{KernelChoice, OutputMode, Parallelism};
 use indicatif::{ProgressBar, ProgressStyle};
 use loadsim::{Effects, GeneratorConfig, JointCompliance, RobotDynamics, SimulatedCell};
+use pipeline::effects::{EffectSelection, EffectSpec};
 use pipeline::simulated::{Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
 use pipeline::{CompensationOptions, FitOptions, MeasurementSet, Method, ResidualFrame, RobotDescription};
 use rand::seq::SliceRandom;
@@ -144,7 +145,7 @@ fn variants() -> Vec<Variant> {
     };
     // Beyond the paper: joint compliance identified with the geometry through gravity-torque
     // regressors (no masses), alone and followed by the GP with the payload.
-    let compliance = FitOptions { joint_compliance: true, ..ours.clone() };
+    let compliance = ours.clone().with_effects(EffectSelection::List(vec![EffectSpec::JointCompliance]));
     let beyond = |key, label, method| Variant { beyond: true, ..row(key, label, method, &compliance, false) };
     vec![
         row("base-tool", "Base-tool", Method::BaseTool, &ours, false),

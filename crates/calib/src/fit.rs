@@ -1,5 +1,6 @@
 //! `calib fit`: fit a calibration method to measurements and write the model.
 
+use pipeline::effects::{EffectSelection, EffectSpec};
 use pipeline::{ErrorSummary, FitOptions, Method, ReadOptions};
 use std::path::PathBuf;
 
@@ -20,10 +21,19 @@ pub struct Args {
     /// Where to write the calibrated model (RON).
     #[arg(long)]
     out: PathBuf,
-    /// Also identify joint compliance with the geometry, through gravity-torque regressors (no
-    /// masses needed; uses the payload column). Beyond the paper; applied before any GP.
-    #[arg(long)]
+    /// Non-geometric effects identified with the geometry, applied before any GP (beyond the
+    /// paper): a comma-separated list of joint_compliance, gear_periodic:JOINT:HARMONICS,
+    /// backlash:JOINT, thermal, time_drift; or auto, what `calib diagnose` selects on the data.
+    #[arg(long, value_name = "LIST|auto")]
+    effects: Option<EffectSelection>,
+    /// The same as --effects joint_compliance: joint compliance through measured torques
+    /// (tauN_nm) where the data has them, gravity-torque regressors otherwise (no masses needed).
+    #[arg(long, conflicts_with = "effects")]
     joint_compliance: bool,
+    /// Fit options (RON): any field of pipeline's FitOptions, e.g. (identification: (max_iterations:
+    /// 100), effects: (prior_sigma: 1e-3)); --effects given here too is overridden by the flag.
+    #[arg(long, value_name = "FIT.ron")]
+    options: Option<PathBuf>,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
@@ -31,7 +41,15 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let options = ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
     let data = pipeline::read_measurements(&args.data, &options)?;
     println!("{}", data.read_summary());
-    let options = FitOptions { joint_compliance: args.joint_compliance, ..FitOptions::default() };
+    let mut options = match &args.options {
+        Some(path) => FitOptions::read(path)?,
+        None => FitOptions::default(),
+    };
+    match (&args.effects, args.joint_compliance) {
+        (Some(selection), _) => options.effects.selection = selection.clone(),
+        (None, true) => options.effects.selection = EffectSelection::List(vec![EffectSpec::JointCompliance]),
+        (None, false) => {}
+    }
     let (model, report) = pipeline::fit(&robot, &data, args.method, &options)?;
     pipeline::write_model(&args.out, &model)?;
 
@@ -52,8 +70,27 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         "  identifiable: {} of {} free parameters, condition number {:.3e}",
         id.rank, id.free_parameters, id.condition_number
     );
-    if let Some(compliance) = &model.joint_compliance {
-        println!("  joint compliance: {} torque-regressor terms identified with the geometry", compliance.terms.len());
+    if let Some(auto) = &report.auto {
+        let chosen: Vec<String> = auto.chosen.iter().map(ToString::to_string).collect();
+        println!(
+            "  effects auto: the diagnosis of the training data (held-out {:.4} mm with the geometry alone) selected {}",
+            auto.heldout_before_mm,
+            if auto.selected.is_empty() { "nothing".to_owned() } else { chosen.join(", ") }
+        );
+        for s in &auto.selected {
+            let joints: Vec<String> = s.joints.iter().map(ToString::to_string).collect();
+            let harmonic = s.harmonic.map_or(String::new(), |h| format!(" harmonic {h}"));
+            println!(
+                "    {} on joint(s) {}{harmonic}: held-out {:.4} mm (paired t = {:.1})",
+                s.effect.name(),
+                joints.join(","),
+                s.heldout_after_mm,
+                s.t
+            );
+        }
+    }
+    for effect in &model.effects {
+        println!("  effect {}: {} parameters identified with the geometry", effect.label(), effect.parameter_count());
     }
     for direction in &id.unidentifiable {
         println!("    unidentifiable: {direction}");

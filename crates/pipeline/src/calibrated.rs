@@ -1,5 +1,6 @@
 //! A calibrated model: the identified kinematics, the optional GP compensation, and prediction.
 
+use crate::effects::IdentifiedEffect;
 use crate::{Error, Measurement, Method, PoseError};
 use lie::SE3;
 use poe::LocalPoe;
@@ -20,10 +21,10 @@ pub struct CalibratedModel {
     pub tools: Vec<String>,
     /// The identified local POE model; its reference frame is the tracker frame.
     pub kinematics: LocalPoe,
-    /// Joint compliance identified with the geometry (`calib fit --joint-compliance`), applied
-    /// before the GP.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub joint_compliance: Option<crate::ComplianceModel>,
+    /// Non-geometric effects identified with the geometry (`calib fit --effects`), applied after
+    /// it and before the GP, in one left exponential of the sum of their twists.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub effects: Vec<IdentifiedEffect>,
     /// The GP compensation of the residual (methods `poe-gp`, `poe-gp-load`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compensation: Option<crate::Compensation>,
@@ -65,33 +66,24 @@ impl CalibratedModel {
     /// The model without its non-geometric parts (joint compliance, the GP): the geometry alone,
     /// which is what a URDF can hold (`calib export`).
     pub fn geometry_only(&self) -> CalibratedModel {
-        CalibratedModel { joint_compliance: None, compensation: None, ..self.clone() }
+        CalibratedModel { effects: Vec::new(), compensation: None, ..self.clone() }
     }
 
     /// The names of the parts besides the geometry, in the order they apply.
-    pub fn non_geometric_parts(&self) -> Vec<&'static str> {
-        let mut parts = Vec::new();
-        if self.joint_compliance.is_some() {
-            parts.push("joint_compliance");
-        }
+    pub fn non_geometric_parts(&self) -> Vec<String> {
+        let mut parts: Vec<String> = self.effects.iter().map(IdentifiedEffect::label).collect();
         if self.compensation.is_some() {
-            parts.push("gaussian_process");
+            parts.push("gaussian_process".into());
         }
         parts
     }
 
-    /// The poses of the kinematics, with the joint compliance if the model has it, before any GP.
+    /// The poses of the kinematics moved by the effects, before any GP.
     pub fn geometric_poses(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<SE3>, Error> {
         let mut poses = Vec::with_capacity(rows.len());
         for (row, &tool) in rows.iter().zip(tools) {
             let pose = self.kinematics.forward(&row.q, tool)?;
-            poses.push(match &self.joint_compliance {
-                Some(compliance) => {
-                    let row = Measurement { tool, ..row.clone() };
-                    compliance.apply(&self.kinematics, &row, pose)?
-                }
-                None => pose,
-            });
+            poses.push(crate::effects::apply(&self.effects, &self.kinematics, row, tool, pose)?);
         }
         Ok(poses)
     }

@@ -381,6 +381,31 @@ pub enum Error {
         /// Rows needed.
         needed: usize,
     },
+    /// An `--effects` argument that does not parse.
+    EffectList {
+        /// 1-based character of the argument where the faulty item starts.
+        column: usize,
+        /// The faulty item.
+        text: String,
+        /// What is wrong with it.
+        fault: crate::effects::EffectListFault,
+    },
+    /// An effect names a joint the robot does not have.
+    EffectJoint {
+        /// The 1-based joint named.
+        joint: usize,
+        /// The robot's joint count.
+        joint_count: usize,
+    },
+    /// An effect needs a column that a row lacks (e.g. `thermal` without `temp_c`).
+    EffectNeedsColumn {
+        /// 1-based line of the row (0 for rows made in memory).
+        line: u64,
+        /// The effect.
+        effect: &'static str,
+        /// The column it needs.
+        column: &'static str,
+    },
 }
 
 impl fmt::Display for Error {
@@ -510,13 +535,23 @@ impl fmt::Display for Error {
                 "joint {joint} is prismatic and a URDF needs its limits: give the robot description (--robot or --like)"
             ),
             Error::SchemaVersion { file, found, supported } => {
-                write!(f, "{file}:1:1: model file has schema version {found}, this calib reads version {supported}")
+                write!(
+                    f,
+                    "{file}:1:1: model file has schema version {found}, this calib reads versions 1 to {supported}"
+                )
             }
             Error::Kinematics { source } => write!(f, "{source}"),
             Error::Load { source } => write!(f, "load model: {source}"),
             Error::Gp { source } => write!(f, "Gaussian process: {source}"),
             Error::TooFewRows { file, rows, needed } => {
                 write!(f, "{file}: {rows} measurement rows, at least {needed} needed")
+            }
+            Error::EffectList { column, text, fault } => write!(f, "--effects:1:{column}: '{text}' {fault}"),
+            Error::EffectJoint { joint, joint_count } => {
+                write!(f, "effect on joint {joint}: the robot has joints 1 to {joint_count}")
+            }
+            Error::EffectNeedsColumn { line, effect, column } => {
+                write!(f, "line {line}: {effect} needs the column '{column}', which this row lacks")
             }
         }
     }

@@ -1,26 +1,13 @@
 //! The fit of a method on a measurement set, and the evaluation of a fitted model.
 
+use crate::effects::{AutoChoice, EffectContext, EffectCorrection, EffectSelection, EffectSpec, IdentifiedEffect};
+use crate::fit_options::FitOptions;
 use crate::geometric::{fit_geometry, observations};
-use crate::load_model::ComplianceCorrection;
 use crate::{
-    CalibratedModel, Compensation, CompensationOptions, CompensationReport, ComplianceModel, Error, ErrorSummary,
-    MeasurementSet, Method, PoseError, RobotDescription, SCHEMA_VERSION, pose_error,
+    CalibratedModel, Compensation, CompensationReport, Error, ErrorSummary, MeasurementSet, Method, PoseError,
+    RobotDescription, SCHEMA_VERSION, pose_error,
 };
 use poe::identify::{IdentificationOptions, IdentificationReport, ParameterMask, Scope, identify_with_correction};
-use serde::{Deserialize, Serialize};
-
-/// Options of a fit.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct FitOptions {
-    /// The geometric identification.
-    pub identification: IdentificationOptions,
-    /// The Gaussian-process compensation (methods `poe-gp`, `poe-gp-load`).
-    pub compensation: CompensationOptions,
-    /// Identify joint compliance together with the geometry, through gravity-torque regressors
-    /// (no masses needed), before any GP. Beyond the paper.
-    pub joint_compliance: bool,
-}
 
 /// What a fit reports besides the model.
 #[derive(Debug, Clone)]
@@ -31,10 +18,12 @@ pub struct FitReport {
     pub before: ErrorSummary,
     /// Training errors of the fitted model.
     pub after: ErrorSummary,
-    /// The geometric identification's report.
+    /// The geometric identification's report (with the effects, where there are some).
     pub identification: IdentificationReport,
     /// The GP stage's report, for the GP methods.
     pub compensation: Option<CompensationReport>,
+    /// What `--effects auto` chose and why.
+    pub auto: Option<AutoChoice>,
 }
 
 /// Per-row errors and their summary.
@@ -46,8 +35,22 @@ pub struct Evaluation {
     pub summary: ErrorSummary,
 }
 
+/// The effects a list names, built on the training rows.
+fn build_effects(
+    specs: &[EffectSpec],
+    robot: &RobotDescription,
+    kinematics: &poe::LocalPoe,
+    data: &MeasurementSet,
+) -> Result<Vec<IdentifiedEffect>, Error> {
+    let context = EffectContext { robot, tools: kinematics.tools() };
+    let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
+    specs.iter().map(|spec| IdentifiedEffect::new(spec, &context, &data.rows, &tools)).collect()
+}
+
 /// Fits `method` to `data` for `robot` (paper Section III: step 1, then step 2 for the GP
-/// methods, trained on the error the identified model leaves on the same rows, Eq. 8).
+/// methods, trained on the error the identified model leaves on the same rows, Eq. 8). Effects
+/// named in `options.effects` are identified jointly with the geometry, after it has been fitted
+/// alone, and before the GP.
 pub fn fit(
     robot: &RobotDescription,
     data: &MeasurementSet,
@@ -65,30 +68,33 @@ pub fn fit(
         full_pose: data.full_pose,
         tools: data.tools.clone(),
         kinematics: geometry.model,
-        joint_compliance: None,
+        effects: Vec::new(),
         compensation: None,
     };
     let mut identification = geometry.report;
-    if options.joint_compliance {
-        let mut compliance = ComplianceModel::terms(robot, model.kinematics.tools(), data)?;
-        let correction = ComplianceCorrection {
-            terms: &compliance.terms,
-            regressors: data.rows.iter().map(|row| compliance.regressors(row)).collect::<Result<_, _>>()?,
-            q: data.rows.iter().map(|row| row.q.clone()).collect(),
-        };
+    let mut auto = None;
+    let specs: Vec<EffectSpec> = match &options.effects.selection {
+        EffectSelection::None => Vec::new(),
+        EffectSelection::List(list) => list.clone(),
+        EffectSelection::Auto => {
+            let choice = crate::effects::choose(robot, data, &options.effects.diagnose)?;
+            let chosen = choice.chosen.clone();
+            auto = Some(choice);
+            chosen
+        }
+    };
+    if !specs.is_empty() {
+        let mut effects = build_effects(&specs, robot, &model.kinematics, data)?;
+        let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
+        let correction = EffectCorrection::new(&effects, &data.rows, &tools, options.effects.prior_sigma)?;
         let layout = model.kinematics.layout();
         let mask = if scope == Scope::BaseTool { ParameterMask::base_tool(layout) } else { ParameterMask::all(layout) };
-        let observations = observations(data);
-        // The torque regressors of neighbouring links are nearly collinear; directions kept at
-        // 1e-9 of the largest singular value made the iterations crawl (50 without converging on
-        // 250 position-only poses, 0.20 mm held-out), at 1e-6 they converge in 20 to the noise
-        // floor (0.027 mm). The geometric directions sit far above it (condition numbers to 1e5).
-        let id_options =
-            IdentificationOptions { rcond: options.identification.rcond.max(1e-6), ..options.identification.clone() };
-        let fitted = identify_with_correction(&model.kinematics, &observations, &mask, Some(&correction), &id_options)?;
-        compliance.theta = fitted.correction;
+        let id_options = IdentificationOptions { solver: options.effects.solver, ..options.identification.clone() };
+        let fitted =
+            identify_with_correction(&model.kinematics, &observations(data), &mask, Some(&correction), &id_options)?;
+        EffectCorrection::distribute(&mut effects, &fitted.correction);
         model.kinematics = fitted.model;
-        model.joint_compliance = Some(compliance);
+        model.effects = effects;
         identification = fitted.report;
     }
     let mut compensation = None;
@@ -100,15 +106,11 @@ pub fn fit(
         model.compensation = Some(fitted);
         compensation = Some(report);
     }
-    let registered = CalibratedModel {
-        kinematics: geometry.registered,
-        joint_compliance: None,
-        compensation: None,
-        ..model.clone()
-    };
+    let registered =
+        CalibratedModel { kinematics: geometry.registered, effects: Vec::new(), compensation: None, ..model.clone() };
     let before = evaluate(&registered, data)?.summary;
     let after = evaluate(&model, data)?.summary;
-    Ok((model, FitReport { method, before, after, identification, compensation }))
+    Ok((model, FitReport { method, before, after, identification, compensation, auto }))
 }
 
 /// Evaluates a fitted model on measurements.

@@ -11,13 +11,14 @@ mod calibrated;
 pub mod chart;
 mod compensation;
 pub mod diagnose;
+pub mod effects;
 mod error;
 mod eval_report;
 mod fit;
+mod fit_options;
 pub mod geometric;
 mod inverse;
 mod joint_targets;
-mod load_model;
 mod measurements;
 mod method;
 mod metrics;
@@ -38,13 +39,13 @@ pub use calibrated::{CalibratedModel, PredictedPose, pose_error};
 pub use compensation::{Compensation, CompensationOptions, CompensationReport, ResidualFrame, ResidualSet};
 pub use error::Error;
 pub use eval_report::EvalReport;
-pub use fit::{Evaluation, FitOptions, FitReport, evaluate, fit, tool_indices};
+pub use fit::{Evaluation, FitReport, evaluate, fit, tool_indices};
+pub use fit_options::{EffectOptions, FitOptions};
 pub use inverse::{InverseOptions, PoseTarget, Solved, TargetStatus, solve_targets};
 pub use joint_targets::{
     CompensateOptions, CompensationSummary, RegisteredNominal, TargetFile, TargetFrame, compensate, pose_targets,
     read_targets, registered_nominal, write_compensated,
 };
-pub use load_model::{ComplianceModel, ComplianceTerm};
 pub use measurements::{
     Cells, ColumnMap, ColumnMapFault, Decimal, DecimalFault, Delimiter, Dialect, FileFormat, JointColumn, Measurement,
     MeasurementSet, ReadOptions, parse_measurements, read_configurations, read_configurations_with_cells,

@@ -23,11 +23,6 @@ impl Located<'_> {
         Error::ModelCount { file: self.file.to_owned(), line, column, field, what, found, expected }
     }
 
-    fn index(&self, at: (&str, usize), field: String, index: usize, limit: usize) -> Error {
-        let (line, column) = self.at(at.0, at.1);
-        Error::ModelIndex { file: self.file.to_owned(), line, column, field, index, limit }
-    }
-
     fn not_finite(&self, at: (&str, usize), field: String, value: f64) -> Error {
         let (line, column) = self.at(at.0, at.1);
         Error::NotFinite { file: self.file.to_owned(), line, column, field, value }
@@ -39,6 +34,18 @@ impl Located<'_> {
     }
 }
 
+/// How many times `field:` occurs before the first `part:` (so that a field of the part can be
+/// located by its occurrence within it).
+fn occurrences_before(text: &str, field: &str, part: &str) -> usize {
+    let start = field_position(text, part, 0);
+    (0..)
+        .take_while(|&k| {
+            let position = field_position(text, field, k);
+            position != (1, 1) && position < start
+        })
+        .count()
+}
+
 /// The first non-finite translation among `transforms`, with its position in the list.
 fn non_finite_translation(transforms: impl Iterator<Item = SE3>) -> Option<(usize, f64)> {
     transforms.enumerate().find_map(|(k, t)| t.translation().iter().copied().find(|v| !v.is_finite()).map(|v| (k, v)))
@@ -46,7 +53,7 @@ fn non_finite_translation(transforms: impl Iterator<Item = SE3>) -> Option<(usiz
 
 impl CalibratedModel {
     /// Checks that the parts of the model fit together: the kinematics' joint and tool counts,
-    /// the tool names, the compliance terms' indices and values, the GP's input and output
+    /// the tool names, the effects' joints, indices and values, the GP's input and output
     /// dimensions. `text` is the file the model was read from, `file` its name, for positions.
     pub fn check(&self, text: &str, file: &str) -> Result<(), Error> {
         let at = Located { text, file };
@@ -71,50 +78,11 @@ impl CalibratedModel {
             let has = if self.compensation.is_some() { "has a" } else { "has no" };
             return Err(at.part("method", format!("method {} but the model {has} GP compensation", self.method)));
         }
-        if let Some(compliance) = &self.joint_compliance {
-            let base = &compliance.base_model;
-            if base.joint_count() != n {
-                let found = base.joint_count();
-                return Err(at.count(("base_model", 0), "joint_compliance.base_model".into(), "joints", found, n));
-            }
-            if base.tool_count() != tool_count {
-                let found = base.tool_count();
-                return Err(at.count(
-                    ("base_model", 0),
-                    "joint_compliance.base_model".into(),
-                    "tools",
-                    found,
-                    tool_count,
-                ));
-            }
-            let moved = base.joints().iter().map(|j| j.previous_from_joint_zero).chain(base.tools().iter().copied());
-            if let Some((_, value)) = non_finite_translation(moved) {
-                return Err(at.not_finite(("base_model", 0), "joint_compliance.base_model".into(), value));
-            }
-            if let Some(&g) = compliance.gravity_m_per_s2.iter().find(|g| !g.is_finite()) {
-                return Err(at.not_finite(("gravity_m_per_s2", 0), "joint_compliance.gravity_m_per_s2".into(), g));
-            }
-            // A regressor row holds 4 columns per link and the payload's: 4n + 1.
-            for (k, term) in compliance.terms.iter().enumerate() {
-                let field = |name: &str| format!("joint_compliance.terms[{k}].{name}");
-                if term.joint >= n {
-                    return Err(at.index(("joint", k), field("joint"), term.joint, n));
-                }
-                if term.column > 4 * n {
-                    return Err(at.index(("column", k), field("column"), term.column, 4 * n + 1));
-                }
-                if !(term.scale.is_finite() && term.scale > 0.0) {
-                    return Err(at.not_finite(("scale", k), field("scale"), term.scale));
-                }
-            }
-            if compliance.theta.len() != compliance.terms.len() {
-                let (found, expected) = (compliance.theta.len(), compliance.terms.len());
-                return Err(at.count(("theta", 0), "joint_compliance.theta".into(), "values", found, expected));
-            }
-            if let Some(&value) = compliance.theta.iter().find(|v| !v.is_finite()) {
-                return Err(at.not_finite(("theta", 0), "joint_compliance.theta".into(), value));
-            }
-        }
+        crate::effects::check_effects(&self.effects, n, tool_count, &|field, occurrence| {
+            let before = occurrences_before(text, field, "effects");
+            at.at(field, before + occurrence)
+        })
+        .map_err(|fault| fault.into_error(file))?;
         if let Some(compensation) = &self.compensation {
             if compensation.with_payload != (self.method == Method::PoeGpLoad) {
                 let message =

@@ -4,8 +4,9 @@ use crate::{CalibratedModel, Error};
 use std::io::Write;
 use std::path::Path;
 
-/// The schema version this build writes and reads.
-pub const SCHEMA_VERSION: u32 = 1;
+/// The schema version this build writes. Version 2 holds the non-geometric effects as a list
+/// (`effects`); version 1 files, whose only effect was `joint_compliance`, still read.
+pub const SCHEMA_VERSION: u32 = 2;
 
 /// Writes `model` to `path` as RON. The text goes to a temporary file in the same folder that is
 /// then renamed over `path`, so a crash never leaves a half-written model behind.
@@ -64,14 +65,69 @@ pub fn parse_model(text: &str, file: &str) -> Result<CalibratedModel, Error> {
         })?,
         Err(e) => return Err(position_error(e)),
     };
-    if version.schema_version != SCHEMA_VERSION {
-        return Err(Error::SchemaVersion {
-            file: file.to_owned(),
-            found: version.schema_version,
-            supported: SCHEMA_VERSION,
-        });
-    }
-    let model: CalibratedModel = options.from_str(text).map_err(position_error)?;
+    let model: CalibratedModel = match version.schema_version {
+        1 => options.from_str::<version_1::Model>(text).map_err(position_error)?.into(),
+        SCHEMA_VERSION => options.from_str(text).map_err(position_error)?,
+        found => return Err(Error::SchemaVersion { file: file.to_owned(), found, supported: SCHEMA_VERSION }),
+    };
     model.check(text, file)?;
     Ok(model)
+}
+
+/// The version-1 layout: the same model with joint compliance as its only possible effect.
+mod version_1 {
+    use crate::effects::{ComplianceTerm, ComplianceTorque, IdentifiedEffect, JointCompliance, LoadFrame};
+    use crate::{CalibratedModel, Compensation, Method, SCHEMA_VERSION};
+    use poe::LocalPoe;
+    use serde::Deserialize;
+
+    #[derive(Deserialize)]
+    pub(super) struct Compliance {
+        base_model: LocalPoe,
+        gravity_m_per_s2: [f64; 3],
+        terms: Vec<ComplianceTerm>,
+        theta: Vec<f64>,
+    }
+
+    #[derive(Deserialize)]
+    pub(super) struct Model {
+        #[allow(dead_code)]
+        schema_version: u32,
+        robot: String,
+        method: Method,
+        full_pose: bool,
+        tools: Vec<String>,
+        kinematics: LocalPoe,
+        #[serde(default)]
+        joint_compliance: Option<Compliance>,
+        #[serde(default)]
+        compensation: Option<Compensation>,
+    }
+
+    impl From<Model> for CalibratedModel {
+        fn from(v1: Model) -> Self {
+            let effects = v1
+                .joint_compliance
+                .map(|c| {
+                    let load = LoadFrame { base_model: c.base_model, gravity_m_per_s2: c.gravity_m_per_s2 };
+                    IdentifiedEffect::JointCompliance(JointCompliance {
+                        torque: ComplianceTorque::GravityRegressor(load),
+                        terms: c.terms,
+                        theta: c.theta,
+                    })
+                })
+                .into_iter()
+                .collect();
+            CalibratedModel {
+                schema_version: SCHEMA_VERSION,
+                robot: v1.robot,
+                method: v1.method,
+                full_pose: v1.full_pose,
+                tools: v1.tools,
+                kinematics: v1.kinematics,
+                effects,
+                compensation: v1.compensation,
+            }
+        }
+    }
 }

@@ -98,7 +98,7 @@ pub fn export_urdf(
     training: Option<&MeasurementSet>,
     tolerance: &NominalTolerance,
 ) -> Result<UrdfExport, Error> {
-    let not_in_urdf: Vec<String> = model.non_geometric_parts().into_iter().map(str::to_owned).collect();
+    let not_in_urdf: Vec<String> = model.non_geometric_parts();
     let training_error = match training {
         Some(data) => Some(TrainingErrors {
             model: crate::evaluate(model, data)?.summary,

@@ -115,8 +115,8 @@ fn model_files_of_another_schema_or_broken_are_refused_with_a_position() {
     pipeline::write_model(&path, &model).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
     let error =
-        pipeline::parse_model(&text.replacen("schema_version: 1", "schema_version: 99", 1), "m.ron").unwrap_err();
-    assert!(matches!(error, Error::SchemaVersion { found: 99, supported: 1, .. }), "{error}");
+        pipeline::parse_model(&text.replacen("schema_version: 2", "schema_version: 99", 1), "m.ron").unwrap_err();
+    assert!(matches!(error, Error::SchemaVersion { found: 99, supported: 2, .. }), "{error}");
     let error = pipeline::parse_model(&text.replacen("kinematics", "kinematic", 1), "m.ron").unwrap_err();
     assert!(matches!(error, Error::RonFormat { line, .. } if line > 1), "{error}");
     let error = pipeline::parse_model("(schema_version: 1,", "m.ron").unwrap_err();

@@ -48,8 +48,9 @@ fn identified_joint_compliance_leaves_little_more_than_the_noise() {
         let all = loaded_data(&robot, 400, full_pose, seed);
         let train = all.subset(&(0..250).collect::<Vec<_>>());
         let test = all.subset(&(250..400).collect::<Vec<_>>());
-        let error = |method, joint_compliance| {
-            let options = FitOptions { joint_compliance, ..FitOptions::default() };
+        let error = |method, joint_compliance: bool| {
+            let effects = if joint_compliance { "joint_compliance".parse().unwrap() } else { Default::default() };
+            let options = FitOptions::default().with_effects(effects);
             let (model, _) = pipeline::fit(&robot, &train, method, &options).unwrap();
             pipeline::evaluate(&model, &test).unwrap().summary.mean_position_error_mm
         };

@@ -2,6 +2,7 @@
 //! at the field at fault; before, `eval` and `predict` panicked on an index or silently dropped
 //! compliance terms.
 
+use pipeline::effects::IdentifiedEffect;
 use pipeline::simulated::{GeneratorConfig, Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
 use pipeline::{CalibratedModel, Error, FitOptions, Method, RobotDescription};
 use std::path::PathBuf;
@@ -17,7 +18,7 @@ fn fitted(full_pose: bool) -> (CalibratedModel, String) {
     let cell = simulated_cell(&robot, &Perturbation::default(), 3).unwrap();
     let config = GeneratorConfig { sample_count: 60, seed: 3, ..GeneratorConfig::default() };
     let data = simulate(&cell, &paper_effects(), &joint_ranges(&robot), &config, full_pose).unwrap();
-    let options = FitOptions { joint_compliance: true, ..FitOptions::default() };
+    let options = FitOptions::default().with_effects("joint_compliance".parse().unwrap());
     let (model, _) = pipeline::fit(&robot, &data, Method::PoeGpLoad, &options).unwrap();
     (model.clone(), text_of(&model))
 }
@@ -51,7 +52,7 @@ fn a_compliance_term_of_a_joint_the_robot_lacks_is_refused() {
     let (_, text) = fitted(false);
     let (error, message) = refused(&text.replacen("joint: 1,", "joint: 9,", 1));
     assert!(matches!(error, Error::ModelIndex { index: 9, limit: 6, .. }), "{message}");
-    assert!(message.contains("joint_compliance.terms[") && message.contains("].joint is 9, it must be below 6"));
+    assert!(message.contains("effects[0].terms[") && message.contains("].joint is 9, it must be below 6"), "{message}");
     let (error, message) = refused(&text.replacen("column: ", "column: 9999", 1));
     assert!(matches!(error, Error::ModelIndex { limit: 25, .. }), "{message}");
 }
@@ -59,7 +60,9 @@ fn a_compliance_term_of_a_joint_the_robot_lacks_is_refused() {
 #[test]
 fn compliance_values_that_do_not_match_their_terms_are_refused() {
     let (mut model, _) = fitted(false);
-    let compliance = model.joint_compliance.as_mut().unwrap();
+    let Some(IdentifiedEffect::JointCompliance(compliance)) = model.effects.first_mut() else {
+        panic!("no compliance")
+    };
     compliance.theta.pop();
     let terms = compliance.terms.len();
     let (error, message) = refused(&text_of(&model));
@@ -67,7 +70,7 @@ fn compliance_values_that_do_not_match_their_terms_are_refused() {
         matches!(error, Error::ModelCount { found, expected, .. } if found == terms - 1 && expected == terms),
         "{message}"
     );
-    assert!(message.contains("joint_compliance.theta has"), "{message}");
+    assert!(message.contains("effects[0].theta has"), "{message}");
 }
 
 #[test]
@@ -116,4 +119,74 @@ fn a_non_finite_transform_is_refused_at_its_translation() {
     let edited = format!("{}NaN{}", &text[..at], &text[end..]);
     let (error, message) = refused(&edited);
     assert!(matches!(error, Error::NotFinite { ref field, .. } if field == "kinematics.joints[0]"), "{message}");
+}
+
+/// The layout of a version-1 model file, whose only effect was joint compliance.
+#[derive(serde::Serialize)]
+struct Version1 {
+    schema_version: u32,
+    robot: String,
+    method: Method,
+    full_pose: bool,
+    tools: Vec<String>,
+    kinematics: poe::LocalPoe,
+    joint_compliance: Option<Version1Compliance>,
+    compensation: Option<pipeline::Compensation>,
+}
+
+#[derive(serde::Serialize)]
+struct Version1Compliance {
+    base_model: poe::LocalPoe,
+    gravity_m_per_s2: [f64; 3],
+    terms: Vec<pipeline::effects::ComplianceTerm>,
+    theta: Vec<f64>,
+}
+
+#[test]
+fn a_version_1_file_with_joint_compliance_reads_and_predicts_as_before() {
+    let (model, _) = fitted(true);
+    let Some(IdentifiedEffect::JointCompliance(compliance)) = model.effects.first() else { panic!("no compliance") };
+    let pipeline::effects::ComplianceTorque::GravityRegressor(load) = &compliance.torque else {
+        panic!("simulated data without torques")
+    };
+    let old = Version1 {
+        schema_version: 1,
+        robot: model.robot.clone(),
+        method: model.method,
+        full_pose: model.full_pose,
+        tools: model.tools.clone(),
+        kinematics: model.kinematics.clone(),
+        joint_compliance: Some(Version1Compliance {
+            base_model: load.base_model.clone(),
+            gravity_m_per_s2: load.gravity_m_per_s2,
+            terms: compliance.terms.clone(),
+            theta: compliance.theta.clone(),
+        }),
+        compensation: model.compensation.clone(),
+    };
+    let text = ron::ser::to_string_pretty(&old, ron::ser::PrettyConfig::default()).unwrap();
+    assert!(text.contains("joint_compliance:") && !text.contains("effects:"), "{text}");
+    let read = pipeline::parse_model(&text, "old.ron").unwrap();
+    assert_eq!(read.schema_version, pipeline::SCHEMA_VERSION);
+    let (Some(IdentifiedEffect::JointCompliance(again)), 1) = (read.effects.first(), read.effects.len()) else {
+        panic!("{:?}", read.effects)
+    };
+    assert_eq!((&again.terms, &again.theta), (&compliance.terms, &compliance.theta));
+    let data = simulate(
+        &simulated_cell(&irb4400(), &Perturbation::default(), 3).unwrap(),
+        &paper_effects(),
+        &joint_ranges(&irb4400()),
+        &GeneratorConfig { sample_count: 20, seed: 4, ..GeneratorConfig::default() },
+        true,
+    )
+    .unwrap();
+    let now = pipeline::evaluate(&model, &data).unwrap().errors;
+    let then = pipeline::evaluate(&read, &data).unwrap().errors;
+    for (a, b) in now.iter().zip(&then) {
+        assert!((a.position_mm - b.position_mm).abs() < 1e-9, "{a:?} {b:?}");
+    }
+    // A version this build does not know is refused with both versions.
+    let future = text.replacen("schema_version: 1", "schema_version: 9", 1);
+    let message = pipeline::parse_model(&future, "new.ron").unwrap_err().to_string();
+    assert!(message.contains("schema version 9") && message.contains("versions 1 to 2"), "{message}");
 }

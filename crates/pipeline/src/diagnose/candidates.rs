@@ -7,9 +7,11 @@
 //! frame, and the twists from the calibrated model.
 
 use super::design::Design;
+use crate::effects::{
+    Backlash, ComplianceTorque, EffectContext, GearPeriodic, IdentifiedEffect, JointCompliance, Thermal, TimeDrift,
+    TorqueSign, has_torques, stand_in_dynamics,
+};
 use crate::{Error, MeasurementSet, RobotDescription};
-use lie::{Vector3, Vector6};
-use loadsim::{LinkInertia, Payload, RobotDynamics};
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
 
@@ -58,35 +60,31 @@ pub(crate) struct Candidate {
     pub harmonic: Option<u32>,
     /// One column per parameter: `rows_per_pose × poses` weighted values.
     pub columns: Vec<Vec<f64>>,
+    /// The effect as the fit models it (its parameters at zero): the columns are its regressor.
+    #[allow(dead_code)]
+    pub model: IdentifiedEffect,
 }
 
-/// A stand-in mass model where the robot file gives none, used only for the *sign* of the static
-/// torque (backlash): each link a slender bar from its joint's axis point to the next one's, 50 kg
-/// per metre, so that the torque's sign follows where the arm's weight lies, which depends on the
-/// geometry far more than on the masses.
-fn stand_in_dynamics(robot: &RobotDescription) -> RobotDynamics {
-    let mut points: Vec<Vector3> = robot.joints.iter().map(|j| Vector3::from(j.point)).collect();
-    points.push(Vector3::from(robot.flange.position));
-    let links = points
-        .windows(2)
-        .map(|w| LinkInertia { mass_kg: 50.0 * (w[1] - w[0]).norm().max(0.05), com_m: ((w[0] + w[1]) * 0.5).into() })
-        .collect();
-    RobotDynamics {
-        links,
-        stiffness_nm_per_rad: vec![1.0; robot.joint_count()],
-        counterbalance: None,
-        gravity_m_per_s2: loadsim::FLOOR_GRAVITY_M_PER_S2,
-    }
-}
-
-fn sign(x: f64) -> f64 {
-    if x > 0.0 {
-        1.0
-    } else if x < 0.0 {
-        -1.0
-    } else {
-        0.0
-    }
+/// The weighted columns of an effect's regressor at every measurement.
+fn columns_of(
+    design: &Design,
+    effect: &IdentifiedEffect,
+    model: &LocalPoe,
+    data: &MeasurementSet,
+    tools: &[usize],
+) -> Result<Vec<Vec<f64>>, Error> {
+    let k = design.rows_per_pose;
+    let twists = effect.parameter_twists(model, &data.rows, tools)?;
+    Ok(twists
+        .iter()
+        .map(|per_row| {
+            let mut column = vec![0.0; k * per_row.len()];
+            for (i, twist) in per_row.iter().enumerate() {
+                design.twist_rows(i, twist, &mut column[i * k..(i + 1) * k]);
+            }
+            column
+        })
+        .collect())
 }
 
 /// The side of the backlash band each pose is on, learnt from the data: the sign of the joint's
@@ -94,8 +92,9 @@ fn sign(x: f64) -> f64 {
 /// (proportional to the torque), then alternates: given the signs, fit the band and flip every pose
 /// whose residual the other side explains better; given the flipped signs, refit `π` by least
 /// squares on them (a linear classifier over the torque regressors), so that the sign stays a
-/// function of the torque and does not merely follow the noise.
-fn learnt_torque_sign(
+/// function of the torque and does not merely follow the noise. Returns the torque's coefficients
+/// over `scalars` (whose signs those are).
+fn learnt_torque(
     design: &Design,
     scalars: &[Vec<f64>],
     compliance_columns: &[Vec<f64>],
@@ -106,7 +105,8 @@ fn learnt_torque_sign(
     let torque = |theta: &[f64]| -> Vec<f64> {
         (0..poses).map(|i| scalars.iter().zip(theta).map(|(s, t)| s[i] * t).sum()).collect()
     };
-    let mut signs: Vec<f64> = torque(&design.fit_all(compliance_columns)).into_iter().map(sign).collect();
+    let mut coefficients = design.fit_all(compliance_columns);
+    let mut signs: Vec<f64> = torque(&coefficients).into_iter().map(sign).collect();
     for _ in 0..5 {
         let column = column_of(&signs);
         let (band, residual) = design.fit_all_residual(std::slice::from_ref(&column));
@@ -132,8 +132,19 @@ fn learnt_torque_sign(
             break;
         }
         signs = next;
+        coefficients = pi;
     }
-    signs
+    coefficients
+}
+
+fn sign(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
 }
 
 /// Which candidates to build.
@@ -150,8 +161,10 @@ impl Default for CandidateOptions {
     }
 }
 
-/// Builds every candidate the data can support: compliance, backlash and gear error per joint;
-/// thermal growth when the temperature varies by more than 0.2 K; drift when time varies.
+/// Builds every candidate the data can support: compliance (gravity-torque regressors, and
+/// measured torques where the data has them), backlash and gear error per joint; thermal growth
+/// when the temperature varies by more than 0.2 K; drift when time varies. Each is an
+/// [`IdentifiedEffect`] of `crate::effects`, its columns that effect's regressor.
 pub(crate) fn build_candidates(
     robot: &RobotDescription,
     model: &LocalPoe,
@@ -160,126 +173,124 @@ pub(crate) fn build_candidates(
     options: &CandidateOptions,
 ) -> Result<Vec<Candidate>, Error> {
     let n = robot.joint_count();
-    let k = design.rows_per_pose;
-    let poses = data.rows.len();
+    let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
     // The nominal arm in the base frame, carrying the calibrated tools (their offsets from the
     // last joint are what the payload hangs from).
-    let mut base_model = robot.nominal_model()?;
-    base_model.set_tools(model.tools().to_vec());
+    let load = EffectContext { robot, tools: model.tools() }.load_frame()?;
     let dynamics = robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(robot));
-    let gravity = Vector3::from(dynamics.gravity_m_per_s2);
-
-    let mut twists_per_pose: Vec<Vec<lie::Twist>> = Vec::with_capacity(poses);
-    let mut gravity_rows: Vec<nalgebra::DMatrix<f64>> = Vec::with_capacity(poses);
-    let mut payload_torque: Vec<Vec<f64>> = Vec::with_capacity(poses);
-    let mut static_torque: Vec<Vec<f64>> = Vec::with_capacity(poses);
-    for row in &data.rows {
-        twists_per_pose.push(model.spatial_twists(&row.q)?);
-        gravity_rows.push(loadsim::gravity_regressor(&base_model, &row.q, &gravity)?);
-        let payload = Payload::at_tool(row.payload_kg);
-        payload_torque.push(loadsim::payload_gravity_torque(&base_model, &row.q, row.tool, &payload, &gravity)?);
-        static_torque.push(loadsim::static_torque(&base_model, &dynamics, &row.q, row.tool, &payload)?);
-    }
-    // A column from a joint twist times a scalar per pose.
-    let joint_column = |joint: usize, scalar: &dyn Fn(usize) -> f64| -> Vec<f64> {
-        let mut column = vec![0.0; k * poses];
-        for i in 0..poses {
-            let twist = twists_per_pose[i][joint].to_vector() * scalar(i);
-            design.twist_rows(i, &twist, &mut column[i * k..(i + 1) * k]);
-        }
-        column
-    };
-    let nonzero = |column: &Vec<f64>| column.iter().any(|v| v.abs() > 1e-12);
-
+    let measured = has_torques(&data.rows);
+    let nonzero = |columns: &[Vec<f64>]| columns.iter().flatten().any(|v| v.abs() > 1e-12);
+    let columns = |effect: &IdentifiedEffect| columns_of(design, effect, model, data, &tools);
     let mut candidates = Vec::new();
+    let mut push = |effect: IdentifiedEffect, harmonic: Option<u32>, columns: Vec<Vec<f64>>| {
+        candidates.push(Candidate {
+            effect: effect_of(&effect),
+            joints: effect.joints(),
+            harmonic,
+            columns,
+            model: effect,
+        });
+    };
     for j in 0..n {
         // Compliance: δq_j = c_j τ_j, τ_j = Y_j(q) π + payload torque, π unknown: one column per
         // entry of Y's row j (the products c_j π_l), and one for the payload (c_j itself).
-        let mut scalars: Vec<Vec<f64>> =
-            (0..4 * n).map(|l| (0..poses).map(|i| gravity_rows[i][(j, l)]).collect()).collect();
-        scalars.push((0..poses).map(|i| payload_torque[i][j]).collect());
-        scalars.retain(|s| s.iter().any(|v| v.abs() > 1e-12));
-        let columns: Vec<Vec<f64>> = scalars.iter().map(|s| joint_column(j, &|i| s[i])).collect();
+        let gravity = ComplianceTorque::GravityRegressor(load.clone());
+        let compliance = JointCompliance::new(gravity, &[j], &data.rows, &tools)?;
+        let terms = compliance.terms.clone();
+        let compliance = IdentifiedEffect::JointCompliance(compliance);
+        let compliance_columns = columns(&compliance)?;
         // Backlash: δq_j = b_j sign(τ_j). The torque's sign comes from the robot's mass model
         // (or a stand-in), and, since a balancer or an unknown mass can move its zero, also from
         // the compliance fit of this joint: the fitted deflection is proportional to the torque
         // the data says the joint carries.
-        let stated = joint_column(j, &|i| sign(static_torque[i][j]));
-        if nonzero(&stated) {
-            candidates.push(Candidate {
-                effect: Effect::Backlash,
-                joints: vec![j + 1],
-                harmonic: None,
-                columns: vec![stated],
-            });
+        let stated = TorqueSign::Stated { load: load.clone(), dynamics: dynamics.clone() };
+        let stated = IdentifiedEffect::Backlash(Backlash::new(j, stated, &data.rows, &tools)?);
+        let stated_columns = columns(&stated)?;
+        if nonzero(&stated_columns) {
+            push(stated, None, stated_columns);
         }
-        if !columns.is_empty() {
-            let signs = learnt_torque_sign(design, &scalars, &columns, &|s: &[f64]| joint_column(j, &|i| s[i]));
-            let learnt = joint_column(j, &|i| signs[i]);
-            if nonzero(&learnt) {
-                candidates.push(Candidate {
-                    effect: Effect::Backlash,
-                    joints: vec![j + 1],
-                    harmonic: None,
-                    columns: vec![learnt],
-                });
+        if !compliance_columns.is_empty() {
+            // The compliance terms' scaled regressors, pose by pose.
+            let per_row: Vec<Vec<f64>> = data
+                .rows
+                .iter()
+                .zip(&tools)
+                .map(|(row, &tool)| compliance.features(row, tool))
+                .collect::<Result<_, _>>()?;
+            let scalars: Vec<Vec<f64>> = (0..terms.len()).map(|l| per_row.iter().map(|r| r[l]).collect()).collect();
+            // The joint's bare twist: order 0's cosine feature is 1 on every row.
+            let bare = IdentifiedEffect::GearPeriodic(GearPeriodic::new(j, vec![0], &data.rows)?);
+            let joint_twists = bare.parameter_twists(model, &data.rows, &tools)?;
+            let column_of = |s: &[f64]| -> Vec<f64> {
+                let k = design.rows_per_pose;
+                let mut column = vec![0.0; k * s.len()];
+                for (i, value) in s.iter().enumerate() {
+                    design.twist_rows(i, &(joint_twists[0][i] * *value), &mut column[i * k..(i + 1) * k]);
+                }
+                column
+            };
+            let scaled = learnt_torque(design, &scalars, &compliance_columns, &column_of);
+            let learnt = TorqueSign::Learnt {
+                load: load.clone(),
+                columns: terms.iter().map(|t| t.column).collect(),
+                coefficients: scaled.iter().zip(&terms).map(|(c, t)| c / t.scale).collect(),
+            };
+            let learnt = IdentifiedEffect::Backlash(Backlash::new(j, learnt, &data.rows, &tools)?);
+            let learnt_columns = columns(&learnt)?;
+            if nonzero(&learnt_columns) {
+                push(learnt, None, learnt_columns);
             }
-            candidates.push(Candidate {
-                effect: Effect::JointCompliance,
-                joints: vec![j + 1],
-                harmonic: None,
-                columns,
-            });
+            push(compliance, None, compliance_columns);
+        }
+        if measured {
+            // Measured torques (SPEC `tauN_nm`): δq_j = c_j τ_j with τ_j as measured, and the
+            // band's side from its sign.
+            let compliance = JointCompliance::new(ComplianceTorque::Measured, &[j], &data.rows, &tools)?;
+            if !compliance.terms.is_empty() {
+                let effect = IdentifiedEffect::JointCompliance(compliance);
+                let effect_columns = columns(&effect)?;
+                push(effect, None, effect_columns);
+            }
+            let backlash = IdentifiedEffect::Backlash(Backlash::new(j, TorqueSign::Measured, &data.rows, &tools)?);
+            let backlash_columns = columns(&backlash)?;
+            if nonzero(&backlash_columns) {
+                push(backlash, None, backlash_columns);
+            }
         }
         for &h in &options.harmonics {
-            let order = f64::from(h);
-            let columns = vec![
-                joint_column(j, &|i| (order * data.rows[i].q[j]).cos()),
-                joint_column(j, &|i| (order * data.rows[i].q[j]).sin()),
-            ];
-            candidates.push(Candidate {
-                effect: Effect::GearPeriodic,
-                joints: vec![j + 1],
-                harmonic: Some(h),
-                columns,
-            });
+            let gear = IdentifiedEffect::GearPeriodic(GearPeriodic::new(j, vec![h], &data.rows)?);
+            let gear_columns = columns(&gear)?;
+            push(gear, Some(h), gear_columns);
         }
     }
     if let Some(temps) = data.rows.iter().map(|r| r.temp_c).collect::<Option<Vec<f64>>>() {
-        let mean = temps.iter().sum::<f64>() / poses as f64;
         let (low, high) = temps.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| (a.min(t), b.max(t)));
         if high - low > 0.2 {
             // One expansion coefficient for the whole arm: every link but the tracker-to-base
             // placement grows by α ΔT.
-            let mut column = vec![0.0; k * poses];
-            for (i, row) in data.rows.iter().enumerate() {
-                let columns = loadsim::thermal_regressor(model, &row.q, row.tool, temps[i] - mean)?;
-                let twist: Vector6 = columns.iter().skip(1).map(|c| c.twist).sum();
-                design.twist_rows(i, &twist, &mut column[i * k..(i + 1) * k]);
-            }
-            candidates.push(Candidate {
-                effect: Effect::Thermal,
-                joints: vec![],
-                harmonic: None,
-                columns: vec![column],
-            });
+            let thermal = IdentifiedEffect::Thermal(Thermal::new(&data.rows)?);
+            let thermal_columns = columns(&thermal)?;
+            push(thermal, None, thermal_columns);
         }
     }
     if let Some(times) = data.rows.iter().map(|r| r.t_s).collect::<Option<Vec<f64>>>() {
-        let mean = times.iter().sum::<f64>() / poses as f64;
+        let mean = times.iter().sum::<f64>() / data.rows.len() as f64;
         if times.iter().any(|t| (t - mean).abs() > 1.0) {
-            let columns = (0..6)
-                .map(|component| {
-                    let mut column = vec![0.0; k * poses];
-                    for (i, t) in times.iter().enumerate() {
-                        let twist = loadsim::drift_regressor(t - mean)[component].twist;
-                        design.twist_rows(i, &twist, &mut column[i * k..(i + 1) * k]);
-                    }
-                    column
-                })
-                .collect();
-            candidates.push(Candidate { effect: Effect::TimeDrift, joints: vec![], harmonic: None, columns });
+            let drift = IdentifiedEffect::TimeDrift(TimeDrift::new(&data.rows)?);
+            let drift_columns = columns(&drift)?;
+            push(drift, None, drift_columns);
         }
     }
     Ok(candidates)
+}
+
+/// The verdict name of an effect.
+fn effect_of(effect: &IdentifiedEffect) -> Effect {
+    match effect {
+        IdentifiedEffect::JointCompliance(_) => Effect::JointCompliance,
+        IdentifiedEffect::GearPeriodic(_) => Effect::GearPeriodic,
+        IdentifiedEffect::Backlash(_) => Effect::Backlash,
+        IdentifiedEffect::Thermal(_) => Effect::Thermal,
+        IdentifiedEffect::TimeDrift(_) => Effect::TimeDrift,
+    }
 }

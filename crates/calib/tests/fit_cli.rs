@@ -1,0 +1,125 @@
+//! `calib fit` end to end: `--effects` lists and their refusals, `--options` files, and data too
+//! thin for the parameters.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn calib(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_calib")).args(args).output().expect("the calib binary runs")
+}
+
+fn fixture(name: &str) -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name).display().to_string()
+}
+
+fn text(path: &Path) -> String {
+    path.display().to_string()
+}
+
+fn succeeds(args: &[&str]) -> String {
+    let out = calib(args);
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Runs a command that must fail and returns its stderr, checked to be exactly one line.
+fn fails(args: &[&str]) -> String {
+    let out = calib(args);
+    assert!(!out.status.success(), "{args:?} should fail");
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: not one line:\n{stderr}");
+    stderr.trim_end().to_owned()
+}
+
+fn simulated(dir: &Path, rows: usize, seed: u64) -> PathBuf {
+    let path = dir.join(format!("sim{seed}.csv"));
+    let (rows, seed) = (rows.to_string(), seed.to_string());
+    succeeds(&[
+        "simulate",
+        "--robot",
+        &fixture("irb4400.ron"),
+        "--out",
+        &text(&path),
+        "--rows",
+        &rows,
+        "--seed",
+        &seed,
+    ]);
+    path
+}
+
+/// `calib fit … --method poe` with `extra` arguments.
+fn fit(data: &Path, model: &Path, extra: &[&str]) -> Output {
+    let robot = fixture("irb4400.ron");
+    let mut args = vec!["fit", "--robot", &robot, "--data"];
+    let (data, model) = (text(data), text(model));
+    args.extend([data.as_str(), "--method", "poe", "--out", model.as_str()]);
+    args.extend(extra);
+    calib(&args)
+}
+
+fn fit_fails(data: &Path, model: &Path, extra: &[&str]) -> String {
+    let out = fit(data, model, extra);
+    assert!(!out.status.success(), "{extra:?} should fail");
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{extra:?}: not one line:\n{stderr}");
+    stderr.trim_end().to_owned()
+}
+
+#[test]
+fn an_effects_list_is_fitted_and_each_bad_item_is_refused_where_it_stands() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 80, 41);
+    let model = dir.path().join("m.ron");
+    let out = fit(&data, &model, &["--effects", "gear_periodic:2:3,thermal"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("effect gear_periodic:2:3: 6 parameters"), "{stdout}");
+    assert!(stdout.contains("effect thermal: 1 parameters"), "{stdout}");
+    let cases = [
+        ("thermal,gear_periodic:2", "--effects:1:9: 'gear_periodic:2' takes 2 ':' argument(s), 1 given"),
+        ("backlash:0", "--effects:1:1: 'backlash:0' has a joint that is not a whole number from 1"),
+        ("compliance", "--effects:1:1: 'compliance' is not an effect"),
+        ("thermal,thermal", "--effects:1:9: 'thermal' is named twice"),
+        ("auto,thermal", "--effects:1:1: 'auto' stands alone"),
+    ];
+    for (list, expected) in cases {
+        let message = fit_fails(&data, &model, &["--effects", list]);
+        assert!(message.contains(expected), "{list}: {message}");
+    }
+    let message = fit_fails(&data, &model, &["--effects", "backlash:9"]);
+    assert_eq!(message, "error: effect on joint 9: the robot has joints 1 to 6");
+    let message = fit_fails(&data, &model, &["--effects", "thermal", "--joint-compliance"]);
+    assert!(message.contains("cannot be used with"), "{message}");
+}
+
+#[test]
+fn an_options_file_sets_any_solver_field_and_refuses_an_unknown_one_at_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 80, 42);
+    let model = dir.path().join("m.ron");
+    let options = dir.path().join("fit.ron");
+    std::fs::write(&options, "(\n  identification: (max_iterations: 1),\n)\n").unwrap();
+    let out = fit(&data, &model, &["--options", &text(&options)]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("NOT converged: stopped at the iteration limit (1)"), "{stdout}");
+    std::fs::write(&options, "(\n  identification: (\n    max_iteration: 1,\n  ),\n)\n").unwrap();
+    let message = fit_fails(&data, &model, &["--options", &text(&options)]);
+    assert!(message.contains("fit.ron:3:5") && message.contains("max_iteration"), "{message}");
+    std::fs::write(&options, "(effects: (prior_sigma: -1.0))\n").unwrap();
+    let message = fit_fails(&data, &model, &["--options", &text(&options)]);
+    assert!(message.contains("fit.ron:1:12") && message.contains("prior_sigma is -1"), "{message}");
+    std::fs::write(&options, "(identification: (rcond: 2.0))\n").unwrap();
+    let message = fit_fails(&data, &model, &["--options", &text(&options)]);
+    assert!(message.contains("fit.ron:1:19") && message.contains("rcond is 2"), "{message}");
+}
+
+#[test]
+fn thirteen_position_only_poses_of_a_six_axis_arm_are_refused_with_both_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 13, 43);
+    let model = dir.path().join("m.ron");
+    let message = fit_fails(&data, &model, &[]);
+    assert!(message.contains("13 measurements give 39 residual rows, fewer than the 42 free parameters"), "{message}");
+    assert!(!model.exists());
+}

@@ -1,0 +1,244 @@
+//! The effects of a model file checked once, on reading: every index within the robot, every
+//! count consistent, every value finite. A fault names the field and its occurrence within the
+//! `effects` list, so that the caller can place it in the file.
+
+use super::{Backlash, ComplianceTorque, IdentifiedEffect, LoadFrame, MAX_HARMONICS, TorqueSign};
+use crate::Error;
+
+/// What is wrong, where.
+#[derive(Debug)]
+pub(crate) struct EffectFault {
+    /// The field path, e.g. `effects[1].theta`.
+    pub path: String,
+    /// The line and column of the field in the file.
+    pub position: (usize, usize),
+    /// What is wrong.
+    pub kind: FaultKind,
+}
+
+#[derive(Debug)]
+pub(crate) enum FaultKind {
+    Count { what: &'static str, found: usize, expected: usize },
+    Index { index: usize, limit: usize },
+    NotFinite { value: f64 },
+}
+
+impl EffectFault {
+    pub(crate) fn into_error(self, file: &str) -> Error {
+        let (line, column) = self.position;
+        let file = file.to_owned();
+        let field = self.path;
+        match self.kind {
+            FaultKind::Count { what, found, expected } => {
+                Error::ModelCount { file, line, column, field, what, found, expected }
+            }
+            FaultKind::Index { index, limit } => Error::ModelIndex { file, line, column, field, index, limit },
+            FaultKind::NotFinite { value } => Error::NotFinite { file, line, column, field, value },
+        }
+    }
+}
+
+/// Counts occurrences of field names within the effects list, effect by effect, so that a fault
+/// is placed at its own occurrence.
+struct Cursor<'a> {
+    effect: usize,
+    seen: std::collections::HashMap<&'static str, usize>,
+    locate: &'a dyn Fn(&str, usize) -> (usize, usize),
+}
+
+impl Cursor<'_> {
+    fn fault(&self, field: &'static str, within: usize, path: String, kind: FaultKind) -> EffectFault {
+        let occurrence = self.seen.get(field).copied().unwrap_or(0) + within;
+        EffectFault {
+            path: format!("effects[{}].{path}", self.effect),
+            position: (self.locate)(field, occurrence),
+            kind,
+        }
+    }
+
+    fn finite(&self, field: &'static str, values: &[f64], positive: bool) -> Result<(), EffectFault> {
+        match values.iter().position(|v| !v.is_finite() || (positive && *v <= 0.0)) {
+            Some(k) => Err(self.fault(field, 0, format!("{field}[{k}]"), FaultKind::NotFinite { value: values[k] })),
+            None => Ok(()),
+        }
+    }
+
+    fn count(&self, field: &'static str, found: usize, expected: usize) -> Result<(), EffectFault> {
+        if found == expected {
+            Ok(())
+        } else {
+            Err(self.fault(field, 0, field.to_owned(), FaultKind::Count { what: "values", found, expected }))
+        }
+    }
+
+    fn joint(
+        &self,
+        field: &'static str,
+        within: usize,
+        path: String,
+        joint: usize,
+        n: usize,
+    ) -> Result<(), EffectFault> {
+        if joint < n {
+            Ok(())
+        } else {
+            Err(self.fault(field, within, path, FaultKind::Index { index: joint, limit: n }))
+        }
+    }
+
+    fn load(&self, load: &LoadFrame, n: usize, tools: usize) -> Result<(), EffectFault> {
+        let base = &load.base_model;
+        if base.joint_count() != n {
+            let kind = FaultKind::Count { what: "joints", found: base.joint_count(), expected: n };
+            return Err(self.fault("base_model", 0, "base_model".into(), kind));
+        }
+        if base.tool_count() != tools {
+            let kind = FaultKind::Count { what: "tools", found: base.tool_count(), expected: tools };
+            return Err(self.fault("base_model", 0, "base_model".into(), kind));
+        }
+        let moved = base.joints().iter().map(|j| j.previous_from_joint_zero).chain(base.tools().iter().copied());
+        if let Some(value) =
+            moved.flat_map(|t| t.translation().iter().copied().collect::<Vec<_>>()).find(|v| !v.is_finite())
+        {
+            return Err(self.fault("base_model", 0, "base_model".into(), FaultKind::NotFinite { value }));
+        }
+        self.finite("gravity_m_per_s2", &load.gravity_m_per_s2, false)
+    }
+
+    /// Counts the fields of one effect, so that the next effect's occurrences start after them.
+    fn advance(&mut self, effect: &IdentifiedEffect) {
+        let mut add = |field: &'static str, count: usize| *self.seen.entry(field).or_insert(0) += count;
+        add("theta", 1);
+        match effect {
+            IdentifiedEffect::JointCompliance(c) => {
+                add("joint", c.terms.len());
+                add("column", c.terms.len());
+                add("scale", c.terms.len());
+                if let ComplianceTorque::GravityRegressor(_) = c.torque {
+                    add("base_model", 1);
+                    add("gravity_m_per_s2", 1);
+                }
+            }
+            IdentifiedEffect::GearPeriodic(_) => {
+                add("joint", 1);
+                add("orders", 1);
+                add("scale", 1);
+            }
+            IdentifiedEffect::Backlash(b) => {
+                add("joint", 1);
+                add("scale", 1);
+                match &b.sign {
+                    TorqueSign::Measured => {}
+                    TorqueSign::Stated { .. } => {
+                        add("base_model", 1);
+                        add("gravity_m_per_s2", 1);
+                    }
+                    TorqueSign::Learnt { .. } => {
+                        add("base_model", 1);
+                        add("gravity_m_per_s2", 1);
+                        add("columns", 1);
+                        add("coefficients", 1);
+                    }
+                }
+            }
+            IdentifiedEffect::Thermal(_) => {
+                add("reference_c", 1);
+                add("scale", 1);
+            }
+            IdentifiedEffect::TimeDrift(_) => {
+                add("reference_s", 1);
+                add("scale", 1);
+            }
+        }
+        self.effect += 1;
+    }
+
+    fn backlash(&self, b: &Backlash, n: usize, tools: usize) -> Result<(), EffectFault> {
+        self.joint("joint", 0, "joint".into(), b.joint, n)?;
+        self.count("scale", b.scale.len(), 1)?;
+        self.count("theta", b.theta.len(), 1)?;
+        match &b.sign {
+            TorqueSign::Measured => Ok(()),
+            TorqueSign::Stated { load, dynamics } => {
+                self.load(load, n, tools)?;
+                dynamics.validate(n).map_err(|_| {
+                    let kind = FaultKind::Count { what: "links", found: dynamics.links.len(), expected: n };
+                    self.fault("dynamics", 0, "sign.dynamics".into(), kind)
+                })
+            }
+            TorqueSign::Learnt { load, columns, coefficients } => {
+                self.load(load, n, tools)?;
+                if let Some(k) = columns.iter().position(|&c| c > 4 * n) {
+                    let kind = FaultKind::Index { index: columns[k], limit: 4 * n + 1 };
+                    return Err(self.fault("columns", 0, format!("columns[{k}]"), kind));
+                }
+                self.count("coefficients", coefficients.len(), columns.len())?;
+                self.finite("coefficients", coefficients, false)
+            }
+        }
+    }
+}
+
+/// Checks every effect of a model with `n` joints and `tools` tools; `locate` gives the line and
+/// column of the `occurrence`-th (0-based, counted from the start of the effects list) `field:`.
+pub(crate) fn check_effects(
+    effects: &[IdentifiedEffect],
+    n: usize,
+    tools: usize,
+    locate: &dyn Fn(&str, usize) -> (usize, usize),
+) -> Result<(), EffectFault> {
+    let mut cursor = Cursor { effect: 0, seen: std::collections::HashMap::new(), locate };
+    for effect in effects {
+        match effect {
+            IdentifiedEffect::JointCompliance(c) => {
+                if let ComplianceTorque::GravityRegressor(load) = &c.torque {
+                    cursor.load(load, n, tools)?;
+                }
+                // A regressor row holds 4 columns per link and the payload's: 4n + 1; a measured
+                // torque has one.
+                let width = if matches!(c.torque, ComplianceTorque::Measured) { 1 } else { 4 * n + 1 };
+                for (k, term) in c.terms.iter().enumerate() {
+                    cursor.joint("joint", k, format!("terms[{k}].joint"), term.joint, n)?;
+                    if term.column >= width {
+                        let kind = FaultKind::Index { index: term.column, limit: width };
+                        return Err(cursor.fault("column", k, format!("terms[{k}].column"), kind));
+                    }
+                    if !(term.scale.is_finite() && term.scale > 0.0) {
+                        let kind = FaultKind::NotFinite { value: term.scale };
+                        return Err(cursor.fault("scale", k, format!("terms[{k}].scale"), kind));
+                    }
+                }
+                cursor.count("theta", c.theta.len(), c.terms.len())?;
+            }
+            IdentifiedEffect::GearPeriodic(g) => {
+                cursor.joint("joint", 0, "joint".into(), g.joint, n)?;
+                if let Some(k) = g.orders.iter().position(|&h| h > MAX_HARMONICS) {
+                    let kind = FaultKind::Index { index: g.orders[k] as usize, limit: MAX_HARMONICS as usize + 1 };
+                    return Err(cursor.fault("orders", 0, format!("orders[{k}]"), kind));
+                }
+                cursor.count("scale", g.scale.len(), 2 * g.orders.len())?;
+                cursor.count("theta", g.theta.len(), 2 * g.orders.len())?;
+                cursor.finite("scale", &g.scale, true)?;
+            }
+            IdentifiedEffect::Backlash(b) => {
+                cursor.backlash(b, n, tools)?;
+                cursor.finite("scale", &b.scale, true)?;
+            }
+            IdentifiedEffect::Thermal(t) => {
+                cursor.finite("reference_c", &[t.reference_c], false)?;
+                cursor.count("scale", t.scale.len(), 1)?;
+                cursor.count("theta", t.theta.len(), 1)?;
+                cursor.finite("scale", &t.scale, true)?;
+            }
+            IdentifiedEffect::TimeDrift(d) => {
+                cursor.finite("reference_s", &[d.reference_s], false)?;
+                cursor.count("scale", d.scale.len(), 6)?;
+                cursor.count("theta", d.theta.len(), 6)?;
+                cursor.finite("scale", &d.scale, true)?;
+            }
+        }
+        cursor.finite("theta", effect.theta(), false)?;
+        cursor.advance(effect);
+    }
+    Ok(())
+}

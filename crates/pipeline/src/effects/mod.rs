@@ -1,0 +1,322 @@
+//! Non-geometric effects, each defined once as its regressor: per row, one scalar feature per
+//! parameter, times the twist that parameter moves the pose along ([`Direction`]: a joint's
+//! spatial twist, a fixed left twist, or the arm's thermal growth). The pose error is, to first
+//! order, `y ≈ Σ_l θ_l f_l(row) c_l(q)`, and the effect moves a pose by `exp((Σ_l θ_l f_l c_l)^) T`.
+//!
+//! The same definition gives the diagnosis's candidate columns (`diagnose/candidates.rs`), the
+//! fit's [`poe::identify::PoseCorrection`] (module `correction`), and the calibrated model's
+//! prediction ([`IdentifiedEffect::twist`]): what the diagnosis predicts is what the fit does.
+
+mod auto;
+mod backlash;
+mod check;
+mod compliance;
+mod correction;
+mod direction;
+mod drift;
+mod gear;
+mod load_frame;
+mod spec;
+mod thermal;
+
+pub use auto::{AutoChoice, choose, effects_of};
+pub use backlash::{Backlash, TorqueSign};
+pub use compliance::{ComplianceTerm, ComplianceTorque, JointCompliance};
+pub use direction::Direction;
+pub use drift::TimeDrift;
+pub use gear::GearPeriodic;
+pub use load_frame::LoadFrame;
+pub use spec::{EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS};
+pub use thermal::Thermal;
+
+pub(crate) use check::check_effects;
+pub(crate) use correction::EffectCorrection;
+pub(crate) use direction::RowTwists;
+
+use crate::{Error, Measurement, RobotDescription};
+use lie::{SE3, Twist, Vector6};
+use poe::LocalPoe;
+use serde::{Deserialize, Serialize};
+
+/// An effect as linear in its parameters.
+pub(crate) trait Regressor {
+    /// The twist of each parameter.
+    fn directions(&self) -> Vec<Direction>;
+    /// The scaled feature of each parameter at one row (`tool`: the model's tool index).
+    fn features(&self, row: &Measurement, tool: usize) -> Result<Vec<f64>, Error>;
+    /// The parameters' values.
+    fn theta(&self) -> &[f64];
+    /// The parameters' values, to set after a fit.
+    fn theta_mut(&mut self) -> &mut Vec<f64>;
+}
+
+/// The RMS of each feature over `rows` (one `Vec` per row), 1 where a feature is zero throughout,
+/// so that a scaled parameter is the effect's size at a typical row.
+pub(crate) fn rms_scales(rows: &[Vec<f64>]) -> Vec<f64> {
+    let width = rows.first().map_or(0, Vec::len);
+    (0..width)
+        .map(|l| {
+            let mean_sq = rows.iter().map(|r| r[l] * r[l]).sum::<f64>() / rows.len().max(1) as f64;
+            if mean_sq > 0.0 && mean_sq.is_finite() { mean_sq.sqrt() } else { 1.0 }
+        })
+        .collect()
+}
+
+/// Whether every row has measured joint torques.
+pub(crate) fn has_torques(rows: &[Measurement]) -> bool {
+    !rows.is_empty() && rows.iter().all(|r| r.torques_nm.is_some())
+}
+
+/// An effect of a calibrated model, with its identified parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IdentifiedEffect {
+    /// Joint compliance.
+    JointCompliance(JointCompliance),
+    /// Periodic error of one joint in its own angle.
+    GearPeriodic(GearPeriodic),
+    /// Backlash of one joint.
+    Backlash(Backlash),
+    /// Thermal growth with `temp_c`.
+    Thermal(Thermal),
+    /// Drift with `t_s`.
+    TimeDrift(TimeDrift),
+}
+
+/// What the effects of a fit are built from: the robot (for gravity and masses) and the
+/// calibrated tools (the payload hangs from them).
+#[derive(Debug, Clone, Copy)]
+pub struct EffectContext<'a> {
+    /// The robot description.
+    pub robot: &'a RobotDescription,
+    /// The tools of the kinematic model, `flange_from_tool`.
+    pub tools: &'a [SE3],
+}
+
+impl EffectContext<'_> {
+    pub(crate) fn load_frame(&self) -> Result<LoadFrame, Error> {
+        LoadFrame::new(self.robot, self.tools)
+    }
+
+    fn check_joint(&self, spec: &EffectSpec) -> Result<usize, Error> {
+        let joint_count = self.robot.joint_count();
+        match spec.joint() {
+            Some(joint) if joint == 0 || joint > joint_count => Err(Error::EffectJoint { joint, joint_count }),
+            Some(joint) => Ok(joint - 1),
+            None => Ok(0),
+        }
+    }
+}
+
+impl IdentifiedEffect {
+    /// The effect `spec` names, its features scaled on `rows` (`tools`: each row's model tool),
+    /// its parameters at zero. Backlash takes the sign of the measured torque where every row has
+    /// one, of the robot's static torque otherwise (its mass model, or a stand-in).
+    pub fn new(
+        spec: &EffectSpec,
+        context: &EffectContext<'_>,
+        rows: &[Measurement],
+        tools: &[usize],
+    ) -> Result<Self, Error> {
+        let joint = context.check_joint(spec)?;
+        Ok(match *spec {
+            EffectSpec::JointCompliance => {
+                let joints: Vec<usize> = (0..context.robot.joint_count()).collect();
+                let torque = if has_torques(rows) {
+                    ComplianceTorque::Measured
+                } else {
+                    ComplianceTorque::GravityRegressor(context.load_frame()?)
+                };
+                IdentifiedEffect::JointCompliance(JointCompliance::new(torque, &joints, rows, tools)?)
+            }
+            EffectSpec::GearPeriodic { harmonics, .. } => {
+                IdentifiedEffect::GearPeriodic(GearPeriodic::new(joint, (1..=harmonics).collect(), rows)?)
+            }
+            EffectSpec::Backlash { .. } => {
+                let sign = if has_torques(rows) {
+                    TorqueSign::Measured
+                } else {
+                    let dynamics = context.robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(context.robot));
+                    TorqueSign::Stated { load: context.load_frame()?, dynamics }
+                };
+                IdentifiedEffect::Backlash(Backlash::new(joint, sign, rows, tools)?)
+            }
+            EffectSpec::Thermal => IdentifiedEffect::Thermal(Thermal::new(rows)?),
+            EffectSpec::TimeDrift => IdentifiedEffect::TimeDrift(TimeDrift::new(rows)?),
+        })
+    }
+
+    fn regressor(&self) -> &dyn Regressor {
+        match self {
+            IdentifiedEffect::JointCompliance(e) => e,
+            IdentifiedEffect::GearPeriodic(e) => e,
+            IdentifiedEffect::Backlash(e) => e,
+            IdentifiedEffect::Thermal(e) => e,
+            IdentifiedEffect::TimeDrift(e) => e,
+        }
+    }
+
+    fn regressor_mut(&mut self) -> &mut dyn Regressor {
+        match self {
+            IdentifiedEffect::JointCompliance(e) => e,
+            IdentifiedEffect::GearPeriodic(e) => e,
+            IdentifiedEffect::Backlash(e) => e,
+            IdentifiedEffect::Thermal(e) => e,
+            IdentifiedEffect::TimeDrift(e) => e,
+        }
+    }
+
+    /// The SPEC name of the effect (`joint_compliance`, `gear_periodic`, …).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            IdentifiedEffect::JointCompliance(_) => "joint_compliance",
+            IdentifiedEffect::GearPeriodic(_) => "gear_periodic",
+            IdentifiedEffect::Backlash(_) => "backlash",
+            IdentifiedEffect::Thermal(_) => "thermal",
+            IdentifiedEffect::TimeDrift(_) => "time_drift",
+        }
+    }
+
+    /// The 1-based joints the effect acts on (empty for thermal growth and drift).
+    pub fn joints(&self) -> Vec<usize> {
+        match self {
+            IdentifiedEffect::JointCompliance(e) => e.joints().into_iter().map(|j| j + 1).collect(),
+            IdentifiedEffect::GearPeriodic(e) => vec![e.joint + 1],
+            IdentifiedEffect::Backlash(e) => vec![e.joint + 1],
+            IdentifiedEffect::Thermal(_) | IdentifiedEffect::TimeDrift(_) => Vec::new(),
+        }
+    }
+
+    /// A name for reports: the SPEC item where there is one (`gear_periodic:1:24`), with what
+    /// drives it.
+    pub fn label(&self) -> String {
+        match self {
+            IdentifiedEffect::JointCompliance(e) => match e.torque {
+                ComplianceTorque::Measured => "joint_compliance (measured torques)".into(),
+                ComplianceTorque::GravityRegressor(_) => "joint_compliance (gravity-torque regressors)".into(),
+            },
+            IdentifiedEffect::GearPeriodic(e) => {
+                let consecutive = e.orders.iter().enumerate().all(|(k, &h)| h as usize == k + 1);
+                match (consecutive, e.orders.last()) {
+                    (true, Some(last)) => format!("gear_periodic:{}:{last}", e.joint + 1),
+                    _ => format!("gear_periodic:{} (harmonics {:?})", e.joint + 1, e.orders),
+                }
+            }
+            IdentifiedEffect::Backlash(e) => {
+                let source = match e.sign {
+                    TorqueSign::Measured => "measured torque",
+                    TorqueSign::Stated { .. } => "static torque of the mass model",
+                    TorqueSign::Learnt { .. } => "torque learnt from the data",
+                };
+                format!("backlash:{} (sign of the {source})", e.joint + 1)
+            }
+            IdentifiedEffect::Thermal(_) => "thermal".into(),
+            IdentifiedEffect::TimeDrift(_) => "time_drift".into(),
+        }
+    }
+
+    /// Number of parameters.
+    pub fn parameter_count(&self) -> usize {
+        self.regressor().theta().len()
+    }
+
+    /// The identified parameters (scaled: the effect's size at a typical training row).
+    pub fn theta(&self) -> &[f64] {
+        self.regressor().theta()
+    }
+
+    pub(crate) fn set_theta(&mut self, theta: &[f64]) {
+        let own = self.regressor_mut().theta_mut();
+        own.clear();
+        own.extend_from_slice(theta);
+    }
+
+    /// The twist of each parameter.
+    pub(crate) fn directions(&self) -> Vec<Direction> {
+        self.regressor().directions()
+    }
+
+    /// The scaled features of one row.
+    pub(crate) fn features(&self, row: &Measurement, tool: usize) -> Result<Vec<f64>, Error> {
+        self.regressor().features(row, tool)
+    }
+
+    /// The twist the effect adds at one row under `kinematics`: `Σ_l θ_l f_l c_l`.
+    pub fn twist(&self, kinematics: &LocalPoe, row: &Measurement, tool: usize) -> Result<Vector6, Error> {
+        let mut twists = RowTwists::new(kinematics, &row.q, tool);
+        self.twist_with(&mut twists, row, tool)
+    }
+
+    fn twist_with(&self, twists: &mut RowTwists<'_>, row: &Measurement, tool: usize) -> Result<Vector6, Error> {
+        let features = self.features(row, tool)?;
+        let mut total = Vector6::zeros();
+        for ((direction, f), t) in self.directions().into_iter().zip(features).zip(self.theta()) {
+            if *t != 0.0 && f != 0.0 {
+                total += twists.twist(direction)? * (f * t);
+            }
+        }
+        Ok(total)
+    }
+
+    /// The twist per unit of each parameter at every row: `[parameter][row]`, for the diagnosis.
+    pub(crate) fn parameter_twists(
+        &self,
+        kinematics: &LocalPoe,
+        rows: &[Measurement],
+        tools: &[usize],
+    ) -> Result<Vec<Vec<Vector6>>, Error> {
+        let directions = self.directions();
+        let mut out = vec![Vec::with_capacity(rows.len()); directions.len()];
+        for (row, &tool) in rows.iter().zip(tools) {
+            let features = self.features(row, tool)?;
+            let mut twists = RowTwists::new(kinematics, &row.q, tool);
+            for (l, (direction, f)) in directions.iter().zip(features).enumerate() {
+                out[l].push(twists.twist(*direction)? * f);
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// `exp((Σ_effects Σ_l θ_l f_l c_l)^) · pose`: every effect of a model moves the pose by one left
+/// exponential of the sum of their twists, as the identification models them
+/// ([`poe::identify::PoseCorrection`]).
+pub(crate) fn apply(
+    effects: &[IdentifiedEffect],
+    kinematics: &LocalPoe,
+    row: &Measurement,
+    tool: usize,
+    pose: SE3,
+) -> Result<SE3, Error> {
+    if effects.is_empty() {
+        return Ok(pose);
+    }
+    let mut twists = RowTwists::new(kinematics, &row.q, tool);
+    let mut total = Vector6::zeros();
+    for effect in effects {
+        total += effect.twist_with(&mut twists, row, tool)?;
+    }
+    Ok(Twist::from_vector(&total).exp() * pose)
+}
+
+/// A stand-in mass model where the robot file gives none, used only for the *sign* of the static
+/// torque (backlash): each link a slender bar from its joint's axis point to the next one's, 50 kg
+/// per metre, so that the torque's sign follows where the arm's weight lies, which depends on the
+/// geometry far more than on the masses.
+pub(crate) fn stand_in_dynamics(robot: &RobotDescription) -> loadsim::RobotDynamics {
+    let mut points: Vec<lie::Vector3> = robot.joints.iter().map(|j| lie::Vector3::from(j.point)).collect();
+    points.push(lie::Vector3::from(robot.flange.position));
+    let links = points
+        .windows(2)
+        .map(|w| loadsim::LinkInertia {
+            mass_kg: 50.0 * (w[1] - w[0]).norm().max(0.05),
+            com_m: ((w[0] + w[1]) * 0.5).into(),
+        })
+        .collect();
+    loadsim::RobotDynamics {
+        links,
+        stiffness_nm_per_rad: vec![1.0; robot.joint_count()],
+        counterbalance: None,
+        gravity_m_per_s2: loadsim::FLOOR_GRAVITY_M_PER_S2,
+    }
+}

@@ -1,0 +1,116 @@
+//! The options of a fit, and the options file (`calib fit --options FIT.ron`) that sets any of
+//! them: unknown fields are refused at their line and column, values checked once.
+
+use crate::diagnose::DiagnoseOptions;
+use crate::effects::EffectSelection;
+use crate::{CompensationOptions, Error};
+use poe::identify::{IdentificationOptions, Solver};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// How the non-geometric effects are identified with the geometry.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct EffectOptions {
+    /// Which effects (`--effects`; none by default: the paper's methods).
+    #[serde(with = "selection_text")]
+    pub selection: EffectSelection,
+    /// Prior standard deviation of every effect parameter about zero, in the unit of its scaled
+    /// feature: radians of joint deflection (gear, compliance, backlash), metres or radians of
+    /// drift, strain of thermal growth, each at the feature's RMS over the training rows. A ridge
+    /// that keeps parameters the data does not excite at zero; 5 mrad is the largest joint-angle
+    /// error the blind check draws (backlash and gear error capped at 5 mrad, commit 3f522bb), so
+    /// the prior never pulls a real effect of that size by more than a small fraction.
+    pub prior_sigma: f64,
+    /// The solver of the joint identification. Levenberg–Marquardt with the prior: the paper's
+    /// pseudo-inverse cannot hold unexcited effect directions at their prior.
+    pub solver: Solver,
+    /// The diagnosis that `auto` runs on the training data.
+    pub diagnose: DiagnoseOptions,
+}
+
+impl Default for EffectOptions {
+    fn default() -> Self {
+        Self {
+            selection: EffectSelection::None,
+            prior_sigma: 5e-3,
+            solver: Solver::LevenbergMarquardt,
+            diagnose: DiagnoseOptions::default(),
+        }
+    }
+}
+
+mod selection_text {
+    use crate::effects::EffectSelection;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(selection: &EffectSelection, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(&selection.to_string())
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<EffectSelection, D::Error> {
+        let text = String::deserialize(deserializer)?;
+        if text == "none" {
+            return Ok(EffectSelection::None);
+        }
+        text.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+/// Options of a fit.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FitOptions {
+    /// The geometric identification.
+    pub identification: IdentificationOptions,
+    /// The Gaussian-process compensation (methods `poe-gp`, `poe-gp-load`).
+    pub compensation: CompensationOptions,
+    /// Non-geometric effects identified with the geometry, before any GP. Beyond the paper.
+    pub effects: EffectOptions,
+}
+
+impl FitOptions {
+    /// The options with `effects` identified with the geometry.
+    pub fn with_effects(mut self, selection: EffectSelection) -> Self {
+        self.effects.selection = selection;
+        self
+    }
+}
+
+impl FitOptions {
+    /// Reads an options file (RON; every field optional, unknown fields refused).
+    pub fn read(path: &Path) -> Result<Self, Error> {
+        let text = crate::ron_position::read_text(path)?;
+        Self::parse(&text, &path.display().to_string())
+    }
+
+    /// Parses options from RON text and checks them; `file` names it in errors.
+    pub fn parse(text: &str, file: &str) -> Result<Self, Error> {
+        let options: FitOptions = crate::ron_position::ron_options().from_str(text).map_err(|e| Error::RonFormat {
+            file: file.to_owned(),
+            line: e.span.start.line,
+            column: e.span.start.col,
+            message: e.code.to_string(),
+        })?;
+        options.validate().map_err(|(field, message)| {
+            let (line, column) = crate::ron_position::field_position(text, field, 0);
+            Error::RonFormat { file: file.to_owned(), line, column, message }
+        })?;
+        Ok(options)
+    }
+
+    /// Checks every value once: the identification's, and the effects' prior.
+    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+        if let Err(poe::Error::InvalidOption { name, value, expected }) = self.identification.validate() {
+            return Err((name, format!("identification.{name} is {value}, expected {expected}")));
+        }
+        let prior = self.effects.prior_sigma;
+        if prior.is_nan() || prior <= 0.0 {
+            return Err((
+                "prior_sigma",
+                format!("effects.prior_sigma is {prior}, expected a number above 0 (inf for none)"),
+            ));
+        }
+        Ok(())
+    }
+}
