@@ -22,15 +22,6 @@ fn succeeds(args: &[&str]) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
-/// Runs a command that must fail and returns its stderr, checked to be exactly one line.
-fn fails(args: &[&str]) -> String {
-    let out = calib(args);
-    assert!(!out.status.success(), "{args:?} should fail");
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: not one line:\n{stderr}");
-    stderr.trim_end().to_owned()
-}
-
 fn simulated(dir: &Path, rows: usize, seed: u64) -> PathBuf {
     let path = dir.join(format!("sim{seed}.csv"));
     let (rows, seed) = (rows.to_string(), seed.to_string());
