@@ -7,6 +7,11 @@ mod blind_check;
 mod box_plot;
 mod compensate_check;
 mod convert_ur10;
+mod fuzz;
+mod fuzz_inputs;
+mod fuzz_seeds;
+mod fuzz_worker;
+mod msrv;
 mod reproduce_sim;
 mod reproduce_sim_params;
 mod reproduce_sim_report;
@@ -43,6 +48,13 @@ enum Command {
     UrdfCheck(urdf_check::Args),
     /// Compensated programs executed on the true simulated robot; 10,000 targets timed against SciPy.
     CompensateCheck(compensate_check::Args),
+    /// Feed every file reader generated and broken inputs: no panic, crash or hang, bounded memory, located refusals.
+    Fuzz(fuzz::Args),
+    /// The Rust version Cargo.lock needs, checked against Cargo.toml and the README.
+    Msrv(msrv::Args),
+    /// One fuzz worker (started by `fuzz`).
+    #[command(hide = true)]
+    FuzzWorker(fuzz_worker::Args),
 }
 
 fn main() -> ExitCode {
@@ -56,6 +68,9 @@ fn main() -> ExitCode {
         Command::Ur10(args) => ur10::run(args),
         Command::UrdfCheck(args) => urdf_check::run(args),
         Command::CompensateCheck(args) => compensate_check::run(args),
+        Command::Fuzz(args) => fuzz::run(args).map_err(|e| format!("{e:#}")),
+        Command::Msrv(args) => msrv::run(args).map_err(|e| format!("{e:#}")),
+        Command::FuzzWorker(args) => fuzz_worker::run(args).map_err(|e| format!("{e:#}")),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -33,10 +33,10 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    if let Some(noise) = args.noise_mm {
-        if !(noise.is_finite() && noise > 0.0) {
-            return Err(format!("--noise-mm must be a positive number of millimetres, got {noise}").into());
-        }
+    if let Some(noise) = args.noise_mm
+        && !(noise.is_finite() && noise > 0.0)
+    {
+        return Err(format!("--noise-mm must be a positive number of millimetres, got {noise}").into());
     }
     let robot = args.robot.read()?;
     let read = ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());

@@ -25,6 +25,10 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
     let data = pipeline::read_measurements(&args.data, &options)?;
     let evaluation = pipeline::evaluate(&model, &data)?;
+    let finite = |e: &pipeline::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
+    if let Some((row, _)) = data.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
+        return Err(crate::predict::non_finite(&args.model, &data.source, row.line).into());
+    }
     if args.json {
         println!("{}", serde_json::to_string(&EvalReport::new(&model, &data, &evaluation))?);
         eprintln!("{}", data.read_summary());

@@ -25,6 +25,13 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let data = pipeline::read_configurations(&args.data, &options)?;
     let tools = pipeline::tool_indices(&model, &data)?;
     let predictions = model.predict(&data.rows, &tools)?;
+    let finite = |p: &pipeline::PredictedPose| {
+        let pose = p.pose;
+        pose.translation().iter().chain(pose.rotation().matrix().iter()).all(|v| v.is_finite())
+    };
+    if let Some(row) = data.rows.iter().zip(&predictions).find_map(|(row, p)| (!finite(p)).then_some(row)) {
+        return Err(non_finite(&args.model, &data.source, row.line).into());
+    }
     let stdout = std::io::stdout();
     let mut out = csv::Writer::from_writer(stdout.lock());
     let gp = model.compensation.is_some();
@@ -64,4 +71,13 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     std::io::stdout().flush()?;
     eprintln!("{}", data.read_summary());
     Ok(())
+}
+
+/// The refusal of a model that predicts a non-finite pose: a value in its file beyond any real
+/// range (the file's check accepts every finite number), never a NaN printed as an answer.
+pub(crate) fn non_finite(model: &std::path::Path, data: &str, line: u64) -> String {
+    format!(
+        "{}: the model predicts a non-finite pose for line {line} of {data}: a value in the model file is beyond any real range",
+        model.display()
+    )
 }

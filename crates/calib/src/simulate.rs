@@ -64,7 +64,7 @@ pub struct Args {
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let robot = args.robot.read()?;
     let effects = match &args.effects {
-        Some(path) => simulated::read_effects(path)?,
+        Some(path) => simulated::read_effects(path, &robot)?,
         None => simulated::paper_effects(),
     };
     if args.rows == 0 {

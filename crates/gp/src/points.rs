@@ -34,7 +34,7 @@ impl Points {
 
     /// Builds from row-major data; `data.len()` must be a multiple of `dim`.
     pub(crate) fn from_row_major(dim: usize, data: Vec<f64>) -> Self {
-        debug_assert!(dim > 0 && data.len() % dim == 0);
+        debug_assert!(dim > 0 && data.len().is_multiple_of(dim));
         Self { dim, data }
     }
 

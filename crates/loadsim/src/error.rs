@@ -91,7 +91,12 @@ impl fmt::Display for Error {
                 write!(f, "{field} has {given} entries, {expected} expected")
             }
             Error::UnknownJoint { field, joint_index, joint_count } => {
-                write!(f, "{field} names joint {} but the robot has {joint_count} joints", joint_index + 1)
+                // A user's file can hold usize::MAX: no overflow when numbering it from 1.
+                write!(
+                    f,
+                    "{field} names joint {} but the robot has {joint_count} joints",
+                    joint_index.saturating_add(1)
+                )
             }
             Error::InvalidParameter { field, value } => write!(f, "{field} = {value} is out of range"),
             Error::MissingDynamics { effect } => {
@@ -100,12 +105,12 @@ impl fmt::Display for Error {
             Error::EmptyJointRange { joint_index, lower_rad, upper_rad, margin_rad } => write!(
                 f,
                 "joint {} range [{lower_rad}, {upper_rad}] rad is empty after a margin of {margin_rad} rad",
-                joint_index + 1
+                joint_index.saturating_add(1)
             ),
             Error::SelfCoupling { joint_index } => write!(
                 f,
                 "coupling: joint {} is coupled to its own angle (a periodic error of its own angle is `periodic`)",
-                joint_index + 1
+                joint_index.saturating_add(1)
             ),
             Error::Campaign { field, needs, given, expected } => {
                 write!(f, "{field} needs {needs}: {given} given, {expected} needed")
@@ -124,5 +129,17 @@ impl std::error::Error for Error {
             Error::Kinematics { source } => Some(source),
             _ => None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Error;
+
+    #[test]
+    fn the_largest_joint_index_a_file_can_hold_is_shown_without_overflow() {
+        let error = Error::UnknownJoint { field: "backlash", joint_index: usize::MAX, joint_count: 6 };
+        assert_eq!(error.to_string(), format!("backlash names joint {} but the robot has 6 joints", usize::MAX));
+        assert!(Error::SelfCoupling { joint_index: usize::MAX }.to_string().contains(&usize::MAX.to_string()));
     }
 }

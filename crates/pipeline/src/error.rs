@@ -372,6 +372,11 @@ pub enum Error {
         /// The underlying error.
         source: gp::Error,
     },
+    /// A simulated pose that is not finite: an effect or a robot beyond any real range.
+    NonFiniteSimulation {
+        /// 1-based row of the simulated set.
+        row: usize,
+    },
     /// Too few rows for what was asked.
     TooFewRows {
         /// The file.
@@ -543,6 +548,10 @@ impl fmt::Display for Error {
             Error::Kinematics { source } => write!(f, "{source}"),
             Error::Load { source } => write!(f, "load model: {source}"),
             Error::Gp { source } => write!(f, "Gaussian process: {source}"),
+            Error::NonFiniteSimulation { row } => write!(
+                f,
+                "simulated row {row} is not finite: an effect or the robot is beyond any real range (nothing written)"
+            ),
             Error::TooFewRows { file, rows, needed } => {
                 write!(f, "{file}: {rows} measurement rows, at least {needed} needed")
             }

@@ -31,25 +31,25 @@ pub(crate) fn check_values(robot: &RobotDescription, text: &str, file: &str) -> 
     if let Some(value) = first_bad(&dynamics.gravity_m_per_s2) {
         return Err(not_finite("gravity_m_per_s2", 0, "gravity_m_per_s2".into(), value));
     }
-    if let Some(balancer) = &dynamics.counterbalance {
-        if let Err(error) = balancer.validate(robot.joint_count()) {
-            // loadsim names the field as `counterbalance.<name>`; the file writes `<name>:`.
-            let (field, message) = match &error {
-                loadsim::Error::InvalidParameter { field, value } if !value.is_finite() => {
-                    let name = field.rsplit('.').next().unwrap_or(field);
-                    return Err(not_finite(name, 0, format!("counterbalance.{name}"), *value));
-                }
-                loadsim::Error::InvalidParameter { field, .. } => {
-                    (field.rsplit('.').next().unwrap_or("counterbalance"), error.to_string())
-                }
-                loadsim::Error::UnknownJoint { .. } => ("joint_index", error.to_string()),
-                _ => ("counterbalance", error.to_string()),
-            };
-            // The radii-difference check names no single field: point at the first radius.
-            let field = if field.contains(' ') { "anchor_radius_m" } else { field };
-            let (line, column) = field_position(text, field, 0);
-            return Err(Error::RonFormat { file: file.to_owned(), line, column, message });
-        }
+    if let Some(balancer) = &dynamics.counterbalance
+        && let Err(error) = balancer.validate(robot.joint_count())
+    {
+        // loadsim names the field as `counterbalance.<name>`; the file writes `<name>:`.
+        let (field, message) = match &error {
+            loadsim::Error::InvalidParameter { field, value } if !value.is_finite() => {
+                let name = field.rsplit('.').next().unwrap_or(field);
+                return Err(not_finite(name, 0, format!("counterbalance.{name}"), *value));
+            }
+            loadsim::Error::InvalidParameter { field, .. } => {
+                (field.rsplit('.').next().unwrap_or("counterbalance"), error.to_string())
+            }
+            loadsim::Error::UnknownJoint { .. } => ("joint_index", error.to_string()),
+            _ => ("counterbalance", error.to_string()),
+        };
+        // The radii-difference check names no single field: point at the first radius.
+        let field = if field.contains(' ') { "anchor_radius_m" } else { field };
+        let (line, column) = field_position(text, field, 0);
+        return Err(Error::RonFormat { file: file.to_owned(), line, column, message });
     }
     Ok(())
 }

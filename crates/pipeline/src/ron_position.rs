@@ -28,8 +28,26 @@ pub(crate) fn ron_options() -> ron::Options {
 /// 1-based line and column of the `index`-th (0-based) occurrence of `field:` in `text` outside
 /// comments and strings; (1, 1) when there are not that many.
 pub(crate) fn field_position(text: &str, field: &str, index: usize) -> (usize, usize) {
+    occurrences(text, field).get(index).map_or((1, 1), |&(_, line, column)| (line, column))
+}
+
+/// The position of the `index`-th occurrence of `field:` after the first `section:` (a field of a
+/// nested struct, say the third `joint_index` in `periodic`); the section's own position when there
+/// are not that many (the field left out, its default used), and (1, 1) without the section.
+pub(crate) fn field_position_in(text: &str, section: &str, field: &str, index: usize) -> (usize, usize) {
+    let Some(&(start, line, column)) = occurrences(text, section).first() else { return (1, 1) };
+    occurrences(text, field)
+        .into_iter()
+        .filter(|&(offset, _, _)| offset > start)
+        .nth(index)
+        .map_or((line, column), |(_, line, column)| (line, column))
+}
+
+/// Byte offset, 1-based line and column of every occurrence of `field:` in `text` outside comments
+/// and strings, in order.
+fn occurrences(text: &str, field: &str) -> Vec<(usize, usize, usize)> {
     let bytes = text.as_bytes();
-    let mut seen = 0;
+    let mut found = Vec::new();
     let (mut line, mut column) = (1, 1);
     let mut i = 0;
     while i < bytes.len() {
@@ -61,21 +79,18 @@ pub(crate) fn field_position(text: &str, field: &str, index: usize) -> (usize, u
         }
         let boundary = i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_');
         if boundary && rest.starts_with(field) && rest[field.len()..].trim_start().starts_with(':') {
-            if seen == index {
-                return (line, column);
-            }
-            seen += 1;
+            found.push((i, line, column));
         }
         let c = rest.chars().next().unwrap_or(' ');
         (line, column) = if c == '\n' { (line + 1, 1) } else { (line, column + 1) };
         i += c.len_utf8();
     }
-    (1, 1)
+    found
 }
 
 #[cfg(test)]
 mod tests {
-    use super::{field_position, text_of};
+    use super::{field_position, field_position_in, text_of};
 
     #[test]
     fn bytes_that_are_not_utf8_are_placed_at_their_line_and_column() {
@@ -89,5 +104,14 @@ mod tests {
         assert_eq!(field_position(text, "axis", 0), (3, 3));
         assert_eq!(field_position(text, "axis", 1), (3, 20));
         assert_eq!(field_position(text, "axis", 2), (1, 1));
+    }
+
+    #[test]
+    fn a_field_is_found_within_its_section_or_the_section_stands_for_it() {
+        let text = "(backlash: (joints: [(joint_index: 1)]),\n periodic: (harmonics: [\n  (joint_index: 0),\n  (joint_index: 9)]))";
+        assert_eq!(field_position_in(text, "periodic", "joint_index", 1), (4, 4));
+        assert_eq!(field_position_in(text, "backlash", "joint_index", 0), (1, 23));
+        assert_eq!(field_position_in(text, "periodic", "order", 0), (2, 2));
+        assert_eq!(field_position_in(text, "thermal", "order", 0), (1, 1));
     }
 }

@@ -11,7 +11,7 @@
 use crate::xml_outline::{Element, Position, outline};
 use crate::{Error, FlangeDescription, JointDescription, JointType, RobotDescription};
 use lie::{SE3, SO3, Vector3};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 /// Which links the chain runs between; `None` picks the only candidate or refuses.
@@ -79,6 +79,21 @@ pub struct UrdfDocument {
     text: String,
     robot: urdf_rs::Robot,
     outline: Element,
+    /// Indices looked up by name, so that every walk of the tree stays linear in its size (a
+    /// file of 100,000 links took minutes with scans of the lists; found by `cargo xtask fuzz`).
+    index: NameIndex,
+}
+
+/// The links, joints and top-level elements of a URDF by name.
+#[derive(Debug, Clone, Default)]
+struct NameIndex {
+    links: HashSet<String>,
+    /// Child link → the joint (index into `robot.joints`) it hangs from.
+    parent_joint: HashMap<String, usize>,
+    /// Parent link → the joints below it, in file order.
+    child_joints: HashMap<String, Vec<usize>>,
+    /// `(element name, name attribute)` → index among the outline's children (the first one).
+    elements: HashMap<(String, String), usize>,
 }
 
 /// Largest allowed `|axis|` below which a joint axis counts as zero.
@@ -88,7 +103,8 @@ impl UrdfDocument {
     /// Reads and checks a URDF file.
     pub fn read(path: &Path) -> Result<Self, Error> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+        // Bytes that are not UTF-8 are refused at their line and column, like a RON file's.
+        let text = crate::ron_position::read_text(path)?;
         Self::parse(&text, &file)
     }
 
@@ -119,7 +135,8 @@ impl UrdfDocument {
                 .map_or(root.position, |offset| line_column(text, offset));
             at(position, format!("URDF: {message}"))
         })?;
-        let document = Self { file: file.to_owned(), text: text.to_owned(), robot, outline: root };
+        let mut document =
+            Self { file: file.to_owned(), text: text.to_owned(), robot, outline: root, index: NameIndex::default() };
         document.check_structure()?;
         Ok(document)
     }
@@ -146,7 +163,8 @@ impl UrdfDocument {
 
     /// The top-level element `<kind name="name">` of the outline.
     pub(crate) fn element(&self, kind: &str, name: &str) -> Option<&Element> {
-        self.outline.children.iter().find(|e| e.name == kind && e.attribute("name") == Some(name))
+        let index = self.index.elements.get(&(kind.to_owned(), name.to_owned()))?;
+        self.outline.children.get(*index)
     }
 
     /// An error at the element `<kind name="name">` (or at `<robot>` if there is none).
@@ -155,37 +173,47 @@ impl UrdfDocument {
         Error::UrdfFormat { file: self.file.clone(), line, column, message }
     }
 
-    fn check_structure(&self) -> Result<(), Error> {
-        for kind in ["link", "joint"] {
-            let mut seen: Vec<&str> = Vec::new();
-            for element in self.outline.children.iter().filter(|e| e.name == kind) {
-                let Some(name) = element.attribute("name") else {
-                    return Err(self.at(element.position, format!("<{kind}> has no name")));
-                };
-                if seen.contains(&name) {
-                    return Err(self.at(element.position, format!("a second {kind} named '{name}'")));
+    /// Checks names (present, unique, joints naming defined links, one parent per link) and
+    /// builds the name index.
+    fn check_structure(&mut self) -> Result<(), Error> {
+        let mut index = NameIndex::default();
+        for (k, element) in self.outline.children.iter().enumerate() {
+            let kind = element.name.as_str();
+            if !matches!(kind, "link" | "joint") {
+                if let Some(name) = element.attribute("name") {
+                    index.elements.entry((kind.to_owned(), name.to_owned())).or_insert(k);
                 }
-                seen.push(name);
+                continue;
+            }
+            let Some(name) = element.attribute("name") else {
+                return Err(self.at(element.position, format!("<{kind}> has no name")));
+            };
+            if index.elements.insert((kind.to_owned(), name.to_owned()), k).is_some() {
+                return Err(self.at(element.position, format!("a second {kind} named '{name}'")));
             }
         }
-        let mut parent_of: HashMap<&str, &str> = HashMap::new();
-        for (joint, element) in self.robot.joints.iter().zip(self.outline.children.iter().filter(|e| e.name == "joint"))
+        index.links = self.robot.links.iter().map(|l| l.name.clone()).collect();
+        for (j, (joint, element)) in
+            self.robot.joints.iter().zip(self.outline.children.iter().filter(|e| e.name == "joint")).enumerate()
         {
             for link in [&joint.parent.link, &joint.child.link] {
-                if !self.robot.links.iter().any(|l| l.name == *link) {
+                if !index.links.contains(link) {
                     return Err(self.at(
                         element.position,
                         format!("joint '{}' names link '{link}', which is not defined", joint.name),
                     ));
                 }
             }
-            if let Some(other) = parent_of.insert(&joint.child.link, &joint.name) {
+            if let Some(other) = index.parent_joint.insert(joint.child.link.clone(), j) {
+                let other = &self.robot.joints[other].name;
                 return Err(self.at(
                     element.position,
                     format!("link '{}' is the child of joints '{other}' and '{}'", joint.child.link, joint.name),
                 ));
             }
+            index.child_joints.entry(joint.parent.link.clone()).or_default().push(j);
         }
+        self.index = index;
         Ok(())
     }
 
@@ -195,11 +223,11 @@ impl UrdfDocument {
 
     /// The joint of which `link` is the child.
     fn parent_joint(&self, link: &str) -> Option<&urdf_rs::Joint> {
-        self.robot.joints.iter().find(|j| j.child.link == link)
+        self.index.parent_joint.get(link).and_then(|&j| self.robot.joints.get(j))
     }
 
     fn link_exists(&self, link: &str, flag: &str) -> Result<(), Error> {
-        if self.robot.links.iter().any(|l| l.name == link) {
+        if self.index.links.contains(link) {
             return Ok(());
         }
         let known: Vec<&str> = self.robot.links.iter().map(|l| l.name.as_str()).collect();
@@ -225,16 +253,17 @@ impl UrdfDocument {
         // Ancestors of each end, nearest first, as (link, joint above it).
         let up = |from: &str| {
             let mut path = vec![from.to_owned()];
+            let mut on_path: HashSet<String> = path.iter().cloned().collect();
             while let Some(joint) = self.parent_joint(path.last().map_or("", String::as_str)) {
-                if path.contains(&joint.parent.link) {
+                if !on_path.insert(joint.parent.link.clone()) {
                     break;
                 }
                 path.push(joint.parent.link.clone());
             }
-            path
+            (path, on_path)
         };
-        let (from_base, from_tip) = (up(&base), up(&tip));
-        let Some(meet) = from_base.iter().position(|l| from_tip.contains(l)) else {
+        let ((from_base, _), (from_tip, tip_links)) = (up(&base), up(&tip));
+        let Some(meet) = from_base.iter().position(|l| tip_links.contains(l)) else {
             return Err(self.error_at("link", &tip, format!("no chain joins base link '{base}' and tip link '{tip}'")));
         };
         let down = from_tip.iter().position(|l| *l == from_base[meet]).unwrap_or(0);
@@ -272,13 +301,12 @@ impl UrdfDocument {
     /// The highest link reached from `link` up through fixed joints: the chain may start there.
     fn fixed_top(&self, link: &str) -> String {
         let mut top = link.to_owned();
-        let mut seen = vec![top.clone()];
+        let mut seen = HashSet::from([top.clone()]);
         while let Some(joint) = self.parent_joint(&top).filter(|j| j.joint_type == urdf_rs::JointType::Fixed) {
-            if seen.contains(&joint.parent.link) {
+            if !seen.insert(joint.parent.link.clone()) {
                 break;
             }
             top = joint.parent.link.clone();
-            seen.push(top.clone());
         }
         top
     }
@@ -287,15 +315,15 @@ impl UrdfDocument {
     /// base in messages).
     fn deepest_leaf(&self, top: &str, base: &str) -> Result<String, Error> {
         let mut leaves: Vec<(String, usize)> = Vec::new();
-        let mut visited: Vec<String> = Vec::new();
+        let mut visited: HashSet<String> = HashSet::new();
         let mut stack = vec![(top.to_owned(), 0usize)];
         while let Some((link, movable)) = stack.pop() {
             // A loop of joints (no root) would otherwise be walked for ever.
-            if visited.contains(&link) {
+            if !visited.insert(link.clone()) {
                 continue;
             }
-            visited.push(link.clone());
-            let children: Vec<&urdf_rs::Joint> = self.robot.joints.iter().filter(|j| j.parent.link == link).collect();
+            let below = self.index.child_joints.get(&link).map_or(&[][..], Vec::as_slice);
+            let children: Vec<&urdf_rs::Joint> = below.iter().filter_map(|&j| self.robot.joints.get(j)).collect();
             if children.is_empty() {
                 leaves.push((link, movable));
             }
@@ -371,7 +399,9 @@ impl UrdfDocument {
         if motion != StepMotion::Fixed && axis.norm() < ZERO_AXIS {
             return Err(refuse("the axis is zero".into()));
         }
-        let [roll, pitch, yaw] = *joint.origin.rpy;
+        // Each angle brought into one turn first: the rotation is the same, and an angle such as
+        // 1e308 no longer overflows the exponential map into NaN (found by `cargo xtask fuzz`).
+        let [roll, pitch, yaw] = joint.origin.rpy.map(|a| a.rem_euclid(std::f64::consts::TAU));
         let origin = SE3::new(SO3::from_rpy(roll, pitch, yaw), Vector3::from(*joint.origin.xyz));
         let (from_link, to_link) = if reversed {
             (joint.child.link.clone(), joint.parent.link.clone())
@@ -385,7 +415,9 @@ impl UrdfDocument {
             reversed,
             motion,
             from_to: if reversed { origin.inverse() } else { origin },
-            axis: if motion == StepMotion::Fixed { Vector3::z() } else { axis.normalize() },
+            // Scaled by its largest component before normalising: `0 -1e308 1` overflowed the norm
+            // into a NaN axis (found by `cargo xtask fuzz`).
+            axis: if motion == StepMotion::Fixed { Vector3::z() } else { (axis / axis.amax()).normalize() },
         })
     }
 }

@@ -34,6 +34,12 @@ impl Element {
     }
 }
 
+/// Deepest nesting of elements accepted. A URDF is four levels deep (`robot`, `link`, `visual`,
+/// `geometry`, `mesh`), xacro-expanded files and `<gazebo>` blocks a few more; the outline and
+/// its users recurse once per level, so a hostile file nested 200,000 deep would overflow the
+/// stack (the process aborts, no message) where it is now refused at the element too deep.
+pub(crate) const MAX_DEPTH: usize = 256;
+
 /// A syntax error: where, and what.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct SyntaxError {
@@ -112,6 +118,8 @@ fn start_tag(cursor: &mut Cursor<'_>, position: Position) -> Result<StartTag, Sy
         return Err(SyntaxError { position, message: "'<' is not followed by an element name".into() });
     }
     let mut attributes = Vec::new();
+    // Names seen, so that an element with 100,000 attributes is read in linear time.
+    let mut seen = std::collections::HashSet::new();
     loop {
         cursor.skip_space();
         let rest = cursor.rest();
@@ -150,7 +158,7 @@ fn start_tag(cursor: &mut Cursor<'_>, position: Position) -> Result<StartTag, Sy
         };
         let value = decode(&cursor.rest()[..end]);
         cursor.advance(end + 1);
-        if attributes.iter().any(|(n, _)| *n == attribute) {
+        if !seen.insert(attribute.clone()) {
             return Err(SyntaxError {
                 position: attribute_at.position,
                 message: format!("attribute '{attribute}' appears twice"),
@@ -210,6 +218,15 @@ pub(crate) fn outline(text: &str) -> Result<Element, SyntaxError> {
             if root.is_some() && open.is_empty() {
                 return Err(SyntaxError { position, message: format!("<{name}> follows the root element") });
             }
+            if open.len() >= MAX_DEPTH {
+                return Err(SyntaxError {
+                    position,
+                    message: format!(
+                        "<{name}> is nested {} elements deep, at most {MAX_DEPTH} are read",
+                        open.len() + 1
+                    ),
+                });
+            }
             let element = Element { name, attributes, position, span: (start, cursor.at), children: Vec::new() };
             match (closed, open.last_mut()) {
                 (false, _) => open.push(element),
@@ -244,6 +261,8 @@ mod tests {
 
     #[test]
     fn syntax_errors_are_found_at_their_line_and_column() {
+        // 200,000 levels overflowed the stack (found by `cargo xtask fuzz`); MAX_DEPTH + 1 is refused.
+        let deep = "<a>".repeat(200_000) + &"</a>".repeat(200_000);
         for (text, position, words) in [
             ("<robot>\n  <link name=\"a\">\n</robot>", (3, 1), "does not match <link> opened at line 2, column 3"),
             ("<robot>\n  <link name=\"a\"/>", (1, 1), "<robot> is never closed"),
@@ -252,6 +271,7 @@ mod tests {
             ("<robot>\n <!-- open\n</robot>", (2, 2), "comment is not closed"),
             ("<robot/>\n<robot/>", (2, 1), "follows the root element"),
             ("<robot>\n  <link name=\"a\" name=\"b\"/>\n</robot>", (2, 18), "appears twice"),
+            (deep.as_str(), (1, 1 + 3 * MAX_DEPTH), "nested 257 elements deep"),
         ] {
             let error = outline(text).unwrap_err();
             assert_eq!(error.position, position, "{text}: {}", error.message);

@@ -146,3 +146,28 @@ fn a_urdf_with_prismatic_continuous_and_tilted_axes_moves_like_its_joints() {
         assert!(difference < 1e-12, "{q:?}: {difference:e} m");
     }
 }
+
+#[test]
+fn origin_angles_and_axes_of_any_size_give_the_motion_they_mean() {
+    // rpy = 1e308 overflowed the exponential map into a NaN pose (found by `cargo xtask fuzz`).
+    let arm = |rpy: &str, axis: &str| {
+        let text = format!(
+            r#"<robot name="r"><link name="a"/><link name="b"/><link name="tip"/>
+  <joint name="j1" type="continuous"><parent link="a"/><child link="b"/><origin xyz="0 0 0.3" rpy="{rpy}"/><axis xyz="{axis}"/></joint>
+  <joint name="end" type="fixed"><parent link="b"/><child link="tip"/><origin xyz="0.4 0.1 0" rpy="0 0 0"/></joint>
+</robot>"#
+        );
+        let chain = UrdfDocument::parse(&text, "r.urdf").unwrap().chain(&ChainEnds::default()).unwrap();
+        chain.description().nominal_model().unwrap()
+    };
+    let huge = arm("1e308 -1e308 1e300", "0 0 1");
+    let pose = huge.forward(&[0.7], 0).unwrap();
+    assert!(pose.translation().iter().chain(pose.rotation().matrix().iter()).all(|v| v.is_finite()), "{pose:?}");
+    let tau = std::f64::consts::TAU;
+    let plain = arm(&format!("{} {} {}", 7.0 - tau, -8.0 + 2.0 * tau, 9.0 - tau), "0 0.6 0.8");
+    let difference = largest_difference_m(&arm("7 -8 9", "0 0.6 0.8"), &plain);
+    assert!(difference < 1e-12, "{difference:e} m");
+    // An axis of any length is its direction: `0 -1e308 1` overflowed the norm into a NaN axis.
+    let difference = largest_difference_m(&arm("0 0 0", "0 -1e308 1"), &arm("0 0 0", "0 -1 0"));
+    assert!(difference < 1e-12, "{difference:e} m");
+}

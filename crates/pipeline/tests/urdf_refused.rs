@@ -70,6 +70,27 @@ fn xml_that_is_not_well_formed_is_refused_where_it_breaks() {
 }
 
 #[test]
+fn bytes_that_are_not_utf8_are_refused_at_their_line_and_column() {
+    let folder = tempfile::tempdir().unwrap();
+    let path = folder.path().join("arm.urdf");
+    let mut bytes = ARM.as_bytes().to_vec();
+    let at = ARM.find("<link name=\"tip\"/>").unwrap() + "<link name=\"".len();
+    bytes.insert(at, 0xff);
+    std::fs::write(&path, bytes).unwrap();
+    let message = RobotDescription::read(&path).unwrap_err().to_string();
+    assert_eq!(message, format!("{}:5:15: the text is not UTF-8", path.display()));
+}
+
+#[test]
+fn a_file_nested_deeper_than_any_urdf_is_refused_not_a_stack_overflow() {
+    // 200,000 nested elements aborted the process on a stack overflow (found by `cargo xtask fuzz`).
+    let deep = format!("<robot name=\"r\">\n{}{}</robot>\n", "<a>".repeat(200_000), "</a>".repeat(200_000));
+    let (line, column, message) = refuse(&deep);
+    assert_eq!((line, column), (2, 1 + 3 * 255), "{message}");
+    assert!(message.contains("nested 257 elements deep"), "{message}");
+}
+
+#[test]
 fn a_xacro_file_or_another_root_is_refused() {
     assert_refused(
         &ARM.replace("<robot name=\"arm\">", "<robot name=\"arm\" xmlns:xacro=\"http://ros.org/wiki/xacro\">"),

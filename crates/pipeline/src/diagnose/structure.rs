@@ -31,10 +31,10 @@ fn inputs(data: &MeasurementSet) -> Mat<f64> {
         (0..data.joint_count).map(|j| data.rows.iter().map(|r| r.q[j]).collect()).collect();
     let extra: [Column; 3] = [|r| Some(r.payload_kg), |r| r.temp_c, |r| r.t_s];
     for key in extra {
-        if let Some(values) = data.rows.iter().map(key).collect::<Option<Vec<f64>>>() {
-            if values.iter().any(|v| (v - values[0]).abs() > 1e-9) {
-                columns.push(values);
-            }
+        if let Some(values) = data.rows.iter().map(key).collect::<Option<Vec<f64>>>()
+            && values.iter().any(|v| (v - values[0]).abs() > 1e-9)
+        {
+            columns.push(values);
         }
     }
     Mat::from_fn(data.rows.len(), columns.len(), |i, c| columns[c][i])

@@ -4,6 +4,7 @@
 use super::ColumnMap;
 use crate::Error;
 use poe::JointKind;
+use std::collections::HashSet;
 
 /// A quantity the SPEC names, with the factor that turns its unit into SI.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -140,6 +141,10 @@ impl Layout {
         let width = header.len();
         let at_end = |name: String| Error::MissingColumn { file: file.to_owned(), line: 1, column: width + 1, name };
         let mut names: Vec<String> = Vec::with_capacity(width);
+        // Sets, not scans of the lists: a header of 400,000 columns took minutes when each name was
+        // compared with every earlier one (found by `cargo xtask fuzz`).
+        let mut seen: HashSet<String> = HashSet::with_capacity(width);
+        let (mut joint_numbers, mut torque_numbers) = (HashSet::new(), HashSet::new());
         let mut joints: Vec<(usize, Column, JointKind)> = Vec::new();
         let mut torques: Vec<(usize, Column)> = Vec::new();
         let mut position = [None; 3];
@@ -152,20 +157,18 @@ impl Layout {
             let name = expect.columns.target_of(raw).unwrap_or(raw).to_owned();
             let duplicate =
                 || Error::DuplicateColumn { file: file.to_owned(), line: 1, column: index + 1, name: name.clone() };
-            if names.contains(&name) {
+            if !seen.insert(name.clone()) {
                 return Err(duplicate());
             }
             let column = |scale| Column { index, scale };
             let fresh = match quantity(&name) {
                 Some(Quantity::Joint { index: k, kind, scale }) => {
-                    let fresh = joints.iter().all(|(j, _, _)| *j != k);
                     joints.push((k, column(scale), kind));
-                    fresh
+                    joint_numbers.insert(k)
                 }
                 Some(Quantity::Torque(k)) => {
-                    let fresh = torques.iter().all(|(j, _)| *j != k);
                     torques.push((k, column(1.0)));
-                    fresh
+                    torque_numbers.insert(k)
                 }
                 Some(Quantity::Position { axis, scale }) => position[axis].replace(column(scale)).is_none(),
                 Some(Quantity::Quaternion(k)) => quaternion[k].replace(column(1.0)).is_none(),
@@ -209,10 +212,10 @@ impl Layout {
                 joints: n,
             });
         }
-        if !torques.is_empty() {
-            if let Some(k) = (1..=n).find(|k| torques.get(k - 1).is_none_or(|(j, _)| j != k)) {
-                return Err(at_end(format!("tau{k}_nm")));
-            }
+        if !torques.is_empty()
+            && let Some(k) = (1..=n).find(|k| torques.get(k - 1).is_none_or(|(j, _)| j != k))
+        {
+            return Err(at_end(format!("tau{k}_nm")));
         }
 
         let any_position = position.iter().any(Option::is_some);

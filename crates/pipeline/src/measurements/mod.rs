@@ -20,6 +20,7 @@ use lie::{SO3, Vector3};
 use poe::JointKind;
 use row::{Row, syntax_error};
 use serde::Serialize;
+use std::collections::HashMap;
 use std::fmt;
 use std::io::Read;
 use std::path::Path;
@@ -211,6 +212,8 @@ fn parse_keeping<R: Read>(
     }
     let joints: Vec<Column> = layout.joints.iter().map(|(c, _)| *c).collect();
     let mut tools: Vec<String> = Vec::new();
+    // Each tool's index by name: a file whose every row names another tool stays linear.
+    let mut tool_index: HashMap<String, usize> = HashMap::new();
     let mut rows = Vec::new();
     let mut record = csv::StringRecord::new();
     loop {
@@ -244,13 +247,10 @@ fn parse_keeping<R: Read>(
         let t_s = layout.time.map(|c| row.number(c)).transpose()?;
         let torques_nm = if layout.torques.is_empty() { None } else { Some(row.numbers(&layout.torques)?) };
         let tool_name = layout.tool.and_then(|i| record.get(i)).unwrap_or("");
-        let tool = match tools.iter().position(|t| t == tool_name) {
-            Some(t) => t,
-            None => {
-                tools.push(tool_name.to_owned());
-                tools.len() - 1
-            }
-        };
+        let tool = *tool_index.entry(tool_name.to_owned()).or_insert_with(|| {
+            tools.push(tool_name.to_owned());
+            tools.len() - 1
+        });
         rows.push(Measurement { line, q, position, orientation, payload_kg, tool, temp_c, t_s, torques_nm });
         if let Some(cells) = cells.as_deref_mut() {
             cells.rows.push(record.iter().map(str::to_owned).collect());

@@ -27,16 +27,19 @@
 //! The loadsim types a caller needs to configure a campaign are re-exported here, so that the
 //! `calib` binary depends on this crate alone.
 
-use crate::ron_position::{field_position, ron_options};
+mod effects_file;
+
 use crate::{Error, Measurement, MeasurementSet, RobotDescription};
 use lie::{SE3, SO3, Twist, Vector3};
 use poe::LocalPoe;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use ron::Value;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
+pub use effects_file::{
+    MAX_DRIFT_PER_S, MAX_EXPANSION_PER_K, MAX_FIXED_POINT_ITERATIONS, MAX_JOINT_ERROR_RAD, MAX_NOISE, MAX_ORDER,
+    MAX_TEMPERATURE_C, check_effects, parse_effects, read_effects,
+};
 pub use loadsim::{
     CouplingFactor, CouplingTerm, Effects, GeneratorConfig, JointCompliance, JointCoupling, JointRange, Sample,
     SimulatedCell, TorqueSensorNoise, TrackerNoise,
@@ -261,56 +264,16 @@ pub fn simulate(
     full_pose: bool,
 ) -> Result<MeasurementSet, Error> {
     let samples = loadsim::generate(cell, effects, ranges, config)?;
+    // Never a data set with a NaN in it: an effect or a robot out of any real range can overflow.
+    let finite = |s: &Sample| {
+        let pose = s.tracker_from_tool;
+        let numbers = pose.translation().iter().chain(pose.rotation().matrix().iter()).copied().collect::<Vec<f64>>();
+        numbers.into_iter().chain(s.q.iter().copied()).chain(s.torques_nm.iter().flatten().copied()).all(f64::is_finite)
+    };
+    if let Some(row) = samples.iter().position(|s| !finite(s)) {
+        return Err(Error::NonFiniteSimulation { row: row + 1 });
+    }
     Ok(measurement_set("simulated", samples, full_pose))
-}
-
-/// Reads an [`Effects`] RON file (fields left out are off; `Some(..)` may be omitted).
-pub fn read_effects(path: &Path) -> Result<Effects, Error> {
-    let text = crate::ron_position::read_text(path)?;
-    parse_effects(&text, &path.display().to_string())
-}
-
-/// Parses an [`Effects`] RON text; `file` names it in errors. A field name that no effect has is
-/// refused at its line: serde would skip it, and a misspelt effect would silently stay off.
-pub fn parse_effects(text: &str, file: &str) -> Result<Effects, Error> {
-    let at =
-        |line: usize, column: usize, message: String| Error::RonFormat { file: file.to_owned(), line, column, message };
-    let syntax = |e: ron::error::SpannedError| at(e.span.start.line, e.span.start.col, e.code.to_string());
-    let effects: Effects = ron_options().from_str(text).map_err(syntax)?;
-    let given: Value = ron_options().from_str(text).map_err(syntax)?;
-    // The parsed effects written back hold every field they know, switched on or not.
-    let known = ron::to_string(&effects)
-        .ok()
-        .and_then(|written| ron::from_str::<Value>(&written).ok())
-        .ok_or_else(|| at(1, 1, "the effects do not write back as RON".into()))?;
-    match unknown_field(&given, &known) {
-        Some(name) => {
-            let (line, column) = field_position(text, &name, 0);
-            Err(at(line, column, format!("unknown field `{name}`")))
-        }
-        None => Ok(effects),
-    }
-}
-
-/// The first field name in `given` that `known` lacks, at any depth.
-fn unknown_field(given: &Value, known: &Value) -> Option<String> {
-    fn unwrap(value: &Value) -> &Value {
-        match value {
-            Value::Option(Some(inner)) => unwrap(inner),
-            other => other,
-        }
-    }
-    match (unwrap(given), unwrap(known)) {
-        (Value::Map(given), Value::Map(known)) => given.iter().find_map(|(key, value)| match known.get(key) {
-            Some(inner) => unknown_field(value, inner),
-            None => Some(match key {
-                Value::String(name) => name.clone(),
-                other => format!("{other:?}"),
-            }),
-        }),
-        (Value::Seq(given), Value::Seq(known)) => given.iter().zip(known).find_map(|(a, b)| unknown_field(a, b)),
-        _ => None,
-    }
 }
 
 #[cfg(test)]
@@ -353,6 +316,17 @@ mod tests {
     }
 
     #[test]
+    fn a_simulation_that_overflows_is_refused_not_written() {
+        let robot = irb4400();
+        let cell = simulated_cell(&robot, &Perturbation::default(), 1).unwrap();
+        let config = GeneratorConfig { sample_count: 3, ..GeneratorConfig::default() };
+        let noise = TrackerNoise { transverse_sigma_per_m: 1e308, ..TrackerNoise::default() };
+        let effects = Effects { tracker_noise: Some(noise), ..Effects::default() };
+        let result = simulate(&cell, &effects, &joint_ranges(&robot), &config, true);
+        assert!(matches!(result, Err(Error::NonFiniteSimulation { row: 1 })), "{result:?}");
+    }
+
+    #[test]
     fn a_payload_run_campaign_has_a_remounted_tool_per_run_fixed_joints_and_torques() {
         let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/iiwa7.ron");
         let robot = RobotDescription::read(&path).unwrap();
@@ -380,34 +354,5 @@ mod tests {
         let plain = campaign_cell(&robot, &Perturbation::default(), &Remount::default(), &one_tool).unwrap();
         assert_eq!(plain, simulated_cell(&robot, &Perturbation::default(), 2).unwrap());
         assert_eq!(cell.robot.tools()[0], plain.robot.tools()[0]);
-    }
-
-    #[test]
-    fn an_effects_file_with_a_typo_is_refused_at_its_line() {
-        let good = parse_effects("(compliance: (payload_only: true), tracker_noise: ())", "e.ron").unwrap();
-        assert_eq!(good.compliance, Some(JointCompliance { payload_only: true, ..JointCompliance::default() }));
-        assert_eq!(good.tracker_noise, Some(TrackerNoise::default()));
-        let coupled = parse_effects(
-            "(coupling: (terms: [(joint_index: 2, amplitude_rad: 1e-3, factors: [(source_joint_index: 1, order: 2.0, phase_rad: 0.0)])]))",
-            "e.ron",
-        )
-        .unwrap();
-        assert_eq!(coupled.coupling.map(|c| c.terms[0].factors[0].order), Some(2.0));
-        for (text, line) in [
-            ("(\n  complaince: (),\n)", 2),
-            ("(\n  compliance: (),\n  tracker_noise: (\n    radial_sigma: 1e-5),\n)", 4),
-            ("(\n  compliance: (payload_only: maybe),\n)", 2),
-            (
-                "(\n  coupling: (terms: [(joint_index: 2, amplitude_rad: 1e-3,\n    factors: [(source_joint: 1, order: 1.0, phase_rad: 0.0)])]),\n)",
-                3,
-            ),
-        ] {
-            match parse_effects(text, "e.ron") {
-                Err(Error::RonFormat { file, line: at, .. }) => {
-                    assert_eq!((file.as_str(), at), ("e.ron", line), "{text}")
-                }
-                other => panic!("{text}: {other:?}"),
-            }
-        }
     }
 }
