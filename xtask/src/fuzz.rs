@@ -20,7 +20,8 @@ use std::time::{Duration, Instant};
 /// Feed every reader generated inputs; fail on any panic, crash, hang or unlocated refusal.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Which reader: csv, robot, model, effects, or all of them.
+    /// Which reader: csv, robot, model, effects (`calib simulate`), effects-list (`calib fit
+    /// --effects`), options (`calib fit --options`), or all of them.
     #[arg(long, default_value = "all")]
     reader: ReaderChoice,
     /// Inputs per reader.
@@ -56,6 +57,8 @@ enum ReaderChoice {
     Robot,
     Model,
     Effects,
+    EffectsList,
+    Options,
     All,
 }
 
@@ -66,6 +69,8 @@ impl ReaderChoice {
             ReaderChoice::Robot => vec![Reader::Robot],
             ReaderChoice::Model => vec![Reader::Model],
             ReaderChoice::Effects => vec![Reader::Effects],
+            ReaderChoice::EffectsList => vec![Reader::EffectsList],
+            ReaderChoice::Options => vec![Reader::Options],
             ReaderChoice::All => Reader::ALL.to_vec(),
         }
     }

@@ -4,6 +4,7 @@
 //! model files written by `calib fit`'s writer for every kind of part, and effects files.
 
 use anyhow::{Context, Result};
+use pipeline::effects::{EffectSelection, EffectSpec};
 use pipeline::simulated::{self, Effects, GeneratorConfig, JointCoupling, Perturbation, Remount};
 use pipeline::{FitOptions, MeasurementSet, Method, RobotDescription};
 use poe::JointKind;
@@ -20,11 +21,16 @@ pub enum Reader {
     Model,
     /// The effects RON of `calib simulate --effects`.
     Effects,
+    /// The `--effects LIST` argument of `calib fit`.
+    EffectsList,
+    /// The `--options FIT.ron` file of `calib fit`.
+    Options,
 }
 
 impl Reader {
     /// Every reader, in the order `--reader all` runs them.
-    pub const ALL: [Reader; 4] = [Reader::Csv, Reader::Robot, Reader::Model, Reader::Effects];
+    pub const ALL: [Reader; 6] =
+        [Reader::Csv, Reader::Robot, Reader::Model, Reader::Effects, Reader::EffectsList, Reader::Options];
 
     /// The name on the command line.
     pub fn name(self) -> &'static str {
@@ -33,6 +39,8 @@ impl Reader {
             Reader::Robot => "robot",
             Reader::Model => "model",
             Reader::Effects => "effects",
+            Reader::EffectsList => "effects-list",
+            Reader::Options => "options",
         }
     }
 }
@@ -187,16 +195,23 @@ fn model_seeds(folder: &Path) -> Result<Vec<Seed>> {
     let irb = fixture_robot("irb4400.ron")?;
     let position = simulated_set(&irb, &rows(40, 4), false)?;
     let full = simulated_set(&irb, &rows(40, 5), true)?;
-    let fit = |data: &MeasurementSet, method: Method, joint_compliance: bool| {
-        let options = FitOptions { joint_compliance, ..FitOptions::default() };
+    let fit = |data: &MeasurementSet, method: Method, effects: &[EffectSpec]| {
+        let options = FitOptions::default().with_effects(EffectSelection::List(effects.to_vec()));
         pipeline::fit(&irb, data, method, &options).map(|(model, _)| model).context("fitting a seed model")
     };
     let small = position.subset(&(0..30).collect::<Vec<_>>());
+    let every_effect = [
+        EffectSpec::JointCompliance,
+        EffectSpec::GearPeriodic { joint: 2, harmonics: 3 },
+        EffectSpec::Backlash { joint: 3 },
+        EffectSpec::Thermal,
+        EffectSpec::TimeDrift,
+    ];
     Ok(vec![
-        Seed::file("poe, position only", "ron", model_text(&fit(&position, Method::Poe, false)?, folder)?),
-        Seed::file("base-tool, full pose", "ron", model_text(&fit(&full, Method::BaseTool, false)?, folder)?),
-        Seed::file("poe with joint compliance", "ron", model_text(&fit(&full, Method::Poe, true)?, folder)?),
-        Seed::file("poe-gp-load", "ron", model_text(&fit(&small, Method::PoeGpLoad, false)?, folder)?),
+        Seed::file("poe, position only", "ron", model_text(&fit(&position, Method::Poe, &[])?, folder)?),
+        Seed::file("base-tool, full pose", "ron", model_text(&fit(&full, Method::BaseTool, &[])?, folder)?),
+        Seed::file("poe with every effect", "ron", model_text(&fit(&full, Method::Poe, &every_effect)?, folder)?),
+        Seed::file("poe-gp-load", "ron", model_text(&fit(&small, Method::PoeGpLoad, &[])?, folder)?),
     ])
 }
 
@@ -221,6 +236,32 @@ fn effects_seeds() -> Result<Vec<Seed>> {
     Ok(seeds)
 }
 
+fn effects_list_seeds() -> Vec<Seed> {
+    let lists = [
+        "joint_compliance",
+        "gear_periodic:2:3,backlash:2",
+        "joint_compliance,gear_periodic:1:32,gear_periodic:2:24,backlash:3,thermal,time_drift",
+        "auto",
+    ];
+    lists.iter().map(|list| Seed::file(list, "txt", list.as_bytes().to_vec())).collect()
+}
+
+fn options_seeds() -> Result<Vec<Seed>> {
+    let pretty = ron::ser::PrettyConfig::default();
+    let every = FitOptions::default().with_effects(EffectSelection::List(vec![
+        EffectSpec::JointCompliance,
+        EffectSpec::GearPeriodic { joint: 1, harmonics: 8 },
+    ]));
+    let mut seeds = Vec::new();
+    for (name, options) in [("the defaults", FitOptions::default()), ("with effects", every)] {
+        let text = ron::ser::to_string_pretty(&options, pretty.clone()).context("writing a seed options file")?;
+        seeds.push(Seed::file(name, "ron", text.into_bytes()));
+    }
+    let by_hand = "// fewer iterations, a looser prior\n(identification: (max_iterations: 20), effects: (prior_sigma: 0.01, selection: \"thermal\"))\n";
+    seeds.push(Seed::file("written by hand", "ron", by_hand.as_bytes().to_vec()));
+    Ok(seeds)
+}
+
 /// The seeds of `reader`; `folder` is scratch space.
 pub fn seeds(reader: Reader, folder: &Path) -> Result<Vec<Seed>> {
     match reader {
@@ -228,5 +269,7 @@ pub fn seeds(reader: Reader, folder: &Path) -> Result<Vec<Seed>> {
         Reader::Robot => robot_seeds(),
         Reader::Model => model_seeds(folder),
         Reader::Effects => effects_seeds(),
+        Reader::EffectsList => Ok(effects_list_seeds()),
+        Reader::Options => options_seeds(),
     }
 }

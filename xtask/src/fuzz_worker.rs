@@ -10,8 +10,9 @@
 use crate::fuzz_inputs::{Case, generate, regressions};
 use crate::fuzz_seeds::{Reader, Seed, fixture_robot, seeds};
 use anyhow::{Context, Result};
+use pipeline::effects::EffectSelection;
 use pipeline::simulated::{self, GeneratorConfig, SimulatedCell};
-use pipeline::{ColumnMap, Measurement, ReadOptions, RobotDescription};
+use pipeline::{ColumnMap, FitOptions, Measurement, ReadOptions, RobotDescription};
 use std::io::Write;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
@@ -74,7 +75,8 @@ static LAST_PANIC: Mutex<Option<String>> = Mutex::new(None);
 /// Whether `message` starts with `file:LINE:COLUMN:` (or `--columns:1:COLUMN:`), LINE and COLUMN
 /// at least 1 and LINE inside `bytes`.
 pub fn located(message: &str, file: &str, bytes: &[u8]) -> bool {
-    let Some(rest) = message.strip_prefix(file).or_else(|| message.strip_prefix("--columns")) else {
+    let argument = message.strip_prefix("--columns").or_else(|| message.strip_prefix("--effects"));
+    let Some(rest) = message.strip_prefix(file).or(argument) else {
         return false;
     };
     let mut parts = rest.splitn(4, ':');
@@ -137,6 +139,18 @@ impl Bench {
             Reader::Effects => match simulated::read_effects(&path, &self.robot) {
                 Err(e) => refused(e.to_string()),
                 Ok(effects) => self.use_effects(&effects),
+            },
+            // A command-line argument is text: clap refuses bytes that are not UTF-8 before us.
+            Reader::EffectsList => match String::from_utf8_lossy(&case.bytes).parse::<EffectSelection>() {
+                Err(e) => refused(e.to_string()),
+                Ok(_) => Outcome::Accepted,
+            },
+            Reader::Options => match FitOptions::read(&path) {
+                Err(e) => refused(e.to_string()),
+                Ok(options) => match options.validate() {
+                    Ok(()) => Outcome::Accepted,
+                    Err((field, message)) => Outcome::Late(format!("{field}: {message}")),
+                },
             },
         })
     }

@@ -113,6 +113,20 @@ impl RobotFile {
 /// Largest deviation from 1 of an axis norm, or from 0 of the flange axes' dot product.
 const UNIT_TOLERANCE: f64 = 1e-6;
 
+/// Largest magnitude of a joint limit, in the joint's SI unit (rad, m). No arm turns a joint
+/// 160,000 times or slides a kilometre; a joint without limits is written with limits this wide
+/// or less. Beyond it the angles of a sampled or compensated pose lose their digits, and beyond
+/// 1e154 rad the exponential map overflows into NaN poses (found by `cargo xtask fuzz`).
+pub(crate) const MAX_LIMIT: [f64; 2] = [1e6, 1e3];
+
+/// The limit bound of a joint kind, SI, and its unit.
+pub(crate) fn limit_bound(kind: JointType) -> (f64, &'static str) {
+    match kind {
+        JointType::Revolute => (MAX_LIMIT[0], "rad"),
+        JointType::Prismatic => (MAX_LIMIT[1], "m"),
+    }
+}
+
 impl RobotDescription {
     /// Reads and validates a robot description file: RON, or a URDF (`.urdf`) whose chain runs
     /// from its only root link to its only deepest leaf.
@@ -192,7 +206,21 @@ impl RobotDescription {
                         format!("joint {}: limits ({lo}, {hi}) must be finite and increasing", i + 1),
                     ));
                 }
-                Some(_) => *index += 1,
+                Some((lo, hi)) => {
+                    let (bound, unit) = limit_bound(joint.kind);
+                    let si = if joint.kind == JointType::Revolute { 1f64.to_radians() } else { 1.0 };
+                    if lo.abs().max(hi.abs()) * si > bound {
+                        return Err(at(
+                            field,
+                            *index,
+                            format!(
+                                "joint {}: limits ({lo:e}, {hi:e}) reach beyond ±{bound:e} {unit}, further than any joint moves",
+                                i + 1
+                            ),
+                        ));
+                    }
+                    *index += 1;
+                }
             }
         }
         let x = Vector3::from(self.flange.x_axis);

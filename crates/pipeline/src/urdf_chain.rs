@@ -368,6 +368,17 @@ impl UrdfDocument {
             if !(lower.is_finite() && upper.is_finite() && lower < upper) {
                 return Err(format!("limits lower {lower} upper {upper} must be finite and increasing"));
             }
+            let kind = if joint.joint_type == urdf_rs::JointType::Prismatic {
+                crate::JointType::Prismatic
+            } else {
+                crate::JointType::Revolute
+            };
+            let (bound, unit) = crate::robot::limit_bound(kind);
+            if lower.abs().max(upper.abs()) > bound {
+                return Err(format!(
+                    "limits lower {lower:e} upper {upper:e} reach beyond ±{bound:e} {unit}, further than any joint moves"
+                ));
+            }
             Ok((lower, upper))
         };
         use urdf_rs::JointType as T;

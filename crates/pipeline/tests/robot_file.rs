@@ -104,6 +104,14 @@ fn limits_of_the_wrong_unit_or_order_are_refused() {
     let (line, column, message) = refuse(&GOOD.replace("(-90.0, 90.0)", "(90.0, -90.0)"));
     assert_eq!((line, column), (5, 73), "{message}");
     assert!(message.contains("increasing"), "{message}");
+    // Limits of 1e308 degrees are finite and increasing, and sampled poses overflowed into NaN
+    // (found by `cargo xtask fuzz`): refused at the limits, for either kind of joint.
+    let (line, column, message) = refuse(&GOOD.replace("(-90.0, 90.0)", "(-1e308, 90.0)"));
+    assert_eq!((line, column), (5, 73), "{message}");
+    assert!(message.contains("joint 1: limits (-1e308, 9e1) reach beyond ±1e6 rad"), "{message}");
+    let (line, _, message) = refuse(&GOOD.replace("limits_m: (0.0, 0.5)", "limits_m: (0.0, 5000.0)"));
+    assert_eq!(line, 6, "{message}");
+    assert!(message.contains("beyond ±1e3 m"), "{message}");
 }
 
 #[test]

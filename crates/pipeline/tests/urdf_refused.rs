@@ -152,6 +152,8 @@ fn missing_or_reversed_limits_are_refused() {
     assert_refused(&text, (13, 3), "a <limit lower=.. upper=..> is required");
     let text = ARM.replace("lower=\"-2\" upper=\"2\"", "lower=\"2\" upper=\"-2\"");
     assert_refused(&text, (13, 3), "must be finite and increasing");
+    let text = ARM.replace("lower=\"-2\" upper=\"2\"", "lower=\"-1e308\" upper=\"2\"");
+    assert_refused(&text, (13, 3), "limits lower -1e308 upper 2e0 reach beyond ±1e6 rad");
 }
 
 #[test]
