@@ -1,64 +1,86 @@
 #!/usr/bin/env python3
-"""scikit-learn side of `cargo xtask bench-gp`.
+"""scikit-learn side of `cargo xtask bench-gp`: one fit and prediction per call.
 
-Reads the JSON request written by xtask/src/bench_gp.rs (argv[1]), fits scikit-learn's
-GaussianProcessRegressor on exactly the same data, kernel, start, bounds and normalisation, and
-writes timings and log marginal likelihoods as JSON to argv[2].
+Usage: bench_gp_sklearn.py REQUEST.json RESPONSE.json
 
-Kernel: the paper's Eq. 5, th0 exp(-th1 r^2/2) + th2 + th3 x.x' + white noise, written as
-C(th0) * RBF(1/sqrt(th1)) + C(th2) + C(th3) * DotProduct(sigma_0=0, fixed) + WhiteKernel(sn2).
-Inputs are standardised here with the training mean and population std (as `gp` does); outputs are
-normalised by normalize_y=True; all six outputs share one kernel (gp's OutputMode::Shared), and
-scikit-learn sums the log marginal likelihood over them as gp does.
+The request (written by xtask/src/bench_gp_sklearn.rs) holds the training inputs and outputs, the
+test inputs and the kernel's options; the response holds the fit and predict times (seconds), the
+peak resident memory of this process and its workers (bytes) and the predicted means at the test
+inputs. The caller applies the time limit (it kills this process).
+
+Kernel, as a scikit-learn user writes it for this problem:
+    C * RBF(length_scale=ones(d))  [ARD]  + C  [+ C * DotProduct(sigma_0=0)]  + WhiteKernel
+Inputs are standardised with the training mean and population std (as `gp` does); outputs are
+normalised by normalize_y=True. With "independent": true each output column gets its own GP
+(fitted in a pool of "processes" workers), otherwise one GP with shared hyperparameters serves
+all columns.
 """
 
 import json
+import resource
 import sys
 import time
+from multiprocessing import Pool
 
 import numpy as np
 from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel as C, DotProduct, WhiteKernel
 
 
-def kernel(p, lower, upper):
-    th0, th1, th2, th3, sn2 = p
-    return (
-        C(th0, (lower[0], upper[0])) * RBF(1.0 / np.sqrt(th1), (1.0 / np.sqrt(upper[1]), 1.0 / np.sqrt(lower[1])))
-        + C(th2, (lower[2], upper[2]))
-        + C(th3, (lower[3], upper[3])) * DotProduct(sigma_0=0.0, sigma_0_bounds="fixed")
-        + WhiteKernel(sn2, (lower[4], upper[4]))
+def kernel(d, linear):
+    k = C(1.0, (1e-3, 1e2)) * RBF(np.ones(d), (1e-2, 1e3)) + C(0.1, (1e-6, 1e2))
+    if linear:
+        k = k + C(0.1, (1e-6, 1e2)) * DotProduct(sigma_0=0.0, sigma_0_bounds="fixed")
+    return k + WhiteKernel(0.01, (1e-9, 1e1))
+
+
+def fit_predict(args):
+    xs, y, xq, linear, restarts = args
+    gpr = GaussianProcessRegressor(
+        kernel(xs.shape[1], linear), alpha=1e-10, normalize_y=True, n_restarts_optimizer=restarts, random_state=0
     )
+    gpr.fit(xs, y)
+    t = time.perf_counter()
+    mean = gpr.predict(xq)
+    return mean.reshape(len(xq), -1), time.perf_counter() - t
+
+
+def peak_bytes():
+    own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    children = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    return 1024 * (own + children)
 
 
 def main():
     with open(sys.argv[1]) as f:
         req = json.load(f)
-    x = np.asarray(req["x"])
-    y = np.asarray(req["y"])
-    x_test = np.asarray(req["x_test"])
-    results = []
-    for n in req["sizes"]:
-        xt, yt = x[:n], y[:n]
-        mean, std = xt.mean(axis=0), xt.std(axis=0)
-        std[std == 0.0] = 1.0
-        xs, xq = (xt - mean) / std, (x_test - mean) / std
-        gpr = GaussianProcessRegressor(
-            kernel(req["start"], req["lower"], req["upper"]),
-            alpha=0.0,
-            normalize_y=True,
-            n_restarts_optimizer=req["restarts"],
-            random_state=0,
-        )
-        t0 = time.perf_counter()
-        gpr.fit(xs, yt)
-        t1 = time.perf_counter()
-        gpr.predict(xq, return_std=True)
-        t2 = time.perf_counter()
-        results.append({"n": n, "fit_s": t1 - t0, "predict_s": t2 - t1, "lml": float(gpr.log_marginal_likelihood_value_)})
-        print(f"sklearn n={n}: fit {t1 - t0:.3f} s, predict {t2 - t1:.3f} s", file=sys.stderr, flush=True)
+    x = np.asarray(req["x"], dtype=float)
+    y = np.asarray(req["y"], dtype=float)
+    x_test = np.asarray(req["x_test"], dtype=float)
+    mean, std = x.mean(axis=0), x.std(axis=0)
+    std[std == 0.0] = 1.0
+    xs, xq = (x - mean) / std, (x_test - mean) / std
+    linear, restarts = bool(req["linear"]), int(req["restarts"])
+    t0 = time.perf_counter()
+    if req["independent"]:
+        jobs = [(xs, y[:, j], xq, linear, restarts) for j in range(y.shape[1])]
+        with Pool(int(req["processes"])) as pool:
+            parts = pool.map(fit_predict, jobs)
+        prediction = np.hstack([p[0] for p in parts])
+        predict_s = sum(p[1] for p in parts)
+    else:
+        prediction, predict_s = fit_predict((xs, y, xq, linear, restarts))
+    total = time.perf_counter() - t0
     with open(sys.argv[2], "w") as f:
-        json.dump({"results": results}, f)
+        json.dump(
+            {
+                "fit_s": total - predict_s,
+                "predict_s": predict_s,
+                "peak_bytes": peak_bytes(),
+                "mean": prediction.tolist(),
+            },
+            f,
+        )
 
 
 if __name__ == "__main__":

@@ -35,6 +35,14 @@ pub struct Args {
     /// Also write the table to this file.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Compare the GP stage with scikit-learn on real and simulated residuals instead.
+    #[arg(long)]
+    compare: bool,
+    /// Compare the candidate kernels on real and simulated residuals instead.
+    #[arg(long)]
+    kernels: bool,
+    #[command(flatten)]
+    kernel_args: crate::bench_gp_kernels::KernelArgs,
 }
 
 const DIM: usize = 7;
@@ -266,6 +274,16 @@ fn fmt_opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
 
 /// Runs the benchmark and prints the markdown table.
 pub fn run(args: &Args) -> Result<(), String> {
+    if args.compare {
+        let md = crate::bench_gp_compare::run(&args.kernel_args, std::time::Duration::from_secs(300))?;
+        println!("{md}");
+        return Ok(());
+    }
+    if args.kernels {
+        let md = crate::bench_gp_kernels::run(&args.kernel_args)?;
+        println!("{md}");
+        return Ok(());
+    }
     let sizes: Vec<usize> = if args.quick { vec![100, 300] } else { vec![100, 300, 1000, 3000] };
     let max_n = *sizes.iter().max().unwrap_or(&100);
     let sparse_sizes: Vec<usize> = if args.quick { vec![1000] } else { vec![3000, 10000] };

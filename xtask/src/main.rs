@@ -2,6 +2,10 @@
 //! command lives in a file of its own.
 
 mod bench_gp;
+mod bench_gp_compare;
+mod bench_gp_kernels;
+mod bench_gp_residuals;
+mod bench_gp_sklearn;
 mod bench_identify;
 mod blind_check;
 mod box_plot;

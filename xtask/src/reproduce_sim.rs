@@ -132,6 +132,7 @@ fn variants() -> Vec<Variant> {
                 ..ours.compensation.gp.clone()
             },
             residual_frame: ResidualFrame::Tracker,
+            ..CompensationOptions::default()
         },
         ..ours.clone()
     };

@@ -43,6 +43,7 @@ pub fn run(args: &Args) -> Result<(), String> {
     let paper = CompensationOptions {
         gp: gp::GpConfig { kernel: gp::KernelChoice::Quadratic, ..gp::GpConfig::default() },
         residual_frame: ResidualFrame::Tracker,
+        ..CompensationOptions::default()
     };
     let variants: Vec<(String, Method, FitOptions)> = vec![
         ("base-tool".into(), Method::BaseTool, FitOptions::default()),

@@ -34,6 +34,10 @@ pub struct Args {
     /// 100), effects: (prior_sigma: 1e-3)); --effects given here too is overridden by the flag.
     #[arg(long, value_name = "FIT.ron")]
     options: Option<PathBuf>,
+    /// The GP of the -gp methods: exact, sparse (variational, inducing inputs: for large data
+    /// sets) or auto (sparse above 4000 training rows) [default: auto, or what --options says].
+    #[arg(long)]
+    gp: Option<pipeline::GpChoice>,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
@@ -49,6 +53,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         (Some(selection), _) => options.effects.selection = selection.clone(),
         (None, true) => options.effects.selection = EffectSelection::List(vec![EffectSpec::JointCompliance]),
         (None, false) => {}
+    }
+    if let Some(choice) = args.gp {
+        options.compensation.method = choice;
     }
     let (model, report) = pipeline::fit(&robot, &data, args.method, &options)?;
     pipeline::write_model(&args.out, &model)?;
@@ -91,6 +98,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     for effect in &model.effects {
         println!("  effect {}: {} parameters identified with the geometry", effect.label(), effect.parameter_count());
+    }
+    if let Some(compensation) = &model.compensation {
+        println!("  GP: {}", compensation.gp.choice());
     }
     for direction in &id.unidentifiable {
         println!("    unidentifiable: {direction}");

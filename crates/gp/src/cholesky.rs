@@ -84,9 +84,34 @@ impl Factor {
         })
     }
 
+    /// A factor read back from storage: lower triangular (the upper triangle is ignored), every
+    /// entry finite, a positive diagonal; otherwise the index of the first bad pivot.
+    pub(crate) fn from_lower(mut l: Mat<f64>) -> Result<Self, usize> {
+        let n = l.nrows();
+        for j in 0..n {
+            if !(l[(j, j)] > 0.0 && l[(j, j)].is_finite()) || (j..n).any(|i| !l[(i, j)].is_finite()) {
+                return Err(j);
+            }
+            for i in 0..j {
+                l[(i, j)] = 0.0;
+            }
+        }
+        Ok(Self { l })
+    }
+
+    /// The lower-triangular factor.
+    pub(crate) fn lower(&self) -> &Mat<f64> {
+        &self.l
+    }
+
     /// `rhs ← L⁻¹ rhs`.
     pub(crate) fn solve_lower_in_place(&self, rhs: MatMut<'_, f64>, par: Par) {
         triangular_solve::solve_lower_triangular_in_place(self.l.as_ref(), rhs, par);
+    }
+
+    /// `rhs ← L⁻ᵀ rhs`.
+    pub(crate) fn solve_upper_transposed_in_place(&self, rhs: MatMut<'_, f64>, par: Par) {
+        triangular_solve::solve_upper_triangular_in_place(self.l.transpose(), rhs, par);
     }
 
     /// `rhs ← (L Lᵀ)⁻¹ rhs` (R&W Algorithm 2.1, line 3).

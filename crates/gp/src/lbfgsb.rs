@@ -35,7 +35,10 @@ pub(crate) struct Minimum {
     pub x: Vec<f64>,
     pub f: f64,
     pub iterations: usize,
+    /// Objective values computed (every trial point of the line searches).
     pub evaluations: usize,
+    /// Gradients computed (accepted points only).
+    pub gradients: usize,
     pub termination: Termination,
 }
 
@@ -95,25 +98,59 @@ fn direction(g: &[f64], free: &[bool], history: &VecDeque<Pair>) -> Vec<f64> {
     q
 }
 
+/// A function to minimise, evaluated in two stages so that a line search that rejects a trial
+/// point does not pay for its gradient.
+pub(crate) trait Objective {
+    /// `f(x)`, or `None` where it cannot be evaluated (e.g. a failed factorisation).
+    fn value(&mut self, x: &[f64]) -> Option<f64>;
+    /// `∇f` at the point of the last `value` call that returned `Some`.
+    fn gradient(&mut self) -> Option<Vec<f64>>;
+}
+
+/// An objective from a closure that returns value and gradient together.
+#[cfg(test)]
+pub(crate) struct Joint<F> {
+    f: F,
+    gradient: Option<Vec<f64>>,
+}
+
+#[cfg(test)]
+impl<F: FnMut(&[f64]) -> Option<(f64, Vec<f64>)>> Joint<F> {
+    pub(crate) fn new(f: F) -> Self {
+        Self { f, gradient: None }
+    }
+}
+
+#[cfg(test)]
+impl<F: FnMut(&[f64]) -> Option<(f64, Vec<f64>)>> Objective for Joint<F> {
+    fn value(&mut self, x: &[f64]) -> Option<f64> {
+        let (v, g) = (self.f)(x)?;
+        self.gradient = Some(g);
+        Some(v)
+    }
+    fn gradient(&mut self) -> Option<Vec<f64>> {
+        self.gradient.take()
+    }
+}
+
 /// Minimises `objective` over the box `[lower, upper]` from `start`.
 ///
-/// `objective` returns `None` where it cannot be evaluated (e.g. a failed factorisation); the line
-/// search then backtracks. Returns `None` only if the (projected) start itself cannot be evaluated.
-pub(crate) fn minimise<F>(
-    mut objective: F,
+/// Where the objective cannot be evaluated the line search backtracks. Returns `None` only if the
+/// (projected) start itself cannot be evaluated.
+pub(crate) fn minimise(
+    objective: &mut impl Objective,
     start: &[f64],
     lower: &[f64],
     upper: &[f64],
     settings: &Settings,
-) -> Option<Minimum>
-where
-    F: FnMut(&[f64]) -> Option<(f64, Vec<f64>)>,
-{
+) -> Option<Minimum> {
     let n = start.len();
     let mut x = start.to_vec();
     project(&mut x, lower, upper);
     let mut evaluations = 1;
-    let (mut f, mut g) = objective(&x).filter(|(f, g)| f.is_finite() && g.iter().all(|v| v.is_finite()))?;
+    let mut gradients = 1;
+    let mut f = objective.value(&x).filter(|f| f.is_finite())?;
+    let mut g = objective.gradient().filter(|g| g.iter().all(|v| v.is_finite()))?;
     let mut history: VecDeque<Pair> = VecDeque::with_capacity(settings.memory);
     let mut termination = Termination::MaxIterations;
     let mut iterations = 0;
@@ -148,13 +185,18 @@ where
                 break;
             }
             evaluations += 1;
-            if let Some((ft, gt)) = objective(&trial)
+            if let Some(ft) = objective.value(&trial)
                 && ft.is_finite()
-                && gt.iter().all(|v| v.is_finite())
                 && ft <= f + 1e-4 * decrease
             {
-                accepted = Some((trial, ft, gt));
-                break;
+                gradients += 1;
+                match objective.gradient() {
+                    Some(gt) if gt.iter().all(|v| v.is_finite()) => accepted = Some((trial, ft, gt)),
+                    _ => {}
+                }
+                if accepted.is_some() {
+                    break;
+                }
             }
             step *= 0.5;
         }
@@ -183,7 +225,7 @@ where
             break;
         }
     }
-    Some(Minimum { x, f, iterations, evaluations, termination })
+    Some(Minimum { x, f, iterations, evaluations, gradients, termination })
 }
 
 #[cfg(test)]
@@ -205,7 +247,8 @@ mod tests {
             let g = (0..4).map(|i| 2.0 * c[i] * (x[i] - t[i])).collect();
             Some((v, g))
         };
-        let m = minimise(f, &[0.0, 0.9, 0.5, -0.9], &lower, &upper, &settings()).expect("start evaluates");
+        let m =
+            minimise(&mut Joint::new(f), &[0.0, 0.9, 0.5, -0.9], &lower, &upper, &settings()).expect("start evaluates");
         let expected = [1.0, -0.3, -1.0, 0.7];
         for (a, b) in m.x.iter().zip(expected) {
             assert!((a - b).abs() < 1e-7, "{:?}", m);
@@ -221,7 +264,8 @@ mod tests {
             let g = vec![-2.0 * (1.0 - a) - 400.0 * a * (b - a * a), 200.0 * (b - a * a)];
             Some((v, g))
         };
-        let m = minimise(f, &[-1.2, 1.0], &[-2.0, -2.0], &[2.0, 2.0], &settings()).expect("start evaluates");
+        let m = minimise(&mut Joint::new(f), &[-1.2, 1.0], &[-2.0, -2.0], &[2.0, 2.0], &settings())
+            .expect("start evaluates");
         assert!((m.x[0] - 1.0).abs() < 1e-5 && (m.x[1] - 1.0).abs() < 1e-5, "{m:?}");
     }
 
@@ -234,7 +278,8 @@ mod tests {
             let g = vec![-2.0 * (1.0 - a) - 400.0 * a * (b - a * a), 200.0 * (b - a * a)];
             Some((v, g))
         };
-        let m = minimise(f, &[-1.2, 1.0], &[-2.0, -2.0], &[0.5, 2.0], &settings()).expect("start evaluates");
+        let m = minimise(&mut Joint::new(f), &[-1.2, 1.0], &[-2.0, -2.0], &[0.5, 2.0], &settings())
+            .expect("start evaluates");
         assert!((m.x[0] - 0.5).abs() < 1e-8 && (m.x[1] - 0.25).abs() < 1e-5, "{m:?}");
     }
 
@@ -242,7 +287,7 @@ mod tests {
     fn unevaluable_region_is_backtracked_out_of() {
         // f undefined for x > 0.5; minimum of (x − 0.4)² inside the defined part.
         let f = |x: &[f64]| (x[0] <= 0.5).then(|| ((x[0] - 0.4).powi(2), vec![2.0 * (x[0] - 0.4)]));
-        let m = minimise(f, &[-3.0], &[-10.0], &[10.0], &settings()).expect("start evaluates");
+        let m = minimise(&mut Joint::new(f), &[-3.0], &[-10.0], &[10.0], &settings()).expect("start evaluates");
         assert!((m.x[0] - 0.4).abs() < 1e-6, "{m:?}");
     }
 }

@@ -30,6 +30,8 @@
 
 mod cholesky;
 mod config;
+mod cross_gradient;
+mod elbo;
 mod error;
 mod exact;
 mod gram;
@@ -45,6 +47,7 @@ mod sparse;
 
 pub use cholesky::JitterOutcome;
 pub use config::{GpConfig, JitterConfig, OptimiserConfig, OutputMode, Parallelism};
+pub use elbo::sparse_evidence_lower_bound;
 pub use error::Error;
 pub use exact::{ComponentReport, ExactGp, FitReport};
 pub use inducing::InducingSelection;

@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 use crate::Error;
 use crate::config::Parallelism;
 use crate::gram::{contract_gradient, fill_training_lower};
-use crate::kernel::Kernel;
+use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::points::Points;
 
 /// The log marginal likelihood and, if asked for, its gradient in the kernel's log-parameters.
@@ -61,27 +61,27 @@ pub(crate) fn check_finite_outputs(y: MatRef<'_, f64>) -> Result<(), Error> {
     Ok(())
 }
 
-/// The two `n × n` buffers of an evaluation, kept between the evaluations of one search.
+/// The two `n × n` buffers of an evaluation, kept between the evaluations of one search, and what
+/// the value stage leaves for the gradient stage (the factor, the weights, the prepared inputs).
 #[derive(Debug)]
 pub(crate) struct Workspace {
     factor: Mat<f64>,
     inverse: Mat<f64>,
+    /// Set by a successful [`evaluate_value`], taken by [`evaluate_gradient`].
+    last: Option<LastValue>,
+}
+
+#[derive(Debug)]
+struct LastValue {
+    kernel: Kernel,
+    evaluator: Evaluator,
+    prepared: Prepared,
+    alpha: Mat<f64>,
 }
 
 impl Default for Workspace {
     fn default() -> Self {
-        Self { factor: Mat::new(), inverse: Mat::new() }
-    }
-}
-
-impl Workspace {
-    fn fit(&mut self, n: usize, with_gradient: bool) {
-        if self.factor.nrows() != n {
-            self.factor = Mat::zeros(n, n);
-        }
-        if with_gradient && self.inverse.nrows() != n {
-            self.inverse = Mat::zeros(n, n);
-        }
+        Self { factor: Mat::new(), inverse: Mat::new(), last: None }
     }
 }
 
@@ -94,13 +94,31 @@ pub(crate) fn evaluate(
     with_gradient: bool,
     parallelism: Parallelism,
 ) -> Result<LogMarginalLikelihood, Error> {
+    let value = evaluate_value(workspace, kernel, x, y, parallelism)?;
+    let gradient = if with_gradient { evaluate_gradient(workspace, x.dim(), parallelism) } else { Vec::new() };
+    Ok(LogMarginalLikelihood { value, gradient })
+}
+
+/// The value stage: `K + σn² I = L Lᵀ` (`n³/3` flops) and `α = K⁻¹ Y`; the factor stays in the
+/// workspace so that [`evaluate_gradient`] can follow without factoring again. A line search that
+/// rejects a trial point pays only this stage.
+pub(crate) fn evaluate_value(
+    workspace: &mut Workspace,
+    kernel: &Kernel,
+    x: &Points,
+    y: MatRef<'_, f64>,
+    parallelism: Parallelism,
+) -> Result<f64, Error> {
     let par = parallelism.faer();
     let (n, m) = (y.nrows(), y.ncols());
+    workspace.last = None;
     let terms = kernel.terms(x.dim());
     let prepared = terms.prepare(x);
     let evaluator = terms.evaluator;
-    workspace.fit(n, with_gradient);
-    let Workspace { factor, inverse } = workspace;
+    if workspace.factor.nrows() != n {
+        workspace.factor = Mat::zeros(n, n);
+    }
+    let factor = &mut workspace.factor;
     fill_training_lower(factor.as_mut(), &evaluator, &prepared, evaluator.noise_variance, parallelism);
     let mut mem = MemBuffer::new(llt::factor::cholesky_in_place_scratch::<f64>(n, par, Default::default()));
     llt::factor::cholesky_in_place(
@@ -122,10 +140,23 @@ pub(crate) fn evaluate(
     let data_fit: f64 = (0..m).map(|c| (0..n).map(|i| y[(i, c)] * alpha[(i, c)]).sum::<f64>()).sum();
     let value =
         -0.5 * data_fit - 0.5 * m as f64 * log_determinant - 0.5 * (n * m) as f64 * (2.0 * std::f64::consts::PI).ln();
-    if !with_gradient {
-        return Ok(LogMarginalLikelihood { value, gradient: Vec::new() });
+    workspace.last = Some(LastValue { kernel: kernel.clone(), evaluator, prepared, alpha });
+    Ok(value)
+}
+
+/// The gradient stage at the point of the last successful [`evaluate_value`] (empty if there was
+/// none): `L⁻¹` (`n³/3`), the lower triangle of `K⁻¹ = L⁻ᵀ L⁻¹` (`n³/3`) over the factor, and one
+/// contraction for every parameter (R&W Eq. 5.9).
+pub(crate) fn evaluate_gradient(workspace: &mut Workspace, dim: usize, parallelism: Parallelism) -> Vec<f64> {
+    let par = parallelism.faer();
+    let Some(LastValue { kernel, evaluator, prepared, alpha }) = workspace.last.take() else {
+        return Vec::new();
+    };
+    let n = alpha.nrows();
+    if workspace.inverse.nrows() != n {
+        workspace.inverse = Mat::zeros(n, n);
     }
-    // L⁻¹ into the second buffer, then the lower triangle of K⁻¹ = L⁻ᵀ L⁻¹ over the factor.
+    let Workspace { factor, inverse, .. } = workspace;
     triangular_inverse::invert_lower_triangular(inverse.as_mut(), factor.as_ref(), par);
     triangular::matmul(
         factor.as_mut(),
@@ -140,5 +171,5 @@ pub(crate) fn evaluate(
     );
     let expanded =
         contract_gradient(&evaluator, &prepared, factor.as_mut(), alpha.as_ref(), inverse.as_mut(), parallelism);
-    Ok(LogMarginalLikelihood { value, gradient: kernel.fold_gradient(&expanded, x.dim()) })
+    kernel.fold_gradient(&expanded, dim)
 }

@@ -66,6 +66,11 @@ impl Points {
         Self { dim: self.dim, data }
     }
 
+    /// The points in `range`, in order.
+    pub(crate) fn rows(&self, range: std::ops::Range<usize>) -> Self {
+        Self { dim: self.dim, data: self.data[range.start * self.dim..range.end * self.dim].to_vec() }
+    }
+
     /// The points at `indices`, in that order.
     pub(crate) fn select(&self, indices: &[usize]) -> Self {
         let mut data = Vec::with_capacity(indices.len() * self.dim);

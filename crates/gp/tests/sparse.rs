@@ -5,8 +5,8 @@ mod common;
 use common::{rng, uniform_points};
 use faer::Mat;
 use gp::{
-    Error, ExactGp, GpConfig, InducingSelection, Kernel, KernelChoice, Matern52Ard, OptimiserConfig, PredictOptions,
-    SparseConfig, SparseGp,
+    Error, ExactGp, GpConfig, InducingSelection, Kernel, KernelChoice, Matern52Ard, OptimiserConfig, Parallelism,
+    PredictOptions, SparseConfig, SparseGp,
 };
 use rand::Rng;
 use rand_distr::StandardNormal;
@@ -145,11 +145,72 @@ fn sparse_model_survives_a_ron_round_trip() {
 #[test]
 fn more_inducing_points_than_training_points_are_refused() {
     let (x, y) = noisy_data(8, 30);
-    for requested in [0, 31] {
-        let config = SparseConfig { inducing_points: requested, ..SparseConfig::default() };
-        assert_eq!(
-            SparseGp::fit(x.as_ref(), y.as_ref(), &config).err(),
-            Some(Error::TooManyInducingPoints { requested, available: 30 })
-        );
-    }
+    let config = SparseConfig { inducing_points: 31, ..SparseConfig::default() };
+    assert_eq!(
+        SparseGp::fit(x.as_ref(), y.as_ref(), &config).err(),
+        Some(Error::TooManyInducingPoints { requested: 31, available: 30 })
+    );
+    let config = SparseConfig { inducing_points: 0, ..SparseConfig::default() };
+    assert_eq!(
+        SparseGp::fit(x.as_ref(), y.as_ref(), &config).err(),
+        Some(Error::InvalidConfig { field: "inducing_points", value: 0.0 })
+    );
+}
+
+#[test]
+fn sparse_fit_and_prediction_are_bit_identical_serial_and_parallel() {
+    // 2500 rows: more than one chunk of the bound's row loop.
+    let (x, y) = noisy_data(9, 2500);
+    let (xq, _) = noisy_data(10, 50);
+    let run = |parallelism| {
+        let config = SparseConfig {
+            gp: GpConfig {
+                kernel: KernelChoice::SquaredExponentialArd,
+                optimiser: OptimiserConfig { restarts: 1, max_iterations: 30, ..OptimiserConfig::default() },
+                parallelism,
+                ..GpConfig::default()
+            },
+            inducing_points: 60,
+            hyperparameter_subset: 200,
+            bound_rows: 2500,
+            bound_iterations: 10,
+            ..SparseConfig::default()
+        };
+        let model = SparseGp::fit(x.as_ref(), y.as_ref(), &config).expect("fit");
+        let p = model.predict(xq.as_ref()).expect("predict");
+        let bits = |m: &Mat<f64>| {
+            (0..m.nrows()).flat_map(|i| (0..m.ncols()).map(move |j| m[(i, j)].to_bits())).collect::<Vec<_>>()
+        };
+        (model.report().clone(), bits(&p.mean), bits(&p.variance))
+    };
+    let (serial, parallel) = (run(Parallelism::Sequential), run(Parallelism::Rayon));
+    assert!(serial.0.components.iter().all(|c| c.bound_iterations > 0), "{:?}", serial.0);
+    assert_eq!(serial.0, parallel.0);
+    assert_eq!(serial.1, parallel.1);
+    assert_eq!(serial.2, parallel.2);
+}
+
+#[test]
+fn maximising_the_bound_raises_it_above_the_subset_hyperparameters() {
+    let (x, y) = noisy_data(11, 800);
+    let base = SparseConfig {
+        gp: GpConfig {
+            kernel: KernelChoice::SquaredExponentialArd,
+            optimiser: OptimiserConfig { restarts: 0, ..OptimiserConfig::default() },
+            ..GpConfig::default()
+        },
+        inducing_points: 30,
+        hyperparameter_subset: 150,
+        ..SparseConfig::default()
+    };
+    let fixed = SparseGp::fit(x.as_ref(), y.as_ref(), &SparseConfig { bound_rows: 0, ..base.clone() }).expect("fit");
+    let refined = SparseGp::fit(x.as_ref(), y.as_ref(), &base).expect("fit");
+    assert_eq!(fixed.report().bound_rows, 0);
+    assert_eq!(refined.report().bound_rows, 800);
+    assert!(
+        refined.evidence_lower_bound() > fixed.evidence_lower_bound(),
+        "{} <= {}",
+        refined.evidence_lower_bound(),
+        fixed.evidence_lower_bound()
+    );
 }

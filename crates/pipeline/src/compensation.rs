@@ -6,6 +6,8 @@ use crate::{Error, Measurement, MeasurementSet};
 use faer::Mat;
 use lie::{SE3, Twist, Vector3, Vector6};
 use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::str::FromStr;
 
 /// Where the error twist of Eq. 8 is expressed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -21,12 +23,77 @@ pub enum ResidualFrame {
     Tracker,
 }
 
+/// Which Gaussian process the GP stage fits (`calib fit --gp`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GpChoice {
+    /// The exact GP: `O(n³)` time, `O(n²)` memory.
+    Exact,
+    /// The sparse variational GP (VFE) with inducing inputs: `O(n m²)` time, `O(n m)` memory.
+    Sparse,
+    /// Exact up to [`CompensationOptions::sparse_above_rows`] training rows, sparse beyond.
+    #[default]
+    Auto,
+}
+
+impl GpChoice {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Exact => "exact",
+            Self::Sparse => "sparse",
+            Self::Auto => "auto",
+        }
+    }
+}
+
+impl fmt::Display for GpChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A `--gp` value that is not `exact`, `sparse` or `auto`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnknownGpChoice {
+    /// The name given.
+    pub name: String,
+}
+
+impl fmt::Display for UnknownGpChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "unknown GP '{}': expected one of exact, sparse, auto", self.name)
+    }
+}
+
+impl std::error::Error for UnknownGpChoice {}
+
+impl FromStr for GpChoice {
+    type Err = UnknownGpChoice;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        [Self::Exact, Self::Sparse, Self::Auto]
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| UnknownGpChoice { name: s.to_owned() })
+    }
+}
+
 /// Options of the GP stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct CompensationOptions {
-    /// The Gaussian process.
+    /// The exact Gaussian process (and the kernel, outputs, scaling and optimiser of both).
     pub gp: gp::GpConfig,
+    /// Exact, sparse, or chosen by the number of training rows.
+    pub method: GpChoice,
+    /// With [`GpChoice::Auto`], the sparse GP above this many training rows.
+    pub sparse_above_rows: usize,
+    /// The sparse GP (its `gp` field is replaced by [`CompensationOptions::gp`], but for the
+    /// outputs, which [`CompensationOptions::sparse_outputs`] sets).
+    pub sparse: gp::SparseConfig,
+    /// One kernel for all outputs or one each, in the sparse GP.
+    pub sparse_outputs: gp::OutputMode,
     /// Where the error twist is expressed.
     pub residual_frame: ResidualFrame,
 }
@@ -37,12 +104,89 @@ impl Default for CompensationOptions {
         // besides the default start: on the UR10 data (series C, 1386 training poses, position
         // only) the paper's kernel left 0.307 mm held-out against 0.205 mm, and three restarts
         // found the same optimum as one in 2.2x the time (176 s against 79 s).
-        let optimiser = gp::OptimiserConfig { restarts: 1, ..gp::OptimiserConfig::default() };
+        let optimiser = gp::OptimiserConfig { restarts: 2, warm_start_rows: 500, ..gp::OptimiserConfig::default() };
         Self {
             gp: gp::GpConfig { kernel: gp::KernelChoice::SquaredExponentialArd, optimiser, ..gp::GpConfig::default() },
+            method: GpChoice::default(),
+            // One exact evaluation with its gradient costs n³ flops: 64 GFLOP at n = 4000, about
+            // 3 s on 2 cores at faer's measured rate (docs/results/bench-gp.md), so a search of
+            // 50 evaluations takes minutes; the sparse GP with 500 inducing points takes seconds
+            // there and is within a few percent of the exact error (bench-gp's sweep).
+            sparse_above_rows: 4000,
+            sparse: gp::SparseConfig::default(),
+            // Shared: the sparse GP serves large data sets, where one bound search instead of
+            // three matters more than the small gain of a kernel per output.
+            sparse_outputs: gp::OutputMode::Shared,
             residual_frame: ResidualFrame::default(),
         }
     }
+}
+
+impl CompensationOptions {
+    /// The GP that `rows` training rows get.
+    pub fn choice_for(&self, rows: usize) -> GpChoice {
+        match self.method {
+            GpChoice::Auto if rows > self.sparse_above_rows => GpChoice::Sparse,
+            GpChoice::Auto => GpChoice::Exact,
+            other => other,
+        }
+    }
+}
+
+/// The fitted GP of the stage: exact or sparse.
+///
+/// Stored untagged, so that model files written before the sparse GP existed (an exact GP in the
+/// `gp` field) still read.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum GpModel {
+    /// The sparse variational GP.
+    Sparse(gp::SparseGp),
+    /// The exact GP.
+    Exact(gp::ExactGp),
+}
+
+impl GpModel {
+    /// Number of inputs.
+    pub fn input_dim(&self) -> usize {
+        match self {
+            Self::Exact(g) => g.input_dim(),
+            Self::Sparse(g) => g.input_dim(),
+        }
+    }
+
+    /// Number of outputs.
+    pub fn output_count(&self) -> usize {
+        match self {
+            Self::Exact(g) => g.output_count(),
+            Self::Sparse(g) => g.output_count(),
+        }
+    }
+
+    /// Which one it is.
+    pub fn choice(&self) -> GpChoice {
+        match self {
+            Self::Exact(_) => GpChoice::Exact,
+            Self::Sparse(_) => GpChoice::Sparse,
+        }
+    }
+
+    /// Posterior mean and variance at the rows of `x`.
+    pub fn predict(&self, x: faer::MatRef<'_, f64>) -> Result<gp::Prediction, gp::Error> {
+        match self {
+            Self::Exact(g) => g.predict(x),
+            Self::Sparse(g) => g.predict(x),
+        }
+    }
+}
+
+/// What the GP's fit reported.
+#[derive(Debug, Clone)]
+pub enum GpFitReport {
+    /// The exact GP's report.
+    Exact(gp::FitReport),
+    /// The sparse GP's report.
+    Sparse(gp::SparseFitReport),
 }
 
 /// A fitted GP compensation, stored in the model file.
@@ -55,14 +199,14 @@ pub struct Compensation {
     /// Where the error twist is expressed.
     pub residual_frame: ResidualFrame,
     /// The GP: inputs `(q_1 … q_n[, m])`, outputs the error components.
-    pub gp: gp::ExactGp,
+    pub gp: GpModel,
 }
 
 /// What the GP stage reports.
 #[derive(Debug, Clone)]
 pub struct CompensationReport {
-    /// The GP's own report (hyperparameters, log marginal likelihood, jitter).
-    pub gp: gp::FitReport,
+    /// The GP's own report (hyperparameters, log marginal likelihood or bound, jitter).
+    pub gp: GpFitReport,
 }
 
 fn inputs(rows: &[Measurement], with_payload: bool) -> Mat<f64> {
@@ -126,8 +270,22 @@ impl Compensation {
         options: &CompensationOptions,
     ) -> Result<(Self, CompensationReport), Error> {
         let ResidualSet { inputs: x, outputs: y } = ResidualSet::new(poses, data, with_payload, options.residual_frame);
-        let gp = gp::ExactGp::fit(x.as_ref(), y.as_ref(), &options.gp)?;
-        let report = CompensationReport { gp: gp.report().clone() };
+        let (gp, report) = match options.choice_for(x.nrows()) {
+            GpChoice::Sparse => {
+                let inducing_points = options.sparse.inducing_points.min(x.nrows());
+                let gp = gp::GpConfig { outputs: options.sparse_outputs, ..options.gp.clone() };
+                let config = gp::SparseConfig { gp, inducing_points, ..options.sparse.clone() };
+                let model = gp::SparseGp::fit(x.as_ref(), y.as_ref(), &config)?;
+                let report = GpFitReport::Sparse(model.report().clone());
+                (GpModel::Sparse(model), report)
+            }
+            GpChoice::Exact | GpChoice::Auto => {
+                let model = gp::ExactGp::fit(x.as_ref(), y.as_ref(), &options.gp)?;
+                let report = GpFitReport::Exact(model.report().clone());
+                (GpModel::Exact(model), report)
+            }
+        };
+        let report = CompensationReport { gp: report };
         Ok((Self { with_payload, full_pose: data.full_pose, residual_frame: options.residual_frame, gp }, report))
     }
 

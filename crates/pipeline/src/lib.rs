@@ -36,7 +36,10 @@ mod xml_outline;
 
 pub use base_frame::{NominalTolerance, axis_changes, check_nominal, in_base_frame, tracker_from_base};
 pub use calibrated::{CalibratedModel, PredictedPose, pose_error};
-pub use compensation::{Compensation, CompensationOptions, CompensationReport, ResidualFrame, ResidualSet};
+pub use compensation::{
+    Compensation, CompensationOptions, CompensationReport, GpChoice, GpFitReport, GpModel, ResidualFrame, ResidualSet,
+    UnknownGpChoice,
+};
 pub use error::Error;
 pub use eval_report::EvalReport;
 pub use fit::{Evaluation, FitReport, evaluate, fit, tool_indices};

@@ -30,6 +30,11 @@ impl Prepared {
     pub(crate) fn len(&self) -> usize {
         self.stationary.len()
     }
+
+    /// The points in `range`, in order.
+    pub(crate) fn rows(&self, range: std::ops::Range<usize>) -> Self {
+        Self { stationary: self.stationary.rows(range.clone()), linear: self.linear.as_ref().map(|l| l.rows(range)) }
+    }
 }
 
 /// The expanded form of a kernel for `dim` inputs.

@@ -1,0 +1,123 @@
+//! `cargo xtask bench-gp --kernels`: which kernel the GP stage should use by default. Every
+//! candidate kernel on the residuals of the real UR10 series (C even → odd, B and D split the same
+//! way) and of simulated soft joints with payloads (several seeds), held-out error in mm.
+
+use std::fmt::Write;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use gp::{ExactGp, KernelChoice, OutputMode, StationaryShape};
+use indicatif::{ProgressBar, ProgressStyle};
+use pipeline::{CompensationOptions, RobotDescription};
+
+use crate::bench_gp_residuals::{Residuals, heldout_mm, real, simulated};
+
+/// Where the data are.
+#[derive(Debug, Clone, clap::Args)]
+pub struct KernelArgs {
+    /// Folder with `ur10_C_even.csv`, `ur10_C_odd.csv`, `ur10_B.csv`, `ur10_D.csv` (SPEC CSV from
+    /// `cargo xtask convert-ur10`); real data are skipped when it does not exist.
+    #[arg(long, default_value = "../shared/data/ipa-ur10")]
+    pub ur10_data: PathBuf,
+    /// Seeds of the simulated sets.
+    #[arg(long, value_delimiter = ',', default_value = "1,2,3")]
+    pub seeds: Vec<u64>,
+}
+
+/// The candidates, by name.
+pub fn candidates() -> Vec<(&'static str, KernelChoice, OutputMode)> {
+    use StationaryShape::{Matern52, SquaredExponential};
+    let composite = |shape, constant, linear| KernelChoice::Composite { shape, constant, linear };
+    vec![
+        ("Eq. 5 (paper, isotropic)", KernelChoice::Quadratic, OutputMode::Shared),
+        ("SE-ARD", KernelChoice::SquaredExponentialArd, OutputMode::Shared),
+        ("SE-ARD, independent outputs", KernelChoice::SquaredExponentialArd, OutputMode::Independent),
+        ("SE-ARD + const", composite(SquaredExponential, true, false), OutputMode::Shared),
+        ("SE-ARD + const + linear-ARD", composite(SquaredExponential, true, true), OutputMode::Shared),
+        (
+            "SE-ARD + const + linear-ARD, independent outputs",
+            composite(SquaredExponential, true, true),
+            OutputMode::Independent,
+        ),
+        ("Matérn52-ARD", KernelChoice::Matern52Ard, OutputMode::Shared),
+        ("Matérn52-ARD + const", composite(Matern52, true, false), OutputMode::Shared),
+        ("Matérn52-ARD + const + linear-ARD", composite(Matern52, true, true), OutputMode::Shared),
+        (
+            "Matérn52-ARD + const + linear-ARD, independent outputs",
+            composite(Matern52, true, true),
+            OutputMode::Independent,
+        ),
+    ]
+}
+
+/// Every data set this machine has.
+pub fn data_sets(args: &KernelArgs) -> Result<Vec<Residuals>, String> {
+    let mut sets = Vec::new();
+    let ur10_path = PathBuf::from("fixtures/robots/ur10.ron");
+    if args.ur10_data.join("ur10_C_even.csv").exists() {
+        let ur10 = RobotDescription::read(&ur10_path).map_err(|e| e.to_string())?;
+        let d = &args.ur10_data;
+        sets.push(real("UR10 C even → odd", &ur10, &d.join("ur10_C_even.csv"), Some(&d.join("ur10_C_odd.csv")))?);
+        for series in ["B", "D"] {
+            let file = d.join(format!("ur10_{series}.csv"));
+            if file.exists() {
+                sets.push(real(&format!("UR10 {series} even → odd"), &ur10, &file, None)?);
+            }
+        }
+    } else {
+        eprintln!("{}: no UR10 data, real sets skipped", args.ur10_data.display());
+    }
+    let irb = RobotDescription::read(&PathBuf::from("fixtures/robots/irb4400.ron")).map_err(|e| e.to_string())?;
+    for &seed in &args.seeds {
+        sets.push(simulated(&irb, seed, 300, 1000)?);
+    }
+    Ok(sets)
+}
+
+/// Runs every candidate on every set and returns the markdown table.
+pub fn run(args: &KernelArgs) -> Result<String, String> {
+    let sets = data_sets(args)?;
+    let kernels = candidates();
+    let bar = ProgressBar::new((sets.len() * kernels.len()) as u64);
+    bar.set_style(
+        ProgressStyle::with_template("kernels {msg} [{bar:30}] {pos}/{len} {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let mut table = vec![vec![(f64::NAN, f64::NAN); sets.len()]; kernels.len()];
+    for (s, set) in sets.iter().enumerate() {
+        for (k, (name, choice, outputs)) in kernels.iter().enumerate() {
+            bar.set_message(format!("{} / {name}", set.name));
+            let mut config = CompensationOptions::default().gp;
+            config.kernel = *choice;
+            config.outputs = *outputs;
+            let t = Instant::now();
+            let model = ExactGp::fit(set.train.inputs.as_ref(), set.train.outputs.as_ref(), &config)
+                .map_err(|e| format!("{} / {name}: {e}", set.name))?;
+            let seconds = t.elapsed().as_secs_f64();
+            let mean = model.predict_mean(set.test.inputs.as_ref()).map_err(|e| e.to_string())?;
+            table[k][s] = (heldout_mm(&mean, &set.test), seconds);
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    let mut md = String::new();
+    let _ = write!(md, "| kernel |");
+    for set in &sets {
+        let _ = write!(md, " {} (mm) |", set.name);
+    }
+    let _ = writeln!(md, " mean ratio to best | fit time, sum (s) |");
+    let _ = writeln!(md, "|---|{}---:|---:|", "---:|".repeat(sets.len()));
+    let best: Vec<f64> = (0..sets.len()).map(|s| table.iter().map(|r| r[s].0).fold(f64::INFINITY, f64::min)).collect();
+    for (k, (name, _, _)) in kernels.iter().enumerate() {
+        let _ = write!(md, "| {name} |");
+        for (s, b) in best.iter().enumerate() {
+            let (e, _) = table[k][s];
+            let mark = if e == *b { "**" } else { "" };
+            let _ = write!(md, " {mark}{e:.4}{mark} |");
+        }
+        let ratio = (0..sets.len()).map(|s| table[k][s].0 / best[s]).sum::<f64>() / sets.len() as f64;
+        let time: f64 = table[k].iter().map(|c| c.1).sum();
+        let _ = writeln!(md, " {ratio:.4} | {time:.1} |");
+    }
+    Ok(md)
+}

@@ -1,0 +1,107 @@
+//! The scikit-learn side of `cargo xtask bench-gp`: one fit and prediction in a python3 process
+//! (`xtask/scripts/bench_gp_sklearn.py`), killed when it passes its time limit.
+
+use std::os::unix::process::CommandExt;
+use std::path::Path;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use faer::Mat;
+
+/// How scikit-learn is asked to fit.
+#[derive(Debug, Clone, Copy)]
+pub struct SklearnOptions {
+    /// With the `C · DotProduct` term.
+    pub linear: bool,
+    /// `n_restarts_optimizer`.
+    pub restarts: usize,
+    /// One GP per output column (in a pool of `processes` workers) rather than one for all.
+    pub independent: bool,
+    /// Worker processes for independent outputs.
+    pub processes: usize,
+    /// Kill the fit after this long.
+    pub timeout: Duration,
+}
+
+/// What scikit-learn did.
+#[derive(Debug, Clone)]
+pub struct SklearnResult {
+    /// Wall-clock seconds of the fit (the whole process when it finished).
+    pub fit_s: f64,
+    /// Peak resident memory of the python process and its workers, bytes.
+    pub peak_bytes: f64,
+    /// Predicted means at the test inputs.
+    pub mean: Mat<f64>,
+}
+
+/// `true` when `python3 -c "import sklearn"` works.
+pub fn available() -> bool {
+    Command::new("python3").args(["-c", "import sklearn"]).output().map(|o| o.status.success()).unwrap_or(false)
+}
+
+fn rows(m: &Mat<f64>) -> Vec<Vec<f64>> {
+    (0..m.nrows()).map(|i| (0..m.ncols()).map(|j| m[(i, j)]).collect()).collect()
+}
+
+/// Fits and predicts; `Ok(None)` when the process passed `options.timeout` and was killed.
+pub fn fit_predict(
+    x: &Mat<f64>,
+    y: &Mat<f64>,
+    x_test: &Mat<f64>,
+    options: &SklearnOptions,
+) -> Result<Option<SklearnResult>, String> {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/bench_gp_sklearn.py");
+    let dir = std::env::temp_dir().join(format!("calib-bench-gp-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let (request, response) = (dir.join("request.json"), dir.join("response.json"));
+    let body = serde_json::json!({
+        "x": rows(x),
+        "y": rows(y),
+        "x_test": rows(x_test),
+        "linear": options.linear,
+        "restarts": options.restarts,
+        "independent": options.independent,
+        "processes": options.processes,
+    });
+    std::fs::write(&request, body.to_string()).map_err(|e| format!("{}: {e}", request.display()))?;
+    let _ = std::fs::remove_file(&response);
+    let start = Instant::now();
+    // Its own process group, so that a timeout ends the pool's workers with it.
+    let mut child = Command::new("python3")
+        .process_group(0)
+        .arg(&script)
+        .arg(&request)
+        .arg(&response)
+        .spawn()
+        .map_err(|e| format!("{}: {e}", script.display()))?;
+    let status = loop {
+        if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+            break status;
+        }
+        if start.elapsed() > options.timeout {
+            let group = format!("-{}", child.id());
+            let _ = Command::new("kill").args(["-KILL", "--", &group]).status();
+            let _ = child.kill();
+            let _ = child.wait();
+            let _ = std::fs::remove_dir_all(&dir);
+            return Ok(None);
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    if !status.success() {
+        return Err(format!("{} failed: {status}", script.display()));
+    }
+    let text = std::fs::read_to_string(&response).map_err(|e| format!("{}: {e}", response.display()))?;
+    let _ = std::fs::remove_dir_all(&dir);
+    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| e.to_string())?;
+    let num = |k: &str| v[k].as_f64().ok_or(format!("scikit-learn response lacks {k}"));
+    let mean_rows = v["mean"].as_array().ok_or("scikit-learn response lacks mean")?;
+    let cols = y.ncols();
+    let mut mean = Mat::zeros(mean_rows.len(), cols);
+    for (i, r) in mean_rows.iter().enumerate() {
+        for j in 0..cols {
+            mean[(i, j)] = r[j].as_f64().ok_or("scikit-learn mean is not a number")?;
+        }
+    }
+    Ok(Some(SklearnResult { fit_s: num("fit_s")?, peak_bytes: num("peak_bytes")?, mean }))
+}
