@@ -58,14 +58,16 @@ pub fn run(args: &KernelArgs, timeout: Duration) -> Result<String, String> {
             }
         }
         let speedup = if fastest.is_finite() { format!("{:.0}×", fastest / ours_s) } else { "–".into() };
-        let _ = writeln!(
-            md,
+        let row = format!(
             "| {} | {} / {} | {ours:.4} | {ours_s:.2} | {} | {speedup} |",
             set.name,
             set.train.inputs.nrows(),
             set.test.inputs.nrows(),
             cells.join(" | ")
         );
+        // Each row as soon as it is measured: a long run stopped half-way keeps what it did.
+        eprintln!("{row}");
+        let _ = writeln!(md, "{row}");
     }
     Ok(md)
 }
