@@ -1,7 +1,8 @@
 //! `calib fit`: fit a calibration method to measurements and write the model.
 
 use pipeline::effects::{EffectSelection, EffectSpec};
-use pipeline::{ErrorSummary, FitOptions, Method, ReadOptions};
+use pipeline::{ErrorSummary, FitOptions, FitReport, Method, ReadOptions};
+use std::fmt::Write;
 use std::path::PathBuf;
 
 /// Fit a calibrated model to measurements.
@@ -38,13 +39,15 @@ pub struct Args {
     /// sets) or auto (sparse above 4000 training rows) [default: auto, or what --options says].
     #[arg(long)]
     gp: Option<pipeline::GpChoice>,
+    /// Print the fit report as one JSON object on stdout (the summary goes to stderr).
+    #[arg(long)]
+    json: bool,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let robot = args.robot.read()?;
     let options = ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
     let data = pipeline::read_measurements(&args.data, &options)?;
-    println!("{}", data.read_summary());
     let mut options = match &args.options {
         Some(path) => FitOptions::read(path)?,
         None => FitOptions::default(),
@@ -59,64 +62,99 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     let (model, report) = pipeline::fit(&robot, &data, args.method, &options)?;
     pipeline::write_model(&args.out, &model)?;
+    // With --json the report is the one object on stdout and the summary goes to stderr.
+    let mut summary = String::new();
+    summary.push_str(&data.read_summary());
+    summary.push('\n');
+    summarise(&mut summary, args, &robot.name, &data, &report);
+    if args.json {
+        eprint!("{summary}");
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print!("{summary}");
+    }
+    Ok(())
+}
 
+fn summarise(out: &mut String, args: &Args, robot: &str, data: &pipeline::MeasurementSet, report: &FitReport) {
     let kind = if data.full_pose { "full pose" } else { "position only" };
     let tools = data.tools.iter().filter(|t| !t.is_empty()).count().max(1);
-    println!(
-        "{} on {} ({} rows, {kind}, {tools} tool{}) for {}",
+    let plural = if tools == 1 { "" } else { "s" };
+    let rows = data.rows.len();
+    let _ = writeln!(
+        out,
+        "{} on {} ({rows} rows, {kind}, {tools} tool{plural}) for {robot}",
         args.method,
-        args.data.display(),
-        data.rows.len(),
-        if tools == 1 { "" } else { "s" },
-        robot.name
+        args.data.display()
     );
-    print_errors("training error before (nominal, registered)", &report.before);
-    print_errors("training error after", &report.after);
+    errors(out, "training error before (nominal, registered)", &report.before);
+    errors(out, "training error after", &report.after);
     let id = &report.identification;
-    println!(
+    let _ = writeln!(
+        out,
         "  identifiable: {} of {} free parameters, condition number {:.3e}",
         id.rank, id.free_parameters, id.condition_number
     );
     if let Some(auto) = &report.auto {
         let chosen: Vec<String> = auto.chosen.iter().map(ToString::to_string).collect();
-        println!(
-            "  effects auto: the diagnosis of the training data (held-out {:.4} mm with the geometry alone) selected {}",
+        let _ = writeln!(
+            out,
+            "  effects auto: the diagnosis of the training data (verdict {}; held-out {:.4} mm with the geometry alone) selected {}",
+            auto.verdict.effect.name(),
             auto.heldout_before_mm,
-            if auto.selected.is_empty() { "nothing".to_owned() } else { chosen.join(", ") }
+            if chosen.is_empty() { "nothing".to_owned() } else { chosen.join(", ") }
         );
         for s in &auto.selected {
             let joints: Vec<String> = s.joints.iter().map(ToString::to_string).collect();
-            let harmonic = s.harmonic.map_or(String::new(), |h| format!(" harmonic {h}"));
-            println!(
-                "    {} on joint(s) {}{harmonic}: held-out {:.4} mm (paired t = {:.1})",
+            let harmonic = s.harmonic.map_or(String::new(), |h| format!(", harmonics 1 to {h}"));
+            let _ = writeln!(
+                out,
+                "    {} on joint(s) {}{harmonic}: cross-validated {:.4} mm with it and those above",
                 s.effect.name(),
                 joints.join(","),
-                s.heldout_after_mm,
-                s.t
+                s.heldout_after_mm
             );
         }
     }
-    for effect in &model.effects {
-        println!("  effect {}: {} parameters identified with the geometry", effect.label(), effect.parameter_count());
+    for effect in &report.effects {
+        let held: Vec<&str> = effect.parameters.iter().filter(|p| p.held_at_prior).map(|p| p.name.as_str()).collect();
+        let _ = writeln!(
+            out,
+            "  effect {}: {} parameters identified with the geometry",
+            effect.label,
+            effect.parameters.len()
+        );
+        if !held.is_empty() {
+            let _ = writeln!(out, "    held at the prior, the data barely sees them: {}", held.join(", "));
+        }
     }
     if let Some(compensation) = &model.compensation {
         println!("  GP: {}", compensation.gp.choice());
     }
     for direction in &id.unidentifiable {
-        println!("    unidentifiable: {direction}");
+        let _ = writeln!(out, "    unidentifiable: {direction}");
     }
-    println!("  iterations: {} ({})", id.iteration_count(), id.termination);
-    println!("  wrote {}", args.out.display());
-    Ok(())
+    let _ = writeln!(
+        out,
+        "  iterations: {} ({}; cost {:.6e}, gradient cosine {:.1e})",
+        id.iteration_count(),
+        id.termination,
+        id.final_cost,
+        id.gradient_cosine
+    );
+    let _ = writeln!(out, "  wrote {}", args.out.display());
 }
 
-fn print_errors(label: &str, summary: &ErrorSummary) {
-    print!(
+fn errors(out: &mut String, label: &str, summary: &ErrorSummary) {
+    let _ = write!(
+        out,
         "  {label}: mean {:.4} mm, rms {:.4} mm, max {:.4} mm",
         summary.mean_position_error_mm, summary.rms_position_error_mm, summary.max_position_error_mm
     );
     match summary.mean_rotation_error_mrad {
-        Some(rotation) => println!(", rotation mean {rotation:.4} mrad"),
-        None => println!(),
+        Some(rotation) => {
+            let _ = writeln!(out, ", rotation mean {rotation:.4} mrad");
+        }
+        None => out.push('\n'),
     }
 }

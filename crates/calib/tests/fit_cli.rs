@@ -114,3 +114,35 @@ fn thirteen_position_only_poses_of_a_six_axis_arm_are_refused_with_both_counts()
     assert!(message.contains("13 measurements give 39 residual rows, fewer than the 42 free parameters"), "{message}");
     assert!(!model.exists());
 }
+
+#[test]
+fn the_fit_report_is_one_json_object_on_stdout_with_the_solver_and_the_effects() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 80, 44);
+    let model = dir.path().join("m.ron");
+    let out = fit(&data, &model, &["--effects", "gear_periodic:2:2", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(stdout.trim_end().lines().count(), 1, "{stdout}");
+    let json: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(json["method"], "poe");
+    assert!(
+        json["before"]["mean_position_error_mm"].as_f64().unwrap()
+            > json["after"]["mean_position_error_mm"].as_f64().unwrap()
+    );
+    let id = &json["identification"];
+    for key in ["rank", "condition_number", "free_parameters", "final_cost", "gradient_cosine", "converged"] {
+        assert!(!id[key].is_null(), "identification.{key} missing: {id}");
+    }
+    assert!(id["iterations"].as_array().unwrap().len() > 1);
+    assert!(id["termination"]["criterion"].is_string(), "{id}");
+    assert!(id["unidentifiable"][0].as_str().unwrap().contains("joint 1"), "{id}");
+    let effect = &json["effects"][0];
+    assert_eq!(effect["effect"], "gear_periodic");
+    assert_eq!(effect["joints"], serde_json::json!([2]));
+    let names: Vec<&str> =
+        effect["parameters"].as_array().unwrap().iter().map(|p| p["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["cos(1 q2)", "sin(1 q2)", "cos(2 q2)", "sin(2 q2)"]);
+    // The summary a person reads goes to stderr.
+    assert!(String::from_utf8_lossy(&out.stderr).contains("training error after"));
+}

@@ -204,7 +204,7 @@ pub struct Compensation {
 }
 
 /// What the GP stage reports.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize)]
 pub struct CompensationReport {
     /// The GP's own report (hyperparameters, log marginal likelihood or bound, jitter).
     pub gp: GpFitReport,

@@ -1,6 +1,9 @@
 //! The fit of a method on a measurement set, and the evaluation of a fitted model.
 
-use crate::effects::{AutoChoice, EffectContext, EffectCorrection, EffectSelection, EffectSpec, IdentifiedEffect};
+use crate::effects::{
+    AutoChoice, EffectContext, EffectCorrection, EffectReport, EffectSelection, EffectSpec, IdentifiedEffect,
+    effect_reports,
+};
 use crate::fit_options::FitOptions;
 use crate::geometric::{fit_geometry, observations};
 use crate::{
@@ -8,21 +11,32 @@ use crate::{
     RobotDescription, SCHEMA_VERSION, pose_error,
 };
 use poe::identify::{IdentificationOptions, IdentificationReport, ParameterMask, Scope, identify_with_correction};
+use serde::Serialize;
 
-/// What a fit reports besides the model.
-#[derive(Debug, Clone)]
+/// What a fit reports besides the model (`calib fit --json` prints it as it is).
+#[derive(Debug, Clone, Serialize)]
 pub struct FitReport {
     /// The method fitted.
     pub method: Method,
+    /// Number of training rows.
+    pub n: usize,
+    /// Whether the data had orientations.
+    pub full_pose: bool,
     /// Training errors of the nominal model, registered into the tracker frame.
     pub before: ErrorSummary,
     /// Training errors of the fitted model.
     pub after: ErrorSummary,
-    /// The geometric identification's report (with the effects, where there are some).
+    /// The geometric identification's report (with the effects, where there are some): errors
+    /// per iteration, why it stopped (`termination`, `converged`, `final_cost`,
+    /// `gradient_cosine`), rank, condition number, the unidentifiable directions in words.
     pub identification: IdentificationReport,
-    /// The GP stage's report, for the GP methods.
+    /// The effects identified with the geometry, their parameters by name.
+    pub effects: Vec<EffectReport>,
+    /// The GP stage's report, for the GP methods: its hyperparameters.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub compensation: Option<CompensationReport>,
     /// What `--effects auto` chose and why.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub auto: Option<AutoChoice>,
 }
 
@@ -42,7 +56,7 @@ fn build_effects(
     kinematics: &poe::LocalPoe,
     data: &MeasurementSet,
 ) -> Result<Vec<IdentifiedEffect>, Error> {
-    let context = EffectContext { robot, tools: kinematics.tools() };
+    let context = EffectContext { robot, kinematics };
     let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
     specs.iter().map(|spec| IdentifiedEffect::new(spec, &context, &data.rows, &tools)).collect()
 }
@@ -73,6 +87,7 @@ pub fn fit(
     };
     let mut identification = geometry.report;
     let mut auto = None;
+    let mut effect_report = Vec::new();
     let specs: Vec<EffectSpec> = match &options.effects.selection {
         EffectSelection::None => Vec::new(),
         EffectSelection::List(list) => list.clone(),
@@ -89,10 +104,15 @@ pub fn fit(
         let correction = EffectCorrection::new(&effects, &data.rows, &tools, options.effects.prior_sigma)?;
         let layout = model.kinematics.layout();
         let mask = if scope == Scope::BaseTool { ParameterMask::base_tool(layout) } else { ParameterMask::all(layout) };
-        let id_options = IdentificationOptions { solver: options.effects.solver, ..options.identification.clone() };
+        let id_options = IdentificationOptions {
+            solver: options.effects.solver,
+            max_iterations: options.effects.max_iterations,
+            ..options.identification.clone()
+        };
         let fitted =
             identify_with_correction(&model.kinematics, &observations(data), &mask, Some(&correction), &id_options)?;
         EffectCorrection::distribute(&mut effects, &fitted.correction);
+        effect_report = effect_reports(&effects, &fitted.report.held_at_prior);
         model.kinematics = fitted.model;
         model.effects = effects;
         identification = fitted.report;
@@ -110,7 +130,18 @@ pub fn fit(
         CalibratedModel { kinematics: geometry.registered, effects: Vec::new(), compensation: None, ..model.clone() };
     let before = evaluate(&registered, data)?.summary;
     let after = evaluate(&model, data)?.summary;
-    Ok((model, FitReport { method, before, after, identification, compensation, auto }))
+    let report = FitReport {
+        method,
+        n: data.rows.len(),
+        full_pose: data.full_pose,
+        before,
+        after,
+        identification,
+        effects: effect_report,
+        compensation,
+        auto,
+    };
+    Ok((model, report))
 }
 
 /// Evaluates a fitted model on measurements.

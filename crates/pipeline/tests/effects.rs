@@ -135,3 +135,87 @@ fn a_model_with_every_effect_reads_back_and_predicts_the_same() {
         assert!((a.position_mm - b.position_mm).abs() < 1e-9, "{a:?} {b:?}");
     }
 }
+
+fn iiwa7() -> RobotDescription {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/iiwa7.ron");
+    RobotDescription::read(&path).unwrap()
+}
+
+/// The 7-axis campaign of issue 11 (joints 1 and 2 moving, the others at 0 within 2 mrad, four
+/// payload runs with a tool each, measured torques), full pose, split even / odd rows.
+fn campaign(effects: &Effects, seed: u64) -> (MeasurementSet, MeasurementSet) {
+    let robot = iiwa7();
+    let config = pipeline::simulated::payload_run_campaign(400, seed);
+    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..effects.clone() };
+    let remount = pipeline::simulated::Remount::default();
+    let (_, all) =
+        pipeline::simulated::simulate_campaign(&robot, &effects, &Perturbation::default(), &remount, &config, true)
+            .unwrap();
+    let even: Vec<usize> = (0..all.rows.len()).step_by(2).collect();
+    let odd: Vec<usize> = (1..all.rows.len()).step_by(2).collect();
+    (all.subset(&even), all.subset(&odd))
+}
+
+#[test]
+fn a_seven_axis_campaign_with_two_moving_joints_reaches_the_noise_with_joint_compliance() {
+    let robot = iiwa7();
+    let seed = 35;
+    let (train, test) = campaign(&pipeline::simulated::paper_effects(), seed);
+    let (noise_train, noise_test) = campaign(&Effects::default(), seed);
+    let floor = heldout(&robot, &noise_train, &noise_test, "");
+    let poe = heldout(&robot, &train, &test, "");
+    // With the measured torques (modelled on the gravity regressors), then without them.
+    let measured = heldout(&robot, &train, &test, "joint_compliance");
+    let strip = |set: &MeasurementSet| {
+        let mut set = set.clone();
+        set.rows.iter_mut().for_each(|r| r.torques_nm = None);
+        set
+    };
+    let gravity = heldout(&robot, &strip(&train), &strip(&test), "joint_compliance");
+    eprintln!("noise {floor:.4} mm, poe {poe:.4} mm, compliance: torques {measured:.4} mm, gravity {gravity:.4} mm");
+    for (name, error) in [("measured torques", measured), ("gravity regressors", gravity)] {
+        assert!(error < 1.5 * floor, "{name}: {error} mm against the noise's {floor} mm");
+        assert!(error < poe, "{name}: {error} mm against poe's {poe} mm");
+    }
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 8, ..proptest::prelude::ProptestConfig::default() })]
+
+    /// The training cost a fit minimises (data and prior) with a superset of effects ends at or
+    /// below the cost with a subset: the subset's solution is a point of the superset's problem
+    /// (its extra parameters at zero), and every effect fit starts from the geometry's solution.
+    #[test]
+    fn more_effects_never_end_at_a_higher_training_cost(seed in 0_u64..500, mask in 1_u32..32, extra in 1_u32..32) {
+        const ITEMS: [&str; 5] = ["gear_periodic:2:2", "gear_periodic:3:1", "backlash:3", "thermal", "time_drift"];
+        let pick = |bits: u32| -> String {
+            ITEMS.iter().enumerate().filter(|(k, _)| bits & (1 << k) != 0).map(|(_, s)| *s).collect::<Vec<_>>().join(",")
+        };
+        let (subset, superset) = (pick(mask), pick(mask | extra));
+        let robot = irb4400();
+        let effects = Effects {
+            periodic: Some(PeriodicError { harmonics: vec![Harmonic { joint_index: 1, order: 3.0, amplitude_rad: 2e-4, phase_rad: 0.5 }] }),
+            ..Effects::default()
+        };
+        let cell = simulated_cell(&robot, &Perturbation::default(), seed).unwrap();
+        let config = GeneratorConfig { sample_count: 80, seed, ..GeneratorConfig::default() };
+        let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..effects };
+        let data = simulate(&cell, &effects, &joint_ranges(&robot), &config, seed % 2 == 0).unwrap();
+        let cost = |list: &str| {
+            let options = FitOptions::default().with_effects(list.parse().unwrap());
+            let (_, report) = pipeline::fit(&robot, &data, Method::Poe, &options).unwrap();
+            let id = &report.identification;
+            (id.final_cost, id.converged.then_some(()).ok_or_else(|| format!("{list}: {} after {}", id.termination, id.iteration_count())))
+        };
+        let (geometry, _) = {
+            let (_, report) = pipeline::fit(&robot, &data, Method::Poe, &FitOptions::default()).unwrap();
+            (report.identification.final_cost, ())
+        };
+        let (small, small_converged) = cost(&subset);
+        let (large, large_converged) = cost(&superset);
+        proptest::prop_assert!(small <= geometry * (1.0 + 1e-12), "{subset}: {small} above the geometry's {geometry}");
+        proptest::prop_assert!(large <= geometry * (1.0 + 1e-12), "{superset}: {large} above the geometry's {geometry}");
+        proptest::prop_assert!(small_converged.is_ok() && large_converged.is_ok(), "{small_converged:?} / {large_converged:?}");
+        proptest::prop_assert!(large <= small * (1.0 + 1e-6), "{superset}: {large} above {subset}: {small}");
+    }
+}

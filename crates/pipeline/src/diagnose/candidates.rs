@@ -174,9 +174,9 @@ pub(crate) fn build_candidates(
 ) -> Result<Vec<Candidate>, Error> {
     let n = robot.joint_count();
     let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
-    // The nominal arm in the base frame, carrying the calibrated tools (their offsets from the
-    // last joint are what the payload hangs from).
-    let load = EffectContext { robot, tools: model.tools() }.load_frame()?;
+    // The nominal arm in the base frame, where gravity is known, with the calibrated tools placed
+    // on its flange (the payload hangs from them).
+    let load = EffectContext { robot, kinematics: model }.load_frame(&data.rows, &tools)?;
     let dynamics = robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(robot));
     let measured = has_torques(&data.rows);
     let nonzero = |columns: &[Vec<f64>]| columns.iter().flatten().any(|v| v.abs() > 1e-12);
@@ -243,9 +243,10 @@ pub(crate) fn build_candidates(
             push(compliance, None, compliance_columns);
         }
         if measured {
-            // Measured torques (SPEC `tauN_nm`): δq_j = c_j τ_j with τ_j as measured, and the
-            // band's side from its sign.
-            let compliance = JointCompliance::new(ComplianceTorque::Measured, &[j], &data.rows, &tools)?;
+            // Measured torques (SPEC `tauN_nm`): δq_j = c_j τ_j with τ_j the measured torque as
+            // the gravity regressors explain it (the sensor's noise left out, as the fit does),
+            // and the band's side from the measured torque's sign.
+            let compliance = JointCompliance::modelled(load.clone(), &[j], &data.rows, &tools)?;
             if !compliance.terms.is_empty() {
                 let effect = IdentifiedEffect::JointCompliance(compliance);
                 let effect_columns = columns(&effect)?;

@@ -98,4 +98,8 @@ impl Regressor for Backlash {
     fn theta_mut(&mut self) -> &mut Vec<f64> {
         &mut self.theta
     }
+
+    fn parameter_names(&self) -> Vec<String> {
+        vec![format!("joint {} half band", self.joint + 1)]
+    }
 }

@@ -114,9 +114,19 @@ impl Cursor<'_> {
                 add("joint", c.terms.len());
                 add("column", c.terms.len());
                 add("scale", c.terms.len());
-                if let ComplianceTorque::GravityRegressor(_) = c.torque {
-                    add("base_model", 1);
-                    add("gravity_m_per_s2", 1);
+                match &c.torque {
+                    ComplianceTorque::Measured => {}
+                    ComplianceTorque::GravityRegressor(_) => {
+                        add("base_model", 1);
+                        add("gravity_m_per_s2", 1);
+                    }
+                    ComplianceTorque::Modelled { fits, .. } => {
+                        add("base_model", 1);
+                        add("gravity_m_per_s2", 1);
+                        add("fits", 1);
+                        add("columns", fits.len());
+                        add("coefficients", fits.len());
+                    }
                 }
             }
             IdentifiedEffect::GearPeriodic(_) => {
@@ -191,12 +201,35 @@ pub(crate) fn check_effects(
     for effect in effects {
         match effect {
             IdentifiedEffect::JointCompliance(c) => {
-                if let ComplianceTorque::GravityRegressor(load) = &c.torque {
-                    cursor.load(load, n, tools)?;
+                match &c.torque {
+                    ComplianceTorque::Measured => {}
+                    ComplianceTorque::GravityRegressor(load) => cursor.load(load, n, tools)?,
+                    ComplianceTorque::Modelled { load, fits } => {
+                        cursor.load(load, n, tools)?;
+                        cursor.count("fits", fits.len(), n)?;
+                        for (k, fit) in fits.iter().enumerate() {
+                            if let Some(m) = fit.columns.iter().position(|&c| c > 4 * n) {
+                                let kind = FaultKind::Index { index: fit.columns[m], limit: 4 * n + 1 };
+                                return Err(cursor.fault("columns", k, format!("fits[{k}].columns[{m}]"), kind));
+                            }
+                            if fit.coefficients.len() != fit.columns.len() {
+                                let kind = FaultKind::Count {
+                                    what: "values",
+                                    found: fit.coefficients.len(),
+                                    expected: fit.columns.len(),
+                                };
+                                return Err(cursor.fault("coefficients", k, format!("fits[{k}].coefficients"), kind));
+                            }
+                            if let Some(&value) = fit.coefficients.iter().find(|v| !v.is_finite()) {
+                                let kind = FaultKind::NotFinite { value };
+                                return Err(cursor.fault("coefficients", k, format!("fits[{k}].coefficients"), kind));
+                            }
+                        }
+                    }
                 }
                 // A regressor row holds 4 columns per link and the payload's: 4n + 1; a measured
-                // torque has one.
-                let width = if matches!(c.torque, ComplianceTorque::Measured) { 1 } else { 4 * n + 1 };
+                // or modelled torque has one.
+                let width = if matches!(c.torque, ComplianceTorque::GravityRegressor(_)) { 4 * n + 1 } else { 1 };
                 for (k, term) in c.terms.iter().enumerate() {
                     cursor.joint("joint", k, format!("terms[{k}].joint"), term.joint, n)?;
                     if term.column >= width {

@@ -75,4 +75,13 @@ impl PoseCorrection for EffectCorrection {
     fn prior_sigma(&self, parameter: usize) -> f64 {
         self.prior_sigma[parameter]
     }
+
+    fn joint(&self, parameter: usize) -> Option<usize> {
+        match self.directions[parameter] {
+            Direction::Joint(j) => Some(j),
+            // A fixed twist does not follow the kinematics; the arm's growth does, but its
+            // derivative (strain 1e-5 to 1e-4 times a link change) is far below the noise.
+            Direction::Component(_) | Direction::LinkGrowth => None,
+        }
+    }
 }

@@ -46,4 +46,8 @@ impl Regressor for TimeDrift {
     fn theta_mut(&mut self) -> &mut Vec<f64> {
         &mut self.theta
     }
+
+    fn parameter_names(&self) -> Vec<String> {
+        ["v_x", "v_y", "v_z", "w_x", "w_y", "w_z"].iter().map(|c| format!("drift {c}")).collect()
+    }
 }

@@ -55,4 +55,9 @@ impl Regressor for GearPeriodic {
     fn theta_mut(&mut self) -> &mut Vec<f64> {
         &mut self.theta
     }
+
+    fn parameter_names(&self) -> Vec<String> {
+        let j = self.joint + 1;
+        self.orders.iter().flat_map(|h| [format!("cos({h} q{j})"), format!("sin({h} q{j})")]).collect()
+    }
 }

@@ -16,16 +16,19 @@ mod direction;
 mod drift;
 mod gear;
 mod load_frame;
+mod report;
 mod spec;
 mod thermal;
 
 pub use auto::{AutoChoice, choose, effects_of};
 pub use backlash::{Backlash, TorqueSign};
-pub use compliance::{ComplianceTerm, ComplianceTorque, JointCompliance};
+pub use compliance::{ComplianceTerm, ComplianceTorque, JointCompliance, TorqueFit};
 pub use direction::Direction;
 pub use drift::TimeDrift;
 pub use gear::GearPeriodic;
 pub use load_frame::LoadFrame;
+pub(crate) use report::effect_reports;
+pub use report::{EffectReport, ParameterReport};
 pub use spec::{EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS};
 pub use thermal::Thermal;
 
@@ -48,6 +51,8 @@ pub(crate) trait Regressor {
     fn theta(&self) -> &[f64];
     /// The parameters' values, to set after a fit.
     fn theta_mut(&mut self) -> &mut Vec<f64>;
+    /// A name for each parameter, for reports (1-based joints).
+    fn parameter_names(&self) -> Vec<String>;
 }
 
 /// The RMS of each feature over `rows` (one `Vec` per row), 1 where a feature is zero throughout,
@@ -84,18 +89,19 @@ pub enum IdentifiedEffect {
 }
 
 /// What the effects of a fit are built from: the robot (for gravity and masses) and the
-/// calibrated tools (the payload hangs from them).
+/// calibrated kinematics (where the arm and its tools are; the payload hangs from the tools).
 #[derive(Debug, Clone, Copy)]
 pub struct EffectContext<'a> {
     /// The robot description.
     pub robot: &'a RobotDescription,
-    /// The tools of the kinematic model, `flange_from_tool`.
-    pub tools: &'a [SE3],
+    /// The calibrated kinematics (reference frame: the tracker).
+    pub kinematics: &'a LocalPoe,
 }
 
 impl EffectContext<'_> {
-    pub(crate) fn load_frame(&self) -> Result<LoadFrame, Error> {
-        LoadFrame::new(self.robot, self.tools)
+    /// The load frame, its tools placed from `rows` (`tools`: each row's model tool).
+    pub(crate) fn load_frame(&self, rows: &[Measurement], tools: &[usize]) -> Result<LoadFrame, Error> {
+        LoadFrame::new(self.robot, self.kinematics, rows, tools)
     }
 
     fn check_joint(&self, spec: &EffectSpec) -> Result<usize, Error> {
@@ -122,12 +128,12 @@ impl IdentifiedEffect {
         Ok(match *spec {
             EffectSpec::JointCompliance => {
                 let joints: Vec<usize> = (0..context.robot.joint_count()).collect();
-                let torque = if has_torques(rows) {
-                    ComplianceTorque::Measured
+                let load = context.load_frame(rows, tools)?;
+                IdentifiedEffect::JointCompliance(if has_torques(rows) {
+                    JointCompliance::modelled(load, &joints, rows, tools)?
                 } else {
-                    ComplianceTorque::GravityRegressor(context.load_frame()?)
-                };
-                IdentifiedEffect::JointCompliance(JointCompliance::new(torque, &joints, rows, tools)?)
+                    JointCompliance::new(ComplianceTorque::GravityRegressor(load), &joints, rows, tools)?
+                })
             }
             EffectSpec::GearPeriodic { harmonics, .. } => {
                 IdentifiedEffect::GearPeriodic(GearPeriodic::new(joint, (1..=harmonics).collect(), rows)?)
@@ -137,7 +143,7 @@ impl IdentifiedEffect {
                     TorqueSign::Measured
                 } else {
                     let dynamics = context.robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(context.robot));
-                    TorqueSign::Stated { load: context.load_frame()?, dynamics }
+                    TorqueSign::Stated { load: context.load_frame(rows, tools)?, dynamics }
                 };
                 IdentifiedEffect::Backlash(Backlash::new(joint, sign, rows, tools)?)
             }
@@ -193,6 +199,9 @@ impl IdentifiedEffect {
         match self {
             IdentifiedEffect::JointCompliance(e) => match e.torque {
                 ComplianceTorque::Measured => "joint_compliance (measured torques)".into(),
+                ComplianceTorque::Modelled { .. } => {
+                    "joint_compliance (measured torques, modelled on the gravity regressors)".into()
+                }
                 ComplianceTorque::GravityRegressor(_) => "joint_compliance (gravity-torque regressors)".into(),
             },
             IdentifiedEffect::GearPeriodic(e) => {
@@ -229,6 +238,11 @@ impl IdentifiedEffect {
         let own = self.regressor_mut().theta_mut();
         own.clear();
         own.extend_from_slice(theta);
+    }
+
+    /// A name for each parameter (1-based joints), for reports.
+    pub fn parameter_names(&self) -> Vec<String> {
+        self.regressor().parameter_names()
     }
 
     /// The twist of each parameter.

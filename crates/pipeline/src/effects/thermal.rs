@@ -46,4 +46,8 @@ impl Regressor for Thermal {
     fn theta_mut(&mut self) -> &mut Vec<f64> {
         &mut self.theta
     }
+
+    fn parameter_names(&self) -> Vec<String> {
+        vec!["link strain".into()]
+    }
 }

@@ -83,6 +83,14 @@ pub(super) fn levenberg_marquardt(problem: &Problem<'_>, start: State) -> Result
                 break;
             }
         } else {
+            // MINPACK's xtol: when even a step this short does not lower the cost, the minimum is
+            // within it (the trust region has shrunk below the step tolerance).
+            let step_norm = step.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let deviation = state.deviation.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if step_norm <= options.step_tolerance * (deviation + options.step_tolerance) {
+                termination = Termination::StepTolerance { step_norm };
+                break;
+            }
             lambda *= growth;
             growth *= 2.0;
             if lambda > options.max_damping {

@@ -1,9 +1,10 @@
 //! What an identification reports.
 
 use super::{Redundancy, Termination};
+use serde::Serialize;
 
 /// The errors after one iteration (index 0: before the first).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct IterationRecord {
     /// RMS tool position error, metres.
     pub rms_position_m: f64,
@@ -17,7 +18,7 @@ pub struct IterationRecord {
 }
 
 /// How an identification went and what the data could and could not determine.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct IdentificationReport {
     /// Errors per iteration, the initial model first.
     pub iterations: Vec<IterationRecord>,
@@ -39,7 +40,8 @@ pub struct IdentificationReport {
     pub singular_values: Vec<f64>,
     /// Ratio of the largest to the smallest singular value kept.
     pub condition_number: f64,
-    /// The directions the data cannot determine, in words.
+    /// The directions the data cannot determine, in words (serialised as their sentences).
+    #[serde(serialize_with = "sentences")]
     pub unidentifiable: Vec<Redundancy>,
     /// Correction parameters (indices into the correction's θ) that the data barely determines:
     /// their posterior standard deviation is more than half their prior's, so the prior holds
@@ -57,4 +59,8 @@ impl IdentificationReport {
     pub fn redundancy(&self) -> f64 {
         self.residual_rows as f64 / self.rank.max(1) as f64
     }
+}
+
+fn sentences<S: serde::Serializer>(redundancies: &[Redundancy], serializer: S) -> Result<S::Ok, S::Error> {
+    serializer.collect_seq(redundancies.iter().map(ToString::to_string))
 }

@@ -1,17 +1,20 @@
 //! Why an identification stopped, stated so that "converged" always names the criterion it met.
 
+use serde::Serialize;
 use std::fmt;
 
 /// Why the iterations ended. Only the first three mean the solution was reached.
 #[non_exhaustive]
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "criterion", rename_all = "snake_case")]
 pub enum Termination {
     /// An accepted step lowered the weighted cost by less than the cost tolerance.
     CostTolerance {
         /// The relative decrease of the last step.
         relative_decrease: f64,
     },
-    /// The step became shorter than the step tolerance.
+    /// The step became shorter than the step tolerance: an accepted step, or a rejected one (no
+    /// step that short lowers the cost: the minimum is within it, MINPACK's `xtol`).
     StepTolerance {
         /// Its norm.
         step_norm: f64,
