@@ -66,7 +66,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let mut summary = String::new();
     summary.push_str(&data.read_summary());
     summary.push('\n');
-    summarise(&mut summary, args, &robot.name, &data, &report);
+    summarise(&mut summary, args, &robot.name, &data, &model, &report);
     if args.json {
         eprint!("{summary}");
         println!("{}", serde_json::to_string(&report)?);
@@ -76,7 +76,14 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
-fn summarise(out: &mut String, args: &Args, robot: &str, data: &pipeline::MeasurementSet, report: &FitReport) {
+fn summarise(
+    out: &mut String,
+    args: &Args,
+    robot: &str,
+    data: &pipeline::MeasurementSet,
+    model: &pipeline::CalibratedModel,
+    report: &FitReport,
+) {
     let kind = if data.full_pose { "full pose" } else { "position only" };
     let tools = data.tools.iter().filter(|t| !t.is_empty()).count().max(1);
     let plural = if tools == 1 { "" } else { "s" };
@@ -129,7 +136,7 @@ fn summarise(out: &mut String, args: &Args, robot: &str, data: &pipeline::Measur
         }
     }
     if let Some(compensation) = &model.compensation {
-        println!("  GP: {}", compensation.gp.choice());
+        let _ = writeln!(out, "  GP: {}", compensation.gp.choice());
     }
     for direction in &id.unidentifiable {
         let _ = writeln!(out, "    unidentifiable: {direction}");

@@ -182,7 +182,8 @@ impl GpModel {
 }
 
 /// What the GP's fit reported.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum GpFitReport {
     /// The exact GP's report.
     Exact(gp::FitReport),
