@@ -15,7 +15,7 @@ use loadsim::{
     Backlash, BaseDrift, Effects, GeneratorConfig, Harmonic, JointBacklash, JointCompliance, PeriodicError,
     SimulatedCell, ThermalGrowth, TrackerNoise,
 };
-use pipeline::diagnose::{DiagnoseOptions, Effect, diagnose};
+use pipeline::diagnose::{DiagnoseOptions, Effect, StructureOptions, diagnose};
 use pipeline::{FitOptions, Method, RobotDescription};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -204,7 +204,8 @@ fn run_case(robot: &RobotDescription, index: usize, seed: u64, rows: usize) -> R
     let diagnosis = diagnose(&blind, &data, &options).map_err(|e| e.to_string())?;
     // The true "after": the geometric model's held-out error on the same poses and noise without
     // the effect (no need to look for structure there).
-    let oracle_options = DiagnoseOptions { check_structure: false, ..options };
+    let oracle_options =
+        DiagnoseOptions { structure: StructureOptions { enabled: false, ..StructureOptions::default() }, ..options };
     let oracle = diagnose(&blind, &noisy_none, &oracle_options).map_err(|e| e.to_string())?;
     Ok(Case {
         truth,

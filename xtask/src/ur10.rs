@@ -93,14 +93,7 @@ pub fn run(args: &Args) -> Result<(), String> {
     let diagnose_s = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
-    let folder = args.out.join("ur10-diagnosis");
-    std::fs::create_dir_all(&folder).map_err(|e| format!("{}: {e}", folder.display()))?;
-    let plots = diagnosis.plots();
-    for (name, svg) in &plots {
-        std::fs::write(folder.join(name), svg).map_err(|e| format!("{}: {e}", folder.display()))?;
-    }
-    let names: Vec<String> = plots.into_iter().map(|(n, _)| n).collect();
-    std::fs::write(folder.join("diagnosis.md"), diagnosis.markdown(&names)).map_err(|e| e.to_string())?;
+    diagnosis.write_report(&args.out.join("ur10-diagnosis")).map_err(|e| e.to_string())?;
 
     let mut md = String::new();
     let _ = writeln!(md, "# The real UR10: every method and the diagnosis\n");

@@ -18,7 +18,8 @@ pub struct Args {
     /// Print one JSON object on stdout instead of the summary.
     #[arg(long)]
     json: bool,
-    /// The tracker's noise per axis, mm, if known (otherwise estimated from the data).
+    /// The instrument's noise per axis, mm, if known (otherwise from repeated poses, or a laser
+    /// tracker's default, as the report says).
     #[arg(long)]
     noise_mm: Option<f64>,
     /// Write a markdown report with SVG plots into this folder.
@@ -44,44 +45,16 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let options =
         DiagnoseOptions { folds: args.folds, seed: args.seed, noise_mm: args.noise_mm, ..DiagnoseOptions::default() };
     let diagnosis = diagnose(&robot, &data, &options)?;
-    if let Some(folder) = &args.report {
-        std::fs::create_dir_all(folder).map_err(|e| format!("{}: {e}", folder.display()))?;
-        let plots = diagnosis.plots();
-        for (name, svg) in &plots {
-            let path = folder.join(name);
-            std::fs::write(&path, svg).map_err(|e| format!("{}: {e}", path.display()))?;
-        }
-        let names: Vec<String> = plots.into_iter().map(|(name, _)| name).collect();
-        let path = folder.join("diagnosis.md");
-        std::fs::write(&path, diagnosis.markdown(&names)).map_err(|e| format!("{}: {e}", path.display()))?;
-    }
+    let report = args.report.as_deref().map(|folder| diagnosis.write_report(folder)).transpose()?;
     if args.json {
-        println!("{}", json_text(diagnosis.to_json())?);
+        println!("{}", diagnosis.to_json()?);
         eprintln!("{}", data.read_summary());
     } else {
         println!("{}", data.read_summary());
         print!("{}", diagnosis.summary());
-        if let Some(folder) = &args.report {
-            println!("  report:         {}", folder.join("diagnosis.md").display());
+        if let Some(path) = report {
+            println!("  report:         {}", path.display());
         }
     }
     Ok(())
-}
-
-/// The diagnosis's JSON text. `Diagnosis::to_json` gives `null` when serialisation failed: that is
-/// an error with a non-zero exit, never a `null` printed as if it were the answer.
-fn json_text(value: serde_json::Value) -> Result<String, String> {
-    match value {
-        serde_json::Value::Null => Err("the diagnosis could not be written as JSON".into()),
-        value => Ok(value.to_string()),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn a_diagnosis_that_did_not_serialise_is_an_error_not_null() {
-        assert!(super::json_text(serde_json::Value::Null).is_err());
-        assert_eq!(super::json_text(serde_json::json!({"n": 1})).unwrap(), r#"{"n":1}"#);
-    }
 }

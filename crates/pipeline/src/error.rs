@@ -377,6 +377,30 @@ pub enum Error {
         /// 1-based row of the simulated set.
         row: usize,
     },
+    /// A diagnosis option out of its range.
+    DiagnoseOption {
+        /// The option.
+        field: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// A report could not be written as JSON.
+    Json {
+        /// What was being written.
+        what: &'static str,
+        /// The underlying error.
+        source: serde_json::Error,
+    },
+    /// The diagnosis's regularised normal equations were not positive definite: the data hold a
+    /// non-finite number or are degenerate beyond what the prior can hold.
+    DiagnoseSolve {
+        /// Folds whose rows were left out of the fit (empty: every row).
+        left_out: Vec<usize>,
+        /// Number of columns of the system.
+        columns: usize,
+        /// The pivot at which the factorisation failed.
+        pivot: usize,
+    },
     /// Too few rows for what was asked.
     TooFewRows {
         /// The file.
@@ -552,6 +576,12 @@ impl fmt::Display for Error {
                 f,
                 "simulated row {row} is not finite: an effect or the robot is beyond any real range (nothing written)"
             ),
+            Error::DiagnoseOption { field, value } => write!(f, "diagnose option {field} = {value} is out of range"),
+            Error::Json { what, source } => write!(f, "{what} as JSON: {source}"),
+            Error::DiagnoseSolve { left_out, columns, pivot } => write!(
+                f,
+                "diagnose: the regularised fit without folds {left_out:?} ({columns} columns) is not positive definite at pivot {pivot}"
+            ),
             Error::TooFewRows { file, rows, needed } => {
                 write!(f, "{file}: {rows} measurement rows, at least {needed} needed")
             }
@@ -573,6 +603,7 @@ impl std::error::Error for Error {
             Error::Kinematics { source } => Some(source),
             Error::Load { source } => Some(source),
             Error::Gp { source } => Some(source),
+            Error::Json { source, .. } => Some(source),
             _ => None,
         }
     }

@@ -133,35 +133,6 @@ impl Design {
         let b: Vec<f64> = rows().map(|row| self.y[row]).collect();
         (pseudo_inverse_solve(&a, &b), scale)
     }
-
-    /// Held-out residuals of every measurement by K-fold cross-validation of one linear step
-    /// with the kinematic columns and `extra` columns (one `Vec` of weighted rows per column,
-    /// `rows_per_pose × poses` long). Returns the unweighted held-out position residual (m) and,
-    /// for full-pose data, the orientation residual (rad), per measurement.
-    pub(crate) fn cross_validate(&self, extra: &[Vec<f64>], folds: &[usize], fold_count: usize) -> Vec<Vector6> {
-        let k = self.rows_per_pose;
-        let columns = self.kinematic.ncols() + extra.len();
-        let mut out = vec![Vector6::zeros(); self.poses()];
-        for fold in 0..fold_count {
-            let train: Vec<usize> = (0..self.poses()).filter(|&i| folds[i] != fold).collect();
-            let test: Vec<usize> = (0..self.poses()).filter(|&i| folds[i] == fold).collect();
-            if train.is_empty() || test.is_empty() {
-                continue;
-            }
-            let (beta, scale) = self.solve(extra, &train);
-            for &i in &test {
-                let mut residual = Vector6::zeros();
-                for r in 0..k {
-                    let row = i * k + r;
-                    let predicted: f64 = (0..columns).map(|c| self.value(extra, row, c) * scale[c] * beta[c]).sum();
-                    let weight = if r < 3 { self.weights.position_m } else { self.weights.rotation_rad };
-                    residual[r] = (self.y[row] - predicted) * weight;
-                }
-                out[i] = residual;
-            }
-        }
-        out
-    }
 }
 
 /// `x = A⁺ b` through the thin SVD, dropping directions below `1e-10 σ_max` (the kinematic

@@ -92,8 +92,9 @@ fn quantile_regions(
         .collect()
 }
 
-/// Every breakdown the data supports.
-pub(crate) fn regions(poses: &[PoseDiagnosis]) -> Vec<Region> {
+/// Every breakdown the data supports; joint bins only over the joints that move (`moving`,
+/// 0-based): a bin of a joint held still splits encoder jitter, not the workspace.
+pub(crate) fn regions(poses: &[PoseDiagnosis], moving: &[usize]) -> Vec<Region> {
     let mut out = Vec::new();
     for (axis, name) in ["x", "y", "z"].iter().enumerate() {
         out.push(Region {
@@ -131,8 +132,7 @@ pub(crate) fn regions(poses: &[PoseDiagnosis]) -> Vec<Region> {
     } else if payloads.len() > 12 {
         out.extend(quantile_regions(poses, "payload", "kg", 5, &|p| p.payload_kg));
     }
-    let joints = poses.first().map_or(0, |p| p.q.len());
-    for j in 0..joints {
+    for &j in moving {
         out.extend(quantile_regions(poses, &format!("joint {}", j + 1), "deg", 6, &|p| p.q[j].to_degrees()));
     }
     out.extend(quantile_regions(poses, "reach", "m", 5, &|p| p.reach_m));

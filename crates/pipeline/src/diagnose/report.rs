@@ -1,22 +1,13 @@
-//! The diagnosis as people read it: the verdict, the ranking, a ten-second summary, a markdown
-//! report with plots, and the SPEC's JSON.
+//! The diagnosis as people read it: a ten-second summary, a markdown report with plots written
+//! into a folder, and the SPEC's JSON (the [`Diagnosis`] itself, serialised as it is).
 
-use super::candidates::{Candidate, Effect};
-use super::noise::{NoiseFloor, NoiseSource};
+use super::candidates::Effect;
+use super::noise::NoiseSource;
 use super::regions::{PoseDiagnosis, Region};
-use super::selection::{CrossValidated, Selection};
 use super::{Diagnosis, svg};
-use crate::{MeasurementSet, RobotDescription};
+use crate::Error;
 use serde::{Deserialize, Serialize};
-
-/// The SPEC's `verdict`: the effect that explains the residual and the joints it involves.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Verdict {
-    /// The effect.
-    pub effect: Effect,
-    /// 1-based joints, ascending; empty where none.
-    pub joints: Vec<usize>,
-}
+use std::path::{Path, PathBuf};
 
 /// One candidate tried alone on top of the geometric model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -25,13 +16,37 @@ pub struct CandidateScore {
     pub effect: Effect,
     /// 1-based joints.
     pub joints: Vec<usize>,
-    /// Harmonic order, for gear periodic error.
+    /// For gear periodic error: the order of the Fourier series (harmonics 1 to this), as the
+    /// cross-validation of all folds prefers it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub harmonic: Option<u32>,
     /// Number of parameters it adds.
     pub parameters: usize,
     /// Cross-validated mean position error with it, mm.
     pub heldout_after_mm: f64,
+}
+
+/// One harmonic of a selected periodic error, fitted on every row.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DominantHarmonic {
+    /// Cycles per turn of the joint.
+    pub order: u32,
+    /// Its period in the joint's angle, degrees.
+    pub period_deg: f64,
+    /// Its amplitude, µrad.
+    pub amplitude_urad: f64,
+}
+
+/// The shape of a selected periodic error, fitted on every row.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SeriesShape {
+    /// RMS of the joint error over the data (its mean removed), µrad.
+    pub rms_urad: f64,
+    /// The span of the joint's angles in the data, degrees: no period longer than this is
+    /// resolved.
+    pub range_deg: f64,
+    /// The strongest harmonics among those whose period fits in the range, largest first.
+    pub dominant: Vec<DominantHarmonic>,
 }
 
 /// An effect the selection kept.
@@ -41,96 +56,20 @@ pub struct SelectedEffect {
     pub effect: Effect,
     /// 1-based joints.
     pub joints: Vec<usize>,
-    /// Harmonic order, for gear periodic error.
+    /// For gear periodic error: the order of the Fourier series a fit on every row should use
+    /// (harmonics 1 to this).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub harmonic: Option<u32>,
+    /// For gear periodic error: the order each fold chose by cross-validation on its own rows.
+    #[serde(skip_serializing_if = "Vec::is_empty", default)]
+    pub fold_orders: Vec<u32>,
+    /// For gear periodic error: its size and strongest periods.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub shape: Option<SeriesShape>,
     /// Cross-validated mean position error with it and every earlier selection, mm.
     pub heldout_after_mm: f64,
-    /// Paired t statistic of its gain.
-    pub t: f64,
-}
-
-/// What a GP on the final held-out residual still finds.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Remaining {
-    /// Cross-validated mean position error once the GP's prediction of the residual is removed, mm.
-    pub heldout_after_gp_mm: f64,
-    /// Paired t statistic of the GP's gain.
-    pub t: f64,
-    /// Whether the gain is significant and large enough to call the residual structured.
-    pub significant: bool,
-}
-
-/// The per-axis RMS of the held-out residual, as a noise level (an upper bound).
-pub(crate) fn residual_noise(result: &CrossValidated) -> NoiseFloor {
-    let n = result.residuals.len().max(1) as f64;
-    let sum: f64 = result.residuals.iter().map(|r| r.fixed_rows::<3>(0).norm_squared()).sum();
-    NoiseFloor::from_sigma((sum / (3.0 * n)).sqrt() * 1e3, NoiseSource::HeldOutResidual)
-}
-
-pub(crate) fn assemble(
-    robot: &RobotDescription,
-    data: &MeasurementSet,
-    candidates: &[Candidate],
-    selection: &Selection,
-    remaining: Option<Remaining>,
-    noise: NoiseFloor,
-    poses: Vec<PoseDiagnosis>,
-) -> Diagnosis {
-    let regions = super::regions::regions(&poses);
-    let mut scores: Vec<CandidateScore> = candidates
-        .iter()
-        .zip(&selection.single)
-        .map(|(c, r)| CandidateScore {
-            effect: c.effect,
-            joints: c.joints.clone(),
-            harmonic: c.harmonic,
-            parameters: c.columns.len(),
-            heldout_after_mm: r.mean_error() * 1e3,
-        })
-        .collect();
-    scores.sort_by(|a, b| a.heldout_after_mm.total_cmp(&b.heldout_after_mm));
-    let selected: Vec<SelectedEffect> = selection
-        .steps
-        .iter()
-        .map(|s| {
-            let c = &candidates[s.candidate];
-            SelectedEffect {
-                effect: c.effect,
-                joints: c.joints.clone(),
-                harmonic: c.harmonic,
-                heldout_after_mm: s.result.mean_error() * 1e3,
-                t: s.t,
-            }
-        })
-        .collect();
-    let verdict = match selected.first() {
-        None if remaining.is_some_and(|r| r.significant) => Verdict { effect: Effect::Unknown, joints: vec![] },
-        None => Verdict { effect: Effect::None, joints: vec![] },
-        Some(first) => {
-            let mut joints: Vec<usize> =
-                selected.iter().filter(|s| s.effect == first.effect).flat_map(|s| s.joints.iter().copied()).collect();
-            joints.sort_unstable();
-            joints.dedup();
-            Verdict { effect: first.effect, joints }
-        }
-    };
-    let after = selection.steps.last().map_or(&selection.baseline, |s| &s.result);
-    Diagnosis {
-        robot: robot.name.clone(),
-        n: data.rows.len(),
-        full_pose: data.full_pose,
-        verdict,
-        heldout_before_mm: selection.baseline.mean_error() * 1e3,
-        heldout_after_mm: after.mean_error() * 1e3,
-        candidates: scores,
-        selected,
-        critical_t: selection.critical_t,
-        remaining,
-        noise,
-        regions,
-        poses,
-    }
+    /// Signed-rank statistic of its per-pose gain over the previous step.
+    pub z: f64,
 }
 
 fn describe(effect: Effect, joints: &[usize], harmonic: Option<u32>) -> String {
@@ -140,28 +79,44 @@ fn describe(effect: Effect, joints: &[usize], harmonic: Option<u32>) -> String {
         text.push_str(&format!(" on joint{} {}", if joints.len() > 1 { "s" } else { "" }, list.join(", ")));
     }
     if let Some(h) = harmonic {
-        text.push_str(&format!(" (harmonic {h})"));
+        text.push_str(&format!(" (harmonics 1–{h})"));
     }
     text
 }
 
-fn noise_source(source: NoiseSource) -> &'static str {
-    match source {
-        NoiseSource::Given => "given",
-        NoiseSource::Repeats => "from repeated poses",
-        NoiseSource::HeldOutResidual => "upper bound from the held-out residual",
-        NoiseSource::ResidualGp => "what a GP leaves of the held-out residual",
+fn describe_selected(s: &SelectedEffect) -> String {
+    let mut text = describe(s.effect, &s.joints, s.harmonic);
+    if let Some(shape) = &s.shape {
+        text.push_str(&format!(", {:.0} µrad RMS", shape.rms_urad));
+        if shape.dominant.is_empty() {
+            text.push_str(&format!(", no period shorter than its {:.0}° range", shape.range_deg));
+        } else {
+            let periods: Vec<String> =
+                shape.dominant.iter().map(|h| format!("{:.1}° ({:.0} µrad)", h.period_deg, h.amplitude_urad)).collect();
+            text.push_str(&format!(", dominant periods {}", periods.join(", ")));
+        }
+    }
+    text
+}
+
+fn noise_source(noise: &super::NoiseFloor) -> String {
+    match noise.source {
+        NoiseSource::Given => "given".into(),
+        NoiseSource::Repeats => "from repeated poses".into(),
+        NoiseSource::TrackerDefault => {
+            format!("tracker default: {}", noise.instrument.as_deref().unwrap_or("laser tracker"))
+        }
     }
 }
 
+fn list(joints: &[usize]) -> String {
+    joints.iter().map(usize::to_string).collect::<Vec<_>>().join(", ")
+}
+
 impl Diagnosis {
-    /// The SPEC JSON object (with more fields than the SPEC requires).
-    pub fn to_json(&self) -> serde_json::Value {
-        let mut value = serde_json::to_value(self).unwrap_or(serde_json::Value::Null);
-        if let Some(object) = value.as_object_mut() {
-            object.remove("poses");
-        }
-        value
+    /// The SPEC JSON text: the diagnosis as it is, without the per-pose table.
+    pub fn to_json(&self) -> Result<String, Error> {
+        serde_json::to_string(self).map_err(|source| Error::Json { what: "diagnosis", source })
     }
 
     /// The region whose geometric-model error is largest, with at least 15 poses.
@@ -176,38 +131,69 @@ impl Diagnosis {
     pub fn summary(&self) -> String {
         let mut out = String::new();
         let kind = if self.full_pose { "full pose" } else { "position only" };
-        out.push_str(&format!("{}: {} poses, {kind}\n", self.robot, self.n));
+        out.push_str(&format!(
+            "{}: {} poses, {kind}, joints moving: {}\n",
+            self.robot,
+            self.n,
+            list(&self.moving_joints)
+        ));
         let verdict = match self.verdict.effect {
             Effect::None => "none: nothing beats the noise floor significantly".to_owned(),
-            Effect::Unknown => "unknown: structure is left that no candidate explains".to_owned(),
+            Effect::Unknown if self.verdict.joints.is_empty() => {
+                "unknown: structure is left that no candidate explains".to_owned()
+            }
+            Effect::Unknown => format!(
+                "unknown: structure no candidate explains, in the angles of joint{} {}",
+                if self.verdict.joints.len() > 1 { "s" } else { "" },
+                list(&self.verdict.joints)
+            ),
             _ => describe(self.verdict.effect, &self.verdict.joints, None),
         };
         out.push_str(&format!("  verdict:        {verdict}\n"));
-        let change = 100.0 * (1.0 - self.heldout_after_mm / self.heldout_before_mm.max(f64::MIN_POSITIVE));
+        let change = |after: f64| 100.0 * (1.0 - after / self.heldout_before_mm.max(f64::MIN_POSITIVE));
         out.push_str(&format!(
-            "  held-out error: {:.4} mm -> {:.4} mm ({change:.0} % less)\n",
-            self.heldout_before_mm, self.heldout_after_mm
+            "  held-out error: {:.4} mm -> {:.4} mm with the verdict's effect ({:.0} % less)\n",
+            self.heldout_before_mm,
+            self.heldout_after_mm,
+            change(self.heldout_after_mm)
         ));
+        if (self.heldout_after_selected_mm - self.heldout_after_mm).abs() > 1e-9 {
+            out.push_str(&format!(
+                "                  {:.4} mm with every selected effect ({:.0} % less)\n",
+                self.heldout_after_selected_mm,
+                change(self.heldout_after_selected_mm)
+            ));
+        }
+        for s in &self.selected {
+            out.push_str(&format!(
+                "  selected:       {} -> {:.4} mm (z = {:.1})\n",
+                describe_selected(s),
+                s.heldout_after_mm,
+                s.z
+            ));
+        }
+        if let Some(gp) = &self.explainable {
+            out.push_str(&format!(
+                "  a GP on the joint angles: {:.4} mm held out (what any smooth model could reach)",
+                gp.heldout_after_gp_mm
+            ));
+            match self.explained_fraction {
+                Some(f) => out.push_str(&format!("; the selected effects explain {:.0} % of that\n", 100.0 * f)),
+                None => out.push('\n'),
+            }
+        }
+        if let Some(r) = self.remaining.as_ref().filter(|r| r.significant) {
+            out.push_str(&format!(
+                "  left:           a GP on what the effects leave still lowers it to {:.4} mm (z = {:.1})\n",
+                r.heldout_after_gp_mm, r.z
+            ));
+        }
         out.push_str(&format!(
             "  noise floor:    {:.4} mm ({:.4} mm per axis, {})\n",
             self.noise.floor_mm,
             self.noise.sigma_mm,
-            noise_source(self.noise.source)
+            noise_source(&self.noise)
         ));
-        for s in self.selected.iter().skip(1) {
-            out.push_str(&format!(
-                "  also:           {} -> {:.4} mm (t = {:.1})\n",
-                describe(s.effect, &s.joints, s.harmonic),
-                s.heldout_after_mm,
-                s.t
-            ));
-        }
-        if let Some(r) = self.remaining.filter(|r| r.significant) {
-            out.push_str(&format!(
-                "  left:           a GP on the residual still lowers it to {:.4} mm (t = {:.1}): something is unmodelled\n",
-                r.heldout_after_gp_mm, r.t
-            ));
-        }
         let runners: Vec<String> = self
             .candidates
             .iter()
@@ -224,8 +210,8 @@ impl Diagnosis {
         out
     }
 
-    /// The plots, as `(file name, SVG text)`: held-out error against each joint, the payload, the
-    /// temperature and the time, before and after.
+    /// The plots, as `(file name, SVG text)`: held-out error against each moving joint, the
+    /// payload, the temperature and the time, before and after.
     pub fn plots(&self) -> Vec<(String, String)> {
         let mut plots = Vec::new();
         let series = |key: &dyn Fn(&PoseDiagnosis) -> f64| -> Vec<svg::Series> {
@@ -236,36 +222,28 @@ impl Diagnosis {
                     points: self.poses.iter().map(|p| (key(p), p.before_error_mm())).collect(),
                 },
                 svg::Series {
-                    name: "with the verdict".into(),
+                    name: "with the selected effects".into(),
                     colour: "#1f6fb4",
                     points: self.poses.iter().map(|p| (key(p), p.after_error_mm())).collect(),
                 },
             ]
         };
-        let joints = self.poses.first().map_or(0, |p| p.q.len());
-        for j in 0..joints {
-            let title = format!("Held-out error against joint {}", j + 1);
-            let svg = svg::scatter(
-                &title,
-                &format!("joint {} (deg)", j + 1),
-                "error (mm)",
-                &series(&|p| p.q[j].to_degrees()),
-            );
-            plots.push((format!("joint{}.svg", j + 1), svg));
+        for &joint in &self.moving_joints {
+            let j = joint - 1;
+            let title = format!("Held-out error against joint {joint}");
+            let svg =
+                svg::scatter(&title, &format!("joint {joint} (deg)"), "error (mm)", &series(&|p| p.q[j].to_degrees()));
+            plots.push((format!("joint{joint}.svg"), svg));
         }
         let varies = |key: &dyn Fn(&PoseDiagnosis) -> Option<f64>| {
             let values: Vec<f64> = self.poses.iter().filter_map(key).collect();
             values.len() == self.poses.len() && values.iter().any(|v| *v != values[0])
         };
         if varies(&|p| Some(p.payload_kg)) {
+            let s = series(&|p| p.payload_kg);
             plots.push((
                 "payload.svg".into(),
-                svg::scatter(
-                    "Held-out error against payload",
-                    "payload (kg)",
-                    "error (mm)",
-                    &series(&|p| p.payload_kg),
-                ),
+                svg::scatter("Held-out error against payload", "payload (kg)", "error (mm)", &s),
             ));
         }
         if varies(&|p| p.temp_c) {
@@ -287,8 +265,8 @@ impl Diagnosis {
         let mut out = format!("# Diagnosis: {}\n\n```\n{}```\n\n", self.robot, self.summary());
         out.push_str("## Which effect\n\nEvery candidate alone on top of the geometric model, cross-validated ");
         out.push_str(&format!(
-            "({} poses; a step is kept when its paired t exceeds {:.2}):\n\n",
-            self.n, self.critical_t
+            "({} poses; a step is kept when its signed-rank z exceeds {:.2}):\n\n",
+            self.n, self.critical_z
         ));
         out.push_str("| candidate | parameters | held-out mean error (mm) |\n| --- | ---: | ---: |\n");
         out.push_str(&format!("| geometric model alone | 0 | {:.4} |\n", self.heldout_before_mm));
@@ -305,19 +283,37 @@ impl Diagnosis {
             out.push_str("- nothing\n");
         }
         for s in &self.selected {
-            out.push_str(&format!(
-                "- {}: {:.4} mm (t = {:.1})\n",
-                describe(s.effect, &s.joints, s.harmonic),
-                s.heldout_after_mm,
-                s.t
-            ));
+            out.push_str(&format!("- {}: {:.4} mm (z = {:.1})", describe_selected(s), s.heldout_after_mm, s.z));
+            if !s.fold_orders.is_empty() {
+                out.push_str(&format!("; orders chosen inside the folds: {:?}", s.fold_orders));
+            }
+            out.push('\n');
+        }
+        for (title, check) in [
+            ("the geometric model's residual", &self.explainable),
+            ("what the selected effects leave", &self.remaining),
+        ] {
+            if let Some(gp) = check {
+                out.push_str(&format!(
+                    "\nA cross-validated GP on {title}: {:.4} mm held out (z = {:.1}, {:.0} % less{}). Length scales (input standard deviations): {}.\n",
+                    gp.heldout_after_gp_mm,
+                    gp.z,
+                    100.0 * gp.gain,
+                    if gp.significant { ", significant" } else { "" },
+                    gp.length_scales
+                        .iter()
+                        .map(|s| format!("{:?} {:.2}", s.input, s.length_scale))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+            }
         }
         out.push_str(&format!(
             "\n## Where\n\nHeld-out position error by region (mm), noise floor {:.4} mm ({}).\n\n",
             self.noise.floor_mm,
-            noise_source(self.noise.source)
+            noise_source(&self.noise)
         ));
-        out.push_str("| by | group | poses | geometric model | with the verdict | before / floor |\n| --- | --- | ---: | ---: | ---: | ---: |\n");
+        out.push_str("| by | group | poses | geometric model | with the selected effects | before / floor |\n| --- | --- | ---: | ---: | ---: | ---: |\n");
         for r in &self.regions {
             out.push_str(&format!(
                 "| {} | {} | {} | {:.4} | {:.4} | {:.1} |\n",
@@ -336,5 +332,24 @@ impl Diagnosis {
             }
         }
         out
+    }
+
+    /// Writes the report folder: `diagnosis.md` and its SVG plots (the folder is made if need
+    /// be). Returns the path of `diagnosis.md`.
+    pub fn write_report(&self, folder: &Path) -> Result<PathBuf, Error> {
+        let io = |path: &Path| {
+            let path = path.display().to_string();
+            move |source| Error::Io { path, source }
+        };
+        std::fs::create_dir_all(folder).map_err(io(folder))?;
+        let plots = self.plots();
+        for (name, svg) in &plots {
+            let path = folder.join(name);
+            std::fs::write(&path, svg).map_err(io(&path))?;
+        }
+        let names: Vec<String> = plots.into_iter().map(|(name, _)| name).collect();
+        let path = folder.join("diagnosis.md");
+        std::fs::write(&path, self.markdown(&names)).map_err(io(&path))?;
+        Ok(path)
     }
 }
