@@ -1,8 +1,8 @@
 //! The linearised problem the diagnosis scores candidates on: at the geometric solution fitted to
 //! all rows, each measured pose gives weighted residual rows `y_i` and kinematic Jacobian rows
-//! `A_i`; a candidate effect adds columns `C_i`. One Gauss–Newton step from that solution on the
-//! training rows, `[A C]⁺ y`, predicts the held-out rows. The residuals are millimetres against
-//! metres of lever, so the step is the converged refit to first order.
+//! `A_i`; a candidate effect adds columns `C_i`. One regularised Gauss–Newton step from that
+//! solution on the training rows (module `pool`) predicts the held-out rows. The residuals are
+//! millimetres against metres of lever, so the step is the converged refit to first order.
 
 use crate::{Error, MeasurementSet};
 use faer::Mat;
@@ -68,11 +68,6 @@ impl Design {
         Ok(Self { rows_per_pose, y, kinematic, points, weights })
     }
 
-    /// Number of measurements.
-    pub(crate) fn poses(&self) -> usize {
-        self.points.len()
-    }
-
     /// The weighted residual rows of a left twist `c` at measurement `i`: the point moves by
     /// `v + ω × p`, the orientation by `ω`.
     pub(crate) fn twist_rows(&self, i: usize, twist: &Vector6, out: &mut [f64]) {
@@ -88,71 +83,4 @@ impl Design {
             }
         }
     }
-
-    /// The coefficients of the `extra` columns fitted together with the kinematic ones on every
-    /// measurement (one linear step, as in [`Design::cross_validate`]).
-    pub(crate) fn fit_all(&self, extra: &[Vec<f64>]) -> Vec<f64> {
-        let (beta, scale) = self.solve(extra, &(0..self.poses()).collect::<Vec<_>>());
-        let kinematic_columns = self.kinematic.ncols();
-        (0..extra.len()).map(|l| beta[kinematic_columns + l] * scale[kinematic_columns + l]).collect()
-    }
-
-    /// [`Design::fit_all`] with the weighted residual rows it leaves.
-    pub(crate) fn fit_all_residual(&self, extra: &[Vec<f64>]) -> (Vec<f64>, Vec<f64>) {
-        let (beta, scale) = self.solve(extra, &(0..self.poses()).collect::<Vec<_>>());
-        let columns = beta.len();
-        let residual = (0..self.y.len())
-            .map(|row| self.y[row] - (0..columns).map(|c| self.value(extra, row, c) * scale[c] * beta[c]).sum::<f64>())
-            .collect();
-        let kinematic_columns = self.kinematic.ncols();
-        ((0..extra.len()).map(|l| beta[kinematic_columns + l] * scale[kinematic_columns + l]).collect(), residual)
-    }
-
-    fn value(&self, extra: &[Vec<f64>], row: usize, c: usize) -> f64 {
-        let kinematic_columns = self.kinematic.ncols();
-        if c < kinematic_columns { self.kinematic[(row, c)] } else { extra[c - kinematic_columns][row] }
-    }
-
-    /// Least squares on the rows of `train`: the coefficients of the scaled columns and the
-    /// column scales (unit norm on the training rows, so that the rank decision does not depend
-    /// on the columns' units: torques in N·m against lever arms in metres).
-    fn solve(&self, extra: &[Vec<f64>], train: &[usize]) -> (Vec<f64>, Vec<f64>) {
-        let k = self.rows_per_pose;
-        let columns = self.kinematic.ncols() + extra.len();
-        let rows = || train.iter().flat_map(move |&i| (0..k).map(move |r| i * k + r));
-        let scale: Vec<f64> = (0..columns)
-            .map(|c| {
-                let norm = rows().map(|row| self.value(extra, row, c).powi(2)).sum::<f64>().sqrt();
-                if norm > 0.0 { 1.0 / norm } else { 0.0 }
-            })
-            .collect();
-        let a = Mat::<f64>::from_fn(train.len() * k, columns, |row, c| {
-            let (i, r) = (train[row / k], row % k);
-            self.value(extra, i * k + r, c) * scale[c]
-        });
-        let b: Vec<f64> = rows().map(|row| self.y[row]).collect();
-        (pseudo_inverse_solve(&a, &b), scale)
-    }
-}
-
-/// `x = A⁺ b` through the thin SVD, dropping directions below `1e-10 σ_max` (the kinematic
-/// model's unidentifiable directions and any a candidate shares with it).
-fn pseudo_inverse_solve(a: &Mat<f64>, b: &[f64]) -> Vec<f64> {
-    let mut x = vec![0.0; a.ncols()];
-    let Ok(svd) = a.thin_svd() else {
-        return x;
-    };
-    let s = svd.S().column_vector();
-    let (u, v) = (svd.U(), svd.V());
-    let threshold = 1e-10 * (0..s.nrows()).map(|i| s[i]).fold(0.0, f64::max);
-    for k in 0..s.nrows() {
-        if s[k] <= threshold {
-            continue;
-        }
-        let utb: f64 = (0..b.len()).map(|i| u[(i, k)] * b[i]).sum::<f64>() / s[k];
-        for (j, xj) in x.iter_mut().enumerate() {
-            *xj += v[(j, k)] * utb;
-        }
-    }
-    x
 }

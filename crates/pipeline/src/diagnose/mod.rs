@@ -18,6 +18,7 @@
 
 mod candidates;
 mod design;
+mod learnt_side;
 mod noise;
 mod pool;
 mod regions;
@@ -28,7 +29,7 @@ mod structure;
 mod svg;
 mod verdict;
 
-pub use candidates::{CandidateOptions, Effect};
+pub use candidates::Effect;
 pub use noise::{NoiseFloor, NoiseSource};
 pub use pool::PriorOptions;
 pub use regions::{PoseDiagnosis, Region};
@@ -37,6 +38,7 @@ pub use selection::SelectionOptions;
 pub use structure::{GpInput, StructureOptions};
 pub use verdict::{GpCheck, InputScale, Verdict, VerdictOptions};
 
+use crate::effects::IdentifiedEffect;
 use crate::geometric::{fit_geometry, observations};
 use crate::{Error, MeasurementSet, RobotDescription};
 use design::{Design, Weights};
@@ -196,49 +198,26 @@ fn moving_joints(data: &MeasurementSet, min_range: f64) -> Vec<usize> {
         .collect()
 }
 
-/// The candidates as terms over pool columns: one per candidate, except that the harmonics of
-/// one joint's periodic error form one Fourier series (only on moving joints: on a joint held
-/// still it is a constant the kinematics hold).
-fn terms_of<'a>(
-    candidates: &'a [candidates::Candidate],
-    kinematic: usize,
-    moving: &[usize],
-    grid: &[u32],
-    series_sd: f64,
-) -> (Vec<Term>, Vec<pool::Block<'a>>) {
+/// The candidates as terms over pool columns, and the blocks of columns the pool is built from.
+fn terms_of(candidates: &[candidates::Candidate], kinematic: usize) -> (Vec<Term>, Vec<pool::Block<'_>>) {
     let mut terms: Vec<Term> = Vec::new();
     let mut blocks: Vec<pool::Block<'_>> = Vec::new();
     let mut next = kinematic;
-    let mut series: Vec<(usize, Vec<(u32, usize)>)> = Vec::new();
-    for (index, c) in candidates.iter().enumerate() {
-        if c.effect == Effect::GearPeriodic {
-            let joint = c.joints[0];
-            if !moving.contains(&(joint - 1)) {
-                continue;
-            }
-            match series.iter_mut().find(|(j, _)| *j == joint) {
-                Some((_, harmonics)) => harmonics.push((c.harmonic.unwrap_or(1), index)),
-                None => series.push((joint, vec![(c.harmonic.unwrap_or(1), index)])),
-            }
-            continue;
-        }
+    for c in candidates {
         let columns: Vec<usize> = (next..next + c.columns.len()).collect();
         next += c.columns.len();
-        blocks.push((&c.columns, None));
-        terms.push(Term { effect: c.effect, joints: c.joints.clone(), columns, orders: None });
-    }
-    for (joint, mut harmonics) in series {
-        harmonics.sort_unstable();
-        let mut columns = Vec::new();
-        for &(_, index) in &harmonics {
-            blocks.push((&candidates[index].columns, Some(series_sd)));
-            columns.extend(next..next + candidates[index].columns.len());
-            next += candidates[index].columns.len();
-        }
-        let available: Vec<u32> = harmonics.iter().map(|(h, _)| *h).collect();
-        // Orders h of the grid whose harmonics 1..=h are all there.
-        let orders: Vec<u32> = grid.iter().copied().filter(|&h| (1..=h).all(|k| available.contains(&k))).collect();
-        terms.push(Term { effect: Effect::GearPeriodic, joints: vec![joint], columns, orders: Some(orders) });
+        blocks.push((&c.columns, c.prior_sd));
+        // A series takes the orders whose harmonics are all among its columns.
+        let orders =
+            c.orders.as_ref().map(|o| o.iter().copied().filter(|&h| 2 * h as usize <= columns.len()).collect());
+        terms.push(Term {
+            effect: c.effect,
+            joints: c.joints.clone(),
+            columns,
+            per_fold: None,
+            orders,
+            model: c.model.clone(),
+        });
     }
     (terms, blocks)
 }
@@ -274,12 +253,18 @@ fn series_shapes(
             out.push(None);
             continue;
         };
-        let joint = terms[step.term].joints[0] - 1;
+        let IdentifiedEffect::GearPeriodic(gear) = &terms[step.term].model else {
+            out.push(None);
+            continue;
+        };
+        let joint = gear.joint;
+        // The parameters multiply the features `cos hq / scale`, `sin hq / scale`.
+        let coefficient = |l: usize| beta[start + l] / gear.scale.get(l).copied().unwrap_or(1.0);
         let series = |q: f64| -> f64 {
             (1..=order as usize)
                 .map(|h| {
                     let (sin, cos) = (h as f64 * q).sin_cos();
-                    beta[start + 2 * (h - 1)] * cos + beta[start + 2 * (h - 1) + 1] * sin
+                    coefficient(2 * (h - 1)) * cos + coefficient(2 * (h - 1) + 1) * sin
                 })
                 .sum()
         };
@@ -353,19 +338,33 @@ pub fn diagnose(
     };
     let design = Design::new(&model, data, weights)?;
     let moving = moving_joints(data, options.moving_min_range_rad);
-    let longest = options.selection.series_orders.iter().copied().max().unwrap_or(1);
-    let candidate_options = CandidateOptions { harmonics: (1..=longest).collect() };
-    let candidates = candidates::build_candidates(robot, &model, data, &design, &candidate_options)?;
-    let (terms, blocks) = terms_of(
-        &candidates,
-        design.kinematic.ncols(),
-        &moving,
-        &options.selection.series_orders,
-        options.prior.series_rad,
-    );
+    let settings = candidates::Settings {
+        moving: &moving,
+        orders: &options.selection.series_orders,
+        series_sd: options.prior.series_rad,
+    };
+    let (candidates, sides) = candidates::build_candidates(robot, &model, data, &design, &settings)?;
+    let (mut terms, blocks) = terms_of(&candidates, design.kinematic.ncols());
     let fold = fold_assignment(data.rows.len(), folds, options.seed);
     let kinematic_prior = pool::KinematicPrior::new(&nominal, &model, &options.prior);
-    let pool = Pool::new(&design, &kinematic_prior, &blocks, &fold, folds, &options.prior);
+    let mut pool = Pool::new(&design, &kinematic_prior, &blocks, &fold, folds, &options.prior);
+    // Backlash sides learnt inside each fold: a column per fold and one on every row.
+    let candidate_columns: Vec<Vec<usize>> = terms.iter().map(|t| t.columns.clone()).collect();
+    for side in learnt_side::learnt_sides(&pool, &design, &model, data, &candidates, &candidate_columns, &sides)? {
+        let mut columns = side.per_fold;
+        columns.push(side.all);
+        let range = pool.extend(&columns, None, &options.prior);
+        let indices: Vec<usize> = range.collect();
+        let all = indices[indices.len() - 1];
+        terms.push(Term {
+            effect: Effect::Backlash,
+            joints: vec![side.joint + 1],
+            columns: vec![all],
+            per_fold: Some(indices[..indices.len() - 1].iter().map(|&c| vec![c]).collect()),
+            orders: None,
+            model: side.model,
+        });
+    }
     let selection = selection::select(&pool, &terms, &options.selection)?;
     let all_selected = selection.last();
 

@@ -154,6 +154,18 @@ impl Factor {
     }
 }
 
+/// The prior precision of an effect parameter whose weighted column is `column`: `1/sd²`, or
+/// [`PriorOptions::effect_m`] of RMS tool displacement.
+fn effect_precision(column: &[f64], sd: Option<f64>, k: usize, w: f64, prior: &PriorOptions) -> f64 {
+    if let Some(sd) = sd {
+        return 1.0 / (sd * sd);
+    }
+    let poses = column.len() / k;
+    let displacement_sq: f64 = (0..poses).map(|i| (0..3).map(|r| (column[i * k + r] * w).powi(2)).sum::<f64>()).sum();
+    let rms = (displacement_sq / poses.max(1) as f64).sqrt();
+    if rms > 0.0 { (rms / prior.effect_m).powi(2) } else { 1.0 }
+}
+
 impl Pool {
     /// The pool of `design`'s kinematic columns and `blocks` of further columns (weighted rows,
     /// `rows_per_pose × poses` each) with the prior standard deviation of their parameters (`None`:
@@ -168,7 +180,6 @@ impl Pool {
         prior: &PriorOptions,
     ) -> Self {
         let k = design.rows_per_pose;
-        let poses = design.poses();
         let kinematic = design.kinematic.ncols();
         let extra: Vec<&Vec<f64>> = blocks.iter().flat_map(|b| b.0.iter()).collect();
         let extra_sd: Vec<Option<f64>> = blocks.iter().flat_map(|b| std::iter::repeat_n(b.1, b.0.len())).collect();
@@ -179,17 +190,8 @@ impl Pool {
         let mut precision = kinematic_prior.precision.clone();
         let mut prior_mean = kinematic_prior.mean.clone();
         prior_mean.resize(columns, 0.0);
-        let w = design.weights.position_m;
         for (column, sd) in extra.iter().zip(&extra_sd) {
-            if let Some(sd) = sd {
-                precision.push(1.0 / (sd * sd));
-                continue;
-            }
-            let displacement_sq: f64 =
-                (0..poses).map(|i| (0..3).map(|r| (column[i * k + r] * w).powi(2)).sum::<f64>()).sum();
-            let rms = (displacement_sq / poses.max(1) as f64).sqrt();
-            let precision_c = if rms > 0.0 { (rms / prior.effect_m).powi(2) } else { 1.0 };
-            precision.push(precision_c);
+            precision.push(effect_precision(column, *sd, k, design.weights.position_m, prior));
         }
         let mut fold_poses = vec![Vec::new(); folds];
         for (i, &f) in fold.iter().enumerate() {
@@ -256,6 +258,98 @@ impl Pool {
             gram,
             xty,
         }
+    }
+
+    /// The folds whose rows Gram matrix `index` leaves out.
+    fn left_out_of(&self, index: usize) -> Vec<usize> {
+        let folds = self.folds();
+        if index < folds {
+            return vec![index];
+        }
+        for f in 0..folds {
+            for g in f + 1..folds {
+                if pair_index(folds, f, g) == index {
+                    return vec![f, g];
+                }
+            }
+        }
+        vec![]
+    }
+
+    /// Appends `columns` (weighted rows of every pose) whose parameters have the prior standard
+    /// deviation `sd` (`None`: [`PriorOptions::effect_m`] of tool displacement); returns their
+    /// indices.
+    pub(crate) fn extend(
+        &mut self,
+        columns: &[Vec<f64>],
+        sd: Option<f64>,
+        prior: &PriorOptions,
+    ) -> std::ops::Range<usize> {
+        let k = self.k;
+        let old = self.x.first().map_or(0, |x| x.ncols());
+        let m = columns.len();
+        let total = old + m;
+        let mut cross = Vec::with_capacity(self.folds());
+        let mut cross_y = Vec::with_capacity(self.folds());
+        for f in 0..self.folds() {
+            let poses = &self.fold_poses[f];
+            let rows = poses.len() * k;
+            let mut xf = Mat::<f64>::zeros(rows, total);
+            for c in 0..old {
+                xf.col_as_slice_mut(c).copy_from_slice(self.x[f].col_as_slice(c));
+            }
+            for (l, column) in columns.iter().enumerate() {
+                for (r, v) in xf.col_as_slice_mut(old + l).iter_mut().enumerate() {
+                    *v = column[poses[r / k] * k + r % k];
+                }
+            }
+            let fresh = xf.as_ref().subcols(old, m);
+            let mut block = Mat::<f64>::zeros(total, m);
+            matmul(block.as_mut(), Accum::Replace, xf.transpose(), fresh, 1.0, Par::Seq);
+            let by: Vec<f64> = (0..m).map(|l| fresh.col(l).iter().zip(&self.y[f]).map(|(a, b)| a * b).sum()).collect();
+            cross.push(block);
+            cross_y.push(by);
+            self.x[f] = xf;
+        }
+        for index in 0..self.gram.len() {
+            let left_out = self.left_out_of(index);
+            let mut g = Mat::<f64>::zeros(total, total);
+            for c in 0..old {
+                g.col_as_slice_mut(c)[..old].copy_from_slice(&self.gram[index].col_as_slice(c)[..old]);
+            }
+            let mut added_y = vec![0.0; m];
+            for f in (0..self.folds()).filter(|f| !left_out.contains(f)) {
+                for l in 0..m {
+                    for r in 0..total {
+                        let v = cross[f][(r, l)];
+                        g[(r, old + l)] += v;
+                        if r < old {
+                            g[(old + l, r)] += v;
+                        }
+                    }
+                    added_y[l] += cross_y[f][l];
+                }
+            }
+            self.xty[index].extend(added_y);
+            self.gram[index] = g;
+        }
+        for column in columns {
+            self.precision.push(effect_precision(column, sd, k, self.weights.position_m, prior));
+            self.prior_mean.push(0.0);
+        }
+        old..total
+    }
+
+    /// The weighted residual rows `y − X β` of the poses of fold `fold` (in their order).
+    pub(crate) fn weighted_residual(&self, fold: usize, columns: &[usize], beta: &[f64]) -> Vec<f64> {
+        let xf = &self.x[fold];
+        let mut r = self.y[fold].clone();
+        for (&c, b) in columns.iter().zip(beta) {
+            for (v, x) in r.iter_mut().zip(xf.col_as_slice(c)) {
+                *v -= x * b;
+            }
+        }
+        r
     }
 
     /// Number of folds.
@@ -476,7 +570,19 @@ mod tests {
         let fold = super::super::fold_assignment(200, 5, 3);
         let blocks = [(std::slice::from_ref(&effect), None)];
         let loose = Pool::new(&design, &prior(1e6), &blocks, &fold, 5, &PriorOptions::default());
-        let term = Term { effect: Effect::JointCompliance, joints: vec![2], columns: vec![12], orders: None };
+        let model = crate::effects::IdentifiedEffect::Thermal(crate::effects::Thermal {
+            reference_c: 20.0,
+            scale: vec![1.0],
+            theta: vec![0.0],
+        });
+        let term = Term {
+            effect: Effect::JointCompliance,
+            joints: vec![2],
+            columns: vec![12],
+            per_fold: None,
+            orders: None,
+            model,
+        };
         let selection = select(&loose, std::slice::from_ref(&term), &Default::default()).unwrap();
         assert_eq!(selection.steps.len(), 1, "the effect is kept despite the exploding poses");
         // The paired t on squared errors that used to decide sees mostly the two exploding poses.

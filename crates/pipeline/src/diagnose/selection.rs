@@ -10,6 +10,7 @@ use super::candidates::Effect;
 use super::pool::Pool;
 use super::statistics::{mean, median, normal_quantile, signed_rank_z};
 use crate::Error;
+use crate::effects::IdentifiedEffect;
 use lie::Vector6;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -21,10 +22,15 @@ pub(crate) struct Term {
     pub effect: Effect,
     /// 1-based joints.
     pub joints: Vec<usize>,
-    /// Pool columns; for a series `cos q, sin q, cos 2q, sin 2q, …`.
+    /// Pool columns (of the version learnt on every row); for a series `cos q, sin q, cos 2q, …`.
     pub columns: Vec<usize>,
+    /// Where the columns are learnt from the data (a backlash side), each fold's own version,
+    /// learnt without its rows.
+    pub per_fold: Option<Vec<Vec<usize>>>,
     /// For a Fourier series, the orders it may take (ascending).
     pub orders: Option<Vec<u32>>,
+    /// The effect as the fit models it (for a learnt side, the side learnt on every row).
+    pub model: IdentifiedEffect,
 }
 
 /// How a model of the residual did on held-out rows.
@@ -36,6 +42,13 @@ pub(crate) struct CrossValidated {
     pub errors: Vec<f64>,
     /// The columns each fold's fit used.
     pub fold_columns: Vec<Vec<usize>>,
+}
+
+impl Term {
+    /// The columns fold `f`'s fit uses.
+    pub(crate) fn columns_for(&self, f: usize) -> &[usize] {
+        self.per_fold.as_ref().and_then(|p| p.get(f)).map_or(&self.columns, |c| c)
+    }
 }
 
 impl CrossValidated {
@@ -130,7 +143,7 @@ pub(crate) fn score(pool: &Pool, base: &[Vec<usize>], term: &Term) -> Result<Sco
     let folds = pool.folds();
     let Some(orders) = &term.orders else {
         let fold_columns: Vec<Vec<usize>> =
-            base.iter().map(|b| b.iter().chain(&term.columns).copied().collect()).collect();
+            base.iter().enumerate().map(|(f, b)| b.iter().chain(term.columns_for(f)).copied().collect()).collect();
         let residuals = pool.cross_validate(&|f| fold_columns[f].clone())?;
         return Ok(Scored { result: CrossValidated::new(residuals, fold_columns), order: None, fold_orders: vec![] });
     };
@@ -239,8 +252,9 @@ pub(crate) fn with_steps(
             for &s in keep {
                 let step = &selection.steps[s];
                 let term = &terms[step.term];
-                let width = step.scored.fold_orders.get(f).map_or(term.columns.len(), |&h| 2 * h as usize);
-                columns.extend_from_slice(&term.columns[..width]);
+                let own = term.columns_for(f);
+                let width = step.scored.fold_orders.get(f).map_or(own.len(), |&h| 2 * h as usize);
+                columns.extend_from_slice(&own[..width]);
             }
             columns
         })
