@@ -58,8 +58,8 @@ impl VariantResult {
             "base-tool" => "base-tool",
             "poe" => "POE",
             "poe-gp" => "POE+GP",
-            "poe-compliance" => "POE+compl.\n(beyond)",
-            "poe-compliance-gp-load" => "POE+compl.\n+GP load",
+            "poe-effects-auto" => "POE+effects\nauto",
+            "poe-gp-load-effects-auto" => "POE+effects\n+GP load",
             _ => "POE+GP load",
         };
         if self.paper_faithful { format!("{base}\n(Eq. 5, Eq. 8)") } else { base.to_owned() }
@@ -289,19 +289,20 @@ be learnt with the payload as an input.\n",
 /// What the rows beyond the paper show.
 fn beyond_reading(outcome: &Outcome) -> String {
     let mean = |key| mean_test(outcome, key, false);
-    let (Some(load), Some(compliance), Some(both)) =
-        (mean("poe-gp-load"), mean("poe-compliance"), mean("poe-compliance-gp-load"))
+    let (Some(load), Some(effects), Some(both)) =
+        (mean("poe-gp-load"), mean("poe-effects-auto"), mean("poe-gp-load-effects-auto"))
     else {
         return String::new();
     };
     format!(
         "## Beyond the paper
 
-- **POE + joint compliance** (`calib fit --method poe --joint-compliance`) identifies how \
-each joint gives under the arm's weight and the payload together with the geometry, through gravity-torque regressors \
-that need no masses. It leaves {compliance:.3} mm on the test sets against {load:.3} mm for POE + GP with loading \
-({:.0} % less); the tracker noise alone moves the tool by {:.3} mm. With the GP on what is left it leaves {both:.3} mm.\n\n",
-        100.0 * (1.0 - compliance / load),
+- **POE + effects auto** (`calib fit --method poe --effects auto`) runs the diagnosis on each training set and \
+identifies the effects it selects together with the geometry (here the simulated effect is joint compliance, which \
+the fit models through gravity-torque regressors that need no masses). It leaves {effects:.3} mm on the test sets \
+against {load:.3} mm for POE + GP with loading ({:.0} % less); the tracker noise alone moves the tool by {:.3} mm. \
+With the GP with loading on what is left (`--method poe-gp-load --effects auto`) it leaves {both:.3} mm.\n\n",
+        100.0 * (1.0 - effects / load),
         outcome.magnitudes.noise_mm
     )
 }

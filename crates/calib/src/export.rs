@@ -116,6 +116,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             errors.urdf.mean_position_error_mm,
             errors.urdf.max_position_error_mm
         );
+        for part in &errors.without_each {
+            println!("    without {}: mean {:.4} mm", part.part, part.error.mean_position_error_mm);
+        }
     }
     let tip = report.tool_links.first().map_or("tool", String::as_str);
     println!("  read it back with: --robot {} --tip-link {tip}", args.urdf.display());

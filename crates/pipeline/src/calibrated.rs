@@ -1,6 +1,8 @@
-//! A calibrated model: the identified kinematics, the optional GP compensation, and prediction.
+//! A calibrated model: the identified kinematics, the effects identified with them, the optional
+//! GP compensation, and prediction by walking them in order (module `model_parts`).
 
 use crate::effects::IdentifiedEffect;
+use crate::model_parts::{Part, Walk};
 use crate::{Error, Measurement, Method, PoseError};
 use lie::SE3;
 use poe::LocalPoe;
@@ -63,46 +65,62 @@ impl CalibratedModel {
         })
     }
 
-    /// The model without its non-geometric parts (joint compliance, the GP): the geometry alone,
-    /// which is what a URDF can hold (`calib export`).
+    /// The parts of the model in the order they apply: the geometry, each effect, the GP.
+    pub fn parts(&self) -> Vec<Part<'_>> {
+        let mut parts = vec![Part::Geometry(&self.kinematics)];
+        parts.extend(self.effects.iter().map(Part::Effect));
+        parts.extend(self.compensation.iter().map(Part::GaussianProcess));
+        parts
+    }
+
+    /// The model without part `index` of [`CalibratedModel::parts`] (the geometry, index 0, stays:
+    /// everything else applies to it).
+    pub fn without_part(&self, index: usize) -> CalibratedModel {
+        let mut model = self.clone();
+        let effects = self.effects.len();
+        if (1..=effects).contains(&index) {
+            model.effects.remove(index - 1);
+        } else if index == effects + 1 {
+            model.compensation = None;
+        }
+        model
+    }
+
+    /// The model without its non-geometric parts (effects, the GP): the geometry alone, which is
+    /// what a URDF can hold (`calib export`).
     pub fn geometry_only(&self) -> CalibratedModel {
         CalibratedModel { effects: Vec::new(), compensation: None, ..self.clone() }
     }
 
-    /// The names of the parts besides the geometry, in the order they apply.
+    /// The names of the parts a URDF cannot hold, in the order they apply.
     pub fn non_geometric_parts(&self) -> Vec<String> {
-        let mut parts: Vec<String> = self.effects.iter().map(IdentifiedEffect::label).collect();
-        if self.compensation.is_some() {
-            parts.push("gaussian_process".into());
-        }
-        parts
+        self.parts().iter().filter(|p| !p.in_urdf()).map(Part::name).collect()
     }
 
-    /// The poses of the kinematics moved by the effects, before any GP.
+    /// The poses of the geometry and the effects, before any GP.
     pub fn geometric_poses(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<SE3>, Error> {
-        let mut poses = Vec::with_capacity(rows.len());
-        for (row, &tool) in rows.iter().zip(tools) {
-            let pose = self.kinematics.forward(&row.q, tool)?;
-            poses.push(crate::effects::apply(&self.effects, &self.kinematics, row, tool, pose)?);
+        let mut walk = Walk::new(rows, tools);
+        for part in self.parts().iter().filter(|p| !matches!(p, Part::GaussianProcess(_))) {
+            part.apply(&mut walk)?;
         }
-        Ok(poses)
+        walk.flush();
+        Ok(walk.poses)
     }
 
-    /// Predicts the tool pose of rows of a measurement set, with the GP placed before the POE
-    /// model as in the paper's Eq. 9: `T = exp(ĝ(q, m)) · T_POE(q)`.
+    /// Predicts the tool pose of rows of a measurement set by applying every part in turn; the
+    /// GP is placed before the POE model as in the paper's Eq. 9: `T = exp(ĝ(q, m)) · T_POE(q)`.
     pub fn predict(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<PredictedPose>, Error> {
-        let poses = self.geometric_poses(rows, tools)?;
-        match &self.compensation {
-            None => Ok(poses.into_iter().map(|pose| PredictedPose { pose, std: None }).collect()),
-            Some(compensation) => {
-                let corrections = compensation.predict(rows, &poses)?;
-                Ok(poses
-                    .into_iter()
-                    .zip(corrections)
-                    .map(|(pose, (g, std))| PredictedPose { pose: g * pose, std: Some(std) })
-                    .collect())
-            }
+        let mut walk = Walk::new(rows, tools);
+        for part in self.parts() {
+            part.apply(&mut walk)?;
         }
+        walk.flush();
+        Ok(match walk.std {
+            Some(std) => {
+                walk.poses.into_iter().zip(std).map(|(pose, s)| PredictedPose { pose, std: Some(s) }).collect()
+            }
+            None => walk.poses.into_iter().map(|pose| PredictedPose { pose, std: None }).collect(),
+        })
     }
 }
 

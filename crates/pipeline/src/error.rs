@@ -426,6 +426,11 @@ pub enum Error {
         /// The robot's joint count.
         joint_count: usize,
     },
+    /// A model's parts in an order they cannot apply in (an effect before the geometry).
+    PartOrder {
+        /// The part out of place.
+        part: &'static str,
+    },
     /// An effect needs a column that a row lacks (e.g. `thermal` without `temp_c`).
     EffectNeedsColumn {
         /// 1-based line of the row (0 for rows made in memory).
@@ -589,6 +594,7 @@ impl fmt::Display for Error {
             Error::EffectJoint { joint, joint_count } => {
                 write!(f, "effect on joint {joint}: the robot has joints 1 to {joint_count}")
             }
+            Error::PartOrder { part } => write!(f, "a model's {part} comes before its geometry"),
             Error::EffectNeedsColumn { line, effect, column } => {
                 write!(f, "line {line}: {effect} needs the column '{column}', which this row lacks")
             }

@@ -24,6 +24,7 @@ mod method;
 mod metrics;
 mod model_check;
 mod model_file;
+mod model_parts;
 mod robot;
 mod robot_check;
 mod robot_dh;
@@ -57,9 +58,10 @@ pub use measurements::{
 pub use method::{Method, UnknownMethod};
 pub use metrics::{ErrorSummary, PoseError};
 pub use model_file::{SCHEMA_VERSION, parse_model, read_model, write_model};
+pub use model_parts::Part;
 pub use robot::{FlangeDescription, JointDescription, JointType, RobotDescription};
 pub use robot_dh::{DhTable, DhTableRow};
 pub use urdf_chain::{ChainEnds, ChainStep, StepMotion, UrdfChain, UrdfDocument};
 pub use urdf_export::{
-    AxisChange, TrainingErrors, UrdfExport, UrdfExportReport, UrdfTemplate, export_urdf, write_urdf,
+    AxisChange, PartError, TrainingErrors, UrdfExport, UrdfExportReport, UrdfTemplate, export_urdf, write_urdf,
 };

@@ -65,6 +65,18 @@ pub struct TrainingErrors {
     pub model: ErrorSummary,
     /// The geometry alone, as the URDF holds it.
     pub urdf: ErrorSummary,
+    /// The whole model without each part the URDF cannot hold, in turn: what leaving that part
+    /// out costs.
+    pub without_each: Vec<PartError>,
+}
+
+/// The training error of a model with one of its parts left out.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PartError {
+    /// The part left out.
+    pub part: String,
+    /// The error without it.
+    pub error: ErrorSummary,
 }
 
 /// What `calib export` reports (`--json`).
@@ -100,10 +112,21 @@ pub fn export_urdf(
 ) -> Result<UrdfExport, Error> {
     let not_in_urdf: Vec<String> = model.non_geometric_parts();
     let training_error = match training {
-        Some(data) => Some(TrainingErrors {
-            model: crate::evaluate(model, data)?.summary,
-            urdf: crate::evaluate(&model.geometry_only(), data)?.summary,
-        }),
+        Some(data) => {
+            let parts = model.parts();
+            let without_each = (0..parts.len())
+                .filter(|&k| !parts[k].in_urdf())
+                .map(|k| {
+                    let error = crate::evaluate(&model.without_part(k), data)?.summary;
+                    Ok(PartError { part: parts[k].name(), error })
+                })
+                .collect::<Result<_, Error>>()?;
+            Some(TrainingErrors {
+                model: crate::evaluate(model, data)?.summary,
+                urdf: crate::evaluate(&model.geometry_only(), data)?.summary,
+                without_each,
+            })
+        }
         None if !not_in_urdf.is_empty() => return Err(Error::ExportNeedsData { parts: not_in_urdf }),
         None => None,
     };

@@ -219,3 +219,50 @@ proptest::proptest! {
         proptest::prop_assert!(large <= small * (1.0 + 1e-6), "{superset}: {large} above {subset}: {small}");
     }
 }
+
+#[test]
+fn a_model_is_its_parts_applied_in_order_and_export_reports_each_one() {
+    let robot = irb4400();
+    let effects = Effects {
+        periodic: Some(PeriodicError {
+            harmonics: vec![Harmonic { joint_index: 2, order: 2.0, amplitude_rad: 3e-4, phase_rad: 0.1 }],
+        }),
+        backlash: Some(loadsim::Backlash { joints: vec![JointBacklash { joint_index: 1, half_band_rad: 3e-4 }] }),
+        ..Effects::default()
+    };
+    let (train, test) = split(&robot, &effects, 36);
+    let selection = "gear_periodic:3:2,backlash:2".parse().unwrap();
+    let (model, _) =
+        pipeline::fit(&robot, &train, Method::PoeGp, &FitOptions::default().with_effects(selection)).unwrap();
+    let names: Vec<String> = model.parts().iter().map(pipeline::Part::name).collect();
+    assert_eq!(
+        names,
+        [
+            "geometry",
+            "gear_periodic:3:2",
+            "backlash:2 (sign of the static torque of the mass model)",
+            "gaussian_process"
+        ]
+    );
+    assert_eq!(model.non_geometric_parts(), names[1..].to_vec());
+    // Every part matters on held-out rows, and leaving one out costs what it explained.
+    let error = |m: &pipeline::CalibratedModel| pipeline::evaluate(m, &test).unwrap().summary.mean_position_error_mm;
+    let whole = error(&model);
+    for (k, name) in names.iter().enumerate().take(3).skip(1) {
+        let without = error(&model.without_part(k));
+        assert!(without > 1.5 * whole, "without {name}: {without} mm against {whole} mm");
+    }
+    let export = pipeline::export_urdf(
+        &model,
+        pipeline::UrdfTemplate::Plain { nominal: Some((&robot, "irb4400.ron")) },
+        Some(&train),
+        &pipeline::NominalTolerance::default(),
+    )
+    .unwrap();
+    let training = export.report.training_error.unwrap();
+    let left_out: Vec<&str> = training.without_each.iter().map(|p| p.part.as_str()).collect();
+    assert_eq!(left_out, names[1..].iter().map(String::as_str).collect::<Vec<_>>());
+    for part in &training.without_each {
+        assert!(part.error.mean_position_error_mm > training.model.mean_position_error_mm, "{part:?}");
+    }
+}

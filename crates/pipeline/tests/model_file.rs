@@ -190,3 +190,45 @@ fn a_version_1_file_with_joint_compliance_reads_and_predicts_as_before() {
     let message = pipeline::parse_model(&future, "new.ron").unwrap_err().to_string();
     assert!(message.contains("schema version 9") && message.contains("versions 1 to 2"), "{message}");
 }
+
+/// A `poe` model with a gear error and time drift, and its file text.
+fn with_effects() -> (CalibratedModel, String) {
+    let robot = irb4400();
+    let cell = simulated_cell(&robot, &Perturbation::default(), 5).unwrap();
+    let config = GeneratorConfig { sample_count: 60, seed: 5, ..GeneratorConfig::default() };
+    let data = simulate(&cell, &paper_effects(), &joint_ranges(&robot), &config, false).unwrap();
+    let options = FitOptions::default().with_effects("gear_periodic:2:3,time_drift".parse().unwrap());
+    let (model, _) = pipeline::fit(&robot, &data, Method::Poe, &options).unwrap();
+    (model.clone(), text_of(&model))
+}
+
+#[test]
+fn an_effect_on_a_joint_the_robot_lacks_is_refused_at_its_field() {
+    let (mut model, _) = with_effects();
+    let Some(IdentifiedEffect::GearPeriodic(gear)) = model.effects.first_mut() else { panic!("no gear effect") };
+    gear.joint = 8;
+    let (error, message) = refused(&text_of(&model));
+    assert!(matches!(error, Error::ModelIndex { index: 8, limit: 6, .. }), "{message}");
+    assert!(message.contains("effects[0].joint is 8"), "{message}");
+}
+
+#[test]
+fn effect_values_that_do_not_match_their_features_are_refused_at_their_field() {
+    let (mut model, _) = with_effects();
+    let Some(IdentifiedEffect::GearPeriodic(gear)) = model.effects.first_mut() else { panic!("no gear effect") };
+    gear.theta.push(0.0);
+    let (error, message) = refused(&text_of(&model));
+    assert!(matches!(error, Error::ModelCount { found: 7, expected: 6, .. }), "{message}");
+    assert!(message.contains("effects[0].theta"), "{message}");
+    // The second effect's field is placed at its own occurrence, past the first effect's.
+    let (model, text) = with_effects();
+    let Some(IdentifiedEffect::TimeDrift(drift)) = model.effects.get(1) else { panic!("no drift") };
+    let reference = format!("reference_s: {:?}", drift.reference_s);
+    assert!(text.contains(&reference), "{text}");
+    let broken = text.replacen(&reference, "reference_s: inf", 1);
+    let (error, message) = refused(&broken);
+    assert!(matches!(error, Error::NotFinite { .. }), "{message}");
+    let line = broken.lines().position(|l| l.contains("reference_s: inf")).unwrap() + 1;
+    assert!(message.starts_with(&format!("m.ron:{line}:")), "{message}");
+    assert!(message.contains("effects[1].reference_s[0]"), "{message}");
+}

@@ -5,7 +5,7 @@
 //!
 //! The same definition gives the diagnosis's candidate columns (`diagnose/candidates.rs`), the
 //! fit's [`poe::identify::PoseCorrection`] (module `correction`), and the calibrated model's
-//! prediction ([`IdentifiedEffect::twist`]): what the diagnosis predicts is what the fit does.
+//! prediction ([`IdentifiedEffect::twist`], applied by `crate::Part`): what the diagnosis predicts is what the fit does.
 
 mod auto;
 mod backlash;
@@ -37,7 +37,7 @@ pub(crate) use correction::EffectCorrection;
 pub(crate) use direction::RowTwists;
 
 use crate::{Error, Measurement, RobotDescription};
-use lie::{SE3, Twist, Vector6};
+use lie::Vector6;
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
 
@@ -290,27 +290,6 @@ impl IdentifiedEffect {
         }
         Ok(out)
     }
-}
-
-/// `exp((Σ_effects Σ_l θ_l f_l c_l)^) · pose`: every effect of a model moves the pose by one left
-/// exponential of the sum of their twists, as the identification models them
-/// ([`poe::identify::PoseCorrection`]).
-pub(crate) fn apply(
-    effects: &[IdentifiedEffect],
-    kinematics: &LocalPoe,
-    row: &Measurement,
-    tool: usize,
-    pose: SE3,
-) -> Result<SE3, Error> {
-    if effects.is_empty() {
-        return Ok(pose);
-    }
-    let mut twists = RowTwists::new(kinematics, &row.q, tool);
-    let mut total = Vector6::zeros();
-    for effect in effects {
-        total += effect.twist_with(&mut twists, row, tool)?;
-    }
-    Ok(Twist::from_vector(&total).exp() * pose)
 }
 
 /// A stand-in mass model where the robot file gives none, used only for the *sign* of the static

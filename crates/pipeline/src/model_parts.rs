@@ -1,0 +1,102 @@
+//! A calibrated model as a sequence of parts: the geometry, then the named effects, then the GP.
+//! Each part applies itself to the poses of a set of rows ([`Part::apply`]); prediction, the fit's
+//! "after" report, export (what a URDF cannot hold) and compensation all walk the same sequence, so
+//! a new kind of part is one new variant here.
+//!
+//! The effects move a pose by one left exponential of the sum of their twists, exactly as the
+//! identification models them (`poe::identify::PoseCorrection`): each effect adds its twist to the
+//! rows' pending twist, and the pending twist is applied before the GP reads the poses and at the
+//! end.
+
+use crate::effects::IdentifiedEffect;
+use crate::{Compensation, Error, Measurement};
+use lie::{SE3, Twist, Vector6};
+use poe::LocalPoe;
+
+/// One part of a calibrated model, in the order the parts apply.
+#[derive(Debug, Clone, Copy)]
+pub enum Part<'a> {
+    /// The identified local POE kinematics (reference frame: the tracker).
+    Geometry(&'a LocalPoe),
+    /// A non-geometric effect identified with the geometry.
+    Effect(&'a IdentifiedEffect),
+    /// The Gaussian-process compensation of what is left.
+    GaussianProcess(&'a Compensation),
+}
+
+impl<'a> Part<'a> {
+    /// The part's name in reports: `geometry`, the effect's label, `gaussian_process`.
+    pub fn name(&self) -> String {
+        match self {
+            Part::Geometry(_) => "geometry".into(),
+            Part::Effect(effect) => effect.label(),
+            Part::GaussianProcess(_) => "gaussian_process".into(),
+        }
+    }
+
+    /// Whether a URDF can hold the part (only the geometry).
+    pub fn in_urdf(&self) -> bool {
+        matches!(self, Part::Geometry(_))
+    }
+
+    /// Applies the part to the state of a walk over `rows`.
+    pub(crate) fn apply(&self, walk: &mut Walk<'a>) -> Result<(), Error> {
+        match *self {
+            Part::Geometry(kinematics) => {
+                walk.kinematics = Some(kinematics);
+                walk.poses = walk
+                    .rows
+                    .iter()
+                    .zip(walk.tools)
+                    .map(|(row, &tool)| kinematics.forward(&row.q, tool))
+                    .collect::<Result<_, _>>()?;
+                walk.pending = vec![Vector6::zeros(); walk.rows.len()];
+            }
+            Part::Effect(effect) => {
+                let kinematics = walk.kinematics.ok_or(Error::PartOrder { part: "effect" })?;
+                for ((pending, row), &tool) in walk.pending.iter_mut().zip(walk.rows).zip(walk.tools) {
+                    *pending += effect.twist(kinematics, row, tool)?;
+                }
+            }
+            Part::GaussianProcess(compensation) => {
+                walk.flush();
+                let corrections = compensation.predict(walk.rows, &walk.poses)?;
+                let mut std = Vec::with_capacity(corrections.len());
+                for (pose, (g, s)) in walk.poses.iter_mut().zip(corrections) {
+                    *pose = g * *pose;
+                    std.push(s);
+                }
+                walk.std = Some(std);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The state of a walk over the parts: the poses so far, the effects' pending twist, the GP's
+/// standard deviations.
+#[derive(Debug)]
+pub(crate) struct Walk<'a> {
+    rows: &'a [Measurement],
+    tools: &'a [usize],
+    kinematics: Option<&'a LocalPoe>,
+    pub(crate) poses: Vec<SE3>,
+    pending: Vec<Vector6>,
+    pub(crate) std: Option<Vec<[f64; 6]>>,
+}
+
+impl<'a> Walk<'a> {
+    pub(crate) fn new(rows: &'a [Measurement], tools: &'a [usize]) -> Self {
+        Self { rows, tools, kinematics: None, poses: Vec::new(), pending: Vec::new(), std: None }
+    }
+
+    /// Applies the effects' pending twists: `exp(Σ twists) · pose`.
+    pub(crate) fn flush(&mut self) {
+        for (pose, pending) in self.poses.iter_mut().zip(&mut self.pending) {
+            if *pending != Vector6::zeros() {
+                *pose = Twist::from_vector(pending).exp() * *pose;
+                *pending = Vector6::zeros();
+            }
+        }
+    }
+}
