@@ -170,6 +170,7 @@ fn robot_seeds() -> Result<Vec<Seed>> {
         "iiwa7.ron",
         "ur10_dh.ron",
         "iiwa7_dh.ron",
+        "irb4400_dh.ron",
         "ur10.urdf",
         "iiwa7.urdf",
         "irb4400.urdf",

@@ -50,7 +50,7 @@ fn every_form_of_a_robot_has_the_same_forward_kinematics() {
             ("ur10.urdf", Some("base_link_inertia")),
         ],
         &[("iiwa7.ron", None), ("iiwa7_dh.ron", None), ("iiwa7.urdf", None)],
-        &[("irb4400.ron", None), ("irb4400.urdf", None)],
+        &[("irb4400.ron", None), ("irb4400_dh.ron", None), ("irb4400.urdf", None)],
     ];
     for robot in forms {
         let reference = read(robot[0].0, None).nominal_model().unwrap();
