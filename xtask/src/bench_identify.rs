@@ -6,6 +6,7 @@
 //! tracker metres away, full-pose measurements with 0.02 mm / 0.02 mrad noise. Both start from the
 //! same closed-form registration.
 
+use anyhow::Context;
 use lie::{Matrix4, SE3, Vector3};
 use pipeline::RobotDescription;
 use pipeline::simulated::{Perturbation, simulated_cell};
@@ -46,11 +47,29 @@ fn matrix(t: &SE3) -> Vec<Vec<f64>> {
     (0..4).map(|r| (0..4).map(|c| m[(r, c)]).collect()).collect()
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
-    let robot = RobotDescription::read(&args.robot).map_err(|e| e.to_string())?;
-    let nominal = robot.nominal_model().map_err(|e| e.to_string())?;
+/// What `xtask/scripts/identify_scipy.py` is given: the same start, joints and measurements.
+#[derive(Debug, serde::Serialize)]
+struct ScipyProblem {
+    local_transforms: Vec<Vec<Vec<f64>>>,
+    q: Vec<Vec<f64>>,
+    measured: Vec<Vec<Vec<f64>>>,
+    position_sigma_m: f64,
+    rotation_sigma_rad: f64,
+}
+
+/// What it answers.
+#[derive(Debug, serde::Deserialize)]
+struct ScipyResult {
+    seconds: f64,
+    evaluations: u64,
+    rms_position_m: f64,
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let robot = RobotDescription::read(&args.robot)?;
+    let nominal = robot.nominal_model()?;
     let perturbation = Perturbation { translation_m: 2e-3, rotation_rad: 2e-3, tool_m: 0.2 };
-    let cell = simulated_cell(&robot, &perturbation, 7).map_err(|e| e.to_string())?;
+    let cell = simulated_cell(&robot, &perturbation, 7)?;
     let truth = {
         let mut t = cell.robot.clone();
         t.change_reference(cell.tracker_from_base);
@@ -69,8 +88,7 @@ pub fn run(args: &Args) -> Result<(), String> {
             0,
             &pipeline::simulated::joint_ranges(&robot),
             &loadsim::GeneratorConfig { sample_count: rows, seed: rows as u64, ..Default::default() },
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         let observations: Vec<Observation> = configurations
             .into_iter()
             .map(|q| {
@@ -81,7 +99,7 @@ pub fn run(args: &Args) -> Result<(), String> {
                 Observation { q, tool: 0, target: Target::Pose(noisy) }
             })
             .collect();
-        let start = register(&nominal, &observations).map_err(|e| e.to_string())?;
+        let start = register(&nominal, &observations)?;
         let mask = ParameterMask::all(start.layout());
         // One core, as the SciPy fit runs.
         faer::set_global_parallelism(faer::Par::Seq);
@@ -89,13 +107,13 @@ pub fn run(args: &Args) -> Result<(), String> {
         let mut last = None;
         for _ in 0..args.repeats.max(1) {
             let begin = Instant::now();
-            let fit = identify(&start, &observations, &mask, &options).map_err(|e| e.to_string())?;
+            let fit = identify(&start, &observations, &mask, &options)?;
             times.push(begin.elapsed().as_secs_f64());
             last = Some(fit);
         }
         times.sort_by(f64::total_cmp);
         let ours_s = times[times.len() / 2];
-        let fit = last.ok_or("no fit")?;
+        let fit = last.context("no fit")?;
         let ours_rms = fit.report.iterations.last().map_or(f64::NAN, |r| r.rms_position_m);
         let _ = write!(
             table,
@@ -105,15 +123,22 @@ pub fn run(args: &Args) -> Result<(), String> {
             ours_rms * 1e3
         );
         if python {
-            let problem = serde_json::json!({
-                "local_transforms": start.joints().iter().map(|j| matrix(&j.previous_from_joint_zero)).chain(std::iter::once(matrix(&start.tools()[0]))).collect::<Vec<_>>(),
-                "q": observations.iter().map(|o| o.q.clone()).collect::<Vec<_>>(),
-                "measured": observations.iter().map(|o| match o.target { Target::Pose(p) => matrix(&p), Target::Point(_) => vec![] }).collect::<Vec<_>>(),
-                "position_sigma_m": SIGMA,
-                "rotation_sigma_rad": SIGMA,
-            });
+            let local = start.joints().iter().map(|j| matrix(&j.previous_from_joint_zero));
+            let problem = ScipyProblem {
+                local_transforms: local.chain(std::iter::once(matrix(&start.tools()[0]))).collect(),
+                q: observations.iter().map(|o| o.q.clone()).collect(),
+                measured: observations
+                    .iter()
+                    .map(|o| match o.target {
+                        Target::Pose(p) => matrix(&p),
+                        Target::Point(_) => vec![],
+                    })
+                    .collect(),
+                position_sigma_m: SIGMA,
+                rotation_sigma_rad: SIGMA,
+            };
             let path = std::env::temp_dir().join(format!("calib-identify-{rows}.json"));
-            std::fs::write(&path, problem.to_string()).map_err(|e| e.to_string())?;
+            std::fs::write(&path, serde_json::to_string(&problem)?)?;
             let script = crate::reproduce_sim::workspace_root().join("xtask/scripts/identify_scipy.py");
             let repeats = if rows > 300 { 1 } else { args.repeats.clamp(1, 3) };
             let output = Command::new("python3")
@@ -121,18 +146,18 @@ pub fn run(args: &Args) -> Result<(), String> {
                 .arg(&path)
                 .arg(repeats.to_string())
                 .output()
-                .map_err(|e| format!("python3: {e}"))?;
+                .context("running python3")?;
             if !output.status.success() {
-                return Err(format!("{}: {}", script.display(), String::from_utf8_lossy(&output.stderr)));
+                anyhow::bail!("{}: {}", script.display(), String::from_utf8_lossy(&output.stderr));
             }
-            let result: serde_json::Value = serde_json::from_slice(&output.stdout).map_err(|e| e.to_string())?;
-            let theirs = result["seconds"].as_f64().unwrap_or(f64::NAN);
+            let result: ScipyResult = serde_json::from_slice(&output.stdout).context("reading SciPy's answer")?;
+            let theirs = result.seconds;
             let _ = writeln!(
                 table,
                 " {:.1} | {} | {:.4} | {:.0}× |",
                 theirs * 1e3,
-                result["evaluations"],
-                result["rms_position_m"].as_f64().unwrap_or(f64::NAN) * 1e3,
+                result.evaluations,
+                result.rms_position_m * 1e3,
                 theirs / ours_s
             );
         } else {
@@ -147,7 +172,7 @@ pub fn run(args: &Args) -> Result<(), String> {
 registration, calib's iterative least squares (one core) against `scipy.optimize.least_squares` (trf, \
 finite-difference Jacobian) on the same weighted residual. Median of the timed fits.\n\n{table}"
         );
-        std::fs::write(path, body).map_err(|e| format!("{}: {e}", path.display()))?;
+        std::fs::write(path, body).with_context(|| path.display().to_string())?;
     }
     Ok(())
 }

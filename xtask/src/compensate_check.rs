@@ -9,6 +9,7 @@
 //! against SciPy's `least_squares` per target (`xtask/scripts/compensate_scipy.py`). Writes
 //! `compensate.md` into `--out`.
 
+use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use lie::{Matrix4, SE3};
 use loadsim::{Payload, PoseContext};
@@ -112,11 +113,10 @@ fn program(
     count: usize,
     seed: u64,
     payloads: &[f64],
-) -> Result<Vec<(Vec<f64>, f64)>, String> {
+) -> anyhow::Result<Vec<(Vec<f64>, f64)>> {
     let config =
         GeneratorConfig { sample_count: count, seed, payloads_kg: payloads.to_vec(), ..GeneratorConfig::default() };
-    let set = simulated::simulate(cell, &Effects::default(), &simulated::joint_ranges(robot), &config, false)
-        .map_err(|e| e.to_string())?;
+    let set = simulated::simulate(cell, &Effects::default(), &simulated::joint_ranges(robot), &config, false)?;
     Ok(set.rows.into_iter().map(|r| (r.q, r.payload_kg)).collect())
 }
 
@@ -125,14 +125,13 @@ fn targets(
     model: &CalibratedModel,
     robot: &RobotDescription,
     rows: &[(Vec<f64>, f64)],
-) -> Result<Vec<PoseTarget>, String> {
-    let registered = pipeline::registered_nominal(model, robot, "robot", &CompensateOptions::default())
-        .map_err(|e| e.to_string())?;
+) -> anyhow::Result<Vec<PoseTarget>> {
+    let registered = pipeline::registered_nominal(model, robot, "robot", &CompensateOptions::default())?;
     rows.iter()
         .map(|(q, payload_kg)| {
             Ok(PoseTarget {
                 seed: q.clone(),
-                pose: registered.model.forward(q, 0).map_err(|e| e.to_string())?,
+                pose: registered.model.forward(q, 0)?,
                 orientation: model.full_pose,
                 payload_kg: *payload_kg,
                 tool: 0,
@@ -146,7 +145,7 @@ fn run_case(
     robot: &RobotDescription,
     cell: &SimulatedCell,
     args: &Args,
-) -> Result<(Outcome, CalibratedModel), String> {
+) -> anyhow::Result<(Outcome, CalibratedModel)> {
     let ranges = simulated::joint_ranges(robot);
     let data = |count: usize, seed: u64| {
         let config = GeneratorConfig {
@@ -155,15 +154,14 @@ fn run_case(
             payloads_kg: case.payloads_kg.clone(),
             ..GeneratorConfig::default()
         };
-        simulated::simulate(cell, &case.effects, &ranges, &config, true).map_err(|e| e.to_string())
+        simulated::simulate(cell, &case.effects, &ranges, &config, true)
     };
     let (train, test) = (data(args.train, args.seed)?, data(args.test, args.seed + 1000)?);
-    let (model, _) = pipeline::fit(robot, &train, case.method, &FitOptions::default()).map_err(|e| e.to_string())?;
-    let heldout = pipeline::evaluate(&model, &test).map_err(|e| e.to_string())?.summary;
+    let (model, _) = pipeline::fit(robot, &train, case.method, &FitOptions::default())?;
+    let heldout = pipeline::evaluate(&model, &test)?.summary;
     let rows = program(cell, robot, args.program, args.seed + 2000, &case.payloads_kg)?;
     let targets = targets(&model, robot, &rows)?;
-    let solved = pipeline::solve_targets(&model, &targets, Some(&robot.limits()), &InverseOptions::default())
-        .map_err(|e| e.to_string())?;
+    let solved = pipeline::solve_targets(&model, &targets, Some(&robot.limits()), &InverseOptions::default())?;
     let truth = Effects { tracker_noise: None, ..case.effects.clone() };
     let (mut before, mut after, mut wanted) = (Vec::new(), Vec::new(), Vec::new());
     for ((target, solved), (q, payload_kg)) in targets.iter().zip(&solved).zip(&rows) {
@@ -171,8 +169,8 @@ fn run_case(
             continue;
         }
         let context = PoseContext { payload: Payload::at_tool(*payload_kg), ..PoseContext::default() };
-        before.push(truth.true_pose(cell, q, &context).map_err(|e| e.to_string())?);
-        after.push(truth.true_pose(cell, &solved.q, &context).map_err(|e| e.to_string())?);
+        before.push(truth.true_pose(cell, q, &context)?);
+        after.push(truth.true_pose(cell, &solved.q, &context)?);
         wanted.push(target.pose);
     }
     let (before_mm, before_mrad, _) = distances(&before, &wanted);
@@ -198,11 +196,10 @@ fn time_targets(
     model: &CalibratedModel,
     robot: &RobotDescription,
     rows: &[(Vec<f64>, f64)],
-) -> Result<(f64, usize), String> {
+) -> anyhow::Result<(f64, usize)> {
     let begin = Instant::now();
     let targets = targets(model, robot, rows)?;
-    let solved = pipeline::solve_targets(model, &targets, Some(&robot.limits()), &InverseOptions::default())
-        .map_err(|e| e.to_string())?;
+    let solved = pipeline::solve_targets(model, &targets, Some(&robot.limits()), &InverseOptions::default())?;
     Ok((begin.elapsed().as_secs_f64(), solved.iter().filter(|s| s.status.is_ok()).count()))
 }
 
@@ -212,32 +209,47 @@ fn matrix(t: &SE3) -> Vec<Vec<f64>> {
 }
 
 /// SciPy's seconds per target and the largest point residual, or `None` without SciPy.
-fn scipy(model: &CalibratedModel, targets: &[PoseTarget]) -> Result<Option<(f64, f64)>, String> {
+fn scipy(model: &CalibratedModel, targets: &[PoseTarget]) -> anyhow::Result<Option<(f64, f64)>> {
     let python = Command::new("python3").args(["-c", "import scipy"]).output().is_ok_and(|o| o.status.success());
     if !python {
         return Ok(None);
     }
     let kinematics = &model.kinematics;
-    let problem = serde_json::json!({
-        "local_transforms": kinematics.joints().iter().map(|j| matrix(&j.previous_from_joint_zero)).chain(std::iter::once(matrix(&kinematics.tools()[0]))).collect::<Vec<_>>(),
-        "seeds": targets.iter().map(|t| t.seed.clone()).collect::<Vec<_>>(),
-        "targets": targets.iter().map(|t| matrix(&t.pose)).collect::<Vec<_>>(),
-    });
+    let local = kinematics.joints().iter().map(|j| matrix(&j.previous_from_joint_zero));
+    let problem = ScipyProblem {
+        local_transforms: local.chain(std::iter::once(matrix(&kinematics.tools()[0]))).collect(),
+        seeds: targets.iter().map(|t| t.seed.clone()).collect(),
+        targets: targets.iter().map(|t| matrix(&t.pose)).collect(),
+    };
     let path = std::env::temp_dir().join("calib-compensate-scipy.json");
-    std::fs::write(&path, problem.to_string()).map_err(|e| e.to_string())?;
+    std::fs::write(&path, serde_json::to_string(&problem)?)?;
     let script = crate::reproduce_sim::workspace_root().join("xtask/scripts/compensate_scipy.py");
-    let output = Command::new("python3").arg(&script).arg(&path).output().map_err(|e| format!("python3: {e}"))?;
+    let output = Command::new("python3").arg(&script).arg(&path).output().context("running python3")?;
     if !output.status.success() {
-        return Err(format!("{}: {}", script.display(), String::from_utf8_lossy(&output.stderr)));
+        anyhow::bail!("{}: {}", script.display(), String::from_utf8_lossy(&output.stderr));
     }
-    let result: serde_json::Value = serde_json::from_slice(&output.stdout).map_err(|e| e.to_string())?;
-    let seconds = result["seconds"].as_f64().unwrap_or(f64::NAN);
-    Ok(Some((seconds / targets.len().max(1) as f64, result["max_residual_m"].as_f64().unwrap_or(f64::NAN))))
+    let result: ScipyResult = serde_json::from_slice(&output.stdout).context("reading SciPy's answer")?;
+    Ok(Some((result.seconds / targets.len().max(1) as f64, result.max_residual_m)))
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
-    let robot = RobotDescription::read(&args.robot).map_err(|e| e.to_string())?;
-    let cell = simulated::simulated_cell(&robot, &Perturbation::default(), args.seed).map_err(|e| e.to_string())?;
+/// What `xtask/scripts/compensate_scipy.py` is given: the geometric model, seeds and targets.
+#[derive(Debug, serde::Serialize)]
+struct ScipyProblem {
+    local_transforms: Vec<Vec<Vec<f64>>>,
+    seeds: Vec<Vec<f64>>,
+    targets: Vec<Vec<Vec<f64>>>,
+}
+
+/// What it answers.
+#[derive(Debug, serde::Deserialize)]
+struct ScipyResult {
+    seconds: f64,
+    max_residual_m: f64,
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let robot = RobotDescription::read(&args.robot)?;
+    let cell = simulated::simulated_cell(&robot, &Perturbation::default(), args.seed)?;
     let cases = cases();
     let bar = ProgressBar::new(cases.len() as u64 + 2);
     bar.set_style(
@@ -340,10 +352,10 @@ pub fn run(args: &Args) -> Result<(), String> {
         }
     }
     let path = args.out.join("compensate.md");
-    std::fs::write(&path, &md).map_err(|e| format!("{}: {e}", path.display()))?;
+    std::fs::write(&path, &md).with_context(|| path.display().to_string())?;
     println!("{md}");
     if !failed.is_empty() {
-        return Err(format!("compensated error above 1.2× the held-out error: {}", failed.join("; ")));
+        anyhow::bail!("compensated error above 1.2× the held-out error: {}", failed.join("; "));
     }
     Ok(())
 }

@@ -6,6 +6,7 @@
 //! decimal comma; joints in radians (UR's DH zero), the T-Mac position in millimetres and its
 //! orientation as `rx, ry, rz` in degrees, and the cell temperature.
 
+use anyhow::Context;
 use lie::{SO3, Vector3};
 use pipeline::{Measurement, MeasurementSet};
 use std::path::{Path, PathBuf};
@@ -139,15 +140,15 @@ pub fn read_series(input: &Path, series: &str, full_pose: bool) -> Result<Measur
     Ok(MeasurementSet::from_rows(&file.display().to_string(), rows, vec![]))
 }
 
-fn write(set: &MeasurementSet, path: &Path) -> Result<(), String> {
-    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    set.write_csv(std::io::BufWriter::new(file)).map_err(|e| format!("{}: {e}", path.display()))?;
+fn write(set: &MeasurementSet, path: &Path) -> anyhow::Result<()> {
+    let file = std::fs::File::create(path).with_context(|| path.display().to_string())?;
+    set.write_csv(std::io::BufWriter::new(file)).with_context(|| path.display().to_string())?;
     println!("wrote {} rows to {}", set.rows.len(), path.display());
     Ok(())
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
-    let set = read_series(&args.dataset.input, &args.dataset.series, args.full_pose)?;
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let set = read_series(&args.dataset.input, &args.dataset.series, args.full_pose).map_err(anyhow::Error::msg)?;
     match (&args.out, &args.train, &args.test) {
         (Some(out), _, _) => write(&set, out),
         (None, Some(train), Some(test)) => {
@@ -155,7 +156,7 @@ pub fn run(args: &Args) -> Result<(), String> {
             write(&set.subset(&(0..half).collect::<Vec<_>>()), train)?;
             write(&set.subset(&(half..set.rows.len()).collect::<Vec<_>>()), test)
         }
-        _ => Err("give --out FILE, or --train FILE and --test FILE".into()),
+        _ => Err(anyhow::anyhow!("give --out FILE, or --train FILE and --test FILE")),
     }
 }
 

@@ -4,6 +4,7 @@
 //! Writes `urdf.md` into `--out`.
 
 use crate::convert_ur10::{Dataset, read_series};
+use anyhow::Context;
 use lie::{SE3, Vector3};
 use pipeline::{
     ChainEnds, FitOptions, MeasurementSet, Method, NominalTolerance, RobotDescription, UrdfDocument, UrdfTemplate,
@@ -29,12 +30,11 @@ fn halves(set: &MeasurementSet) -> (MeasurementSet, MeasurementSet) {
 }
 
 /// Largest distance between the tool poses (origin and the ends of 1 m axes) of two models.
-fn largest_difference_m(a: &poe::LocalPoe, b: &poe::LocalPoe, rows: &MeasurementSet) -> Result<f64, String> {
+fn largest_difference_m(a: &poe::LocalPoe, b: &poe::LocalPoe, rows: &MeasurementSet) -> anyhow::Result<f64> {
     let points = [Vector3::zeros(), Vector3::x(), Vector3::y(), Vector3::z()];
     let mut largest = 0.0_f64;
     for row in &rows.rows {
-        let (ta, tb): (SE3, SE3) =
-            (a.forward(&row.q, 0).map_err(|e| e.to_string())?, b.forward(&row.q, 0).map_err(|e| e.to_string())?);
+        let (ta, tb): (SE3, SE3) = (a.forward(&row.q, 0)?, b.forward(&row.q, 0)?);
         for p in &points {
             largest = largest.max((ta.transform_point(p) - tb.transform_point(p)).norm());
         }
@@ -42,7 +42,7 @@ fn largest_difference_m(a: &poe::LocalPoe, b: &poe::LocalPoe, rows: &Measurement
     Ok(largest)
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut md = String::new();
     let _ = writeln!(md, "# The UR10 as RON, DH table and URDF, and the calibrated URDF\n");
     let _ = writeln!(
@@ -57,14 +57,13 @@ pub fn run(args: &Args) -> Result<(), String> {
     let _ = writeln!(md, "| --- | --- | ---: | ---: | ---: | ---: |");
     let mut round_trips = Vec::new();
     for (label, full_pose) in [("position", false), ("full pose", true)] {
-        let set = read_series(&args.dataset.input, &args.dataset.series, full_pose)?;
+        let set = read_series(&args.dataset.input, &args.dataset.series, full_pose).map_err(anyhow::Error::msg)?;
         let (train, test) = halves(&set);
         let mut means = Vec::new();
         for form in FORMS {
-            let robot = RobotDescription::read(&PathBuf::from(form)).map_err(|e| e.to_string())?;
-            let (model, _) =
-                pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default()).map_err(|e| e.to_string())?;
-            let s = pipeline::evaluate(&model, &test).map_err(|e| e.to_string())?.summary;
+            let robot = RobotDescription::read(&PathBuf::from(form))?;
+            let (model, _) = pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default())?;
+            let s = pipeline::evaluate(&model, &test)?.summary;
             let _ = writeln!(
                 md,
                 "| {label} | `{form}` | {:.6} | {:.6} | {:.6} | {} |",
@@ -94,28 +93,26 @@ pub fn run(args: &Args) -> Result<(), String> {
         let _ = writeln!(md, "| {label} | {difference:.2e} |");
     }
     let path = args.out.join("urdf.md");
-    std::fs::write(&path, &md).map_err(|e| format!("{}: {e}", path.display()))?;
+    std::fs::write(&path, &md).with_context(|| path.display().to_string())?;
     println!("{md}");
     if let Some((label, difference)) = round_trips.iter().find(|(_, d)| *d > 1e-9) {
-        return Err(format!("{label}: the exported URDF reads back {difference:e} m from the model"));
+        anyhow::bail!("{label}: the exported URDF reads back {difference:e} m from the model");
     }
     Ok(())
 }
 
 /// Exports `model` like `urdf` and reads the result back from the tracker link to the tool.
-fn round_trip(urdf: &str, model: &pipeline::CalibratedModel, test: &MeasurementSet) -> Result<f64, String> {
-    let document = UrdfDocument::read(&PathBuf::from(urdf)).map_err(|e| e.to_string())?;
-    let chain = document.chain(&ChainEnds::default()).map_err(|e| e.to_string())?;
+fn round_trip(urdf: &str, model: &pipeline::CalibratedModel, test: &MeasurementSet) -> anyhow::Result<f64> {
+    let document = UrdfDocument::read(&PathBuf::from(urdf))?;
+    let chain = document.chain(&ChainEnds::default())?;
     let template = UrdfTemplate::Like { document: &document, chain: &chain };
-    let export =
-        pipeline::export_urdf(model, template, None, &NominalTolerance::default()).map_err(|e| e.to_string())?;
+    let export = pipeline::export_urdf(model, template, None, &NominalTolerance::default())?;
     let ends = ChainEnds {
         base_link: Some(export.report.tracker_link.clone()),
         tip_link: export.report.tool_links.first().cloned(),
     };
     let back = UrdfDocument::parse(&export.text, "exported.urdf")
         .and_then(|d| d.chain(&ends))
-        .and_then(|c| c.description().nominal_model())
-        .map_err(|e| e.to_string())?;
+        .and_then(|c| c.description().nominal_model())?;
     largest_difference_m(&back, &model.kinematics, test)
 }

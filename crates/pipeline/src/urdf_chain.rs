@@ -127,12 +127,14 @@ impl UrdfDocument {
         }
         let robot = urdf_rs::read_from_string(text).map_err(|e| {
             let message = e.to_string();
-            // urdf-rs quotes the offending value in brackets where it can; find it in the text.
-            let position = message
-                .split_once('[')
-                .and_then(|(_, rest)| rest.split_once(']'))
-                .and_then(|(quoted, _)| text.find(quoted))
-                .map_or(root.position, |offset| line_column(text, offset));
+            // The XML parser's own position where it gives one; else urdf-rs quotes the offending
+            // value in brackets where it can: find it in the text.
+            let quoted = || {
+                let (_, rest) = message.split_once('[')?;
+                let (quoted, _) = rest.split_once(']')?;
+                text.find(quoted).map(|offset| line_column(text, offset))
+            };
+            let position = parser_position(&message, text).or_else(quoted).unwrap_or(root.position);
             at(position, format!("URDF: {message}"))
         })?;
         let mut document =
@@ -441,6 +443,26 @@ fn find<'a>(element: &'a Element, matches: &dyn Fn(&Element) -> bool) -> Option<
     element.children.iter().find_map(|c| find(c, matches))
 }
 
+/// The position an XML parser's message gives, 1-based, if it is inside `text`: serde-xml-rs
+/// writes `Line: 3, Column: 22` (1-based), xml-rs `Syntax: 1:684587` (0-based row and column).
+fn parser_position(message: &str, text: &str) -> Option<Position> {
+    let number = |s: &str| -> Option<usize> {
+        let digits: String = s.chars().take_while(char::is_ascii_digit).collect();
+        digits.parse().ok()
+    };
+    let position = if let Some((_, rest)) = message.split_once("Line: ") {
+        let line = number(rest)?;
+        let (_, rest) = rest.split_once("Column: ")?;
+        (line, number(rest)?)
+    } else {
+        let (_, rest) = message.split_once("Syntax: ")?;
+        let (row, rest) = rest.split_once(':')?;
+        (number(row)? + 1, number(rest)? + 1)
+    };
+    let lines = text.lines().count().max(1);
+    (position.0 >= 1 && position.0 <= lines && position.1 >= 1).then_some(position)
+}
+
 /// 1-based line and column of a byte offset.
 fn line_column(text: &str, offset: usize) -> Position {
     let before = &text[..offset.min(text.len())];
@@ -502,5 +524,22 @@ impl UrdfChain {
             tool: None,
             dynamics: None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parser_position;
+
+    #[test]
+    fn the_xml_parsers_positions_are_read_in_either_form_and_only_inside_the_text() {
+        let text = "<robot>\n  <link/>\n  <link/>\n</robot>";
+        assert_eq!(
+            parser_position("Parse error; Line: 3, Column: 22, Reason: Found invalid entity", text),
+            Some((3, 22))
+        );
+        assert_eq!(parser_position("URDF: Syntax: 1:6 This document is larger", text), Some((2, 7)));
+        assert_eq!(parser_position("Syntax: 9:6 beyond the end", text), None);
+        assert_eq!(parser_position("custom: missing field `name`", text), None);
     }
 }
