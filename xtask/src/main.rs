@@ -8,6 +8,7 @@ mod bench_gp_residuals;
 mod bench_gp_sklearn;
 mod bench_identify;
 mod blind_check;
+mod blind_check_cases;
 mod box_plot;
 mod compensate_check;
 mod convert_ur10;
@@ -68,8 +69,8 @@ fn main() -> ExitCode {
         Command::BenchGp(args) => bench_gp::run(args),
         Command::BenchIdentify(args) => bench_identify::run(args).map_err(|e| format!("{e:#}")),
         Command::ConvertUr10(args) => convert_ur10::run(args).map_err(|e| format!("{e:#}")),
-        Command::BlindCheck(args) => blind_check::run(args),
-        Command::Ur10(args) => ur10::run(args),
+        Command::BlindCheck(args) => blind_check::run(args).map_err(|e| format!("{e:#}")),
+        Command::Ur10(args) => ur10::run(args).map_err(|e| format!("{e:#}")),
         Command::UrdfCheck(args) => urdf_check::run(args).map_err(|e| format!("{e:#}")),
         Command::CompensateCheck(args) => compensate_check::run(args).map_err(|e| format!("{e:#}")),
         Command::Fuzz(args) => fuzz::run(args).map_err(|e| format!("{e:#}")),

@@ -389,6 +389,11 @@ pub fn diagnose(
         None if selection.steps.is_empty() => explainable.clone(),
         None => None,
     };
+    let noise = match (options.noise_mm, noise::from_repeats(data)) {
+        (Some(sigma), _) => NoiseFloor::from_sigma(sigma, NoiseSource::Given),
+        (None, Some(sigma)) => NoiseFloor::from_sigma(sigma, NoiseSource::Repeats),
+        (None, None) => noise::tracker_default(data, &options.tracker),
+    };
     let evidence = verdict::Evidence {
         before: &selection.baseline.errors,
         selected: &all_selected.errors,
@@ -396,11 +401,22 @@ pub fn diagnose(
             .as_ref()
             .map(|s| (s.errors.as_slice(), explainable.as_ref().is_some_and(|c| c.significant))),
         gp_after: gp_after.as_ref().map(|s| s.errors.as_slice()),
+        floor: noise.floor_mm * 1e-3,
     };
     let decision = verdict::decide(&evidence, !selection.steps.is_empty(), &options.verdict);
     let (verdict, verdict_result) = match selection.steps.first() {
         _ if decision.unknown => {
-            let relevant = gp_after.as_ref().or(gp_before.as_ref()).map_or(vec![], |s| {
+            // The joints of a GP that found significant structure (after the effects if it did
+            // there); an insignificant GP's length scales point nowhere.
+            let significant = |check: &Option<GpCheck>| check.as_ref().is_some_and(|c| c.significant);
+            let telling = if significant(&remaining) && gp_after.is_some() {
+                gp_after.as_ref()
+            } else if significant(&explainable) {
+                gp_before.as_ref()
+            } else {
+                None
+            };
+            let relevant = telling.map_or(vec![], |s| {
                 let mut joints: Vec<usize> = s
                     .relevant(options.structure.short_length_scale)
                     .into_iter()
@@ -430,11 +446,6 @@ pub fn diagnose(
             };
             (Verdict { effect, joints }, Some(result.map_or(all_selected.mean_error(), |r| r.mean_error())))
         }
-    };
-    let noise = match (options.noise_mm, noise::from_repeats(data)) {
-        (Some(sigma), _) => NoiseFloor::from_sigma(sigma, NoiseSource::Given),
-        (None, Some(sigma)) => NoiseFloor::from_sigma(sigma, NoiseSource::Repeats),
-        (None, None) => noise::tracker_default(data, &options.tracker),
     };
     let shapes = series_shapes(&pool, &terms, &selection, data)?;
 

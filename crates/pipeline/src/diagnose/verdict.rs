@@ -24,11 +24,17 @@ pub struct VerdictOptions {
     /// The share of the explainable reduction of the mean held-out error a named effect must
     /// achieve: "most", i.e. more than half (issue 11).
     pub min_explained_fraction: f64,
+    /// `none` means the geometric model is at the noise floor: with nothing selected and a
+    /// held-out error above this multiple of the floor the verdict is `unknown` even when the GP
+    /// finds no structure (an error too rough for a GP on a few hundred poses, or noise larger
+    /// than the floor says). 1.5: with a few hundred poses the mean error scatters by a few per
+    /// cent, so 50 % above the floor is not noise.
+    pub none_max_floor_ratio: f64,
 }
 
 impl Default for VerdictOptions {
     fn default() -> Self {
-        Self { structure_min_gain: 0.1, min_explained_fraction: 0.5 }
+        Self { structure_min_gain: 0.1, min_explained_fraction: 0.5, none_max_floor_ratio: 1.5 }
     }
 }
 
@@ -96,6 +102,8 @@ pub(crate) struct Evidence<'a> {
     pub gp_before: Option<(&'a [f64], bool)>,
     /// The GP on what the selected effects leave, if it ran.
     pub gp_after: Option<&'a [f64]>,
+    /// The noise floor (mean position error of a perfect model), m.
+    pub floor: f64,
 }
 
 /// The decision and its reason.
@@ -117,7 +125,8 @@ pub(crate) fn decide(evidence: &Evidence<'_>, any_selected: bool, options: &Verd
     let explainable = explained.max(by_gp_before).max(by_gp_after);
     if !any_selected {
         let structured = evidence.gp_before.is_some_and(|(_, significant)| significant);
-        return Decision { unknown: structured, explained_fraction: None };
+        let above_floor = before > options.none_max_floor_ratio * evidence.floor;
+        return Decision { unknown: structured || above_floor, explained_fraction: None };
     }
     if evidence.gp_before.is_none() && evidence.gp_after.is_none() {
         return Decision { unknown: false, explained_fraction: None };
@@ -136,8 +145,13 @@ mod tests {
         let selected = [0.3; 10];
         let gp = [0.4; 10];
         let after = [0.25; 10];
-        let evidence =
-            Evidence { before: &before, selected: &selected, gp_before: Some((&gp, true)), gp_after: Some(&after) };
+        let evidence = Evidence {
+            before: &before,
+            selected: &selected,
+            gp_before: Some((&gp, true)),
+            gp_after: Some(&after),
+            floor: 0.2,
+        };
         let d = decide(&evidence, true, &VerdictOptions::default());
         assert!(!d.unknown);
         // (1 − 0.3) / (1 − 0.25)
@@ -150,7 +164,8 @@ mod tests {
         let before = [1.0; 10];
         let selected = [0.9; 10];
         let gp = [0.4; 10];
-        let evidence = Evidence { before: &before, selected: &selected, gp_before: Some((&gp, true)), gp_after: None };
+        let evidence =
+            Evidence { before: &before, selected: &selected, gp_before: Some((&gp, true)), gp_after: None, floor: 0.2 };
         let d = decide(&evidence, true, &VerdictOptions::default());
         assert!(d.unknown);
         assert!((d.explained_fraction.unwrap() - 0.1 / 0.6).abs() < 1e-12);
@@ -161,11 +176,27 @@ mod tests {
         let before = [1.0; 10];
         let gp = [0.5; 10];
         for significant in [true, false] {
-            let evidence =
-                Evidence { before: &before, selected: &before, gp_before: Some((&gp, significant)), gp_after: None };
+            let evidence = Evidence {
+                before: &before,
+                selected: &before,
+                gp_before: Some((&gp, significant)),
+                gp_after: None,
+                floor: 0.9,
+            };
             assert_eq!(decide(&evidence, false, &VerdictOptions::default()).unknown, significant);
         }
-        let evidence = Evidence { before: &before, selected: &before, gp_before: None, gp_after: None };
+        let evidence = Evidence { before: &before, selected: &before, gp_before: None, gp_after: None, floor: 0.9 };
         assert!(!decide(&evidence, false, &VerdictOptions::default()).unknown);
+    }
+
+    #[test]
+    fn an_error_far_above_the_floor_that_nothing_explains_is_unknown_not_none() {
+        let before = [1.0; 10];
+        let gp = [1.05; 10];
+        for (floor, unknown) in [(0.9, false), (0.5, true)] {
+            let evidence =
+                Evidence { before: &before, selected: &before, gp_before: Some((&gp, false)), gp_after: None, floor };
+            assert_eq!(decide(&evidence, false, &VerdictOptions::default()).unknown, unknown, "floor {floor}");
+        }
     }
 }
