@@ -5,7 +5,6 @@ use crate::box_plot::BoxStatistics;
 use crate::reproduce_sim::{PAPER_LIKE_SOFTENING, Preset};
 use crate::reproduce_sim_params::Params;
 use serde::Serialize;
-use serde_json::{Map, Value};
 use std::fmt::Write;
 
 /// The paper's Table I (mm, test sets 1–3), in the order of the JSON keys.
@@ -106,36 +105,47 @@ fn ordering(outcome: &Outcome) -> Vec<bool> {
     (0..rows[0].test.len()).map(|s| rows.windows(2).all(|w| w[0].test[s] > w[1].test[s])).collect()
 }
 
+/// Error per method key (mm, one entry per test set or fold mean), keys sorted.
+type PerMethod = std::collections::BTreeMap<String, Vec<f64>>;
+
+/// Test-set and cross-validation errors of one family of methods.
+#[derive(Debug, Serialize)]
+struct Family {
+    methods: PerMethod,
+    cv: PerMethod,
+}
+
+/// The SPEC "Experiment output" object (`methods`, `cv`, `params`), plus the paper-faithful and
+/// beyond-the-paper rows under their own keys.
+#[derive(Debug, Serialize)]
+struct ExperimentOutput<'a> {
+    methods: PerMethod,
+    cv: PerMethod,
+    params: &'a Params,
+    paper_faithful: Family,
+    beyond_the_paper: Family,
+}
+
 /// The SPEC "Experiment output" object, plus `paper_faithful` with the extra rows.
 pub fn json(params: &Params, outcome: &Outcome) -> String {
-    let family = |paper_faithful: bool, pick: &dyn Fn(&VariantResult) -> Vec<f64>| -> Value {
-        let map: Map<String, Value> = outcome
-            .variants
-            .iter()
-            .filter(|v| v.paper_faithful == paper_faithful && !v.beyond)
-            .map(|v| (v.key.to_owned(), Value::from(pick(v))))
-            .collect();
-        Value::Object(map)
+    let pick = |keep: &dyn Fn(&VariantResult) -> bool, value: &dyn Fn(&VariantResult) -> Vec<f64>| -> PerMethod {
+        outcome.variants.iter().filter(|v| keep(v)).map(|v| (v.key.to_owned(), value(v))).collect()
     };
-    let beyond = |pick: &dyn Fn(&VariantResult) -> Vec<f64>| -> Value {
-        Value::Object(
-            outcome.variants.iter().filter(|v| v.beyond).map(|v| (v.key.to_owned(), Value::from(pick(v)))).collect(),
-        )
+    let family = |keep: &dyn Fn(&VariantResult) -> bool| Family {
+        methods: pick(keep, &|v| v.test.clone()),
+        cv: pick(keep, &|v| v.cv.clone()),
     };
-    let value = serde_json::json!({
-        "methods": family(false, &|v| v.test.clone()),
-        "cv": family(false, &|v| v.cv.clone()),
-        "params": params,
-        "paper_faithful": {
-            "methods": family(true, &|v| v.test.clone()),
-            "cv": family(true, &|v| v.cv.clone()),
-        },
-        "beyond_the_paper": {
-            "methods": beyond(&|v| v.test.clone()),
-            "cv": beyond(&|v| v.cv.clone()),
-        },
-    });
-    format!("{value:#}\n")
+    let paper = |v: &VariantResult| !v.paper_faithful && !v.beyond;
+    let output = ExperimentOutput {
+        methods: pick(&paper, &|v| v.test.clone()),
+        cv: pick(&paper, &|v| v.cv.clone()),
+        params,
+        paper_faithful: family(&|v| v.paper_faithful && !v.beyond),
+        beyond_the_paper: family(&|v| v.beyond),
+    };
+    // A struct of maps, strings and finite numbers: serialisation cannot fail.
+    let text = serde_json::to_string_pretty(&output).expect("the experiment output serialises");
+    format!("{text}\n")
 }
 
 /// The console summary: the table against the paper's.
