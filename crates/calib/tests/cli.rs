@@ -289,23 +289,26 @@ fn a_bad_column_map_is_one_line_naming_where_it_is() {
 }
 
 #[test]
-fn a_model_that_predicts_a_non_finite_pose_is_refused_not_printed() {
+fn a_model_whose_values_overflow_is_refused_at_its_field_not_printed() {
     let dir = tempfile::tempdir().unwrap();
     let data = simulated(dir.path(), 40, 35);
     let model = dir.path().join("m.ron");
     fit_poe(&data, &model, &[]);
-    // Finite values the model file's check accepts, whose sum along the vertical overflows: the
-    // first two joints' offsets set to 1.5e308 m up (found by `cargo xtask fuzz` in many forms).
+    // Finite values whose sum along the vertical overflows: the first two joints' offsets set to
+    // 1.5e308 m up (found by `cargo xtask fuzz` in many forms). Once printed as NaN poses, then
+    // refused per row; now refused on reading, at the first of them.
     let mut content = std::fs::read_to_string(&model).unwrap();
     let starts: Vec<usize> = content.match_indices("translation: (").map(|(i, _)| i).take(2).collect();
     for &at in starts.iter().rev() {
         let end = at + content[at..].find(')').unwrap() + 1;
         content.replace_range(at..end, "translation: (0.0, 0.0, 1.5e308)");
     }
+    let line = content.lines().position(|l| l.contains("1.5e308")).unwrap() + 1;
     let broken = dir.path().join("broken.ron");
     std::fs::write(&broken, content).unwrap();
     for command in ["eval", "predict"] {
         let message = fails(&[command, "--model", &text(&broken), "--data", &text(&data)]);
-        assert!(message.contains("the model predicts a non-finite pose for line 2 of"), "{command}: {message}");
+        let at = format!("{}:{line}:21: kinematics.joints[0] is 1.5e308, beyond the 1e3", text(&broken));
+        assert!(message.contains(&at), "{command}: {message}");
     }
 }

@@ -191,6 +191,22 @@ pub enum Error {
         /// The index must be below this.
         limit: usize,
     },
+    /// A model file with a finite value far outside what a calibrated model can hold (an edited or
+    /// corrupt file): left in, its products overflow and the model predicts NaN poses.
+    ModelValue {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// The field, e.g. `kinematics.joints[1]`.
+        field: String,
+        /// The value found.
+        value: f64,
+        /// Its magnitude must not exceed this.
+        limit: f64,
+    },
     /// A required column is absent.
     MissingColumn {
         /// The file.
@@ -496,6 +512,10 @@ impl fmt::Display for Error {
             Error::ModelIndex { file, line, column, field, index, limit } => {
                 write!(f, "{file}:{line}:{column}: {field} is {index}, it must be below {limit}")
             }
+            Error::ModelValue { file, line, column, field, value, limit } => write!(
+                f,
+                "{file}:{line}:{column}: {field} is {value:e}, beyond the {limit:e} a calibrated model can hold (an edited or corrupt file)"
+            ),
             Error::MissingColumn { file, line, column, name } => {
                 write!(f, "{file}:{line}:{column}: missing required column '{name}'")
             }

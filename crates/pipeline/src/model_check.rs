@@ -3,8 +3,9 @@
 //! silently truncated by a `zip`) in `eval` or `predict`. One function, so that each new part of a
 //! model adds its checks here.
 
+use crate::model_parts::{Part, Walk};
 use crate::ron_position::field_position;
-use crate::{CalibratedModel, Error, Method};
+use crate::{CalibratedModel, Error, Measurement, Method};
 use lie::SE3;
 
 /// Where a field is in the file's text, and the error makers that use it.
@@ -28,6 +29,15 @@ impl Located<'_> {
         Error::NotFinite { file: self.file.to_owned(), line, column, field, value }
     }
 
+    /// A value that is not finite, or finite and beyond [`MAX_TRANSLATION_M`].
+    fn value(&self, at: (&str, usize), field: String, value: f64) -> Error {
+        if !value.is_finite() {
+            return self.not_finite(at, field, value);
+        }
+        let (line, column) = self.at(at.0, at.1);
+        Error::ModelValue { file: self.file.to_owned(), line, column, field, value, limit: MAX_TRANSLATION_M }
+    }
+
     fn part(&self, field: &str, message: String) -> Error {
         let (line, column) = self.at(field, 0);
         Error::RonFormat { file: self.file.to_owned(), line, column, message }
@@ -46,9 +56,18 @@ fn occurrences_before(text: &str, field: &str, part: &str) -> usize {
         .count()
 }
 
-/// The first non-finite translation among `transforms`, with its position in the list.
-fn non_finite_translation(transforms: impl Iterator<Item = SE3>) -> Option<(usize, f64)> {
-    transforms.enumerate().find_map(|(k, t)| t.translation().iter().copied().find(|v| !v.is_finite()).map(|v| (k, v)))
+/// The largest translation a model file may hold, m: a kilometre, two orders of magnitude beyond
+/// any robot cell. It is a sanity bound on a file, not a tuning constant: a corrupt or edited value
+/// beyond it (1e308 is finite) makes the products of forward kinematics and gravity torques
+/// overflow, and the model would then predict NaN poses instead of being refused here.
+pub(crate) const MAX_TRANSLATION_M: f64 = 1.0e3;
+
+/// The first translation among `transforms` that is not finite or beyond [`MAX_TRANSLATION_M`],
+/// with its position in the list.
+pub(crate) fn bad_translation(transforms: impl Iterator<Item = SE3>) -> Option<(usize, f64)> {
+    transforms.enumerate().find_map(|(k, t)| {
+        t.translation().iter().copied().find(|v| !v.is_finite() || v.abs() > MAX_TRANSLATION_M).map(|v| (k, v))
+    })
 }
 
 impl CalibratedModel {
@@ -64,9 +83,9 @@ impl CalibratedModel {
         }
         // Translations appear in the file in this order: the joints', then the tools'.
         let transforms = self.kinematics.joints().iter().map(|j| j.previous_from_joint_zero);
-        if let Some((k, value)) = non_finite_translation(transforms.chain(self.kinematics.tools().iter().copied())) {
+        if let Some((k, value)) = bad_translation(transforms.chain(self.kinematics.tools().iter().copied())) {
             let field = if k < n { format!("kinematics.joints[{k}]") } else { format!("kinematics.tools[{}]", k - n) };
-            return Err(at.not_finite(("translation", k), field, value));
+            return Err(at.value(("translation", k), field, value));
         }
         if self.tools.len() != tool_count {
             return Err(at.count(("tools", 0), "tools".into(), "tool names", self.tools.len(), tool_count));
@@ -106,6 +125,51 @@ impl CalibratedModel {
                 let found = compensation.gp.output_count();
                 return Err(at.count(("gp", 0), "compensation.gp".into(), "outputs", found, outputs));
             }
+        }
+        self.check_values(&at)
+    }
+
+    /// Walks the parts at two reference rows (every joint at 0, then at 1 rad or 1 m; payload,
+    /// torques, temperature and time at 0) and refuses the first part that makes a number
+    /// non-finite or puts the tool beyond [`MAX_TRANSLATION_M`]. The checks above bound what they
+    /// can name; this catches any finite but absurd value they leave (1e308 in the GP's training
+    /// outputs, a feature scale of 1e-320) that would make predictions NaN or kilometres off, and
+    /// names the part.
+    fn check_values(&self, at: &Located<'_>) -> Result<(), Error> {
+        let n = self.kinematics.joint_count();
+        let row = |q: f64| Measurement {
+            line: 0,
+            q: vec![q; n],
+            position: lie::Vector3::zeros(),
+            orientation: None,
+            payload_kg: 0.0,
+            tool: 0,
+            temp_c: Some(0.0),
+            t_s: Some(0.0),
+            torques_nm: Some(vec![0.0; n]),
+        };
+        let rows = [row(0.0), row(1.0)];
+        let tools = [0, 0];
+        let mut walk = Walk::new(&rows, &tools);
+        for (k, part) in self.parts().iter().enumerate() {
+            let applied = part.apply(&mut walk);
+            if applied.is_ok() && walk.is_bounded(MAX_TRANSLATION_M) {
+                continue;
+            }
+            let field = match part {
+                Part::Geometry(_) => "kinematics",
+                Part::Effect(_) => "effects",
+                Part::GaussianProcess(_) => "compensation",
+            };
+            let why = applied
+                .err()
+                .map_or("a pose that is not finite or beyond a kilometre".to_owned(), |e| format!("'{e}'"));
+            let message = format!(
+                "{field}: part {k} ({}) gives {why} with every joint at 0 or 1: a value in it is out of range \
+                 (an edited or corrupt file)",
+                part.name()
+            );
+            return Err(at.part(field, message));
         }
         Ok(())
     }

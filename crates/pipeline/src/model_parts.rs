@@ -90,6 +90,17 @@ impl<'a> Walk<'a> {
         Self { rows, tools, kinematics: None, poses: Vec::new(), pending: Vec::new(), std: None }
     }
 
+    /// Whether every number of the walk so far (poses, pending twists, GP deviations) is finite,
+    /// and every pose within `reach` metres of the reference frame.
+    pub(crate) fn is_bounded(&self, reach: f64) -> bool {
+        let pose = |p: &SE3| {
+            p.translation().iter().all(|v| v.abs() <= reach) && p.rotation().matrix().iter().all(|v| v.is_finite())
+        };
+        self.poses.iter().all(pose)
+            && self.pending.iter().all(|t| t.iter().all(|v| v.is_finite()))
+            && self.std.iter().flatten().all(|s| s.iter().all(|v| v.is_finite()))
+    }
+
     /// Applies the effects' pending twists: `exp(Σ twists) · pose`.
     pub(crate) fn flush(&mut self) {
         for (pose, pending) in self.poses.iter_mut().zip(&mut self.pending) {

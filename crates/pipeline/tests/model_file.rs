@@ -232,3 +232,38 @@ fn effect_values_that_do_not_match_their_features_are_refused_at_their_field() {
     assert!(message.starts_with(&format!("m.ron:{line}:")), "{message}");
     assert!(message.contains("effects[1].reference_s[0]"), "{message}");
 }
+
+#[test]
+fn a_finite_but_absurd_translation_is_refused_at_its_field() {
+    // 1e308 is finite: before, it was read, and every prediction was NaN (cargo xtask fuzz).
+    let (_, text) = fitted(false);
+    let at = text.find("translation: (").unwrap() + "translation: (".len();
+    let end = at + text[at..].find(',').unwrap();
+    let edited = format!("{}1e308{}", &text[..at], &text[end..]);
+    let (error, message) = refused(&edited);
+    assert!(matches!(error, Error::ModelValue { ref field, .. } if field == "kinematics.joints[0]"), "{message}");
+    assert!(message.contains("1e308") && message.contains("a calibrated model can hold"), "{message}");
+}
+
+#[test]
+fn a_vanishing_feature_scale_is_refused_not_left_to_predict_nan() {
+    // A scale of 1e-320 passes "positive and finite" but makes the scaled feature overflow.
+    let (mut model, _) = with_effects();
+    let Some(IdentifiedEffect::GearPeriodic(gear)) = model.effects.first_mut() else { panic!("no gear effect") };
+    gear.scale[1] = 1e-320;
+    let (error, message) = refused(&text_of(&model));
+    assert!(matches!(error, Error::RonFormat { .. }), "{message}");
+    assert!(message.contains("effects: part 1 (gear_periodic"), "{message}");
+}
+
+#[test]
+fn gp_training_data_that_overflow_its_weights_are_refused() {
+    let (model, text) = fitted(false);
+    assert!(model.compensation.is_some());
+    let at = text.find("training_outputs: [").unwrap();
+    let first = at + text[at..].find(|c: char| c == '-' || c.is_ascii_digit()).unwrap();
+    let end = first + text[first..].find(',').unwrap();
+    let edited = format!("{}1e308{}", &text[..first], &text[end..]);
+    let (_, message) = refused(&edited);
+    assert!(message.contains("compensation: part") && message.contains("gaussian_process"), "{message}");
+}

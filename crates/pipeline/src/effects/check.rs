@@ -21,6 +21,7 @@ pub(crate) enum FaultKind {
     Count { what: &'static str, found: usize, expected: usize },
     Index { index: usize, limit: usize },
     NotFinite { value: f64 },
+    Value { value: f64, limit: f64 },
 }
 
 impl EffectFault {
@@ -34,6 +35,7 @@ impl EffectFault {
             }
             FaultKind::Index { index, limit } => Error::ModelIndex { file, line, column, field, index, limit },
             FaultKind::NotFinite { value } => Error::NotFinite { file, line, column, field, value },
+            FaultKind::Value { value, limit } => Error::ModelValue { file, line, column, field, value, limit },
         }
     }
 }
@@ -97,10 +99,13 @@ impl Cursor<'_> {
             return Err(self.fault("base_model", 0, "base_model".into(), kind));
         }
         let moved = base.joints().iter().map(|j| j.previous_from_joint_zero).chain(base.tools().iter().copied());
-        if let Some(value) =
-            moved.flat_map(|t| t.translation().iter().copied().collect::<Vec<_>>()).find(|v| !v.is_finite())
-        {
-            return Err(self.fault("base_model", 0, "base_model".into(), FaultKind::NotFinite { value }));
+        if let Some((_, value)) = crate::model_check::bad_translation(moved) {
+            let kind = if value.is_finite() {
+                FaultKind::Value { value, limit: crate::model_check::MAX_TRANSLATION_M }
+            } else {
+                FaultKind::NotFinite { value }
+            };
+            return Err(self.fault("base_model", 0, "base_model".into(), kind));
         }
         self.finite("gravity_m_per_s2", &load.gravity_m_per_s2, false)
     }
