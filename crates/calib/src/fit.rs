@@ -149,6 +149,9 @@ fn summarise(
         id.final_cost,
         id.gradient_cosine
     );
+    for warning in &report.warnings {
+        let _ = writeln!(out, "  warning: {warning}");
+    }
     let _ = writeln!(out, "  wrote {}", args.out.display());
 }
 

@@ -146,3 +146,25 @@ fn the_fit_report_is_one_json_object_on_stdout_with_the_solver_and_the_effects()
     // The summary a person reads goes to stderr.
     assert!(String::from_utf8_lossy(&out.stderr).contains("training error after"));
 }
+
+#[test]
+fn few_rows_per_parameter_fit_with_a_warning_and_enough_without() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("m.ron");
+    // 20 position-only poses: 60 residual rows for 42 free parameters.
+    let thin = simulated(dir.path(), 20, 45);
+    let out = fit(&thin, &model, &["--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("warning: 60 residual rows for") && stderr.contains("below 3)"), "{stderr}");
+    let json: serde_json::Value = serde_json::from_str(&String::from_utf8_lossy(&out.stdout)).unwrap();
+    let warning = &json["warnings"][0];
+    assert_eq!(warning["kind"], "low_redundancy", "{json}");
+    assert!(warning["redundancy"].as_f64().unwrap() < 3.0, "{warning}");
+    // 80 poses: 240 rows, about six per parameter.
+    let enough = simulated(dir.path(), 80, 46);
+    let out = fit(&enough, &model, &["--json"]);
+    let json: serde_json::Value = serde_json::from_str(&String::from_utf8_lossy(&out.stdout)).unwrap();
+    assert_eq!(json["warnings"].as_array().map(Vec::len), Some(0), "{json}");
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning:"));
+}

@@ -38,6 +38,39 @@ pub struct FitReport {
     /// What `--effects auto` chose and why.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub auto: Option<AutoChoice>,
+    /// What the user should know before trusting the numbers above.
+    pub warnings: Vec<FitWarning>,
+}
+
+/// A fit that ran but deserves caution.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum FitWarning {
+    /// Few residual rows per identifiable parameter: the training error understates the held-out
+    /// error ([`crate::FitOptions::min_redundancy`]).
+    LowRedundancy {
+        /// Residual rows (3 per position, 6 per pose).
+        residual_rows: usize,
+        /// Identifiable parameters (the rank of the identification).
+        identifiable: usize,
+        /// Their ratio.
+        redundancy: f64,
+        /// The ratio below which this warning is given.
+        min_redundancy: f64,
+    },
+}
+
+impl std::fmt::Display for FitWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FitWarning::LowRedundancy { residual_rows, identifiable, redundancy, min_redundancy } => write!(
+                f,
+                "{residual_rows} residual rows for {identifiable} identifiable parameters ({redundancy:.2} per parameter, \
+                 below {min_redundancy}): the training error understates the error on new poses; measure more poses \
+                 or check the model on held-out data"
+            ),
+        }
+    }
 }
 
 /// Per-row errors and their summary.
@@ -130,6 +163,15 @@ pub fn fit(
         CalibratedModel { kinematics: geometry.registered, effects: Vec::new(), compensation: None, ..model.clone() };
     let before = evaluate(&registered, data)?.summary;
     let after = evaluate(&model, data)?.summary;
+    let mut warnings = Vec::new();
+    if identification.redundancy() < options.min_redundancy {
+        warnings.push(FitWarning::LowRedundancy {
+            residual_rows: identification.residual_rows,
+            identifiable: identification.rank,
+            redundancy: identification.redundancy(),
+            min_redundancy: options.min_redundancy,
+        });
+    }
     let report = FitReport {
         method,
         n: data.rows.len(),
@@ -140,6 +182,7 @@ pub fn fit(
         effects: effect_report,
         compensation,
         auto,
+        warnings,
     };
     Ok((model, report))
 }

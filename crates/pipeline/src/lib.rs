@@ -43,7 +43,7 @@ pub use compensation::{
 };
 pub use error::Error;
 pub use eval_report::EvalReport;
-pub use fit::{Evaluation, FitReport, evaluate, fit, tool_indices};
+pub use fit::{Evaluation, FitReport, FitWarning, evaluate, fit, tool_indices};
 pub use fit_options::{EffectOptions, FitOptions};
 pub use inverse::{InverseOptions, PoseTarget, Solved, TargetStatus, solve_targets};
 pub use joint_targets::{
