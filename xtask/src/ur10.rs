@@ -6,8 +6,8 @@
 //! rows, timed; then the verdict's effect fitted with the geometry on the same rows (`calib fit
 //! --effects …`, the list `pipeline::effects::effects_of` makes of the verdict's selected effects)
 //! and evaluated on the test rows, against the diagnosis's cross-validated prediction. Writes
-//! `ur10.md` (unless `--diagnosis-only`), `ur10-diagnosis.md` and the report folder
-//! `ur10-diagnosis/` (series C) into `--out`.
+//! `ur10.md` into `--out` (with `--diagnosis-only`, only its section from `## Diagnosis` on is
+//! replaced, the methods table kept) and the report folder `ur10-diagnosis/` (the first series).
 
 use crate::convert_ur10::{Dataset, read_series};
 use anyhow::{Context, Result};
@@ -18,6 +18,9 @@ use pipeline::{CompensationOptions, FitOptions, MeasurementSet, Method, Residual
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::time::Instant;
+
+/// The heading of the diagnosis section of `ur10.md`; `--diagnosis-only` replaces the file from it on.
+const DIAGNOSIS_HEADING: &str = "## Diagnosis";
 
 /// How the rows of a series are split into training and test rows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -36,13 +39,14 @@ pub struct Args {
     /// Robot description.
     #[arg(long, default_value = "fixtures/robots/ur10.ron")]
     robot: PathBuf,
-    /// Where `ur10.md`, `ur10-diagnosis.md` and `ur10-diagnosis/` go.
+    /// Where `ur10.md` and `ur10-diagnosis/` go.
     #[arg(long, default_value = "docs/results")]
     out: PathBuf,
     /// How training and test rows are split.
     #[arg(long, value_enum, default_value = "even-odd")]
     split: Split,
-    /// Only the diagnosis part (the methods table takes minutes of GP fits).
+    /// Only the diagnosis part: replaces the `## Diagnosis` section of `ur10.md`, keeping its
+    /// methods table (which takes minutes of GP fits).
     #[arg(long)]
     diagnosis_only: bool,
     /// The series the diagnosis part runs on (comma separated).
@@ -140,7 +144,7 @@ fn methods(args: &Args, robot: &RobotDescription) -> Result<String> {
          network approach for increasing the absolute accuracy of industrial robots*, CASE 2021; MIT licence; not part of \
          this repository): a UR10 measured with a Leica laser tracker and a T-Mac at random poses, no payload variation. \
          {} ({} training poses, {} test poses). Orientation from the tracker's rx, ry, rz as R = Rx Ry Rz. Produced by \
-         `cargo xtask ur10`; the diagnosis: [ur10-diagnosis.md](ur10-diagnosis.md).\n",
+         `cargo xtask ur10`; the diagnosis: below.\n",
         args.dataset.series,
         split_name(args.split),
         sizes.0,
@@ -177,7 +181,28 @@ struct Checked {
     seconds: Vec<f64>,
     effects: String,
     poe_test_mm: f64,
-    effect_test_mm: Option<f64>,
+    effect_test_mm: Option<Fitted>,
+}
+
+/// The verdict's effect fitted on the training rows, evaluated on the test rows: all of them, and
+/// those whose every joint angle lies within (and outside) the range of the training rows' angles
+/// (a periodic series of high order is determined only where the training rows are).
+struct Fitted {
+    all_mm: f64,
+    inside: (usize, Option<f64>),
+    outside: (usize, Option<f64>),
+}
+
+/// The test rows whose joint angles all lie within the training rows' range on every joint, and
+/// the others.
+fn by_training_range(train: &MeasurementSet, test: &MeasurementSet) -> (Vec<usize>, Vec<usize>) {
+    let joints = train.rows.first().map_or(0, |r| r.q.len());
+    let range: Vec<(f64, f64)> = (0..joints)
+        .map(|j| {
+            train.rows.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| (lo.min(r.q[j]), hi.max(r.q[j])))
+        })
+        .collect();
+    (0..test.rows.len()).partition(|&i| test.rows[i].q.iter().zip(&range).all(|(q, (lo, hi))| (lo..=hi).contains(&q)))
 }
 
 fn check_series(args: &Args, robot: &RobotDescription, series: &str) -> Result<Checked> {
@@ -203,7 +228,18 @@ fn check_series(args: &Args, robot: &RobotDescription, series: &str) -> Result<C
         let mut options = FitOptions::default();
         options.effects.selection = EffectSelection::List(specs);
         let (model, _) = pipeline::fit(robot, &train, Method::Poe, &options)?;
-        Some(pipeline::evaluate(&model, &test)?.summary.mean_position_error_mm)
+        let (inside, outside) = by_training_range(&train, &test);
+        let mean = |rows: &[usize]| -> Result<Option<f64>> {
+            if rows.is_empty() {
+                return Ok(None);
+            }
+            Ok(Some(pipeline::evaluate(&model, &test.subset(rows))?.summary.mean_position_error_mm))
+        };
+        Some(Fitted {
+            all_mm: pipeline::evaluate(&model, &test)?.summary.mean_position_error_mm,
+            inside: (inside.len(), mean(&inside)?),
+            outside: (outside.len(), mean(&outside)?),
+        })
     };
     Ok(Checked {
         series: series.to_owned(),
@@ -219,15 +255,20 @@ fn check_series(args: &Args, robot: &RobotDescription, series: &str) -> Result<C
 
 fn diagnosis_section(args: &Args, checked: &[Checked]) -> String {
     let mut md = String::new();
-    let _ = writeln!(md, "# The real UR10: the diagnosis, and its prediction tested\n");
+    let _ = writeln!(md, "{DIAGNOSIS_HEADING}: the verdict, and its prediction tested\n");
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     let _ = writeln!(
         md,
         "Series {} of the IPA UR10 data set (see [ur10.md](ur10.md)), position only, {}. Produced by `cargo xtask ur10 \
          --diagnosis-only` (release build, {} threads; load average when it ran: {}). \"predicted\" is the diagnosis's \
          cross-validated held-out error with the verdict's effect, on the training rows alone; \"fitted, test rows\" is \
-         that effect identified with the geometry on the training rows (`calib fit --method poe --effects …`) and \
-         evaluated on the test rows. Diagnose time: median of {} runs.\n",
+         that effect identified with the geometry on the training rows and evaluated on the test rows. Diagnose time: \
+         median of {} runs (wall clock, `pipeline::diagnose` alone, data already read). The same by hand, for series C \
+         (`/work/data` holds the converted CSVs, see `cargo xtask convert-ur10`):\n\n```sh\n\
+         calib diagnose --robot fixtures/robots/ur10.ron --data ur10_C_even.csv\n\
+         calib fit --robot fixtures/robots/ur10.ron --data ur10_C_even.csv --method poe --effects LIST --out m.ron\n\
+         calib eval --model m.ron --data ur10_C_odd.csv\n```\n\nwith LIST the verdict's effects as listed below \
+         for each series.\n",
         args.diagnose_series.join(", "),
         split_name(args.split),
         rayon::current_num_threads(),
@@ -252,13 +293,35 @@ fn diagnosis_section(args: &Args, checked: &[Checked]) -> String {
             d.heldout_before_mm,
             d.heldout_after_mm,
             c.poe_test_mm,
-            c.effect_test_mm.map_or("–".into(), |v| format!("{v:.4}")),
-            c.effect_test_mm.map_or("–".into(), |v| format!("{:.3}", v / d.heldout_after_mm)),
+            c.effect_test_mm.as_ref().map_or("–".into(), |v| format!("{:.4}", v.all_mm)),
+            c.effect_test_mm.as_ref().map_or("–".into(), |v| format!("{:.3}", v.all_mm / d.heldout_after_mm)),
             c.seconds[c.seconds.len() / 2]
         );
     }
+    let _ = writeln!(
+        md,
+        "\nThe fitted effect on the test rows whose every joint angle lies within the training rows' range, and on \
+         the others (where a series of high order extrapolates):\n"
+    );
+    let _ =
+        writeln!(md, "| series | test rows inside | fitted, inside (mm) | test rows outside | fitted, outside (mm) |");
+    let _ = writeln!(md, "| --- | ---: | ---: | ---: | ---: |");
+    let value = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{v:.4}"));
     for c in checked {
-        let _ = writeln!(md, "\n## Series {}\n", c.series);
+        if let Some(f) = &c.effect_test_mm {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} |",
+                c.series,
+                f.inside.0,
+                value(f.inside.1),
+                f.outside.0,
+                value(f.outside.1)
+            );
+        }
+    }
+    for c in checked {
+        let _ = writeln!(md, "\n### Series {}\n", c.series);
         if !c.effects.is_empty() {
             let _ = writeln!(md, "Fitted: `--effects {}`.\n", c.effects);
         }
@@ -275,12 +338,8 @@ fn diagnosis_section(args: &Args, checked: &[Checked]) -> String {
 pub fn run(args: &Args) -> Result<()> {
     let robot = RobotDescription::read(&args.robot).with_context(|| args.robot.display().to_string())?;
     std::fs::create_dir_all(&args.out).with_context(|| args.out.display().to_string())?;
-    if !args.diagnosis_only {
-        let md = methods(args, &robot)?;
-        let path = args.out.join("ur10.md");
-        std::fs::write(&path, &md).with_context(|| path.display().to_string())?;
-        println!("{md}");
-    }
+    let methods_md = if args.diagnosis_only { String::new() } else { methods(args, &robot)? };
+    println!("{methods_md}");
     let progress = bar(args.diagnose_series.len());
     let mut checked = Vec::new();
     for series in &args.diagnose_series {
@@ -292,9 +351,16 @@ pub fn run(args: &Args) -> Result<()> {
     if let Some(first) = checked.first() {
         first.diagnosis.write_report(&args.out.join("ur10-diagnosis"))?;
     }
-    let md = diagnosis_section(args, &checked);
-    let path = args.out.join("ur10-diagnosis.md");
+    let section = diagnosis_section(args, &checked);
+    let path = args.out.join("ur10.md");
+    let methods_md = if args.diagnosis_only {
+        let old = std::fs::read_to_string(&path).with_context(|| path.display().to_string())?;
+        old.find(DIAGNOSIS_HEADING).map_or(old.clone(), |at| old[..at].to_owned())
+    } else {
+        methods_md
+    };
+    let md = format!("{}\n\n{section}", methods_md.trim_end());
     std::fs::write(&path, &md).with_context(|| path.display().to_string())?;
-    println!("{md}");
+    println!("{section}");
     Ok(())
 }
