@@ -55,6 +55,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     pipeline::write_compensated(&mut out, &file, &solved)?;
     out.flush()?;
     eprintln!("{}", file.set.read_summary());
+    for warning in model.extrapolation(&file.set.rows) {
+        eprintln!("warning: {warning}");
+    }
     let refused = summary.rows - summary.ok;
     let mut line = format!("compensated {} of {} targets", summary.ok, summary.rows);
     if refused > 0 {

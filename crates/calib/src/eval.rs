@@ -29,9 +29,13 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     if let Some((row, _)) = data.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
         return Err(crate::predict::non_finite(&args.model, &data.source, row.line).into());
     }
+    let report = EvalReport::new(&model, &data, &evaluation);
     if args.json {
-        println!("{}", serde_json::to_string(&EvalReport::new(&model, &data, &evaluation))?);
+        println!("{}", serde_json::to_string(&report)?);
         eprintln!("{}", data.read_summary());
+        for warning in &report.warnings {
+            eprintln!("warning: {warning}");
+        }
         return Ok(());
     }
     let s = &evaluation.summary;
@@ -43,6 +47,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     );
     if let (Some(mean), Some(max)) = (s.mean_rotation_error_mrad, s.max_rotation_error_mrad) {
         println!("  rotation error: mean {mean:.4} mrad, max {max:.4} mrad");
+    }
+    for warning in &report.warnings {
+        println!("  warning: {warning}");
     }
     Ok(())
 }

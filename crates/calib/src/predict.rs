@@ -32,6 +32,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(row) = data.rows.iter().zip(&predictions).find_map(|(row, p)| (!finite(p)).then_some(row)) {
         return Err(non_finite(&args.model, &data.source, row.line).into());
     }
+    for warning in model.extrapolation(&data.rows) {
+        eprintln!("warning: {warning}");
+    }
     let stdout = std::io::stdout();
     let mut out = csv::Writer::from_writer(stdout.lock());
     let gp = model.compensation.is_some();

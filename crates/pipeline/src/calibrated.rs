@@ -124,6 +124,75 @@ impl CalibratedModel {
     }
 }
 
+/// Rows at which an effect of the model is used outside the joint angles it was fitted on: there
+/// the model extrapolates, and its error on them is not what the fit measured.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ExtrapolationWarning {
+    /// The effect, as reports name it (`gear_periodic:1:48`).
+    pub effect: String,
+    /// The 1-based joint.
+    pub joint: usize,
+    /// The joint's smallest and largest angle on the training poses, rad.
+    pub fitted_range_rad: [f64; 2],
+    /// The gaps inside that range where no training pose was (wider than half the series'
+    /// shortest period), rad.
+    pub gaps_rad: Vec<[f64; 2]>,
+    /// How many of the rows put the joint outside that range or in a gap.
+    pub rows_outside: usize,
+    /// How many rows there are.
+    pub rows: usize,
+    /// The file line of the first of them.
+    pub first_line: u64,
+}
+
+impl std::fmt::Display for ExtrapolationWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let [low, high] = self.fitted_range_rad;
+        write!(
+            f,
+            "{} of {} rows (the first at line {}) put joint {} outside the angles its {} effect was fitted on \
+             ({:.4} … {:.4} rad{}): there the model extrapolates, and may be worse than without the effect",
+            self.rows_outside,
+            self.rows,
+            self.first_line,
+            self.joint,
+            self.effect,
+            low,
+            high,
+            match self.gaps_rad.len() {
+                0 => String::new(),
+                1 => ", less one gap".to_owned(),
+                k => format!(", less {k} gaps"),
+            }
+        )
+    }
+}
+
+impl CalibratedModel {
+    /// One warning per effect that `rows` use outside the joint angles it was fitted on.
+    pub fn extrapolation(&self, rows: &[Measurement]) -> Vec<ExtrapolationWarning> {
+        self.effects
+            .iter()
+            .filter_map(|effect| {
+                let gear = effect.angle_coverage()?;
+                let (joint, [low, high]) = (gear.joint, gear.fitted_range?);
+                let outside: Vec<&Measurement> =
+                    rows.iter().filter(|r| r.q.get(joint).is_some_and(|&q| !gear.covers(q))).collect();
+                let first = outside.first()?;
+                Some(ExtrapolationWarning {
+                    effect: effect.label(),
+                    joint: joint + 1,
+                    fitted_range_rad: [low, high],
+                    gaps_rad: gear.fitted_gaps.clone(),
+                    rows_outside: outside.len(),
+                    rows: rows.len(),
+                    first_line: first.line,
+                })
+            })
+            .collect()
+    }
+}
+
 /// The error of a prediction against a measured row.
 pub fn pose_error(predicted: &SE3, row: &Measurement) -> PoseError {
     PoseError {

@@ -2,7 +2,7 @@
 //! `mean_position_error_mm`, `rms_position_error_mm`, `max_position_error_mm`, and for
 //! full-pose data `mean_rotation_error_mrad`) and what identifies the run.
 
-use crate::{CalibratedModel, ErrorSummary, Evaluation, FileFormat, MeasurementSet, Method};
+use crate::{CalibratedModel, ErrorSummary, Evaluation, ExtrapolationWarning, FileFormat, MeasurementSet, Method};
 use serde::Serialize;
 
 /// The evaluation of a model on one measurement file.
@@ -21,6 +21,8 @@ pub struct EvalReport {
     pub errors: ErrorSummary,
     /// How the measurement file was written.
     pub format: FileFormat,
+    /// Effects used outside the joint angles they were fitted on.
+    pub warnings: Vec<ExtrapolationWarning>,
 }
 
 impl EvalReport {
@@ -33,6 +35,7 @@ impl EvalReport {
             full_pose: data.full_pose,
             errors: evaluation.summary,
             format: data.format.clone(),
+            warnings: model.extrapolation(&data.rows),
         }
     }
 }

@@ -36,7 +36,7 @@ mod urdf_like;
 mod xml_outline;
 
 pub use base_frame::{NominalTolerance, axis_changes, check_nominal, in_base_frame, tracker_from_base};
-pub use calibrated::{CalibratedModel, PredictedPose, pose_error};
+pub use calibrated::{CalibratedModel, ExtrapolationWarning, PredictedPose, pose_error};
 pub use compensation::{
     Compensation, CompensationOptions, CompensationReport, GpChoice, GpFitReport, GpModel, ResidualFrame, ResidualSet,
     UnknownGpChoice,

@@ -266,3 +266,35 @@ fn a_model_is_its_parts_applied_in_order_and_export_reports_each_one() {
         assert!(part.error.mean_position_error_mm > training.model.mean_position_error_mm, "{part:?}");
     }
 }
+
+/// Rows of `all` whose joint 2 satisfies `keep`.
+fn rows_where(all: &MeasurementSet, keep: impl Fn(f64) -> bool) -> MeasurementSet {
+    let rows: Vec<usize> = (0..all.rows.len()).filter(|&i| keep(all.rows[i].q[1])).collect();
+    all.subset(&rows)
+}
+
+#[test]
+fn a_gear_series_warns_where_it_is_used_outside_the_angles_it_was_fitted_on() {
+    let robot = irb4400();
+    let cell = simulated_cell(&robot, &Perturbation::default(), 47).unwrap();
+    let config = GeneratorConfig { sample_count: 900, seed: 47, ..GeneratorConfig::default() };
+    let all = simulate(&cell, &Effects::default(), &joint_ranges(&robot), &config, false).unwrap();
+    // Trained on joint 2 in -0.6 … -0.15 and 0.15 … 0.6 rad: a 0.3 rad gap, wider than half the
+    // shortest period of order 24 (π/24 = 0.13 rad).
+    let trained = |q: f64| (0.15..=0.6).contains(&q.abs());
+    let train = rows_where(&all, trained);
+    let options = FitOptions::default().with_effects("gear_periodic:2:24".parse().unwrap());
+    let (model, _) = pipeline::fit(&robot, &train, Method::Poe, &options).unwrap();
+    assert!(model.extrapolation(&train.rows).is_empty());
+    let beyond = rows_where(&all, |q| q.abs() > 0.65);
+    let gap = rows_where(&all, |q| q.abs() < 0.1);
+    for (set, what) in [(&beyond, "beyond the range"), (&gap, "in the gap")] {
+        assert!(!set.rows.is_empty(), "{what}: no rows");
+        let warnings = model.extrapolation(&set.rows);
+        assert_eq!(warnings.len(), 1, "{what}: {warnings:?}");
+        assert_eq!((warnings[0].joint, warnings[0].rows_outside), (2, set.rows.len()), "{what}");
+        assert_eq!(warnings[0].gaps_rad.len(), 1, "{what}: {:?}", warnings[0].gaps_rad);
+        let report = pipeline::EvalReport::new(&model, set, &pipeline::evaluate(&model, set).unwrap());
+        assert_eq!(report.warnings, warnings, "{what}: eval --json carries them");
+    }
+}

@@ -22,6 +22,7 @@ pub(crate) enum FaultKind {
     Index { index: usize, limit: usize },
     NotFinite { value: f64 },
     Value { value: f64, limit: f64 },
+    Order { low: f64, high: f64 },
 }
 
 impl EffectFault {
@@ -36,6 +37,12 @@ impl EffectFault {
             FaultKind::Index { index, limit } => Error::ModelIndex { file, line, column, field, index, limit },
             FaultKind::NotFinite { value } => Error::NotFinite { file, line, column, field, value },
             FaultKind::Value { value, limit } => Error::ModelValue { file, line, column, field, value, limit },
+            FaultKind::Order { low, high } => Error::RonFormat {
+                file,
+                line,
+                column,
+                message: format!("{field} is [{low}, {high}]: its first value must not exceed its second"),
+            },
         }
     }
 }
@@ -134,10 +141,12 @@ impl Cursor<'_> {
                     }
                 }
             }
-            IdentifiedEffect::GearPeriodic(_) => {
+            IdentifiedEffect::GearPeriodic(g) => {
                 add("joint", 1);
                 add("orders", 1);
                 add("scale", 1);
+                add("fitted_range", usize::from(g.fitted_range.is_some()));
+                add("fitted_gaps", usize::from(!g.fitted_gaps.is_empty()));
             }
             IdentifiedEffect::Backlash(b) => {
                 add("joint", 1);
@@ -257,6 +266,20 @@ pub(crate) fn check_effects(
                 cursor.count("scale", g.scale.len(), 2 * g.orders.len())?;
                 cursor.count("theta", g.theta.len(), 2 * g.orders.len())?;
                 cursor.finite("scale", &g.scale, true)?;
+                if let Some([low, high]) = g.fitted_range {
+                    cursor.finite("fitted_range", &[low, high], false)?;
+                    if low > high {
+                        let kind = FaultKind::Order { low, high };
+                        return Err(cursor.fault("fitted_range", 0, "fitted_range".into(), kind));
+                    }
+                }
+                for (k, &[a, b]) in g.fitted_gaps.iter().enumerate() {
+                    cursor.finite("fitted_gaps", &[a, b], false)?;
+                    if a > b {
+                        let kind = FaultKind::Order { low: a, high: b };
+                        return Err(cursor.fault("fitted_gaps", 0, format!("fitted_gaps[{k}]"), kind));
+                    }
+                }
             }
             IdentifiedEffect::Backlash(b) => {
                 cursor.backlash(b, n, tools)?;

@@ -183,6 +183,15 @@ impl IdentifiedEffect {
         }
     }
 
+    /// The gear series of an effect known only near the angles it was fitted on (see
+    /// [`GearPeriodic::covers`]); `None` for other effects.
+    pub fn angle_coverage(&self) -> Option<&GearPeriodic> {
+        match self {
+            IdentifiedEffect::GearPeriodic(e) if e.fitted_range.is_some() => Some(e),
+            _ => None,
+        }
+    }
+
     /// The 1-based joints the effect acts on (empty for thermal growth and drift).
     pub fn joints(&self) -> Vec<usize> {
         match self {
