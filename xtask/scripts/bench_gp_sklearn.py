@@ -5,8 +5,9 @@ Usage: bench_gp_sklearn.py REQUEST.json RESPONSE.json
 
 The request (written by xtask/src/bench_gp_sklearn.rs) holds the training inputs and outputs, the
 test inputs and the kernel's options; the response holds the fit and predict times (seconds), the
-peak resident memory of this process and its workers (bytes) and the predicted means at the test
-inputs. The caller applies the time limit (it kills this process).
+peak resident memory of this process and its workers (bytes), the predicted means at the test
+inputs, and per GP the fitted kernel and its log marginal likelihood (of the normalised outputs).
+The caller applies the time limit (it kills this process).
 
 Kernel, as a scikit-learn user writes it for this problem:
     C * RBF(length_scale=ones(d))  [ARD]  + C  [+ C * DotProduct(sigma_0=0)]  + WhiteKernel
@@ -42,7 +43,8 @@ def fit_predict(args):
     gpr.fit(xs, y)
     t = time.perf_counter()
     mean = gpr.predict(xq)
-    return mean.reshape(len(xq), -1), time.perf_counter() - t
+    fitted = {"kernel": str(gpr.kernel_), "lml": float(gpr.log_marginal_likelihood_value_)}
+    return mean.reshape(len(xq), -1), time.perf_counter() - t, fitted
 
 
 def peak_bytes():
@@ -68,8 +70,10 @@ def main():
             parts = pool.map(fit_predict, jobs)
         prediction = np.hstack([p[0] for p in parts])
         predict_s = sum(p[1] for p in parts)
+        fitted = [p[2] for p in parts]
     else:
-        prediction, predict_s = fit_predict((xs, y, xq, linear, restarts))
+        prediction, predict_s, one = fit_predict((xs, y, xq, linear, restarts))
+        fitted = [one]
     total = time.perf_counter() - t0
     with open(sys.argv[2], "w") as f:
         json.dump(
@@ -78,6 +82,7 @@ def main():
                 "predict_s": predict_s,
                 "peak_bytes": peak_bytes(),
                 "mean": prediction.tolist(),
+                "fitted": fitted,
             },
             f,
         )

@@ -41,6 +41,10 @@ pub struct Args {
     /// Compare the candidate kernels on real and simulated residuals instead.
     #[arg(long)]
     kernels: bool,
+    /// Write the residual sets of `--kernels`/`--compare` to this folder as CSV (`NAME.train.csv`,
+    /// `NAME.test.csv`: inputs, then outputs) instead, for other tools to read.
+    #[arg(long)]
+    dump_residuals: Option<PathBuf>,
     #[command(flatten)]
     kernel_args: crate::bench_gp_kernels::KernelArgs,
 }
@@ -278,6 +282,9 @@ pub fn run(args: &Args) -> Result<(), String> {
         let md = crate::bench_gp_compare::run(&args.kernel_args, std::time::Duration::from_secs(300))?;
         println!("{md}");
         return Ok(());
+    }
+    if let Some(dir) = &args.dump_residuals {
+        return crate::bench_gp_residuals::dump(&crate::bench_gp_kernels::data_sets(&args.kernel_args)?, dir);
     }
     if args.kernels {
         let md = crate::bench_gp_kernels::run(&args.kernel_args)?;

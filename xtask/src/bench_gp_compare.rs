@@ -35,6 +35,9 @@ pub fn run(args: &KernelArgs, timeout: Duration) -> Result<String, String> {
         let ours_s = t.elapsed().as_secs_f64();
         let mean = model.predict_mean(set.test.inputs.as_ref()).map_err(|e| e.to_string())?;
         let ours = heldout_mm(&mean, &set.test);
+        for c in &model.report().components {
+            eprintln!("  gp outputs {:?}: LML {:.3}, {:?}", c.outputs, c.log_marginal_likelihood, c.kernel);
+        }
         let mut cells = Vec::new();
         let mut fastest = f64::INFINITY;
         for linear in [false, true] {
@@ -46,6 +49,9 @@ pub fn run(args: &KernelArgs, timeout: Duration) -> Result<String, String> {
             };
             match result {
                 Some(r) => {
+                    for (k, (kernel, lml)) in r.fitted.iter().enumerate() {
+                        eprintln!("  sklearn (linear: {linear}) GP {k}: LML {lml:.3}, {kernel}");
+                    }
                     fastest = fastest.min(r.fit_s);
                     cells.push(format!(
                         "{:.4} | {:.1} ({:.0} MB)",

@@ -10,7 +10,7 @@ use gp::{ExactGp, KernelChoice, OutputMode, StationaryShape};
 use indicatif::{ProgressBar, ProgressStyle};
 use pipeline::{CompensationOptions, RobotDescription};
 
-use crate::bench_gp_residuals::{Residuals, heldout_mm, real, simulated};
+use crate::bench_gp_residuals::{Residuals, heldout_mm, real, simulated, simulated_payload_runs};
 
 /// Where the data are.
 #[derive(Debug, Clone, clap::Args)]
@@ -19,9 +19,23 @@ pub struct KernelArgs {
     /// `cargo xtask convert-ur10`); real data are skipped when it does not exist.
     #[arg(long, default_value = "../shared/data/ipa-ur10")]
     pub ur10_data: PathBuf,
-    /// Seeds of the simulated sets.
+    /// Seeds of the simulated sets (IRB 4400, a payload drawn per pose; 300 poses to train on, the
+    /// next 1000 to test).
     #[arg(long, value_delimiter = ',', default_value = "1,2,3")]
     pub seeds: Vec<u64>,
+    /// Seeds of the simulated 7-axis payload-run sets (iiwa 7, joints 1 and 2 moving, four payload
+    /// runs with a tool each; 300 poses to train on, 1000 to test, interleaved).
+    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    pub payload_run_seeds: Vec<u64>,
+    /// Only the sets whose name contains one of these (case-sensitive); all when empty.
+    #[arg(long, value_delimiter = ',')]
+    pub only: Vec<String>,
+}
+
+impl KernelArgs {
+    fn wanted(&self, name: &str) -> bool {
+        self.only.is_empty() || self.only.iter().any(|o| name.contains(o.as_str()))
+    }
 }
 
 /// The candidates, by name.
@@ -53,23 +67,38 @@ pub fn candidates() -> Vec<(&'static str, KernelChoice, OutputMode)> {
 /// Every data set this machine has.
 pub fn data_sets(args: &KernelArgs) -> Result<Vec<Residuals>, String> {
     let mut sets = Vec::new();
-    let ur10_path = PathBuf::from("fixtures/robots/ur10.ron");
+    let robot =
+        |file: &str| RobotDescription::read(&PathBuf::from("fixtures/robots").join(file)).map_err(|e| e.to_string());
     if args.ur10_data.join("ur10_C_even.csv").exists() {
-        let ur10 = RobotDescription::read(&ur10_path).map_err(|e| e.to_string())?;
+        let ur10 = robot("ur10.ron")?;
         let d = &args.ur10_data;
-        sets.push(real("UR10 C even → odd", &ur10, &d.join("ur10_C_even.csv"), Some(&d.join("ur10_C_odd.csv")))?);
+        let name = "UR10 C even → odd";
+        if args.wanted(name) {
+            sets.push(real(name, &ur10, &d.join("ur10_C_even.csv"), Some(&d.join("ur10_C_odd.csv")))?);
+        }
         for series in ["B", "D"] {
             let file = d.join(format!("ur10_{series}.csv"));
-            if file.exists() {
-                sets.push(real(&format!("UR10 {series} even → odd"), &ur10, &file, None)?);
+            let name = format!("UR10 {series} even → odd");
+            if file.exists() && args.wanted(&name) {
+                sets.push(real(&name, &ur10, &file, None)?);
             }
         }
     } else {
         eprintln!("{}: no UR10 data, real sets skipped", args.ur10_data.display());
     }
-    let irb = RobotDescription::read(&PathBuf::from("fixtures/robots/irb4400.ron")).map_err(|e| e.to_string())?;
+    let irb = robot("irb4400.ron")?;
     for &seed in &args.seeds {
-        sets.push(simulated(&irb, seed, 300, 1000)?);
+        let set = simulated(&irb, seed, 300, 1000)?;
+        if args.wanted(&set.name) {
+            sets.push(set);
+        }
+    }
+    let iiwa = robot("iiwa7.ron")?;
+    for &seed in &args.payload_run_seeds {
+        let set = simulated_payload_runs(&iiwa, seed, 300, 1000)?;
+        if args.wanted(&set.name) {
+            sets.push(set);
+        }
     }
     Ok(sets)
 }

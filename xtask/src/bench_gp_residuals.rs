@@ -5,7 +5,9 @@
 use std::path::Path;
 
 use faer::Mat;
-use pipeline::simulated::{GeneratorConfig, Perturbation, Remount, paper_effects, simulate_campaign};
+use pipeline::simulated::{
+    GeneratorConfig, Perturbation, Remount, paper_effects, payload_run_campaign, simulate_campaign,
+};
 use pipeline::{FitOptions, MeasurementSet, Method, ReadOptions, ResidualFrame, ResidualSet, RobotDescription};
 
 /// Training and test residuals of one data set.
@@ -65,6 +67,35 @@ pub fn simulated(robot: &RobotDescription, seed: u64, train: usize, test: usize)
     residuals(format!("simulated {}, seed {seed}, {train} poses", robot.name), robot, &train_set, &test_set, true)
 }
 
+/// The shape of a real 7-axis campaign ([`payload_run_campaign`]: joints 1 and 2 moving, four
+/// payload runs with a tool each) with the paper's effects: `train + test` poses, every run in both
+/// sets (the training rows spread evenly over the campaign), so that no payload is seen only at
+/// test time.
+pub fn simulated_payload_runs(
+    robot: &RobotDescription,
+    seed: u64,
+    train: usize,
+    test: usize,
+) -> Result<Residuals, String> {
+    let total = train + test;
+    let config = payload_run_campaign(total, seed);
+    let (_, data) =
+        simulate_campaign(robot, &paper_effects(), &Perturbation::default(), &Remount::default(), &config, false)
+            .map_err(|e| e.to_string())?;
+    // Row i is a training row when ⌊(i + 1)·train/total⌋ > ⌊i·train/total⌋: `train` rows spread
+    // evenly over the campaign.
+    let is_train = |i: usize| (i + 1) * train / total > i * train / total;
+    let train_rows: Vec<usize> = (0..total).filter(|&i| is_train(i)).collect();
+    let test_rows: Vec<usize> = (0..total).filter(|&i| !is_train(i)).collect();
+    residuals(
+        format!("simulated {} payload runs, seed {seed}, {train} poses", robot.name),
+        robot,
+        &data.subset(&train_rows),
+        &data.subset(&test_rows),
+        true,
+    )
+}
+
 /// Mean position error (mm) after correcting the test residuals by the predicted means: the
 /// held-out error `calib eval` reports for position-only data.
 pub fn heldout_mm(mean: &Mat<f64>, test: &ResidualSet) -> f64 {
@@ -72,4 +103,31 @@ pub fn heldout_mm(mean: &Mat<f64>, test: &ResidualSet) -> f64 {
     let n = y.nrows();
     let total: f64 = (0..n).map(|i| (0..3).map(|c| (y[(i, c)] - mean[(i, c)]).powi(2)).sum::<f64>().sqrt()).sum();
     1e3 * total / n.max(1) as f64
+}
+
+/// Writes every set as `DIR/NAME.train.csv` and `DIR/NAME.test.csv` (name made file-safe): columns
+/// `x0 … x{d−1}`, then `y0 … y{m−1}`, full precision.
+pub fn dump(sets: &[Residuals], dir: &Path) -> Result<(), String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    for set in sets {
+        let stem: String = set.name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
+        for (part, r) in [("train", &set.train), ("test", &set.test)] {
+            let (d, m) = (r.inputs.ncols(), r.outputs.ncols());
+            let mut text =
+                (0..d).map(|j| format!("x{j}")).chain((0..m).map(|j| format!("y{j}"))).collect::<Vec<_>>().join(",");
+            text.push('\n');
+            for i in 0..r.inputs.nrows() {
+                let row: Vec<String> = (0..d)
+                    .map(|j| format!("{:e}", r.inputs[(i, j)]))
+                    .chain((0..m).map(|j| format!("{:e}", r.outputs[(i, j)])))
+                    .collect();
+                text.push_str(&row.join(","));
+                text.push('\n');
+            }
+            let path = dir.join(format!("{stem}.{part}.csv"));
+            std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+            eprintln!("{}", path.display());
+        }
+    }
+    Ok(())
 }

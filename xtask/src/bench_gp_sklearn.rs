@@ -32,6 +32,9 @@ pub struct SklearnResult {
     pub peak_bytes: f64,
     /// Predicted means at the test inputs.
     pub mean: Mat<f64>,
+    /// Per GP (one per output, or one for all): the fitted kernel as scikit-learn prints it and its
+    /// log marginal likelihood of the normalised outputs.
+    pub fitted: Vec<(String, f64)>,
 }
 
 /// `true` when `python3 -c "import sklearn"` works.
@@ -103,5 +106,13 @@ pub fn fit_predict(
             mean[(i, j)] = r[j].as_f64().ok_or("scikit-learn mean is not a number")?;
         }
     }
-    Ok(Some(SklearnResult { fit_s: num("fit_s")?, peak_bytes: num("peak_bytes")?, mean }))
+    let fitted = v["fitted"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .map(|f| (f["kernel"].as_str().unwrap_or("?").to_owned(), f["lml"].as_f64().unwrap_or(f64::NAN)))
+                .collect()
+        })
+        .unwrap_or_default();
+    Ok(Some(SklearnResult { fit_s: num("fit_s")?, peak_bytes: num("peak_bytes")?, mean, fitted }))
 }
