@@ -81,3 +81,28 @@ impl fmt::Display for Termination {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Termination;
+
+    /// Issue 15: a failed line search once set `converged = true`. Every way to stop says in
+    /// words what `converged()` says, and only the three criteria count as convergence.
+    #[test]
+    fn only_a_met_criterion_is_convergence_and_the_words_say_so() {
+        let all = [
+            (Termination::CostTolerance { relative_decrease: 1e-12 }, true),
+            (Termination::StepTolerance { step_norm: 1e-12 }, true),
+            (Termination::GradientTolerance { gradient_cosine: 1e-12 }, true),
+            (Termination::IterationLimit { iterations: 50 }, false),
+            (Termination::LineSearchFailed { gradient_cosine: 0.3 }, false),
+            (Termination::DampingLimit { damping: 1e16, gradient_cosine: 0.3 }, false),
+        ];
+        for (termination, converged) in all {
+            assert_eq!(termination.converged(), converged, "{termination}");
+            let words = termination.to_string();
+            let prefix = if converged { "converged: " } else { "NOT converged: " };
+            assert!(words.starts_with(prefix), "{words}");
+        }
+    }
+}
