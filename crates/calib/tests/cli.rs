@@ -308,7 +308,7 @@ fn a_model_whose_values_overflow_is_refused_at_its_field_not_printed() {
     std::fs::write(&broken, content).unwrap();
     for command in ["eval", "predict"] {
         let message = fails(&[command, "--model", &text(&broken), "--data", &text(&data)]);
-        let at = format!("{}:{line}:21: kinematics.joints[0] is 1.5e308, beyond the 1e3", text(&broken));
+        let at = format!("{}:{line}:21: kinematics.joints[0] is 1.5e308, beyond ±1e3", text(&broken));
         assert!(message.contains(&at), "{command}: {message}");
     }
 }

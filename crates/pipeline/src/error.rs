@@ -191,8 +191,8 @@ pub enum Error {
         /// The index must be below this.
         limit: usize,
     },
-    /// A model file with a finite value far outside what a calibrated model can hold (an edited or
-    /// corrupt file): left in, its products overflow and the model predicts NaN poses.
+    /// A robot or model file with a finite value far outside any robot cell (an edited or corrupt
+    /// file): left in, its products overflow and the model predicts NaN poses.
     ModelValue {
         /// The file.
         file: String,
@@ -514,7 +514,7 @@ impl fmt::Display for Error {
             }
             Error::ModelValue { file, line, column, field, value, limit } => write!(
                 f,
-                "{file}:{line}:{column}: {field} is {value:e}, beyond the {limit:e} a calibrated model can hold (an edited or corrupt file)"
+                "{file}:{line}:{column}: {field} is {value:e}, beyond ±{limit:e}: larger than any robot cell (an edited or corrupt file)"
             ),
             Error::MissingColumn { file, line, column, name } => {
                 write!(f, "{file}:{line}:{column}: missing required column '{name}'")

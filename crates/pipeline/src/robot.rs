@@ -186,6 +186,12 @@ impl RobotDescription {
             if !joint.axis.iter().chain(&joint.point).all(|v| v.is_finite()) {
                 return Err(at("axis", i, format!("joint {}: axis or point is not finite", i + 1)));
             }
+            let limit = crate::model_check::MAX_TRANSLATION_M;
+            if let Some(v) = joint.point.iter().find(|v| v.abs() > limit) {
+                let message =
+                    format!("joint {}: point coordinate {v:e} m is beyond ±{limit:e} m, larger than any robot", i + 1);
+                return Err(at("point", i, message));
+            }
             let (limits, field, index) = match joint.kind {
                 JointType::Revolute => (joint.limits_deg, "limits_deg", &mut deg_index),
                 JointType::Prismatic => (joint.limits_m, "limits_m", &mut m_index),

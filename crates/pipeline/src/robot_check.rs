@@ -10,9 +10,17 @@ use crate::{Error, RobotDescription};
 pub(crate) fn check_values(robot: &RobotDescription, text: &str, file: &str) -> Result<(), Error> {
     let not_finite = |field: &str, index: usize, name: String, value: f64| {
         let (line, column) = field_position(text, field, index);
-        Error::NotFinite { file: file.to_owned(), line, column, field: name, value }
+        let file = file.to_owned();
+        if value.is_finite() {
+            Error::ModelValue { file, line, column, field: name, value, limit: crate::model_check::MAX_TRANSLATION_M }
+        } else {
+            Error::NotFinite { file, line, column, field: name, value }
+        }
     };
-    let first_bad = |values: &[f64]| values.iter().copied().find(|v| !v.is_finite());
+    // Not finite, or beyond a kilometre (in m, m/s² or rad): larger than any robot, and its
+    // products overflow downstream (`model_check::MAX_TRANSLATION_M`).
+    let limit = crate::model_check::MAX_TRANSLATION_M;
+    let first_bad = |values: &[f64]| values.iter().copied().find(|v| !v.is_finite() || v.abs() > limit);
     let flange = &robot.flange;
     for (field, values) in [("position", flange.position), ("x_axis", flange.x_axis), ("z_axis", flange.z_axis)] {
         if let Some(value) = first_bad(&values) {

@@ -242,7 +242,7 @@ fn a_finite_but_absurd_translation_is_refused_at_its_field() {
     let edited = format!("{}1e308{}", &text[..at], &text[end..]);
     let (error, message) = refused(&edited);
     assert!(matches!(error, Error::ModelValue { ref field, .. } if field == "kinematics.joints[0]"), "{message}");
-    assert!(message.contains("1e308") && message.contains("a calibrated model can hold"), "{message}");
+    assert!(message.contains("1e308") && message.contains("larger than any robot cell"), "{message}");
 }
 
 #[test]
@@ -266,4 +266,15 @@ fn gp_training_data_that_overflow_its_weights_are_refused() {
     let edited = format!("{}1e308{}", &text[..first], &text[end..]);
     let (_, message) = refused(&edited);
     assert!(message.contains("compensation: part") && message.contains("gaussian_process"), "{message}");
+}
+
+#[test]
+fn an_absurd_effect_coefficient_is_refused_at_its_field() {
+    // Found by `cargo xtask fuzz` (seed 2026): theta = 1e308 of a term whose feature is 0 at the
+    // reference rows passed the walk, and predicted NaN on real rows.
+    let (mut model, _) = with_effects();
+    let Some(IdentifiedEffect::TimeDrift(drift)) = model.effects.get_mut(1) else { panic!("no drift") };
+    drift.theta[0] = -1e308;
+    let (error, message) = refused(&text_of(&model));
+    assert!(matches!(error, Error::ModelValue { ref field, .. } if field == "effects[1].theta[0]"), "{message}");
 }

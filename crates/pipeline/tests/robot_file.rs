@@ -203,3 +203,15 @@ fn a_balancer_out_of_range_is_refused_at_its_field() {
     assert_eq!((line, column), (14, 26), "{message}");
     assert!(message.contains("names joint 6 but the robot has 2 joints"), "{message}");
 }
+
+#[test]
+fn finite_but_absurd_geometry_is_refused_at_its_field() {
+    // Found by `cargo xtask fuzz` (seed 2026): a joint point of 1e308 m was read, and the forward
+    // kinematics overflowed to infinity.
+    let (line, column, message) = refuse(&GOOD.replace("point: (0.0, 0.0, 1.0)", "point: (0.0, 1e308, 1.0)"));
+    assert_eq!(line, 6, "{message}");
+    assert!(column > 1 && message.contains("joint 2: point coordinate 1e308 m is beyond ±1e3 m"), "{message}");
+    let text = GOOD.replace("position: (1.0, 0.0, 1.0)", "position: (1.0, 0.0, 2e3)");
+    let error = RobotDescription::parse(&text, "robot.ron").unwrap_err();
+    assert!(matches!(error, Error::ModelValue { ref field, line: 8, .. } if field == "flange.position"), "{error}");
+}

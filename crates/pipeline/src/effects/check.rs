@@ -299,6 +299,13 @@ pub(crate) fn check_effects(
             }
         }
         cursor.finite("theta", effect.theta(), false)?;
+        // The features are scaled to RMS 1 on the training poses, so a coefficient is the effect's
+        // RMS size in rad or m: beyond a kilometre it is a corrupt file, not a robot.
+        let limit = crate::model_check::MAX_TRANSLATION_M;
+        if let Some(k) = effect.theta().iter().position(|v| v.abs() > limit) {
+            let kind = FaultKind::Value { value: effect.theta()[k], limit };
+            return Err(cursor.fault("theta", 0, format!("theta[{k}]"), kind));
+        }
         cursor.advance(effect);
     }
     Ok(())
