@@ -111,13 +111,17 @@ fn a_gp_method_without_a_gp_is_refused() {
     assert!(message.contains("method poe-gp-load but the model has no GP compensation"), "{message}");
 }
 
-#[test]
-fn a_non_finite_transform_is_refused_at_its_translation() {
+/// A fitted model's file with the first coordinate of its first translation set to `value`.
+fn first_translation_set_to(value: &str) -> String {
     let (_, text) = fitted(false);
     let at = text.find("translation: (").unwrap() + "translation: (".len();
     let end = at + text[at..].find(',').unwrap();
-    let edited = format!("{}NaN{}", &text[..at], &text[end..]);
-    let (error, message) = refused(&edited);
+    format!("{}{value}{}", &text[..at], &text[end..])
+}
+
+#[test]
+fn a_non_finite_transform_is_refused_at_its_translation() {
+    let (error, message) = refused(&first_translation_set_to("NaN"));
     assert!(matches!(error, Error::NotFinite { ref field, .. } if field == "kinematics.joints[0]"), "{message}");
 }
 
@@ -236,11 +240,7 @@ fn effect_values_that_do_not_match_their_features_are_refused_at_their_field() {
 #[test]
 fn a_finite_but_absurd_translation_is_refused_at_its_field() {
     // 1e308 is finite: before, it was read, and every prediction was NaN (cargo xtask fuzz).
-    let (_, text) = fitted(false);
-    let at = text.find("translation: (").unwrap() + "translation: (".len();
-    let end = at + text[at..].find(',').unwrap();
-    let edited = format!("{}1e308{}", &text[..at], &text[end..]);
-    let (error, message) = refused(&edited);
+    let (error, message) = refused(&first_translation_set_to("1e308"));
     assert!(matches!(error, Error::ModelValue { ref field, .. } if field == "kinematics.joints[0]"), "{message}");
     assert!(message.contains("1e308") && message.contains("larger than any robot cell"), "{message}");
 }
