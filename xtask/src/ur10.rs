@@ -22,6 +22,19 @@ use std::time::Instant;
 /// The heading of the diagnosis section of `ur10.md`; `--diagnosis-only` replaces the file from it on.
 const DIAGNOSIS_HEADING: &str = "## Diagnosis";
 
+/// CPU time this process has used so far (all threads, user and system), s: fields 14 and 15 of
+/// `/proc/self/stat`, in clock ticks of 1/100 s (Linux's USER_HZ on every architecture it
+/// exports to user space); NaN where that file cannot be read.
+fn process_cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else { return f64::NAN };
+    // The command name (field 2) is in parentheses and may hold spaces: count from after it.
+    let Some(after) = stat.rfind(')').map(|at| &stat[at + 1..]) else { return f64::NAN };
+    let fields: Vec<&str> = after.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i).and_then(|f| f.parse::<f64>().ok()).unwrap_or(f64::NAN);
+    // After the name, field 3 is at index 0: utime (14) at 11, stime (15) at 12.
+    (ticks(11) + ticks(12)) / 100.0
+}
+
 /// How the rows of a series are split into training and test rows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Split {
@@ -179,6 +192,8 @@ struct Checked {
     test: usize,
     diagnosis: Diagnosis,
     seconds: Vec<f64>,
+    /// CPU seconds (every thread, user and system) of each timed run, sorted.
+    cpu_seconds: Vec<f64>,
     effects: String,
     poe_test_mm: f64,
     effect_test_mm: Option<Fitted>,
@@ -209,14 +224,18 @@ fn check_series(args: &Args, robot: &RobotDescription, series: &str) -> Result<C
     let set = read_series(&args.dataset.input, series, false).map_err(anyhow::Error::msg)?;
     let (train, test) = split(&set, args.split);
     let mut seconds = Vec::new();
+    let mut cpu_seconds = Vec::new();
     let mut diagnosis = None;
     for _ in 0..args.repeats.max(1) {
+        let cpu = process_cpu_seconds();
         let start = Instant::now();
         diagnosis = Some(diagnose(robot, &train, &DiagnoseOptions::default())?);
         seconds.push(start.elapsed().as_secs_f64());
+        cpu_seconds.push(process_cpu_seconds() - cpu);
     }
     let diagnosis = diagnosis.context("no diagnosis ran")?;
     seconds.sort_by(f64::total_cmp);
+    cpu_seconds.sort_by(f64::total_cmp);
     let (poe, _) = pipeline::fit(robot, &train, Method::Poe, &FitOptions::default())?;
     let poe_test_mm = pipeline::evaluate(&poe, &test)?.summary.mean_position_error_mm;
     let verdict: Vec<_> = diagnosis.selected.iter().filter(|s| s.effect == diagnosis.verdict.effect).cloned().collect();
@@ -247,6 +266,7 @@ fn check_series(args: &Args, robot: &RobotDescription, series: &str) -> Result<C
         test: test.rows.len(),
         diagnosis,
         seconds,
+        cpu_seconds,
         effects,
         poe_test_mm,
         effect_test_mm,
@@ -263,7 +283,8 @@ fn diagnosis_section(args: &Args, checked: &[Checked]) -> String {
          --diagnosis-only` (release build, {} threads; load average when it ran: {}). \"predicted\" is the diagnosis's \
          cross-validated held-out error with the verdict's effect, on the training rows alone; \"fitted, test rows\" is \
          that effect identified with the geometry on the training rows and evaluated on the test rows. Diagnose time: \
-         median of {} runs (wall clock, `pipeline::diagnose` alone, data already read). The same by hand, for series C \
+         median of {} runs (wall clock, `pipeline::diagnose` alone, data already read); CPU: the CPU time it used on \
+         all threads (about the wall clock on one idle core; rayon's idle threads spin briefly, which adds a little). The same by hand, for series C \
          (`/work/data` holds the converted CSVs, see `cargo xtask convert-ur10`):\n\n```sh\n\
          calib diagnose --robot fixtures/robots/ur10.ron --data ur10_C_even.csv\n\
          calib fit --robot fixtures/robots/ur10.ron --data ur10_C_even.csv --method poe --effects LIST --out m.ron\n\
@@ -277,15 +298,15 @@ fn diagnosis_section(args: &Args, checked: &[Checked]) -> String {
     );
     let _ = writeln!(
         md,
-        "| series | train / test poses | verdict | joints | held out before (mm) | predicted (mm) | `poe`, test rows (mm) | fitted, test rows (mm) | fitted / predicted | diagnose (s) |"
+        "| series | train / test poses | verdict | joints | held out before (mm) | predicted (mm) | `poe`, test rows (mm) | fitted, test rows (mm) | fitted / predicted | diagnose (s) | CPU (s) |"
     );
-    let _ = writeln!(md, "| --- | ---: | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |");
+    let _ = writeln!(md, "| --- | ---: | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
     for c in checked {
         let d = &c.diagnosis;
         let joints = d.verdict.joints.iter().map(usize::to_string).collect::<Vec<_>>().join(", ");
         let _ = writeln!(
             md,
-            "| {} | {} / {} | {} | {joints} | {:.4} | {:.4} | {:.4} | {} | {} | {:.2} |",
+            "| {} | {} / {} | {} | {joints} | {:.4} | {:.4} | {:.4} | {} | {} | {:.2} | {:.2} |",
             c.series,
             c.train,
             c.test,
@@ -295,7 +316,8 @@ fn diagnosis_section(args: &Args, checked: &[Checked]) -> String {
             c.poe_test_mm,
             c.effect_test_mm.as_ref().map_or("–".into(), |v| format!("{:.4}", v.all_mm)),
             c.effect_test_mm.as_ref().map_or("–".into(), |v| format!("{:.3}", v.all_mm / d.heldout_after_mm)),
-            c.seconds[c.seconds.len() / 2]
+            c.seconds[c.seconds.len() / 2],
+            c.cpu_seconds[c.cpu_seconds.len() / 2]
         );
     }
     let _ = writeln!(

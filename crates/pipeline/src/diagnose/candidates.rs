@@ -17,6 +17,7 @@ use crate::effects::{
 };
 use crate::{Error, MeasurementSet, RobotDescription};
 use poe::LocalPoe;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// An effect a verdict can name (the SPEC's `verdict.effect`).
@@ -94,6 +95,12 @@ pub(crate) struct SideSource {
     pub load: LoadFrame,
 }
 
+/// One candidate before it is numbered: the effect, its columns, its prior, its series orders.
+type Built = (IdentifiedEffect, Vec<Vec<f64>>, Option<f64>, Option<Vec<u32>>);
+/// One joint's candidates, and where among them its gravity-regressor compliance is (with its
+/// terms), for the learnt backlash side.
+type JointCandidates = (Vec<Built>, Option<(usize, Vec<ComplianceTerm>)>);
+
 /// The weighted columns of an effect's regressor at every measurement.
 pub(crate) fn columns_of(
     design: &Design,
@@ -151,46 +158,63 @@ pub(crate) fn build_candidates(
         candidates.len() - 1
     };
     let longest = settings.orders.iter().copied().max().unwrap_or(1);
-    for j in 0..n {
-        // Compliance: δq_j = c_j τ_j, τ_j = Y_j(q) π + payload torque, π unknown: one column per
-        // entry of Y's row j (the products c_j π_l), and one for the payload (c_j itself).
-        let gravity = ComplianceTorque::GravityRegressor(load.clone());
-        let compliance = JointCompliance::new(gravity, &[j], &data.rows, &tools)?;
-        let terms = compliance.terms.clone();
-        let compliance = IdentifiedEffect::JointCompliance(compliance);
-        let compliance_columns = columns(&compliance)?;
-        // Backlash: δq_j = b_j sign(τ_j), the sign from the robot's mass model or a stand-in.
-        let stated = TorqueSign::Stated { load: load.clone(), dynamics: dynamics.clone() };
-        let stated = IdentifiedEffect::Backlash(Backlash::new(j, stated, &data.rows, &tools)?);
-        let stated_columns = columns(&stated)?;
-        if nonzero(&stated_columns) {
-            push(stated, stated_columns, None, None);
-        }
-        if !compliance_columns.is_empty() {
-            let index = push(compliance, compliance_columns, None, None);
-            // A balancer or an unknown mass moves the torque's zero: the side is also learnt.
-            sides.push(SideSource { joint: j, compliance: index, terms, load: load.clone() });
-        }
-        if measured {
-            // Measured torques (SPEC `tauN_nm`): δq_j = c_j τ_j with τ_j the measured torque as
-            // the gravity regressors explain it (the sensor's noise left out, as the fit does),
-            // and the band's side from the measured torque's sign.
-            let compliance = JointCompliance::modelled(load.clone(), &[j], &data.rows, &tools)?;
-            if !compliance.terms.is_empty() {
-                let effect = IdentifiedEffect::JointCompliance(compliance);
-                let effect_columns = columns(&effect)?;
-                push(effect, effect_columns, None, None);
+    // Each joint's candidates are independent: built in parallel, then numbered in joint order,
+    // so the candidate list (and everything after it) is the same on any number of threads.
+    let per_joint: Vec<JointCandidates> = (0..n)
+        .into_par_iter()
+        .map(|j| -> Result<JointCandidates, Error> {
+            let mut built: Vec<Built> = Vec::new();
+            let mut side = None;
+            // Compliance: δq_j = c_j τ_j, τ_j = Y_j(q) π + payload torque, π unknown: one column per
+            // entry of Y's row j (the products c_j π_l), and one for the payload (c_j itself).
+            let gravity = ComplianceTorque::GravityRegressor(load.clone());
+            let compliance = JointCompliance::new(gravity, &[j], &data.rows, &tools)?;
+            let terms = compliance.terms.clone();
+            let compliance = IdentifiedEffect::JointCompliance(compliance);
+            let compliance_columns = columns(&compliance)?;
+            // Backlash: δq_j = b_j sign(τ_j), the sign from the robot's mass model or a stand-in.
+            let stated = TorqueSign::Stated { load: load.clone(), dynamics: dynamics.clone() };
+            let stated = IdentifiedEffect::Backlash(Backlash::new(j, stated, &data.rows, &tools)?);
+            let stated_columns = columns(&stated)?;
+            if nonzero(&stated_columns) {
+                built.push((stated, stated_columns, None, None));
             }
-            let backlash = IdentifiedEffect::Backlash(Backlash::new(j, TorqueSign::Measured, &data.rows, &tools)?);
-            let backlash_columns = columns(&backlash)?;
-            if nonzero(&backlash_columns) {
-                push(backlash, backlash_columns, None, None);
+            if !compliance_columns.is_empty() {
+                // A balancer or an unknown mass moves the torque's zero: the side is also learnt.
+                side = Some((built.len(), terms));
+                built.push((compliance, compliance_columns, None, None));
             }
-        }
-        if settings.moving.contains(&j) {
-            let gear = IdentifiedEffect::GearPeriodic(GearPeriodic::new(j, (1..=longest).collect(), &data.rows)?);
-            let gear_columns = columns(&gear)?;
-            push(gear, gear_columns, Some(settings.series_sd), Some(settings.orders.to_vec()));
+            if measured {
+                // Measured torques (SPEC `tauN_nm`): δq_j = c_j τ_j with τ_j the measured torque as
+                // the gravity regressors explain it (the sensor's noise left out, as the fit does),
+                // and the band's side from the measured torque's sign.
+                let compliance = JointCompliance::modelled(load.clone(), &[j], &data.rows, &tools)?;
+                if !compliance.terms.is_empty() {
+                    let effect = IdentifiedEffect::JointCompliance(compliance);
+                    let effect_columns = columns(&effect)?;
+                    built.push((effect, effect_columns, None, None));
+                }
+                let backlash = IdentifiedEffect::Backlash(Backlash::new(j, TorqueSign::Measured, &data.rows, &tools)?);
+                let backlash_columns = columns(&backlash)?;
+                if nonzero(&backlash_columns) {
+                    built.push((backlash, backlash_columns, None, None));
+                }
+            }
+            if settings.moving.contains(&j) {
+                let gear = IdentifiedEffect::GearPeriodic(GearPeriodic::new(j, (1..=longest).collect(), &data.rows)?);
+                let gear_columns = columns(&gear)?;
+                built.push((gear, gear_columns, Some(settings.series_sd), Some(settings.orders.to_vec())));
+            }
+            Ok((built, side))
+        })
+        .collect::<Result<_, _>>()?;
+    for (j, (built, side)) in per_joint.into_iter().enumerate() {
+        let indices: Vec<usize> = built
+            .into_iter()
+            .map(|(effect, columns, prior_sd, orders)| push(effect, columns, prior_sd, orders))
+            .collect();
+        if let Some((at, terms)) = side {
+            sides.push(SideSource { joint: j, compliance: indices[at], terms, load: load.clone() });
         }
     }
     if let Some(temps) = data.rows.iter().map(|r| r.temp_c).collect::<Option<Vec<f64>>>() {

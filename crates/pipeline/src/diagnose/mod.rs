@@ -376,9 +376,13 @@ pub fn diagnose(
         structure::residual_structure(residuals, &link1, data, &moving, &fold, folds, &options.structure)
     };
     let (gp_before, gp_after) = if options.structure.enabled {
-        let before = structure(&selection.baseline.residuals)?;
-        let after = if selection.steps.is_empty() { None } else { Some(structure(&all_selected.residuals)?) };
-        (Some(before), after)
+        // The two are independent (each deterministic): run side by side, so that their ten fold
+        // fits share the threads.
+        let (before, after) = rayon::join(
+            || structure(&selection.baseline.residuals),
+            || (!selection.steps.is_empty()).then(|| structure(&all_selected.residuals)).transpose(),
+        );
+        (Some(before?), after?)
     } else {
         (None, None)
     };

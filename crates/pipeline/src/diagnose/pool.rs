@@ -20,6 +20,10 @@ use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_uppe
 use faer::{Accum, Mat, Par, Side};
 use lie::Vector6;
 use poe::LocalPoe;
+use rayon::prelude::*;
+
+/// One fold's weighted rows `X_f`, targets `y_f`, Gram matrix `X_fᵀ X_f` and `X_fᵀ y_f`.
+type FoldProducts = (Mat<f64>, Vec<f64>, Mat<f64>, Vec<f64>);
 
 /// The prior standard deviation of each column's parameter.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -197,23 +201,31 @@ impl Pool {
         for (i, &f) in fold.iter().enumerate() {
             fold_poses[f].push(i);
         }
+        // One fold per task, each product sequential: the sums run in the same order on any number
+        // of threads, so the pool (and the diagnosis) is the same serial or parallel.
+        let per_fold: Vec<FoldProducts> = fold_poses
+            .par_iter()
+            .map(|poses_f| {
+                let rows_f: Vec<usize> = poses_f.iter().flat_map(|&i| (0..k).map(move |r| i * k + r)).collect();
+                let xf = Mat::<f64>::from_fn(rows_f.len(), columns, |r, c| value(rows_f[r], c));
+                let yf: Vec<f64> = rows_f.iter().map(|&r| design.y[r]).collect();
+                let ym = Mat::<f64>::from_fn(rows_f.len(), 1, |r, _| yf[r]);
+                let mut g = Mat::<f64>::zeros(columns, columns);
+                matmul(g.as_mut(), Accum::Replace, xf.transpose(), xf.as_ref(), 1.0, Par::Seq);
+                let mut b = Mat::<f64>::zeros(columns, 1);
+                matmul(b.as_mut(), Accum::Replace, xf.transpose(), ym.as_ref(), 1.0, Par::Seq);
+                (xf, yf, g, (0..columns).map(|c| b[(c, 0)]).collect::<Vec<f64>>())
+            })
+            .collect();
         let mut x = Vec::with_capacity(folds);
         let mut y = Vec::with_capacity(folds);
         let mut fold_gram = Vec::with_capacity(folds);
         let mut fold_xty = Vec::with_capacity(folds);
-        for poses_f in &fold_poses {
-            let rows_f: Vec<usize> = poses_f.iter().flat_map(|&i| (0..k).map(move |r| i * k + r)).collect();
-            let xf = Mat::<f64>::from_fn(rows_f.len(), columns, |r, c| value(rows_f[r], c));
-            let yf: Vec<f64> = rows_f.iter().map(|&r| design.y[r]).collect();
-            let ym = Mat::<f64>::from_fn(rows_f.len(), 1, |r, _| yf[r]);
-            let mut g = Mat::<f64>::zeros(columns, columns);
-            matmul(g.as_mut(), Accum::Replace, xf.transpose(), xf.as_ref(), 1.0, Par::rayon(0));
-            let mut b = Mat::<f64>::zeros(columns, 1);
-            matmul(b.as_mut(), Accum::Replace, xf.transpose(), ym.as_ref(), 1.0, Par::Seq);
-            fold_gram.push(g);
-            fold_xty.push((0..columns).map(|c| b[(c, 0)]).collect::<Vec<f64>>());
+        for (xf, yf, g, b) in per_fold {
             x.push(xf);
             y.push(yf);
+            fold_gram.push(g);
+            fold_xty.push(b);
         }
         let mut gram_all = Mat::<f64>::zeros(columns, columns);
         let mut xty_all = vec![0.0; columns];
