@@ -41,6 +41,36 @@ fn fit_and_prediction_are_bit_identical_serial_and_parallel() {
     }
 }
 
+/// The calibration's configuration (restarts searched on a warm-start subset, then the full data
+/// from the subset's best), fitted serially, on a one-thread rayon pool and on a four-thread pool:
+/// the same report and predictions to the last bit.
+#[test]
+fn warm_started_fit_is_bit_identical_on_any_pool() {
+    let (x, y) = data(5, 150, 4, 3);
+    let (xq, _) = data(6, 25, 4, 1);
+    let composite = KernelChoice::Composite { shape: StationaryShape::Matern52, constant: true, linear: true };
+    for kernel in [KernelChoice::SquaredExponentialArd, composite] {
+        let optimiser = OptimiserConfig { restarts: 2, warm_start_rows: 60, ..OptimiserConfig::default() };
+        let fit = |parallelism| {
+            let config = GpConfig { kernel, parallelism, optimiser: optimiser.clone(), ..GpConfig::default() };
+            let model = ExactGp::fit(x.as_ref(), y.as_ref(), &config).expect("fit");
+            let p = model.predict(xq.as_ref()).expect("predict");
+            (model.report().clone(), bits(&p.mean), bits(&p.variance))
+        };
+        let pool = |threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
+        let serial = fit(Parallelism::Sequential);
+        let one = pool(1).install(|| fit(Parallelism::Rayon));
+        let four = pool(4).install(|| fit(Parallelism::Rayon));
+        let search = serial.0.components[0].optimisation.as_ref().expect("optimised");
+        assert_eq!(search.warm_start_rows, 60, "{kernel:?}: the warm start was not used");
+        for (name, other) in [("one-thread pool", &one), ("four-thread pool", &four)] {
+            assert_eq!(serial.0, other.0, "{kernel:?}, {name}: reports differ");
+            assert_eq!(serial.1, other.1, "{kernel:?}, {name}: means differ");
+            assert_eq!(serial.2, other.2, "{kernel:?}, {name}: variances differ");
+        }
+    }
+}
+
 #[test]
 fn restarts_are_seeded_and_the_best_start_is_kept() {
     let (x, y) = data(3, 80, 3, 1);
