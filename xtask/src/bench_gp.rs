@@ -45,8 +45,40 @@ pub struct Args {
     /// `NAME.test.csv`: inputs, then outputs) instead, for other tools to read.
     #[arg(long)]
     dump_residuals: Option<PathBuf>,
+    /// Time one log marginal likelihood with its gradient at this n (SE-ARD, one output) against
+    /// the n³-flop floor measured with faer's matrix product at the same n, instead.
+    #[arg(long)]
+    lml_floor: Option<usize>,
     #[command(flatten)]
     kernel_args: crate::bench_gp_kernels::KernelArgs,
+}
+
+/// One LML + gradient evaluation at `n` (best of three) against the time faer's own n × n matrix
+/// product takes for n³ flops (half of its 2n³), both on the rayon pool and serially.
+fn lml_floor(n: usize) -> Result<String, String> {
+    let d = data(n, 2024);
+    let kernel = Kernel::start(KernelChoice::SquaredExponentialArd, DIM);
+    let y = Mat::from_fn(n, 1, |i, _| d.y[(i, 0)]);
+    let mut md = String::new();
+    md.push_str(&format!(
+        "| n = {n} | one LML + gradient (s) | n³ flops at faer's matmul rate (s) | ratio |\n|---|---:|---:|---:|\n"
+    ));
+    for (name, parallelism, par) in
+        [("rayon", Parallelism::Rayon, Par::rayon(0)), ("serial", Parallelism::Sequential, Par::Seq)]
+    {
+        let mut failed = None;
+        let t = best_of(3, || {
+            if let Err(e) = gp::log_marginal_likelihood(&kernel, d.x.as_ref(), y.as_ref(), true, parallelism) {
+                failed = Some(e.to_string());
+            }
+        });
+        if let Some(e) = failed {
+            return Err(format!("LML at n = {n}: {e}"));
+        }
+        let floor = (n as f64).powi(3) / (peak_gflops(n, par) * 1e9);
+        md.push_str(&format!("| {name} | {t:.3} | {floor:.3} | {:.2}× |\n", t / floor));
+    }
+    Ok(md)
 }
 
 const DIM: usize = 7;
@@ -285,6 +317,10 @@ pub fn run(args: &Args) -> Result<(), String> {
     }
     if let Some(dir) = &args.dump_residuals {
         return crate::bench_gp_residuals::dump(&crate::bench_gp_kernels::data_sets(&args.kernel_args)?, dir);
+    }
+    if let Some(n) = args.lml_floor {
+        println!("{}", lml_floor(n)?);
+        return Ok(());
     }
     if args.kernels {
         let md = crate::bench_gp_kernels::run(&args.kernel_args)?;
