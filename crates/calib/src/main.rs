@@ -33,6 +33,10 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // faer's high-level operations (products, SVD, Cholesky) split their work by the global
+    // thread count, so their last bits change with it; parallelism comes from our own rayon loops,
+    // which write disjoint results in a fixed order. Results are then the same on 1 or 64 threads.
+    faer::set_global_parallelism(faer::Par::Seq);
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
