@@ -251,15 +251,21 @@ mod tests {
         .unwrap()
     }
 
+    /// A pose and a point measured near the prediction of `model` (a small left nudge), as at
+    /// convergence, where Gauss–Newton's first-order columns are exact.
+    fn near_prediction(model: &LocalPoe) -> Vec<Observation> {
+        let nudge = Twist::new(Vector3::new(2e-4, -1e-4, 5e-5), Vector3::new(3e-4, 1e-4, 2e-4)).exp();
+        let pose = nudge * model.forward(&[0.4, -0.7], 0).unwrap();
+        vec![
+            Observation { q: vec![0.4, -0.7], tool: 0, target: Target::Pose(pose) },
+            Observation { q: vec![-1.0, 0.2], tool: 0, target: Target::Point(pose.translation()) },
+        ]
+    }
+
     #[test]
     fn kinematic_columns_under_a_correction_match_finite_differences_of_the_residual() {
         let model = two_joint_arm();
-        let nudge = Twist::new(Vector3::new(2e-4, -1e-4, 5e-5), Vector3::new(3e-4, 1e-4, 2e-4)).exp();
-        let pose = nudge * model.forward(&[0.4, -0.7], 0).unwrap();
-        let observations = vec![
-            Observation { q: vec![0.4, -0.7], tool: 0, target: Target::Pose(pose) },
-            Observation { q: vec![-1.0, 0.2], tool: 0, target: Target::Point(pose.translation()) },
-        ];
+        let observations = near_prediction(&model);
         let options = IdentificationOptions::default();
         // A correction of a few mrad, so that leaving it out of the kinematic columns would show.
         let theta = [4e-3, -3e-3, 2e-3];
@@ -289,21 +295,8 @@ mod tests {
 
     #[test]
     fn correction_columns_match_finite_differences_of_the_residual() {
-        let axis =
-            |d: [f64; 3], p: [f64; 3]| JointAxis { kind: JointKind::Revolute, direction: d.into(), point: p.into() };
-        let model = LocalPoe::from_zero_configuration(
-            &[axis([0.0, 0.0, 1.0], [0.0, 0.0, 0.0]), axis([0.0, 1.0, 0.0], [0.3, 0.0, 0.5])],
-            SE3::from_translation(Vector3::new(0.8, 0.1, 0.6)),
-        )
-        .unwrap();
-        // Measured near the prediction, as at convergence, where Gauss–Newton's first-order
-        // columns are exact.
-        let nudge = Twist::new(Vector3::new(2e-4, -1e-4, 5e-5), Vector3::new(3e-4, 1e-4, 2e-4)).exp();
-        let pose = nudge * model.forward(&[0.4, -0.7], 0).unwrap();
-        let observations = vec![
-            Observation { q: vec![0.4, -0.7], tool: 0, target: Target::Pose(pose) },
-            Observation { q: vec![-1.0, 0.2], tool: 0, target: Target::Point(pose.translation()) },
-        ];
+        let model = two_joint_arm();
+        let observations = near_prediction(&model);
         let options = IdentificationOptions::default();
         let theta = [2e-3, -1e-3];
         let corrected = Some(Corrected { correction: &Fixed, theta: &theta });
