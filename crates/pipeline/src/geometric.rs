@@ -3,7 +3,7 @@
 use crate::{Error, MeasurementSet};
 use lie::SE3;
 use poe::LocalPoe;
-use poe::identify::{IdentificationOptions, IdentificationReport, Observation, ParameterMask, Scope, Target};
+use poe::identify::{IdentificationOptions, IdentificationReport, Observation, Scope, Target};
 
 /// The measurements as identification observations (SI units, tracker frame).
 pub fn observations(data: &MeasurementSet) -> Vec<Observation> {
@@ -41,17 +41,8 @@ pub fn fit_geometry(
     options: &IdentificationOptions,
 ) -> Result<GeometricFit, Error> {
     let observations = observations(data);
-    // The "before": the nominal model at its best base and tool placement (the base-tool fit),
-    // not the closed-form registration that starts it, which can be metres off where the flange
-    // orientations vary little (UR10 series B: 24 m against 0.87 mm for the base-tool fit).
-    let base_tool = poe::identify::calibrate(nominal, &observations, Scope::BaseTool, options)?;
-    let registered = base_tool.model.clone();
-    let identification = match scope {
-        Scope::BaseTool => base_tool,
-        Scope::Full => {
-            let mask = ParameterMask::all(base_tool.model.layout());
-            poe::identify::identify(&base_tool.model, &observations, &mask, options)?
-        }
-    };
+    // The "before" is the nominal model at its base-tool fit, not the closed-form registration
+    // that starts it (UR10 series B: 24 m off against 0.87 mm).
+    let (registered, identification) = poe::identify::calibrate_placed(nominal, &observations, scope, options)?;
     Ok(GeometricFit { model: identification.model, registered, report: identification.report })
 }

@@ -41,16 +41,30 @@ pub fn calibrate(
     scope: Scope,
     options: &IdentificationOptions,
 ) -> Result<Identification, Error> {
+    calibrate_placed(nominal, observations, scope, options).map(|(_, fit)| fit)
+}
+
+/// [`calibrate`], also returning the base-tool stage's model: the nominal model at its best base
+/// and tool placement, the fair "before" of a calibration (the closed-form registration that
+/// starts it can be far off where the flange orientations vary little).
+pub fn calibrate_placed(
+    nominal: &LocalPoe,
+    observations: &[Observation],
+    scope: Scope,
+    options: &IdentificationOptions,
+) -> Result<(LocalPoe, Identification), Error> {
     let registered = register(nominal, observations)?;
     let base_tool_mask = ParameterMask::base_tool(registered.layout());
     let base_tool = identify(&registered, observations, &base_tool_mask, options)?;
-    match scope {
-        Scope::BaseTool => Ok(base_tool),
+    let placed = base_tool.model.clone();
+    let fit = match scope {
+        Scope::BaseTool => base_tool,
         Scope::Full => {
             let mask = ParameterMask::all(base_tool.model.layout());
-            identify(&base_tool.model, observations, &mask, options)
+            identify(&base_tool.model, observations, &mask, options)?
         }
-    }
+    };
+    Ok((placed, fit))
 }
 
 /// Error statistics of a model on observations (no identification).
