@@ -30,6 +30,10 @@ pub struct KernelArgs {
     /// Only the sets whose name contains one of these (case-sensitive); all when empty.
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
+    /// With `--kernels`: only the candidate kernels whose name is one of these exactly; all when
+    /// empty.
+    #[arg(long, value_delimiter = ';')]
+    pub kernel_names: Vec<String>,
 }
 
 impl KernelArgs {
@@ -41,7 +45,8 @@ impl KernelArgs {
 /// The candidates, by name.
 pub fn candidates() -> Vec<(&'static str, KernelChoice, OutputMode)> {
     use StationaryShape::{Matern52, SquaredExponential};
-    let composite = |shape, constant, linear| KernelChoice::Composite { shape, constant, linear };
+    let composite = |shape, constant, linear| KernelChoice::Composite { shape, constant, linear, additive: false };
+    let additive = |shape, constant, linear| KernelChoice::Composite { shape, constant, linear, additive: true };
     vec![
         ("Eq. 5 (paper, isotropic)", KernelChoice::Quadratic, OutputMode::Shared),
         ("SE-ARD", KernelChoice::SquaredExponentialArd, OutputMode::Shared),
@@ -59,6 +64,22 @@ pub fn candidates() -> Vec<(&'static str, KernelChoice, OutputMode)> {
         (
             "Matérn52-ARD + const + linear-ARD, independent outputs",
             composite(Matern52, true, true),
+            OutputMode::Independent,
+        ),
+        ("SE-ARD + additive SE", additive(SquaredExponential, false, false), OutputMode::Shared),
+        (
+            "SE-ARD + additive SE, independent outputs",
+            additive(SquaredExponential, false, false),
+            OutputMode::Independent,
+        ),
+        (
+            "SE-ARD + const + linear-ARD + additive SE, independent outputs",
+            additive(SquaredExponential, true, true),
+            OutputMode::Independent,
+        ),
+        (
+            "Matérn52-ARD + additive Matérn52, independent outputs",
+            additive(Matern52, false, false),
             OutputMode::Independent,
         ),
     ]
@@ -106,7 +127,13 @@ pub fn data_sets(args: &KernelArgs) -> Result<Vec<Residuals>, String> {
 /// Runs every candidate on every set and returns the markdown table.
 pub fn run(args: &KernelArgs) -> Result<String, String> {
     let sets = data_sets(args)?;
-    let kernels = candidates();
+    let kernels: Vec<_> = candidates()
+        .into_iter()
+        .filter(|(name, ..)| args.kernel_names.is_empty() || args.kernel_names.iter().any(|k| k == name))
+        .collect();
+    if kernels.is_empty() {
+        return Err(format!("no candidate kernel is named {:?}", args.kernel_names));
+    }
     let bar = ProgressBar::new((sets.len() * kernels.len()) as u64);
     bar.set_style(
         ProgressStyle::with_template("kernels {msg} [{bar:30}] {pos}/{len} {elapsed}")

@@ -36,9 +36,16 @@ pub(crate) fn contract_cross(
     let mut h = Mat::zeros(m, c);
     matmul(h.as_mut(), Accum::Replace, zm, xm.transpose(), 1.0, par);
     let (shape, signal) = (kernel.shape, kernel.signal_variance);
-    // Per column j: Σᵢ Gᵢⱼ s(r²ᵢⱼ), Σᵢ Gᵢⱼ, Σᵢ Hᵢⱼ; H overwrites the inner products.
-    let column = |j: usize, col: faer::col::ColMut<'_, f64>| -> [f64; 3] {
-        let mut sums = [0.0; 3];
+    let additive = z
+        .additive
+        .as_ref()
+        .zip(x.additive.as_ref())
+        .map(|(az, ax)| (crate::additive::columns(az), crate::additive::columns(ax)));
+    let additive_dim = if additive.is_some() { kernel.additive_variances.len() } else { 0 };
+    // Per column j: Σᵢ Gᵢⱼ s(r²ᵢⱼ), Σᵢ Gᵢⱼ, Σᵢ Hᵢⱼ; H overwrites the inner products; then, with an
+    // additive term, for each input k, Σᵢ Gᵢⱼ aₖ s(rₖ²) and Σᵢ Gᵢⱼ mₖ rₖ².
+    let column = |j: usize, col: faer::col::ColMut<'_, f64>| -> Vec<f64> {
+        let mut sums = vec![0.0; 3 + 2 * additive_dim];
         let col = col.try_as_col_major_mut().expect("columns of an owned matrix are contiguous").as_slice_mut();
         for (i, v) in col.iter_mut().enumerate() {
             let r2 = if same && i == j { 0.0 } else { (sz[i] + sx[j] - 2.0 * *v).max(0.0) };
@@ -49,9 +56,15 @@ pub(crate) fn contract_cross(
             sums[1] += gij;
             sums[2] += *v;
         }
+        if let Some((az, ax)) = &additive {
+            let gj: Vec<f64> = (0..m).map(|i| g[(i, j)]).collect();
+            let term =
+                crate::additive::Additive { shape, variances: &kernel.additive_variances, columns: az, query: ax };
+            term.gradient_sums(&mut sums[3..], &gj, j, 0);
+        }
         sums
     };
-    let partial: Vec<[f64; 3]> = match parallelism {
+    let partial: Vec<Vec<f64>> = match parallelism {
         Parallelism::Sequential => h.col_iter_mut().enumerate().map(|(j, col)| column(j, col)).collect(),
         Parallelism::Rayon => h.par_col_iter_mut().enumerate().map(|(j, col)| column(j, col)).collect(),
     };
@@ -60,6 +73,10 @@ pub(crate) fn contract_cross(
     for p in &partial {
         out[Expanded::SIGNAL] += p[0];
         out[layout.constant()] += p[1];
+        for k in 0..additive_dim {
+            out[layout.additive_variance(k)] += p[3 + k];
+            out[layout.additive_length(k)] += p[3 + additive_dim + k];
+        }
     }
     out[layout.constant()] *= kernel.constant;
     // H 1 (rows) and H X (m × d).

@@ -187,10 +187,13 @@ pub(crate) fn evidence_lower_bound(
         for (a, b) in g.iter_mut().zip(&gc) {
             *a += b;
         }
-        // −(p / 2σ²) Σ ∂k_ii: k_ii = σf² + σc² + Σ_d l_id².
+        // −(p / 2σ²) Σ ∂k_ii: k_ii = σf² + σc² + Σ_d l_id² + Σ_d a_d.
         let scale = -pf / (2.0 * s);
         g[Expanded::SIGNAL] += scale * evaluator.signal_variance * r.len() as f64;
         g[layout.constant()] += scale * evaluator.constant * r.len() as f64;
+        for (k, a) in evaluator.additive_variances.iter().enumerate() {
+            g[layout.additive_variance(k)] += scale * a * r.len() as f64;
+        }
         if let Some(l) = &xc.linear {
             for i in 0..l.len() {
                 for (d, v) in l.row(i).iter().enumerate() {

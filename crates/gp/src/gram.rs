@@ -18,6 +18,7 @@ use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef};
 use rayon::prelude::*;
 
+use crate::additive;
 use crate::config::Parallelism;
 use crate::kernel::{Evaluator, Expanded, Prepared};
 use crate::points::Points;
@@ -79,9 +80,15 @@ pub(crate) fn fill_training_lower(
     let sq = squared_norms(&x.stationary);
     lower_inner_products(dst.rb_mut(), &x.stationary, par);
     let (shape, signal, constant) = (kernel.shape, kernel.signal_variance, kernel.constant);
+    let additive = x.additive.as_ref().map(additive::columns);
     for_each_column(dst.rb_mut(), par, |j, col| {
-        for (i, v) in slice_mut(col).iter_mut().enumerate().skip(j) {
+        let col = slice_mut(col);
+        for (i, v) in col.iter_mut().enumerate().skip(j) {
             *v = shape.value(signal, squared_distance(sq[i], sq[j], *v, i == j)) + constant;
+        }
+        if let Some(a) = &additive {
+            let term = additive::Additive { shape, variances: &kernel.additive_variances, columns: a, query: a };
+            term.add_column(&mut col[j..], j, j);
         }
     });
     if let Some(l) = &x.linear {
@@ -117,9 +124,16 @@ fn covariance(kernel: &Evaluator, x: &Prepared, z: &Prepared, same: bool, par: P
     let mut k = Mat::zeros(x.len(), z.len());
     matmul(k.as_mut(), Accum::Replace, as_matrix(&x.stationary), as_matrix(&z.stationary).transpose(), 1.0, par.faer());
     let (shape, signal, constant) = (kernel.shape, kernel.signal_variance, kernel.constant);
+    let additive =
+        x.additive.as_ref().zip(z.additive.as_ref()).map(|(ax, az)| (additive::columns(ax), additive::columns(az)));
     for_each_column(k.as_mut(), par, |j, col| {
-        for (i, v) in slice_mut(col).iter_mut().enumerate() {
+        let col = slice_mut(col);
+        for (i, v) in col.iter_mut().enumerate() {
             *v = shape.value(signal, squared_distance(sx[i], sz[j], *v, same && i == j)) + constant;
+        }
+        if let Some((ax, az)) = &additive {
+            let term = additive::Additive { shape, variances: &kernel.additive_variances, columns: ax, query: az };
+            term.add_column(col, j, 0);
         }
     });
     if let (Some(lx), Some(lz)) = (&x.linear, &z.linear) {
@@ -141,7 +155,7 @@ pub(crate) fn full_covariance(kernel: &Evaluator, z: &Prepared, par: Parallelism
 /// `k(z, z)` for every point, without noise.
 pub(crate) fn prior_variances(kernel: &Evaluator, z: &Prepared) -> Vec<f64> {
     let linear = z.linear.as_ref().map(squared_norms).unwrap_or_else(|| vec![0.0; z.len()]);
-    linear.into_iter().map(|l| kernel.signal_variance + kernel.constant + l).collect()
+    linear.into_iter().map(|l| kernel.prior_variance(l)).collect()
 }
 
 /// `sym(A) R` where only the lower triangle of `A` is meaningful: `tril(A) R + stril(A)ᵀ R`.
@@ -196,12 +210,15 @@ pub(crate) fn contract_gradient(
     lower_inner_products(scratch.rb_mut(), &x.stationary, par);
     let (shape, signal) = (kernel.shape, kernel.signal_variance);
     let scale = m as f64;
+    let additive = x.additive.as_ref().map(additive::columns);
+    let additive_dim = if additive.is_some() { kernel.additive_variances.len() } else { 0 };
     // Per column: Σ f Wᵢⱼ sᵢⱼ, Σ f Wᵢⱼ, ½ Wⱼⱼ, with f = ½ on the diagonal and 1 below it (each
-    // strict-lower entry stands for itself and its mirror).
-    let column = |j: usize, wc: ColMut<'_, f64>, mc: ColMut<'_, f64>| -> [f64; 3] {
+    // strict-lower entry stands for itself and its mirror); then, with an additive term, for each
+    // input k, Σ f Wᵢⱼ aₖ s(rₖ²) and Σ f Wᵢⱼ mₖ rₖ² (its variance's and its length scale's).
+    let column = |j: usize, wc: ColMut<'_, f64>, mc: ColMut<'_, f64>| -> Vec<f64> {
         let (wc, mc) = (slice_mut(wc), slice_mut(mc));
         let aj = &alpha_rows[j * m..(j + 1) * m];
-        let mut sums = [0.0; 3];
+        let mut sums = vec![0.0; 3 + 2 * additive_dim];
         for i in j..n {
             let ai = &alpha_rows[i * m..(i + 1) * m];
             let w = ai.iter().zip(aj).map(|(a, b)| a * b).sum::<f64>() - scale * wc[i];
@@ -214,9 +231,18 @@ pub(crate) fn contract_gradient(
             sums[1] += f * w;
         }
         sums[2] = 0.5 * wc[j];
+        if let Some(a) = &additive {
+            // Below the diagonal each entry stands for itself and its mirror; on it r = 0, so the
+            // length scales get nothing and each variance ½ Wⱼⱼ aₖ.
+            let term = additive::Additive { shape, variances: &kernel.additive_variances, columns: a, query: a };
+            term.gradient_sums(&mut sums[3..], &wc[j + 1..], j, j + 1);
+            for (k, v) in kernel.additive_variances.iter().enumerate() {
+                sums[3 + k] += 0.5 * wc[j] * v;
+            }
+        }
         sums
     };
-    let partial: Vec<[f64; 3]> = match par {
+    let partial: Vec<Vec<f64>> = match par {
         Parallelism::Sequential => inverse
             .rb_mut()
             .col_iter_mut()
@@ -232,7 +258,7 @@ pub(crate) fn contract_gradient(
             .map(|(j, (w, mc))| column(j, w, mc))
             .collect(),
     };
-    let mut total = [0.0; 3];
+    let mut total = vec![0.0; 3 + 2 * additive_dim];
     for p in &partial {
         for (t, v) in total.iter_mut().zip(p) {
             *t += v;
@@ -242,6 +268,10 @@ pub(crate) fn contract_gradient(
     g[Expanded::SIGNAL] = total[0];
     g[layout.constant()] = kernel.constant * total[1];
     g[layout.noise()] = kernel.noise_variance * total[2];
+    for k in 0..additive_dim {
+        g[layout.additive_variance(k)] = total[3 + k];
+        g[layout.additive_length(k)] = total[3 + additive_dim + k];
+    }
     // [M X | M 1] in one product.
     let p = &x.stationary;
     let x1 = Mat::from_fn(n, dim + 1, |i, d| if d < dim { p.row(i)[d] } else { 1.0 });

@@ -28,6 +28,7 @@
 //! ```
 #![deny(missing_docs)]
 
+mod additive;
 mod cholesky;
 mod config;
 mod cross_gradient;
@@ -52,7 +53,8 @@ pub use error::Error;
 pub use exact::{ComponentReport, ExactGp, FitReport};
 pub use inducing::InducingSelection;
 pub use kernel::{
-    Bounds, CompositeKernel, Kernel, KernelChoice, Matern52Ard, QuadraticKernel, SquaredExponentialArd, StationaryShape,
+    AdditiveTerm, Bounds, CompositeKernel, Kernel, KernelChoice, Matern52Ard, QuadraticKernel, SquaredExponentialArd,
+    StationaryShape,
 };
 pub use lml::{LogMarginalLikelihood, log_marginal_likelihood};
 pub use optimise::OptimisationReport;

@@ -55,10 +55,17 @@ pub(crate) struct Optimised {
     pub report: OptimisationReport,
 }
 
-/// The log-space starting points: `start` (projected into the box), then `config.restarts` draws,
-/// each uniform in the log box from its own ChaCha stream.
-fn starting_points(start: &[f64], lower: &[f64], upper: &[f64], config: &OptimiserConfig) -> Vec<Vec<f64>> {
-    let mut points = vec![start.iter().zip(lower).zip(upper).map(|((s, l), u)| s.clamp(*l, *u)).collect()];
+/// The log-space starting points: `start` and then `nested` (each projected into the box), then
+/// `config.restarts` draws, each uniform in the log box from its own ChaCha stream.
+fn starting_points(
+    start: &[f64],
+    nested: &[Vec<f64>],
+    lower: &[f64],
+    upper: &[f64],
+    config: &OptimiserConfig,
+) -> Vec<Vec<f64>> {
+    let project = |p: &Vec<f64>| p.iter().zip(lower).zip(upper).map(|((s, l), u)| s.clamp(*l, *u)).collect();
+    let mut points: Vec<Vec<f64>> = std::iter::once(&start.to_vec()).chain(nested).map(project).collect();
     for i in 1..=config.restarts {
         let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
         rng.set_stream(i as u64);
@@ -131,7 +138,8 @@ pub(crate) fn fit_hyperparameters(
     parallelism: Parallelism,
 ) -> Result<Optimised, Error> {
     let (lower, upper) = bounds.to_log(start)?;
-    let starts = starting_points(&start.log_parameters(), &lower, &upper, config);
+    let nested: Vec<Vec<f64>> = start.nested_starts().iter().map(Kernel::log_parameters).collect();
+    let starts = starting_points(&start.log_parameters(), &nested, &lower, &upper, config);
     let settings = Settings {
         memory: config.memory,
         max_iterations: config.max_iterations,

@@ -1,6 +1,6 @@
 //! Laws every covariance function obeys, on random parameters and points (proptest).
 
-use gp::{CompositeKernel, Kernel, Matern52Ard, QuadraticKernel, SquaredExponentialArd, StationaryShape};
+use gp::{AdditiveTerm, CompositeKernel, Kernel, Matern52Ard, QuadraticKernel, SquaredExponentialArd, StationaryShape};
 use proptest::prelude::*;
 
 const DIM: usize = 3;
@@ -30,15 +30,17 @@ fn kernel() -> impl Strategy<Value = Kernel> {
         prop::collection::vec(positive(), DIM),
         prop::option::of(positive()),
         prop::option::of(prop::collection::vec(positive(), DIM)),
+        prop::option::of((prop::collection::vec(positive(), DIM), prop::collection::vec(positive(), DIM))),
         positive(),
     )
-        .prop_map(|(shape, s, l, c, w, n)| {
+        .prop_map(|(shape, s, l, c, w, a, n)| {
             Kernel::Composite(CompositeKernel {
                 shape,
                 signal_variance: s,
                 length_scales: l,
                 constant: c,
                 linear_weights: w,
+                additive: a.map(|(variances, length_scales)| AdditiveTerm { variances, length_scales }),
                 noise_variance: n,
             })
         });

@@ -26,7 +26,8 @@ fn bits(m: &Mat<f64>) -> Vec<u64> {
 fn fit_and_prediction_are_bit_identical_serial_and_parallel() {
     let (x, y) = data(1, 120, 4, 3);
     let (xq, _) = data(2, 30, 4, 1);
-    let composite = KernelChoice::Composite { shape: StationaryShape::Matern52, constant: true, linear: true };
+    let composite =
+        KernelChoice::Composite { shape: StationaryShape::Matern52, constant: true, linear: true, additive: true };
     for kernel in [KernelChoice::Quadratic, KernelChoice::SquaredExponentialArd, KernelChoice::Matern52Ard, composite] {
         let mut results = Vec::new();
         for parallelism in [Parallelism::Sequential, Parallelism::Rayon] {
@@ -48,7 +49,8 @@ fn fit_and_prediction_are_bit_identical_serial_and_parallel() {
 fn warm_started_fit_is_bit_identical_on_any_pool() {
     let (x, y) = data(5, 150, 4, 3);
     let (xq, _) = data(6, 25, 4, 1);
-    let composite = KernelChoice::Composite { shape: StationaryShape::Matern52, constant: true, linear: true };
+    let composite =
+        KernelChoice::Composite { shape: StationaryShape::Matern52, constant: true, linear: true, additive: true };
     for kernel in [KernelChoice::SquaredExponentialArd, composite] {
         let optimiser = OptimiserConfig { restarts: 2, warm_start_rows: 60, ..OptimiserConfig::default() };
         let fit = |parallelism| {

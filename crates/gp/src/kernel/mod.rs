@@ -16,7 +16,7 @@ mod shape;
 mod squared_exponential;
 mod terms;
 
-pub use composite::CompositeKernel;
+pub use composite::{AdditiveTerm, CompositeKernel};
 pub use matern52::Matern52Ard;
 pub use quadratic::QuadraticKernel;
 pub use shape::StationaryShape;
@@ -46,6 +46,9 @@ pub enum KernelChoice {
         constant: bool,
         /// With an ARD linear term.
         linear: bool,
+        /// With a first-order additive term (one one-dimensional kernel per input).
+        #[serde(default)]
+        additive: bool,
     },
 }
 
@@ -90,8 +93,8 @@ impl Kernel {
                 Self::SquaredExponentialArd(SquaredExponentialArd::isotropic_start(dim))
             }
             KernelChoice::Matern52Ard => Self::Matern52Ard(Matern52Ard::isotropic_start(dim)),
-            KernelChoice::Composite { shape, constant, linear } => {
-                Self::Composite(CompositeKernel::start(shape, dim, constant, linear))
+            KernelChoice::Composite { shape, constant, linear, additive } => {
+                Self::Composite(CompositeKernel::start(shape, dim, constant, linear, additive))
             }
         }
     }
@@ -106,6 +109,7 @@ impl Kernel {
                 shape: k.shape,
                 constant: k.constant.is_some(),
                 linear: k.linear_weights.is_some(),
+                additive: k.additive.is_some(),
             },
         }
     }
@@ -152,6 +156,10 @@ impl Kernel {
                 p.extend_from_slice(&k.length_scales);
                 p.extend(k.constant);
                 p.extend(k.linear_weights.iter().flatten());
+                if let Some(a) = &k.additive {
+                    p.extend_from_slice(&a.variances);
+                    p.extend_from_slice(&a.length_scales);
+                }
                 p.push(k.noise_variance);
                 p
             }
@@ -194,17 +202,24 @@ impl Kernel {
             Self::Composite(k) => {
                 let d = k.length_scales.len();
                 let mut rest = &parameters[1 + d..n - 1];
-                let constant = k.constant.map(|_| {
-                    let c = rest[0];
-                    rest = &rest[1..];
-                    c
+                let mut take = |count: usize| {
+                    let (head, tail) = rest.split_at(count);
+                    rest = tail;
+                    head.to_vec()
+                };
+                let constant = k.constant.map(|_| take(1)[0]);
+                let linear_weights = k.linear_weights.as_ref().map(|w| take(w.len()));
+                let additive = k.additive.as_ref().map(|a| AdditiveTerm {
+                    variances: take(a.variances.len()),
+                    length_scales: take(a.length_scales.len()),
                 });
                 Self::Composite(CompositeKernel {
                     shape: k.shape,
                     signal_variance: parameters[0],
                     length_scales: parameters[1..1 + d].to_vec(),
                     constant,
-                    linear_weights: k.linear_weights.as_ref().map(|_| rest.to_vec()),
+                    linear_weights,
+                    additive,
                     noise_variance: parameters[n - 1],
                 })
             }
@@ -223,6 +238,13 @@ impl Kernel {
         {
             return Err(Error::InputDimensionMismatch { expected: length_scales.len(), found: w.len() });
         }
+        if let Self::Composite(CompositeKernel { additive: Some(a), length_scales, .. }) = self {
+            for found in [a.variances.len(), a.length_scales.len()] {
+                if found != length_scales.len() {
+                    return Err(Error::InputDimensionMismatch { expected: length_scales.len(), found });
+                }
+            }
+        }
         self.with_parameters(&self.parameters()).map(|_| ())
     }
 
@@ -237,6 +259,9 @@ impl Kernel {
         if let Self::Composite(k) = self {
             blocks.push((OFFSET_BOUNDS, usize::from(k.constant.is_some())));
             blocks.push((OFFSET_BOUNDS, k.linear_weights.as_ref().map_or(0, Vec::len)));
+            let additive = k.additive.as_ref().map_or(0, |a| a.variances.len());
+            blocks.push((OFFSET_BOUNDS, additive));
+            blocks.push((LENGTH_BOUNDS, additive));
         }
         blocks.push((NOISE_BOUNDS, 1));
         let expand = |pick: fn((f64, f64)) -> f64| {
@@ -245,12 +270,39 @@ impl Kernel {
         Bounds { lower: expand(|b| b.0), upper: expand(|b| b.1) }
     }
 
+    /// Further deterministic starts for a search from this kernel: the same kernel with its
+    /// optional extra terms nearly switched off, so that the search also follows the path of the
+    /// smaller model it contains and its optimum cannot end far below that model's.
+    ///
+    /// Only the additive term has one (its variances at [`AdditiveTerm::OFF_VARIANCE`]): on a
+    /// simulated 7-axis campaign (300 poses, payload runs) the search from the default start alone
+    /// ended at a log marginal likelihood of 96 for one output, where SE-ARD alone reaches 442.
+    pub(crate) fn nested_starts(&self) -> Vec<Kernel> {
+        match self {
+            Self::Composite(k) if k.additive.is_some() => {
+                let mut off = k.clone();
+                if let Some(a) = &mut off.additive {
+                    a.variances.iter_mut().for_each(|v| *v = AdditiveTerm::OFF_VARIANCE);
+                }
+                vec![Self::Composite(off)]
+            }
+            _ => Vec::new(),
+        }
+    }
+
     /// The expanded form of this kernel for `dim` inputs.
     pub(crate) fn terms(&self, dim: usize) -> Terms {
         let stationary = |shape, signal_variance, lengths: &[f64], noise_variance| Terms {
-            evaluator: Evaluator { shape, signal_variance, constant: 0.0, noise_variance },
+            evaluator: Evaluator {
+                shape,
+                signal_variance,
+                constant: 0.0,
+                additive_variances: Vec::new(),
+                noise_variance,
+            },
             inverse_length_scales: lengths.iter().map(|l| 1.0 / l).collect(),
             linear_roots: None,
+            additive_inverse_length_scales: None,
         };
         match self {
             Self::Quadratic(k) => Terms {
@@ -258,11 +310,13 @@ impl Kernel {
                     shape: StationaryShape::SquaredExponential,
                     signal_variance: k.theta0,
                     constant: k.theta2,
+                    additive_variances: Vec::new(),
                     noise_variance: k.noise_variance,
                 },
                 // θ1 = 1/ℓ² for every input, θ3 the weight of every input's slope.
                 inverse_length_scales: vec![k.theta1.sqrt(); dim],
                 linear_roots: Some(vec![k.theta3.sqrt(); dim]),
+                additive_inverse_length_scales: None,
             },
             Self::SquaredExponentialArd(k) => {
                 stationary(StationaryShape::SquaredExponential, k.signal_variance, &k.length_scales, k.noise_variance)
@@ -275,10 +329,15 @@ impl Kernel {
                     shape: k.shape,
                     signal_variance: k.signal_variance,
                     constant: k.constant.unwrap_or(0.0),
+                    additive_variances: k.additive.as_ref().map(|a| a.variances.clone()).unwrap_or_default(),
                     noise_variance: k.noise_variance,
                 },
                 inverse_length_scales: k.length_scales.iter().map(|l| 1.0 / l).collect(),
                 linear_roots: k.linear_weights.as_ref().map(|w| w.iter().map(|v| v.sqrt()).collect()),
+                additive_inverse_length_scales: k
+                    .additive
+                    .as_ref()
+                    .map(|a| a.length_scales.iter().map(|l| 1.0 / l).collect()),
             },
         }
     }
@@ -286,7 +345,8 @@ impl Kernel {
     /// The evaluator and `points` prepared for it.
     pub(crate) fn prepare(&self, points: &Points) -> (Evaluator, Prepared) {
         let terms = self.terms(points.dim());
-        (terms.evaluator, terms.prepare(points))
+        let prepared = terms.prepare(points);
+        (terms.evaluator, prepared)
     }
 
     /// The gradient in this kernel's log-parameters from the gradient in the expanded ones (chain
@@ -310,6 +370,10 @@ impl Kernel {
                 }
                 if k.linear_weights.is_some() {
                     g.extend((0..dim).map(|i| expanded[layout.linear(i)]));
+                }
+                if k.additive.is_some() {
+                    g.extend((0..dim).map(|i| expanded[layout.additive_variance(i)]));
+                    g.extend((0..dim).map(|i| expanded[layout.additive_length(i)]));
                 }
             }
         }

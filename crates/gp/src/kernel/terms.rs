@@ -1,29 +1,41 @@
 //! Every kernel of the crate as one sum of terms, for the inner loops:
-//! `σf² s(‖(x − x') ∘ ℓ⁻¹‖²) + σc² + Σᵢ wᵢ xᵢ x'ᵢ`, and the chain rule from the gradient in this
-//! expanded form back to each kernel's own log-parameters.
+//! `σf² s(‖(x − x') ∘ ℓ⁻¹‖²) + σc² + Σᵢ wᵢ xᵢ x'ᵢ + Σᵢ aᵢ s((xᵢ − x'ᵢ)²/bᵢ²)`, and the chain rule
+//! from the gradient in this expanded form back to each kernel's own log-parameters.
 //!
 //! The expanded log-parameters are, always in this order and whether or not the kernel has the
-//! term: `ln σf², ln ℓ₁ … ln ℓ_d, ln σc², ln w₁ … ln w_d, ln σn²` (`2d + 3` of them).
+//! term: `ln σf², ln ℓ₁ … ln ℓ_d, ln σc², ln w₁ … ln w_d, ln a₁ … ln a_d, ln b₁ … ln b_d, ln σn²`
+//! (`4d + 3` of them).
 
 use super::StationaryShape;
 use crate::points::Points;
 
 /// What the Gram-matrix loops need besides the prepared points.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub(crate) struct Evaluator {
     pub(crate) shape: StationaryShape,
     pub(crate) signal_variance: f64,
     /// `σc²`, 0 without a constant term.
     pub(crate) constant: f64,
+    /// `aᵢ` of the additive term, empty without one.
+    pub(crate) additive_variances: Vec<f64>,
     pub(crate) noise_variance: f64,
 }
 
-/// Inputs prepared for an [`Evaluator`]: divided by the length scales for the stationary term, and
-/// multiplied by `√wᵢ` for the linear term (so that it is a plain inner product).
+impl Evaluator {
+    /// `k(x, x)` without noise, given `Σᵢ wᵢ xᵢ²` of the linear term.
+    pub(crate) fn prior_variance(&self, linear: f64) -> f64 {
+        self.signal_variance + self.constant + linear + self.additive_variances.iter().sum::<f64>()
+    }
+}
+
+/// Inputs prepared for an [`Evaluator`]: divided by the length scales for the stationary term,
+/// multiplied by `√wᵢ` for the linear term (so that it is a plain inner product), and divided by
+/// the additive term's own length scales `bᵢ`.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Prepared {
     pub(crate) stationary: Points,
     pub(crate) linear: Option<Points>,
+    pub(crate) additive: Option<Points>,
 }
 
 impl Prepared {
@@ -33,7 +45,11 @@ impl Prepared {
 
     /// The points in `range`, in order.
     pub(crate) fn rows(&self, range: std::ops::Range<usize>) -> Self {
-        Self { stationary: self.stationary.rows(range.clone()), linear: self.linear.as_ref().map(|l| l.rows(range)) }
+        Self {
+            stationary: self.stationary.rows(range.clone()),
+            linear: self.linear.as_ref().map(|l| l.rows(range.clone())),
+            additive: self.additive.as_ref().map(|a| a.rows(range)),
+        }
     }
 }
 
@@ -44,6 +60,8 @@ pub(crate) struct Terms {
     pub(crate) inverse_length_scales: Vec<f64>,
     /// `√wᵢ`, `None` without a linear term.
     pub(crate) linear_roots: Option<Vec<f64>>,
+    /// `1/bᵢ` of the additive term, `None` without one.
+    pub(crate) additive_inverse_length_scales: Option<Vec<f64>>,
 }
 
 /// Index of each block in the expanded log-parameters for `dim` inputs.
@@ -63,11 +81,17 @@ impl Expanded {
     pub(crate) fn linear(self, i: usize) -> usize {
         2 + self.dim + i
     }
+    pub(crate) fn additive_variance(self, i: usize) -> usize {
+        2 + 2 * self.dim + i
+    }
+    pub(crate) fn additive_length(self, i: usize) -> usize {
+        2 + 3 * self.dim + i
+    }
     pub(crate) fn noise(self) -> usize {
-        2 + 2 * self.dim
+        2 + 4 * self.dim
     }
     pub(crate) fn len(self) -> usize {
-        3 + 2 * self.dim
+        3 + 4 * self.dim
     }
 }
 
@@ -77,6 +101,7 @@ impl Terms {
         Prepared {
             stationary: points.scaled_columns(&self.inverse_length_scales),
             linear: self.linear_roots.as_ref().map(|r| points.scaled_columns(r)),
+            additive: self.additive_inverse_length_scales.as_ref().map(|r| points.scaled_columns(r)),
         }
     }
 
@@ -101,7 +126,25 @@ impl Terms {
             for (i, v) in linear.iter().enumerate() {
                 g[layout.linear(i)] = *v;
             }
+            if let Some(inverse) = &self.additive_inverse_length_scales {
+                for (i, ((x, y), s)) in a.iter().zip(b).zip(inverse).enumerate() {
+                    let r2 = ((x - y) * s).powi(2);
+                    let (value, weight) = e.shape.value_and_weight(e.additive_variances[i], r2);
+                    g[layout.additive_variance(i)] = value;
+                    g[layout.additive_length(i)] = weight * r2;
+                }
+            }
         }
-        stationary + e.constant + linear.iter().sum::<f64>()
+        let additive: f64 = match &self.additive_inverse_length_scales {
+            Some(inverse) => a
+                .iter()
+                .zip(b)
+                .zip(inverse)
+                .zip(&e.additive_variances)
+                .map(|(((x, y), s), v)| e.shape.value(*v, ((x - y) * s).powi(2)))
+                .sum(),
+            None => 0.0,
+        };
+        stationary + e.constant + linear.iter().sum::<f64>() + additive
     }
 }

@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use faer::Mat;
-use gp::{CompositeKernel, Kernel, Matern52Ard, QuadraticKernel, SquaredExponentialArd, StationaryShape};
+use gp::{AdditiveTerm, CompositeKernel, Kernel, Matern52Ard, QuadraticKernel, SquaredExponentialArd, StationaryShape};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
@@ -22,13 +22,19 @@ pub fn random_kernels(rng: &mut ChaCha8Rng, d: usize) -> Vec<Kernel> {
     let mut p = || rng.random_range(0.3f64.ln()..3.0f64.ln()).exp();
     let mut composites = Vec::new();
     for shape in [StationaryShape::SquaredExponential, StationaryShape::Matern52] {
-        for (constant, linear) in [(true, true), (true, false), (false, true)] {
+        for (constant, linear, additive) in
+            [(true, true, false), (true, false, false), (false, true, false), (false, false, true), (true, true, true)]
+        {
             composites.push(Kernel::Composite(CompositeKernel {
                 shape,
                 signal_variance: p(),
                 length_scales: (0..d).map(|_| p()).collect(),
                 constant: constant.then(&mut p),
                 linear_weights: linear.then(|| (0..d).map(|_| p()).collect()),
+                additive: additive.then(|| AdditiveTerm {
+                    variances: (0..d).map(|_| p()).collect(),
+                    length_scales: (0..d).map(|_| p()).collect(),
+                }),
                 noise_variance: p(),
             }));
         }
