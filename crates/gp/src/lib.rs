@@ -56,7 +56,7 @@ pub use kernel::{
     AdditiveTerm, Bounds, CompositeKernel, Kernel, KernelChoice, Matern52Ard, QuadraticKernel, SquaredExponentialArd,
     StationaryShape,
 };
-pub use lml::{LogMarginalLikelihood, log_marginal_likelihood};
+pub use lml::{LmlWorkspace, LogMarginalLikelihood, log_marginal_likelihood};
 pub use optimise::OptimisationReport;
 pub use predict::{PredictOptions, Prediction};
 pub use scaling::{InputStandardiser, OutputNormaliser};

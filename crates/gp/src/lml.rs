@@ -34,6 +34,8 @@ pub struct LogMarginalLikelihood {
 /// (n × d), used as given: no standardisation, no jitter.
 ///
 /// Fails with [`Error::CholeskyFailed`] when `K + σn² I` is not numerically positive definite.
+/// Allocates the two `n × n` buffers of the evaluation; a caller that evaluates many times keeps
+/// them in an [`LmlWorkspace`] instead.
 pub fn log_marginal_likelihood(
     kernel: &Kernel,
     x: MatRef<'_, f64>,
@@ -41,13 +43,7 @@ pub fn log_marginal_likelihood(
     with_gradient: bool,
     parallelism: Parallelism,
 ) -> Result<LogMarginalLikelihood, Error> {
-    if x.nrows() != y.nrows() {
-        return Err(Error::RowCountMismatch { input_rows: x.nrows(), output_rows: y.nrows() });
-    }
-    kernel.validate(x.ncols())?;
-    let points = Points::from_rows(x)?;
-    check_finite_outputs(y)?;
-    evaluate(&mut Workspace::default(), kernel, &points, y, with_gradient, parallelism)
+    LmlWorkspace::default().log_marginal_likelihood(kernel, x, y, with_gradient, parallelism)
 }
 
 pub(crate) fn check_finite_outputs(y: MatRef<'_, f64>) -> Result<(), Error> {
@@ -61,15 +57,19 @@ pub(crate) fn check_finite_outputs(y: MatRef<'_, f64>) -> Result<(), Error> {
     Ok(())
 }
 
-/// The two `n × n` buffers of an evaluation, kept between the evaluations of one search, and what
-/// the value stage leaves for the gradient stage (the factor, the weights, the prepared inputs).
+/// The two `n × n` buffers of an evaluation, kept from one evaluation to the next (as the
+/// hyperparameter search does): at n = 3,000 they are 144 MB, and the page faults of allocating
+/// them afresh cost as much as a tenth of the evaluation. Also holds what the value stage leaves
+/// for the gradient stage (the factor, the weights, the prepared inputs).
 #[derive(Debug)]
-pub(crate) struct Workspace {
+pub struct LmlWorkspace {
     factor: Mat<f64>,
     inverse: Mat<f64>,
     /// Set by a successful [`evaluate_value`], taken by [`evaluate_gradient`].
     last: Option<LastValue>,
 }
+
+pub(crate) type Workspace = LmlWorkspace;
 
 #[derive(Debug)]
 struct LastValue {
@@ -79,9 +79,30 @@ struct LastValue {
     alpha: Mat<f64>,
 }
 
-impl Default for Workspace {
+impl Default for LmlWorkspace {
     fn default() -> Self {
         Self { factor: Mat::new(), inverse: Mat::new(), last: None }
+    }
+}
+
+impl LmlWorkspace {
+    /// [`log_marginal_likelihood`] in this workspace's buffers (grown or shrunk to `n × n` as
+    /// needed); the result does not depend on what the workspace held before.
+    pub fn log_marginal_likelihood(
+        &mut self,
+        kernel: &Kernel,
+        x: MatRef<'_, f64>,
+        y: MatRef<'_, f64>,
+        with_gradient: bool,
+        parallelism: Parallelism,
+    ) -> Result<LogMarginalLikelihood, Error> {
+        if x.nrows() != y.nrows() {
+            return Err(Error::RowCountMismatch { input_rows: x.nrows(), output_rows: y.nrows() });
+        }
+        kernel.validate(x.ncols())?;
+        let points = Points::from_rows(x)?;
+        check_finite_outputs(y)?;
+        evaluate(self, kernel, &points, y, with_gradient, parallelism)
     }
 }
 

@@ -4,7 +4,7 @@ mod common;
 
 use common::{close, random_kernels, rng, uniform_points};
 use faer::Mat;
-use gp::{Kernel, Parallelism, log_marginal_likelihood, sparse_evidence_lower_bound};
+use gp::{Kernel, LmlWorkspace, Parallelism, log_marginal_likelihood, sparse_evidence_lower_bound};
 use rand::Rng;
 
 const STEP: f64 = 1e-5;
@@ -80,6 +80,30 @@ fn log_marginal_likelihood_gradient_matches_central_differences_at_random_points
                     );
                 }
             }
+        }
+    }
+}
+
+#[test]
+fn a_reused_workspace_gives_the_likelihood_of_fresh_buffers_to_the_bit() {
+    // Sizes that shrink and grow again, value-only evaluations between gradient ones, serial and
+    // rayon: nothing a previous evaluation left in the workspace may show in the next.
+    let d = 3;
+    let mut r = rng(17);
+    let kernels = random_kernels(&mut r, d);
+    let mut workspace = LmlWorkspace::default();
+    for (step, n) in [40, 25, 40, 40, 60].into_iter().enumerate() {
+        let x = uniform_points(&mut r, n, d, -2.0, 2.0);
+        let y = Mat::from_fn(n, 2, |i, c| (x[(i, 0)] * (c + 1) as f64).sin() + 0.1 * r.random::<f64>());
+        for (k, kernel) in kernels.iter().enumerate() {
+            let with_gradient = (step + k) % 2 == 0;
+            let parallelism = if k % 2 == 0 { Parallelism::Sequential } else { Parallelism::Rayon };
+            let fresh = log_marginal_likelihood(kernel, x.as_ref(), y.as_ref(), with_gradient, parallelism)
+                .expect("positive definite");
+            let reused = workspace
+                .log_marginal_likelihood(kernel, x.as_ref(), y.as_ref(), with_gradient, parallelism)
+                .expect("positive definite");
+            assert_eq!(reused, fresh, "step {step} n {n} {kernel:?}");
         }
     }
 }
