@@ -90,10 +90,13 @@ pub struct CompensationOptions {
     /// With [`GpChoice::Auto`], the sparse GP above this many training rows.
     pub sparse_above_rows: usize,
     /// The sparse GP (its `gp` field is replaced by [`CompensationOptions::gp`], but for the
-    /// outputs, which [`CompensationOptions::sparse_outputs`] sets).
+    /// outputs and the kernel, which [`CompensationOptions::sparse_outputs`] and
+    /// [`CompensationOptions::sparse_kernel`] set).
     pub sparse: gp::SparseConfig,
     /// One kernel for all outputs or one each, in the sparse GP.
     pub sparse_outputs: gp::OutputMode,
+    /// The covariance family of the sparse GP.
+    pub sparse_kernel: gp::KernelChoice,
     /// Where the error twist is expressed.
     pub residual_frame: ResidualFrame,
 }
@@ -105,15 +108,18 @@ impl Default for CompensationOptions {
         // C, 1387 training poses, position only, even rows → odd rows) the paper's kernel left
         // 0.307 mm held out, SE-ARD 0.205 mm and SE-ARD + additive 0.136 mm; the additive term
         // learns a joint's periodic gear error from the poses that move that joint, which the
-        // joint ARD term cannot (docs/results/bench-gp.md has the other data sets). Two random
-        // restarts besides the default start, searched on a 500-row warm-start subset.
+        // joint ARD term cannot (docs/results/bench-gp.md has the other data sets). The default
+        // start and the kernel's nested start (additive term nearly off), searched on a 500-row
+        // warm-start subset; no random restarts: over the 8 data sets of `bench-gp --kernels`
+        // (24 searches) a random start never reached the best likelihood, and they cost a third
+        // of the search at 300 poses.
         //
         // The search stops when an iteration raises the log marginal likelihood by less than
         // 1e-6 of itself (≈ 5e-4 nats on these data, far below the ~1 nat that separates models
         // in a likelihood-ratio sense) instead of scipy's 2.2e-9: on UR10 C that halved the fit
         // (52 s → 26 s under load) and changed the held-out error by 0.0001 mm.
         let optimiser = gp::OptimiserConfig {
-            restarts: 2,
+            restarts: 0,
             warm_start_rows: 500,
             function_tolerance: 1e-6,
             ..gp::OptimiserConfig::default()
@@ -140,6 +146,11 @@ impl Default for CompensationOptions {
             // tested on 3000 more) shared hyperparameters left 0.105 mm in 31 s, one kernel per
             // output 0.073 mm in 52 s (the exact GP on the first 3000 poses: 0.075 mm).
             sparse_outputs: gp::OutputMode::Independent,
+            // SE-ARD, not the exact GP's additive kernel: on the same 100,000 poses the additive
+            // term left 0.0730 mm against 0.0729 mm and took 219 s against 84 s (both under load
+            // ≈ 4): its d one-dimensional kernels cost d more exponentials for each of the
+            // n·m entries of every bound evaluation.
+            sparse_kernel: gp::KernelChoice::SquaredExponentialArd,
             residual_frame: ResidualFrame::default(),
         }
     }
@@ -297,7 +308,11 @@ impl Compensation {
         let (gp, report) = match options.choice_for(x.nrows()) {
             GpChoice::Sparse => {
                 let inducing_points = options.sparse.inducing_points.min(x.nrows());
-                let gp = gp::GpConfig { outputs: options.sparse_outputs, ..options.gp.clone() };
+                let gp = gp::GpConfig {
+                    outputs: options.sparse_outputs,
+                    kernel: options.sparse_kernel,
+                    ..options.gp.clone()
+                };
                 let config = gp::SparseConfig { gp, inducing_points, ..options.sparse.clone() };
                 let model = gp::SparseGp::fit(x.as_ref(), y.as_ref(), &config)?;
                 let report = GpFitReport::Sparse(model.report().clone());
