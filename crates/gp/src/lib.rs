@@ -46,7 +46,7 @@ mod predict;
 mod scaling;
 mod sparse;
 
-pub use cholesky::JitterOutcome;
+pub use cholesky::{FactorOptions, JitterOutcome};
 pub use config::{GpConfig, JitterConfig, OptimiserConfig, OutputMode, Parallelism};
 pub use elbo::sparse_evidence_lower_bound;
 pub use error::Error;

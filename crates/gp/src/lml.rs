@@ -4,18 +4,18 @@
 //! `ln p(Y | X) = Σ_c [−½ y_cᵀ K⁻¹ y_c] − (m/2) ln |K| − (n m / 2) ln 2π` (R&W Eq. 2.30 summed over
 //! columns) and `∂/∂θⱼ = ½ tr((A Aᵀ − m K⁻¹) ∂K/∂θⱼ)` with `A = K⁻¹ Y` (R&W Eq. 5.9).
 //!
-//! One evaluation with the gradient costs `n³` flops: the Cholesky factor (`n³/3`), its inverse
-//! (`n³/3`) and `K⁻¹ = L⁻ᵀ L⁻¹` (`n³/3`, lower triangle only), all in two `n × n` buffers that a
-//! search reuses from one evaluation to the next ([`Workspace`]).
+//! One evaluation with the gradient costs `n³` flops: the Cholesky factor (`n³/3`, by halves, see
+//! [`FactorOptions`]), its inverse (`n³/3`) and `K⁻¹ = L⁻ᵀ L⁻¹` (`n³/3`, lower triangle only), all
+//! in two `n × n` buffers that a search reuses from one evaluation to the next ([`LmlWorkspace`]).
+//! `cargo xtask bench-gp --lml-floor 3000` times it against faer's matrix product doing `n³` flops.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::{triangular_inverse, triangular_solve};
 use faer::{Accum, Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
 use crate::Error;
+use crate::cholesky::{FactorOptions, cholesky_lower_in_place};
 use crate::config::Parallelism;
 use crate::gram::{contract_gradient, fill_training_lower};
 use crate::kernel::{Evaluator, Kernel, Prepared};
@@ -63,6 +63,7 @@ pub(crate) fn check_finite_outputs(y: MatRef<'_, f64>) -> Result<(), Error> {
 /// for the gradient stage (the factor, the weights, the prepared inputs).
 #[derive(Debug)]
 pub struct LmlWorkspace {
+    options: FactorOptions,
     factor: Mat<f64>,
     inverse: Mat<f64>,
     /// Set by a successful [`evaluate_value`], taken by [`evaluate_gradient`].
@@ -81,11 +82,17 @@ struct LastValue {
 
 impl Default for LmlWorkspace {
     fn default() -> Self {
-        Self { factor: Mat::new(), inverse: Mat::new(), last: None }
+        Self { options: FactorOptions::default(), factor: Mat::new(), inverse: Mat::new(), last: None }
     }
 }
 
 impl LmlWorkspace {
+    /// An empty workspace whose factorisations use `options` (validated here).
+    pub fn with_options(options: FactorOptions) -> Result<Self, Error> {
+        options.validate()?;
+        Ok(Self { options, ..Self::default() })
+    }
+
     /// [`log_marginal_likelihood`] in this workspace's buffers (grown or shrunk to `n × n` as
     /// needed); the result does not depend on what the workspace held before.
     pub fn log_marginal_likelihood(
@@ -141,17 +148,9 @@ pub(crate) fn evaluate_value(
     }
     let factor = &mut workspace.factor;
     fill_training_lower(factor.as_mut(), &evaluator, &prepared, evaluator.noise_variance, parallelism);
-    let mut mem = MemBuffer::new(llt::factor::cholesky_in_place_scratch::<f64>(n, par, Default::default()));
-    llt::factor::cholesky_in_place(
-        factor.as_mut(),
-        Default::default(),
-        par,
-        MemStack::new(&mut mem),
-        Default::default(),
-    )
-    .map_err(|llt::factor::LltError::NonPositivePivot { index }| Error::CholeskyFailed {
+    cholesky_lower_in_place(factor.as_mut(), &workspace.options, par).map_err(|pivot| Error::CholeskyFailed {
         size: n,
-        pivot: index,
+        pivot,
         jitter_tried: 0.0,
     })?;
     let log_determinant = 2.0 * (0..n).map(|i| factor[(i, i)].ln()).sum::<f64>();

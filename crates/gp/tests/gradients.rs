@@ -4,7 +4,7 @@ mod common;
 
 use common::{close, random_kernels, rng, uniform_points};
 use faer::Mat;
-use gp::{Kernel, LmlWorkspace, Parallelism, log_marginal_likelihood, sparse_evidence_lower_bound};
+use gp::{FactorOptions, Kernel, LmlWorkspace, Parallelism, log_marginal_likelihood, sparse_evidence_lower_bound};
 use rand::Rng;
 
 const STEP: f64 = 1e-5;
@@ -106,6 +106,32 @@ fn a_reused_workspace_gives_the_likelihood_of_fresh_buffers_to_the_bit() {
             assert_eq!(reused, fresh, "step {step} n {n} {kernel:?}");
         }
     }
+}
+
+#[test]
+fn the_factorisation_block_sizes_change_the_likelihood_only_by_rounding() {
+    // Leaves of 3 rows make the factorisation by halves recurse five levels deep at n = 60.
+    let (n, d) = (60, 3);
+    let mut r = rng(19);
+    let x = uniform_points(&mut r, n, d, -2.0, 2.0);
+    let y = Mat::from_fn(n, 2, |i, c| (x[(i, 0)] * (c + 1) as f64).sin() + 0.1 * r.random::<f64>());
+    let small = FactorOptions { recursion_leaf: 3, leaf_block: 2 };
+    let mut halves = LmlWorkspace::with_options(small).expect("valid sizes");
+    for kernel in random_kernels(&mut r, d) {
+        let expected = log_marginal_likelihood(&kernel, x.as_ref(), y.as_ref(), true, Parallelism::Sequential)
+            .expect("positive definite");
+        for parallelism in [Parallelism::Sequential, Parallelism::Rayon] {
+            let found = halves
+                .log_marginal_likelihood(&kernel, x.as_ref(), y.as_ref(), true, parallelism)
+                .expect("positive definite");
+            assert!(close(found.value, expected.value, 1e-9), "{kernel:?}: {} vs {}", found.value, expected.value);
+            for (g, e) in found.gradient.iter().zip(&expected.gradient) {
+                assert!(close(*g, *e, 1e-8), "{kernel:?}: gradient {g} vs {e}");
+            }
+        }
+    }
+    let zero = FactorOptions { recursion_leaf: 0, leaf_block: 2 };
+    assert!(matches!(LmlWorkspace::with_options(zero), Err(gp::Error::InvalidConfig { field: "recursion_leaf", .. })));
 }
 
 #[test]
