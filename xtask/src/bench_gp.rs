@@ -58,11 +58,11 @@ pub struct Args {
 ///
 /// The evaluation is timed twice: in a workspace kept from the previous evaluation (as the
 /// hyperparameter search runs it) and with fresh buffers (`gp::log_marginal_likelihood`, which pays
-/// the page faults of 144 MB at n = 3,000). Other jobs share the machine, so each of the five
+/// the page faults of 144 MB at n = 3,000). Other jobs share the machine, so each of the seven
 /// rounds times the product and both evaluations back to back and the best of each is kept: a
 /// floor measured minutes apart from the evaluation would compare two different machines.
 fn lml_floor(n: usize) -> Result<String, String> {
-    const ROUNDS: usize = 5;
+    const ROUNDS: usize = 7;
     let d = data(n, 2024);
     let kernel = Kernel::start(KernelChoice::SquaredExponentialArd, DIM);
     let y = Mat::from_fn(n, 1, |i, _| d.y[(i, 0)]);
