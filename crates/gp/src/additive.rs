@@ -89,16 +89,16 @@ fn add_squared_exponential(out: &mut [f64], col: &[f64], a: f64, q: f64) {
     }
 }
 
-/// `(Σᵢ wᵢ a e^{−rᵢ²/2}, Σᵢ wᵢ a e^{−rᵢ²/2} rᵢ²)` in four interleaved partial sums combined in a
-/// fixed order (so that the loop vectorises and the result does not depend on the thread).
+/// `(Σᵢ wᵢ a e^{−rᵢ²/2}, Σᵢ wᵢ a e^{−rᵢ²/2} rᵢ²)` in [`LANES`] interleaved partial sums combined
+/// in a fixed order (so that the loop vectorises and the result does not depend on the thread).
 #[inline(always)]
 fn squared_exponential_sums(col: &[f64], w: &[f64], a: f64, q: f64) -> (f64, f64) {
-    let mut value = [0.0; 4];
-    let mut length = [0.0; 4];
-    let (cc, wc) = (col.chunks_exact(4), w.chunks_exact(4));
+    let mut value = [0.0; LANES];
+    let mut length = [0.0; LANES];
+    let (cc, wc) = (col.chunks_exact(LANES), w.chunks_exact(LANES));
     let (c_tail, w_tail) = (cc.remainder(), wc.remainder());
     for (p, wi) in cc.zip(wc) {
-        for l in 0..4 {
+        for l in 0..LANES {
             let t = p[l] - q;
             let r = t * t;
             let v = wi[l] * a * exp_nonpositive(-0.5 * r);
@@ -113,7 +113,16 @@ fn squared_exponential_sums(col: &[f64], w: &[f64], a: f64, q: f64) -> (f64, f64
         value[0] += v;
         length[0] += v * r;
     }
-    ((value[0] + value[1]) + (value[2] + value[3]), (length[0] + length[1]) + (length[2] + length[3]))
+    (pairwise(&value), pairwise(&length))
+}
+
+/// Partial sums per loop lane: eight, one AVX-512 register of `f64` (two AVX2 registers).
+const LANES: usize = 8;
+
+/// `Σ v` of the lanes in a fixed pairwise order.
+#[inline(always)]
+fn pairwise(v: &[f64; LANES]) -> f64 {
+    ((v[0] + v[1]) + (v[2] + v[3])) + ((v[4] + v[5]) + (v[6] + v[7]))
 }
 
 /// [`add_squared_exponential`] for `pulp`'s dispatch: `with_simd` is inlined into a function
