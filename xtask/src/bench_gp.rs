@@ -1,10 +1,14 @@
-//! `cargo xtask bench-gp`: the `gp` crate's timing table (markdown on stdout).
+//! `cargo xtask bench-gp`: the `gp` crate's benchmarks (markdown on stdout).
 //!
-//! Fit (with the hyperparameter search) and predict of the exact GP on robot-like data (d = 7: six
-//! joint angles and the payload; six outputs), the log–log slope of fit time against n, the same
-//! fits with scikit-learn in the same run when `python3 -c "import sklearn"` works
-//! (`xtask/scripts/bench_gp_sklearn.py`), the machine's peak GFLOP/s measured with a faer matrix
-//! product against the Cholesky rate at the largest n, and the sparse GP against the exact GP.
+//! By default the sweep of `bench_gp_sweep`: `calib fit --method poe-gp-load` with `--gp exact` and
+//! `--gp sparse` on n = 300 … 100,000 simulated poses, run as child processes (wall clock and peak
+//! resident memory), held-out error on the same 3,000 poses, scikit-learn on the same residuals in
+//! the same run, the log–log slopes, and an SVG plot beside `--out`. The flags pick the other
+//! benches instead: `--synthetic` the older table of the exact GP on synthetic robot-like data
+//! (d = 7, six outputs, beside scikit-learn via `xtask/scripts/bench_gp_sklearn.py`, the machine's
+//! peak GFLOP/s from a faer matrix product, the sparse GP against the exact one), `--compare` and
+//! `--kernels` the real and simulated residual sets of `bench_gp_kernels`, `--lml-floor N` one
+//! evaluation against the n³ flop floor.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -51,6 +55,12 @@ pub struct Args {
     lml_floor: Option<usize>,
     #[command(flatten)]
     kernel_args: crate::bench_gp_kernels::KernelArgs,
+    /// The older table instead of the sweep: exact GP fit and predict on synthetic robot-like data
+    /// (Eq. 5 kernel, shared outputs), n = 100 … 3000, beside scikit-learn.
+    #[arg(long)]
+    synthetic: bool,
+    #[command(flatten)]
+    sweep: crate::bench_gp_sweep::SweepArgs,
 }
 
 /// One LML + gradient evaluation at `n` against the time faer's own n × n matrix product takes for
@@ -348,6 +358,19 @@ pub fn run(args: &Args) -> Result<(), String> {
     if args.kernels {
         let md = crate::bench_gp_kernels::run(&args.kernel_args)?;
         println!("{md}");
+        return Ok(());
+    }
+    if !args.synthetic {
+        let mut sweep = args.sweep.clone();
+        if args.quick {
+            sweep.sizes = vec![300, 1000];
+        }
+        let svg = args.out.as_ref().map(|p| p.with_extension("svg"));
+        let md = crate::bench_gp_sweep::run(&sweep, svg.as_deref())?;
+        println!("{md}");
+        if let Some(path) = &args.out {
+            std::fs::write(path, &md).map_err(|e| format!("{}: {e}", path.display()))?;
+        }
         return Ok(());
     }
     let sizes: Vec<usize> = if args.quick { vec![100, 300] } else { vec![100, 300, 1000, 3000] };

@@ -6,6 +6,7 @@ mod bench_gp_compare;
 mod bench_gp_kernels;
 mod bench_gp_residuals;
 mod bench_gp_sklearn;
+mod bench_gp_sweep;
 mod bench_identify;
 mod blind_check;
 mod blind_check_cases;

@@ -135,8 +135,17 @@ fn summarise(
             let _ = writeln!(out, "    held at the prior, the data barely sees them: {}", held.join(", "));
         }
     }
-    if let Some(compensation) = &model.compensation {
-        let _ = writeln!(out, "  GP: {}", compensation.gp.choice());
+    if let (Some(compensation), Some(gp)) = (&model.compensation, &report.compensation) {
+        let kernels = match &gp.gp {
+            pipeline::GpFitReport::Exact(r) => r.components.len(),
+            pipeline::GpFitReport::Sparse(r) => r.components.len(),
+        };
+        let converged = kernels - gp.gp.unconverged().len();
+        let _ = writeln!(
+            out,
+            "  GP: {}, {kernels} kernel(s), hyperparameter search met its tolerance for {converged} of {kernels}",
+            compensation.gp.choice()
+        );
     }
     for direction in &id.unidentifiable {
         let _ = writeln!(out, "    unidentifiable: {direction}");

@@ -224,6 +224,23 @@ pub enum GpFitReport {
     Sparse(gp::SparseFitReport),
 }
 
+impl GpFitReport {
+    /// The output columns whose kernel's hyperparameter search stopped on its iteration limit or a
+    /// failed line search rather than on a tolerance, with the iterations it ran. For the sparse GP
+    /// that is the exact search on its subset: the bound's search that refines it runs a fixed
+    /// budget ([`gp::SparseConfig::bound_iterations`]) and its outcome stays in the report.
+    pub fn unconverged(&self) -> Vec<(Vec<usize>, usize)> {
+        let exact = |c: &gp::ComponentReport| match &c.optimisation {
+            Some(o) if !o.converged => Some((c.outputs.clone(), o.iterations)),
+            _ => None,
+        };
+        match self {
+            Self::Exact(r) => r.components.iter().filter_map(exact).collect(),
+            Self::Sparse(r) => r.components.iter().filter_map(|c| c.subset_fit.as_ref().and_then(exact)).collect(),
+        }
+    }
+}
+
 /// A fitted GP compensation, stored in the model file.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Compensation {

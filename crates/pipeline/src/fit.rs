@@ -58,6 +58,14 @@ pub enum FitWarning {
         /// The ratio below which this warning is given.
         min_redundancy: f64,
     },
+    /// The GP's hyperparameter search stopped before a tolerance was met for some outputs: the
+    /// compensation is usable but its hyperparameters are not at the likelihood's optimum.
+    GpSearchNotConverged {
+        /// Output columns (0–2 position, 3–5 rotation) of the kernels concerned.
+        outputs: Vec<usize>,
+        /// The most L-BFGS iterations any of them ran.
+        iterations: usize,
+    },
 }
 
 impl std::fmt::Display for FitWarning {
@@ -68,6 +76,12 @@ impl std::fmt::Display for FitWarning {
                 "{residual_rows} residual rows for {identifiable} identifiable parameters ({redundancy:.2} per parameter, \
                  below {min_redundancy}): the training error understates the error on new poses; measure more poses \
                  or check the model on held-out data"
+            ),
+            FitWarning::GpSearchNotConverged { outputs, iterations } => write!(
+                f,
+                "the GP's hyperparameter search for output(s) {outputs:?} stopped after {iterations} iterations \
+                 without meeting its tolerance: the compensation may be less accurate than it could be; check it on \
+                 held-out data"
             ),
         }
     }
@@ -171,6 +185,15 @@ pub fn fit(
             redundancy: identification.redundancy(),
             min_redundancy: options.min_redundancy,
         });
+    }
+    if let Some(report) = &compensation {
+        let unconverged = report.gp.unconverged();
+        if !unconverged.is_empty() {
+            warnings.push(FitWarning::GpSearchNotConverged {
+                outputs: unconverged.iter().flat_map(|(o, _)| o.iter().copied()).collect(),
+                iterations: unconverged.iter().map(|(_, i)| *i).max().unwrap_or(0),
+            });
+        }
     }
     let report = FitReport {
         method,

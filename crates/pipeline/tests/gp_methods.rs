@@ -64,3 +64,25 @@ fn identified_joint_compliance_leaves_little_more_than_the_noise() {
         assert!(compliance < 0.5 * load, "joint compliance {compliance} mm against poe-gp-load {load} mm");
     }
 }
+
+#[test]
+fn a_gp_search_stopped_by_its_iteration_limit_is_reported_not_passed_off_as_converged() {
+    let robot = irb4400();
+    let data = loaded_data(&robot, 120, false, 21);
+    let warned = |max_iterations: usize, method: pipeline::GpChoice| {
+        let mut options = FitOptions::default();
+        options.compensation.gp.optimiser.max_iterations = max_iterations;
+        options.compensation.method = method;
+        let (_, report) = pipeline::fit(&robot, &data, Method::PoeGpLoad, &options).unwrap();
+        report.warnings.iter().find_map(|w| match w {
+            pipeline::FitWarning::GpSearchNotConverged { outputs, iterations } => Some((outputs.clone(), *iterations)),
+            _ => None,
+        })
+    };
+    for method in [pipeline::GpChoice::Exact, pipeline::GpChoice::Sparse] {
+        let (outputs, iterations) = warned(1, method).expect("one iteration cannot meet the tolerance");
+        assert!(!outputs.is_empty() && outputs.iter().all(|o| *o < 3), "{method:?}: outputs {outputs:?}");
+        assert_eq!(iterations, 1, "{method:?}");
+        assert_eq!(warned(200, method), None, "{method:?}: the default limit converges on these data");
+    }
+}

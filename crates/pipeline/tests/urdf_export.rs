@@ -97,9 +97,9 @@ fn a_plain_export_reads_back_to_the_model_in_the_tracker_and_the_base_frame() {
     }
 }
 
-fn write(text: &str) -> PathBuf {
-    let file = tempfile::Builder::new().suffix(".urdf").tempfile().unwrap();
-    let (_, path) = file.keep().unwrap();
+/// `text` in a temporary `.urdf` file, deleted when the returned path is dropped.
+fn write(text: &str) -> tempfile::TempPath {
+    let path = tempfile::Builder::new().suffix(".urdf").tempfile().unwrap().into_temp_path();
     std::fs::write(&path, text).unwrap();
     path
 }
