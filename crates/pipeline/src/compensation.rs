@@ -83,7 +83,10 @@ impl FromStr for GpChoice {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct CompensationOptions {
-    /// The exact Gaussian process (and the kernel, outputs, scaling and optimiser of both).
+    /// The exact Gaussian process (and the kernel, outputs, scaling and optimiser of both). Read
+    /// from an options file field by field onto this stage's default, so that `gp: (optimiser:
+    /// (max_iterations: 100))` changes that one field and keeps the stage's kernel and search.
+    #[serde(deserialize_with = "onto_default_gp")]
     pub gp: gp::GpConfig,
     /// Exact, sparse, or chosen by the number of training rows.
     pub method: GpChoice,
@@ -154,6 +157,90 @@ impl Default for CompensationOptions {
             residual_frame: ResidualFrame::default(),
         }
     }
+}
+
+/// A field given in an options file, or `None` when it was left out.
+fn given<'de, D: serde::Deserializer<'de>, T: Deserialize<'de>>(deserializer: D) -> Result<Option<T>, D::Error> {
+    T::deserialize(deserializer).map(Some)
+}
+
+/// The fields of [`gp::OptimiserConfig`] an options file may set.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OptimiserPatch {
+    #[serde(default, deserialize_with = "given")]
+    restarts: Option<usize>,
+    #[serde(default, deserialize_with = "given")]
+    seed: Option<u64>,
+    #[serde(default, deserialize_with = "given")]
+    max_iterations: Option<usize>,
+    #[serde(default, deserialize_with = "given")]
+    memory: Option<usize>,
+    #[serde(default, deserialize_with = "given")]
+    gradient_tolerance: Option<f64>,
+    #[serde(default, deserialize_with = "given")]
+    function_tolerance: Option<f64>,
+    #[serde(default, deserialize_with = "given")]
+    warm_start_rows: Option<usize>,
+}
+
+/// The fields of [`gp::GpConfig`] an options file may set.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GpPatch {
+    #[serde(default, deserialize_with = "given")]
+    kernel: Option<gp::KernelChoice>,
+    #[serde(default, deserialize_with = "given")]
+    bounds: Option<Option<gp::Bounds>>,
+    #[serde(default, deserialize_with = "given")]
+    outputs: Option<gp::OutputMode>,
+    #[serde(default, deserialize_with = "given")]
+    standardise_inputs: Option<bool>,
+    #[serde(default, deserialize_with = "given")]
+    normalise_outputs: Option<bool>,
+    #[serde(default, deserialize_with = "given")]
+    optimiser: Option<OptimiserPatch>,
+    #[serde(default, deserialize_with = "given")]
+    jitter: Option<gp::JitterConfig>,
+    #[serde(default, deserialize_with = "given")]
+    parallelism: Option<gp::Parallelism>,
+}
+
+/// `gp` as an options file gives it, laid over [`CompensationOptions::default`]'s: derived
+/// `#[serde(default)]` would fill the fields left out from [`gp::GpConfig::default`] (the
+/// library's kernel, three restarts, no warm start) and silently change the fit.
+fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<gp::GpConfig, D::Error> {
+    let patch = GpPatch::deserialize(deserializer)?;
+    let mut gp = CompensationOptions::default().gp;
+    let GpPatch { kernel, bounds, outputs, standardise_inputs, normalise_outputs, optimiser, jitter, parallelism } =
+        patch;
+    gp.kernel = kernel.unwrap_or(gp.kernel);
+    gp.bounds = bounds.unwrap_or(gp.bounds);
+    gp.outputs = outputs.unwrap_or(gp.outputs);
+    gp.standardise_inputs = standardise_inputs.unwrap_or(gp.standardise_inputs);
+    gp.normalise_outputs = normalise_outputs.unwrap_or(gp.normalise_outputs);
+    gp.jitter = jitter.unwrap_or(gp.jitter);
+    gp.parallelism = parallelism.unwrap_or(gp.parallelism);
+    if let Some(o) = optimiser {
+        let OptimiserPatch {
+            restarts,
+            seed,
+            max_iterations,
+            memory,
+            gradient_tolerance,
+            function_tolerance,
+            warm_start_rows,
+        } = o;
+        let d = &mut gp.optimiser;
+        d.restarts = restarts.unwrap_or(d.restarts);
+        d.seed = seed.unwrap_or(d.seed);
+        d.max_iterations = max_iterations.unwrap_or(d.max_iterations);
+        d.memory = memory.unwrap_or(d.memory);
+        d.gradient_tolerance = gradient_tolerance.unwrap_or(d.gradient_tolerance);
+        d.function_tolerance = function_tolerance.unwrap_or(d.function_tolerance);
+        d.warm_start_rows = warm_start_rows.unwrap_or(d.warm_start_rows);
+    }
+    Ok(gp)
 }
 
 impl CompensationOptions {

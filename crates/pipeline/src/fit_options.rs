@@ -142,6 +142,18 @@ impl FitOptions {
                 format!("min_redundancy is {value}, expected a finite number of at least 1"),
             ));
         }
+        if let Err(gp::Error::InvalidConfig { field, value }) = self.compensation.gp.validate() {
+            // The field's own name, where the file gives it (`function_tolerance:` for
+            // `optimiser.function_tolerance`).
+            let last = field.rsplit('.').next().unwrap_or(field);
+            let expected = match last {
+                "memory" => "at least 1",
+                "growth" => "a finite number above 1",
+                "initial_relative" => "a finite number above 0",
+                _ => "a number of at least 0",
+            };
+            return Err((last, format!("compensation.gp.{field} is {value}, expected {expected}")));
+        }
         let prior = self.effects.prior_sigma;
         if prior.is_nan() || prior <= 0.0 {
             return Err((
@@ -150,5 +162,48 @@ impl FitOptions {
             ));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_gp_field_given_alone_keeps_the_stages_kernel_and_search() {
+        let options = FitOptions::parse("(compensation: (gp: (optimiser: (max_iterations: 100))))", "fit.ron").unwrap();
+        let default = CompensationOptions::default().gp;
+        let gp = &options.compensation.gp;
+        assert_eq!(gp.optimiser.max_iterations, 100);
+        assert_eq!(gp.kernel, default.kernel);
+        assert_eq!((gp.optimiser.restarts, gp.optimiser.warm_start_rows), (0, 500));
+        assert_eq!(gp.optimiser.function_tolerance, default.optimiser.function_tolerance);
+        assert_ne!(default.kernel, gp::GpConfig::default().kernel, "the trap this guards against exists");
+    }
+
+    #[test]
+    fn every_gp_field_can_be_given_and_reads_back() {
+        // A field added to gp::GpConfig or OptimiserConfig without a patch field fails here.
+        let mut options = FitOptions::default();
+        options.compensation.gp.optimiser.seed = 9;
+        options.compensation.gp.kernel = gp::KernelChoice::Matern52Ard;
+        options.compensation.gp.bounds = Some(gp::Kernel::start(gp::KernelChoice::Matern52Ard, 3).default_bounds());
+        let text = ron::ser::to_string(&options).unwrap();
+        assert_eq!(FitOptions::parse(&text, "fit.ron").unwrap(), options, "{text}");
+    }
+
+    #[test]
+    fn bad_gp_fields_are_refused_with_file_line_and_column() {
+        let error =
+            FitOptions::parse("(compensation: (gp: (\n  optimiser: (max_iteration: 1))))", "fit.ron").unwrap_err();
+        let message = error.to_string();
+        assert!(message.contains("fit.ron:2:") && message.contains("max_iteration"), "{message}");
+        let error = FitOptions::parse("(compensation: (gp: (optimiser: (\n    function_tolerance: -1.0))))", "fit.ron")
+            .unwrap_err();
+        let message = error.to_string();
+        assert!(message.contains("fit.ron:2:5") && message.contains("function_tolerance is -1"), "{message}");
+        let error = FitOptions::parse("(compensation: (gp: (jitter: (growth: 0.5))))", "fit.ron").unwrap_err();
+        let message = error.to_string();
+        assert!(message.contains("fit.ron:1:31") && message.contains("jitter.growth is 0.5"), "{message}");
     }
 }
