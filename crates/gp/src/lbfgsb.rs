@@ -201,6 +201,14 @@ pub(crate) fn minimise(
             step *= 0.5;
         }
         let Some((x_new, f_new, g_new)) = accepted else {
+            // As L-BFGS-B does: a failed search along the quasi-Newton direction is retried once
+            // down the projected gradient with the memory cleared (stale curvature pairs can point
+            // the direction where no step decreases f); only a failed steepest-descent search ends
+            // the minimisation. Bounded: the memory refills only through accepted steps.
+            if !history.is_empty() {
+                history.clear();
+                continue;
+            }
             termination = Termination::LineSearchFailed;
             break;
         };
@@ -281,6 +289,55 @@ mod tests {
         let m = minimise(&mut Joint::new(f), &[-1.2, 1.0], &[-2.0, -2.0], &[0.5, 2.0], &settings())
             .expect("start evaluates");
         assert!((m.x[0] - 0.5).abs() < 1e-8 && (m.x[1] - 0.25).abs() < 1e-5, "{m:?}");
+    }
+
+    /// A quadratic that refuses every trial point off the steepest-descent ray of the last
+    /// accepted point: the quasi-Newton direction always fails there.
+    struct SteepestOnly {
+        at: Vec<f64>,
+        gradient_at: Vec<f64>,
+        pending: Option<(Vec<f64>, Vec<f64>)>,
+    }
+
+    impl SteepestOnly {
+        fn f(x: &[f64]) -> (f64, Vec<f64>) {
+            let c = [1.0, 4.0, 9.0];
+            ((0..3).map(|i| c[i] * (x[i] - 0.5).powi(2)).sum(), (0..3).map(|i| 2.0 * c[i] * (x[i] - 0.5)).collect())
+        }
+    }
+
+    impl Objective for SteepestOnly {
+        fn value(&mut self, x: &[f64]) -> Option<f64> {
+            if !self.at.is_empty() {
+                let d: Vec<f64> = x.iter().zip(&self.at).map(|(a, b)| a - b).collect();
+                let cos = -d.iter().zip(&self.gradient_at).map(|(a, b)| a * b).sum::<f64>()
+                    / (d.iter().map(|v| v * v).sum::<f64>().sqrt()
+                        * self.gradient_at.iter().map(|v| v * v).sum::<f64>().sqrt());
+                if cos < 1.0 - 1e-9 {
+                    return None;
+                }
+            }
+            let (v, g) = Self::f(x);
+            self.pending = Some((x.to_vec(), g));
+            Some(v)
+        }
+        fn gradient(&mut self) -> Option<Vec<f64>> {
+            let (x, g) = self.pending.take()?;
+            self.at = x;
+            self.gradient_at = g.clone();
+            Some(g)
+        }
+    }
+
+    #[test]
+    fn a_failed_quasi_newton_search_is_retried_down_the_gradient() {
+        let mut objective = SteepestOnly { at: Vec::new(), gradient_at: Vec::new(), pending: None };
+        let settings = Settings { memory: 8, max_iterations: 500, gradient_tolerance: 1e-8, function_tolerance: 0.0 };
+        let m =
+            minimise(&mut objective, &[-1.0, 2.0, 1.5], &[-10.0; 3], &[10.0; 3], &settings).expect("start evaluates");
+        assert!(matches!(m.termination, Termination::GradientTolerance), "{m:?}");
+        assert!(m.x.iter().all(|v| (v - 0.5).abs() < 1e-6), "{m:?}");
+        assert!(m.iterations > 2, "the search took more than one step: {m:?}");
     }
 
     #[test]
