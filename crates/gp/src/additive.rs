@@ -66,7 +66,7 @@ pub(crate) fn exp_nonpositive(x: f64) -> f64 {
 
 thread_local! {
     /// The widest instruction set of this processor, detected once per thread.
-    static ARCH: pulp::Arch = pulp::Arch::new();
+    pub(crate) static ARCH: pulp::Arch = pulp::Arch::new();
 }
 
 /// The additive term between the rows of `columns` (`i`) and those of `query` (`j`), both
@@ -117,11 +117,11 @@ fn squared_exponential_sums(col: &[f64], w: &[f64], a: f64, q: f64) -> (f64, f64
 }
 
 /// Partial sums per loop lane: eight, one AVX-512 register of `f64` (two AVX2 registers).
-const LANES: usize = 8;
+pub(crate) const LANES: usize = 8;
 
 /// `Σ v` of the lanes in a fixed pairwise order.
 #[inline(always)]
-fn pairwise(v: &[f64; LANES]) -> f64 {
+pub(crate) fn pairwise(v: &[f64; LANES]) -> f64 {
     ((v[0] + v[1]) + (v[2] + v[3])) + ((v[4] + v[5]) + (v[6] + v[7]))
 }
 

@@ -20,8 +20,9 @@ use rayon::prelude::*;
 
 use crate::additive;
 use crate::config::Parallelism;
-use crate::kernel::{Evaluator, Expanded, Prepared};
+use crate::kernel::{Evaluator, Expanded, Prepared, StationaryShape};
 use crate::points::Points;
+use crate::stationary;
 
 /// Runs `f(j, column j)` over the columns, in parallel or not.
 fn for_each_column(mat: MatMut<'_, f64>, par: Parallelism, f: impl Fn(usize, ColMut<'_, f64>) + Sync + Send) {
@@ -83,8 +84,16 @@ pub(crate) fn fill_training_lower(
     let additive = x.additive.as_ref().map(additive::columns);
     for_each_column(dst.rb_mut(), par, |j, col| {
         let col = slice_mut(col);
-        for (i, v) in col.iter_mut().enumerate().skip(j) {
-            *v = shape.value(signal, squared_distance(sq[i], sq[j], *v, i == j)) + constant;
+        match shape {
+            StationaryShape::SquaredExponential => {
+                col[j] = shape.value(signal, 0.0) + constant;
+                stationary::fill_column(&mut col[j + 1..], &sq[j + 1..], sq[j], signal, constant);
+            }
+            StationaryShape::Matern52 => {
+                for (i, v) in col.iter_mut().enumerate().skip(j) {
+                    *v = shape.value(signal, squared_distance(sq[i], sq[j], *v, i == j)) + constant;
+                }
+            }
         }
         if let Some(a) = &additive {
             let term = additive::Additive { shape, variances: &kernel.additive_variances, columns: a, query: a };
@@ -221,14 +230,28 @@ pub(crate) fn contract_gradient(
         let mut sums = vec![0.0; 3 + 2 * additive_dim];
         for i in j..n {
             let ai = &alpha_rows[i * m..(i + 1) * m];
-            let w = ai.iter().zip(aj).map(|(a, b)| a * b).sum::<f64>() - scale * wc[i];
-            wc[i] = w;
-            let r2 = squared_distance(sq[i], sq[j], mc[i], i == j);
-            let (value, weight) = shape.value_and_weight(signal, r2);
-            mc[i] = w * weight;
-            let f = if i == j { 0.5 } else { 1.0 };
-            sums[0] += f * w * value;
-            sums[1] += f * w;
+            wc[i] = ai.iter().zip(aj).map(|(a, b)| a * b).sum::<f64>() - scale * wc[i];
+        }
+        match shape {
+            StationaryShape::SquaredExponential => {
+                // The diagonal (r = 0, weight ½) apart, the rest of the column vectorised.
+                let (value, weight) = shape.value_and_weight(signal, 0.0);
+                mc[j] = wc[j] * weight;
+                let (v, w) = stationary::weigh_column(&mut mc[j + 1..], &wc[j + 1..], &sq[j + 1..], sq[j], signal);
+                sums[0] = 0.5 * wc[j] * value + v;
+                sums[1] = 0.5 * wc[j] + w;
+            }
+            StationaryShape::Matern52 => {
+                for i in j..n {
+                    let w = wc[i];
+                    let r2 = squared_distance(sq[i], sq[j], mc[i], i == j);
+                    let (value, weight) = shape.value_and_weight(signal, r2);
+                    mc[i] = w * weight;
+                    let f = if i == j { 0.5 } else { 1.0 };
+                    sums[0] += f * w * value;
+                    sums[1] += f * w;
+                }
+            }
         }
         sums[2] = 0.5 * wc[j];
         if let Some(a) = &additive {

@@ -45,6 +45,7 @@ mod points;
 mod predict;
 mod scaling;
 mod sparse;
+mod stationary;
 
 pub use cholesky::{FactorOptions, JitterOutcome};
 pub use config::{GpConfig, JitterConfig, OptimiserConfig, OutputMode, Parallelism};
