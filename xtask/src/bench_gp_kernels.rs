@@ -6,7 +6,7 @@ use std::fmt::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use gp::{ExactGp, KernelChoice, OutputMode, StationaryShape};
+use gp::{ExactGp, Kernel, KernelChoice, OutputMode, StationaryShape};
 use indicatif::{ProgressBar, ProgressStyle};
 use pipeline::{CompensationOptions, RobotDescription};
 
@@ -34,6 +34,22 @@ pub struct KernelArgs {
     /// empty.
     #[arg(long, value_delimiter = ';')]
     pub kernel_names: Vec<String>,
+    /// With `--kernels`: seeds of the hyperparameter search, one fit per seed: each draws its own
+    /// warm-start subset and, above 0, moves the start by up to ±1e-3 in every log-parameter. The
+    /// table gives the mean held-out error over the seeds ± half the spread (largest − smallest),
+    /// which shows how much of a difference between two searches is the luck of the local optimum
+    /// reached.
+    #[arg(long, value_delimiter = ',', default_value = "0")]
+    pub search_seeds: Vec<u64>,
+    /// With `--kernels`: the search's L-BFGS memory instead of the GP stage's.
+    #[arg(long)]
+    pub search_memory: Option<usize>,
+    /// With `--kernels`: the search's relative function tolerance instead of the GP stage's.
+    #[arg(long)]
+    pub search_tolerance: Option<f64>,
+    /// With `--kernels`: the search's warm-start subset rows instead of the GP stage's.
+    #[arg(long)]
+    pub search_warm_rows: Option<usize>,
 }
 
 impl KernelArgs {
@@ -124,6 +140,28 @@ pub fn data_sets(args: &KernelArgs) -> Result<Vec<Residuals>, String> {
     Ok(sets)
 }
 
+/// The search's default start, and for `seed > 0` each log-parameter moved by up to ±1e-3 (a
+/// thousandth of its value, immaterial to the model) drawn from a SplitMix64 stream: together with
+/// the seed's own warm-start subset, it shows how far the held-out error depends on which of
+/// several nearly equal local optima the search happens to reach. Sets no larger than the
+/// warm-start subset have no subset to draw, so without it every seed would give the same fit.
+fn perturbed_start(choice: KernelChoice, dim: usize, seed: u64) -> Result<Kernel, String> {
+    let start = Kernel::start(choice, dim);
+    if seed == 0 {
+        return Ok(start);
+    }
+    let mut state = seed;
+    let mut next = || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let p: Vec<f64> = start.log_parameters().iter().map(|v| v + 1e-3 * (2.0 * next() - 1.0)).collect();
+    start.with_log_parameters(&p).map_err(|e| e.to_string())
+}
+
 /// Runs every candidate on every set and returns the markdown table.
 pub fn run(args: &KernelArgs) -> Result<String, String> {
     let sets = data_sets(args)?;
@@ -134,25 +172,50 @@ pub fn run(args: &KernelArgs) -> Result<String, String> {
     if kernels.is_empty() {
         return Err(format!("no candidate kernel is named {:?}", args.kernel_names));
     }
-    let bar = ProgressBar::new((sets.len() * kernels.len()) as u64);
+    let seeds = &args.search_seeds;
+    if seeds.is_empty() {
+        return Err("--search-seeds is empty".into());
+    }
+    let bar = ProgressBar::new((sets.len() * kernels.len() * seeds.len()) as u64);
     bar.set_style(
         ProgressStyle::with_template("kernels {msg} [{bar:30}] {pos}/{len} {elapsed}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let mut table = vec![vec![(f64::NAN, f64::NAN); sets.len()]; kernels.len()];
+    // (mean held-out error, spread over the seeds, fit time summed over the seeds, log marginal
+    // likelihood summed over the seeds).
+    let mut table = vec![vec![(f64::NAN, f64::NAN, f64::NAN, f64::NAN); sets.len()]; kernels.len()];
     for (s, set) in sets.iter().enumerate() {
         for (k, (name, choice, outputs)) in kernels.iter().enumerate() {
-            bar.set_message(format!("{} / {name}", set.name));
-            let mut config = CompensationOptions::default().gp;
-            config.kernel = *choice;
-            config.outputs = *outputs;
-            let t = Instant::now();
-            let model = ExactGp::fit(set.train.inputs.as_ref(), set.train.outputs.as_ref(), &config)
-                .map_err(|e| format!("{} / {name}: {e}", set.name))?;
-            let seconds = t.elapsed().as_secs_f64();
-            let mean = model.predict_mean(set.test.inputs.as_ref()).map_err(|e| e.to_string())?;
-            table[k][s] = (heldout_mm(&mean, &set.test), seconds);
-            bar.inc(1);
+            let (mut errors, mut seconds, mut lml) = (Vec::new(), 0.0, 0.0);
+            for &seed in seeds {
+                bar.set_message(format!("{} / {name} / seed {seed}", set.name));
+                let mut config = CompensationOptions::default().gp;
+                config.kernel = *choice;
+                config.outputs = *outputs;
+                config.optimiser.seed = seed;
+                if let Some(m) = args.search_memory {
+                    config.optimiser.memory = m;
+                }
+                if let Some(t) = args.search_tolerance {
+                    config.optimiser.function_tolerance = t;
+                }
+                if let Some(r) = args.search_warm_rows {
+                    config.optimiser.warm_start_rows = r;
+                }
+                let start = perturbed_start(*choice, set.train.inputs.ncols(), seed)?;
+                let t = Instant::now();
+                let model = ExactGp::fit_from(set.train.inputs.as_ref(), set.train.outputs.as_ref(), &start, &config)
+                    .map_err(|e| format!("{} / {name}: {e}", set.name))?;
+                seconds += t.elapsed().as_secs_f64();
+                lml += model.log_marginal_likelihood();
+                let mean = model.predict_mean(set.test.inputs.as_ref()).map_err(|e| e.to_string())?;
+                errors.push(heldout_mm(&mean, &set.test));
+                bar.inc(1);
+            }
+            let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+            let spread = errors.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
+                - errors.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+            table[k][s] = (mean, spread, seconds, lml);
         }
     }
     bar.finish_and_clear();
@@ -161,19 +224,29 @@ pub fn run(args: &KernelArgs) -> Result<String, String> {
     for set in &sets {
         let _ = write!(md, " {} (mm) |", set.name);
     }
-    let _ = writeln!(md, " mean ratio to best | fit time, sum (s) |");
-    let _ = writeln!(md, "|---|{}---:|---:|", "---:|".repeat(sets.len()));
+    let _ = writeln!(
+        md,
+        " mean ratio to best | fit time, sum over the sets (s, mean over the seeds) | log marginal likelihood, sum over \
+         the sets (mean over the seeds) |"
+    );
+    let spreads = seeds.len() > 1;
+    let _ = writeln!(md, "|---|{}---:|---:|---:|", "---:|".repeat(sets.len()));
     let best: Vec<f64> = (0..sets.len()).map(|s| table.iter().map(|r| r[s].0).fold(f64::INFINITY, f64::min)).collect();
     for (k, (name, _, _)) in kernels.iter().enumerate() {
         let _ = write!(md, "| {name} |");
         for (s, b) in best.iter().enumerate() {
-            let (e, _) = table[k][s];
+            let (e, spread, seconds, _) = table[k][s];
             let mark = if e == *b { "**" } else { "" };
-            let _ = write!(md, " {mark}{e:.4}{mark} |");
+            let _ = write!(md, " {mark}{e:.4}{mark}");
+            if spreads {
+                let _ = write!(md, " ± {:.4}", spread / 2.0);
+            }
+            let _ = write!(md, " ({:.2} s) |", seconds / seeds.len() as f64);
         }
         let ratio = (0..sets.len()).map(|s| table[k][s].0 / best[s]).sum::<f64>() / sets.len() as f64;
-        let time: f64 = table[k].iter().map(|c| c.1).sum();
-        let _ = writeln!(md, " {ratio:.4} | {time:.1} |");
+        let time: f64 = table[k].iter().map(|c| c.2).sum::<f64>() / seeds.len() as f64;
+        let lml: f64 = table[k].iter().map(|c| c.3).sum::<f64>() / seeds.len() as f64;
+        let _ = writeln!(md, " {ratio:.4} | {time:.1} | {lml:.1} |");
     }
     Ok(md)
 }

@@ -41,7 +41,7 @@ enum Command {
     /// The paper's simulation study (Fig. 1, Table I): writes docs/results/reproduce-sim.md and its box plot.
     ReproduceSim(reproduce_sim::Args),
     /// Time the gp crate (fit, predict, Cholesky vs peak, sparse vs exact, scikit-learn); print a markdown table.
-    BenchGp(bench_gp::Args),
+    BenchGp(Box<bench_gp::Args>),
     /// Time the local POE identification against SciPy's least_squares on the same data; print a table.
     BenchIdentify(bench_identify::Args),
     /// Convert the IPA UR10 tracker dataset to SPEC measurement CSV.
