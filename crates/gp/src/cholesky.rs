@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::Error;
 use crate::config::JitterConfig;
+use crate::dense::{solve_lower, solve_upper_transposed};
 
 /// Block sizes of the dense Cholesky factorisation of a kernel matrix.
 ///
@@ -174,18 +175,18 @@ impl Factor {
 
     /// `rhs ← L⁻¹ rhs`.
     pub(crate) fn solve_lower_in_place(&self, rhs: MatMut<'_, f64>, par: Par) {
-        triangular_solve::solve_lower_triangular_in_place(self.l.as_ref(), rhs, par);
+        solve_lower(self.l.as_ref(), rhs, par);
     }
 
     /// `rhs ← L⁻ᵀ rhs`.
     pub(crate) fn solve_upper_transposed_in_place(&self, rhs: MatMut<'_, f64>, par: Par) {
-        triangular_solve::solve_upper_triangular_in_place(self.l.transpose(), rhs, par);
+        solve_upper_transposed(self.l.as_ref(), rhs, par);
     }
 
     /// `rhs ← (L Lᵀ)⁻¹ rhs` (R&W Algorithm 2.1, line 3).
     pub(crate) fn solve_in_place(&self, mut rhs: MatMut<'_, f64>, par: Par) {
-        triangular_solve::solve_lower_triangular_in_place(self.l.as_ref(), rhs.as_mut(), par);
-        triangular_solve::solve_upper_triangular_in_place(self.l.transpose(), rhs, par);
+        solve_lower(self.l.as_ref(), rhs.as_mut(), par);
+        solve_upper_transposed(self.l.as_ref(), rhs, par);
     }
 
     /// `ln |L Lᵀ| = 2 Σ ln Lᵢᵢ`.

@@ -12,6 +12,7 @@ use faer::{Accum, Mat, MatRef};
 use rayon::prelude::*;
 
 use crate::config::Parallelism;
+use crate::dense::product;
 use crate::gram::as_matrix;
 use crate::kernel::{Evaluator, Expanded, Prepared};
 
@@ -34,7 +35,7 @@ pub(crate) fn contract_cross(
     let (m, c, dim) = (zm.nrows(), xm.nrows(), zm.ncols());
     let (sz, sx) = (squared_norms(zm), squared_norms(xm));
     let mut h = Mat::zeros(m, c);
-    matmul(h.as_mut(), Accum::Replace, zm, xm.transpose(), 1.0, par);
+    product(h.as_mut(), Accum::Replace, zm, xm.transpose(), 1.0, par);
     let (shape, signal) = (kernel.shape, kernel.signal_variance);
     let additive = z
         .additive

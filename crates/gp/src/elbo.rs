@@ -22,6 +22,7 @@ use crate::Error;
 use crate::cholesky::{Factor, JitterOutcome};
 use crate::config::{JitterConfig, Parallelism};
 use crate::cross_gradient::contract_cross;
+use crate::dense::product;
 use crate::gram::{cross_covariance, prior_variances, training_covariance};
 use crate::kernel::{Evaluator, Expanded, Kernel, Prepared};
 use crate::points::Points;
@@ -160,7 +161,7 @@ pub(crate) fn evidence_lower_bound(
     let mut b_inv = Mat::<f64>::identity(m, m);
     l_b.solve_in_place(b_inv.as_mut(), par);
     let mut wwt = Mat::zeros(m, m);
-    matmul(wwt.as_mut(), Accum::Replace, w.as_ref(), w.transpose(), 1.0, par);
+    product(wwt.as_mut(), Accum::Replace, w.as_ref(), w.transpose(), 1.0, par);
     let identity = |i: usize, j: usize| if i == j { 1.0 } else { 0.0 };
     let mut e = Mat::from_fn(m, m, |i, j| pf * (identity(i, j) - b_inv[(i, j)]) - wwt[(i, j)]);
     let mut cz =
@@ -181,8 +182,8 @@ pub(crate) fn evidence_lower_bound(
         let xc = xp.rows(r.clone());
         let kc = cross_covariance(evaluator, zp, &xc, parallelism);
         let mut mc = Mat::zeros(m, r.len());
-        matmul(mc.as_mut(), Accum::Replace, e.as_ref(), kc.as_ref(), 1.0 / s, par);
-        matmul(mc.as_mut(), Accum::Add, u.as_ref(), rows_of(y, &r).transpose(), 1.0 / s, par);
+        product(mc.as_mut(), Accum::Replace, e.as_ref(), kc.as_ref(), 1.0 / s, par);
+        product(mc.as_mut(), Accum::Add, u.as_ref(), rows_of(y, &r).transpose(), 1.0 / s, par);
         let gc = contract_cross(evaluator, zp, &xc, mc.as_ref(), false, parallelism);
         for (a, b) in g.iter_mut().zip(&gc) {
             *a += b;
@@ -205,7 +206,7 @@ pub(crate) fn evidence_lower_bound(
     let tr_b_inv: f64 = (0..m).map(|i| b_inv[(i, i)]).sum();
     let aw: f64 = (0..p).map(|k| (0..m).map(|i| ay[(i, k)] * w[(i, k)]).sum::<f64>()).sum();
     let mut aat_w = Mat::zeros(m, p);
-    matmul(aat_w.as_mut(), Accum::Replace, aat.as_ref(), w.as_ref(), 1.0, par);
+    product(aat_w.as_mut(), Accum::Replace, aat.as_ref(), w.as_ref(), 1.0, par);
     let waaw: f64 = (0..p).map(|k| (0..m).map(|i| w[(i, k)] * aat_w[(i, k)]).sum::<f64>()).sum();
     g[layout.noise()] = -0.5 * nf * pf + 0.5 * pf * (mf - tr_b_inv) + 0.5 * yy / s - aw
         + 0.5 * waaw

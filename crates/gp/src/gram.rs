@@ -11,8 +11,8 @@
 //! reductions sum one partial vector per column in column order: with faer's products, which
 //! split work by output blocks, the results are the same serial or parallel (tested to the bit).
 
+use crate::dense::product;
 use faer::col::ColMut;
-use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef};
@@ -131,7 +131,14 @@ pub(crate) fn training_covariance(kernel: &Evaluator, x: &Prepared, diagonal: f6
 fn covariance(kernel: &Evaluator, x: &Prepared, z: &Prepared, same: bool, par: Parallelism) -> Mat<f64> {
     let (sx, sz) = (squared_norms(&x.stationary), squared_norms(&z.stationary));
     let mut k = Mat::zeros(x.len(), z.len());
-    matmul(k.as_mut(), Accum::Replace, as_matrix(&x.stationary), as_matrix(&z.stationary).transpose(), 1.0, par.faer());
+    product(
+        k.as_mut(),
+        Accum::Replace,
+        as_matrix(&x.stationary),
+        as_matrix(&z.stationary).transpose(),
+        1.0,
+        par.faer(),
+    );
     let (shape, signal, constant) = (kernel.shape, kernel.signal_variance, kernel.constant);
     let additive =
         x.additive.as_ref().zip(z.additive.as_ref()).map(|(ax, az)| (additive::columns(ax), additive::columns(az)));
@@ -146,7 +153,7 @@ fn covariance(kernel: &Evaluator, x: &Prepared, z: &Prepared, same: bool, par: P
         }
     });
     if let (Some(lx), Some(lz)) = (&x.linear, &z.linear) {
-        matmul(k.as_mut(), Accum::Add, as_matrix(lx), as_matrix(lz).transpose(), 1.0, par.faer());
+        product(k.as_mut(), Accum::Add, as_matrix(lx), as_matrix(lz).transpose(), 1.0, par.faer());
     }
     k
 }
@@ -170,6 +177,8 @@ pub(crate) fn prior_variances(kernel: &Evaluator, z: &Prepared) -> Vec<f64> {
 /// `sym(A) R` where only the lower triangle of `A` is meaningful: `tril(A) R + stril(A)ᵀ R`.
 fn symmetric_product(a: MatRef<'_, f64>, r: MatRef<'_, f64>, par: Parallelism) -> Mat<f64> {
     let mut out = Mat::zeros(a.nrows(), r.ncols());
+    // One column: a matrix–vector product, whose sums faer splits by thread count (crate::dense).
+    let par = if r.ncols() <= 1 { Parallelism::Sequential } else { par };
     triangular::matmul(
         out.as_mut(),
         BlockStructure::Rectangular,

@@ -32,6 +32,7 @@ mod additive;
 mod cholesky;
 mod config;
 mod cross_gradient;
+mod dense;
 mod elbo;
 mod error;
 mod exact;

@@ -10,13 +10,14 @@
 //! `cargo xtask bench-gp --lml-floor 3000` times it against faer's matrix product doing `n³` flops.
 
 use faer::linalg::matmul::triangular::{self, BlockStructure};
-use faer::linalg::{triangular_inverse, triangular_solve};
+use faer::linalg::triangular_inverse;
 use faer::{Accum, Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
 use crate::Error;
 use crate::cholesky::{FactorOptions, cholesky_lower_in_place};
 use crate::config::Parallelism;
+use crate::dense::{solve_lower, solve_upper_transposed};
 use crate::gram::{contract_gradient, fill_training_lower};
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::points::Points;
@@ -155,8 +156,8 @@ pub(crate) fn evaluate_value(
     })?;
     let log_determinant = 2.0 * (0..n).map(|i| factor[(i, i)].ln()).sum::<f64>();
     let mut alpha = y.to_owned();
-    triangular_solve::solve_lower_triangular_in_place(factor.as_ref(), alpha.as_mut(), par);
-    triangular_solve::solve_upper_triangular_in_place(factor.transpose(), alpha.as_mut(), par);
+    solve_lower(factor.as_ref(), alpha.as_mut(), par);
+    solve_upper_transposed(factor.as_ref(), alpha.as_mut(), par);
     let data_fit: f64 = (0..m).map(|c| (0..n).map(|i| y[(i, c)] * alpha[(i, c)]).sum::<f64>()).sum();
     let value =
         -0.5 * data_fit - 0.5 * m as f64 * log_determinant - 0.5 * (n * m) as f64 * (2.0 * std::f64::consts::PI).ln();

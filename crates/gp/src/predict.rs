@@ -1,6 +1,6 @@
 //! Posterior prediction of the exact GP (R&W Algorithm 2.1, Eqs. 2.25–2.26).
 
-use faer::linalg::matmul::matmul;
+use crate::dense::product;
 use faer::{Accum, Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
@@ -65,7 +65,7 @@ impl ExactGp {
             let mut ks = cross_covariance(&c.evaluator, &c.prepared, &zp, self.parallelism);
             // f̄* = K(X, X*)ᵀ α (R&W Eq. 2.25).
             let mut f = Mat::zeros(ns, c.outputs.len());
-            matmul(f.as_mut(), Accum::Replace, ks.transpose(), c.alpha.as_ref(), 1.0, par);
+            product(f.as_mut(), Accum::Replace, ks.transpose(), c.alpha.as_ref(), 1.0, par);
             let noise = if options.include_noise { c.kernel.noise_variance() } else { 0.0 };
             let needs_v = options.variance || options.full_covariance;
             if needs_v {
@@ -88,7 +88,7 @@ impl ExactGp {
             let latent_covariance = options.full_covariance.then(|| {
                 // K** − VᵀV (R&W Eq. 2.26).
                 let mut cov = full_covariance(&c.evaluator, &zp, self.parallelism);
-                matmul(cov.as_mut(), Accum::Add, ks.transpose(), ks.as_ref(), -1.0, par);
+                product(cov.as_mut(), Accum::Add, ks.transpose(), ks.as_ref(), -1.0, par);
                 for i in 0..ns {
                     cov[(i, i)] += noise;
                 }

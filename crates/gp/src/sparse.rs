@@ -12,7 +12,7 @@
 //! The stored model is the posterior itself (inducing inputs, `w` and `L_B`), not the training
 //! data: a model fitted on 100,000 poses reads back in milliseconds.
 
-use faer::linalg::matmul::matmul;
+use crate::dense::product;
 use faer::{Accum, Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
@@ -343,7 +343,7 @@ impl SparseGp {
                 let mut a = cross_covariance(&post.evaluator, &post.inducing, &zp, self.parallelism);
                 post.l_uu.solve_lower_in_place(a.as_mut(), par);
                 let mut f = Mat::zeros(nc, c.outputs.len());
-                matmul(f.as_mut(), Accum::Replace, a.transpose(), post.w.as_ref(), 1.0, par);
+                product(f.as_mut(), Accum::Replace, a.transpose(), post.w.as_ref(), 1.0, par);
                 let mut b = Mat::zeros(0, 0);
                 if options.variance || options.full_covariance {
                     b = a.clone();
@@ -363,8 +363,8 @@ impl SparseGp {
                 };
                 let latent_covariance = options.full_covariance.then(|| {
                     let mut cov = full_covariance(&post.evaluator, &zp, self.parallelism);
-                    matmul(cov.as_mut(), Accum::Add, a.transpose(), a.as_ref(), -1.0, par);
-                    matmul(cov.as_mut(), Accum::Add, b.transpose(), b.as_ref(), 1.0, par);
+                    product(cov.as_mut(), Accum::Add, a.transpose(), a.as_ref(), -1.0, par);
+                    product(cov.as_mut(), Accum::Add, b.transpose(), b.as_ref(), 1.0, par);
                     for i in 0..nc {
                         cov[(i, i)] += noise;
                     }

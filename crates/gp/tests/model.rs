@@ -73,6 +73,43 @@ fn warm_started_fit_is_bit_identical_on_any_pool() {
     }
 }
 
+/// At a realistic size (n = 900), where faer splits a matrix–vector product or a one-column
+/// triangular solve by the thread count (it did from about n = 700 on: `gp::dense`), one
+/// likelihood with its gradient and one prediction: the same to the last bit serially and on pools
+/// of two and four threads. The tests above use sizes faer never splits.
+#[test]
+fn likelihood_gradient_and_prediction_are_bit_identical_on_any_pool_at_a_realistic_size() {
+    let (x, y) = data(7, 900, 6, 1);
+    let (xq, _) = data(8, 40, 6, 1);
+    let additive = KernelChoice::Composite {
+        shape: StationaryShape::SquaredExponential,
+        constant: false,
+        linear: false,
+        additive: true,
+    };
+    for choice in [KernelChoice::SquaredExponentialArd, additive] {
+        let kernel = Kernel::start(choice, 6);
+        let run = |parallelism| {
+            let l = gp::log_marginal_likelihood(&kernel, x.as_ref(), y.as_ref(), true, parallelism).expect("lml");
+            let config = GpConfig { kernel: choice, parallelism, ..GpConfig::default() };
+            let model =
+                ExactGp::fit_fixed(x.as_ref(), y.as_ref(), std::slice::from_ref(&kernel), &config).expect("fit");
+            let p = model.predict(xq.as_ref()).expect("predict");
+            let gradient: Vec<u64> = l.gradient.iter().map(|g| g.to_bits()).collect();
+            (l.value.to_bits(), gradient, bits(&p.mean), bits(&p.variance))
+        };
+        let pool = |threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
+        let serial = run(Parallelism::Sequential);
+        for threads in [2, 4] {
+            let parallel = pool(threads).install(|| run(Parallelism::Rayon));
+            assert_eq!(serial.0, parallel.0, "{choice:?}, {threads} threads: likelihoods differ");
+            assert_eq!(serial.1, parallel.1, "{choice:?}, {threads} threads: gradients differ");
+            assert_eq!(serial.2, parallel.2, "{choice:?}, {threads} threads: means differ");
+            assert_eq!(serial.3, parallel.3, "{choice:?}, {threads} threads: variances differ");
+        }
+    }
+}
+
 #[test]
 fn restarts_are_seeded_and_the_best_start_is_kept() {
     let (x, y) = data(3, 80, 3, 1);
@@ -286,3 +323,4 @@ fn standardisation_is_stored_and_applied_at_prediction() {
         assert!((a.variance[(i, 0)] - b.variance[(i, 0)]).abs() < 1e-10);
     }
 }
+
