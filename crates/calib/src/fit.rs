@@ -141,9 +141,23 @@ fn summarise(
             pipeline::GpFitReport::Sparse(r) => r.components.len(),
         };
         let converged = kernels - gp.gp.unconverged().len();
+        // Where the additive term was weighed (BIC), how often it paid for itself.
+        let additive = match &gp.gp {
+            pipeline::GpFitReport::Exact(r) => {
+                let choices: Vec<bool> =
+                    r.components.iter().filter_map(|c| c.additive_choice.as_ref().map(|a| a.kept)).collect();
+                let kept = choices.iter().filter(|k| **k).count();
+                if choices.is_empty() {
+                    String::new()
+                } else {
+                    format!("; additive term kept (BIC) for {kept} of {}", choices.len())
+                }
+            }
+            pipeline::GpFitReport::Sparse(_) => String::new(),
+        };
         let _ = writeln!(
             out,
-            "  GP: {}, {kernels} kernel(s), hyperparameter search met its tolerance for {converged} of {kernels}",
+            "  GP: {}, {kernels} kernel(s), hyperparameter search met its tolerance for {converged} of {kernels}{additive}",
             compensation.gp.choice()
         );
     }

@@ -121,6 +121,12 @@ pub struct GpConfig {
     pub jitter: JitterConfig,
     /// Serial or rayon.
     pub parallelism: Parallelism,
+    /// With a kernel that has an additive term, also fit it without that term and keep, for each
+    /// kernel (output or shared group), the smaller model unless the additive term raises the log
+    /// marginal likelihood by more than the Schwarz (BIC) penalty `½ k ln N` for its `k = 2d`
+    /// extra hyperparameters and `N` observed values. Off by default in the library; the
+    /// calibration's GP stage turns it on (see `pipeline::CompensationOptions`).
+    pub additive_by_bic: bool,
 }
 
 impl Default for GpConfig {
@@ -134,6 +140,7 @@ impl Default for GpConfig {
             optimiser: OptimiserConfig::default(),
             jitter: JitterConfig::default(),
             parallelism: Parallelism::default(),
+            additive_by_bic: false,
         }
     }
 }

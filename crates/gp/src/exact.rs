@@ -11,7 +11,7 @@ use crate::config::{GpConfig, OutputMode, Parallelism};
 use crate::gram::training_covariance;
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::lml::check_finite_outputs;
-use crate::optimise::{OptimisationReport, fit_hyperparameters};
+use crate::optimise::{OptimisationReport, finish, fit_hyperparameters, warm_stage};
 use crate::points::Points;
 use crate::scaling::{InputStandardiser, OutputNormaliser};
 
@@ -69,6 +69,35 @@ pub struct ComponentReport {
     pub jitter: JitterOutcome,
     /// The hyperparameter search (`None` when the hyperparameters were given).
     pub optimisation: Option<OptimisationReport>,
+    /// The choice between the kernel and its form without the additive term
+    /// ([`GpConfig::additive_by_bic`]; `None` when it was not made).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub additive_choice: Option<AdditiveChoice>,
+}
+
+/// The Schwarz (BIC) choice between a kernel with an additive term and the same kernel without.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AdditiveChoice {
+    /// Log marginal likelihood reached with the additive term.
+    pub with_additive: f64,
+    /// Log marginal likelihood reached without it.
+    pub without_additive: f64,
+    /// `½ k ln N`: `k` the additive term's hyperparameters, `N` the observed values the two
+    /// likelihoods were computed on (`rows` times the outputs served).
+    pub penalty: f64,
+    /// Whether the additive term was kept (`with − without > penalty`).
+    pub kept: bool,
+    /// Rows the two likelihoods were computed on: the warm-start subset when the search has one
+    /// (the choice is made there, and only the chosen kernel is searched on all rows), else all.
+    pub rows: usize,
+}
+
+/// `(a(), b())`, side by side on the rayon pool or one after the other.
+fn both<T: Send>(parallelism: Parallelism, a: impl FnOnce() -> T + Send, b: impl FnOnce() -> T + Send) -> (T, T) {
+    match parallelism {
+        Parallelism::Sequential => (a(), b()),
+        Parallelism::Rayon => rayon::join(a, b),
+    }
 }
 
 enum Hyperparameters<'a> {
@@ -126,24 +155,86 @@ impl ExactGp {
             OutputMode::Independent => (0..m).map(|j| vec![j]).collect(),
             OutputMode::Shared => vec![(0..m).collect()],
         };
-        let fit_group = |(g, cols): (usize, &Vec<usize>)| -> Result<(Component, ComponentReport), Error> {
-            let yg = Mat::from_fn(n, cols.len(), |i, c| yn[(i, cols[c])]);
-            let (kernel, optimisation) = match &how {
-                Hyperparameters::Fixed(kernels) => (kernels[g.min(kernels.len() - 1)].clone(), None),
-                Hyperparameters::Optimise(start) => {
-                    start.validate(xs.dim())?;
-                    let bounds = config.bounds.clone().unwrap_or_else(|| start.default_bounds());
-                    let o =
-                        fit_hyperparameters(start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism)?;
-                    (o.kernel, Some(o.report))
-                }
-            };
+        let search = |start: &Kernel, yg: MatRef<'_, f64>| -> Result<(Kernel, OptimisationReport), Error> {
+            start.validate(xs.dim())?;
+            let bounds = config.bounds.clone().unwrap_or_else(|| start.default_bounds());
+            let o = fit_hyperparameters(start, &bounds, &xs, yg, &config.optimiser, config.parallelism)?;
+            Ok((o.kernel, o.report))
+        };
+        let build = |kernel: Kernel, cols: &Vec<usize>, yg: MatRef<'_, f64>, optimisation| {
             kernel.validate(xs.dim())?;
             let (component, jitter) =
-                Component::build(kernel.clone(), cols.clone(), &xs, yg.as_ref(), None, config, config.parallelism)?;
-            let lml = component.log_marginal_likelihood(yg.as_ref());
-            let report =
-                ComponentReport { outputs: cols.clone(), kernel, log_marginal_likelihood: lml, jitter, optimisation };
+                Component::build(kernel.clone(), cols.clone(), &xs, yg, None, config, config.parallelism)?;
+            let lml = component.log_marginal_likelihood(yg);
+            let report = ComponentReport {
+                outputs: cols.clone(),
+                kernel,
+                log_marginal_likelihood: lml,
+                jitter,
+                optimisation,
+                additive_choice: None,
+            };
+            Ok::<_, Error>((component, report))
+        };
+        let fit_group = |(g, cols): (usize, &Vec<usize>)| -> Result<(Component, ComponentReport), Error> {
+            let yg = Mat::from_fn(n, cols.len(), |i, c| yn[(i, cols[c])]);
+            let start = match &how {
+                Hyperparameters::Fixed(kernels) => {
+                    return build(kernels[g.min(kernels.len() - 1)].clone(), cols, yg.as_ref(), None);
+                }
+                Hyperparameters::Optimise(start) => *start,
+            };
+            let reduced = if config.additive_by_bic { start.without_additive() } else { None };
+            let Some(reduced) = reduced else {
+                let (kernel, report) = search(start, yg.as_ref())?;
+                return build(kernel, cols, yg.as_ref(), Some(report));
+            };
+            // The Schwarz choice: ½ k ln N for the additive term's k extra hyperparameters over
+            // the N = rows · (outputs served) values the two likelihoods are computed on.
+            let k = (start.parameter_count() - reduced.parameter_count()) as f64;
+            let penalty = |rows: usize| 0.5 * k * ((rows * cols.len()) as f64).ln();
+            let bounds_of = |k: &Kernel| config.bounds.clone().unwrap_or_else(|| k.default_bounds());
+            // With a warm-start subset, both kernels are searched there and the choice is made
+            // on the subset's likelihoods; only the chosen kernel is searched on all rows.
+            let warm_of = |k: &Kernel| {
+                k.validate(xs.dim())?;
+                warm_stage(k, &bounds_of(k), &xs, yg.as_ref(), &config.optimiser, config.parallelism)
+            };
+            let warm = both(config.parallelism, || warm_of(start), || warm_of(&reduced));
+            if let (Some(with), Some(without)) = (warm.0?, warm.1?) {
+                let rows = with.rows();
+                let (a, b) = (with.best_log_marginal_likelihood(), without.best_log_marginal_likelihood());
+                let kept = a - b > penalty(rows);
+                let choice =
+                    AdditiveChoice { with_additive: a, without_additive: b, penalty: penalty(rows), kept, rows };
+                let (chosen, stage) = if kept { (start, with) } else { (&reduced, without) };
+                let o = finish(
+                    chosen,
+                    &bounds_of(chosen),
+                    &xs,
+                    yg.as_ref(),
+                    &config.optimiser,
+                    config.parallelism,
+                    Some(stage),
+                )?;
+                let (component, mut report) = build(o.kernel, cols, yg.as_ref(), Some(o.report))?;
+                report.additive_choice = Some(choice);
+                return Ok((component, report));
+            }
+            let (full, small) =
+                both(config.parallelism, || search(start, yg.as_ref()), || search(&reduced, yg.as_ref()));
+            let ((full_kernel, full_report), (small_kernel, small_report)) = (full?, small?);
+            let with = build(full_kernel, cols, yg.as_ref(), Some(full_report))?;
+            let without = build(small_kernel, cols, yg.as_ref(), Some(small_report))?;
+            let choice = AdditiveChoice {
+                with_additive: with.1.log_marginal_likelihood,
+                without_additive: without.1.log_marginal_likelihood,
+                penalty: penalty(n),
+                kept: with.1.log_marginal_likelihood - without.1.log_marginal_likelihood > penalty(n),
+                rows: n,
+            };
+            let (component, mut report) = if choice.kept { with } else { without };
+            report.additive_choice = Some(choice);
             Ok((component, report))
         };
         let fitted: Vec<_> = match config.parallelism {

@@ -52,7 +52,7 @@ pub use cholesky::{FactorOptions, JitterOutcome};
 pub use config::{GpConfig, JitterConfig, OptimiserConfig, OutputMode, Parallelism};
 pub use elbo::sparse_evidence_lower_bound;
 pub use error::Error;
-pub use exact::{ComponentReport, ExactGp, FitReport};
+pub use exact::{AdditiveChoice, ComponentReport, ExactGp, FitReport};
 pub use inducing::InducingSelection;
 pub use kernel::{
     AdditiveTerm, Bounds, CompositeKernel, Kernel, KernelChoice, Matern52Ard, QuadraticKernel, SquaredExponentialArd,

@@ -128,15 +128,37 @@ fn best(results: &[Option<lbfgsb::Minimum>]) -> Option<(usize, &lbfgsb::Minimum)
     best
 }
 
-/// Maximises the log marginal likelihood of `y` (n × m, all columns sharing the kernel).
-pub(crate) fn fit_hyperparameters(
-    start: &Kernel,
-    bounds: &Bounds,
-    x: &Points,
-    y: MatRef<'_, f64>,
-    config: &OptimiserConfig,
-    parallelism: Parallelism,
-) -> Result<Optimised, Error> {
+/// The searches of every start on the warm-start subset, before the one full-data search.
+#[derive(Debug, Clone)]
+pub(crate) struct WarmStage {
+    results: Vec<Option<lbfgsb::Minimum>>,
+    rows: usize,
+    evaluations: usize,
+    best: usize,
+}
+
+impl WarmStage {
+    /// The highest log marginal likelihood a start reached on the subset.
+    pub(crate) fn best_log_marginal_likelihood(&self) -> f64 {
+        self.results[self.best].as_ref().map_or(f64::NEG_INFINITY, |m| -m.f)
+    }
+
+    /// Rows of the subset.
+    pub(crate) fn rows(&self) -> usize {
+        self.rows
+    }
+}
+
+/// The search's box (log-parameters), starting points and settings for `start`.
+struct Prepared {
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    starts: Vec<Vec<f64>>,
+    settings: Settings,
+}
+
+/// The search's settings and box for `start`.
+fn prepare(start: &Kernel, bounds: &Bounds, config: &OptimiserConfig) -> Result<Prepared, Error> {
     let (lower, upper) = bounds.to_log(start)?;
     let nested: Vec<Vec<f64>> = start.nested_starts().iter().map(Kernel::log_parameters).collect();
     let starts = starting_points(&start.log_parameters(), &nested, &lower, &upper, config);
@@ -146,22 +168,74 @@ pub(crate) fn fit_hyperparameters(
         gradient_tolerance: config.gradient_tolerance,
         function_tolerance: config.function_tolerance,
     };
+    Ok(Prepared { lower, upper, starts, settings })
+}
+
+/// Every start searched on the warm-start subset (`None` when the configuration has no subset or
+/// the data are no larger than it).
+pub(crate) fn warm_stage(
+    start: &Kernel,
+    bounds: &Bounds,
+    x: &Points,
+    y: MatRef<'_, f64>,
+    config: &OptimiserConfig,
+    parallelism: Parallelism,
+) -> Result<Option<WarmStage>, Error> {
     let n = x.len();
     let warm = config.warm_start_rows;
-    let (results, warm_rows, warm_evaluations, full) = if warm > 0 && n > warm {
-        let idx = random_indices(n, warm, config.seed);
-        let xs = x.select(&idx);
-        let ys = Mat::from_fn(idx.len(), y.ncols(), |i, j| y[(idx[i], j)]);
-        let sub = search_all(start, &starts, (&lower, &upper), &xs, ys.as_ref(), &settings, parallelism);
-        let Some((_, from)) = best(&sub) else {
-            return Err(Error::OptimisationFailed { starts: starts.len() });
-        };
-        let evaluations = sub.iter().flatten().map(|m| m.evaluations).sum();
-        let full = search_all(start, std::slice::from_ref(&from.x), (&lower, &upper), x, y, &settings, parallelism);
-        (sub, idx.len(), evaluations, full.into_iter().next().flatten())
-    } else {
-        let results = search_all(start, &starts, (&lower, &upper), x, y, &settings, parallelism);
-        (results, 0, 0, None)
+    if warm == 0 || n <= warm {
+        return Ok(None);
+    }
+    let Prepared { lower, upper, starts, settings } = prepare(start, bounds, config)?;
+    let idx = random_indices(n, warm, config.seed);
+    let xs = x.select(&idx);
+    let ys = Mat::from_fn(idx.len(), y.ncols(), |i, j| y[(idx[i], j)]);
+    let results = search_all(start, &starts, (&lower, &upper), &xs, ys.as_ref(), &settings, parallelism);
+    let Some((best, _)) = best(&results) else {
+        return Err(Error::OptimisationFailed { starts: starts.len() });
+    };
+    let evaluations = results.iter().flatten().map(|m| m.evaluations).sum();
+    Ok(Some(WarmStage { results, rows: idx.len(), evaluations, best }))
+}
+
+/// Maximises the log marginal likelihood of `y` (n × m, all columns sharing the kernel).
+pub(crate) fn fit_hyperparameters(
+    start: &Kernel,
+    bounds: &Bounds,
+    x: &Points,
+    y: MatRef<'_, f64>,
+    config: &OptimiserConfig,
+    parallelism: Parallelism,
+) -> Result<Optimised, Error> {
+    let warm = warm_stage(start, bounds, x, y, config, parallelism)?;
+    finish(start, bounds, x, y, config, parallelism, warm)
+}
+
+/// The full-data search: from the warm stage's best optimum when there is one, else from every
+/// start.
+pub(crate) fn finish(
+    start: &Kernel,
+    bounds: &Bounds,
+    x: &Points,
+    y: MatRef<'_, f64>,
+    config: &OptimiserConfig,
+    parallelism: Parallelism,
+    warm: Option<WarmStage>,
+) -> Result<Optimised, Error> {
+    let Prepared { lower, upper, starts, settings } = prepare(start, bounds, config)?;
+    let (results, warm_rows, warm_evaluations, full) = match warm {
+        Some(stage) => {
+            let from = stage.results[stage.best]
+                .as_ref()
+                .map(|m| m.x.clone())
+                .ok_or(Error::OptimisationFailed { starts: starts.len() })?;
+            let full = search_all(start, std::slice::from_ref(&from), (&lower, &upper), x, y, &settings, parallelism);
+            (stage.results, stage.rows, stage.evaluations, full.into_iter().next().flatten())
+        }
+        None => {
+            let results = search_all(start, &starts, (&lower, &upper), x, y, &settings, parallelism);
+            (results, 0, 0, None)
+        }
     };
     let Some((best_start, best_minimum)) = best(&results) else {
         return Err(Error::OptimisationFailed { starts: starts.len() });

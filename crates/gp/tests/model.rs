@@ -324,3 +324,55 @@ fn standardisation_is_stored_and_applied_at_prediction() {
     }
 }
 
+/// `additive_by_bic`: a one-dimensional short-scale feature (a gear's periodic error along one
+/// input) keeps the additive term; a smooth function of all inputs together does not pay its
+/// `½ · 2d · ln n` and gets the kernel without it. Either way the report holds both likelihoods.
+#[test]
+fn the_additive_term_is_kept_only_where_bic_says_it_pays() {
+    let n = 160;
+    let d = 3;
+    let mut r = rng(11);
+    let x = uniform_points(&mut r, n, d, -2.0, 2.0);
+    let noise = |i: usize| 0.01 * (((i * 37) % 11) as f64 - 5.0);
+    let smooth = |i: usize| (0.7 * x[(i, 0)] + 0.4 * x[(i, 1)] - 0.3 * x[(i, 2)]).sin();
+    let periodic = Mat::from_fn(n, 1, |i, _| smooth(i) + 0.5 * (12.0 * x[(i, 2)]).sin() + noise(i));
+    let plain = Mat::from_fn(n, 1, |i, _| smooth(i) + noise(i));
+    let kernel = KernelChoice::Composite {
+        shape: StationaryShape::SquaredExponential,
+        constant: false,
+        linear: false,
+        additive: true,
+    };
+    let config = GpConfig { kernel, additive_by_bic: true, ..GpConfig::default() };
+    let choice = |y: &Mat<f64>| {
+        let model = ExactGp::fit(x.as_ref(), y.as_ref(), &config).expect("fit");
+        let report = &model.report().components[0];
+        let c = report.additive_choice.clone().expect("the choice is reported");
+        assert!((c.penalty - 0.5 * (2 * d) as f64 * (n as f64).ln()).abs() < 1e-12, "{c:?}");
+        assert_eq!(c.kept, c.with_additive - c.without_additive > c.penalty, "{c:?}");
+        let has_additive = matches!(&report.kernel, Kernel::Composite(k) if k.additive.is_some());
+        assert_eq!(has_additive, c.kept, "{c:?}");
+        c
+    };
+    let periodic_choice = choice(&periodic);
+    assert!(periodic_choice.kept, "{periodic_choice:?}");
+    let plain_choice = choice(&plain);
+    assert!(!plain_choice.kept, "{plain_choice:?}");
+    assert_eq!((periodic_choice.rows, plain_choice.rows), (n, n));
+    // With a warm-start subset the choice is made on the subset, and only the chosen kernel is
+    // searched on all rows.
+    let warm =
+        GpConfig { optimiser: OptimiserConfig { warm_start_rows: 120, ..config.optimiser.clone() }, ..config.clone() };
+    for (y, expect_kept) in [(&periodic, true), (&plain, false)] {
+        let model = ExactGp::fit(x.as_ref(), y.as_ref(), &warm).expect("fit");
+        let report = &model.report().components[0];
+        let c = report.additive_choice.clone().expect("the choice is reported");
+        assert_eq!((c.rows, c.kept), (120, expect_kept), "{c:?}");
+        assert!((c.penalty - 0.5 * (2 * d) as f64 * 120f64.ln()).abs() < 1e-12, "{c:?}");
+        assert_eq!(report.optimisation.as_ref().map(|o| o.warm_start_rows), Some(120));
+        assert_eq!(matches!(&report.kernel, Kernel::Composite(k) if k.additive.is_some()), expect_kept);
+    }
+    let off =
+        ExactGp::fit(x.as_ref(), plain.as_ref(), &GpConfig { additive_by_bic: false, ..config.clone() }).expect("fit");
+    assert!(off.report().components[0].additive_choice.is_none());
+}

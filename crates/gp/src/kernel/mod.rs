@@ -270,6 +270,17 @@ impl Kernel {
         Bounds { lower: expand(|b| b.0), upper: expand(|b| b.1) }
     }
 
+    /// The smaller model this kernel contains without its additive term (`None` when it has
+    /// none): the candidate of [`crate::GpConfig::additive_by_bic`].
+    pub(crate) fn without_additive(&self) -> Option<Kernel> {
+        match self {
+            Self::Composite(k) if k.additive.is_some() => {
+                Some(Self::Composite(CompositeKernel { additive: None, ..k.clone() }))
+            }
+            _ => None,
+        }
+    }
+
     /// Further deterministic starts for a search from this kernel: the same kernel with its
     /// optional extra terms nearly switched off, so that the search also follows the path of the
     /// smaller model it contains and its optimum cannot end far below that model's.
