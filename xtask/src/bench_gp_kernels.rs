@@ -27,8 +27,9 @@ pub struct KernelArgs {
     /// runs with a tool each; 300 poses to train on, 1000 to test, interleaved).
     #[arg(long, value_delimiter = ',', default_value = "1,2")]
     pub payload_run_seeds: Vec<u64>,
-    /// Only the sets whose name contains one of these (case-sensitive); all when empty.
-    #[arg(long, value_delimiter = ',')]
+    /// Only the sets whose name contains one of these (case-sensitive), separated by `;` (set names
+    /// contain commas); all when none is given. A selection that matches no set is refused.
+    #[arg(long, value_delimiter = ';')]
     pub only: Vec<String>,
     /// With `--kernels`: only the candidate kernels whose name is one of these exactly; all when
     /// empty.
@@ -57,8 +58,14 @@ pub struct KernelArgs {
 }
 
 impl KernelArgs {
+    /// The non-empty `--only` patterns (an empty one would match every set).
+    fn patterns(&self) -> Vec<&str> {
+        self.only.iter().map(|o| o.trim()).filter(|o| !o.is_empty()).collect()
+    }
+
     fn wanted(&self, name: &str) -> bool {
-        self.only.is_empty() || self.only.iter().any(|o| name.contains(o.as_str()))
+        let patterns = self.patterns();
+        patterns.is_empty() || patterns.iter().any(|o| name.contains(o))
     }
 }
 
@@ -140,6 +147,9 @@ pub fn data_sets(args: &KernelArgs) -> Result<Vec<Residuals>, String> {
         if args.wanted(&set.name) {
             sets.push(set);
         }
+    }
+    if sets.is_empty() && !args.patterns().is_empty() {
+        return Err(format!("--only {:?} matches no data set", args.only));
     }
     Ok(sets)
 }
