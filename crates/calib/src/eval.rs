@@ -48,6 +48,16 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     if let (Some(mean), Some(max)) = (s.mean_rotation_error_mrad, s.max_rotation_error_mrad) {
         println!("  rotation error: mean {mean:.4} mrad, max {max:.4} mrad");
     }
+    if let Some(split) = &report.coverage {
+        for (what, part) in [("inside", &split.inside), ("outside", &split.outside)] {
+            if part.n > 0 {
+                println!(
+                    "  {what} the angles the effects were fitted on: {} rows, mean {:.4} mm, max {:.4} mm",
+                    part.n, part.mean_position_error_mm, part.max_position_error_mm
+                );
+            }
+        }
+    }
     for warning in &report.warnings {
         println!("  warning: {warning}");
     }

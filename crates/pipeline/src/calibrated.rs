@@ -27,6 +27,12 @@ pub struct CalibratedModel {
     /// it and before the GP, in one left exponential of the sum of their twists.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub effects: Vec<IdentifiedEffect>,
+    /// The geometry fitted alone, before the effects were identified with it: outside the joint
+    /// angles an effect was fitted on, the model blends to it ([`Part::Fallback`]), so that where
+    /// the effects know nothing the model is no worse than the geometric fit. Absent in files
+    /// written before it was kept (the fitted geometry is then used everywhere).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback_kinematics: Option<LocalPoe>,
     /// The GP compensation of the residual (methods `poe-gp`, `poe-gp-load`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compensation: Option<crate::Compensation>,
@@ -69,6 +75,9 @@ impl CalibratedModel {
     pub fn parts(&self) -> Vec<Part<'_>> {
         let mut parts = vec![Part::Geometry(&self.kinematics)];
         parts.extend(self.effects.iter().map(Part::Effect));
+        if !self.effects.is_empty() {
+            parts.extend(self.fallback_kinematics.iter().map(Part::Fallback));
+        }
         parts.extend(self.compensation.iter().map(Part::GaussianProcess));
         parts
     }
@@ -78,9 +87,12 @@ impl CalibratedModel {
     pub fn without_part(&self, index: usize) -> CalibratedModel {
         let mut model = self.clone();
         let effects = self.effects.len();
+        let fallback = usize::from(self.fallback_kinematics.is_some() && effects > 0);
         if (1..=effects).contains(&index) {
             model.effects.remove(index - 1);
-        } else if index == effects + 1 {
+        } else if fallback == 1 && index == effects + 1 {
+            model.fallback_kinematics = None;
+        } else if index == effects + fallback + 1 {
             model.compensation = None;
         }
         model
@@ -89,7 +101,7 @@ impl CalibratedModel {
     /// The model without its non-geometric parts (effects, the GP): the geometry alone, which is
     /// what a URDF can hold (`calib export`).
     pub fn geometry_only(&self) -> CalibratedModel {
-        CalibratedModel { effects: Vec::new(), compensation: None, ..self.clone() }
+        CalibratedModel { effects: Vec::new(), fallback_kinematics: None, compensation: None, ..self.clone() }
     }
 
     /// The names of the parts a URDF cannot hold, in the order they apply.
@@ -169,6 +181,19 @@ impl std::fmt::Display for ExtrapolationWarning {
 }
 
 impl CalibratedModel {
+    /// Whether any effect records the joint angles it was fitted on.
+    pub fn records_coverage(&self) -> bool {
+        self.effects.iter().any(|e| e.angle_coverage().is_some())
+    }
+
+    /// Whether `row` lies within the angles every effect was fitted on.
+    pub fn covers(&self, row: &Measurement) -> bool {
+        self.effects
+            .iter()
+            .filter_map(IdentifiedEffect::angle_coverage)
+            .all(|gear| row.q.get(gear.joint).is_none_or(|&q| gear.covers(q)))
+    }
+
     /// One warning per effect that `rows` use outside the joint angles it was fitted on.
     pub fn extrapolation(&self, rows: &[Measurement]) -> Vec<ExtrapolationWarning> {
         self.effects
@@ -183,7 +208,7 @@ impl CalibratedModel {
                     effect: effect.label(),
                     joint: joint + 1,
                     fitted_range_rad: [low, high],
-                    gaps_rad: gear.fitted_gaps.clone(),
+                    gaps_rad: if gear.taper_rad.is_some() { gear.turn_gaps.clone() } else { gear.fitted_gaps.clone() },
                     rows_outside: outside.len(),
                     rows: rows.len(),
                     first_line: first.line,

@@ -2,7 +2,9 @@
 //! `mean_position_error_mm`, `rms_position_error_mm`, `max_position_error_mm`, and for
 //! full-pose data `mean_rotation_error_mrad`) and what identifies the run.
 
-use crate::{CalibratedModel, ErrorSummary, Evaluation, ExtrapolationWarning, FileFormat, MeasurementSet, Method};
+use crate::{
+    CalibratedModel, ErrorSummary, Evaluation, ExtrapolationWarning, FileFormat, MeasurementSet, Method, PoseError,
+};
 use serde::Serialize;
 
 /// The evaluation of a model on one measurement file.
@@ -21,8 +23,22 @@ pub struct EvalReport {
     pub errors: ErrorSummary,
     /// How the measurement file was written.
     pub format: FileFormat,
+    /// The errors on the rows inside the model's coverage (every effect's joint within the
+    /// angles it was fitted on) and on the others, apart: the model is on firm ground only on
+    /// the first. `None` for a model without effects that record their angles.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub coverage: Option<CoverageSplit>,
     /// Effects used outside the joint angles they were fitted on.
     pub warnings: Vec<ExtrapolationWarning>,
+}
+
+/// The errors inside and outside a model's coverage.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CoverageSplit {
+    /// Rows whose every effect is within the angles it was fitted on.
+    pub inside: ErrorSummary,
+    /// The other rows: there the effects fade out and the model falls back to the geometry.
+    pub outside: ErrorSummary,
 }
 
 impl EvalReport {
@@ -35,6 +51,14 @@ impl EvalReport {
             full_pose: data.full_pose,
             errors: evaluation.summary,
             format: data.format.clone(),
+            coverage: model.records_coverage().then(|| {
+                let (inside, outside): (Vec<_>, Vec<_>) =
+                    data.rows.iter().zip(&evaluation.errors).partition(|(row, _)| model.covers(row));
+                let summary = |part: Vec<(_, &PoseError)>| {
+                    ErrorSummary::from_errors(&part.into_iter().map(|(_, e)| *e).collect::<Vec<_>>())
+                };
+                CoverageSplit { inside: summary(inside), outside: summary(outside) }
+            }),
             warnings: model.extrapolation(&data.rows),
         }
     }

@@ -102,8 +102,9 @@ fn build_effects(
     robot: &RobotDescription,
     kinematics: &poe::LocalPoe,
     data: &MeasurementSet,
+    gear: &crate::effects::GearOptions,
 ) -> Result<Vec<IdentifiedEffect>, Error> {
-    let context = EffectContext { robot, kinematics };
+    let context = EffectContext { robot, kinematics, gear: *gear };
     let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
     specs.iter().map(|spec| IdentifiedEffect::new(spec, &context, &data.rows, &tools)).collect()
 }
@@ -130,6 +131,7 @@ pub fn fit(
         tools: data.tools.clone(),
         kinematics: geometry.model,
         effects: Vec::new(),
+        fallback_kinematics: None,
         compensation: None,
     };
     let mut identification = geometry.report;
@@ -146,7 +148,7 @@ pub fn fit(
         }
     };
     if !specs.is_empty() {
-        let mut effects = build_effects(&specs, robot, &model.kinematics, data)?;
+        let mut effects = build_effects(&specs, robot, &model.kinematics, data, &options.effects.gear)?;
         let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
         let correction = EffectCorrection::new(&effects, &data.rows, &tools, options.effects.prior_sigma)?;
         let layout = model.kinematics.layout();
@@ -160,7 +162,7 @@ pub fn fit(
             identify_with_correction(&model.kinematics, &observations(data), &mask, Some(&correction), &id_options)?;
         EffectCorrection::distribute(&mut effects, &fitted.correction);
         effect_report = effect_reports(&effects, &fitted.report.held_at_prior);
-        model.kinematics = fitted.model;
+        model.fallback_kinematics = Some(std::mem::replace(&mut model.kinematics, fitted.model));
         model.effects = effects;
         identification = fitted.report;
     }
@@ -173,8 +175,13 @@ pub fn fit(
         model.compensation = Some(fitted);
         compensation = Some(report);
     }
-    let registered =
-        CalibratedModel { kinematics: geometry.registered, effects: Vec::new(), compensation: None, ..model.clone() };
+    let registered = CalibratedModel {
+        kinematics: geometry.registered,
+        effects: Vec::new(),
+        fallback_kinematics: None,
+        compensation: None,
+        ..model.clone()
+    };
     let before = evaluate(&registered, data)?.summary;
     let after = evaluate(&model, data)?.summary;
     let mut warnings = Vec::new();

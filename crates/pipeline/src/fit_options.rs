@@ -35,6 +35,8 @@ pub struct EffectOptions {
     /// through the gravity-torque regressors (81 parameters, condition number 1e9) took 64 to 98
     /// Levenberg–Marquardt iterations to meet the cost or gradient criterion.
     pub max_iterations: usize,
+    /// How gear series are held and faded outside the angles they were fitted on.
+    pub gear: crate::effects::GearOptions,
     /// The diagnosis that `auto` runs on the training data.
     pub diagnose: DiagnoseOptions,
 }
@@ -46,6 +48,7 @@ impl Default for EffectOptions {
             prior_sigma: 1e-3,
             solver: Solver::LevenbergMarquardt,
             max_iterations: 300,
+            gear: crate::effects::GearOptions::default(),
             diagnose: DiagnoseOptions::default(),
         }
     }
@@ -154,6 +157,7 @@ impl FitOptions {
             };
             return Err((last, format!("compensation.gp.{field} is {value}, expected {expected}")));
         }
+        self.effects.gear.validate()?;
         let prior = self.effects.prior_sigma;
         if prior.is_nan() || prior <= 0.0 {
             return Err((

@@ -42,7 +42,7 @@ pub use compensation::{
     UnknownGpChoice,
 };
 pub use error::Error;
-pub use eval_report::EvalReport;
+pub use eval_report::{CoverageSplit, EvalReport};
 pub use fit::{Evaluation, FitReport, FitWarning, evaluate, fit, tool_indices};
 pub use fit_options::{EffectOptions, FitOptions};
 pub use inverse::{InverseOptions, PoseTarget, Solved, TargetStatus, solve_targets};

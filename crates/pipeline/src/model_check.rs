@@ -159,6 +159,7 @@ impl CalibratedModel {
             let field = match part {
                 Part::Geometry(_) => "kinematics",
                 Part::Effect(_) => "effects",
+                Part::Fallback(_) => "fallback_kinematics",
                 Part::GaussianProcess(_) => "compensation",
             };
             let why = applied

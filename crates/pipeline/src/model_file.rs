@@ -126,6 +126,7 @@ mod version_1 {
                 tools: v1.tools,
                 kinematics: v1.kinematics,
                 effects,
+                fallback_kinematics: None,
                 compensation: v1.compensation,
             }
         }

@@ -20,6 +20,10 @@ pub enum Part<'a> {
     Geometry(&'a LocalPoe),
     /// A non-geometric effect identified with the geometry.
     Effect(&'a IdentifiedEffect),
+    /// The geometry fitted alone, before the effects: where an effect fades out (outside the
+    /// joint angles it was fitted on) the pose blends from the geometry-and-effects fit to this
+    /// one, so that far from the training angles the model is the plain geometric fit.
+    Fallback(&'a LocalPoe),
     /// The Gaussian-process compensation of what is left.
     GaussianProcess(&'a Compensation),
 }
@@ -30,13 +34,16 @@ impl<'a> Part<'a> {
         match self {
             Part::Geometry(_) => "geometry".into(),
             Part::Effect(effect) => effect.label(),
+            Part::Fallback(_) => "geometry_fallback".into(),
             Part::GaussianProcess(_) => "gaussian_process".into(),
         }
     }
 
-    /// Whether a URDF can hold the part (only the geometry).
+    /// Whether a URDF can hold the part: the geometry, and the fallback geometry, which changes
+    /// nothing on the joint angles the effects were fitted on (a URDF holds one geometry; the
+    /// exported one is the geometry fitted with the effects).
     pub fn in_urdf(&self) -> bool {
-        matches!(self, Part::Geometry(_))
+        matches!(self, Part::Geometry(_) | Part::Fallback(_))
     }
 
     /// Applies the part to the state of a walk over `rows`.
@@ -51,11 +58,28 @@ impl<'a> Part<'a> {
                     .map(|(row, &tool)| kinematics.forward(&row.q, tool))
                     .collect::<Result<_, _>>()?;
                 walk.pending = vec![Vector6::zeros(); walk.rows.len()];
+                walk.coverage = vec![1.0; walk.rows.len()];
             }
             Part::Effect(effect) => {
                 let kinematics = walk.kinematics.ok_or(Error::PartOrder { part: "effect" })?;
-                for ((pending, row), &tool) in walk.pending.iter_mut().zip(walk.rows).zip(walk.tools) {
+                for (((pending, coverage), row), &tool) in
+                    walk.pending.iter_mut().zip(&mut walk.coverage).zip(walk.rows).zip(walk.tools)
+                {
                     *pending += effect.twist(kinematics, row, tool)?;
+                    *coverage *= effect.coverage_weight(row);
+                }
+            }
+            Part::Fallback(fallback) => {
+                walk.flush();
+                for (((pose, coverage), row), &tool) in
+                    walk.poses.iter_mut().zip(&walk.coverage).zip(walk.rows).zip(walk.tools)
+                {
+                    if *coverage < 1.0 {
+                        // T = exp(w · log(T_e T_g⁻¹)) T_g: the geometry alone at w = 0.
+                        let alone = fallback.forward(&row.q, tool)?;
+                        let towards = (*pose * alone.inverse()).log().to_vector() * *coverage;
+                        *pose = Twist::from_vector(&towards).exp() * alone;
+                    }
                 }
             }
             Part::GaussianProcess(compensation) => {
@@ -82,12 +106,15 @@ pub(crate) struct Walk<'a> {
     kinematics: Option<&'a LocalPoe>,
     pub(crate) poses: Vec<SE3>,
     pending: Vec<Vector6>,
+    /// How far each row lies within the angles every effect so far was fitted on: the product
+    /// of their [`IdentifiedEffect::coverage_weight`]s.
+    coverage: Vec<f64>,
     pub(crate) std: Option<Vec<[f64; 6]>>,
 }
 
 impl<'a> Walk<'a> {
     pub(crate) fn new(rows: &'a [Measurement], tools: &'a [usize]) -> Self {
-        Self { rows, tools, kinematics: None, poses: Vec::new(), pending: Vec::new(), std: None }
+        Self { rows, tools, kinematics: None, poses: Vec::new(), pending: Vec::new(), coverage: Vec::new(), std: None }
     }
 
     /// Whether every number of the walk so far (poses, pending twists, GP deviations) is finite,

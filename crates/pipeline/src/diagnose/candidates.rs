@@ -139,7 +139,8 @@ pub(crate) fn build_candidates(
     let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
     // The nominal arm in the base frame, where gravity is known, with the calibrated tools placed
     // on its flange (the payload hangs from them).
-    let load = EffectContext { robot, kinematics: model }.load_frame(&data.rows, &tools)?;
+    let load = EffectContext { robot, kinematics: model, gear: crate::effects::GearOptions::default() }
+        .load_frame(&data.rows, &tools)?;
     let dynamics = robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(robot));
     let measured = has_torques(&data.rows);
     let nonzero = |columns: &[Vec<f64>]| columns.iter().flatten().any(|v| v.abs() > 1e-12);

@@ -39,7 +39,7 @@ impl EffectCorrection {
             })
             .collect::<Result<_, Error>>()?;
         Ok(Self {
-            prior_sigma: vec![prior_sigma; directions.len()],
+            prior_sigma: effects.iter().flat_map(IdentifiedEffect::prior_scale).map(|s| s * prior_sigma).collect(),
             directions,
             features,
             q: rows.iter().map(|r| r.q.clone()).collect(),

@@ -25,7 +25,7 @@ pub use backlash::{Backlash, TorqueSign};
 pub use compliance::{ComplianceTerm, ComplianceTorque, JointCompliance, TorqueFit};
 pub use direction::Direction;
 pub use drift::TimeDrift;
-pub use gear::GearPeriodic;
+pub use gear::{GearOptions, GearPeriodic};
 pub use load_frame::LoadFrame;
 pub(crate) use report::effect_reports;
 pub use report::{EffectReport, ParameterReport};
@@ -96,6 +96,8 @@ pub struct EffectContext<'a> {
     pub robot: &'a RobotDescription,
     /// The calibrated kinematics (reference frame: the tracker).
     pub kinematics: &'a LocalPoe,
+    /// How gear series fade outside their fitted angles.
+    pub gear: GearOptions,
 }
 
 impl EffectContext<'_> {
@@ -135,9 +137,12 @@ impl IdentifiedEffect {
                     JointCompliance::new(ComplianceTorque::GravityRegressor(load), &joints, rows, tools)?
                 })
             }
-            EffectSpec::GearPeriodic { harmonics, .. } => {
-                IdentifiedEffect::GearPeriodic(GearPeriodic::new(joint, (1..=harmonics).collect(), rows)?)
-            }
+            EffectSpec::GearPeriodic { harmonics, .. } => IdentifiedEffect::GearPeriodic(GearPeriodic::with_options(
+                joint,
+                (1..=harmonics).collect(),
+                rows,
+                &context.gear,
+            )?),
             EffectSpec::Backlash { .. } => {
                 let sign = if has_torques(rows) {
                     TorqueSign::Measured
@@ -189,6 +194,15 @@ impl IdentifiedEffect {
         match self {
             IdentifiedEffect::GearPeriodic(e) if e.fitted_range.is_some() => Some(e),
             _ => None,
+        }
+    }
+
+    /// How fully the effect applies at `row`: 1 on the joint angles it was fitted on, fading to 0
+    /// outside them (a gear series, [`GearPeriodic::held_and_weight`]); 1 for every other effect.
+    pub fn coverage_weight(&self, row: &Measurement) -> f64 {
+        match self {
+            IdentifiedEffect::GearPeriodic(g) => row.q.get(g.joint).map_or(1.0, |&q| g.held_and_weight(q).1),
+            _ => 1.0,
         }
     }
 
@@ -252,6 +266,15 @@ impl IdentifiedEffect {
     /// A name for each parameter (1-based joints), for reports.
     pub fn parameter_names(&self) -> Vec<String> {
         self.regressor().parameter_names()
+    }
+
+    /// Each parameter's prior standard deviation relative to the effects' common one (1 but for
+    /// a gear series' higher harmonics, [`GearPeriodic::prior_scale`]).
+    pub(crate) fn prior_scale(&self) -> Vec<f64> {
+        match self {
+            IdentifiedEffect::GearPeriodic(g) => g.prior_scale(),
+            _ => vec![1.0; self.parameter_count()],
+        }
     }
 
     /// The twist of each parameter.
