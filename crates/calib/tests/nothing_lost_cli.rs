@@ -305,3 +305,26 @@ fn a_killed_simulate_leaves_the_old_file_or_the_whole_new_one() {
         assert!(text.ends_with('\n'));
     }
 }
+
+#[test]
+fn diagnose_refuses_a_report_folder_whose_files_are_its_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let (robot, data, _) = cell(dir.path());
+    // The measurements named as the report's own markdown file.
+    let data_as_report = dir.path().join("diagnosis.md");
+    std::fs::rename(&data, &data_as_report).unwrap();
+    let bytes = std::fs::read(&data_as_report).unwrap();
+    let out =
+        calib(&["diagnose", "--robot", &text(&robot), "--data", &text(&data_as_report), "--report", &text(dir.path())]);
+    let message = refused(&out, "diagnose --report holding --data");
+    assert_eq!(
+        message,
+        format!(
+            "error: --report {} is the same file as --data {}: refusing to overwrite an input",
+            text(&data_as_report),
+            text(&data_as_report)
+        )
+    );
+    assert_eq!(std::fs::read(&data_as_report).unwrap(), bytes);
+    assert_eq!(names(dir.path()), ["diagnosis.md", "model.ron", "robot.ron"], "no plot written either");
+}
