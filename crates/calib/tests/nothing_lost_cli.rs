@@ -200,9 +200,21 @@ fn an_output_that_is_a_symbolic_link_stays_one_and_its_target_gets_the_content()
     assert_eq!(written.lines().count(), 6);
     // The same bytes as a plain output of the same seed.
     let plain = dir.path().join("plain.csv");
-    succeeds(&["simulate", "--robot", &text(&robot), "--out", &text(&plain), "--rows", "5", "--seed", "1"]);
-    assert_eq!(std::fs::read(&plain).unwrap(), written.into_bytes());
-    assert_eq!(names(dir.path()), ["link.csv", "plain.csv", "real.csv"], "no temporary file left");
+    succeeds(&["simulate", "--robot", &text(&robot), "--out", &text(&plain), "--rows", "60", "--seed", "1"]);
+    let plain_5 = dir.path().join("plain5.csv");
+    succeeds(&["simulate", "--robot", &text(&robot), "--out", &text(&plain_5), "--rows", "5", "--seed", "1"]);
+    assert_eq!(std::fs::read(&plain_5).unwrap(), written.into_bytes());
+    assert_eq!(names(dir.path()), ["link.csv", "plain.csv", "plain5.csv", "real.csv"], "no temporary file left");
+
+    // fit writes through a temporary file and a rename: the link must survive that too.
+    let real_model = dir.path().join("real.ron");
+    std::fs::write(&real_model, "old\n").unwrap();
+    let model_link = dir.path().join("model.ron");
+    std::os::unix::fs::symlink(&real_model, &model_link).unwrap();
+    let out = fit_to(&robot, &plain, &text(&model_link));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(std::fs::symlink_metadata(&model_link).unwrap().file_type().is_symlink(), "the model link is kept");
+    assert!(std::fs::read_to_string(&real_model).unwrap().contains("schema_version"), "its target holds the model");
 }
 
 #[test]
