@@ -39,13 +39,15 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     {
         return Err(format!("--noise-mm must be a positive number of millimetres, got {noise}").into());
     }
+    let inputs = pipeline::InputFiles::new().with("--robot", &args.robot.robot).with("--data", &args.data);
     let robot = args.robot.read()?;
     let read = ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
     let data = pipeline::read_measurements(&args.data, &read)?;
     let options =
         DiagnoseOptions { folds: args.folds, seed: args.seed, noise_mm: args.noise_mm, ..DiagnoseOptions::default() };
     let diagnosis = diagnose(&robot, &data, &options)?;
-    let report = args.report.as_deref().map(|folder| diagnosis.write_report(folder)).transpose()?;
+    let report =
+        args.report.as_deref().map(|folder| diagnosis.write_report(folder, "--report", &inputs)).transpose()?;
     if args.json {
         println!("{}", diagnosis.to_json()?);
         eprintln!("{}", data.read_summary());

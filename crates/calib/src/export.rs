@@ -42,6 +42,13 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    // Refused before any work: the URDF must not replace a file this export reads.
+    pipeline::InputFiles::new()
+        .with("--model", &args.model)
+        .with_optional("--like", args.like.as_deref())
+        .with_optional("--robot", args.robot.as_deref())
+        .with_optional("--data", args.data.as_deref())
+        .check_output("--urdf", &args.urdf)?;
     let model = pipeline::read_model(&args.model)?;
     let ends = ChainEnds { base_link: args.base_link.clone(), tip_link: args.tip_link.clone() };
     let training = match &args.data {

@@ -45,6 +45,12 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    // Refused before any work: the model must not replace a file this fit reads.
+    pipeline::InputFiles::new()
+        .with("--robot", &args.robot.robot)
+        .with("--data", &args.data)
+        .with_optional("--options", args.options.as_deref())
+        .check_output("--out", &args.out)?;
     let robot = args.robot.read()?;
     let options = ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
     let data = pipeline::read_measurements(&args.data, &options)?;

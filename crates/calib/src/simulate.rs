@@ -24,7 +24,7 @@ pub struct Args {
     /// Where to write the measurements (SPEC CSV).
     #[arg(long)]
     out: PathBuf,
-    /// Number of poses.
+    /// Number of poses (at most 1,000,000: the set is held in memory before it is written).
     #[arg(long, default_value_t = 300)]
     rows: usize,
     /// Seed of the true robot, the tracker placement, the poses, payloads and noise.
@@ -62,6 +62,16 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    // Refused before any work: the measurements must not replace the robot or the effects file.
+    pipeline::InputFiles::new()
+        .with("--robot", &args.robot.robot)
+        .with_optional("--effects", args.effects.as_deref())
+        .check_output("--out", &args.out)?;
+    if args.rows > simulated::MAX_ROWS {
+        return Err(
+            format!("--rows: {}", Error::TooManySimulatedRows { rows: args.rows, max: simulated::MAX_ROWS }).into()
+        );
+    }
     let robot = args.robot.read()?;
     let effects = match &args.effects {
         Some(path) => simulated::read_effects(path, &robot)?,
@@ -80,10 +90,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         args.full_pose,
     )?;
 
-    let path = args.out.display().to_string();
-    let io = |source: std::io::Error| Error::Io { path: path.clone(), source };
-    let file = std::fs::File::create(&args.out).map_err(io)?;
-    data.write_csv(std::io::BufWriter::new(file)).map_err(io)?;
+    let mut out = pipeline::OutputFile::create(&args.out)?;
+    data.write_csv(&mut out).map_err(|source| Error::Io { path: args.out.display().to_string(), source })?;
+    out.finish()?;
 
     let on: Vec<&str> = effect_names(&effects);
     println!(

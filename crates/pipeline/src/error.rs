@@ -1,7 +1,7 @@
 //! The errors of the `pipeline` crate. Every error about a user's file names the file, and where
 //! it can, the line and the column.
 
-use crate::{ColumnMapFault, DecimalFault};
+use crate::{ColumnMapFault, DecimalFault, FileKind};
 use std::fmt;
 
 /// What can go wrong reading inputs, fitting or evaluating.
@@ -456,6 +456,40 @@ pub enum Error {
         /// The column it needs.
         column: &'static str,
     },
+    /// An output that is one of the command's own inputs (the same path, a symbolic link to it,
+    /// or a hard link): refused before anything is written.
+    OutputIsInput {
+        /// The option that names the output (e.g. `--out`).
+        output_option: &'static str,
+        /// The output path as given.
+        output: String,
+        /// The option that names the input (e.g. `--data`).
+        input_option: &'static str,
+        /// The input path as given.
+        input: String,
+    },
+    /// An output path where something other than a regular file (or a symbolic link to one)
+    /// exists: a directory, a FIFO, a device node. Writing would replace it with a regular file.
+    OutputNotRegularFile {
+        /// The path as given (and where a symbolic link led).
+        path: String,
+        /// What is there.
+        kind: FileKind,
+    },
+    /// A simulation asked for more rows than are made ([`crate::simulated::MAX_ROWS`]).
+    TooManySimulatedRows {
+        /// The rows asked for.
+        rows: usize,
+        /// The most rows made.
+        max: usize,
+    },
+    /// An output path that starts a chain of more symbolic links than are followed (a loop).
+    OutputSymlinkChain {
+        /// The path as given.
+        path: String,
+        /// How many links were followed.
+        links: usize,
+    },
 }
 
 impl fmt::Display for Error {
@@ -617,6 +651,20 @@ impl fmt::Display for Error {
             Error::PartOrder { part } => write!(f, "a model's {part} comes before its geometry"),
             Error::EffectNeedsColumn { line, effect, column } => {
                 write!(f, "line {line}: {effect} needs the column '{column}', which this row lacks")
+            }
+            Error::OutputIsInput { output_option, output, input_option, input } => write!(
+                f,
+                "{output_option} {output} is the same file as {input_option} {input}: refusing to overwrite an input"
+            ),
+            Error::OutputNotRegularFile { path, kind } => {
+                write!(f, "{path}: is {kind}, not a regular file: refusing to replace it with an output")
+            }
+            Error::TooManySimulatedRows { rows, max } => write!(
+                f,
+                "{rows} rows asked for: at most {max} are simulated (the set is held in memory, about 0.5 kB a row)"
+            ),
+            Error::OutputSymlinkChain { path, links } => {
+                write!(f, "{path}: more than {links} symbolic links in a row (a loop?): refusing to write there")
             }
         }
     }

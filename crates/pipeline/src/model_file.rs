@@ -1,37 +1,21 @@
 //! The calibrated model as a file: RON with a schema version, written atomically.
 
 use crate::{CalibratedModel, Error};
-use std::io::Write;
 use std::path::Path;
 
 /// The schema version this build writes. Version 2 holds the non-geometric effects as a list
 /// (`effects`); version 1 files, whose only effect was `joint_compliance`, still read.
 pub const SCHEMA_VERSION: u32 = 2;
 
-/// Writes `model` to `path` as RON. The text goes to a temporary file in the same folder that is
-/// then renamed over `path`, so a crash never leaves a half-written model behind.
+/// Writes `model` to `path` as RON, atomically ([`crate::write_file`]): a crash never leaves a
+/// half-written model behind, and a symbolic link at `path` keeps pointing at the new model.
 pub fn write_model(path: &Path, model: &CalibratedModel) -> Result<(), Error> {
-    let io = |source| Error::Io { path: path.display().to_string(), source };
-    let text = ron::ser::to_string_pretty(model, ron::ser::PrettyConfig::default().depth_limit(6)).map_err(|e| {
-        Error::RonFormat { file: path.display().to_string(), line: 1, column: 1, message: e.to_string() }
-    })?;
-    let folder = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "model".into());
-    let temporary = folder.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let mut file = std::fs::File::create(&temporary)?;
-        file.write_all(text.as_bytes())?;
-        file.write_all(b"\n")?;
-        file.sync_all()?;
-        std::fs::rename(&temporary, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&temporary);
-    }
-    result.map_err(io)
+    let mut text =
+        ron::ser::to_string_pretty(model, ron::ser::PrettyConfig::default().depth_limit(6)).map_err(|e| {
+            Error::RonFormat { file: path.display().to_string(), line: 1, column: 1, message: e.to_string() }
+        })?;
+    text.push('\n');
+    crate::write_file(path, text.as_bytes())
 }
 
 /// Reads a calibrated model, refusing a file of another schema version.

@@ -185,9 +185,9 @@ pub fn export_urdf(
     Ok(UrdfExport { text: written.text, report })
 }
 
-/// Writes the URDF text to `path`.
+/// Writes the URDF text to `path`, atomically ([`crate::write_file`]).
 pub fn write_urdf(path: &Path, export: &UrdfExport) -> Result<(), Error> {
-    std::fs::write(path, &export.text).map_err(|source| Error::Io { path: path.display().to_string(), source })
+    crate::write_file(path, export.text.as_bytes())
 }
 
 /// What a writer produced.

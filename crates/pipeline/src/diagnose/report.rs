@@ -5,7 +5,7 @@ use super::candidates::Effect;
 use super::noise::NoiseSource;
 use super::regions::{PoseDiagnosis, Region};
 use super::{Diagnosis, svg};
-use crate::Error;
+use crate::{Error, InputFiles};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -335,21 +335,21 @@ impl Diagnosis {
     }
 
     /// Writes the report folder: `diagnosis.md` and its SVG plots (the folder is made if need
-    /// be). Returns the path of `diagnosis.md`.
-    pub fn write_report(&self, folder: &Path) -> Result<PathBuf, Error> {
-        let io = |path: &Path| {
-            let path = path.display().to_string();
-            move |source| Error::Io { path, source }
-        };
-        std::fs::create_dir_all(folder).map_err(io(folder))?;
+    /// be), each file atomically ([`crate::write_file`]). Every file is checked against `inputs`
+    /// (as the output of `option`) before the first is written, so a refusal writes nothing.
+    /// Returns the path of `diagnosis.md`.
+    pub fn write_report(&self, folder: &Path, option: &'static str, inputs: &InputFiles) -> Result<PathBuf, Error> {
         let plots = self.plots();
-        for (name, svg) in &plots {
-            let path = folder.join(name);
-            std::fs::write(&path, svg).map_err(io(&path))?;
+        let names: Vec<String> = plots.iter().map(|(name, _)| name.clone()).collect();
+        let markdown = folder.join("diagnosis.md");
+        for path in names.iter().map(|name| folder.join(name)).chain([markdown.clone()]) {
+            inputs.check_output(option, &path)?;
         }
-        let names: Vec<String> = plots.into_iter().map(|(name, _)| name).collect();
-        let path = folder.join("diagnosis.md");
-        std::fs::write(&path, self.markdown(&names)).map_err(io(&path))?;
-        Ok(path)
+        std::fs::create_dir_all(folder).map_err(|source| Error::Io { path: folder.display().to_string(), source })?;
+        for (name, svg) in &plots {
+            crate::write_file(&folder.join(name), svg.as_bytes())?;
+        }
+        crate::write_file(&markdown, self.markdown(&names).as_bytes())?;
+        Ok(markdown)
     }
 }
