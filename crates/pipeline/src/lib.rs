@@ -30,6 +30,7 @@ mod robot_check;
 mod robot_dh;
 mod ron_position;
 pub mod simulated;
+mod training_range;
 mod urdf_chain;
 mod urdf_export;
 mod urdf_like;
@@ -61,6 +62,7 @@ pub use model_file::{SCHEMA_VERSION, parse_model, read_model, write_model};
 pub use model_parts::Part;
 pub use robot::{FlangeDescription, JointDescription, JointType, RobotDescription};
 pub use robot_dh::{DhTable, DhTableRow};
+pub use training_range::TrainingRange;
 pub use urdf_chain::{ChainEnds, ChainStep, StepMotion, UrdfChain, UrdfDocument};
 pub use urdf_export::{
     AxisChange, PartError, TrainingErrors, UrdfExport, UrdfExportReport, UrdfTemplate, export_urdf, write_urdf,

@@ -12,9 +12,7 @@ pub const SCHEMA_VERSION: u32 = 2;
 /// then renamed over `path`, so a crash never leaves a half-written model behind.
 pub fn write_model(path: &Path, model: &CalibratedModel) -> Result<(), Error> {
     let io = |source| Error::Io { path: path.display().to_string(), source };
-    let text = ron::ser::to_string_pretty(model, ron::ser::PrettyConfig::default().depth_limit(6)).map_err(|e| {
-        Error::RonFormat { file: path.display().to_string(), line: 1, column: 1, message: e.to_string() }
-    })?;
+    let text = model_text(model, &path.display().to_string())?;
     let folder = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => std::path::PathBuf::from("."),
@@ -32,6 +30,16 @@ pub fn write_model(path: &Path, model: &CalibratedModel) -> Result<(), Error> {
         let _ = std::fs::remove_file(&temporary);
     }
     result.map_err(io)
+}
+
+/// The text [`write_model`] writes; `file` names it in errors.
+pub(crate) fn model_text(model: &CalibratedModel, file: &str) -> Result<String, Error> {
+    ron::ser::to_string_pretty(model, ron::ser::PrettyConfig::default().depth_limit(6)).map_err(|e| Error::RonFormat {
+        file: file.to_owned(),
+        line: 1,
+        column: 1,
+        message: e.to_string(),
+    })
 }
 
 /// Reads a calibrated model, refusing a file of another schema version.
@@ -127,6 +135,7 @@ mod version_1 {
                 kinematics: v1.kinematics,
                 effects,
                 compensation: v1.compensation,
+                training_range: None,
             }
         }
     }
