@@ -178,6 +178,9 @@ fn summarise(
         id.final_cost,
         id.gradient_cosine
     );
+    if let Some(fallback) = &id.damping_fallback {
+        let _ = writeln!(out, "  damping: {fallback}");
+    }
     for warning in &report.warnings {
         let _ = writeln!(out, "  warning: {warning}");
     }

@@ -295,6 +295,11 @@ impl SparseGp {
         &self.report
     }
 
+    /// The input standardisation (the training inputs' mean and standard deviation).
+    pub fn input_standardiser(&self) -> &InputStandardiser {
+        &self.inputs
+    }
+
     /// Number of inducing inputs.
     pub fn inducing_len(&self) -> usize {
         self.inducing.len()

@@ -36,6 +36,10 @@ pub struct CalibratedModel {
     /// The GP compensation of the residual (methods `poe-gp`, `poe-gp-load`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compensation: Option<crate::Compensation>,
+    /// The range of every input the model was fitted on: the check on reading probes the model
+    /// inside it. Files written before it existed have none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub training_range: Option<crate::TrainingRange>,
 }
 
 /// A predicted tool pose and, where a GP is part of the model, its standard deviation.

@@ -315,6 +315,22 @@ impl GpModel {
         }
     }
 
+    /// Every kernel of the GP (one per group of outputs).
+    pub fn kernels(&self) -> Vec<&gp::Kernel> {
+        match self {
+            Self::Exact(g) => g.report().components.iter().map(|c| &c.kernel).collect(),
+            Self::Sparse(g) => g.report().components.iter().map(|c| &c.kernel).collect(),
+        }
+    }
+
+    /// The mean of each input over the training rows (the GP's input standardisation).
+    pub fn input_mean(&self) -> &[f64] {
+        match self {
+            Self::Exact(g) => &g.input_standardiser().mean,
+            Self::Sparse(g) => &g.input_standardiser().mean,
+        }
+    }
+
     /// Which one it is.
     pub fn choice(&self) -> GpChoice {
         match self {

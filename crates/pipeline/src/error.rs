@@ -442,6 +442,14 @@ pub enum Error {
         /// The robot's joint count.
         joint_count: usize,
     },
+    /// A fit produced a model that the model file's check refuses: `fit` says so rather than
+    /// write a file that `eval` would refuse.
+    FittedModelRefused {
+        /// The method fitted.
+        method: crate::Method,
+        /// The check's refusal.
+        source: Box<Error>,
+    },
     /// A model's parts in an order they cannot apply in (an effect before the geometry).
     PartOrder {
         /// The part out of place.
@@ -648,6 +656,10 @@ impl fmt::Display for Error {
             Error::EffectJoint { joint, joint_count } => {
                 write!(f, "effect on joint {joint}: the robot has joints 1 to {joint_count}")
             }
+            Error::FittedModelRefused { method, source } => write!(
+                f,
+                "the fitted {method} model fails the check every model file passes on reading, so it is not written: {source}"
+            ),
             Error::PartOrder { part } => write!(f, "a model's {part} comes before its geometry"),
             Error::EffectNeedsColumn { line, effect, column } => {
                 write!(f, "line {line}: {effect} needs the column '{column}', which this row lacks")
@@ -678,6 +690,7 @@ impl std::error::Error for Error {
             Error::Load { source } => Some(source),
             Error::Gp { source } => Some(source),
             Error::Json { source, .. } => Some(source),
+            Error::FittedModelRefused { source, .. } => Some(source.as_ref()),
             _ => None,
         }
     }

@@ -133,6 +133,7 @@ pub fn fit(
         effects: Vec::new(),
         fallback_kinematics: None,
         compensation: None,
+        training_range: crate::TrainingRange::of(&data.rows),
     };
     let mut identification = geometry.report;
     let mut auto = None;
@@ -175,6 +176,12 @@ pub fn fit(
         model.compensation = Some(fitted);
         compensation = Some(report);
     }
+    // The check `read_model` runs, on the text `write_model` writes: a fit never hands over a
+    // model that its own file would be refused for, and the cause shows here (issue 23).
+    let text = crate::model_file::model_text(&model, "the fitted model")?;
+    model
+        .check(&text, "the fitted model")
+        .map_err(|source| Error::FittedModelRefused { method, source: Box::new(source) })?;
     let registered = CalibratedModel {
         kinematics: geometry.registered,
         effects: Vec::new(),

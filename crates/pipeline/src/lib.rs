@@ -32,6 +32,7 @@ mod robot_check;
 mod robot_dh;
 mod ron_position;
 pub mod simulated;
+mod training_range;
 mod urdf_chain;
 mod urdf_export;
 mod urdf_like;
@@ -65,6 +66,7 @@ pub use model_parts::Part;
 pub use output_file::{FileKind, MAX_SYMLINKS, OutputFile, output_target, write_file};
 pub use robot::{FlangeDescription, JointDescription, JointType, RobotDescription};
 pub use robot_dh::{DhTable, DhTableRow};
+pub use training_range::TrainingRange;
 pub use urdf_chain::{ChainEnds, ChainStep, StepMotion, UrdfChain, UrdfDocument};
 pub use urdf_export::{
     AxisChange, PartError, TrainingErrors, UrdfExport, UrdfExportReport, UrdfTemplate, export_urdf, write_urdf,

@@ -62,6 +62,13 @@ fn occurrences_before(text: &str, field: &str, part: &str) -> usize {
 /// overflow, and the model would then predict NaN poses instead of being refused here.
 pub(crate) const MAX_TRANSLATION_M: f64 = 1.0e3;
 
+/// The widest a GP hyperparameter of a model file may be, as a factor either way of 1: the GP
+/// works on standardised inputs and normalised outputs, and its search box is far narrower (gp's
+/// default bounds span 1e-9 to 1e3). Like [`MAX_TRANSLATION_M`] a sanity bound on a file, not a
+/// tuning constant: a signal variance of 1e200 is finite, predicts finite poses at any row, and is
+/// still a corrupt file.
+pub(crate) const MAX_HYPERPARAMETER_DECADES: f64 = 100.0;
+
 /// The first translation among `transforms` that is not finite or beyond [`MAX_TRANSLATION_M`],
 /// with its position in the list.
 pub(crate) fn bad_translation(transforms: impl Iterator<Item = SE3>) -> Option<(usize, f64)> {
@@ -120,6 +127,15 @@ impl CalibratedModel {
                 let found = compensation.gp.input_dim();
                 return Err(at.count(("gp", 0), "compensation.gp".into(), "inputs", found, inputs));
             }
+            let bound = 10f64.powf(MAX_HYPERPARAMETER_DECADES);
+            let hyperparameters = compensation.gp.kernels().into_iter().flat_map(|k| k.parameters());
+            if let Some(value) = hyperparameters.into_iter().find(|p| !(p.abs() <= bound && p.abs() >= 1.0 / bound)) {
+                let message = format!(
+                    "compensation.gp: a kernel hyperparameter is {value:e}, outside 1e-{MAX_HYPERPARAMETER_DECADES} to \
+                     1e{MAX_HYPERPARAMETER_DECADES} (the GP works on standardised data; an edited or corrupt file)"
+                );
+                return Err(at.part("kernel", message));
+            }
             let outputs = if self.full_pose { 6 } else { 3 };
             if compensation.gp.output_count() != outputs {
                 let found = compensation.gp.output_count();
@@ -129,27 +145,55 @@ impl CalibratedModel {
         self.check_values(&at)
     }
 
-    /// Walks the parts at two reference rows (every joint at 0, then at 1 rad or 1 m; payload,
-    /// torques, temperature and time at 0) and refuses the first part that makes a number
-    /// non-finite or puts the tool beyond [`MAX_TRANSLATION_M`]. The checks above bound what they
-    /// can name; this catches any finite but absurd value they leave (1e308 in the GP's training
-    /// outputs, a feature scale of 1e-320) that would make predictions NaN or kilometres off, and
-    /// names the part.
-    fn check_values(&self, at: &Located<'_>) -> Result<(), Error> {
+    /// The rows the walk probes, and how to say where they are: inside the ranges the model was
+    /// fitted on (the centre and both corners); for a file without them, the GP's training mean
+    /// where there is a GP, otherwise every joint at 0 and at 1 rad or 1 m (payload, torques,
+    /// temperature and time at 0 where not recorded).
+    fn probe_rows(&self) -> (Vec<Measurement>, &'static str) {
+        if let Some(range) = &self.training_range {
+            return (range.probe_rows(), "at the centre or a corner of the ranges it was fitted on");
+        }
         let n = self.kinematics.joint_count();
-        let row = |q: f64| Measurement {
+        let row = |q: Vec<f64>, payload_kg: f64| Measurement {
             line: 0,
-            q: vec![q; n],
+            q,
             position: lie::Vector3::zeros(),
             orientation: None,
-            payload_kg: 0.0,
+            payload_kg,
             tool: 0,
             temp_c: Some(0.0),
             t_s: Some(0.0),
             torques_nm: Some(vec![0.0; n]),
         };
-        let rows = [row(0.0), row(1.0)];
-        let tools = [0, 0];
+        match &self.compensation {
+            Some(compensation) => {
+                let mean = compensation.gp.input_mean();
+                let payload = if compensation.with_payload { mean.get(n).copied().unwrap_or(0.0) } else { 0.0 };
+                (vec![row(mean[..n.min(mean.len())].to_vec(), payload)], "at the mean of the GP's training inputs")
+            }
+            None => (vec![row(vec![0.0; n], 0.0), row(vec![1.0; n], 0.0)], "with every joint at 0 or 1"),
+        }
+    }
+
+    /// Walks the parts at rows where the model was fitted ([`Self::probe_rows`]) and refuses the
+    /// first part that makes a number non-finite or puts the tool beyond [`MAX_TRANSLATION_M`].
+    /// The checks above bound what they can name; this catches any finite but absurd value they
+    /// leave (1e308 in the GP's training outputs, a feature scale of 1e-320) that would make
+    /// predictions NaN or kilometres off, and names the part. A sound model passes: the rows are
+    /// inside what it was fitted on (issue 23: at every joint 1 rad, a GP fitted with the wrist
+    /// within 2 mrad of zero extrapolated beyond a kilometre and a sound model was refused).
+    fn check_values(&self, at: &Located<'_>) -> Result<(), Error> {
+        if let Some(range) = &self.training_range
+            && let Some((name, index, value)) = range.fault(self.kinematics.joint_count(), MAX_TRANSLATION_M)
+        {
+            let message = format!(
+                "training_range.{name}[{index}]: {value:e} is not a range of finite values, smallest first, one per \
+                 joint, joint values within ±{MAX_TRANSLATION_M:e} (an edited or corrupt file)"
+            );
+            return Err(at.part("training_range", message));
+        }
+        let (rows, where_) = self.probe_rows();
+        let tools = vec![0; rows.len()];
         let mut walk = Walk::new(&rows, &tools);
         for (k, part) in self.parts().iter().enumerate() {
             let applied = part.apply(&mut walk);
@@ -166,7 +210,7 @@ impl CalibratedModel {
                 .err()
                 .map_or("a pose that is not finite or beyond a kilometre".to_owned(), |e| format!("'{e}'"));
             let message = format!(
-                "{field}: part {k} ({}) gives {why} with every joint at 0 or 1: a value in it is out of range \
+                "{field}: part {k} ({}) gives {why} {where_}: a value in it is out of range \
                  (an edited or corrupt file)",
                 part.name()
             );

@@ -10,12 +10,19 @@ pub const SCHEMA_VERSION: u32 = 2;
 /// Writes `model` to `path` as RON, atomically ([`crate::write_file`]): a crash never leaves a
 /// half-written model behind, and a symbolic link at `path` keeps pointing at the new model.
 pub fn write_model(path: &Path, model: &CalibratedModel) -> Result<(), Error> {
-    let mut text =
-        ron::ser::to_string_pretty(model, ron::ser::PrettyConfig::default().depth_limit(6)).map_err(|e| {
-            Error::RonFormat { file: path.display().to_string(), line: 1, column: 1, message: e.to_string() }
-        })?;
+    let mut text = model_text(model, &path.display().to_string())?;
     text.push('\n');
     crate::write_file(path, text.as_bytes())
+}
+
+/// The text [`write_model`] writes; `file` names it in errors.
+pub(crate) fn model_text(model: &CalibratedModel, file: &str) -> Result<String, Error> {
+    ron::ser::to_string_pretty(model, ron::ser::PrettyConfig::default().depth_limit(6)).map_err(|e| Error::RonFormat {
+        file: file.to_owned(),
+        line: 1,
+        column: 1,
+        message: e.to_string(),
+    })
 }
 
 /// Reads a calibrated model, refusing a file of another schema version.
@@ -112,6 +119,7 @@ mod version_1 {
                 effects,
                 fallback_kinematics: None,
                 compensation: v1.compensation,
+                training_range: None,
             }
         }
     }

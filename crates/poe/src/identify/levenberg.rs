@@ -5,9 +5,9 @@
 //! drop weakly excited but real directions. Every accepted step lowers the cost, so a fit started
 //! from a smaller model's solution (the new parameters at zero) can only end below it.
 
-use super::Termination;
 use super::normal::{Normal, gradient_cosine};
 use super::solver::{Problem, Solved, State, cost, record};
+use super::{IterationRecord, Termination};
 use crate::Error;
 
 /// The prior weight `1/σ` of every parameter: kinematic blocks are `(v, ω)` sextuples.
@@ -29,18 +29,47 @@ fn prior_cost(weights: &[f64], deviation: &[f64]) -> f64 {
 }
 
 pub(super) fn levenberg_marquardt(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
-    let options = problem.options;
     let weights = prior_weights(problem);
+    damped(problem, start, &weights, problem.options.max_iterations, Vec::new())
+}
+
+/// Levenberg–Marquardt without a prior, continuing from `start` for at most `max_iterations`:
+/// the pseudo-inverse iteration's fallback when no step along its direction lowers the cost
+/// (the undamped direction overshoots along weakly determined directions; damping shortens and
+/// turns it towards the gradient, so a descent step exists wherever the gradient is not zero).
+/// `history` holds the records of the iterations before it, `start`'s last.
+pub(super) fn continue_damped(
+    problem: &Problem<'_>,
+    start: State,
+    max_iterations: usize,
+    history: Vec<IterationRecord>,
+) -> Result<Solved, Error> {
+    let weights = vec![0.0; problem.parameter_count()];
+    damped(problem, start, &weights, max_iterations, history)
+}
+
+fn damped(
+    problem: &Problem<'_>,
+    start: State,
+    weights: &[f64],
+    max_iterations: usize,
+    history: Vec<IterationRecord>,
+) -> Result<Solved, Error> {
+    let options = problem.options;
+    let weights = weights.to_vec();
     let mut state = start;
     let (mut a, mut y, stats) = problem.linearise(&state)?;
     let mut current = cost(&y) + prior_cost(&weights, &state.deviation);
-    let mut iterations = vec![record(stats, 0.0, current)];
+    let mut iterations = history;
+    if iterations.is_empty() {
+        iterations.push(record(stats, 0.0, current));
+    }
     let mut lambda = options.initial_damping;
     let mut growth = 2.0;
     let mut normal = Normal::new(&a, &y, &weights, &state.deviation);
     let mut termination = Termination::IterationLimit { iterations: options.max_iterations };
     let mut iteration = 0;
-    while iteration < options.max_iterations {
+    while iteration < max_iterations {
         let cosine = gradient_cosine(&a, &y, &weights, &state.deviation);
         if cosine <= options.gradient_tolerance {
             termination = Termination::GradientTolerance { gradient_cosine: cosine };
@@ -106,7 +135,16 @@ pub(super) fn levenberg_marquardt(problem: &Problem<'_>, start: State) -> Result
     }
     let gradient_cosine = gradient_cosine(&a, &y, &weights, &state.deviation);
     let held_at_prior = held_at_prior(problem, &normal, &weights);
-    Ok(Solved { state, a, iterations, termination, final_cost: current, gradient_cosine, held_at_prior })
+    Ok(Solved {
+        state,
+        a,
+        iterations,
+        termination,
+        final_cost: current,
+        gradient_cosine,
+        held_at_prior,
+        damping_fallback: None,
+    })
 }
 
 /// Correction parameters whose posterior standard deviation is more than half the prior's: the

@@ -15,7 +15,7 @@ pub use correction::PoseCorrection;
 pub use options::{IdentificationOptions, Observation, ParameterMask, Solver, Target};
 pub use redundancy::Redundancy;
 pub use registration::register;
-pub use report::{IdentificationReport, IterationRecord};
+pub use report::{DampingFallback, IdentificationReport, IterationRecord};
 pub use residual::ResidualStats;
 pub use solver::{Identification, identify, identify_with_correction};
 pub use termination::Termination;

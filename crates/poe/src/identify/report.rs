@@ -47,6 +47,29 @@ pub struct IdentificationReport {
     /// their posterior standard deviation is more than half their prior's, so the prior holds
     /// them near their start (Levenberg–Marquardt with a prior only).
     pub held_at_prior: Vec<usize>,
+    /// The pseudo-inverse solver only: where no step along its direction lowered the cost and
+    /// Levenberg–Marquardt steps (without a prior) took over; `None` when they never did.
+    pub damping_fallback: Option<DampingFallback>,
+}
+
+/// Where the pseudo-inverse Gauss–Newton iteration handed over to damped steps.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct DampingFallback {
+    /// Gauss–Newton iterations accepted before the hand-over; the later ones are damped.
+    pub after_iteration: usize,
+    /// `max_j |a_jᵀ y| / (‖a_j‖ ‖y‖)` where the Gauss–Newton direction lowered nothing.
+    pub gradient_cosine: f64,
+}
+
+impl std::fmt::Display for DampingFallback {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "no step along the Gauss–Newton direction lowered the cost after iteration {} (gradient cosine {:.1e}): \
+             Levenberg–Marquardt damping continued from there",
+            self.after_iteration, self.gradient_cosine
+        )
+    }
 }
 
 impl IdentificationReport {

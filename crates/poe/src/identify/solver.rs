@@ -3,10 +3,12 @@
 //! stated criterion and say which ([`Termination`]).
 
 use super::correction::{Corrected, PoseCorrection};
-use super::levenberg::levenberg_marquardt;
+use super::levenberg::{continue_damped, levenberg_marquardt};
 use super::redundancy::find_redundancies;
 use super::residual::{ResidualStats, linearise, residuals};
-use super::{IdentificationOptions, IdentificationReport, IterationRecord, Observation, ParameterMask, Solver};
+use super::{
+    DampingFallback, IdentificationOptions, IdentificationReport, IterationRecord, Observation, ParameterMask, Solver,
+};
 use super::{Termination, normal};
 use crate::{Error, LocalPoe};
 use faer::Mat;
@@ -90,6 +92,8 @@ pub(super) struct Solved {
     pub final_cost: f64,
     pub gradient_cosine: f64,
     pub held_at_prior: Vec<usize>,
+    /// Where the pseudo-inverse iteration handed over to damped steps, if it did.
+    pub damping_fallback: Option<DampingFallback>,
 }
 
 /// Identifies the free parameters of `initial` from `observations` by iterating
@@ -162,6 +166,7 @@ pub fn identify_with_correction(
             condition_number,
             unidentifiable,
             held_at_prior: solved.held_at_prior,
+            damping_fallback: solved.damping_fallback,
         },
     })
 }
@@ -193,12 +198,22 @@ fn gauss_newton(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
         }
         let Some((trial, trial_cost, scaled)) = accepted else {
             let gradient_cosine = normal::gradient_cosine(&a, &y, &[], &[]);
-            termination = if gradient_cosine <= options.gradient_tolerance {
-                Termination::GradientTolerance { gradient_cosine }
-            } else {
-                Termination::LineSearchFailed { gradient_cosine }
-            };
-            break;
+            if gradient_cosine <= options.gradient_tolerance {
+                termination = Termination::GradientTolerance { gradient_cosine };
+                break;
+            }
+            // Not stationary, yet the undamped direction lowers nothing within the halvings: it
+            // overshoots along weakly determined directions. Damped steps do lower the cost
+            // wherever the gradient is not zero, so try them before giving up; their own
+            // criteria (or the damping limit) say how the iterations end.
+            let after_iteration = iteration - 1;
+            let remaining = options.max_iterations - after_iteration;
+            let mut damped = continue_damped(problem, state, remaining, iterations)?;
+            if let Termination::IterationLimit { .. } = damped.termination {
+                damped.termination = Termination::IterationLimit { iterations: options.max_iterations };
+            }
+            damped.damping_fallback = Some(DampingFallback { after_iteration, gradient_cosine });
+            return Ok(damped);
         };
         let relative_decrease = (current - trial_cost) / current.max(f64::MIN_POSITIVE);
         state = trial;
@@ -222,5 +237,14 @@ fn gauss_newton(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
         }
     }
     let gradient_cosine = normal::gradient_cosine(&a, &y, &[], &[]);
-    Ok(Solved { state, a, iterations, termination, final_cost: current, gradient_cosine, held_at_prior: Vec::new() })
+    Ok(Solved {
+        state,
+        a,
+        iterations,
+        termination,
+        final_cost: current,
+        gradient_cosine,
+        held_at_prior: Vec::new(),
+        damping_fallback: None,
+    })
 }
