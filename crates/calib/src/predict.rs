@@ -37,7 +37,8 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     let stdout = std::io::stdout();
     let mut out = csv::Writer::from_writer(stdout.lock());
-    let gp = model.compensation.is_some();
+    // The GP's standard deviation, and that of what the effects leave where they fade out.
+    let gp = model.predicts_std();
     let mut header: Vec<&str> = vec!["line", "x_mm", "y_mm", "z_mm"];
     if model.full_pose {
         header.extend(["qw", "qx", "qy", "qz"]);

@@ -131,7 +131,7 @@ impl CalibratedModel {
             part.apply(&mut walk)?;
         }
         walk.flush();
-        Ok(match walk.std {
+        Ok(match walk.standard_deviations() {
             Some(std) => {
                 walk.poses.into_iter().zip(std).map(|(pose, s)| PredictedPose { pose, std: Some(s) }).collect()
             }
@@ -185,6 +185,12 @@ impl std::fmt::Display for ExtrapolationWarning {
 }
 
 impl CalibratedModel {
+    /// Whether predictions carry a standard deviation: a GP, or an effect that reports what it
+    /// leaves uncorrected where it fades out.
+    pub fn predicts_std(&self) -> bool {
+        self.compensation.is_some() || self.effects.iter().any(IdentifiedEffect::has_sigma)
+    }
+
     /// Whether any effect records the joint angles it was fitted on.
     pub fn records_coverage(&self) -> bool {
         self.effects.iter().any(|e| e.angle_coverage().is_some())

@@ -162,6 +162,11 @@ pub fn fit(
         let fitted =
             identify_with_correction(&model.kinematics, &observations(data), &mask, Some(&correction), &id_options)?;
         EffectCorrection::distribute(&mut effects, &fitted.correction);
+        for effect in &mut effects {
+            if let IdentifiedEffect::GearPeriodic(gear) = effect {
+                gear.record_rms(&data.rows);
+            }
+        }
         effect_report = effect_reports(&effects, &fitted.report.held_at_prior);
         model.fallback_kinematics = Some(std::mem::replace(&mut model.kinematics, fitted.model));
         model.effects = effects;

@@ -68,6 +68,17 @@ impl<'a> Part<'a> {
                     *pending += effect.twist(kinematics, row, tool)?;
                     *coverage *= effect.coverage_weight(row);
                 }
+                if effect.has_sigma() {
+                    let variance = walk.effect_variance.get_or_insert_with(|| vec![[0.0; 6]; walk.rows.len()]);
+                    for (((variance, pose), row), &tool) in
+                        variance.iter_mut().zip(&walk.poses).zip(walk.rows).zip(walk.tools)
+                    {
+                        let sigma = effect.sigma(kinematics, row, tool, &pose.translation())?;
+                        for (v, s) in variance.iter_mut().zip(sigma.iter()) {
+                            *v += s * s;
+                        }
+                    }
+                }
             }
             Part::Fallback(fallback) => {
                 walk.flush();
@@ -109,12 +120,24 @@ pub(crate) struct Walk<'a> {
     /// How far each row lies within the angles every effect so far was fitted on: the product
     /// of their [`IdentifiedEffect::coverage_weight`]s.
     coverage: Vec<f64>,
+    /// The variance each row's effects leave uncorrected where they fade out, per component
+    /// (`None` when no effect reports one).
+    pub(crate) effect_variance: Option<Vec<[f64; 6]>>,
     pub(crate) std: Option<Vec<[f64; 6]>>,
 }
 
 impl<'a> Walk<'a> {
     pub(crate) fn new(rows: &'a [Measurement], tools: &'a [usize]) -> Self {
-        Self { rows, tools, kinematics: None, poses: Vec::new(), pending: Vec::new(), coverage: Vec::new(), std: None }
+        Self {
+            rows,
+            tools,
+            kinematics: None,
+            poses: Vec::new(),
+            pending: Vec::new(),
+            coverage: Vec::new(),
+            effect_variance: None,
+            std: None,
+        }
     }
 
     /// Whether every number of the walk so far (poses, pending twists, GP deviations) is finite,
@@ -126,6 +149,25 @@ impl<'a> Walk<'a> {
         self.poses.iter().all(pose)
             && self.pending.iter().all(|t| t.iter().all(|v| v.is_finite()))
             && self.std.iter().flatten().all(|s| s.iter().all(|v| v.is_finite()))
+    }
+
+    /// The standard deviation of each row's pose: the GP's and the faded effects', in
+    /// quadrature (independent sources); `None` when neither is part of the model.
+    pub(crate) fn standard_deviations(&self) -> Option<Vec<[f64; 6]>> {
+        match (&self.std, &self.effect_variance) {
+            (None, None) => None,
+            (Some(std), None) => Some(std.clone()),
+            (std, Some(variance)) => Some(
+                variance
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| {
+                        let gp = std.as_ref().map_or([0.0; 6], |s| s[i]);
+                        std::array::from_fn(|k| (gp[k] * gp[k] + v[k]).sqrt())
+                    })
+                    .collect(),
+            ),
+        }
     }
 
     /// Applies the effects' pending twists: `exp(Σ twists) · pose`.

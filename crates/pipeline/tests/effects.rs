@@ -347,4 +347,25 @@ fn a_gear_series_falls_back_to_the_geometry_in_a_gap_and_past_the_end_of_its_ang
     let (alone, corrected) = (error(&poe, &inside), error(&gear, &inside));
     eprintln!("inside: poe {alone:.4} mm, poe + gear {corrected:.4} mm");
     assert!(corrected < 0.7 * alone, "inside: {corrected} mm against the geometry's {alone} mm");
+    // Where the series is faded out, the prediction says how much of the error it leaves: a
+    // standard deviation of the size of the fitted error's RMS times the joint's lever; where it
+    // was fitted, none.
+    let position_sigma = |set: &MeasurementSet| -> Vec<f64> {
+        let tools = pipeline::tool_indices(&gear, set).unwrap();
+        gear.predict(&set.rows, &tools)
+            .unwrap()
+            .iter()
+            .map(|p| p.std.map_or(f64::NAN, |s| (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt()))
+            .collect()
+    };
+    assert!(position_sigma(&inside).iter().all(|&s| s == 0.0));
+    let beyond_sigma = position_sigma(&beyond);
+    let far: Vec<f64> = beyond_sigma.iter().copied().filter(|&s| s > 0.0).collect();
+    assert!(far.len() > beyond.rows.len() / 2, "{} of {} rows with a deviation", far.len(), beyond.rows.len());
+    let IdentifiedEffect::GearPeriodic(series) = &gear.effects[0] else { panic!("{:?}", gear.effects) };
+    let rms = series.fitted_rms_rad.unwrap();
+    // Joint 2's lever to the tool is under 3 m on this arm (reach 2 m, plus the tool).
+    for s in far {
+        assert!(s <= 3.0 * rms && s >= 1e-3 * rms, "{s} m against an RMS of {rms} rad");
+    }
 }

@@ -147,6 +147,11 @@ impl Cursor<'_> {
                 add("scale", 1);
                 add("fitted_range", usize::from(g.fitted_range.is_some()));
                 add("fitted_gaps", usize::from(!g.fitted_gaps.is_empty()));
+                add("turn_gaps", usize::from(!g.turn_gaps.is_empty()));
+                add("taper_rad", usize::from(g.taper_rad.is_some()));
+                add("mean", usize::from(!g.mean.is_empty()));
+                add("fitted_rms_rad", usize::from(g.fitted_rms_rad.is_some()));
+                add("roughness_order", 1);
             }
             IdentifiedEffect::Backlash(b) => {
                 add("joint", 1);
@@ -279,6 +284,33 @@ pub(crate) fn check_effects(
                         let kind = FaultKind::Order { low: a, high: b };
                         return Err(cursor.fault("fitted_gaps", 0, format!("fitted_gaps[{k}]"), kind));
                     }
+                }
+                // The turn's gaps lie within [0, 4π): a gap starts inside the turn and the one
+                // across 2π ends within the next.
+                for (k, &[a, b]) in g.turn_gaps.iter().enumerate() {
+                    cursor.finite("turn_gaps", &[a, b], false)?;
+                    if a > b || a < 0.0 || b > 2.0 * std::f64::consts::TAU {
+                        let kind = FaultKind::Order { low: a, high: b };
+                        return Err(cursor.fault("turn_gaps", 0, format!("turn_gaps[{k}]"), kind));
+                    }
+                }
+                if let Some(taper) = g.taper_rad {
+                    cursor.finite("taper_rad", &[taper], true)?;
+                }
+                if !g.mean.is_empty() {
+                    cursor.count("mean", g.mean.len(), 2 * g.orders.len())?;
+                    cursor.finite("mean", &g.mean, false)?;
+                }
+                if let Some(rms) = g.fitted_rms_rad {
+                    cursor.finite("fitted_rms_rad", &[rms], false)?;
+                    if rms < 0.0 {
+                        let kind = FaultKind::Order { low: 0.0, high: rms };
+                        return Err(cursor.fault("fitted_rms_rad", 0, "fitted_rms_rad".into(), kind));
+                    }
+                }
+                if !(0.0..=4.0).contains(&g.roughness_order) {
+                    let kind = FaultKind::Value { value: g.roughness_order, limit: 4.0 };
+                    return Err(cursor.fault("roughness_order", 0, "roughness_order".into(), kind));
                 }
             }
             IdentifiedEffect::Backlash(b) => {

@@ -55,6 +55,11 @@ pub struct GearPeriodic {
     /// empty in model files written before it was (nothing subtracted).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub mean: Vec<f64>,
+    /// The RMS of the fitted joint error over the training angles, rad: how large the error the
+    /// series corrects typically is, and so the uncertainty left where it fades out (recorded
+    /// by `fit`; absent in older files).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fitted_rms_rad: Option<f64>,
     /// The prior's smoothness ([`GearOptions::roughness_order`]) the series was fitted with.
     #[serde(default)]
     pub roughness_order: f64,
@@ -147,6 +152,7 @@ impl GearPeriodic {
             turn_gaps,
             taper_rad,
             mean: Vec::new(),
+            fitted_rms_rad: None,
             roughness_order: options.roughness_order,
         };
         let width = 2 * model.orders.len();
@@ -171,6 +177,39 @@ impl GearPeriodic {
         }
         let Some([low, high]) = self.fitted_range else { return true };
         (low..=high).contains(&q) && !self.fitted_gaps.iter().any(|&[a, b]| a < q && q < b)
+    }
+
+    /// The joint error at angle `q`, rad: `Σ θ_l f_l(q)`.
+    pub fn joint_error(&self, q: f64) -> f64 {
+        let row = Measurement {
+            line: 0,
+            q: vec![0.0; self.joint + 1],
+            position: lie::Vector3::zeros(),
+            orientation: None,
+            payload_kg: 0.0,
+            tool: 0,
+            temp_c: None,
+            t_s: None,
+            torques_nm: None,
+        };
+        let mut row = row;
+        row.q[self.joint] = q;
+        self.features(&row, 0).map_or(0.0, |f| f.iter().zip(&self.theta).map(|(f, t)| f * t).sum())
+    }
+
+    /// Records [`GearPeriodic::fitted_rms_rad`] over the training rows, after the fit.
+    pub(crate) fn record_rms(&mut self, rows: &[Measurement]) {
+        let values: Vec<f64> = rows.iter().filter_map(|r| r.q.get(self.joint)).map(|&q| self.joint_error(q)).collect();
+        let rms = (values.iter().map(|v| v * v).sum::<f64>() / values.len().max(1) as f64).sqrt();
+        self.fitted_rms_rad = rms.is_finite().then_some(rms);
+    }
+
+    /// The standard deviation of the joint error the model leaves uncorrected at `q`, rad: where
+    /// the series fades out by `1 − w`, that share of a typical error (its RMS on the training
+    /// angles) is unknown; 0 on the fitted angles (there the series' own uncertainty, a few µrad
+    /// on real data, is far below it) and for files that do not record the RMS.
+    pub fn faded_sigma(&self, q: f64) -> f64 {
+        self.fitted_rms_rad.map_or(0.0, |rms| (1.0 - self.held_and_weight(q).1) * rms)
     }
 
     /// The turn gap `q` lies in, with `q`'s angle in that gap's coordinates.

@@ -206,6 +206,35 @@ impl IdentifiedEffect {
         }
     }
 
+    /// The standard deviation of what the effect leaves uncorrected at `row`, per component of
+    /// the pose error `(v, ω)` at the tool point `point` (m, rad): a gear series faded out of its
+    /// fitted angles leaves a joint error of [`GearPeriodic::faded_sigma`] along the joint's
+    /// twist; zero elsewhere and for every other effect.
+    pub fn sigma(
+        &self,
+        kinematics: &LocalPoe,
+        row: &Measurement,
+        tool: usize,
+        point: &lie::Vector3,
+    ) -> Result<Vector6, Error> {
+        let IdentifiedEffect::GearPeriodic(g) = self else { return Ok(Vector6::zeros()) };
+        let Some(&q) = row.q.get(g.joint) else { return Ok(Vector6::zeros()) };
+        let sigma = g.faded_sigma(q);
+        if sigma == 0.0 {
+            return Ok(Vector6::zeros());
+        }
+        let twist = RowTwists::new(kinematics, &row.q, tool).twist(Direction::Joint(g.joint))?;
+        let w = lie::Vector3::new(twist[3], twist[4], twist[5]);
+        let v = lie::Vector3::new(twist[0], twist[1], twist[2]) + w.cross(point);
+        Ok(Vector6::new(v.x.abs(), v.y.abs(), v.z.abs(), w.x.abs(), w.y.abs(), w.z.abs()) * sigma)
+    }
+
+    /// Whether the effect can report a [`IdentifiedEffect::sigma`] (a gear series that recorded
+    /// its RMS).
+    pub fn has_sigma(&self) -> bool {
+        matches!(self, IdentifiedEffect::GearPeriodic(g) if g.fitted_rms_rad.is_some() && g.taper_rad.is_some())
+    }
+
     /// The 1-based joints the effect acts on (empty for thermal growth and drift).
     pub fn joints(&self) -> Vec<usize> {
         match self {
