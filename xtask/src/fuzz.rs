@@ -35,7 +35,9 @@ pub struct Args {
     #[arg(long, default_value_t = 10_000)]
     timeout_ms: u64,
     /// Address space of the worker, MiB (`ulimit -v`): inputs are at most 4 MiB, so a reader that
-    /// needs more than this much for one is unbounded.
+    /// needs more than this much for one is unbounded. The worker is given this plus what faer's
+    /// matrix products reserve ([`gemm_reserve_mib`]), which depends on the processor, not on
+    /// the input.
     #[arg(long, default_value_t = 2048)]
     memory_mib: u64,
     /// Write case number DUMP of `--reader` (not `all`) to `--out` instead of running, to
@@ -119,6 +121,26 @@ impl Tally {
     }
 }
 
+/// The address space faer's matrix products reserve, MiB: `private-gemm-x86` (faer 0.24's
+/// product kernel, `src/lib.rs`) keeps a thread-local buffer of twice the last-level cache on
+/// every thread that multiplies (960 MiB on a virtual machine that reports a 480 MiB L3), once,
+/// whatever the input. Twice that per thread the worker may run on (its own and rayon's),
+/// from `/sys/devices/system/cpu/cpu0/cache/index3/size` (0 where it cannot be read).
+fn gemm_reserve_mib() -> u64 {
+    let Ok(text) = std::fs::read_to_string("/sys/devices/system/cpu/cpu0/cache/index3/size") else { return 0 };
+    let text = text.trim();
+    let (digits, unit) = text.split_at(text.find(|c: char| !c.is_ascii_digit()).unwrap_or(text.len()));
+    let Ok(value) = digits.parse::<u64>() else { return 0 };
+    let kib = match unit {
+        "K" => value,
+        "M" => value * 1024,
+        "G" => value * 1024 * 1024,
+        _ => value / 1024,
+    };
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get() as u64) + 1;
+    2 * kib.div_ceil(1024) * threads
+}
+
 /// A line from the worker, or the end of its output.
 enum Event {
     Line(String),
@@ -137,7 +159,8 @@ fn spawn(reader: Reader, args: &Args, from: u64, scratch: &Path) -> Result<Worke
     let log = std::fs::File::create(&stderr).with_context(|| format!("creating {}", stderr.display()))?;
     // The cap is set in a shell that then becomes the worker: the standard library has no
     // setrlimit, and the workspace forbids the unsafe code a pre-exec hook would need.
-    let script = format!("ulimit -v {} && exec \"$0\" \"$@\"", args.memory_mib * 1024);
+    let cap_kib = (args.memory_mib + gemm_reserve_mib()) * 1024;
+    let script = format!("ulimit -v {cap_kib} && exec \"$0\" \"$@\"");
     let mut child = Command::new("sh")
         .arg("-c")
         .arg(script)
@@ -294,12 +317,14 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let scratch = tempfolder()?;
     println!(
-        "fuzzing {} reader(s), {} inputs each, seed {}, {} ms and {} MiB per input",
+        "fuzzing {} reader(s), {} inputs each, seed {}, {} ms and {} MiB per input (+ {} MiB that faer's \
+         products reserve on this processor)",
         readers.len(),
         args.cases,
         args.seed,
         args.timeout_ms,
-        args.memory_mib
+        args.memory_mib,
+        gemm_reserve_mib()
     );
     let mut tallies = Vec::new();
     for reader in readers {
