@@ -39,17 +39,17 @@ fn noise_floor(robot: &RobotDescription, seed: u64) -> f64 {
     heldout(robot, &train, &test, "")
 }
 
+/// A gear error of orders 1, 7 and 12 on joint 2, 0.1–0.2 mrad each.
+fn joint_2_gear_error() -> PeriodicError {
+    let harmonic =
+        |order: f64, amplitude_rad: f64, phase_rad: f64| Harmonic { joint_index: 1, order, amplitude_rad, phase_rad };
+    PeriodicError { harmonics: vec![harmonic(1.0, 1e-4, 0.3), harmonic(7.0, 2e-4, -1.0), harmonic(12.0, 1e-4, 2.0)] }
+}
+
 #[test]
 fn a_gear_error_of_high_order_is_identified_down_to_the_noise() {
     let robot = irb4400();
-    let harmonic =
-        |order: f64, amplitude_rad: f64, phase_rad: f64| Harmonic { joint_index: 1, order, amplitude_rad, phase_rad };
-    let effects = Effects {
-        periodic: Some(PeriodicError {
-            harmonics: vec![harmonic(1.0, 1e-4, 0.3), harmonic(7.0, 2e-4, -1.0), harmonic(12.0, 1e-4, 2.0)],
-        }),
-        ..Effects::default()
-    };
+    let effects = Effects { periodic: Some(joint_2_gear_error()), ..Effects::default() };
     let (train, test) = split(&robot, &effects, 31);
     let poe = heldout(&robot, &train, &test, "");
     let gear = heldout(&robot, &train, &test, "gear_periodic:2:12");
@@ -311,12 +311,8 @@ fn a_gear_series_warns_where_it_is_used_outside_the_angles_it_was_fitted_on() {
 #[test]
 fn a_gear_series_falls_back_to_the_geometry_in_a_gap_and_past_the_end_of_its_angles() {
     let robot = irb4400();
-    let harmonic =
-        |order: f64, amplitude_rad: f64, phase_rad: f64| Harmonic { joint_index: 1, order, amplitude_rad, phase_rad };
     let effects = Effects {
-        periodic: Some(PeriodicError {
-            harmonics: vec![harmonic(1.0, 1e-4, 0.3), harmonic(7.0, 2e-4, -1.0), harmonic(12.0, 1e-4, 2.0)],
-        }),
+        periodic: Some(joint_2_gear_error()),
         tracker_noise: Some(TrackerNoise::default()),
         ..Effects::default()
     };

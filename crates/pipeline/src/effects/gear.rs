@@ -173,7 +173,7 @@ impl GearPeriodic {
     /// outside its gaps); true for model files that do not record the range.
     pub fn covers(&self, q: f64) -> bool {
         if self.taper_rad.is_some() {
-            return self.held_and_weight(q).1 == 1.0 && self.turn_gap(q).is_none();
+            return self.turn_gap(q).is_none();
         }
         let Some([low, high]) = self.fitted_range else { return true };
         (low..=high).contains(&q) && !self.fitted_gaps.iter().any(|&[a, b]| a < q && q < b)
@@ -181,20 +181,23 @@ impl GearPeriodic {
 
     /// The joint error at angle `q`, rad: `Σ θ_l f_l(q)`.
     pub fn joint_error(&self, q: f64) -> f64 {
-        let row = Measurement {
-            line: 0,
-            q: vec![0.0; self.joint + 1],
-            position: lie::Vector3::zeros(),
-            orientation: None,
-            payload_kg: 0.0,
-            tool: 0,
-            temp_c: None,
-            t_s: None,
-            torques_nm: None,
-        };
-        let mut row = row;
-        row.q[self.joint] = q;
-        self.features(&row, 0).map_or(0.0, |f| f.iter().zip(&self.theta).map(|(f, t)| f * t).sum())
+        self.features_at(q).iter().zip(&self.theta).map(|(f, t)| f * t).sum()
+    }
+
+    /// The scaled features at the joint angle `q`: held, faded, centred and scaled.
+    fn features_at(&self, q: f64) -> Vec<f64> {
+        let (held, weight) = self.held_and_weight(q);
+        if weight == 0.0 {
+            return vec![0.0; 2 * self.orders.len()];
+        }
+        let mean = |l: usize| self.mean.get(l).copied().unwrap_or(0.0);
+        self.orders
+            .iter()
+            .flat_map(|&h| loadsim::periodic_joint_regressor(held, f64::from(h)))
+            .zip(&self.scale)
+            .enumerate()
+            .map(|(l, (v, s))| (v - mean(l)) * weight / s)
+            .collect()
     }
 
     /// Records [`GearPeriodic::fitted_rms_rad`] over the training rows, after the fit.
@@ -248,19 +251,7 @@ impl Regressor for GearPeriodic {
 
     fn features(&self, row: &Measurement, _tool: usize) -> Result<Vec<f64>, Error> {
         let q = *row.q.get(self.joint).ok_or(Error::EffectJoint { joint: self.joint + 1, joint_count: row.q.len() })?;
-        let (held, weight) = self.held_and_weight(q);
-        if weight == 0.0 {
-            return Ok(vec![0.0; 2 * self.orders.len()]);
-        }
-        let mean = |l: usize| self.mean.get(l).copied().unwrap_or(0.0);
-        Ok(self
-            .orders
-            .iter()
-            .flat_map(|&h| loadsim::periodic_joint_regressor(held, f64::from(h)))
-            .zip(&self.scale)
-            .enumerate()
-            .map(|(l, (v, s))| (v - mean(l)) * weight / s)
-            .collect())
+        Ok(self.features_at(q))
     }
 
     fn theta(&self) -> &[f64] {
