@@ -159,7 +159,11 @@ impl GearPeriodic {
         model.scale = vec![1.0; width];
         let raw: Vec<Vec<f64>> = rows.iter().map(|row| model.features(row, 0)).collect::<Result<_, _>>()?;
         let count = raw.len().max(1) as f64;
-        model.mean = (0..width).map(|l| raw.iter().map(|r| r[l]).sum::<f64>() / count).collect();
+        // Order 0 is the joint's bare twist (the diagnosis's backlash side uses it): a constant
+        // by definition, kept as it is.
+        model.mean = (0..width)
+            .map(|l| if model.orders[l / 2] == 0 { 0.0 } else { raw.iter().map(|r| r[l]).sum::<f64>() / count })
+            .collect();
         let centred: Vec<Vec<f64>> =
             raw.iter().map(|r| r.iter().zip(&model.mean).map(|(v, m)| v - m).collect()).collect();
         model.scale = rms_scales(&centred);
@@ -360,6 +364,12 @@ mod tests {
             assert!(mean.abs() < 1e-12, "feature {l}: mean {mean}");
             assert!((rms - 1.0).abs() < 1e-12, "feature {l}: rms {rms}");
         }
+    }
+
+    #[test]
+    fn order_zero_is_the_bare_twist_and_keeps_its_constant_feature() {
+        let gear = GearPeriodic::new(0, vec![0], &rows(&spread(-0.4, 0.9, 30))).unwrap();
+        assert_eq!(gear.features(&rows(&[0.3])[0], 0).unwrap(), vec![1.0, 0.0]);
     }
 
     #[test]
