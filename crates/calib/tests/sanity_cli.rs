@@ -70,3 +70,57 @@ fn a_position_only_model_reports_no_rotation_error_on_full_pose_data() {
     assert!(!table.contains("rotation error"), "{table}");
     assert!(table.contains(note), "{table}");
 }
+
+/// Writes `from` to `to` with the column `name` set to `value` on every row (appended if absent).
+fn with_constant_column(from: &Path, to: &Path, name: &str, value: &str) {
+    let content = std::fs::read_to_string(from).unwrap();
+    let header: Vec<&str> = content.lines().next().unwrap().split(',').collect();
+    let at = header.iter().position(|c| *c == name);
+    let body: Vec<String> = content
+        .lines()
+        .enumerate()
+        .map(|(i, line)| {
+            let mut cells: Vec<&str> = line.split(',').collect();
+            let cell = if i == 0 { name } else { value };
+            match at {
+                Some(k) => cells[k] = cell,
+                None => cells.push(cell),
+            }
+            cells.join(",")
+        })
+        .collect();
+    std::fs::write(to, body.join("\n") + "\n").unwrap();
+}
+
+#[test]
+fn a_constant_time_or_temperature_column_is_refused_as_unobservable_and_auto_leaves_it_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let (simulated, constant, model) =
+        (dir.path().join("sim.csv"), dir.path().join("constant.csv"), dir.path().join("m.ron"));
+    let robot = fixture("irb4400.ron");
+    succeeds(&["simulate", "--robot", &robot, "--out", &text(&simulated), "--rows", "80", "--seed", "5"]);
+    with_constant_column(&simulated, &constant, "temp_c", "21.5");
+    with_constant_column(&constant, &constant, "t_s", "600");
+    let fit = |effects: &str| {
+        vec!["fit", "--robot", &robot, "--data", constant.to_str().unwrap(), "--method", "poe", "--effects", effects]
+            .into_iter()
+            .map(String::from)
+            .chain(["--out".into(), text(&model)])
+            .collect::<Vec<String>>()
+    };
+    let cases = [
+        ("time_drift", "time_drift needs the column 't_s' to vary, but its values do not vary (t_s = 600 on all 80 rows)"),
+        ("thermal", "thermal needs the column 'temp_c' to vary, but its values do not vary (temp_c = 21.5 on all 80 rows)"),
+    ];
+    for (effect, expected) in cases {
+        let args = fit(effect);
+        let message = fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        assert!(message.contains(expected), "{effect}: {message}");
+        assert!(message.contains("unobservable") && message.contains("lines 2-81"), "{effect}: {message}");
+        assert!(!model.exists(), "{effect}: a model was written");
+    }
+    // The diagnosis behind `auto` never proposes them: the fit goes through without either.
+    let args = fit("auto");
+    let (stdout, _) = succeeds(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(!stdout.contains("time_drift") && !stdout.contains("thermal"), "{stdout}");
+}

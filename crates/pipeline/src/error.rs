@@ -464,6 +464,21 @@ pub enum Error {
         /// The column it needs.
         column: &'static str,
     },
+    /// An effect whose column has the same value on every training row: the effect's
+    /// parameters multiply the column's deviation from its mean, zero everywhere, so they are
+    /// unobservable (fitted, they would read zero and look identified).
+    EffectColumnConstant {
+        /// The effect.
+        effect: &'static str,
+        /// Its column.
+        column: &'static str,
+        /// The one value every row has.
+        value: f64,
+        /// The training rows.
+        rows: usize,
+        /// 1-based lines of the first and the last row (0 for rows made in memory).
+        lines: [u64; 2],
+    },
     /// An output that is one of the command's own inputs (the same path, a symbolic link to it,
     /// or a hard link): refused before anything is written.
     OutputIsInput {
@@ -664,6 +679,11 @@ impl fmt::Display for Error {
             Error::EffectNeedsColumn { line, effect, column } => {
                 write!(f, "line {line}: {effect} needs the column '{column}', which this row lacks")
             }
+            Error::EffectColumnConstant { effect, column, value, rows, lines: [first, last] } => write!(
+                f,
+                "lines {first}-{last}: {effect} needs the column '{column}' to vary, but its values do not vary \
+                 ({column} = {value} on all {rows} rows): its parameters are unobservable; leave {effect} out"
+            ),
             Error::OutputIsInput { output_option, output, input_option, input } => write!(
                 f,
                 "{output_option} {output} is the same file as {input_option} {input}: refusing to overwrite an input"
