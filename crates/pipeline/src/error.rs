@@ -242,6 +242,26 @@ pub enum Error {
         /// The cell's text.
         text: String,
     },
+    /// A number beyond any physical range for its column (e.g. a position beyond 1 km): a unit
+    /// or export error, refused before it wrecks a fit.
+    BeyondPhysicalRange {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: u64,
+        /// 1-based column.
+        column: usize,
+        /// The column's name.
+        name: String,
+        /// The value, in SI units (`unit`).
+        value: f64,
+        /// The largest magnitude accepted, in `unit`.
+        limit: f64,
+        /// The SI unit of `value` and `limit`.
+        unit: &'static str,
+        /// What the column holds (e.g. "position", "joint angle").
+        quantity: &'static str,
+    },
     /// The joint columns do not match the robot's joint count.
     JointCountMismatch {
         /// The file.
@@ -582,6 +602,11 @@ impl fmt::Display for Error {
             Error::NotANumber { file, line, column, name, text } => {
                 write!(f, "{file}:{line}:{column}: column '{name}': '{text}' is not a finite number")
             }
+            Error::BeyondPhysicalRange { file, line, column, name, value, limit, unit, quantity } => write!(
+                f,
+                "{file}:{line}:{column}: column '{name}': {value:e} {unit} is beyond any physical {quantity} \
+                 (at most {limit:e} {unit} in magnitude): check the column's unit"
+            ),
             Error::JointCountMismatch { file, line, column, found, expected } => {
                 write!(f, "{file}:{line}:{column}: {found} joint columns, the robot has {expected} joints")
             }
