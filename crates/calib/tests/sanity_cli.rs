@@ -109,8 +109,14 @@ fn a_constant_time_or_temperature_column_is_refused_as_unobservable_and_auto_lea
             .collect::<Vec<String>>()
     };
     let cases = [
-        ("time_drift", "time_drift needs the column 't_s' to vary, but its values do not vary (t_s = 600 on all 80 rows)"),
-        ("thermal", "thermal needs the column 'temp_c' to vary, but its values do not vary (temp_c = 21.5 on all 80 rows)"),
+        (
+            "time_drift",
+            "time_drift needs the column 't_s' to vary, but its values do not vary (t_s = 600 on all 80 rows)",
+        ),
+        (
+            "thermal",
+            "thermal needs the column 'temp_c' to vary, but its values do not vary (temp_c = 21.5 on all 80 rows)",
+        ),
     ];
     for (effect, expected) in cases {
         let args = fit(effect);
@@ -123,4 +129,33 @@ fn a_constant_time_or_temperature_column_is_refused_as_unobservable_and_auto_lea
     let args = fit("auto");
     let (stdout, _) = succeeds(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(!stdout.contains("time_drift") && !stdout.contains("thermal"), "{stdout}");
+}
+
+#[test]
+fn export_like_a_urdf_whose_joint_kind_differs_from_the_model_is_refused_at_that_joint() {
+    let dir = tempfile::tempdir().unwrap();
+    let (data, model, out) = (dir.path().join("sim.csv"), dir.path().join("m.ron"), dir.path().join("out.urdf"));
+    let robot = fixture("irb4400.ron");
+    succeeds(&["simulate", "--robot", &robot, "--out", &text(&data), "--rows", "80", "--seed", "6"]);
+    succeeds(&["fit", "--robot", &robot, "--data", &text(&data), "--method", "poe", "--out", &text(&model)]);
+    // The same URDF, its third joint sliding: its limits stay numbers, so it reads as a chain.
+    let original = std::fs::read_to_string(fixture("irb4400.urdf")).unwrap();
+    let changed =
+        original.replace("<joint name=\"joint_3\" type=\"revolute\">", "<joint name=\"joint_3\" type=\"prismatic\">");
+    assert_ne!(changed, original);
+    let like = dir.path().join("arm.urdf");
+    std::fs::write(&like, changed).unwrap();
+    // The unchanged URDF is accepted: the refusal is the kind, not the file.
+    succeeds(&["export", "--model", &text(&model), "--urdf", &text(&out), "--like", &fixture("irb4400.urdf")]);
+    std::fs::remove_file(&out).unwrap();
+
+    let message = fails(&["export", "--model", &text(&model), "--urdf", &text(&out), "--like", &text(&like)]);
+    assert!(
+        message.contains(&format!(
+            "{}:28:3: joint 'joint_3' (movable joint 3) is prismatic in the URDF but revolute in the model",
+            text(&like)
+        )),
+        "{message}"
+    );
+    assert!(!out.exists(), "a URDF was written");
 }

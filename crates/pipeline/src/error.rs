@@ -321,6 +321,24 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A joint of the URDF written into (`export --like`) that turns where the model's slides, or
+    /// the other way round: the URDF keeps its joint types, so it would be calibrated wrongly.
+    UrdfJointKind {
+        /// The URDF file.
+        file: String,
+        /// 1-based line of the `<joint>` element.
+        line: usize,
+        /// 1-based column of the `<joint>` element.
+        column: usize,
+        /// The joint's name in the URDF.
+        joint: String,
+        /// The joint's 1-based place among the chain's movable joints.
+        index: usize,
+        /// Its kind in the URDF.
+        urdf: poe::JointKind,
+        /// The model's kind of that joint.
+        model: poe::JointKind,
+    },
     /// A nominal robot description whose joints are not where a calibrated model has them, once
     /// its base is placed by joint 1: not the description the model was fitted with.
     NominalMismatch {
@@ -607,6 +625,13 @@ impl fmt::Display for Error {
                 "{file}:{line}:{column}: column '{name}': {value:e} {unit} is beyond any physical {quantity} \
                  (at most {limit:e} {unit} in magnitude): check the column's unit"
             ),
+            Error::UrdfJointKind { file, line, column, joint, index, urdf, model } => write!(
+                f,
+                "{file}:{line}:{column}: joint '{joint}' (movable joint {index}) is {} in the URDF but {} in the \
+                 model: refusing to write the calibration into a joint of another kind",
+                kind_name(*urdf),
+                kind_name(*model)
+            ),
             Error::JointCountMismatch { file, line, column, found, expected } => {
                 write!(f, "{file}:{line}:{column}: {found} joint columns, the robot has {expected} joints")
             }
@@ -756,5 +781,13 @@ impl From<loadsim::Error> for Error {
 impl From<gp::Error> for Error {
     fn from(source: gp::Error) -> Self {
         Error::Gp { source }
+    }
+}
+
+/// A joint kind as a URDF names it.
+fn kind_name(kind: poe::JointKind) -> &'static str {
+    match kind {
+        poe::JointKind::Revolute => "revolute",
+        poe::JointKind::Prismatic => "prismatic",
     }
 }

@@ -217,7 +217,10 @@ fn a_position_beyond_a_kilometre_is_refused_at_its_cell() {
     let at_bound = format!("{HEADER2}\n0,0,1e6,0,0\n");
     assert!(parse_measurements(at_bound.as_bytes(), "cell.csv", &revolute(Some(2))).is_ok());
     let (error, message) = refuse(&format!("{HEADER2}\n0,0,1,2,3\n0,0,1,-1.5e6,3\n"), Some(2));
-    assert!(matches!(error, Error::BeyondPhysicalRange { line: 3, column: 4, ref name, .. } if name == "y_mm"), "{message}");
+    assert!(
+        matches!(error, Error::BeyondPhysicalRange { line: 3, column: 4, ref name, .. } if name == "y_mm"),
+        "{message}"
+    );
     assert_eq!(
         message,
         "cell.csv:3:4: column 'y_mm': -1.5e3 m is beyond any physical position (at most 1e3 m in magnitude): \
@@ -231,11 +234,17 @@ fn a_position_beyond_a_kilometre_is_refused_at_its_cell() {
 fn a_joint_angle_beyond_a_thousand_radians_is_refused_after_unit_conversion() {
     // 57,000 degrees is 994.8 rad: read; 58,000 degrees is 1012.3 rad: refused.
     let header = "q1_rad,q2_deg,x_mm,y_mm,z_mm";
-    assert!(parse_measurements(format!("{header}\n1000,57000,1,2,3\n").as_bytes(), "cell.csv", &revolute(Some(2))).is_ok());
-    let (error, message) = refuse(&format!("{header}\n0,58000,1,2,3\n"), Some(2));
-    assert!(matches!(error, Error::BeyondPhysicalRange { line: 2, column: 2, ref name, .. } if name == "q2_deg"), "{message}");
     assert!(
-        message.starts_with("cell.csv:2:2: column 'q2_deg': 1.0122") && message.contains("rad is beyond any physical joint angle (at most 1e3 rad in magnitude)"),
+        parse_measurements(format!("{header}\n1000,57000,1,2,3\n").as_bytes(), "cell.csv", &revolute(Some(2))).is_ok()
+    );
+    let (error, message) = refuse(&format!("{header}\n0,58000,1,2,3\n"), Some(2));
+    assert!(
+        matches!(error, Error::BeyondPhysicalRange { line: 2, column: 2, ref name, .. } if name == "q2_deg"),
+        "{message}"
+    );
+    assert!(
+        message.starts_with("cell.csv:2:2: column 'q2_deg': 1.0122")
+            && message.contains("rad is beyond any physical joint angle (at most 1e3 rad in magnitude)"),
         "{message}"
     );
     let (error, message) = refuse(&format!("{header}\n-1000.5,0,1,2,3\n"), Some(2));

@@ -24,7 +24,8 @@ pub(super) const MAX_POSITION_M: f64 = 1e3;
 pub(super) const MAX_JOINT_ANGLE_RAD: f64 = 1e3;
 
 /// The range of a tool position coordinate.
-pub(super) const POSITION_RANGE: PhysicalRange = PhysicalRange { limit: MAX_POSITION_M, unit: "m", quantity: "position" };
+pub(super) const POSITION_RANGE: PhysicalRange =
+    PhysicalRange { limit: MAX_POSITION_M, unit: "m", quantity: "position" };
 
 /// The range of a prismatic joint's travel: no axis is longer than the tracker's reach.
 pub(super) const JOINT_TRAVEL_RANGE: PhysicalRange =
