@@ -33,6 +33,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
         eprintln!("{}", data.read_summary());
+        if report.orientations_not_evaluated {
+            eprintln!("note: {}", pipeline::ORIENTATIONS_NOT_EVALUATED);
+        }
         for warning in &report.warnings {
             eprintln!("warning: {warning}");
         }
@@ -47,6 +50,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     );
     if let (Some(mean), Some(max)) = (s.mean_rotation_error_mrad, s.max_rotation_error_mrad) {
         println!("  rotation error: mean {mean:.4} mrad, max {max:.4} mrad");
+    }
+    if report.orientations_not_evaluated {
+        println!("  note: {}", pipeline::ORIENTATIONS_NOT_EVALUATED);
     }
     if let Some(split) = &report.coverage {
         for (what, part) in [("inside", &split.inside), ("outside", &split.outside)] {

@@ -242,6 +242,26 @@ pub enum Error {
         /// The cell's text.
         text: String,
     },
+    /// A number beyond any physical range for its column (e.g. a position beyond 1 km): a unit
+    /// or export error, refused before it wrecks a fit.
+    BeyondPhysicalRange {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: u64,
+        /// 1-based column.
+        column: usize,
+        /// The column's name.
+        name: String,
+        /// The value, in SI units (`unit`).
+        value: f64,
+        /// The largest magnitude accepted, in `unit`.
+        limit: f64,
+        /// The SI unit of `value` and `limit`.
+        unit: &'static str,
+        /// What the column holds (e.g. "position", "joint angle").
+        quantity: &'static str,
+    },
     /// The joint columns do not match the robot's joint count.
     JointCountMismatch {
         /// The file.
@@ -300,6 +320,24 @@ pub enum Error {
         column: usize,
         /// What is wrong.
         message: String,
+    },
+    /// A joint of the URDF written into (`export --like`) that turns where the model's slides, or
+    /// the other way round: the URDF keeps its joint types, so it would be calibrated wrongly.
+    UrdfJointKind {
+        /// The URDF file.
+        file: String,
+        /// 1-based line of the `<joint>` element.
+        line: usize,
+        /// 1-based column of the `<joint>` element.
+        column: usize,
+        /// The joint's name in the URDF.
+        joint: String,
+        /// The joint's 1-based place among the chain's movable joints.
+        index: usize,
+        /// Its kind in the URDF.
+        urdf: poe::JointKind,
+        /// The model's kind of that joint.
+        model: poe::JointKind,
     },
     /// A nominal robot description whose joints are not where a calibrated model has them, once
     /// its base is placed by joint 1: not the description the model was fitted with.
@@ -464,6 +502,21 @@ pub enum Error {
         /// The column it needs.
         column: &'static str,
     },
+    /// An effect whose column has the same value on every training row: the effect's
+    /// parameters multiply the column's deviation from its mean, zero everywhere, so they are
+    /// unobservable (fitted, they would read zero and look identified).
+    EffectColumnConstant {
+        /// The effect.
+        effect: &'static str,
+        /// Its column.
+        column: &'static str,
+        /// The one value every row has.
+        value: f64,
+        /// The training rows.
+        rows: usize,
+        /// 1-based lines of the first and the last row (0 for rows made in memory).
+        lines: [u64; 2],
+    },
     /// An output that is one of the command's own inputs (the same path, a symbolic link to it,
     /// or a hard link): refused before anything is written.
     OutputIsInput {
@@ -567,6 +620,18 @@ impl fmt::Display for Error {
             Error::NotANumber { file, line, column, name, text } => {
                 write!(f, "{file}:{line}:{column}: column '{name}': '{text}' is not a finite number")
             }
+            Error::BeyondPhysicalRange { file, line, column, name, value, limit, unit, quantity } => write!(
+                f,
+                "{file}:{line}:{column}: column '{name}': {value:e} {unit} is beyond any physical {quantity} \
+                 (at most {limit:e} {unit} in magnitude): check the column's unit"
+            ),
+            Error::UrdfJointKind { file, line, column, joint, index, urdf, model } => write!(
+                f,
+                "{file}:{line}:{column}: joint '{joint}' (movable joint {index}) is {} in the URDF but {} in the \
+                 model: refusing to write the calibration into a joint of another kind",
+                kind_name(*urdf),
+                kind_name(*model)
+            ),
             Error::JointCountMismatch { file, line, column, found, expected } => {
                 write!(f, "{file}:{line}:{column}: {found} joint columns, the robot has {expected} joints")
             }
@@ -664,6 +729,11 @@ impl fmt::Display for Error {
             Error::EffectNeedsColumn { line, effect, column } => {
                 write!(f, "line {line}: {effect} needs the column '{column}', which this row lacks")
             }
+            Error::EffectColumnConstant { effect, column, value, rows, lines: [first, last] } => write!(
+                f,
+                "lines {first}-{last}: {effect} needs the column '{column}' to vary, but its values do not vary \
+                 ({column} = {value} on all {rows} rows): its parameters are unobservable; leave {effect} out"
+            ),
             Error::OutputIsInput { output_option, output, input_option, input } => write!(
                 f,
                 "{output_option} {output} is the same file as {input_option} {input}: refusing to overwrite an input"
@@ -711,5 +781,13 @@ impl From<loadsim::Error> for Error {
 impl From<gp::Error> for Error {
     fn from(source: gp::Error) -> Self {
         Error::Gp { source }
+    }
+}
+
+/// A joint kind as a URDF names it.
+fn kind_name(kind: poe::JointKind) -> &'static str {
+    match kind {
+        poe::JointKind::Revolute => "revolute",
+        poe::JointKind::Prismatic => "prismatic",
     }
 }

@@ -1,11 +1,15 @@
 //! What `calib eval --json` prints: one typed object with the SPEC's keys (`n`,
 //! `mean_position_error_mm`, `rms_position_error_mm`, `max_position_error_mm`, and for
-//! full-pose data `mean_rotation_error_mrad`) and what identifies the run.
+//! full-pose data and a model fitted on it `mean_rotation_error_mrad`) and what identifies the run.
 
 use crate::{
     CalibratedModel, ErrorSummary, Evaluation, ExtrapolationWarning, FileFormat, MeasurementSet, Method, PoseError,
 };
 use serde::Serialize;
+
+/// What `eval` says when the data has orientations that a position-only model cannot be judged on.
+pub const ORIENTATIONS_NOT_EVALUATED: &str =
+    "the model was fitted on positions only: orientations in the data are not evaluated";
 
 /// The evaluation of a model on one measurement file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -16,8 +20,13 @@ pub struct EvalReport {
     pub robot: String,
     /// The measurement file.
     pub data: String,
-    /// Whether the data has orientations (then the rotation errors are given).
+    /// Whether the rotation errors are given: the data has orientations and the model was
+    /// fitted on them.
     pub full_pose: bool,
+    /// The data has orientations but the model was fitted on positions only: they are not
+    /// evaluated (see [`ORIENTATIONS_NOT_EVALUATED`]).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub orientations_not_evaluated: bool,
     /// The error statistics, at the top level of the object.
     #[serde(flatten)]
     pub errors: ErrorSummary,
@@ -48,7 +57,8 @@ impl EvalReport {
             method: model.method,
             robot: model.robot.clone(),
             data: data.source.clone(),
-            full_pose: data.full_pose,
+            full_pose: data.full_pose && model.full_pose,
+            orientations_not_evaluated: data.full_pose && !model.full_pose,
             errors: evaluation.summary,
             format: data.format.clone(),
             coverage: model.records_coverage().then(|| {

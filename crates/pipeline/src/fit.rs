@@ -229,11 +229,20 @@ pub fn fit(
     Ok((model, report))
 }
 
-/// Evaluates a fitted model on measurements.
+/// Evaluates a fitted model on measurements. A model fitted on positions only has no rotation
+/// errors, whatever the data holds: it never calibrated the tool's orientation, so the angle it
+/// would report is that of an uncalibrated frame, not an error of the fit.
 pub fn evaluate(model: &CalibratedModel, data: &MeasurementSet) -> Result<Evaluation, Error> {
     let tools = tool_indices(model, data)?;
     let predictions = model.predict(&data.rows, &tools)?;
-    let errors: Vec<PoseError> = predictions.iter().zip(&data.rows).map(|(p, row)| pose_error(&p.pose, row)).collect();
+    let errors: Vec<PoseError> = predictions
+        .iter()
+        .zip(&data.rows)
+        .map(|(p, row)| {
+            let error = pose_error(&p.pose, row);
+            if model.full_pose { error } else { PoseError { rotation_mrad: None, ..error } }
+        })
+        .collect();
     let summary = ErrorSummary::from_errors(&errors);
     Ok(Evaluation { errors, summary })
 }

@@ -45,7 +45,7 @@ pub use compensation::{
     UnknownGpChoice,
 };
 pub use error::Error;
-pub use eval_report::{CoverageSplit, EvalReport};
+pub use eval_report::{CoverageSplit, EvalReport, ORIENTATIONS_NOT_EVALUATED};
 pub use fit::{Evaluation, FitReport, FitWarning, evaluate, fit, tool_indices};
 pub use fit_options::{EffectOptions, FitOptions};
 pub use input_files::InputFiles;

@@ -10,7 +10,7 @@
 //! data.
 
 use crate::base_frame::{NominalTolerance, axis_changes, check_nominal, in_base_frame, tracker_from_base};
-use crate::urdf_like::write_like;
+use crate::urdf_like::{check_joint_kinds, write_like};
 use crate::{CalibratedModel, Error, ErrorSummary, MeasurementSet, RobotDescription, UrdfChain, UrdfDocument};
 use lie::SE3;
 use poe::{JointKind, LocalPoe};
@@ -137,6 +137,9 @@ pub fn export_urdf(
             (Some(chain.description().nominal_model()?), document.file().to_owned())
         }
     };
+    if let UrdfTemplate::Like { document, chain } = template {
+        check_joint_kinds(document, chain, &model.joint_kinds())?;
+    }
     let in_base = in_base_frame(&model.kinematics, nominal.as_ref());
     if let Some(nominal) = &nominal {
         check_nominal(&in_base, nominal, model.full_pose, tolerance, &nominal_file)?;

@@ -12,7 +12,7 @@
 use crate::urdf_export::{Written, escape, fixed_joint, origin_element};
 use crate::{Error, StepMotion, UrdfChain, UrdfDocument};
 use lie::SE3;
-use poe::LocalPoe;
+use poe::{JointKind, LocalPoe};
 
 /// `name`, or `calib_<name>` if the URDF already has a link so named.
 fn free_link_name(document: &UrdfDocument, name: &str) -> String {
@@ -22,6 +22,31 @@ fn free_link_name(document: &UrdfDocument, name: &str) -> String {
         candidate = format!("calib_{candidate}");
     }
     candidate
+}
+
+/// Refuses a model whose joint kinds differ from the URDF chain's, at the first such `<joint>`:
+/// the written file keeps the URDF's joint types, which would not be the model's.
+pub(crate) fn check_joint_kinds(document: &UrdfDocument, chain: &UrdfChain, model: &[JointKind]) -> Result<(), Error> {
+    let movable = chain.steps.iter().filter(|s| s.motion != StepMotion::Fixed);
+    for (k, (step, &model_kind)) in movable.zip(model).enumerate() {
+        let urdf_kind = match step.motion {
+            StepMotion::Prismatic { .. } => JointKind::Prismatic,
+            StepMotion::Revolute { .. } | StepMotion::Fixed => JointKind::Revolute,
+        };
+        if urdf_kind != model_kind {
+            let (line, column) = document.element("joint", &step.joint).map_or((1, 1), |e| e.position);
+            return Err(Error::UrdfJointKind {
+                file: document.file().to_owned(),
+                line,
+                column,
+                joint: step.joint.clone(),
+                index: k + 1,
+                urdf: urdf_kind,
+                model: model_kind,
+            });
+        }
+    }
+    Ok(())
 }
 
 pub(crate) fn write_like(

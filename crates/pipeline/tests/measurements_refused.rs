@@ -210,3 +210,43 @@ fn invalid_utf8_is_refused_at_its_line_and_field() {
     assert!(matches!(error, Error::InvalidUtf8 { line: 3, column: 6, .. }), "{error}");
     assert_eq!(error.to_string(), "cell.csv:3:6: the text is not UTF-8");
 }
+
+#[test]
+fn a_position_beyond_a_kilometre_is_refused_at_its_cell() {
+    // 1e6 mm is 1 km, the bound itself: read. A tracker's range is under 100 m.
+    let at_bound = format!("{HEADER2}\n0,0,1e6,0,0\n");
+    assert!(parse_measurements(at_bound.as_bytes(), "cell.csv", &revolute(Some(2))).is_ok());
+    let (error, message) = refuse(&format!("{HEADER2}\n0,0,1,2,3\n0,0,1,-1.5e6,3\n"), Some(2));
+    assert!(
+        matches!(error, Error::BeyondPhysicalRange { line: 3, column: 4, ref name, .. } if name == "y_mm"),
+        "{message}"
+    );
+    assert_eq!(
+        message,
+        "cell.csv:3:4: column 'y_mm': -1.5e3 m is beyond any physical position (at most 1e3 m in magnitude): \
+         check the column's unit"
+    );
+    let (error, _) = refuse("q1_rad,q2_rad,x_m,y_m,z_m\n0,0,0,0,2000\n", Some(2));
+    assert!(matches!(error, Error::BeyondPhysicalRange { line: 2, column: 5, .. }), "{error}");
+}
+
+#[test]
+fn a_joint_angle_beyond_a_thousand_radians_is_refused_after_unit_conversion() {
+    // 57,000 degrees is 994.8 rad: read; 58,000 degrees is 1012.3 rad: refused.
+    let header = "q1_rad,q2_deg,x_mm,y_mm,z_mm";
+    assert!(
+        parse_measurements(format!("{header}\n1000,57000,1,2,3\n").as_bytes(), "cell.csv", &revolute(Some(2))).is_ok()
+    );
+    let (error, message) = refuse(&format!("{header}\n0,58000,1,2,3\n"), Some(2));
+    assert!(
+        matches!(error, Error::BeyondPhysicalRange { line: 2, column: 2, ref name, .. } if name == "q2_deg"),
+        "{message}"
+    );
+    assert!(
+        message.starts_with("cell.csv:2:2: column 'q2_deg': 1.0122")
+            && message.contains("rad is beyond any physical joint angle (at most 1e3 rad in magnitude)"),
+        "{message}"
+    );
+    let (error, message) = refuse(&format!("{header}\n-1000.5,0,1,2,3\n"), Some(2));
+    assert!(matches!(error, Error::BeyondPhysicalRange { line: 2, column: 1, .. }), "{message}");
+}

@@ -1,7 +1,7 @@
 //! Drift: the robot's placement in the tracker frame moves at a constant twist rate, `exp(t ξ̂) T`
 //! (`loadsim::BaseDrift`, `loadsim::drift_regressor`): six parameters, `(v, ω)`.
 
-use super::{Regressor, rms_scales};
+use super::{Regressor, check_column_varies, rms_scales};
 use crate::effects::Direction;
 use crate::{Error, Measurement};
 use serde::{Deserialize, Serialize};
@@ -23,6 +23,7 @@ impl TimeDrift {
             .iter()
             .map(|r| r.t_s.ok_or(Error::EffectNeedsColumn { line: r.line, effect: "time_drift", column: "t_s" }))
             .collect::<Result<_, _>>()?;
+        check_column_varies(&times, rows, "time_drift", "t_s")?;
         let reference_s = times.iter().sum::<f64>() / times.len().max(1) as f64;
         let raw: Vec<Vec<f64>> = times.iter().map(|t| vec![t - reference_s; 6]).collect();
         Ok(Self { reference_s, scale: rms_scales(&raw), theta: vec![0.0; 6] })

@@ -67,6 +67,26 @@ pub(crate) fn rms_scales(rows: &[Vec<f64>]) -> Vec<f64> {
         .collect()
 }
 
+/// Refuses a column with one value on every row: an effect linear in its deviation from the mean
+/// would see zero everywhere and its parameters would be unobservable.
+pub(crate) fn check_column_varies(
+    values: &[f64],
+    rows: &[Measurement],
+    effect: &'static str,
+    column: &'static str,
+) -> Result<(), Error> {
+    match values.first() {
+        Some(&value) if values.iter().all(|&v| v == value) => Err(Error::EffectColumnConstant {
+            effect,
+            column,
+            value,
+            rows: values.len(),
+            lines: [rows.first().map_or(0, |r| r.line), rows.last().map_or(0, |r| r.line)],
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// Whether every row has measured joint torques.
 pub(crate) fn has_torques(rows: &[Measurement]) -> bool {
     !rows.is_empty() && rows.iter().all(|r| r.torques_nm.is_some())

@@ -1,7 +1,7 @@
 //! Thermal growth: every link but the base placement grows by `α ΔT` with the temperature
 //! (`loadsim::ThermalGrowth`, one coefficient for the whole arm, `loadsim::thermal_regressor`).
 
-use super::{Regressor, rms_scales};
+use super::{Regressor, check_column_varies, rms_scales};
 use crate::effects::Direction;
 use crate::{Error, Measurement};
 use serde::{Deserialize, Serialize};
@@ -23,6 +23,7 @@ impl Thermal {
             .iter()
             .map(|r| r.temp_c.ok_or(Error::EffectNeedsColumn { line: r.line, effect: "thermal", column: "temp_c" }))
             .collect::<Result<_, _>>()?;
+        check_column_varies(&temps, rows, "thermal", "temp_c")?;
         let reference_c = temps.iter().sum::<f64>() / temps.len().max(1) as f64;
         let raw: Vec<Vec<f64>> = temps.iter().map(|t| vec![t - reference_c]).collect();
         Ok(Self { reference_c, scale: rms_scales(&raw), theta: vec![0.0] })

@@ -15,10 +15,10 @@ pub use column_map::{ColumnMap, ColumnMapFault};
 pub use dialect::{Decimal, DecimalFault, Delimiter, Dialect};
 
 use crate::Error;
-use layout::{Column, Expectation, Layout, OrientationColumns};
+use layout::{Expectation, Layout, OrientationColumns};
 use lie::{SO3, Vector3};
 use poe::JointKind;
-use row::{Row, syntax_error};
+use row::{JOINT_ANGLE_RANGE, JOINT_TRAVEL_RANGE, POSITION_RANGE, Row, syntax_error};
 use serde::Serialize;
 use std::collections::HashMap;
 use std::fmt;
@@ -210,7 +210,6 @@ fn parse_keeping<R: Read>(
     if let Some(cells) = cells.as_deref_mut() {
         cells.header = header.iter().map(str::to_owned).collect();
     }
-    let joints: Vec<Column> = layout.joints.iter().map(|(c, _)| *c).collect();
     let mut tools: Vec<String> = Vec::new();
     // Each tool's index by name: a file whose every row names another tool stays linear.
     let mut tool_index: HashMap<String, usize> = HashMap::new();
@@ -224,10 +223,20 @@ fn parse_keeping<R: Read>(
         }
         let line = record.position().map_or(0, |p| p.line());
         let mut row = Row { record: &record, line, file, names: &layout.names, dialect: &mut dialect };
-        let q = row.numbers(&joints)?;
+        let q = layout
+            .joints
+            .iter()
+            .map(|&(c, kind)| {
+                let range = match kind {
+                    JointKind::Revolute => JOINT_ANGLE_RANGE,
+                    JointKind::Prismatic => JOINT_TRAVEL_RANGE,
+                };
+                row.bounded_numbers(&[c], range).map(|v| v[0])
+            })
+            .collect::<Result<Vec<f64>, Error>>()?;
         let position = match layout.position {
             Some(c) => {
-                let p = row.numbers(&c)?;
+                let p = row.bounded_numbers(&c, POSITION_RANGE)?;
                 Vector3::new(p[0], p[1], p[2])
             }
             None => Vector3::zeros(),

@@ -6,6 +6,35 @@ use super::layout::{Column, OrientationColumns};
 use crate::Error;
 use lie::{SO3, Vector3};
 
+/// The largest magnitude a column's value can have, in SI units: beyond it the cell is a unit or
+/// export error, not a measurement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct PhysicalRange {
+    pub limit: f64,
+    pub unit: &'static str,
+    pub quantity: &'static str,
+}
+
+/// A position coordinate, m: a laser tracker measures to under 100 m, so a coordinate beyond 1 km
+/// (1e6 mm) is a wrong unit or a broken export, never a measurement.
+pub(super) const MAX_POSITION_M: f64 = 1e3;
+
+/// A revolute joint's angle, rad: 1e3 rad is 160 turns, beyond the travel of any joint (even an
+/// endless one's controller wraps its counter long before).
+pub(super) const MAX_JOINT_ANGLE_RAD: f64 = 1e3;
+
+/// The range of a tool position coordinate.
+pub(super) const POSITION_RANGE: PhysicalRange =
+    PhysicalRange { limit: MAX_POSITION_M, unit: "m", quantity: "position" };
+
+/// The range of a prismatic joint's travel: no axis is longer than the tracker's reach.
+pub(super) const JOINT_TRAVEL_RANGE: PhysicalRange =
+    PhysicalRange { limit: MAX_POSITION_M, unit: "m", quantity: "joint travel" };
+
+/// The range of a revolute joint's angle.
+pub(super) const JOINT_ANGLE_RANGE: PhysicalRange =
+    PhysicalRange { limit: MAX_JOINT_ANGLE_RAD, unit: "rad", quantity: "joint angle" };
+
 /// The CSV layer's refusal as ours, at its line and field.
 pub(super) fn syntax_error(e: &csv::Error, file: &str, delimiter: Delimiter) -> Error {
     let line = e.position().map_or(1, |p| p.line());
@@ -55,6 +84,29 @@ impl Row<'_> {
     /// The cells of `columns` as SI numbers.
     pub fn numbers(&mut self, columns: &[Column]) -> Result<Vec<f64>, Error> {
         columns.iter().map(|&c| self.number(c)).collect()
+    }
+
+    /// The cells of `columns` as SI numbers, each within `range` in magnitude.
+    pub fn bounded_numbers(&mut self, columns: &[Column], range: PhysicalRange) -> Result<Vec<f64>, Error> {
+        columns
+            .iter()
+            .map(|&c| {
+                let value = self.number(c)?;
+                if value.abs() <= range.limit {
+                    return Ok(value);
+                }
+                Err(Error::BeyondPhysicalRange {
+                    file: self.file.to_owned(),
+                    line: self.line,
+                    column: c.index + 1,
+                    name: self.names[c.index].clone(),
+                    value,
+                    limit: range.limit,
+                    unit: range.unit,
+                    quantity: range.quantity,
+                })
+            })
+            .collect()
     }
 
     /// The orientation the row's quaternion or Euler angles give.
