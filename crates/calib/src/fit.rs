@@ -42,6 +42,10 @@ pub struct Args {
     /// Print the fit report as one JSON object on stdout (the summary goes to stderr).
     #[arg(long)]
     json: bool,
+    /// Fit data that the plausibility checks refuse (positions whose spread is not the robot's,
+    /// a mirror-image frame, joint values beyond the limits), with a warning instead.
+    #[arg(long)]
+    force: bool,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
@@ -62,6 +66,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         (Some(selection), _) => options.effects.selection = selection.clone(),
         (None, true) => options.effects.selection = EffectSelection::List(vec![EffectSpec::JointCompliance]),
         (None, false) => {}
+    }
+    if args.force {
+        options.plausibility.force = true;
     }
     if let Some(choice) = args.gp {
         options.compensation.method = choice;

@@ -87,6 +87,10 @@ pub struct FitOptions {
     /// held-out RMS is already √2 times the training RMS, so the training error a user reads
     /// flatters the model by more than 40 %.
     pub min_redundancy: f64,
+    /// The checks run on the data before anything is fitted (units, handedness, joint limits),
+    /// and `force`, which turns their refusals into warnings.
+    #[serde(default)]
+    pub plausibility: crate::PlausibilityOptions,
 }
 
 impl Default for FitOptions {
@@ -96,6 +100,7 @@ impl Default for FitOptions {
             compensation: CompensationOptions::default(),
             effects: EffectOptions::default(),
             min_redundancy: 3.0,
+            plausibility: crate::PlausibilityOptions::default(),
         }
     }
 }
@@ -158,6 +163,7 @@ impl FitOptions {
             return Err((last, format!("compensation.gp.{field} is {value}, expected {expected}")));
         }
         self.effects.gear.validate()?;
+        self.plausibility.validate()?;
         let prior = self.effects.prior_sigma;
         if prior.is_nan() || prior <= 0.0 {
             return Err((
