@@ -203,6 +203,17 @@ mod tests {
     }
 
     #[test]
+    fn the_plausibility_block_can_be_given_and_a_bad_value_is_refused_at_its_field() {
+        let options = FitOptions::parse("(plausibility: (force: true, scale_band: (0.9, 1.1)))", "fit.ron").unwrap();
+        assert!(options.plausibility.force);
+        assert_eq!(options.plausibility.scale_band, (0.9, 1.1));
+        assert_eq!(options.plausibility.reflection_ratio, crate::PlausibilityOptions::default().reflection_ratio);
+        let error = FitOptions::parse("(plausibility: (\n  reflection_ratio: 2.0))", "fit.ron").unwrap_err();
+        let message = error.to_string();
+        assert!(message.contains("fit.ron:2:3") && message.contains("reflection_ratio is 2"), "{message}");
+    }
+
+    #[test]
     fn bad_gp_fields_are_refused_with_file_line_and_column() {
         let error =
             FitOptions::parse("(compensation: (gp: (\n  optimiser: (max_iteration: 1))))", "fit.ron").unwrap_err();
