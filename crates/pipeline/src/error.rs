@@ -761,7 +761,15 @@ impl fmt::Display for Error {
                 }
                 write!(f, " (--force fits anyway)")
             }
-            Error::PositionScale { file, measured_spread_mm, robot_spread_mm, ratio, column_unit, likely_unit, band } => {
+            Error::PositionScale {
+                file,
+                measured_spread_mm,
+                robot_spread_mm,
+                ratio,
+                column_unit,
+                likely_unit,
+                band,
+            } => {
                 let spreads = format!(
                     "measured spread {measured_spread_mm:.4} mm, the robot's {robot_spread_mm:.1} mm at these joints: ratio {ratio:.4}"
                 );

@@ -78,19 +78,26 @@ impl PlausibilityOptions {
     pub fn validate(&self) -> Result<(), (&'static str, String)> {
         let (lo, hi) = self.scale_band;
         if !(lo.is_finite() && hi.is_finite() && 0.0 < lo && lo <= 1.0 && hi >= 1.0) {
-            return Err(("scale_band", format!("plausibility.scale_band is ({lo}, {hi}), expected 0 < low ≤ 1 ≤ high")));
+            return Err((
+                "scale_band",
+                format!("plausibility.scale_band is ({lo}, {hi}), expected 0 < low ≤ 1 ≤ high"),
+            ));
         }
-        let positive = [
-            ("unit_factor_tolerance", self.unit_factor_tolerance, 1.0),
-            ("reflection_ratio", self.reflection_ratio, 0.0),
-            ("max_tool_offset_m", self.max_tool_offset_m, 0.0),
-            ("limit_margin_rad", self.limit_margin_rad, -f64::MIN_POSITIVE),
-            ("limit_margin_m", self.limit_margin_m, -f64::MIN_POSITIVE),
+        // (field, value, lowest accepted, whether the lowest itself is accepted)
+        let bounded = [
+            ("unit_factor_tolerance", self.unit_factor_tolerance, 1.0, false),
+            ("reflection_ratio", self.reflection_ratio, 0.0, false),
+            ("max_tool_offset_m", self.max_tool_offset_m, 0.0, false),
+            ("limit_margin_rad", self.limit_margin_rad, 0.0, true),
+            ("limit_margin_m", self.limit_margin_m, 0.0, true),
         ];
-        for (field, value, above) in positive {
-            if !(value.is_finite() && value > above) {
-                let expected = if above < 0.0 { "a finite number of at least 0".to_owned() } else { format!("a finite number above {above}") };
-                return Err((field, format!("plausibility.{field} is {value}, expected {expected}")));
+        for (field, value, lowest, inclusive) in bounded {
+            if !(value.is_finite() && (value > lowest || (inclusive && value == lowest))) {
+                let expected = if inclusive { "of at least" } else { "above" };
+                return Err((
+                    field,
+                    format!("plausibility.{field} is {value}, expected a finite number {expected} {lowest}"),
+                ));
             }
         }
         if self.reflection_ratio > 1.0 {
@@ -278,7 +285,11 @@ impl Alignment<'_> {
         let mut rms = f64::INFINITY;
         for _ in 0..self.options.max_iterations {
             let (rotation, translation) = kabsch(&points, self.measured, determinant);
-            rms = (points.iter().zip(self.measured).map(|(n, p)| (rotation * n + translation - p).norm_squared()).sum::<f64>()
+            rms = (points
+                .iter()
+                .zip(self.measured)
+                .map(|(n, p)| (rotation * n + translation - p).norm_squared())
+                .sum::<f64>()
                 / points.len() as f64)
                 .sqrt();
             // Each step lowers the sum of squares; stop where it no longer does by a part in 1e9.
@@ -330,7 +341,9 @@ mod tests {
     use super::*;
 
     fn cloud() -> Vec<Vector3> {
-        (0..20).map(|i| Vector3::new((i as f64 * 0.7).sin(), (i as f64 * 1.3).cos(), (i as f64 * 0.37).sin() * 0.5)).collect()
+        (0..20)
+            .map(|i| Vector3::new((i as f64 * 0.7).sin(), (i as f64 * 1.3).cos(), (i as f64 * 0.37).sin() * 0.5))
+            .collect()
     }
 
     #[test]
