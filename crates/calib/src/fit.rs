@@ -188,6 +188,14 @@ fn summarise(
     if let Some(fallback) = &id.damping_fallback {
         let _ = writeln!(out, "  damping: {fallback}");
     }
+    if let Some(check) = &report.plausibility {
+        let ratio = check.scale_ratio.map_or("none".to_owned(), |r| format!("{r:.4}"));
+        let _ = writeln!(
+            out,
+            "  plausibility: measured spread {:.1} mm, the nominal robot's {:.1} mm (ratio {ratio}); rotated onto the measurements {:.2} mm RMS, mirrored {:.1} mm",
+            check.measured_spread_mm, check.robot_spread_mm, check.rotation_rms_mm, check.reflection_rms_mm
+        );
+    }
     for warning in &report.warnings {
         let _ = writeln!(out, "  warning: {warning}");
     }
