@@ -42,6 +42,10 @@ pub struct Args {
     /// Print the fit report as one JSON object on stdout (the summary goes to stderr).
     #[arg(long)]
     json: bool,
+    /// Fit data that the plausibility checks refuse (positions whose spread is not the robot's,
+    /// a mirror-image frame, joint values beyond the limits), with a warning instead.
+    #[arg(long)]
+    force: bool,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
@@ -62,6 +66,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         (Some(selection), _) => options.effects.selection = selection.clone(),
         (None, true) => options.effects.selection = EffectSelection::List(vec![EffectSpec::JointCompliance]),
         (None, false) => {}
+    }
+    if args.force {
+        options.plausibility.force = true;
     }
     if let Some(choice) = args.gp {
         options.compensation.method = choice;
@@ -180,6 +187,14 @@ fn summarise(
     );
     if let Some(fallback) = &id.damping_fallback {
         let _ = writeln!(out, "  damping: {fallback}");
+    }
+    if let Some(check) = &report.plausibility {
+        let ratio = check.scale_ratio.map_or("none".to_owned(), |r| format!("{r:.4}"));
+        let _ = writeln!(
+            out,
+            "  plausibility: measured spread {:.1} mm, the nominal robot's {:.1} mm (ratio {ratio}); rotated onto the measurements {:.2} mm RMS, mirrored {:.1} mm",
+            check.measured_spread_mm, check.robot_spread_mm, check.rotation_rms_mm, check.reflection_rms_mm
+        );
     }
     for warning in &report.warnings {
         let _ = writeln!(out, "  warning: {warning}");

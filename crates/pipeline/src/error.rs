@@ -551,6 +551,59 @@ pub enum Error {
         /// How many links were followed.
         links: usize,
     },
+    /// A joint value beyond the robot's limits by more than the margin
+    /// ([`crate::PlausibilityOptions::limit_margin_rad`]): the first in file order.
+    JointBeyondLimits {
+        /// The file.
+        file: String,
+        /// 1-based line (0 for rows made in memory).
+        line: u64,
+        /// 1-based column (the joint's number for rows made in memory).
+        column: usize,
+        /// 1-based joint.
+        joint: usize,
+        /// Revolute (value and limits in radians) or prismatic (metres).
+        kind: poe::JointKind,
+        /// The value, SI.
+        value: f64,
+        /// The robot's limits, SI.
+        limits: (f64, f64),
+        /// The margin allowed beyond them, SI.
+        margin: f64,
+        /// Whether every value of the column, read as degrees, is within the limits (and the
+        /// column says `_rad`).
+        degrees_under_rad: bool,
+    },
+    /// Measured positions whose spread is not the robot's at the same joints: a unit mistake, a
+    /// scale, or another robot ([`crate::PlausibilityOptions::scale_band`]).
+    PositionScale {
+        /// The file.
+        file: String,
+        /// RMS distance of the measured positions from their centroid, mm (read as the columns say).
+        measured_spread_mm: f64,
+        /// The same of the nominal model's tool points at the same joints, the tool fitted, mm.
+        robot_spread_mm: f64,
+        /// Measured over robot.
+        ratio: f64,
+        /// The unit the position columns name (`mm` or `m`).
+        column_unit: &'static str,
+        /// The unit the ratio says the positions are in, where it is near a unit mistake's factor.
+        likely_unit: Option<&'static str>,
+        /// The accepted ratios.
+        band: (f64, f64),
+    },
+    /// Measured positions that a mirror image of the robot fits much better than the robot: a
+    /// left-handed frame ([`crate::PlausibilityOptions::reflection_ratio`]).
+    LeftHandedFrame {
+        /// The file.
+        file: String,
+        /// RMS residual of the best rotation of the nominal tool points onto the measured, mm.
+        rotation_rms_mm: f64,
+        /// RMS residual of the best reflection, mm.
+        reflection_rms_mm: f64,
+        /// Refused where the reflection's residual is below this fraction of the rotation's.
+        reflection_ratio: f64,
+    },
 }
 
 impl fmt::Display for Error {
@@ -748,6 +801,64 @@ impl fmt::Display for Error {
             Error::OutputSymlinkChain { path, links } => {
                 write!(f, "{path}: more than {links} symbolic links in a row (a loop?): refusing to write there")
             }
+            Error::JointBeyondLimits {
+                file,
+                line,
+                column,
+                joint,
+                kind,
+                value,
+                limits: (lo, hi),
+                margin,
+                degrees_under_rad,
+            } => {
+                match kind {
+                    poe::JointKind::Revolute => write!(
+                        f,
+                        "{file}:{line}:{column}: joint {joint} is at {value} rad ({:.1}°), beyond its limits {:.1}° to {:.1}° by more than {:.1}°",
+                        value.to_degrees(),
+                        lo.to_degrees(),
+                        hi.to_degrees(),
+                        margin.to_degrees()
+                    )?,
+                    poe::JointKind::Prismatic => write!(
+                        f,
+                        "{file}:{line}:{column}: joint {joint} is at {value} m, beyond its limits {lo} m to {hi} m by more than {margin} m"
+                    )?,
+                }
+                if *degrees_under_rad {
+                    write!(f, ": degrees under `_rad`? (every value of the column fits the limits read as degrees)")?;
+                }
+                write!(f, " (--force fits anyway)")
+            }
+            Error::PositionScale {
+                file,
+                measured_spread_mm,
+                robot_spread_mm,
+                ratio,
+                column_unit,
+                likely_unit,
+                band,
+            } => {
+                let spreads = format!(
+                    "measured spread {measured_spread_mm:.4} mm, the robot's {robot_spread_mm:.1} mm at these joints: ratio {ratio:.4}"
+                );
+                match likely_unit {
+                    Some(unit) => write!(
+                        f,
+                        "{file}: positions look like {unit} under _{column_unit} columns ({spreads}); give the columns the positions' unit (--force fits anyway)"
+                    ),
+                    None => write!(
+                        f,
+                        "{file}: the positions do not have the robot's size ({spreads}, outside {} to {}): a unit, a scale or another robot's description? (--force fits anyway)",
+                        band.0, band.1
+                    ),
+                }
+            }
+            Error::LeftHandedFrame { file, rotation_rms_mm, reflection_rms_mm, .. } => write!(
+                f,
+                "{file}: the measured frame looks left-handed: two position columns swapped? (the robot turned onto the measurements leaves {rotation_rms_mm:.1} mm RMS, its mirror image {reflection_rms_mm:.1} mm) (--force fits anyway)"
+            ),
         }
     }
 }

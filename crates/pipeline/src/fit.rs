@@ -38,6 +38,8 @@ pub struct FitReport {
     /// What `--effects auto` chose and why.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub auto: Option<AutoChoice>,
+    /// What the plausibility checks measured (absent below 4 rows).
+    pub plausibility: Option<crate::PlausibilityReport>,
     /// What the user should know before trusting the numbers above.
     pub warnings: Vec<FitWarning>,
 }
@@ -46,6 +48,12 @@ pub struct FitReport {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case", tag = "kind")]
 pub enum FitWarning {
+    /// A plausibility check refused the data and `force` fitted it anyway
+    /// ([`crate::PlausibilityOptions::force`]): the refusal as it would have been given.
+    Forced {
+        /// The refusal's message.
+        refusal: String,
+    },
     /// Few residual rows per identifiable parameter: the training error understates the held-out
     /// error ([`crate::FitOptions::min_redundancy`]).
     LowRedundancy {
@@ -71,6 +79,7 @@ pub enum FitWarning {
 impl std::fmt::Display for FitWarning {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
+            FitWarning::Forced { refusal } => write!(f, "fitted despite the plausibility check (--force): {refusal}"),
             FitWarning::LowRedundancy { residual_rows, identifiable, redundancy, min_redundancy } => write!(
                 f,
                 "{residual_rows} residual rows for {identifiable} identifiable parameters ({redundancy:.2} per parameter, \
@@ -120,6 +129,16 @@ pub fn fit(
     options: &FitOptions,
 ) -> Result<(CalibratedModel, FitReport), Error> {
     data.check_joints(&robot.joint_kinds())?;
+    // Before anything is fitted: a unit mistake or a mirrored frame fits as well as the right
+    // data (issue 31), so it is refused here, or with `force` reported as a warning.
+    let findings = crate::plausibility::check(robot, data, &options.plausibility)?;
+    let mut warnings = Vec::new();
+    for refusal in findings.refusals {
+        if !options.plausibility.force {
+            return Err(refusal);
+        }
+        warnings.push(FitWarning::Forced { refusal: refusal.to_string() });
+    }
     let nominal = robot.nominal_model()?;
     let scope = if method == Method::BaseTool { Scope::BaseTool } else { Scope::Full };
     let geometry = fit_geometry(&nominal, data, scope, &options.identification)?;
@@ -196,7 +215,6 @@ pub fn fit(
     };
     let before = evaluate(&registered, data)?.summary;
     let after = evaluate(&model, data)?.summary;
-    let mut warnings = Vec::new();
     if identification.redundancy() < options.min_redundancy {
         warnings.push(FitWarning::LowRedundancy {
             residual_rows: identification.residual_rows,
@@ -224,6 +242,7 @@ pub fn fit(
         effects: effect_report,
         compensation,
         auto,
+        plausibility: findings.report,
         warnings,
     };
     Ok((model, report))

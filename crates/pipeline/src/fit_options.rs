@@ -87,6 +87,10 @@ pub struct FitOptions {
     /// held-out RMS is already √2 times the training RMS, so the training error a user reads
     /// flatters the model by more than 40 %.
     pub min_redundancy: f64,
+    /// The checks run on the data before anything is fitted (units, handedness, joint limits),
+    /// and `force`, which turns their refusals into warnings.
+    #[serde(default)]
+    pub plausibility: crate::PlausibilityOptions,
 }
 
 impl Default for FitOptions {
@@ -96,6 +100,7 @@ impl Default for FitOptions {
             compensation: CompensationOptions::default(),
             effects: EffectOptions::default(),
             min_redundancy: 3.0,
+            plausibility: crate::PlausibilityOptions::default(),
         }
     }
 }
@@ -158,6 +163,7 @@ impl FitOptions {
             return Err((last, format!("compensation.gp.{field} is {value}, expected {expected}")));
         }
         self.effects.gear.validate()?;
+        self.plausibility.validate()?;
         let prior = self.effects.prior_sigma;
         if prior.is_nan() || prior <= 0.0 {
             return Err((
@@ -194,6 +200,17 @@ mod tests {
         options.compensation.gp.bounds = Some(gp::Kernel::start(gp::KernelChoice::Matern52Ard, 3).default_bounds());
         let text = ron::ser::to_string(&options).unwrap();
         assert_eq!(FitOptions::parse(&text, "fit.ron").unwrap(), options, "{text}");
+    }
+
+    #[test]
+    fn the_plausibility_block_can_be_given_and_a_bad_value_is_refused_at_its_field() {
+        let options = FitOptions::parse("(plausibility: (force: true, scale_band: (0.9, 1.1)))", "fit.ron").unwrap();
+        assert!(options.plausibility.force);
+        assert_eq!(options.plausibility.scale_band, (0.9, 1.1));
+        assert_eq!(options.plausibility.reflection_ratio, crate::PlausibilityOptions::default().reflection_ratio);
+        let error = FitOptions::parse("(plausibility: (\n  reflection_ratio: 2.0))", "fit.ron").unwrap_err();
+        let message = error.to_string();
+        assert!(message.contains("fit.ron:2:3") && message.contains("reflection_ratio is 2"), "{message}");
     }
 
     #[test]

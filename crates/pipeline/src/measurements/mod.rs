@@ -55,6 +55,9 @@ pub struct JointColumn {
     pub column: usize,
     /// The kind of joint its unit fits: revolute for `_rad`/`_deg`, prismatic for `_m`/`_mm`.
     pub kind: JointKind,
+    /// The unit its name gives: `rad`, `deg`, `m` or `mm` (the plausibility check's hint
+    /// "degrees under `_rad`?" needs it).
+    pub unit: &'static str,
 }
 
 /// How a file was written, as the reader found it (reported by the CLI in one line).
@@ -103,6 +106,8 @@ pub struct MeasurementSet {
     pub positions_measured: bool,
     /// The joint columns, base first, as the file names them (empty for sets made in memory).
     pub joint_columns: Vec<JointColumn>,
+    /// The unit the position columns name, `mm` or `m` (`None` for sets made in memory).
+    pub position_unit: Option<&'static str>,
     /// How the file was written.
     pub format: FileFormat,
 }
@@ -277,7 +282,12 @@ fn parse_keeping<R: Read>(
         rows,
         ignored_columns: layout.ignored,
         positions_measured: layout.position.is_some(),
-        joint_columns: layout.joints.iter().map(|(c, kind)| JointColumn { column: c.index + 1, kind: *kind }).collect(),
+        joint_columns: layout
+            .joints
+            .iter()
+            .map(|(c, kind)| JointColumn { column: c.index + 1, kind: *kind, unit: joint_unit(*kind, c.scale) })
+            .collect(),
+        position_unit: layout.position.map(|[x, _, _]| if x.scale == 1.0 { "m" } else { "mm" }),
         format: FileFormat {
             dialect,
             euler_angles: matches!(layout.orientation, Some(OrientationColumns::Euler(_))),
@@ -290,6 +300,16 @@ fn parse_keeping<R: Read>(
                 .collect(),
         },
     })
+}
+
+/// The unit a joint column's name gives, from the factor that turns it into SI.
+fn joint_unit(kind: JointKind, scale: f64) -> &'static str {
+    match (kind, scale == 1.0) {
+        (JointKind::Revolute, true) => "rad",
+        (JointKind::Revolute, false) => "deg",
+        (JointKind::Prismatic, true) => "m",
+        (JointKind::Prismatic, false) => "mm",
+    }
 }
 
 impl MeasurementSet {
@@ -308,6 +328,7 @@ impl MeasurementSet {
             ignored_columns: vec![],
             positions_measured: true,
             joint_columns: vec![],
+            position_unit: None,
             format: FileFormat::default(),
         }
     }
@@ -370,6 +391,7 @@ impl MeasurementSet {
             ignored_columns: self.ignored_columns.clone(),
             positions_measured: self.positions_measured,
             joint_columns: self.joint_columns.clone(),
+            position_unit: self.position_unit,
             format: self.format.clone(),
         }
     }
