@@ -39,6 +39,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         for warning in &report.warnings {
             eprintln!("warning: {warning}");
         }
+        for warning in &report.out_of_range {
+            eprintln!("warning: {warning}");
+        }
         return Ok(());
     }
     let s = &evaluation.summary;
@@ -65,6 +68,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     for warning in &report.warnings {
+        println!("  warning: {warning}");
+    }
+    for warning in &report.out_of_range {
         println!("  warning: {warning}");
     }
     Ok(())

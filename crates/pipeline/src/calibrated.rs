@@ -191,6 +191,13 @@ impl CalibratedModel {
         self.compensation.is_some() || self.effects.iter().any(IdentifiedEffect::has_sigma)
     }
 
+    /// One warning per input (joint, payload, temperature, time) that some of `rows` put outside
+    /// the range the model was fitted on; none for model files that do not record it.
+    pub fn outside_training_range(&self, rows: &[Measurement]) -> Vec<crate::OutOfRangeWarning> {
+        let prismatic: Vec<bool> = self.joint_kinds().iter().map(|k| *k == poe::JointKind::Prismatic).collect();
+        self.training_range.as_ref().map_or_else(Vec::new, |range| range.outside(rows, &prismatic))
+    }
+
     /// Whether any effect records the joint angles it was fitted on.
     pub fn records_coverage(&self) -> bool {
         self.effects.iter().any(|e| e.angle_coverage().is_some())

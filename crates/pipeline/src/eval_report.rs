@@ -39,6 +39,10 @@ pub struct EvalReport {
     pub coverage: Option<CoverageSplit>,
     /// Effects used outside the joint angles they were fitted on.
     pub warnings: Vec<ExtrapolationWarning>,
+    /// Inputs (joints, payload, temperature, time) outside the range the model was fitted on,
+    /// for every model that records it.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub out_of_range: Vec<crate::OutOfRangeWarning>,
 }
 
 /// The errors inside and outside a model's coverage.
@@ -70,6 +74,7 @@ impl EvalReport {
                 CoverageSplit { inside: summary(inside), outside: summary(outside) }
             }),
             warnings: model.extrapolation(&data.rows),
+            out_of_range: model.outside_training_range(&data.rows),
         }
     }
 }

@@ -68,7 +68,7 @@ pub use output_file::{FileKind, MAX_SYMLINKS, OutputFile, output_target, write_f
 pub use plausibility::{PlausibilityOptions, PlausibilityReport};
 pub use robot::{FlangeDescription, JointDescription, JointType, RobotDescription};
 pub use robot_dh::{DhTable, DhTableRow};
-pub use training_range::TrainingRange;
+pub use training_range::{OutOfRangeWarning, TrainingRange};
 pub use urdf_chain::{ChainEnds, ChainStep, StepMotion, UrdfChain, UrdfDocument};
 pub use urdf_export::{
     AxisChange, PartError, TrainingErrors, UrdfExport, UrdfExportReport, UrdfTemplate, export_urdf, write_urdf,

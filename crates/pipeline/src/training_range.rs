@@ -94,3 +94,80 @@ impl TrainingRange {
         vec![at(|r| 0.5 * (r[0] + r[1])), at(|r| r[0]), at(|r| r[1])]
     }
 }
+
+/// Rows that put an input outside the range the model was fitted on: there every part of the
+/// model (geometry, effects, GP) answers for poses it never saw, and its error is not what the
+/// fit measured. One per input that some row leaves.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OutOfRangeWarning {
+    /// The input: `joint 3`, `payload_kg`, `temp_c` or `t_s`.
+    pub input: String,
+    /// Its unit: `rad`, `m` (a prismatic joint), `kg`, `°C`, `s`.
+    pub unit: &'static str,
+    /// Its smallest and largest value on the training rows.
+    pub fitted: [f64; 2],
+    /// How many rows lie outside.
+    pub rows_outside: usize,
+    /// How many rows there are.
+    pub rows: usize,
+    /// The file line of the first of them.
+    pub first_line: u64,
+}
+
+impl std::fmt::Display for OutOfRangeWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let [low, high] = self.fitted;
+        write!(
+            f,
+            "{} of {} rows (the first at line {}) put {} outside the range the model was fitted on \
+             ({low:.4} … {high:.4} {}): there the model answers for inputs it never saw",
+            self.rows_outside, self.rows, self.first_line, self.input, self.unit
+        )
+    }
+}
+
+impl TrainingRange {
+    /// One warning per input that some of `rows` put outside its fitted range (`prismatic[j]`:
+    /// whether joint `j` is prismatic, for its unit).
+    pub fn outside(&self, rows: &[Measurement], prismatic: &[bool]) -> Vec<OutOfRangeWarning> {
+        type Pick<'a> = Box<dyn Fn(&Measurement) -> Option<f64> + 'a>;
+        let mut inputs: Vec<(String, &'static str, [f64; 2], Pick<'_>)> = self
+            .q
+            .iter()
+            .enumerate()
+            .map(|(j, &range)| {
+                let unit = if prismatic.get(j).copied().unwrap_or(false) { "m" } else { "rad" };
+                (
+                    format!("joint {}", j + 1),
+                    unit,
+                    range,
+                    Box::new(move |r: &Measurement| r.q.get(j).copied()) as Pick<'_>,
+                )
+            })
+            .collect();
+        inputs.push(("payload_kg".into(), "kg", self.payload_kg, Box::new(|r: &Measurement| Some(r.payload_kg))));
+        if let Some(range) = self.temp_c {
+            inputs.push(("temp_c".into(), "°C", range, Box::new(|r: &Measurement| r.temp_c)));
+        }
+        if let Some(range) = self.t_s {
+            inputs.push(("t_s".into(), "s", range, Box::new(|r: &Measurement| r.t_s)));
+        }
+        inputs
+            .into_iter()
+            .filter_map(|(input, unit, fitted, pick)| {
+                let [low, high] = fitted;
+                let outside: Vec<&Measurement> =
+                    rows.iter().filter(|r| pick(r).is_some_and(|v| v < low || v > high)).collect();
+                let first = outside.first()?;
+                Some(OutOfRangeWarning {
+                    input,
+                    unit,
+                    fitted,
+                    rows_outside: outside.len(),
+                    rows: rows.len(),
+                    first_line: first.line,
+                })
+            })
+            .collect()
+    }
+}

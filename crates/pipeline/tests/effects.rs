@@ -358,6 +358,18 @@ fn a_gear_series_falls_back_to_the_geometry_in_a_gap_and_past_the_end_of_its_ang
     let beyond_sigma = position_sigma(&beyond);
     let far: Vec<f64> = beyond_sigma.iter().copied().filter(|&s| s > 0.0).collect();
     assert!(far.len() > beyond.rows.len() / 2, "{} of {} rows with a deviation", far.len(), beyond.rows.len());
+    // Every model, with effects or not, says which rows lie outside the joint ranges it was fitted
+    // on: here joint 2 past ±0.9 rad, on every such row, and nothing on rows it was fitted on.
+    for model in [&poe, &gear] {
+        let warnings = model.outside_training_range(&beyond.rows);
+        let joint_2: Vec<_> = warnings.iter().filter(|w| w.input == "joint 2").collect();
+        assert_eq!(joint_2.len(), 1, "{warnings:?}");
+        assert_eq!((joint_2[0].rows_outside, joint_2[0].unit), (beyond.rows.len(), "rad"));
+        assert!(joint_2[0].to_string().contains("outside the range the model was fitted on"));
+        assert!(model.outside_training_range(&inside.rows).is_empty());
+        let report = pipeline::EvalReport::new(model, &beyond, &pipeline::evaluate(model, &beyond).unwrap());
+        assert_eq!(report.out_of_range, warnings, "eval --json carries them");
+    }
     let IdentifiedEffect::GearPeriodic(series) = &gear.effects[0] else { panic!("{:?}", gear.effects) };
     let rms = series.fitted_rms_rad.unwrap();
     // Joint 2's lever to the tool is under 3 m on this arm (reach 2 m, plus the tool).
