@@ -323,7 +323,7 @@ fn diagnosis_section(args: &Args, checked: &[Checked]) -> String {
     let _ = writeln!(
         md,
         "\nThe fitted effect on the test rows whose every joint angle lies within the training rows' range, and on \
-         the others (where a series of high order extrapolates):\n"
+         the others (where a series is held at its last fitted angle and faded out, and the model blends to the geometry fitted alone):\n"
     );
     let _ =
         writeln!(md, "| series | test rows inside | fitted, inside (mm) | test rows outside | fitted, outside (mm) |");
