@@ -1,20 +1,10 @@
 //! Issue 31, "no fit that looks right and is not", through the binary: a model is never credited
 //! with what it did not calibrate, and input that cannot be physical is refused with its place.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
-fn calib(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_calib")).args(args).output().expect("the calib binary runs")
-}
-
-fn fixture(name: &str) -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name).display().to_string()
-}
-
-fn text(path: &Path) -> String {
-    path.display().to_string()
-}
+mod common;
+use common::{calib, fixture, text};
 
 /// Runs a command that must succeed and returns its stdout and stderr.
 fn succeeds(args: &[&str]) -> (String, String) {
