@@ -2,19 +2,9 @@
 //! one line on stderr.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn calib(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_calib")).args(args).output().expect("the calib binary runs")
-}
-
-fn fixture(name: &str) -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name).display().to_string()
-}
-
-fn text(path: &Path) -> String {
-    path.display().to_string()
-}
+mod common;
+use common::{calib, fixture, text};
 
 fn succeeds(args: &[&str]) -> String {
     let out = calib(args);
