@@ -124,6 +124,13 @@ fn summarise(
             auto.heldout_before_mm,
             if chosen.is_empty() { "nothing".to_owned() } else { chosen.join(", ") }
         );
+        if let Some([before, after]) = auto.off_poses_mm {
+            let _ = writeln!(
+                out,
+                "    predicted held out: {:.4} -> {:.4} mm on poses like these (random folds); {before:.4} -> {after:.4} mm off them (arcs of each moving joint's angles held out)",
+                auto.heldout_before_mm, auto.heldout_after_mm
+            );
+        }
         for s in &auto.selected {
             let joints: Vec<String> = s.joints.iter().map(ToString::to_string).collect();
             let harmonic = s.harmonic.map_or(String::new(), |h| format!(", harmonics 1 to {h}"));

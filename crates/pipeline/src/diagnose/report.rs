@@ -164,6 +164,15 @@ impl Diagnosis {
                 change(self.heldout_after_selected_mm)
             ));
         }
+        if let (Some(before), Some(after)) = (self.off_poses_before_mm, self.off_poses_after_mm) {
+            let per_joint: Vec<String> =
+                self.arcs.iter().map(|a| format!("{} {:.3} -> {:.3}", a.joint, a.before_mm, a.after_mm)).collect();
+            out.push_str(&format!(
+                "  off the poses:  {before:.4} mm -> {after:.4} mm ({:.0} % less) with arcs of one joint's angles held out\n                  (the ends of its range, gaps, other configurations; per joint, mm: {})\n",
+                100.0 * (1.0 - after / before.max(f64::MIN_POSITIVE)),
+                per_joint.join(", ")
+            ));
+        }
         for s in &self.selected {
             out.push_str(&format!(
                 "  selected:       {} -> {:.4} mm (z = {:.1})\n",

@@ -15,6 +15,13 @@ pub struct AutoChoice {
     pub selected: Vec<SelectedEffect>,
     /// Cross-validated mean position error of the geometric model on the training data, mm.
     pub heldout_before_mm: f64,
+    /// The same with every selected effect: the prediction for poses like the training poses, mm.
+    #[serde(default)]
+    pub heldout_after_mm: f64,
+    /// The diagnosis's prediction off the training poses (arcs of each moving joint held out),
+    /// without and with the selected effects, mm.
+    #[serde(default)]
+    pub off_poses_mm: Option<[f64; 2]>,
     /// The effects the fit identifies.
     #[serde(serialize_with = "as_text")]
     pub chosen: Vec<EffectSpec>,
@@ -67,5 +74,7 @@ pub fn choose(robot: &RobotDescription, data: &MeasurementSet, options: &Diagnos
         verdict: diagnosis.verdict,
         selected: diagnosis.selected,
         heldout_before_mm: diagnosis.heldout_before_mm,
+        heldout_after_mm: diagnosis.heldout_after_selected_mm,
+        off_poses_mm: diagnosis.off_poses_before_mm.zip(diagnosis.off_poses_after_mm).map(|(b, a)| [b, a]),
     })
 }
