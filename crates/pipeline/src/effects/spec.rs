@@ -201,6 +201,10 @@ impl FromStr for EffectSelection {
         if items.len() == 1 && items[0].1.trim() == "auto" {
             return Ok(EffectSelection::Auto);
         }
+        // What `Display` writes for no effects reads back (a script may pass it on).
+        if items.len() == 1 && items[0].1.trim() == "none" {
+            return Ok(EffectSelection::None);
+        }
         let mut list: Vec<EffectSpec> = Vec::new();
         for (offset, item) in items {
             if item.trim() == "auto" {
@@ -244,6 +248,8 @@ mod tests {
         );
         assert_eq!(selection.to_string(), text);
         assert_eq!("auto".parse::<EffectSelection>().unwrap(), EffectSelection::Auto);
+        assert_eq!("none".parse::<EffectSelection>().unwrap(), EffectSelection::None);
+        assert_eq!(EffectSelection::None.to_string().parse::<EffectSelection>().unwrap(), EffectSelection::None);
     }
 
     #[test]
