@@ -111,9 +111,9 @@ fn build_effects(
     robot: &RobotDescription,
     kinematics: &poe::LocalPoe,
     data: &MeasurementSet,
-    gear: &crate::effects::GearOptions,
+    options: &crate::EffectOptions,
 ) -> Result<Vec<IdentifiedEffect>, Error> {
-    let context = EffectContext { robot, kinematics, gear: *gear };
+    let context = EffectContext { robot, kinematics, gear: options.gear, hold_beyond_span: options.hold_beyond_span };
     let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
     specs.iter().map(|spec| IdentifiedEffect::new(spec, &context, &data.rows, &tools)).collect()
 }
@@ -168,7 +168,7 @@ pub fn fit(
         }
     };
     if !specs.is_empty() {
-        let mut effects = build_effects(&specs, robot, &model.kinematics, data, &options.effects.gear)?;
+        let mut effects = build_effects(&specs, robot, &model.kinematics, data, &options.effects)?;
         let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
         let correction = EffectCorrection::new(&effects, &data.rows, &tools, options.effects.prior_sigma)?;
         let layout = model.kinematics.layout();

@@ -37,6 +37,13 @@ pub struct EffectOptions {
     pub max_iterations: usize,
     /// How gear series are held and faded outside the angles they were fitted on.
     pub gear: crate::effects::GearOptions,
+    /// Thermal growth and drift are applied as fitted up to this fraction of their fitted span
+    /// of `temp_c` / `t_s` beyond either end, and held at that value further out (issue 30: a drift
+    /// fitted within a 73-minute session was carried on as a straight line eight days later). 1:
+    /// a linear term is trusted as far beyond its data as the data reaches (the simulated warm-up
+    /// and drift campaigns of `tests/effects.rs` are tested 0.6 of their span past the training
+    /// rows, where the simulated physics is linear); a day later it is held.
+    pub hold_beyond_span: f64,
     /// The diagnosis that `auto` runs on the training data.
     pub diagnose: DiagnoseOptions,
 }
@@ -49,6 +56,7 @@ impl Default for EffectOptions {
             solver: Solver::LevenbergMarquardt,
             max_iterations: 300,
             gear: crate::effects::GearOptions::default(),
+            hold_beyond_span: 1.0,
             diagnose: DiagnoseOptions::default(),
         }
     }
@@ -163,6 +171,13 @@ impl FitOptions {
             return Err((last, format!("compensation.gp.{field} is {value}, expected {expected}")));
         }
         self.effects.gear.validate()?;
+        let hold = self.effects.hold_beyond_span;
+        if !(hold.is_finite() && hold >= 0.0) {
+            return Err((
+                "hold_beyond_span",
+                format!("effects.hold_beyond_span is {hold}, expected a number of at least 0"),
+            ));
+        }
         self.plausibility.validate()?;
         let prior = self.effects.prior_sigma;
         if prior.is_nan() || prior <= 0.0 {

@@ -139,8 +139,13 @@ pub(crate) fn build_candidates(
     let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
     // The nominal arm in the base frame, where gravity is known, with the calibrated tools placed
     // on its flange (the payload hangs from them).
-    let load = EffectContext { robot, kinematics: model, gear: crate::effects::GearOptions::default() }
-        .load_frame(&data.rows, &tools)?;
+    let load = EffectContext {
+        robot,
+        kinematics: model,
+        gear: crate::effects::GearOptions::default(),
+        hold_beyond_span: crate::EffectOptions::default().hold_beyond_span,
+    }
+    .load_frame(&data.rows, &tools)?;
     let dynamics = robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(robot));
     let measured = has_torques(&data.rows);
     let nonzero = |columns: &[Vec<f64>]| columns.iter().flatten().any(|v| v.abs() > 1e-12);
@@ -223,7 +228,8 @@ pub(crate) fn build_candidates(
         if high - low > 0.2 {
             // One expansion coefficient for the whole arm: every link but the tracker-to-base
             // placement grows by α ΔT.
-            let thermal = IdentifiedEffect::Thermal(Thermal::new(&data.rows)?);
+            let thermal =
+                IdentifiedEffect::Thermal(Thermal::new(&data.rows, crate::EffectOptions::default().hold_beyond_span)?);
             let thermal_columns = columns(&thermal)?;
             push(thermal, thermal_columns, None, None);
         }
@@ -231,7 +237,10 @@ pub(crate) fn build_candidates(
     if let Some(times) = data.rows.iter().map(|r| r.t_s).collect::<Option<Vec<f64>>>() {
         let mean = times.iter().sum::<f64>() / data.rows.len() as f64;
         if times.iter().any(|t| (t - mean).abs() > 1.0) {
-            let drift = IdentifiedEffect::TimeDrift(TimeDrift::new(&data.rows)?);
+            let drift = IdentifiedEffect::TimeDrift(TimeDrift::new(
+                &data.rows,
+                crate::EffectOptions::default().hold_beyond_span,
+            )?);
             let drift_columns = columns(&drift)?;
             push(drift, drift_columns, None, None);
         }

@@ -586,6 +586,7 @@ mod tests {
             reference_c: 20.0,
             scale: vec![1.0],
             theta: vec![0.0],
+            fitted_span: None,
         });
         let term = Term {
             effect: Effect::JointCompliance,

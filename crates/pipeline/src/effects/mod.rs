@@ -118,6 +118,8 @@ pub struct EffectContext<'a> {
     pub kinematics: &'a LocalPoe,
     /// How gear series fade outside their fitted angles.
     pub gear: GearOptions,
+    /// [`crate::EffectOptions::hold_beyond_span`].
+    pub hold_beyond_span: f64,
 }
 
 impl EffectContext<'_> {
@@ -172,8 +174,8 @@ impl IdentifiedEffect {
                 };
                 IdentifiedEffect::Backlash(Backlash::new(joint, sign, rows, tools)?)
             }
-            EffectSpec::Thermal => IdentifiedEffect::Thermal(Thermal::new(rows)?),
-            EffectSpec::TimeDrift => IdentifiedEffect::TimeDrift(TimeDrift::new(rows)?),
+            EffectSpec::Thermal => IdentifiedEffect::Thermal(Thermal::new(rows, context.hold_beyond_span)?),
+            EffectSpec::TimeDrift => IdentifiedEffect::TimeDrift(TimeDrift::new(rows, context.hold_beyond_span)?),
         })
     }
 
@@ -393,4 +395,15 @@ pub(crate) fn stand_in_dynamics(robot: &RobotDescription) -> loadsim::RobotDynam
         counterbalance: None,
         gravity_m_per_s2: loadsim::FLOOR_GRAVITY_M_PER_S2,
     }
+}
+
+/// `[min, max]` of `values` widened by `beyond` times its width at either end; `None` when empty.
+pub(crate) fn span_of(values: &[f64], beyond: f64) -> Option<[f64; 2]> {
+    let span = values.iter().fold(None, |span, &v| Some(span.map_or([v, v], |[a, b]: [f64; 2]| [a.min(v), b.max(v)])));
+    span.map(|[low, high]| [low - beyond * (high - low), high + beyond * (high - low)])
+}
+
+/// `value` held inside `span` (unchanged without one).
+pub(crate) fn held_in(value: f64, span: Option<[f64; 2]>) -> f64 {
+    span.map_or(value, |[low, high]| value.clamp(low, high))
 }

@@ -15,10 +15,15 @@ pub struct Thermal {
     pub scale: Vec<f64>,
     /// The strain per unit of the scaled `ΔT`.
     pub theta: Vec<f64>,
+    /// `[min, max]` of `temp_c` on the training rows, °C: outside it the temperature is held at the
+    /// nearer end, so that a term fitted within one session is never carried on as a straight
+    /// line (issue 30). Absent in older model files: applied as fitted, everywhere.
+    #[serde(default)]
+    pub fitted_span: Option<[f64; 2]>,
 }
 
 impl Thermal {
-    pub(crate) fn new(rows: &[Measurement]) -> Result<Self, Error> {
+    pub(crate) fn new(rows: &[Measurement], hold_beyond_span: f64) -> Result<Self, Error> {
         let temps: Vec<f64> = rows
             .iter()
             .map(|r| r.temp_c.ok_or(Error::EffectNeedsColumn { line: r.line, effect: "thermal", column: "temp_c" }))
@@ -26,7 +31,12 @@ impl Thermal {
         check_column_varies(&temps, rows, "thermal", "temp_c")?;
         let reference_c = temps.iter().sum::<f64>() / temps.len().max(1) as f64;
         let raw: Vec<Vec<f64>> = temps.iter().map(|t| vec![t - reference_c]).collect();
-        Ok(Self { reference_c, scale: rms_scales(&raw), theta: vec![0.0] })
+        Ok(Self {
+            reference_c,
+            scale: rms_scales(&raw),
+            theta: vec![0.0],
+            fitted_span: super::span_of(&temps, hold_beyond_span),
+        })
     }
 }
 
@@ -37,6 +47,7 @@ impl Regressor for Thermal {
 
     fn features(&self, row: &Measurement, _tool: usize) -> Result<Vec<f64>, Error> {
         let t = row.temp_c.ok_or(Error::EffectNeedsColumn { line: row.line, effect: "thermal", column: "temp_c" })?;
+        let t = super::held_in(t, self.fitted_span);
         Ok(vec![(t - self.reference_c) / self.scale[0]])
     }
 
