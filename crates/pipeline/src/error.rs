@@ -480,6 +480,14 @@ pub enum Error {
         /// The robot's joint count.
         joint_count: usize,
     },
+    /// An effect that means nothing on the kind of joint it names (a series in a prismatic
+    /// joint's "angle").
+    EffectJointKind {
+        /// The effect's name.
+        effect: &'static str,
+        /// The 1-based joint named.
+        joint: usize,
+    },
     /// A fit produced a model that the model file's check refuses: `fit` says so rather than
     /// write a file that `eval` would refuse.
     FittedModelRefused {
@@ -774,6 +782,10 @@ impl fmt::Display for Error {
             Error::EffectJoint { joint, joint_count } => {
                 write!(f, "effect on joint {joint}: the robot has joints 1 to {joint_count}")
             }
+            Error::EffectJointKind { effect, joint } => write!(
+                f,
+                "{effect} on joint {joint}: joint {joint} is prismatic, and a {effect} is a function of a revolute joint's angle"
+            ),
             Error::FittedModelRefused { method, source } => write!(
                 f,
                 "the fitted {method} model fails the check every model file passes on reading, so it is not written: {source}"

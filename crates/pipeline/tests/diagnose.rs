@@ -181,3 +181,31 @@ fn a_coupling_between_joints_is_unknown_with_the_joints_it_depends_on() {
         assert!(d.explainable.as_ref().is_some_and(|gp| gp.significant), "{}", d.summary());
     }
 }
+
+/// Issue 30: a prismatic joint (a lifting column) is reported in millimetres, gets no series of
+/// its "angle", and a fit asked for one refuses, naming the joint; a revolute joint's series on
+/// the same arm is still found.
+#[test]
+fn a_lifting_column_is_reported_in_millimetres_and_offered_no_series_of_its_angle() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/column_ur10.ron");
+    let robot = RobotDescription::read(&path).unwrap();
+    assert_eq!(robot.joints[0].kind, pipeline::JointType::Prismatic);
+    let periodic =
+        PeriodicError { harmonics: vec![Harmonic { joint_index: 2, order: 3.0, amplitude_rad: 4e-4, phase_rad: 0.3 }] };
+    let data = simulated(&robot, &Effects { periodic: Some(periodic), ..Effects::default() }, false, 5);
+    let diagnosis = diagnose(&robot, &data, &DiagnoseOptions::default()).unwrap();
+    assert_eq!(diagnosis.prismatic_joints, vec![1]);
+    let column: Vec<_> = diagnosis.regions.iter().filter(|r| r.dimension == "joint 1").collect();
+    assert!(!column.is_empty() && column.iter().all(|r| r.bin.ends_with("mm")), "{column:?}");
+    assert!(
+        !diagnosis.candidates.iter().any(|c| c.effect == Effect::GearPeriodic && c.joints == [1]),
+        "a series of the column's position was offered"
+    );
+    assert!(diagnosis.selected.iter().any(|s| s.effect == Effect::GearPeriodic && s.joints == [3]), "{diagnosis:?}");
+    let options = pipeline::FitOptions::default().with_effects("gear_periodic:1:3".parse().unwrap());
+    let error = pipeline::fit(&robot, &data, pipeline::Method::Poe, &options).unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "gear_periodic on joint 1: joint 1 is prismatic, and a gear_periodic is a function of a revolute joint's angle"
+    );
+}

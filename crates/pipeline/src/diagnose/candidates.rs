@@ -206,7 +206,9 @@ pub(crate) fn build_candidates(
                     built.push((backlash, backlash_columns, None, None));
                 }
             }
-            if settings.moving.contains(&j) {
+            // A series of the joint's angle: a revolute joint's only (on a linear axis the period
+            // of a screw or rack is a length, which this series has no parameter for).
+            if settings.moving.contains(&j) && robot.joints[j].kind == crate::JointType::Revolute {
                 let gear = IdentifiedEffect::GearPeriodic(GearPeriodic::new(j, (1..=longest).collect(), &data.rows)?);
                 let gear_columns = columns(&gear)?;
                 built.push((gear, gear_columns, Some(settings.series_sd), Some(settings.orders.to_vec())));

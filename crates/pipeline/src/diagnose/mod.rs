@@ -157,6 +157,9 @@ pub struct Diagnosis {
     pub full_pose: bool,
     /// 1-based joints whose angles span more than `moving_min_range_rad`.
     pub moving_joints: Vec<usize>,
+    /// 1-based prismatic joints (reported in mm, where revolute ones are in degrees).
+    #[serde(default)]
+    pub prismatic_joints: Vec<usize>,
     /// The verdict.
     pub verdict: Verdict,
     /// Cross-validated mean position error of the geometric model, mm.
@@ -520,7 +523,11 @@ pub fn diagnose(
             }
         })
         .collect();
-    let regions = regions::regions(&poses, &moving);
+    let prismatic: Vec<usize> = (0..robot.joint_count())
+        .filter(|&j| robot.joints[j].kind == crate::JointType::Prismatic)
+        .map(|j| j + 1)
+        .collect();
+    let regions = regions::regions(&poses, &moving, &prismatic);
     let mut scores: Vec<CandidateScore> = terms
         .iter()
         .zip(&selection.single)
@@ -553,6 +560,7 @@ pub fn diagnose(
         n: data.rows.len(),
         full_pose: data.full_pose,
         moving_joints: moving.iter().map(|j| j + 1).collect(),
+        prismatic_joints: prismatic,
         verdict,
         heldout_before_mm: before_mm,
         heldout_after_mm: verdict_result.map_or(before_mm, |m| m * 1e3),

@@ -94,7 +94,7 @@ fn quantile_regions(
 
 /// Every breakdown the data supports; joint bins only over the joints that move (`moving`,
 /// 0-based): a bin of a joint held still splits encoder jitter, not the workspace.
-pub(crate) fn regions(poses: &[PoseDiagnosis], moving: &[usize]) -> Vec<Region> {
+pub(crate) fn regions(poses: &[PoseDiagnosis], moving: &[usize], prismatic: &[usize]) -> Vec<Region> {
     let mut out = Vec::new();
     for (axis, name) in ["x", "y", "z"].iter().enumerate() {
         out.push(Region {
@@ -133,7 +133,12 @@ pub(crate) fn regions(poses: &[PoseDiagnosis], moving: &[usize]) -> Vec<Region> 
         out.extend(quantile_regions(poses, "payload", "kg", 5, &|p| p.payload_kg));
     }
     for &j in moving {
-        out.extend(quantile_regions(poses, &format!("joint {}", j + 1), "deg", 6, &|p| p.q[j].to_degrees()));
+        // A prismatic joint in millimetres, a revolute one in degrees.
+        if prismatic.contains(&(j + 1)) {
+            out.extend(quantile_regions(poses, &format!("joint {}", j + 1), "mm", 6, &|p| p.q[j] * 1e3));
+        } else {
+            out.extend(quantile_regions(poses, &format!("joint {}", j + 1), "deg", 6, &|p| p.q[j].to_degrees()));
+        }
     }
     out.extend(quantile_regions(poses, "reach", "m", 5, &|p| p.reach_m));
     out.extend(quantile_regions(poses, "height", "m", 5, &|p| p.height_m));

@@ -143,7 +143,13 @@ impl Diagnosis {
                 "unknown: structure is left that no candidate explains".to_owned()
             }
             Effect::Unknown => format!(
-                "unknown: structure no candidate explains, in the angles of joint{} {}",
+                "unknown: structure no candidate explains, in the {} of joint{} {}",
+                // A prismatic joint has a position, not an angle.
+                match self.verdict.joints.iter().filter(|j| self.prismatic_joints.contains(j)).count() {
+                    0 => "angles",
+                    n if n == self.verdict.joints.len() => "positions",
+                    _ => "angles and positions",
+                },
                 if self.verdict.joints.len() > 1 { "s" } else { "" },
                 list(&self.verdict.joints)
             ),
@@ -240,8 +246,11 @@ impl Diagnosis {
         for &joint in &self.moving_joints {
             let j = joint - 1;
             let title = format!("Held-out error against joint {joint}");
-            let svg =
-                svg::scatter(&title, &format!("joint {joint} (deg)"), "error (mm)", &series(&|p| p.q[j].to_degrees()));
+            let svg = if self.prismatic_joints.contains(&joint) {
+                svg::scatter(&title, &format!("joint {joint} (mm)"), "error (mm)", &series(&|p| p.q[j] * 1e3))
+            } else {
+                svg::scatter(&title, &format!("joint {joint} (deg)"), "error (mm)", &series(&|p| p.q[j].to_degrees()))
+            };
             plots.push((format!("joint{joint}.svg"), svg));
         }
         let varies = |key: &dyn Fn(&PoseDiagnosis) -> Option<f64>| {

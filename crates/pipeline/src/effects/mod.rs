@@ -132,6 +132,12 @@ impl EffectContext<'_> {
         let joint_count = self.robot.joint_count();
         match spec.joint() {
             Some(joint) if joint == 0 || joint > joint_count => Err(Error::EffectJoint { joint, joint_count }),
+            Some(joint)
+                if matches!(spec, EffectSpec::GearPeriodic { .. })
+                    && self.robot.joints[joint - 1].kind == crate::JointType::Prismatic =>
+            {
+                Err(Error::EffectJointKind { effect: "gear_periodic", joint })
+            }
             Some(joint) => Ok(joint - 1),
             None => Ok(0),
         }
