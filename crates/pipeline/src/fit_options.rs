@@ -38,7 +38,8 @@ pub struct EffectOptions {
     /// How gear series are held and faded outside the angles they were fitted on.
     pub gear: crate::effects::GearOptions,
     /// Thermal growth and drift are applied as fitted up to this fraction of their fitted span
-    /// of `temp_c` / `t_s` beyond either end, and held at that value further out (issue 30: a drift
+    /// of `temp_c` / `t_s` beyond either end; further out the growth is held at that value (a
+    /// function of the temperature) and the drift falls back to zero (issue 30: a drift
     /// fitted within a 73-minute session was carried on as a straight line eight days later). 1:
     /// a linear term is trusted as far beyond its data as the data reaches (the simulated warm-up
     /// and drift campaigns of `tests/effects.rs` are tested 0.6 of their span past the training

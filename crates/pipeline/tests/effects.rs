@@ -420,3 +420,41 @@ fn the_diagnosis_predicts_the_error_in_a_gap_and_past_the_end_from_arcs_of_the_j
         joint_2.after_mm
     );
 }
+
+/// Issue 30: a drift fitted within one session was applied as a straight line eight days later.
+/// Session 2 repeats session 1's drift from its own start (its placement drifts again from where
+/// it began), recorded eight days later: the drift fitted on session 1 falls back to the geometry
+/// there, so `--effects time_drift` is no worse than without it, where the line was far worse.
+#[test]
+fn a_drift_fitted_in_one_session_is_not_carried_into_another_days_later() {
+    let robot = irb4400();
+    let effects = Effects {
+        drift: Some(BaseDrift { twist_per_s: [4e-8, -3e-8, 2e-8, 0.0, 1e-8, 0.0] }),
+        tracker_noise: Some(TrackerNoise::default()),
+        ..Effects::default()
+    };
+    let cell = simulated_cell(&robot, &Perturbation::default(), 61).unwrap();
+    let session = |seed: u64| {
+        let config = GeneratorConfig { sample_count: 250, seed, ..GeneratorConfig::default() };
+        simulate(&cell, &effects, &joint_ranges(&robot), &config, false).unwrap()
+    };
+    let first = session(61);
+    let mut later = session(62);
+    for row in &mut later.rows {
+        row.t_s = row.t_s.map(|t| t + 8.0 * 86_400.0);
+    }
+    let fit = |selection: &str, hold: f64| {
+        let mut options = FitOptions::default().with_effects(if selection.is_empty() {
+            EffectSelection::None
+        } else {
+            selection.parse().unwrap()
+        });
+        options.effects.hold_beyond_span = hold;
+        let model = pipeline::fit(&robot, &first, Method::Poe, &options).unwrap().0;
+        pipeline::evaluate(&model, &later).unwrap().summary.mean_position_error_mm
+    };
+    let (alone, with, line) = (fit("", 1.0), fit("time_drift", 1.0), fit("time_drift", 1e9));
+    eprintln!("eight days later: poe {alone:.4} mm, with the drift {with:.4} mm, the drift as a line {line:.4} mm");
+    assert!(with <= 1.02 * alone, "{with} mm against {alone} mm without the drift");
+    assert!(line > 10.0 * alone, "the line carried on: {line} mm");
+}

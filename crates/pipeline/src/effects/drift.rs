@@ -15,9 +15,10 @@ pub struct TimeDrift {
     pub scale: Vec<f64>,
     /// The twist per unit of the scaled `Δt`, `(v, ω)`: metres and radians.
     pub theta: Vec<f64>,
-    /// `[min, max]` of `t_s` on the training rows, s: outside it the time is held at the
-    /// nearer end, so that a term fitted within one session is never carried on as a straight
-    /// line (issue 30). Absent in older model files: applied as fitted, everywhere.
+    /// `[min, max]` of `t_s` on the training rows widened by `EffectOptions::hold_beyond_span` of
+    /// its width at either end, s: outside it the drift falls back to zero (the geometry's own
+    /// placement), so that a term fitted within one session is never carried on as a straight
+    /// line into another (issue 30). Absent in older model files: applied as fitted, everywhere.
     #[serde(default)]
     pub fitted_span: Option<[f64; 2]>,
 }
@@ -47,7 +48,11 @@ impl Regressor for TimeDrift {
 
     fn features(&self, row: &Measurement, _tool: usize) -> Result<Vec<f64>, Error> {
         let t = row.t_s.ok_or(Error::EffectNeedsColumn { line: row.line, effect: "time_drift", column: "t_s" })?;
-        let t = super::held_in(t, self.fitted_span);
+        // Past the span (and its margin) the drift falls back to the placement the geometry holds:
+        // a later session starts from a placement of its own, which no line from this one knows.
+        if self.fitted_span.is_some_and(|[low, high]| !(low..=high).contains(&t)) {
+            return Ok(vec![0.0; self.scale.len()]);
+        }
         Ok(self.scale.iter().map(|s| (t - self.reference_s) / s).collect())
     }
 
@@ -93,21 +98,22 @@ mod tests {
         assert_eq!(drift.fitted_span, Some([0.0, 49.0 * 88.0]));
         let end = session.last().unwrap();
         let week_later = row(8.0 * 86_400.0, 9.0);
-        assert_eq!(drift.features(&week_later, 0).unwrap(), drift.features(end, 0).unwrap());
+        assert_eq!(drift.features(&week_later, 0).unwrap(), vec![0.0; 6]);
+        assert_ne!(drift.features(end, 0).unwrap(), vec![0.0; 6]);
         assert_eq!(thermal.features(&week_later, 0).unwrap(), thermal.features(&session[0], 0).unwrap());
         // Inside the span nothing changes.
         let inside = row(1000.0, 21.0);
         let raw = (1000.0 - drift.reference_s) / drift.scale[0];
         assert_eq!(drift.features(&inside, 0).unwrap()[0], raw);
         // With a margin of one span, half a span past the end is still the line; two spans past
-        // it, the value one span past it.
+        // it, nothing.
         let margin = TimeDrift::new(&session, 1.0).unwrap();
         let width = 49.0 * 88.0;
         let at = |t: f64| margin.features(&row(t, 20.0), 0).unwrap()[0];
         assert_eq!(at(1.5 * width), (1.5 * width - margin.reference_s) / margin.scale[0]);
-        assert_eq!(at(3.0 * width), at(2.0 * width));
+        assert_eq!(at(3.0 * width), 0.0);
         // A model file written before the span was recorded applies the line as it did.
         let old = TimeDrift { fitted_span: None, ..drift.clone() };
-        assert!(old.features(&week_later, 0).unwrap()[0] > 100.0 * drift.features(&week_later, 0).unwrap()[0]);
+        assert!(old.features(&week_later, 0).unwrap()[0] > 100.0);
     }
 }
