@@ -5,8 +5,8 @@ mod common;
 use common::{gaussian, iiwa7, irb4400, mean_position_error, measured_robot, observe, rng};
 use lie::{SE3, SO3, Vector3};
 use poe::identify::{
-    IdentificationOptions, Loss, Observation, ParameterMask, Redundancy, RobustOptions, Scope, Solver, Target, calibrate,
-    identify,
+    IdentificationOptions, Loss, Observation, ParameterMask, Redundancy, RobustOptions, Scope, Solver, Target,
+    calibrate, identify,
 };
 use poe::{Block, LocalPoe};
 

@@ -45,9 +45,10 @@ pub struct RobustOptions {
     /// compliance, reach 5.5 at most outside three rows of series B.
     pub huber_threshold: f64,
     /// Robust sigmas above the median norm beyond which a row is named as a gross outlier and
-    /// left out. 10: the geometric residuals of the real UR10 series reach 9.5 (series B, lines
-    /// 534, 856 and 857, 2 mm against a 0.37 mm median, a region rather than single rows), so
-    /// structure a model can explain stays in; a mistyped digit or a beam break is hundreds.
+    /// left out. 10: on the real UR10 series C and D no row comes near it (5.5 at most), and on
+    /// series B even rows one row passes it (line 268, 2.1 mm against a 0.36 mm median, 10.1
+    /// sigmas), which a GP fitted on the odd rows still misses by 1.9 mm: an error no smooth
+    /// model explains. A mistyped digit or a tracker that lost its target is hundreds.
     pub outlier_threshold: f64,
     /// At most this many reweightings after the first (plain) solve. Each solve starts where the
     /// last ended, so one usually suffices; 10 leaves room for a fit that the outliers had pulled

@@ -186,22 +186,32 @@ fn solve(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
     }
 }
 
-/// The solve under the robust loss (module `robust`): a plain solve, then, while the residuals
+/// The solve under the robust loss (module `robust`): a first solve, then, while the residuals
 /// call for other weights, a solve from where the last ended under the weights they call for
-/// (iteratively reweighted least squares). Where no row is beyond the Huber threshold this is
-/// the plain solve alone. The iteration records of the later solves follow the first's.
+/// (iteratively reweighted least squares). The iteration records of the later solves follow the
+/// first's.
+///
+/// The first solve leaves out the rows already beyond the outlier threshold at the start (and
+/// only those): a row a metre off would otherwise drag the first solve far from the solution,
+/// where Gauss–Newton crawls back for its whole iteration limit. Where no row is beyond the
+/// thresholds, at the start or at the end, this is the plain solve alone.
 fn reweighted(problem: &mut Problem<'_>, start: State) -> Result<(Solved, RobustReport), Error> {
     let options = &problem.options.robust;
+    if options.loss == robust::Loss::Huber {
+        let errors = row_errors(&start.model, problem.observations, problem.corrected(&start.theta))?;
+        let at_start = robust::assess(&errors, options);
+        if !at_start.report.outliers.is_empty() {
+            problem.row_weights =
+                at_start.weights.iter().map(|w| if *w == [0.0, 0.0] { *w } else { [1.0, 1.0] }).collect();
+        }
+    }
     let mut solved = solve(problem, start)?;
     let mut reweightings = 0;
     loop {
         let errors = row_errors(&solved.state.model, problem.observations, problem.corrected(&solved.state.theta))?;
         let assessment = robust::assess(&errors, options);
-        let current: &[[f64; 2]] = if problem.row_weights.is_empty() {
-            &vec![[1.0, 1.0]; errors.len()]
-        } else {
-            &problem.row_weights
-        };
+        let current: &[[f64; 2]] =
+            if problem.row_weights.is_empty() { &vec![[1.0, 1.0]; errors.len()] } else { &problem.row_weights };
         let settled = robust::settled(current, &assessment.weights, options.weight_tolerance);
         if settled || reweightings == options.max_reweightings {
             let report = RobustReport { reweightings, settled, ..assessment.report };
