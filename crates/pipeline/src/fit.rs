@@ -6,12 +6,16 @@ use crate::effects::{
 };
 use crate::fit_options::FitOptions;
 use crate::geometric::{fit_geometry, observations};
+use crate::outliers::{OutlierLine, list_lines, without};
 use crate::{
     CalibratedModel, Compensation, CompensationReport, Error, ErrorSummary, MeasurementSet, Method, PoseError,
     RobotDescription, SCHEMA_VERSION, pose_error,
 };
-use poe::identify::{IdentificationOptions, IdentificationReport, ParameterMask, Scope, identify_with_correction};
+use poe::identify::{
+    IdentificationOptions, IdentificationReport, Loss, ParameterMask, Scope, identify_with_correction,
+};
 use serde::Serialize;
+use std::borrow::Cow;
 
 /// What a fit reports besides the model (`calib fit --json` prints it as it is).
 #[derive(Debug, Clone, Serialize)]
@@ -40,6 +44,10 @@ pub struct FitReport {
     pub auto: Option<AutoChoice>,
     /// What the plausibility checks measured (absent below 4 rows).
     pub plausibility: Option<crate::PlausibilityReport>,
+    /// The rows the identification named as gross outliers (`identification.robust` has the
+    /// scales and thresholds), by line of the measurement file, most sigmas first: left out of the
+    /// geometric fit, the effects and the GP under the default Huber loss.
+    pub outliers: Vec<OutlierLine>,
     /// What the user should know before trusting the numbers above.
     pub warnings: Vec<FitWarning>,
 }
@@ -74,6 +82,17 @@ pub enum FitWarning {
         /// The most L-BFGS iterations any of them ran.
         iterations: usize,
     },
+    /// Rows whose residual is beyond the outlier threshold of the robust loss (issue 31): a
+    /// mistyped value or a tracker that lost its target, which a least-squares fit would absorb
+    /// without a word.
+    GrossOutliers {
+        /// The rows, by line, with their residuals (as [`FitReport::outliers`]).
+        rows: Vec<OutlierLine>,
+        /// The threshold, robust sigmas above the median residual.
+        threshold_sigmas: f64,
+        /// Whether the fit left them out (the Huber loss) or kept them (plain least squares).
+        left_out: bool,
+    },
 }
 
 impl std::fmt::Display for FitWarning {
@@ -91,6 +110,14 @@ impl std::fmt::Display for FitWarning {
                 "the GP's hyperparameter search for output(s) {outputs:?} stopped after {iterations} iterations \
                  without meeting its tolerance: the compensation may be less accurate than it could be; check it on \
                  held-out data"
+            ),
+            FitWarning::GrossOutliers { rows, threshold_sigmas, left_out } => write!(
+                f,
+                "{} row(s) of the data are gross outliers, beyond {threshold_sigmas} robust sigmas of the geometric \
+                 fit's residual: {}; {}; check them (a mistyped value, a tracker that lost its target)",
+                rows.len(),
+                list_lines(rows),
+                if *left_out { "left out of the fit" } else { "KEPT in the fit (least-squares loss)" }
             ),
         }
     }
@@ -191,12 +218,17 @@ pub fn fit(
         model.effects = effects;
         identification = fitted.report;
     }
+    let outliers = OutlierLine::of(&identification.robust, data);
+    let left_out = identification.robust.loss == Loss::Huber && !outliers.is_empty();
     let mut compensation = None;
     if method.uses_gp() {
         let with_payload = method == Method::PoeGpLoad;
-        let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
-        let poses = model.geometric_poses(&data.rows, &tools)?;
-        let (fitted, report) = Compensation::fit(&poses, data, with_payload, &options.compensation)?;
+        // The GP learns what the geometry leaves on the rows the geometry was fitted to: an
+        // outlier's metre would otherwise be its largest "structure".
+        let kept = if left_out { Cow::Owned(without(data, &identification.robust)) } else { Cow::Borrowed(data) };
+        let tools: Vec<usize> = kept.rows.iter().map(|r| r.tool).collect();
+        let poses = model.geometric_poses(&kept.rows, &tools)?;
+        let (fitted, report) = Compensation::fit(&poses, &kept, with_payload, &options.compensation)?;
         model.compensation = Some(fitted);
         compensation = Some(report);
     }
@@ -223,6 +255,13 @@ pub fn fit(
             min_redundancy: options.min_redundancy,
         });
     }
+    if !outliers.is_empty() {
+        warnings.push(FitWarning::GrossOutliers {
+            rows: outliers.clone(),
+            threshold_sigmas: identification.robust.outlier_threshold,
+            left_out,
+        });
+    }
     if let Some(report) = &compensation {
         let unconverged = report.gp.unconverged();
         if !unconverged.is_empty() {
@@ -243,6 +282,7 @@ pub fn fit(
         compensation,
         auto,
         plausibility: findings.report,
+        outliers,
         warnings,
     };
     Ok((model, report))

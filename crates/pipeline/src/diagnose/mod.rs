@@ -21,6 +21,7 @@ mod candidates;
 mod design;
 mod learnt_side;
 mod noise;
+mod outliers;
 mod pool;
 mod regions;
 mod report;
@@ -33,6 +34,7 @@ mod verdict;
 pub use arcs::ArcCheck;
 pub use candidates::Effect;
 pub use noise::{NoiseFloor, NoiseSource};
+pub use outliers::{GrossOutliers, OutlierOptions};
 pub use pool::PriorOptions;
 pub use regions::{PoseDiagnosis, Region};
 pub use report::{CandidateScore, DominantHarmonic, SelectedEffect, SeriesShape};
@@ -82,6 +84,8 @@ pub struct DiagnoseOptions {
     pub structure: StructureOptions,
     /// When to say `unknown`.
     pub verdict: VerdictOptions,
+    /// When gross outliers stop the attribution (module `outliers`).
+    pub outliers: OutlierOptions,
 }
 
 impl Default for DiagnoseOptions {
@@ -97,6 +101,7 @@ impl Default for DiagnoseOptions {
             selection: SelectionOptions::default(),
             structure: StructureOptions::default(),
             verdict: VerdictOptions::default(),
+            outliers: OutlierOptions::default(),
         }
     }
 }
@@ -121,7 +126,8 @@ impl DiagnoseOptions {
                 return Err(Error::DiagnoseOption { field, value });
             }
         }
-        let fractions: [(&'static str, f64); 4] = [
+        let fractions: [(&'static str, f64); 5] = [
+            ("outliers.max_left_out_fraction", self.outliers.max_left_out_fraction),
             ("selection.significance", self.selection.significance),
             ("selection.min_relative_gain", self.selection.min_relative_gain),
             ("verdict.structure_min_gain", self.verdict.structure_min_gain),
@@ -197,6 +203,10 @@ pub struct Diagnosis {
     /// The same with the selected effects, faded where they were not fitted.
     #[serde(default)]
     pub off_poses_after_mm: Option<f64>,
+    /// The rows named as gross outliers and left out of everything above (`n` does not count
+    /// them), checked before anything is attributed (module `outliers`).
+    #[serde(default)]
+    pub gross_outliers: GrossOutliers,
     /// Every pose (not in the JSON).
     #[serde(skip)]
     pub poses: Vec<PoseDiagnosis>,
@@ -354,6 +364,8 @@ pub fn diagnose(
         return Err(Error::TooFewRows { file: data.source.clone(), rows: data.rows.len(), needed });
     }
     let nominal = robot.nominal_model()?;
+    let screened = outliers::screen(&nominal, data, &options.outliers)?;
+    let data = screened.data.as_ref();
     let geometry = fit_geometry(&nominal, data, Scope::Full, &IdentificationOptions::default())?;
     let model = geometry.model;
     let stats = poe::identify::evaluate(&model, &observations(data))?;
@@ -491,6 +503,7 @@ pub fn diagnose(
             (Verdict { effect, joints }, Some(result.map_or(all_selected.mean_error(), |r| r.mean_error())))
         }
     };
+    let (verdict, verdict_result) = screened.verdict(verdict, verdict_result);
     let shapes = series_shapes(&pool, &terms, &selection, data)?;
 
     // Base-frame axes for the breakdown: tracker_from_base = calibrated · nominal⁻¹ at q = 0.
@@ -577,5 +590,6 @@ pub fn diagnose(
         off_poses_after_mm: arcs::mean_of(&arcs, |a| a.after_mm),
         arcs,
         poses,
+        gross_outliers: screened.outliers,
     })
 }

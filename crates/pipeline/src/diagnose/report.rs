@@ -138,6 +138,7 @@ impl Diagnosis {
             list(&self.moving_joints)
         ));
         let verdict = match self.verdict.effect {
+            _ if self.gross_outliers.attribution_refused => self.gross_outliers.verdict_reason().unwrap_or_default(),
             Effect::None => "none: nothing beats the noise floor significantly".to_owned(),
             Effect::Unknown if self.verdict.joints.is_empty() => {
                 "unknown: structure is left that no candidate explains".to_owned()
@@ -155,6 +156,7 @@ impl Diagnosis {
             ),
             _ => describe(self.verdict.effect, &self.verdict.joints, None),
         };
+        out.push_str(&self.gross_outliers.summary_line().unwrap_or_default());
         out.push_str(&format!("  verdict:        {verdict}\n"));
         let change = |after: f64| 100.0 * (1.0 - after / self.heldout_before_mm.max(f64::MIN_POSITIVE));
         out.push_str(&format!(

@@ -8,6 +8,7 @@ mod redundancy;
 mod registration;
 mod report;
 mod residual;
+mod robust;
 mod solver;
 mod termination;
 
@@ -17,6 +18,7 @@ pub use redundancy::Redundancy;
 pub use registration::register;
 pub use report::{DampingFallback, IdentificationReport, IterationRecord};
 pub use residual::ResidualStats;
+pub use robust::{KindScale, Loss, OutlierRow, RobustOptions, RobustReport, huber_loss, huber_weight, median};
 pub use solver::{Identification, identify, identify_with_correction};
 pub use termination::Termination;
 
@@ -69,5 +71,5 @@ pub fn calibrate_placed(
 
 /// Error statistics of a model on observations (no identification).
 pub fn evaluate(model: &LocalPoe, observations: &[Observation]) -> Result<ResidualStats, Error> {
-    residual::residuals(model, observations, None, &IdentificationOptions::default()).map(|(_, s)| s)
+    residual::residuals(model, observations, None, &[], &IdentificationOptions::default()).map(|(_, s)| s)
 }

@@ -1,5 +1,6 @@
 //! What the identification is told: observations, solver choice, weights and masks.
 
+use super::RobustOptions;
 use crate::{Block, Error, ParameterLayout};
 use lie::{SE3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -76,6 +77,9 @@ pub struct IdentificationOptions {
     /// Levenberg–Marquardt only: prior standard deviation of the local frames' rotations about the
     /// start, radians.
     pub prior_rotation_rad: f64,
+    /// The robust loss: Huber weights beyond a generous threshold, gross outliers named and left
+    /// out (module `robust`).
+    pub robust: RobustOptions,
 }
 
 impl Default for IdentificationOptions {
@@ -104,6 +108,7 @@ impl Default for IdentificationOptions {
             // posteriori fit set it, as `pipeline` does for non-geometric effects).
             prior_translation_m: f64::INFINITY,
             prior_rotation_rad: f64::INFINITY,
+            robust: RobustOptions::default(),
         }
     }
 }
@@ -146,7 +151,7 @@ impl IdentificationOptions {
         if !(self.min_damping <= self.initial_damping && self.initial_damping <= self.max_damping) {
             return invalid("initial_damping", self.initial_damping, "between min_damping and max_damping");
         }
-        Ok(())
+        self.robust.validate()
     }
 }
 

@@ -1,6 +1,6 @@
 //! What an identification reports.
 
-use super::{Redundancy, Termination};
+use super::{Redundancy, RobustReport, Termination};
 use serde::Serialize;
 
 /// The errors after one iteration (index 0: before the first).
@@ -50,6 +50,9 @@ pub struct IdentificationReport {
     /// The pseudo-inverse solver only: where no step along its direction lowered the cost and
     /// Levenberg–Marquardt steps (without a prior) took over; `None` when they never did.
     pub damping_fallback: Option<DampingFallback>,
+    /// What the robust loss did: the residuals' robust scales, the rows down-weighted, and the
+    /// gross outliers named (left out under the Huber loss).
+    pub robust: RobustReport,
 }
 
 /// Where the pseudo-inverse Gauss–Newton iteration handed over to damped steps.

@@ -1,6 +1,7 @@
 //! Weighted residuals and Jacobians of a set of observations.
 
 use super::correction::Corrected;
+use super::robust::RowError;
 use super::{IdentificationOptions, Observation, Target};
 use crate::{Error, LocalPoe, RowKind};
 use faer::Mat;
@@ -52,11 +53,11 @@ fn weighted_residual(
     observation: &Observation,
     model_pose: &SE3,
     options: &IdentificationOptions,
+    row_weight: [f64; 2],
     out: &mut [f64],
     acc: &mut Accumulator,
 ) {
-    let wp = 1.0 / options.position_sigma_m;
-    let wr = 1.0 / options.rotation_sigma_rad;
+    let [wp, wr] = scaled_weights(options, row_weight);
     acc.rows += 1;
     match observation.target {
         Target::Pose(measured) => {
@@ -80,6 +81,43 @@ fn weighted_residual(
     }
 }
 
+/// The multipliers of an observation's position and orientation rows: `1/σ` of each kind times
+/// the square root of the robust loss's row weight (module `robust`), so that the squared
+/// residual counts `w` times.
+fn scaled_weights(options: &IdentificationOptions, row_weight: [f64; 2]) -> [f64; 2] {
+    [row_weight[0].sqrt() / options.position_sigma_m, row_weight[1].sqrt() / options.rotation_sigma_rad]
+}
+
+/// The robust weight of observation `index`: `[1, 1]` where `row_weights` is empty.
+fn row_weight(row_weights: &[[f64; 2]], index: usize) -> [f64; 2] {
+    row_weights.get(index).copied().unwrap_or([1.0, 1.0])
+}
+
+/// Each observation's residual norms: the tool point's distance and the orientation's angle.
+pub(crate) fn row_errors(
+    model: &LocalPoe,
+    observations: &[Observation],
+    correction: Option<Corrected<'_>>,
+) -> Result<Vec<RowError>, Error> {
+    let mut twists = Vec::new();
+    observations
+        .iter()
+        .enumerate()
+        .map(|(index, observation)| {
+            let pose = predict(model, observation, index, correction, &mut twists)?;
+            Ok(match observation.target {
+                Target::Pose(measured) => RowError {
+                    position_m: (measured.translation() - pose.translation()).norm(),
+                    rotation_rad: Some((measured.rotation() * pose.rotation().inverse()).log().norm()),
+                },
+                Target::Point(measured) => {
+                    RowError { position_m: (measured - pose.translation()).norm(), rotation_rad: None }
+                }
+            })
+        })
+        .collect()
+}
+
 /// The predicted pose of observation `index`: the model's, moved by the correction if any.
 pub(crate) fn predict(
     model: &LocalPoe,
@@ -95,11 +133,13 @@ pub(crate) fn predict(
     })
 }
 
-/// The weighted residual vector and the error statistics of `model` on `observations`.
+/// The weighted residual vector and the error statistics of `model` on `observations`, each
+/// observation's rows also weighted by its robust weight (`row_weights`, empty for none).
 pub(crate) fn residuals(
     model: &LocalPoe,
     observations: &[Observation],
     correction: Option<Corrected<'_>>,
+    row_weights: &[[f64; 2]],
     options: &IdentificationOptions,
 ) -> Result<(Vec<f64>, ResidualStats), Error> {
     let mut y = vec![0.0; row_count(observations)];
@@ -109,14 +149,15 @@ pub(crate) fn residuals(
     for (index, observation) in observations.iter().enumerate() {
         let rows = row_kind(observation).rows();
         let pose = predict(model, observation, index, correction, &mut twists)?;
-        weighted_residual(observation, &pose, options, &mut y[row..row + rows], &mut acc);
+        let weight = row_weight(row_weights, index);
+        weighted_residual(observation, &pose, options, weight, &mut y[row..row + rows], &mut acc);
         row += rows;
     }
     Ok((y, acc.stats()))
 }
 
 /// The weighted Jacobian restricted to the `free` kinematic columns followed by one column per
-/// correction parameter, the weighted residual and the errors.
+/// correction parameter, the weighted residual and the errors; rows weighted as by [`residuals`].
 ///
 /// With a correction `exp(ξ)`, the kinematic columns are those of the corrected pose: each left
 /// twist of the uncorrected pose is carried through `exp(ξ)`, and the joint twists that `ξ` is made
@@ -127,6 +168,7 @@ pub(crate) fn linearise(
     observations: &[Observation],
     free: &[usize],
     correction: Option<Corrected<'_>>,
+    row_weights: &[[f64; 2]],
     options: &IdentificationOptions,
 ) -> Result<(Mat<f64>, Vec<f64>, ResidualStats), Error> {
     let columns = model.layout().len();
@@ -155,8 +197,16 @@ pub(crate) fn linearise(
                 c.apply_with_map(model, index, pose, &mut twists)
             }
         };
-        weighted_residual(observation, &pose, options, &mut y[row..row + rows], &mut acc);
-        let weight = |r: usize| if r < 3 { 1.0 / options.position_sigma_m } else { 1.0 / options.rotation_sigma_rad };
+        let [wp, wr] = scaled_weights(options, row_weight(row_weights, index));
+        weighted_residual(
+            observation,
+            &pose,
+            options,
+            row_weight(row_weights, index),
+            &mut y[row..row + rows],
+            &mut acc,
+        );
+        let weight = |r: usize| if r < 3 { wp } else { wr };
         // A left twist c moves the tool point by v + ω × p and the orientation by ω.
         let p = pose.translation();
         let rows_of = |twist: &Vector6, out: &mut [f64; 6]| {
@@ -271,7 +321,7 @@ mod tests {
         let theta = [4e-3, -3e-3, 2e-3];
         let corrected = || Some(Corrected { correction: &OnJoints, theta: &theta });
         let free: Vec<usize> = (0..model.layout().len()).collect();
-        let (a, _, _) = linearise(&model, &observations, &free, corrected(), &options).unwrap();
+        let (a, _, _) = linearise(&model, &observations, &free, corrected(), &[], &options).unwrap();
         let h = 1e-7;
         for &k in &free {
             let moved = |sign: f64| {
@@ -279,7 +329,7 @@ mod tests {
                 step[k] = sign * h;
                 let mut m = model.clone();
                 m.apply_update(&step);
-                residuals(&m, &observations, corrected(), &options).unwrap().0
+                residuals(&m, &observations, corrected(), &[], &options).unwrap().0
             };
             let (yp, ym) = (moved(1.0), moved(-1.0));
             for r in 0..yp.len() {
@@ -300,7 +350,7 @@ mod tests {
         let options = IdentificationOptions::default();
         let theta = [2e-3, -1e-3];
         let corrected = Some(Corrected { correction: &Fixed, theta: &theta });
-        let (a, _, _) = linearise(&model, &observations, &[], corrected, &options).unwrap();
+        let (a, _, _) = linearise(&model, &observations, &[], corrected, &[], &options).unwrap();
         let h = 1e-7;
         for l in 0..2 {
             let mut plus = theta;
@@ -308,10 +358,10 @@ mod tests {
             plus[l] += h;
             minus[l] -= h;
             let (yp, _) =
-                residuals(&model, &observations, Some(Corrected { correction: &Fixed, theta: &plus }), &options)
+                residuals(&model, &observations, Some(Corrected { correction: &Fixed, theta: &plus }), &[], &options)
                     .unwrap();
             let (ym, _) =
-                residuals(&model, &observations, Some(Corrected { correction: &Fixed, theta: &minus }), &options)
+                residuals(&model, &observations, Some(Corrected { correction: &Fixed, theta: &minus }), &[], &options)
                     .unwrap();
             for r in 0..yp.len() {
                 // The residual is measured − predicted, so its derivative is −A.
@@ -325,6 +375,39 @@ mod tests {
                     "row {r} column {l}: {} vs {numeric}",
                     a[(r, l)]
                 );
+            }
+        }
+    }
+
+    /// The robust loss's row weights scale each observation's rows by `√w`: the Jacobian so
+    /// weighted is still the derivative of the residual so weighted.
+    #[test]
+    fn row_weighted_columns_match_finite_differences_of_the_row_weighted_residual() {
+        let model = two_joint_arm();
+        let observations = near_prediction(&model);
+        let options = IdentificationOptions::default();
+        let weights = [[0.25, 0.64], [0.09, 1.0]];
+        let free: Vec<usize> = (0..model.layout().len()).collect();
+        let (a, y, _) = linearise(&model, &observations, &free, None, &weights, &options).unwrap();
+        let (plain_a, plain_y, _) = linearise(&model, &observations, &free, None, &[], &options).unwrap();
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
+        assert!(close(y[0], plain_y[0] * 0.5) && close(y[3], plain_y[3] * 0.8) && close(y[6], plain_y[6] * 0.3));
+        assert!(close(a[(7, 4)], plain_a[(7, 4)] * 0.3) && close(a[(4, 2)], plain_a[(4, 2)] * 0.8));
+        let h = 1e-7;
+        for &k in &free {
+            let moved = |sign: f64| {
+                let mut step = vec![0.0; free.len()];
+                step[k] = sign * h;
+                let mut m = model.clone();
+                m.apply_update(&step);
+                residuals(&m, &observations, None, &weights, &options).unwrap().0
+            };
+            let (yp, ym) = (moved(1.0), moved(-1.0));
+            for r in 0..yp.len() {
+                let numeric = -(yp[r] - ym[r]) / (2.0 * h);
+                // Weighted units as above; rotation rows first order in the residual angle.
+                let tolerance = if (3..6).contains(&r) { 1e-3 * 1e4 } else { 1e-6 * 1e4 };
+                assert!((a[(r, k)] - numeric).abs() < tolerance, "row {r} column {k}: {} vs {numeric}", a[(r, k)]);
             }
         }
     }

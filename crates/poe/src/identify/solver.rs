@@ -5,7 +5,8 @@
 use super::correction::{Corrected, PoseCorrection};
 use super::levenberg::{continue_damped, levenberg_marquardt};
 use super::redundancy::find_redundancies;
-use super::residual::{ResidualStats, linearise, residuals};
+use super::residual::{ResidualStats, linearise, residuals, row_errors};
+use super::robust::{self, RobustReport};
 use super::{
     DampingFallback, IdentificationOptions, IdentificationReport, IterationRecord, Observation, ParameterMask, Solver,
 };
@@ -34,6 +35,8 @@ pub(super) struct Problem<'a> {
     pub free: Vec<usize>,
     pub correction: Option<&'a dyn PoseCorrection>,
     pub options: &'a IdentificationOptions,
+    /// The robust loss's weight of each observation's position and orientation rows (empty: 1).
+    pub row_weights: Vec<[f64; 2]>,
 }
 
 /// A point of the parameter space: the model, the correction's θ, and the accumulated steps
@@ -70,12 +73,19 @@ impl Problem<'_> {
 
     /// The weighted residual of a state and its errors.
     pub(super) fn residuals(&self, state: &State) -> Result<(Vec<f64>, ResidualStats), Error> {
-        residuals(&state.model, self.observations, self.corrected(&state.theta), self.options)
+        residuals(&state.model, self.observations, self.corrected(&state.theta), &self.row_weights, self.options)
     }
 
     /// The weighted Jacobian (free columns, then the correction's), residual and errors.
     pub(super) fn linearise(&self, state: &State) -> Result<(Mat<f64>, Vec<f64>, ResidualStats), Error> {
-        linearise(&state.model, self.observations, &self.free, self.corrected(&state.theta), self.options)
+        linearise(
+            &state.model,
+            self.observations,
+            &self.free,
+            self.corrected(&state.theta),
+            &self.row_weights,
+            self.options,
+        )
     }
 }
 
@@ -125,7 +135,7 @@ pub fn identify_with_correction(
     if mask.flags().len() != layout.len() {
         return Err(Error::MaskLength { given: mask.flags().len(), expected: layout.len() });
     }
-    let problem = Problem { observations, free: mask.free_indices(), correction, options };
+    let mut problem = Problem { observations, free: mask.free_indices(), correction, options, row_weights: Vec::new() };
     let rows = super::residual::row_count(observations);
     let parameters = problem.parameter_count();
     if rows < parameters {
@@ -136,10 +146,7 @@ pub fn identify_with_correction(
         theta: vec![0.0; correction.map_or(0, |c| c.parameter_count())],
         deviation: vec![0.0; parameters],
     };
-    let solved = match options.solver {
-        Solver::PseudoInverse => gauss_newton(&problem, start)?,
-        Solver::LevenbergMarquardt => levenberg_marquardt(&problem, start)?,
-    };
+    let (solved, robust) = reweighted(&mut problem, start)?;
     let svd = normal::Decomposition::new(&solved.a, solved.iterations.len())?;
     let smax = svd.singular_values.first().copied().unwrap_or(0.0);
     let kept: Vec<f64> = svd.singular_values.iter().copied().filter(|&s| s > options.rcond * smax && s > 0.0).collect();
@@ -167,8 +174,58 @@ pub fn identify_with_correction(
             unidentifiable,
             held_at_prior: solved.held_at_prior,
             damping_fallback: solved.damping_fallback,
+            robust,
         },
     })
+}
+
+fn solve(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
+    match problem.options.solver {
+        Solver::PseudoInverse => gauss_newton(problem, start),
+        Solver::LevenbergMarquardt => levenberg_marquardt(problem, start),
+    }
+}
+
+/// The solve under the robust loss (module `robust`): a first solve, then, while the residuals
+/// call for other weights, a solve from where the last ended under the weights they call for
+/// (iteratively reweighted least squares). The iteration records of the later solves follow the
+/// first's.
+///
+/// The first solve leaves out the rows already beyond the outlier threshold at the start (and
+/// only those): a row a metre off would otherwise drag the first solve far from the solution,
+/// where Gauss–Newton crawls back for its whole iteration limit. Where no row is beyond the
+/// thresholds, at the start or at the end, this is the plain solve alone.
+fn reweighted(problem: &mut Problem<'_>, start: State) -> Result<(Solved, RobustReport), Error> {
+    let options = &problem.options.robust;
+    if options.loss == robust::Loss::Huber {
+        let errors = row_errors(&start.model, problem.observations, problem.corrected(&start.theta))?;
+        let at_start = robust::assess(&errors, options);
+        if !at_start.report.outliers.is_empty() {
+            problem.row_weights =
+                at_start.weights.iter().map(|w| if *w == [0.0, 0.0] { *w } else { [1.0, 1.0] }).collect();
+        }
+    }
+    let mut solved = solve(problem, start)?;
+    let mut reweightings = 0;
+    loop {
+        let errors = row_errors(&solved.state.model, problem.observations, problem.corrected(&solved.state.theta))?;
+        let assessment = robust::assess(&errors, options);
+        let current: &[[f64; 2]] =
+            if problem.row_weights.is_empty() { &vec![[1.0, 1.0]; errors.len()] } else { &problem.row_weights };
+        let settled = robust::settled(current, &assessment.weights, options.weight_tolerance);
+        if settled || reweightings == options.max_reweightings {
+            let report = RobustReport { reweightings, settled, ..assessment.report };
+            return Ok((solved, report));
+        }
+        reweightings += 1;
+        problem.row_weights = assessment.weights;
+        let history = std::mem::take(&mut solved.iterations);
+        let mut next = solve(problem, solved.state)?;
+        // The new solve's first record is its start under the new weights: the last record
+        // of the previous solve is the same model, so it is dropped.
+        next.iterations = history.into_iter().chain(next.iterations.into_iter().skip(1)).collect();
+        solved = next;
+    }
 }
 
 /// The paper's iteration: `x = A⁺ y` with the directions below `rcond · σ_max` dropped, each step

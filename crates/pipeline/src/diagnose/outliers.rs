@@ -1,0 +1,113 @@
+//! Gross outliers before anything is attributed (issue 31).
+//!
+//! A row a metre off is not the structure of any effect, yet it dominates every held-out error
+//! and every selection, and a GP finds "structure" in the joints it happens to sit at. So the
+//! geometry is fitted first with the identification's robust loss, and the rows it names as
+//! gross outliers (`poe::identify::RobustOptions::outlier_threshold` robust sigmas beyond the
+//! median residual) are named by line and left out of the diagnosis, which says so.
+//!
+//! A few such rows are errors of the data. Many are not: a share of the rows far beyond the
+//! rest is a second population (a tool or frame changed during the campaign, a collision) or a
+//! large effect, and leaving it out could hide the very thing to be found. Beyond
+//! [`OutlierOptions::max_left_out_fraction`] of the rows the diagnosis still leaves them out of
+//! its numbers, but attributes nothing: the verdict is `unknown`, for that reason.
+
+use super::Verdict;
+use super::candidates::Effect;
+use crate::geometric::fit_geometry;
+use crate::outliers::{OutlierLine, list_lines, without};
+use crate::{Error, MeasurementSet};
+use poe::LocalPoe;
+use poe::identify::{IdentificationOptions, Scope};
+use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
+
+/// When gross outliers stop the diagnosis from attributing.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct OutlierOptions {
+    /// Up to this share of the rows, gross outliers are left out as errors of the data and the
+    /// diagnosis goes on; beyond it, the verdict is `unknown`. 2 %: a tracker that loses its
+    /// target now and then, or a mistyped value, spoils a row or two in a few hundred; six rows
+    /// in three hundred, each ten robust sigmas out, are a pattern.
+    pub max_left_out_fraction: f64,
+}
+
+impl Default for OutlierOptions {
+    fn default() -> Self {
+        Self { max_left_out_fraction: 0.02 }
+    }
+}
+
+/// The gross outliers of a diagnosed data set (the JSON's `gross_outliers`).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct GrossOutliers {
+    /// The rows, by line, most sigmas first; left out of every number of the diagnosis.
+    pub rows: Vec<OutlierLine>,
+    /// The threshold they are beyond, robust sigmas above the median residual of the geometry.
+    pub threshold_sigmas: f64,
+    /// Whether they are too many to be errors of the data, so that no effect is attributed.
+    pub attribution_refused: bool,
+}
+
+impl GrossOutliers {
+    /// The reason of an `unknown` verdict they force, if they do.
+    pub fn verdict_reason(&self) -> Option<String> {
+        self.attribution_refused.then(|| {
+            format!(
+                "unknown: gross outliers at {} ({} rows, too many to leave out as errors of the data): no effect is \
+                 attributed; check those rows, or the campaign for a change of tool or frame",
+                list_lines(&self.rows),
+                self.rows.len()
+            )
+        })
+    }
+
+    /// The summary's line about them, if there are any.
+    pub fn summary_line(&self) -> Option<String> {
+        (!self.rows.is_empty()).then(|| {
+            format!(
+                "  gross outliers: {} row(s) beyond {} robust sigmas of the geometric fit, left out of the diagnosis: {}\n",
+                self.rows.len(),
+                self.threshold_sigmas,
+                list_lines(&self.rows)
+            )
+        })
+    }
+}
+
+/// The data the diagnosis works on and the gross outliers left out of it.
+pub(crate) struct Screened<'a> {
+    pub data: Cow<'a, MeasurementSet>,
+    pub outliers: GrossOutliers,
+}
+
+/// Fits the geometry to every row with the robust loss and leaves out the rows it names.
+pub(crate) fn screen<'a>(
+    nominal: &LocalPoe,
+    data: &'a MeasurementSet,
+    options: &OutlierOptions,
+) -> Result<Screened<'a>, Error> {
+    let identification = IdentificationOptions::default();
+    let robust = fit_geometry(nominal, data, Scope::Full, &identification)?.report.robust;
+    let rows = OutlierLine::of(&robust, data);
+    let outliers = GrossOutliers {
+        attribution_refused: rows.len() as f64 > options.max_left_out_fraction * data.rows.len() as f64,
+        threshold_sigmas: robust.outlier_threshold,
+        rows,
+    };
+    let data = if outliers.rows.is_empty() { Cow::Borrowed(data) } else { Cow::Owned(without(data, &robust)) };
+    Ok(Screened { data, outliers })
+}
+
+impl Screened<'_> {
+    /// The verdict, `unknown` without joints where the outliers refuse attribution; the result
+    /// of the verdict's effect goes with an attributed effect only.
+    pub(crate) fn verdict(&self, verdict: Verdict, result: Option<f64>) -> (Verdict, Option<f64>) {
+        if self.outliers.attribution_refused {
+            (Verdict { effect: Effect::Unknown, joints: Vec::new() }, None)
+        } else {
+            (verdict, result)
+        }
+    }
+}
