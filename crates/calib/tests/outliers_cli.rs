@@ -123,7 +123,7 @@ fn diagnose_leaves_a_gross_outlier_out_and_refuses_to_attribute_when_there_are_m
     let many = training(dir.path(), &lines, &moved, "many.csv");
     let out = succeeds(&["diagnose", "--robot", &robot, "--data", &text(&many)]);
     assert!(out.contains("verdict:        unknown: gross outliers at line "), "{out}");
-    assert!(out.contains("(10 rows, too many to leave out as errors of the data): no effect is attributed"), "{out}");
+    assert!(out.contains("(10 rows, too many to be errors of the data, and the selected effects do not explain them): no effect is attributed"), "{out}");
     for line in &moved {
         assert!(out.contains(&format!("line {line} (")), "line {line}: {out}");
     }
@@ -131,5 +131,7 @@ fn diagnose_leaves_a_gross_outlier_out_and_refuses_to_attribute_when_there_are_m
     let diagnosis: serde_json::Value = serde_json::from_str(&json).expect("one JSON object");
     assert_eq!(diagnosis["verdict"]["effect"], "unknown");
     assert_eq!(diagnosis["gross_outliers"]["attribution_refused"], true);
+    assert_eq!(diagnosis["gross_outliers"]["kept"], true);
+    assert_eq!(diagnosis["gross_outliers"]["unexplained"], 10);
     assert_eq!(diagnosis["gross_outliers"]["rows"].as_array().unwrap().len(), 10);
 }

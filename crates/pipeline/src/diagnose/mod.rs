@@ -503,7 +503,8 @@ pub fn diagnose(
             (Verdict { effect, joints }, Some(result.map_or(all_selected.mean_error(), |r| r.mean_error())))
         }
     };
-    let (verdict, verdict_result) = screened.verdict(verdict, verdict_result);
+    let gross_outliers = screened.judged(&all_selected.errors);
+    let (verdict, verdict_result) = gross_outliers.verdict(verdict, verdict_result);
     let shapes = series_shapes(&pool, &terms, &selection, data)?;
 
     // Base-frame axes for the breakdown: tracker_from_base = calibrated · nominal⁻¹ at q = 0.
@@ -590,6 +591,6 @@ pub fn diagnose(
         off_poses_after_mm: arcs::mean_of(&arcs, |a| a.after_mm),
         arcs,
         poses,
-        gross_outliers: screened.outliers,
+        gross_outliers,
     })
 }
