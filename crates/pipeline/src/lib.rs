@@ -56,9 +56,9 @@ pub use joint_targets::{
     read_targets, registered_nominal, write_compensated,
 };
 pub use measurements::{
-    Cells, ColumnMap, ColumnMapFault, Decimal, DecimalFault, Delimiter, Dialect, FileFormat, JointColumn, Measurement,
-    MeasurementSet, ReadOptions, parse_measurements, read_configurations, read_configurations_with_cells,
-    read_measurements,
+    Cells, ColumnMap, ColumnMapFault, CsvColumns, Decimal, DecimalFault, Delimiter, Dialect, FileFormat, JointColumn,
+    Measurement, MeasurementSet, MeasurementWriter, ReadOptions, parse_measurements, read_configurations,
+    read_configurations_with_cells, read_measurements,
 };
 pub use method::{Method, UnknownMethod};
 pub use metrics::{ErrorSummary, PoseError};
