@@ -81,6 +81,14 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         return Err("--rows: at least one pose is needed".into());
     }
     let config = generator_config(args)?;
+    // The generator draws poses where the tool point moves in all three directions: a planar
+    // chain has none, and would be refused after a million draws as "too strict a threshold".
+    if config.moving_joints.is_empty()
+        && let Some(direction) = robot.planar_direction()
+    {
+        let file = args.robot.robot.display().to_string();
+        return Err(Error::PlanarChain { file, direction, joints: robot.joint_count() }.into());
+    }
     let cell = simulated::campaign_cell(&robot, &Perturbation::default(), &Remount::default(), &config)?;
     // Each row is written as it is drawn (memory of one row, whatever --rows), into the atomic
     // output: a failure or a kill leaves the old file, never a part.
