@@ -61,8 +61,7 @@ fn predict_at_q1_100_rad_warns_beyond_the_fitted_angles_and_the_robots_limits() 
     let far = dir.path().join("far.csv");
     with_cell(&data, &far, "q1_rad", 3, "100");
     let (_, stderr) = succeeds(&["predict", "--model", &text(&model), "--data", &text(&far)]);
-    let fitted_span =
-        "1 of 120 rows (the first at line 4) put joint 1 outside the range the model was fitted on (";
+    let fitted_span = "1 of 120 rows (the first at line 4) put joint 1 outside the range the model was fitted on (";
     assert!(stderr.contains(fitted_span), "{stderr}");
     let limits = "warning: 1 of 120 rows (the first at line 4, 100.0000 rad) put joint 1 beyond the robot's limits \
                   (-2.8798 … 2.8798 rad): the arm cannot take these poses";
