@@ -6,7 +6,9 @@
 //! singular values come from it alone; the whole `A` (six rows per pose, 1.45 million rows × 42
 //! columns, 490 MB for a 68 MB measurement file) is never held, and neither is the SVD's `U`.
 
-use faer::{Mat, MatRef};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::qr::no_pivoting::factor;
+use faer::{Mat, MatRef, Par};
 
 /// `R`, `z` and `‖y‖²` of the rows folded so far.
 pub(super) struct Reduced {
@@ -47,15 +49,27 @@ impl Reduced {
             return;
         }
         let held = self.r.nrows();
-        let stacked = Mat::<f64>::from_fn(held + a.nrows(), p + 1, |i, j| match (i < held, j < p) {
+        let mut triangle = Mat::<f64>::from_fn(held + a.nrows(), p + 1, |i, j| match (i < held, j < p) {
             (true, true) => self.r[(i, j)],
             (true, false) => self.z[i],
             (false, true) => a[(i - held, j)],
             (false, false) => y[i - held],
         });
-        let qr = stacked.qr();
-        let triangle = qr.thin_R();
-        let rows = triangle.nrows().min(p);
+        // Householder QR in place, serially: faer's global parallelism would split the sums by
+        // the thread count and change the last bits (the identification must give the same
+        // answer on any machine, and a borderline line search must not flip with the load).
+        let (m, n) = triangle.shape();
+        let block = factor::recommended_block_size::<f64>(m, n);
+        let mut coefficients = Mat::<f64>::zeros(block, m.min(n));
+        let mut memory = MemBuffer::new(factor::qr_in_place_scratch::<f64>(m, n, block, Par::Seq, Default::default()));
+        factor::qr_in_place(
+            triangle.as_mut(),
+            coefficients.as_mut(),
+            Par::Seq,
+            MemStack::new(&mut memory),
+            Default::default(),
+        );
+        let rows = m.min(n).min(p);
         self.r = Mat::from_fn(rows, p, |i, j| if j >= i { triangle[(i, j)] } else { 0.0 });
         self.z = (0..rows).map(|i| triangle[(i, p)]).collect();
     }
