@@ -8,6 +8,7 @@ mod bench_gp_residuals;
 mod bench_gp_sklearn;
 mod bench_gp_sweep;
 mod bench_identify;
+mod bench_memory;
 mod blind_check;
 mod blind_check_cases;
 mod box_plot;
@@ -17,6 +18,7 @@ mod fuzz;
 mod fuzz_inputs;
 mod fuzz_seeds;
 mod fuzz_worker;
+mod hostile;
 mod msrv;
 mod reproduce_sim;
 mod reproduce_sim_params;
@@ -44,6 +46,10 @@ enum Command {
     BenchGp(Box<bench_gp::Args>),
     /// Time the local POE identification against SciPy's least_squares on the same data; print a table.
     BenchIdentify(bench_identify::Args),
+    /// Peak memory of `calib simulate` and `calib fit` on a ~68 MB CSV, beside pandas reading it.
+    BenchMemory(bench_memory::Args),
+    /// Issue 31's table of hostile-but-realistic inputs, run against the release `calib`.
+    Hostile(hostile::Args),
     /// Convert the IPA UR10 tracker dataset to SPEC measurement CSV.
     ConvertUr10(convert_ur10::Args),
     /// Diagnose simulated datasets with a hidden effect, without the truth; print the confusion matrix.
@@ -73,6 +79,8 @@ fn main() -> ExitCode {
         Command::ReproduceSim(args) => reproduce_sim::run(args),
         Command::BenchGp(args) => bench_gp::run(args),
         Command::BenchIdentify(args) => bench_identify::run(args).map_err(|e| format!("{e:#}")),
+        Command::BenchMemory(args) => bench_memory::run(args).map_err(|e| format!("{e:#}")),
+        Command::Hostile(args) => hostile::run(args).map_err(|e| format!("{e:#}")),
         Command::ConvertUr10(args) => convert_ur10::run(args).map_err(|e| format!("{e:#}")),
         Command::BlindCheck(args) => blind_check::run(args).map_err(|e| format!("{e:#}")),
         Command::Ur10(args) => ur10::run(args).map_err(|e| format!("{e:#}")),

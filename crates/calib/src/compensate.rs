@@ -61,6 +61,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     for warning in model.outside_training_range(&file.set.rows) {
         eprintln!("warning: {warning}");
     }
+    for warning in model.beyond_joint_limits(&file.set.rows) {
+        eprintln!("warning: {warning}");
+    }
     let refused = summary.rows - summary.ok;
     let mut line = format!("compensated {} of {} targets", summary.ok, summary.rows);
     if refused > 0 {

@@ -42,6 +42,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         for warning in &report.out_of_range {
             eprintln!("warning: {warning}");
         }
+        for warning in &report.beyond_joint_limits {
+            eprintln!("warning: {warning}");
+        }
         return Ok(());
     }
     let s = &evaluation.summary;
@@ -71,6 +74,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         println!("  warning: {warning}");
     }
     for warning in &report.out_of_range {
+        println!("  warning: {warning}");
+    }
+    for warning in &report.beyond_joint_limits {
         println!("  warning: {warning}");
     }
     Ok(())

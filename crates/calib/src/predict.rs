@@ -38,6 +38,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     for warning in model.outside_training_range(&data.rows) {
         eprintln!("warning: {warning}");
     }
+    for warning in model.beyond_joint_limits(&data.rows) {
+        eprintln!("warning: {warning}");
+    }
     let stdout = std::io::stdout();
     let mut out = csv::Writer::from_writer(stdout.lock());
     // The GP's standard deviation, and that of what the effects leave where they fade out.

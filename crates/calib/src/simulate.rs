@@ -24,7 +24,7 @@ pub struct Args {
     /// Where to write the measurements (SPEC CSV).
     #[arg(long)]
     out: PathBuf,
-    /// Number of poses (at most 1,000,000: the set is held in memory before it is written).
+    /// Number of poses (at most 1,000,000, ~280 MB; rows are written as they are drawn).
     #[arg(long, default_value_t = 300)]
     rows: usize,
     /// Seed of the true robot, the tracker placement, the poses, payloads and noise.
@@ -81,23 +81,33 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         return Err("--rows: at least one pose is needed".into());
     }
     let config = generator_config(args)?;
-    let (_, data) = simulated::simulate_campaign(
-        &robot,
+    // The generator draws poses where the tool point moves in all three directions: a planar
+    // chain has none, and would be refused after a million draws as "too strict a threshold".
+    if config.moving_joints.is_empty()
+        && let Some(direction) = robot.planar_direction()
+    {
+        let file = args.robot.robot.display().to_string();
+        return Err(Error::PlanarChain { file, direction, joints: robot.joint_count() }.into());
+    }
+    let cell = simulated::campaign_cell(&robot, &Perturbation::default(), &Remount::default(), &config)?;
+    // Each row is written as it is drawn (memory of one row, whatever --rows), into the atomic
+    // output: a failure or a kill leaves the old file, never a part.
+    let mut out = pipeline::OutputFile::create(&args.out)?;
+    let rows = simulated::simulate_to_csv(
+        &cell,
         &effects,
-        &Perturbation::default(),
-        &Remount::default(),
+        &simulated::joint_ranges(&robot),
         &config,
         args.full_pose,
+        &mut out,
+        &args.out.display().to_string(),
     )?;
-
-    let mut out = pipeline::OutputFile::create(&args.out)?;
-    data.write_csv(&mut out).map_err(|source| Error::Io { path: args.out.display().to_string(), source })?;
     out.finish()?;
 
     let on: Vec<&str> = effect_names(&effects);
     println!(
         "simulated {} poses of {} ({}), effects: {}, seed {}",
-        data.rows.len(),
+        rows,
         robot.name,
         if args.full_pose { "full pose" } else { "position only" },
         if on.is_empty() { "none".to_owned() } else { on.join(", ") },

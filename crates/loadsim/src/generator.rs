@@ -183,55 +183,95 @@ pub fn sample_configurations(
     ranges: &[JointRange],
     config: &GeneratorConfig,
 ) -> Result<Vec<Vec<f64>>, Error> {
-    let n = model.joint_count();
-    if ranges.len() != n {
-        return Err(Error::LengthMismatch { field: "joint ranges", given: ranges.len(), expected: n });
-    }
-    let margin = config.limit_margin_rad;
-    if !(margin.is_finite() && margin >= 0.0) {
-        return Err(Error::InvalidParameter { field: "limit_margin_rad", value: margin });
-    }
-    let bounds: Vec<(f64, f64)> = ranges.iter().map(|r| (r.lower_rad + margin, r.upper_rad - margin)).collect();
-    for (joint_index, (r, (lo, hi))) in ranges.iter().zip(&bounds).enumerate() {
-        if lo.partial_cmp(hi) != Some(std::cmp::Ordering::Less) {
-            return Err(Error::EmptyJointRange {
-                joint_index,
-                lower_rad: r.lower_rad,
-                upper_rad: r.upper_rad,
-                margin_rad: margin,
-            });
-        }
-    }
-    let fixed = fixed_values(config, &bounds)?;
-    let jitter = config.fixed_jitter_rad;
-    let mut rng = stream(config.seed, CONFIGURATION_STREAM);
+    let mut sampler = ConfigurationSampler::new(model, tool, ranges, config)?;
     let mut accepted = Vec::with_capacity(config.sample_count);
-    let budget = config.sample_count.max(1).saturating_mul(config.max_attempts_per_sample);
-    let mut attempts = 0;
     while accepted.len() < config.sample_count {
-        if attempts >= budget {
-            return Err(Error::SamplingExhausted { accepted: accepted.len(), attempts });
-        }
-        attempts += 1;
-        let q: Vec<f64> = bounds
-            .iter()
-            .enumerate()
-            .map(|(j, &(lo, hi))| match fixed[j] {
-                None => rng.random_range(lo..hi),
-                Some(at) if jitter > 0.0 => (at + rng.random_range(-jitter..jitter)).clamp(lo, hi),
-                Some(at) => at,
-            })
-            .collect();
-        let smallest = if config.moving_joints.is_empty() {
-            smallest_singular_value(model, &q, tool)?
-        } else {
-            smallest_singular_value_of_joints(model, &q, tool, &config.moving_joints)?
-        };
-        if smallest >= config.min_singular_value {
-            accepted.push(q);
-        }
+        accepted.push(sampler.next_configuration(accepted.len())?);
     }
     Ok(accepted)
+}
+
+/// [`sample_configurations`] one configuration at a time, so that a data set can be written as it
+/// is drawn (the draws, and so the configurations, are the same).
+struct ConfigurationSampler<'a> {
+    model: &'a LocalPoe,
+    tool: usize,
+    config: &'a GeneratorConfig,
+    bounds: Vec<(f64, f64)>,
+    fixed: Vec<Option<f64>>,
+    rng: ChaCha8Rng,
+    budget: usize,
+    attempts: usize,
+}
+
+impl<'a> ConfigurationSampler<'a> {
+    fn new(
+        model: &'a LocalPoe,
+        tool: usize,
+        ranges: &[JointRange],
+        config: &'a GeneratorConfig,
+    ) -> Result<Self, Error> {
+        let n = model.joint_count();
+        if ranges.len() != n {
+            return Err(Error::LengthMismatch { field: "joint ranges", given: ranges.len(), expected: n });
+        }
+        let margin = config.limit_margin_rad;
+        if !(margin.is_finite() && margin >= 0.0) {
+            return Err(Error::InvalidParameter { field: "limit_margin_rad", value: margin });
+        }
+        let bounds: Vec<(f64, f64)> = ranges.iter().map(|r| (r.lower_rad + margin, r.upper_rad - margin)).collect();
+        for (joint_index, (r, (lo, hi))) in ranges.iter().zip(&bounds).enumerate() {
+            if lo.partial_cmp(hi) != Some(std::cmp::Ordering::Less) {
+                return Err(Error::EmptyJointRange {
+                    joint_index,
+                    lower_rad: r.lower_rad,
+                    upper_rad: r.upper_rad,
+                    margin_rad: margin,
+                });
+            }
+        }
+        let fixed = fixed_values(config, &bounds)?;
+        Ok(Self {
+            model,
+            tool,
+            config,
+            bounds,
+            fixed,
+            rng: stream(config.seed, CONFIGURATION_STREAM),
+            budget: config.sample_count.max(1).saturating_mul(config.max_attempts_per_sample),
+            attempts: 0,
+        })
+    }
+
+    /// The next accepted configuration; `accepted` of them were drawn before (for the error).
+    fn next_configuration(&mut self, accepted: usize) -> Result<Vec<f64>, Error> {
+        let (config, jitter) = (self.config, self.config.fixed_jitter_rad);
+        loop {
+            if self.attempts >= self.budget {
+                return Err(Error::SamplingExhausted { accepted, attempts: self.attempts });
+            }
+            self.attempts += 1;
+            let rng = &mut self.rng;
+            let q: Vec<f64> = self
+                .bounds
+                .iter()
+                .enumerate()
+                .map(|(j, &(lo, hi))| match self.fixed[j] {
+                    None => rng.random_range(lo..hi),
+                    Some(at) if jitter > 0.0 => (at + rng.random_range(-jitter..jitter)).clamp(lo, hi),
+                    Some(at) => at,
+                })
+                .collect();
+            let smallest = if config.moving_joints.is_empty() {
+                smallest_singular_value(self.model, &q, self.tool)?
+            } else {
+                smallest_singular_value_of_joints(self.model, &q, self.tool, &config.moving_joints)?
+            };
+            if smallest >= config.min_singular_value {
+                return Ok(q);
+            }
+        }
+    }
 }
 
 /// Each joint's fixed value (`None` for a moving joint), checked against the configuration.
@@ -272,12 +312,30 @@ pub fn generate(
     ranges: &[JointRange],
     config: &GeneratorConfig,
 ) -> Result<Vec<Sample>, Error> {
+    let mut samples = Vec::with_capacity(config.sample_count);
+    generate_each(cell, effects, ranges, config, |sample| {
+        samples.push(sample);
+        Ok::<(), Error>(())
+    })?;
+    Ok(samples)
+}
+
+/// [`generate`], handing each sample to `sink` as it is drawn instead of holding them all (the
+/// same samples in the same order): a data set of any size is written in the memory of one row.
+/// An error of `sink` ends the generation and is returned.
+pub fn generate_each<E: From<Error>>(
+    cell: &SimulatedCell,
+    effects: &Effects,
+    ranges: &[JointRange],
+    config: &GeneratorConfig,
+    mut sink: impl FnMut(Sample) -> Result<(), E>,
+) -> Result<(), E> {
     effects.validate(cell)?;
     if config.payloads_kg.is_empty() {
-        return Err(Error::LengthMismatch { field: "payloads_kg", given: 0, expected: 1 });
+        return Err(Error::LengthMismatch { field: "payloads_kg", given: 0, expected: 1 }.into());
     }
     if let Some(&m) = config.payloads_kg.iter().find(|m| !(m.is_finite() && **m >= 0.0)) {
-        return Err(Error::InvalidParameter { field: "payloads_kg", value: m });
+        return Err(Error::InvalidParameter { field: "payloads_kg", value: m }.into());
     }
     let runs = config.payloads_kg.len();
     if config.tool_per_run && cell.robot.tool_count() < runs {
@@ -286,7 +344,8 @@ pub fn generate(
             needs: "one tool of the cell per payload run",
             given: cell.robot.tool_count(),
             expected: runs,
-        });
+        }
+        .into());
     }
     if let Some(sensor) = &config.torque_sensor {
         sensor.validate(cell.robot.joint_count())?;
@@ -296,46 +355,41 @@ pub fn generate(
     let cells: Vec<SimulatedCell> = (0..runs)
         .map(|r| SimulatedCell { tool: if config.tool_per_run { r } else { cell.tool }, ..cell.clone() })
         .collect();
-    let configurations = sample_configurations(&cell.robot, cell.tool, ranges, config)?;
+    let mut sampler = ConfigurationSampler::new(&cell.robot, cell.tool, ranges, config)?;
     let mut payload_rng = stream(config.seed, PAYLOAD_STREAM);
     let mut noise_rng = stream(config.seed, NOISE_STREAM);
     let mut torque_rng = stream(config.seed, TORQUE_STREAM);
-    configurations
-        .into_iter()
-        .enumerate()
-        .map(|(i, q)| {
-            let run = config.run_of(i);
-            let payload_kg = if config.runs() {
-                config.payloads_kg[run]
-            } else {
-                config.payloads_kg[payload_rng.random_range(0..runs)]
-            };
-            let t_s = config.start_time_s + i as f64 * config.seconds_per_pose;
-            let context = PoseContext {
-                payload: Payload { mass_kg: payload_kg, com_offset_m: config.payload_com_offset_m },
-                temp_c: config.temperature.at(t_s),
-                t_s,
-            };
-            let run_cell = &cells[run];
-            let tracker_from_tool = effects.measured_pose(run_cell, &q, &context, &mut noise_rng)?;
-            let torques_nm = match &config.torque_sensor {
-                Some(sensor) => {
-                    let held = effects.joint_offsets(run_cell, &q, &context)?.static_torque_nm;
-                    Some(sensor.measure(&held, &mut torque_rng))
-                }
-                None => None,
-            };
-            Ok(Sample {
-                q,
-                tracker_from_tool,
-                payload_kg,
-                temp_c: context.temp_c,
-                t_s,
-                tool: run_cell.tool,
-                torques_nm,
-            })
-        })
-        .collect()
+    for i in 0..config.sample_count {
+        let q = sampler.next_configuration(i)?;
+        let run = config.run_of(i);
+        let payload_kg =
+            if config.runs() { config.payloads_kg[run] } else { config.payloads_kg[payload_rng.random_range(0..runs)] };
+        let t_s = config.start_time_s + i as f64 * config.seconds_per_pose;
+        let context = PoseContext {
+            payload: Payload { mass_kg: payload_kg, com_offset_m: config.payload_com_offset_m },
+            temp_c: config.temperature.at(t_s),
+            t_s,
+        };
+        let run_cell = &cells[run];
+        let tracker_from_tool = effects.measured_pose(run_cell, &q, &context, &mut noise_rng)?;
+        let torques_nm = match &config.torque_sensor {
+            Some(sensor) => {
+                let held = effects.joint_offsets(run_cell, &q, &context)?.static_torque_nm;
+                Some(sensor.measure(&held, &mut torque_rng))
+            }
+            None => None,
+        };
+        sink(Sample {
+            q,
+            tracker_from_tool,
+            payload_kg,
+            temp_c: context.temp_c,
+            t_s,
+            tool: run_cell.tool,
+            torques_nm,
+        })?;
+    }
+    Ok(())
 }
 
 impl From<(f64, f64)> for JointRange {

@@ -66,7 +66,9 @@ pub use drift::BaseDrift;
 pub use dynamics::{FLOOR_GRAVITY_M_PER_S2, LinkInertia, RobotDynamics, tilted_base_gravity};
 pub use effects::{EffectKind, Effects, JointOffsets};
 pub use error::Error;
-pub use generator::{GeneratorConfig, JointRange, Sample, TemperatureProfile, generate, sample_configurations};
+pub use generator::{
+    GeneratorConfig, JointRange, Sample, TemperatureProfile, generate, generate_each, sample_configurations,
+};
 pub use gravity::{
     Payload, gravity_torque, link_centres_of_mass, link_motions, payload_centre_of_mass, payload_gravity_torque,
     potential_energy, static_torque,

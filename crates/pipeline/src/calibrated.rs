@@ -40,6 +40,10 @@ pub struct CalibratedModel {
     /// inside it. Files written before it existed have none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub training_range: Option<crate::TrainingRange>,
+    /// The robot description's joint limits, SI (`None` for a joint without): `eval`, `predict`
+    /// and `compensate` count rows beyond them. Files written before they were kept have none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joint_limits: Vec<Option<[f64; 2]>>,
 }
 
 /// A predicted tool pose and, where a GP is part of the model, its standard deviation.
@@ -196,6 +200,13 @@ impl CalibratedModel {
     pub fn outside_training_range(&self, rows: &[Measurement]) -> Vec<crate::OutOfRangeWarning> {
         let prismatic: Vec<bool> = self.joint_kinds().iter().map(|k| *k == poe::JointKind::Prismatic).collect();
         self.training_range.as_ref().map_or_else(Vec::new, |range| range.outside(rows, &prismatic))
+    }
+
+    /// One warning per joint that some of `rows` put beyond the robot's limits; none for model
+    /// files that do not keep them.
+    pub fn beyond_joint_limits(&self, rows: &[Measurement]) -> Vec<crate::BeyondLimitsWarning> {
+        let prismatic: Vec<bool> = self.joint_kinds().iter().map(|k| *k == poe::JointKind::Prismatic).collect();
+        crate::beyond_limits(&self.joint_limits, &prismatic, rows)
     }
 
     /// Whether any effect records the joint angles it was fitted on.

@@ -552,6 +552,35 @@ pub enum Error {
         /// The most rows made.
         max: usize,
     },
+    /// Two consecutive joints of a robot description whose motions are one (revolute about the
+    /// same line, or prismatic along the same direction): their Jacobian columns are equal.
+    RepeatedJointAxis {
+        /// The robot file.
+        file: String,
+        /// Line of the second joint's axis (0 where the file is not RON).
+        line: usize,
+        /// Its column.
+        column: usize,
+        /// The first joint, 1-based.
+        first: usize,
+        /// The second joint, 1-based.
+        second: usize,
+        /// Whether they are revolute (otherwise prismatic).
+        revolute: bool,
+        /// The second joint's axis direction.
+        axis: [f64; 3],
+        /// A point on it.
+        point: [f64; 3],
+    },
+    /// A planar chain asked for what needs three dimensions (a simulated 3-D campaign).
+    PlanarChain {
+        /// The robot file.
+        file: String,
+        /// The direction every revolute axis is parallel to.
+        direction: [f64; 3],
+        /// The joint count.
+        joints: usize,
+    },
     /// An output path that starts a chain of more symbolic links than are followed (a loop).
     OutputSymlinkChain {
         /// The path as given.
@@ -808,7 +837,34 @@ impl fmt::Display for Error {
             }
             Error::TooManySimulatedRows { rows, max } => write!(
                 f,
-                "{rows} rows asked for: at most {max} are simulated (the set is held in memory, about 0.5 kB a row)"
+                "{rows} rows asked for: at most {max} are simulated (up to 280 MB of CSV and 25 s; is the count mistyped?)"
+            ),
+            Error::RepeatedJointAxis { file, line, column, first, second, revolute, axis, point } => {
+                let place = if *line > 0 { format!("{file}:{line}:{column}") } else { file.clone() };
+                let [a, b, c] = axis;
+                let [x, y, z] = point;
+                if *revolute {
+                    write!(
+                        f,
+                        "{place}: joints {first} and {second} turn about the same line (direction ({a}, {b}, {c}) through \
+                         ({x}, {y}, {z}) m): no joint between them moves one off the other, so their columns in the \
+                         identification Jacobian are equal at every pose and their angles cannot be told apart; \
+                         correct the axis or merge the two joints"
+                    )
+                } else {
+                    write!(
+                        f,
+                        "{place}: joints {first} and {second} slide along the same direction ({a}, {b}, {c}): their columns \
+                         in the identification Jacobian are equal at every pose and their values cannot be told apart; \
+                         correct the axis or merge the two joints"
+                    )
+                }
+            }
+            Error::PlanarChain { file, direction: [a, b, c], joints } => write!(
+                f,
+                "{file}: the chain is planar: all {joints} joints turn about axes parallel to ({a}, {b}, {c}) (prismatic \
+                 ones slide across it), so the tool moves in a plane and 3-D positions cannot be drawn for it; \
+                 check the joint axes"
             ),
             Error::OutputSymlinkChain { path, links } => {
                 write!(f, "{path}: more than {links} symbolic links in a row (a loop?): refusing to write there")

@@ -43,6 +43,9 @@ pub struct EvalReport {
     /// for every model that records it.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub out_of_range: Vec<crate::OutOfRangeWarning>,
+    /// Joints beyond the robot's limits, for every model that keeps them.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub beyond_joint_limits: Vec<crate::BeyondLimitsWarning>,
 }
 
 /// The errors inside and outside a model's coverage.
@@ -75,6 +78,7 @@ impl EvalReport {
             }),
             warnings: model.extrapolation(&data.rows),
             out_of_range: model.outside_training_range(&data.rows),
+            beyond_joint_limits: model.beyond_joint_limits(&data.rows),
         }
     }
 }

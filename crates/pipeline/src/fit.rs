@@ -180,6 +180,7 @@ pub fn fit(
         fallback_kinematics: None,
         compensation: None,
         training_range: crate::TrainingRange::of(&data.rows),
+        joint_limits: crate::stored_limits(&robot.limits()),
     };
     let mut identification = geometry.report;
     let mut auto = None;

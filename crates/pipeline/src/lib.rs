@@ -19,6 +19,7 @@ mod fit_options;
 pub mod geometric;
 mod input_files;
 mod inverse;
+mod joint_limits;
 mod joint_targets;
 mod measurements;
 mod method;
@@ -52,14 +53,15 @@ pub use fit::{Evaluation, FitReport, FitWarning, evaluate, fit, tool_indices};
 pub use fit_options::{EffectOptions, FitOptions};
 pub use input_files::InputFiles;
 pub use inverse::{InverseOptions, PoseTarget, Solved, TargetStatus, solve_targets};
+pub use joint_limits::{BeyondLimitsWarning, beyond_limits, stored_limits};
 pub use joint_targets::{
     CompensateOptions, CompensationSummary, RegisteredNominal, TargetFile, TargetFrame, compensate, pose_targets,
     read_targets, registered_nominal, write_compensated,
 };
 pub use measurements::{
-    Cells, ColumnMap, ColumnMapFault, Decimal, DecimalFault, Delimiter, Dialect, FileFormat, JointColumn, Measurement,
-    MeasurementSet, ReadOptions, parse_measurements, read_configurations, read_configurations_with_cells,
-    read_measurements,
+    Cells, ColumnMap, ColumnMapFault, CsvColumns, Decimal, DecimalFault, Delimiter, Dialect, FileFormat, JointColumn,
+    Measurement, MeasurementSet, MeasurementWriter, ReadOptions, parse_measurements, read_configurations,
+    read_configurations_with_cells, read_measurements,
 };
 pub use method::{Method, UnknownMethod};
 pub use metrics::{ErrorSummary, PoseError};

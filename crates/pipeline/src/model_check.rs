@@ -192,6 +192,15 @@ impl CalibratedModel {
             );
             return Err(at.part("training_range", message));
         }
+        if let Some((index, value)) =
+            crate::joint_limits::limits_fault(&self.joint_limits, self.kinematics.joint_count())
+        {
+            let message = format!(
+                "joint_limits[{index}]: {value:e} is not a range of finite values, smallest first, one per joint \
+                 (an edited or corrupt file)"
+            );
+            return Err(at.part("joint_limits", message));
+        }
         let (rows, where_) = self.probe_rows();
         let tools = vec![0; rows.len()];
         let mut walk = Walk::new(&rows, &tools);

@@ -120,6 +120,7 @@ mod version_1 {
                 fallback_kinematics: None,
                 compensation: v1.compensation,
                 training_range: None,
+                joint_limits: Vec::new(),
             }
         }
     }

@@ -139,7 +139,9 @@ impl RobotDescription {
     pub fn read_with(path: &Path, ends: &ChainEnds) -> Result<Self, Error> {
         let file = path.display().to_string();
         if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("urdf")) {
-            return Ok(UrdfDocument::read(path)?.chain(ends)?.description());
+            let robot = UrdfDocument::read(path)?.chain(ends)?.description();
+            crate::robot_check::check_chain(&robot, None, &file)?;
+            return Ok(robot);
         }
         if *ends != ChainEnds::default() {
             return Err(Error::RonFormat {
@@ -177,6 +179,7 @@ impl RobotDescription {
             return Err(at("joints", 0, "a robot needs at least one joint".into()));
         }
         crate::robot_check::check_values(self, text, file)?;
+        crate::robot_check::check_chain(self, Some(text), file)?;
         let (mut deg_index, mut m_index) = (0, 0);
         for (i, joint) in self.joints.iter().enumerate() {
             let norm = Vector3::from(joint.axis).norm();
@@ -259,6 +262,12 @@ impl RobotDescription {
             }
         }
         Ok(())
+    }
+
+    /// The common axis direction of a planar chain (every revolute axis parallel to it, every
+    /// prismatic joint across it): its tool moves in a plane. `None` for a spatial chain.
+    pub fn planar_direction(&self) -> Option<[f64; 3]> {
+        crate::robot_check::planar_direction(self)
     }
 
     /// Number of joints.

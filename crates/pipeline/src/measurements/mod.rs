@@ -13,6 +13,7 @@ mod writer;
 
 pub use column_map::{ColumnMap, ColumnMapFault};
 pub use dialect::{Decimal, DecimalFault, Delimiter, Dialect};
+pub use writer::{CsvColumns, MeasurementWriter};
 
 use crate::Error;
 use layout::{Expectation, Layout, OrientationColumns};

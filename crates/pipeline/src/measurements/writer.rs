@@ -5,60 +5,115 @@ use super::{Measurement, MeasurementSet};
 use poe::JointKind;
 use std::io::Write;
 
-impl MeasurementSet {
-    /// Writes the set as SPEC CSV: revolute joints in radians, prismatic joints in metres (the
-    /// kinds the file's units said; radians for a set made in memory), positions in millimetres,
-    /// the orientation as a quaternion.
-    pub fn write_csv<W: Write>(&self, writer: W) -> Result<(), std::io::Error> {
+/// The columns of a written measurement CSV, fixed by its header before the first row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CsvColumns {
+    /// The kind of each joint (`q{k}_rad` or `q{k}_m`).
+    pub joint_kinds: Vec<JointKind>,
+    /// Whether `qw, qx, qy, qz` are written.
+    pub full_pose: bool,
+    /// Tool names by index; a `tool` column only where one is not empty.
+    pub tools: Vec<String>,
+    /// Whether `temp_c` is written.
+    pub temp_c: bool,
+    /// Whether `t_s` is written.
+    pub t_s: bool,
+    /// How many `tau{k}_nm` columns are written.
+    pub torques: usize,
+}
+
+/// The measurement CSV written one row at a time (`calib simulate` streams its rows through it).
+#[derive(Debug)]
+pub struct MeasurementWriter<W: Write> {
+    out: csv::Writer<W>,
+    columns: CsvColumns,
+    named_tools: bool,
+}
+
+impl<W: Write> MeasurementWriter<W> {
+    /// Writes the header of `columns`.
+    pub fn new(writer: W, columns: CsvColumns) -> Result<Self, std::io::Error> {
         let mut out = csv::Writer::from_writer(writer);
-        let has = |f: &dyn Fn(&Measurement) -> bool| self.rows.iter().any(f);
-        let (temp, time) = (has(&|r| r.temp_c.is_some()), has(&|r| r.t_s.is_some()));
-        let torques = self.rows.first().and_then(|r| r.torques_nm.as_ref()).map_or(0, Vec::len);
-        let named_tools = self.tools.iter().any(|t| !t.is_empty());
-        let mut header: Vec<String> = (1..=self.joint_count)
-            .map(|k| match self.joint_columns.get(k - 1).map(|c| c.kind) {
-                Some(JointKind::Prismatic) => format!("q{k}_m"),
-                _ => format!("q{k}_rad"),
+        let named_tools = columns.tools.iter().any(|t| !t.is_empty());
+        let mut header: Vec<String> = columns
+            .joint_kinds
+            .iter()
+            .enumerate()
+            .map(|(j, kind)| match kind {
+                JointKind::Prismatic => format!("q{}_m", j + 1),
+                JointKind::Revolute => format!("q{}_rad", j + 1),
             })
             .collect();
         header.extend(["x_mm", "y_mm", "z_mm"].map(String::from));
-        if self.full_pose {
+        if columns.full_pose {
             header.extend(["qw", "qx", "qy", "qz"].map(String::from));
         }
         header.push("payload_kg".into());
         if named_tools {
             header.push("tool".into());
         }
-        if temp {
+        if columns.temp_c {
             header.push("temp_c".into());
         }
-        if time {
+        if columns.t_s {
             header.push("t_s".into());
         }
-        header.extend((1..=torques).map(|k| format!("tau{k}_nm")));
+        header.extend((1..=columns.torques).map(|k| format!("tau{k}_nm")));
         out.write_record(&header)?;
-        for row in &self.rows {
-            let mut record: Vec<String> = row.q.iter().map(|v| format!("{v:?}")).collect();
-            record.extend(row.position.iter().map(|v| format!("{:?}", v * 1e3)));
-            if self.full_pose {
-                let q = row.orientation.map_or([1.0, 0.0, 0.0, 0.0], |r| r.to_quaternion());
-                record.extend(q.iter().map(|v| format!("{v:?}")));
-            }
-            record.push(format!("{:?}", row.payload_kg));
-            if named_tools {
-                record.push(self.tools.get(row.tool).cloned().unwrap_or_default());
-            }
-            if temp {
-                record.push(row.temp_c.map_or(String::new(), |v| format!("{v:?}")));
-            }
-            if time {
-                record.push(row.t_s.map_or(String::new(), |v| format!("{v:?}")));
-            }
-            if let Some(tau) = &row.torques_nm {
-                record.extend(tau.iter().map(|v| format!("{v:?}")));
-            }
-            out.write_record(&record)?;
+        Ok(Self { out, columns, named_tools })
+    }
+
+    /// Writes one row in full precision (`{:?}`, so that it reads back bit for bit).
+    pub fn write_row(&mut self, row: &Measurement) -> Result<(), std::io::Error> {
+        let columns = &self.columns;
+        let mut record: Vec<String> = row.q.iter().map(|v| format!("{v:?}")).collect();
+        record.extend(row.position.iter().map(|v| format!("{:?}", v * 1e3)));
+        if columns.full_pose {
+            let q = row.orientation.map_or([1.0, 0.0, 0.0, 0.0], |r| r.to_quaternion());
+            record.extend(q.iter().map(|v| format!("{v:?}")));
         }
-        out.flush()
+        record.push(format!("{:?}", row.payload_kg));
+        if self.named_tools {
+            record.push(columns.tools.get(row.tool).cloned().unwrap_or_default());
+        }
+        if columns.temp_c {
+            record.push(row.temp_c.map_or(String::new(), |v| format!("{v:?}")));
+        }
+        if columns.t_s {
+            record.push(row.t_s.map_or(String::new(), |v| format!("{v:?}")));
+        }
+        if let Some(tau) = &row.torques_nm {
+            record.extend(tau.iter().map(|v| format!("{v:?}")));
+        }
+        Ok(self.out.write_record(&record)?)
+    }
+
+    /// Flushes what is buffered.
+    pub fn finish(mut self) -> Result<(), std::io::Error> {
+        self.out.flush()
+    }
+}
+
+impl MeasurementSet {
+    /// Writes the set as SPEC CSV: revolute joints in radians, prismatic joints in metres (the
+    /// kinds the file's units said; radians for a set made in memory), positions in millimetres,
+    /// the orientation as a quaternion.
+    pub fn write_csv<W: Write>(&self, writer: W) -> Result<(), std::io::Error> {
+        let has = |f: &dyn Fn(&Measurement) -> bool| self.rows.iter().any(f);
+        let columns = CsvColumns {
+            joint_kinds: (0..self.joint_count)
+                .map(|j| self.joint_columns.get(j).map_or(JointKind::Revolute, |c| c.kind))
+                .collect(),
+            full_pose: self.full_pose,
+            tools: self.tools.clone(),
+            temp_c: has(&|r| r.temp_c.is_some()),
+            t_s: has(&|r| r.t_s.is_some()),
+            torques: self.rows.first().and_then(|r| r.torques_nm.as_ref()).map_or(0, Vec::len),
+        };
+        let mut out = MeasurementWriter::new(writer, columns)?;
+        for row in &self.rows {
+            out.write_row(row)?;
+        }
+        out.finish()
     }
 }

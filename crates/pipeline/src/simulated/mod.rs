@@ -236,29 +236,31 @@ pub fn measurement_set(source: &str, samples: Vec<Sample>, full_pose: bool) -> M
     used.sort_unstable();
     used.dedup();
     let named = used.len() > 1;
-    let rows = samples
-        .into_iter()
-        .enumerate()
-        .map(|(i, s)| Measurement {
-            line: i as u64 + 2,
-            q: s.q,
-            position: s.tracker_from_tool.translation(),
-            orientation: full_pose.then(|| s.tracker_from_tool.rotation()),
-            payload_kg: s.payload_kg,
-            tool: if named { used.binary_search(&s.tool).unwrap_or(0) } else { 0 },
-            temp_c: Some(s.temp_c),
-            t_s: Some(s.t_s),
-            torques_nm: s.torques_nm,
-        })
-        .collect();
+    let rows = samples.into_iter().enumerate().map(|(i, s)| measurement(i, s, &used, full_pose)).collect();
     let tools = if named { used.iter().map(|t| format!("tool{}", t + 1)).collect() } else { vec![] };
     MeasurementSet::from_rows(source, rows, tools)
 }
 
-/// The most rows [`simulate`] makes. The whole set is held in memory before it is written (about
-/// 0.5 kB a row: 100,000 rows of the IRB 4400 peaked at 51 MB resident), so a million rows is
-/// about 0.5 GB and 20 s; that is a hundred times the sparse GP's largest benchmark and a thousand
-/// times a tracker campaign, and a mistyped count is refused instead of aborting in the allocator.
+/// Sample `i` as the row at line `i + 2`, its tool the index in `used` where more than one is.
+fn measurement(i: usize, s: Sample, used: &[usize], full_pose: bool) -> Measurement {
+    Measurement {
+        line: i as u64 + 2,
+        q: s.q,
+        position: s.tracker_from_tool.translation(),
+        orientation: full_pose.then(|| s.tracker_from_tool.rotation()),
+        payload_kg: s.payload_kg,
+        tool: if used.len() > 1 { used.binary_search(&s.tool).unwrap_or(0) } else { 0 },
+        temp_c: Some(s.temp_c),
+        t_s: Some(s.t_s),
+        torques_nm: s.torques_nm,
+    }
+}
+
+/// The most rows [`simulate`] makes and [`simulate_to_csv`] writes. The writer streams (a row at a
+/// time, ~280 bytes of CSV each with the orientation), so the bound is the time and the disk, not
+/// memory (242,000 full-pose rows, 66 MB, peak 6.6 MB resident where the whole set held 114 MB): a
+/// million rows is 25 s and 190–280 MB; that is a hundred times the sparse GP's largest
+/// benchmark and a thousand times a tracker campaign, and a mistyped count is refused at once.
 pub const MAX_ROWS: usize = 1_000_000;
 
 /// A simulated dataset: [`loadsim::generate`] then [`measurement_set`]; more than [`MAX_ROWS`]
@@ -274,16 +276,64 @@ pub fn simulate(
         return Err(Error::TooManySimulatedRows { rows: config.sample_count, max: MAX_ROWS });
     }
     let samples = loadsim::generate(cell, effects, ranges, config)?;
-    // Never a data set with a NaN in it: an effect or a robot out of any real range can overflow.
-    let finite = |s: &Sample| {
-        let pose = s.tracker_from_tool;
-        let numbers = pose.translation().iter().chain(pose.rotation().matrix().iter()).copied().collect::<Vec<f64>>();
-        numbers.into_iter().chain(s.q.iter().copied()).chain(s.torques_nm.iter().flatten().copied()).all(f64::is_finite)
-    };
     if let Some(row) = samples.iter().position(|s| !finite(s)) {
         return Err(Error::NonFiniteSimulation { row: row + 1 });
     }
     Ok(measurement_set("simulated", samples, full_pose))
+}
+
+/// Whether a sample is finite everywhere (an effect or a robot out of any real range can
+/// overflow): never a data set with a NaN in it.
+fn finite(s: &Sample) -> bool {
+    let pose = s.tracker_from_tool;
+    pose.translation().iter().chain(pose.rotation().matrix().iter()).all(|v| v.is_finite())
+        && s.q.iter().chain(s.torques_nm.iter().flatten()).all(|v| v.is_finite())
+}
+
+/// [`simulate`] written to `writer` as SPEC CSV while it is drawn, each row as it comes: memory
+/// stays that of one row whatever `config.sample_count` (at most [`MAX_ROWS`]). The same rows,
+/// bit for bit, as [`simulate`] followed by [`MeasurementSet::write_csv`]. Returns the row count.
+pub fn simulate_to_csv<W: std::io::Write>(
+    cell: &SimulatedCell,
+    effects: &Effects,
+    ranges: &[JointRange],
+    config: &GeneratorConfig,
+    full_pose: bool,
+    writer: W,
+    path: &str,
+) -> Result<usize, Error> {
+    if config.sample_count > MAX_ROWS {
+        return Err(Error::TooManySimulatedRows { rows: config.sample_count, max: MAX_ROWS });
+    }
+    // The tools the rows will use, known before the first row: with `tool_per_run` the runs
+    // that have a row (`run_of(i) = i·runs/n`: all of them once n ≥ runs), else the cell's.
+    let (n, runs) = (config.sample_count, config.payloads_kg.len());
+    let used: Vec<usize> = match config.tool_per_run {
+        true if n >= runs => (0..runs).collect(),
+        true => (0..n).map(|i| config.run_of(i)).collect(),
+        false => vec![cell.tool],
+    };
+    let columns = crate::CsvColumns {
+        joint_kinds: cell.robot.joints().iter().map(|j| j.kind).collect(),
+        full_pose,
+        tools: if used.len() > 1 { used.iter().map(|t| format!("tool{}", t + 1)).collect() } else { vec![] },
+        temp_c: true,
+        t_s: true,
+        torques: if config.torque_sensor.is_some() { cell.robot.joint_count() } else { 0 },
+    };
+    let io = |source: std::io::Error| Error::Io { path: path.to_owned(), source };
+    let mut out = crate::MeasurementWriter::new(writer, columns).map_err(io)?;
+    let mut written = 0;
+    loadsim::generate_each(cell, effects, ranges, config, |sample| {
+        if !finite(&sample) {
+            return Err(Error::NonFiniteSimulation { row: written + 1 });
+        }
+        out.write_row(&measurement(written, sample, &used, full_pose)).map_err(io)?;
+        written += 1;
+        Ok(())
+    })?;
+    out.finish().map_err(io)?;
+    Ok(written)
 }
 
 #[cfg(test)]
@@ -364,5 +414,60 @@ mod tests {
         let plain = campaign_cell(&robot, &Perturbation::default(), &Remount::default(), &one_tool).unwrap();
         assert_eq!(plain, simulated_cell(&robot, &Perturbation::default(), 2).unwrap());
         assert_eq!(cell.robot.tools()[0], plain.robot.tools()[0]);
+    }
+
+    #[test]
+    fn streamed_rows_are_the_bytes_of_the_set_written_whole() {
+        let iiwa = RobotDescription::read(
+            &std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/iiwa7.ron"),
+        )
+        .unwrap();
+        // Plain, a tool per run with torques, and fewer rows than runs (some runs without a row).
+        let cases = [
+            (irb4400(), GeneratorConfig { sample_count: 7, ..GeneratorConfig::default() }, true),
+            (irb4400(), GeneratorConfig { sample_count: 7, ..GeneratorConfig::default() }, false),
+            (iiwa.clone(), payload_run_campaign(9, 3), true),
+            (iiwa, payload_run_campaign(3, 3), false),
+        ];
+        for (robot, config, full_pose) in cases {
+            let (cell, whole) = simulate_campaign(
+                &robot,
+                &paper_effects(),
+                &Perturbation::default(),
+                &Remount::default(),
+                &config,
+                full_pose,
+            )
+            .unwrap();
+            let mut expected = Vec::new();
+            whole.write_csv(&mut expected).unwrap();
+            let mut streamed = Vec::new();
+            let rows = simulate_to_csv(
+                &cell,
+                &paper_effects(),
+                &joint_ranges(&robot),
+                &config,
+                full_pose,
+                &mut streamed,
+                "mem",
+            )
+            .unwrap();
+            assert_eq!(rows, config.sample_count);
+            assert_eq!(String::from_utf8(streamed).unwrap(), String::from_utf8(expected).unwrap(), "{config:?}");
+        }
+    }
+
+    #[test]
+    fn a_streamed_simulation_that_overflows_is_refused_at_its_row() {
+        let robot = irb4400();
+        let cell = simulated_cell(&robot, &Perturbation::default(), 1).unwrap();
+        let config = GeneratorConfig { sample_count: 3, ..GeneratorConfig::default() };
+        let noise = TrackerNoise { transverse_sigma_per_m: 1e308, ..TrackerNoise::default() };
+        let effects = Effects { tracker_noise: Some(noise), ..Effects::default() };
+        let result = simulate_to_csv(&cell, &effects, &joint_ranges(&robot), &config, true, Vec::new(), "mem");
+        assert!(matches!(result, Err(Error::NonFiniteSimulation { row: 1 })), "{result:?}");
+        let many = GeneratorConfig { sample_count: MAX_ROWS + 1, ..GeneratorConfig::default() };
+        let result = simulate_to_csv(&cell, &effects, &joint_ranges(&robot), &many, true, Vec::new(), "mem");
+        assert!(matches!(result, Err(Error::TooManySimulatedRows { .. })), "{result:?}");
     }
 }

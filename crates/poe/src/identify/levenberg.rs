@@ -58,19 +58,19 @@ fn damped(
     let options = problem.options;
     let weights = weights.to_vec();
     let mut state = start;
-    let (mut a, mut y, stats) = problem.linearise(&state)?;
-    let mut current = cost(&y) + prior_cost(&weights, &state.deviation);
+    let (mut a, stats) = problem.linearise(&state)?;
+    let mut current = a.residual_sq + prior_cost(&weights, &state.deviation);
     let mut iterations = history;
     if iterations.is_empty() {
         iterations.push(record(stats, 0.0, current));
     }
     let mut lambda = options.initial_damping;
     let mut growth = 2.0;
-    let mut normal = Normal::new(&a, &y, &weights, &state.deviation);
+    let mut normal = Normal::new(&a, &weights, &state.deviation);
     let mut termination = Termination::IterationLimit { iterations: options.max_iterations };
     let mut iteration = 0;
     while iteration < max_iterations {
-        let cosine = gradient_cosine(&a, &y, &weights, &state.deviation);
+        let cosine = gradient_cosine(&a, &weights, &state.deviation);
         if cosine <= options.gradient_tolerance {
             termination = Termination::GradientTolerance { gradient_cosine: cosine };
             break;
@@ -96,10 +96,9 @@ fn damped(
             let relative_decrease = (current - trial_cost) / current.max(f64::MIN_POSITIVE);
             state = trial;
             current = trial_cost;
-            let (next_a, next_y, next_stats) = problem.linearise(&state)?;
+            let (next_a, next_stats) = problem.linearise(&state)?;
             a = next_a;
-            y = next_y;
-            normal = Normal::new(&a, &y, &weights, &state.deviation);
+            normal = Normal::new(&a, &weights, &state.deviation);
             let step_norm = step.iter().map(|v| v * v).sum::<f64>().sqrt();
             iterations.push(record(next_stats, step_norm, current));
             if relative_decrease < options.cost_tolerance {
@@ -123,7 +122,7 @@ fn damped(
             lambda *= growth;
             growth *= 2.0;
             if lambda > options.max_damping {
-                let gradient_cosine = gradient_cosine(&a, &y, &weights, &state.deviation);
+                let gradient_cosine = gradient_cosine(&a, &weights, &state.deviation);
                 termination = if gradient_cosine <= options.gradient_tolerance {
                     Termination::GradientTolerance { gradient_cosine }
                 } else {
@@ -133,7 +132,7 @@ fn damped(
             }
         }
     }
-    let gradient_cosine = gradient_cosine(&a, &y, &weights, &state.deviation);
+    let gradient_cosine = gradient_cosine(&a, &weights, &state.deviation);
     let held_at_prior = held_at_prior(problem, &normal, &weights);
     Ok(Solved {
         state,

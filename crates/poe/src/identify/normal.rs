@@ -1,11 +1,13 @@
 //! The linear algebra of one iteration: the SVD pseudo-inverse of the paper's update, and the
 //! damped normal equations of Levenberg–Marquardt with a prior.
 
+use super::reduced::Reduced;
 use crate::Error;
 use faer::prelude::Solve;
 use faer::{Mat, Side};
 
-/// Singular value decomposition of the weighted Jacobian.
+/// Singular value decomposition of the weighted Jacobian, taken of its QR triangle ([`Reduced`]):
+/// the same singular values and right vectors, and `U` only `p × p`.
 pub(super) struct Decomposition {
     pub singular_values: Vec<f64>,
     u: Mat<f64>,
@@ -13,8 +15,8 @@ pub(super) struct Decomposition {
 }
 
 impl Decomposition {
-    pub(super) fn new(a: &Mat<f64>, iteration: usize) -> Result<Self, Error> {
-        let svd = a.thin_svd().map_err(|_| Error::LinearSolveFailed { iteration, decomposition: "SVD" })?;
+    pub(super) fn new(reduced: &Reduced, iteration: usize) -> Result<Self, Error> {
+        let svd = reduced.r.thin_svd().map_err(|_| Error::LinearSolveFailed { iteration, decomposition: "SVD" })?;
         let s = svd.S().column_vector();
         Ok(Self {
             singular_values: (0..s.nrows()).map(|i| s[i]).collect(),
@@ -23,7 +25,8 @@ impl Decomposition {
         })
     }
 
-    /// `x = A⁺ y` with the directions below `rcond · σ_max` dropped (the paper's pseudo-inverse).
+    /// `x = A⁺ y = R⁺ z` with the directions below `rcond · σ_max` dropped (the paper's
+    /// pseudo-inverse), `z = Qᵀy` of [`Reduced`].
     pub(super) fn pseudo_inverse_solve(&self, y: &[f64], rcond: f64) -> Vec<f64> {
         let threshold = rcond * self.singular_values.first().copied().unwrap_or(0.0);
         let mut x = vec![0.0; self.v.nrows()];
@@ -49,10 +52,9 @@ pub(super) struct Normal {
 }
 
 impl Normal {
-    pub(super) fn new(a: &Mat<f64>, y: &[f64], prior_weights: &[f64], deviation: &[f64]) -> Self {
-        let mut h = a.transpose() * a;
-        let p = a.ncols();
-        let mut g: Vec<f64> = (0..p).map(|j| (0..y.len()).map(|i| a[(i, j)] * y[i]).sum()).collect();
+    pub(super) fn new(reduced: &Reduced, prior_weights: &[f64], deviation: &[f64]) -> Self {
+        let mut h = reduced.gram();
+        let mut g = reduced.gradient();
         for (j, (&w, &d)) in prior_weights.iter().zip(deviation).enumerate() {
             h[(j, j)] += w * w;
             g[j] -= w * w * d;
@@ -98,16 +100,15 @@ impl Normal {
 
 /// MINPACK's gradient criterion on the problem augmented by the prior rows:
 /// `max_j |g_j| / (‖a_j‖ ‖y‖)`, 0 at a stationary point, 1 when the residual lies along a column.
-pub(super) fn gradient_cosine(a: &Mat<f64>, y: &[f64], prior_weights: &[f64], deviation: &[f64]) -> f64 {
-    let mut residual_sq: f64 = y.iter().map(|v| v * v).sum();
+pub(super) fn gradient_cosine(reduced: &Reduced, prior_weights: &[f64], deviation: &[f64]) -> f64 {
+    let mut residual_sq = reduced.residual_sq;
     residual_sq += prior_weights.iter().zip(deviation).map(|(w, d)| (w * d).powi(2)).sum::<f64>();
     if residual_sq == 0.0 {
         return 0.0;
     }
     let mut worst = 0.0_f64;
-    for j in 0..a.ncols() {
-        let mut column_sq: f64 = (0..a.nrows()).map(|i| a[(i, j)] * a[(i, j)]).sum();
-        let mut g: f64 = (0..a.nrows()).map(|i| a[(i, j)] * y[i]).sum();
+    let gradient = reduced.gradient();
+    for (j, (mut column_sq, mut g)) in reduced.column_norms_sq().into_iter().zip(gradient).enumerate() {
         if let (Some(&w), Some(&d)) = (prior_weights.get(j), deviation.get(j)) {
             column_sq += w * w;
             g -= w * w * d;

@@ -80,6 +80,10 @@ pub struct IdentificationOptions {
     /// The robust loss: Huber weights beyond a generous threshold, gross outliers named and left
     /// out (module `robust`).
     pub robust: RobustOptions,
+    /// Observations linearised at a time and folded into the QR triangle of the stacked problem
+    /// (`reduced.rs`): memory holds one block of the Jacobian, not all of it. Changes results
+    /// only in their rounding.
+    pub block_observations: usize,
 }
 
 impl Default for IdentificationOptions {
@@ -109,6 +113,9 @@ impl Default for IdentificationOptions {
             prior_translation_m: f64::INFINITY,
             prior_rotation_rad: f64::INFINITY,
             robust: RobustOptions::default(),
+            // 1,024 poses: 6,144 rows of at most ~100 columns, under 5 MB, and each fold's QR
+            // (of ~6,200 × 100) long enough that the per-block overhead is negligible.
+            block_observations: 1024,
         }
     }
 }
@@ -147,6 +154,9 @@ impl IdentificationOptions {
         }
         if self.max_iterations == 0 {
             return invalid("max_iterations", 0.0, "at least 1");
+        }
+        if self.block_observations == 0 {
+            return invalid("block_observations", 0.0, "at least 1");
         }
         if !(self.min_damping <= self.initial_damping && self.initial_damping <= self.max_damping) {
             return invalid("initial_damping", self.initial_damping, "between min_damping and max_damping");

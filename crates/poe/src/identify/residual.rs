@@ -1,10 +1,11 @@
 //! Weighted residuals and Jacobians of a set of observations.
 
 use super::correction::Corrected;
+use super::reduced::Reduced;
 use super::robust::RowError;
 use super::{IdentificationOptions, Observation, Target};
 use crate::{Error, LocalPoe, RowKind};
-use faer::Mat;
+use faer::{Mat, MatMut};
 use lie::{SE3, SO3, Vector6};
 
 /// Root-mean-square errors of a model on a set of observations.
@@ -163,6 +164,7 @@ pub(crate) fn residuals(
 /// twist of the uncorrected pose is carried through `exp(ξ)`, and the joint twists that `ξ` is made
 /// of turn with the blocks before them (`correction::KinematicMap`); rows are then taken at the corrected
 /// tool point. Rotation rows take `d log = I`, first order in the residual angle, as everywhere.
+#[cfg(test)]
 pub(crate) fn linearise(
     model: &LocalPoe,
     observations: &[Observation],
@@ -171,17 +173,70 @@ pub(crate) fn linearise(
     row_weights: &[[f64; 2]],
     options: &IdentificationOptions,
 ) -> Result<(Mat<f64>, Vec<f64>, ResidualStats), Error> {
-    let columns = model.layout().len();
-    let joint_columns = 6 * model.joint_count();
     let extra = correction.map_or(0, |c| c.theta.len());
     let total_rows = row_count(observations);
     let mut a = Mat::<f64>::zeros(total_rows, free.len() + extra);
     let mut y = vec![0.0; total_rows];
     let mut acc = Accumulator::default();
+    let block = Block { observations, first: 0 };
+    linearise_block(model, block, free, correction, row_weights, options, a.as_mut(), &mut y, &mut acc)?;
+    Ok((a, y, acc.stats()))
+}
+
+/// [`linearise`] folded into its QR triangle ([`Reduced`]) `options.block_observations`
+/// observations at a time, so that memory stays that of one block however many rows there are.
+pub(crate) fn linearise_reduced(
+    model: &LocalPoe,
+    observations: &[Observation],
+    free: &[usize],
+    correction: Option<Corrected<'_>>,
+    row_weights: &[[f64; 2]],
+    options: &IdentificationOptions,
+) -> Result<(Reduced, ResidualStats), Error> {
+    let columns = free.len() + correction.map_or(0, |c| c.theta.len());
+    let mut reduced = Reduced::new(columns);
+    let mut acc = Accumulator::default();
+    let size = options.block_observations.max(1);
+    for (k, chunk) in observations.chunks(size).enumerate() {
+        let rows = row_count(chunk);
+        let mut a = Mat::<f64>::zeros(rows, columns);
+        let mut y = vec![0.0; rows];
+        let block = Block { observations: chunk, first: k * size };
+        linearise_block(model, block, free, correction, row_weights, options, a.as_mut(), &mut y, &mut acc)?;
+        reduced.fold(a.as_ref(), &y);
+    }
+    Ok((reduced, acc.stats()))
+}
+
+/// Consecutive observations and the index of the first among all of them (the correction's
+/// twists are per observation).
+#[derive(Clone, Copy)]
+struct Block<'a> {
+    observations: &'a [Observation],
+    first: usize,
+}
+
+/// The rows of one [`Block`] written into `a` and `y`, its errors into `acc`.
+#[allow(clippy::too_many_arguments)]
+fn linearise_block(
+    model: &LocalPoe,
+    block: Block<'_>,
+    free: &[usize],
+    correction: Option<Corrected<'_>>,
+    row_weights: &[[f64; 2]],
+    options: &IdentificationOptions,
+    mut a: MatMut<'_, f64>,
+    y: &mut [f64],
+    acc: &mut Accumulator,
+) -> Result<(), Error> {
+    let columns = model.layout().len();
+    let joint_columns = 6 * model.joint_count();
+    let extra = correction.map_or(0, |c| c.theta.len());
     let mut scratch = vec![0.0; 6 * columns];
     let mut twists = Vec::new();
     let mut row = 0;
-    for (index, observation) in observations.iter().enumerate() {
+    for (offset, observation) in block.observations.iter().enumerate() {
+        let index = block.first + offset;
         let kind = row_kind(observation);
         let rows = kind.rows();
         let (pose, map) = match correction {
@@ -204,7 +259,7 @@ pub(crate) fn linearise(
             options,
             row_weight(row_weights, index),
             &mut y[row..row + rows],
-            &mut acc,
+            acc,
         );
         let weight = |r: usize| if r < 3 { wp } else { wr };
         // A left twist c moves the tool point by v + ω × p and the orientation by ω.
@@ -248,7 +303,7 @@ pub(crate) fn linearise(
         }
         row += rows;
     }
-    Ok((a, y, acc.stats()))
+    Ok(())
 }
 
 #[cfg(test)]

@@ -4,15 +4,15 @@
 
 use super::correction::{Corrected, PoseCorrection};
 use super::levenberg::{continue_damped, levenberg_marquardt};
+use super::reduced::Reduced;
 use super::redundancy::find_redundancies;
-use super::residual::{ResidualStats, linearise, residuals, row_errors};
+use super::residual::{ResidualStats, linearise_reduced, residuals, row_errors};
 use super::robust::{self, RobustReport};
 use super::{
     DampingFallback, IdentificationOptions, IdentificationReport, IterationRecord, Observation, ParameterMask, Solver,
 };
 use super::{Termination, normal};
 use crate::{Error, LocalPoe};
-use faer::Mat;
 
 /// The result of an identification: the identified model and how it got there.
 #[derive(Debug, Clone)]
@@ -76,9 +76,10 @@ impl Problem<'_> {
         residuals(&state.model, self.observations, self.corrected(&state.theta), &self.row_weights, self.options)
     }
 
-    /// The weighted Jacobian (free columns, then the correction's), residual and errors.
-    pub(super) fn linearise(&self, state: &State) -> Result<(Mat<f64>, Vec<f64>, ResidualStats), Error> {
-        linearise(
+    /// The weighted Jacobian (free columns, then the correction's) and residual, reduced to their
+    /// QR triangle, and the errors.
+    pub(super) fn linearise(&self, state: &State) -> Result<(Reduced, ResidualStats), Error> {
+        linearise_reduced(
             &state.model,
             self.observations,
             &self.free,
@@ -96,7 +97,8 @@ pub(super) fn record(stats: ResidualStats, step_norm: f64, cost: f64) -> Iterati
 /// What a solver returns to [`identify_with_correction`].
 pub(super) struct Solved {
     pub state: State,
-    pub a: Mat<f64>,
+    /// The last linearisation, reduced.
+    pub a: Reduced,
     pub iterations: Vec<IterationRecord>,
     pub termination: Termination,
     pub final_cost: f64,
@@ -156,7 +158,7 @@ pub fn identify_with_correction(
         None => f64::INFINITY,
     };
     let unidentifiable =
-        find_redundancies(&solved.state.model, observations, mask, solved.a.ncols().saturating_sub(rank));
+        find_redundancies(&solved.state.model, observations, mask, solved.a.r.ncols().saturating_sub(rank));
     Ok(Identification {
         model: solved.state.model,
         correction: solved.state.theta,
@@ -233,13 +235,13 @@ fn reweighted(problem: &mut Problem<'_>, start: State) -> Result<(Solved, Robust
 fn gauss_newton(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
     let options = problem.options;
     let mut state = start;
-    let (mut a, mut y, stats) = problem.linearise(&state)?;
-    let mut current = cost(&y);
+    let (mut a, stats) = problem.linearise(&state)?;
+    let mut current = a.residual_sq;
     let mut iterations = vec![record(stats, 0.0, current)];
     let mut termination = Termination::IterationLimit { iterations: options.max_iterations };
     for iteration in 1..=options.max_iterations {
         let decomposition = normal::Decomposition::new(&a, iteration)?;
-        let step = decomposition.pseudo_inverse_solve(&y, options.rcond);
+        let step = decomposition.pseudo_inverse_solve(&a.z, options.rcond);
         let mut accepted = None;
         let mut scale = 1.0;
         for _ in 0..=options.line_search_halvings {
@@ -254,7 +256,7 @@ fn gauss_newton(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
             scale *= 0.5;
         }
         let Some((trial, trial_cost, scaled)) = accepted else {
-            let gradient_cosine = normal::gradient_cosine(&a, &y, &[], &[]);
+            let gradient_cosine = normal::gradient_cosine(&a, &[], &[]);
             if gradient_cosine <= options.gradient_tolerance {
                 termination = Termination::GradientTolerance { gradient_cosine };
                 break;
@@ -275,9 +277,8 @@ fn gauss_newton(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
         let relative_decrease = (current - trial_cost) / current.max(f64::MIN_POSITIVE);
         state = trial;
         current = trial_cost;
-        let (next_a, next_y, next_stats) = problem.linearise(&state)?;
+        let (next_a, next_stats) = problem.linearise(&state)?;
         a = next_a;
-        y = next_y;
         let step_norm = scaled.iter().map(|v| v * v).sum::<f64>().sqrt();
         iterations.push(record(next_stats, step_norm, current));
         if !current.is_finite() {
@@ -293,7 +294,7 @@ fn gauss_newton(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
             break;
         }
     }
-    let gradient_cosine = normal::gradient_cosine(&a, &y, &[], &[]);
+    let gradient_cosine = normal::gradient_cosine(&a, &[], &[]);
     Ok(Solved {
         state,
         a,
