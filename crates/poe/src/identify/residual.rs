@@ -253,14 +253,7 @@ fn linearise_block(
             }
         };
         let [wp, wr] = scaled_weights(options, row_weight(row_weights, index));
-        weighted_residual(
-            observation,
-            &pose,
-            options,
-            row_weight(row_weights, index),
-            &mut y[row..row + rows],
-            acc,
-        );
+        weighted_residual(observation, &pose, options, row_weight(row_weights, index), &mut y[row..row + rows], acc);
         let weight = |r: usize| if r < 3 { wp } else { wr };
         // A left twist c moves the tool point by v + ω × p and the orientation by ω.
         let p = pose.translation();
