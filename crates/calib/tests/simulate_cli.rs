@@ -206,3 +206,19 @@ fn campaign_shape_arguments_that_do_not_fit_are_refused_with_one_line() {
     refused(&["simulate", "--robot", &bare, "--out", &out, "--torques"], "dynamics");
     assert!(!Path::new(&out).exists(), "nothing is written when the input is refused");
 }
+
+/// Issue 30: a prismatic joint (a lifting column) is written as `q1_m` and what `simulate` writes
+/// `fit` reads back (it refused its own file when the column was written as `q1_rad`).
+#[test]
+fn a_lifting_column_is_written_in_metres_and_fits_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/column_ur10.ron");
+    let (data, model) = (dir.path().join("column.csv"), dir.path().join("column.ron"));
+    let effects = dir.path().join("effects.ron");
+    std::fs::write(&effects, "(tracker_noise: Some(()))").unwrap();
+    succeeds(&["simulate", "--robot", &text(&robot), "--out", &text(&data), "--rows", "120", "--effects", &text(&effects)]);
+    let header = std::fs::read_to_string(&data).unwrap().lines().next().unwrap().to_owned();
+    assert!(header.starts_with("q1_m,q2_rad,"), "{header}");
+    let out = succeeds(&["fit", "--robot", &text(&robot), "--data", &text(&data), "--method", "poe", "--out", &text(&model)]);
+    assert!(out.contains("training error after: mean 0.0"), "{out}");
+}
