@@ -96,7 +96,7 @@ impl std::fmt::Display for FoldedJoint {
             self.stages.iter().map(|s| format!("'{}' (multiplier {})", s.joint, s.multiplier)).collect();
         write!(
             f,
-            "joint {} is URDF joint '{}' with its mimic joint(s) {}, moving {} per unit of the joint value: only \
+            "joint {} is URDF joint '{}' with its mimic joint(s) {}, together moving {} times the joint value: only \
              their summed motion is observed, how it splits between the stages (and each stage's own axis) cannot \
              be identified; the calibration corrects the combined axis, the multipliers are kept as written",
             self.joint,

@@ -22,7 +22,8 @@ use std::path::Path;
 #[derive(Debug, Clone, Copy)]
 pub enum UrdfTemplate<'a> {
     /// A URDF of our own: links `base_link`, `link_1` … `link_n`; joints `joint_1` … `joint_n`
-    /// with the nominal description's limits, if one is given (its base frame is used; without
+    /// (a joint of scale ≠ 1 followed by `joint_i_stage` on its axis, a mimic joint of multiplier
+    /// `scale − 1`, through a link `link_i_drive`) with the nominal description's limits, if one is given (its base frame is used; without
     /// one the base frame is the calibrated joint 1 frame and revolute joints are continuous).
     Plain {
         /// The nominal description and its file name.

@@ -310,3 +310,85 @@ fn a_mimic_before_the_joint_it_follows_is_refused() {
     );
     assert_refused(&text, "push_stage", &["follows joint 'turn', further from the base"]);
 }
+
+mod export {
+    use super::*;
+    use pipeline::simulated::{self, Effects, GeneratorConfig, Perturbation, TrackerNoise};
+    use pipeline::{FitOptions, Method, NominalTolerance, UrdfTemplate, export_urdf};
+    use poe::LocalPoe;
+
+    /// A poe fit of the column arm on simulated data (noise only) and the URDF text.
+    fn fitted() -> (pipeline::CalibratedModel, pipeline::FitReport, String, RobotDescription) {
+        let text = std::fs::read_to_string(fixture("column_arm.urdf")).unwrap();
+        let robot = chain(&text, &ChainEnds::default()).description();
+        let cell = simulated::simulated_cell(&robot, &Perturbation::default(), 7).unwrap();
+        let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+        let config =
+            GeneratorConfig { sample_count: 150, seed: 7, payloads_kg: vec![0.0], ..GeneratorConfig::default() };
+        let set = simulated::simulate(&cell, &effects, &simulated::joint_ranges(&robot), &config, true).unwrap();
+        let (model, report) = pipeline::fit(&robot, &set, Method::Poe, &FitOptions::default()).unwrap();
+        (model, report, text, robot)
+    }
+
+    fn read_back(text: &str, base: &str, tip: &str) -> LocalPoe {
+        let ends = ChainEnds { base_link: Some(base.into()), tip_link: Some(tip.into()) };
+        chain(text, &ends).description().nominal_model().unwrap()
+    }
+
+    fn largest_difference_m(a: &LocalPoe, b: &LocalPoe) -> f64 {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        (0..20)
+            .map(|_| {
+                let q: Vec<f64> = (0..a.joint_count())
+                    .map(|j| if j == 0 { rng.random_range(0.0..0.8) } else { rng.random_range(-3.0..3.0) })
+                    .collect();
+                (a.forward(&q, 0).unwrap().to_matrix() - b.forward(&q, 0).unwrap().to_matrix()).norm()
+            })
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn the_fit_report_says_the_split_between_the_stages_is_not_observed() {
+        let (model, report, _, _) = fitted();
+        assert_eq!(model.kinematics.joints()[0].scale, 3.0);
+        assert_eq!(report.folded.len(), 1);
+        assert!(report.folded[0].to_string().contains("only their summed motion is observed"));
+    }
+
+    #[test]
+    fn export_like_the_urdf_keeps_its_mimic_joints_and_reads_back_to_the_model() {
+        let (model, _, text, _) = fitted();
+        let document = UrdfDocument::parse(&text, "column_arm.urdf").unwrap();
+        let nominal_chain = document.chain(&ChainEnds::default()).unwrap();
+        let template = UrdfTemplate::Like { document: &document, chain: &nominal_chain };
+        let export =
+            export_urdf(&model, template, None, &NominalTolerance::default()).unwrap_or_else(|e| panic!("{e}"));
+        // The stages, their origins and their <mimic> elements are as written.
+        for joint in ["lift_stage_2", "lift_stage_3"] {
+            let element = |t: &str| {
+                let start = t.find(&format!("<joint name=\"{joint}\"")).unwrap();
+                t[start..start + t[start..].find("</joint>").unwrap()].to_owned()
+            };
+            assert_eq!(element(&export.text), element(&text));
+        }
+        assert_eq!(export.text.matches("<mimic joint=\"lift\" multiplier=\"1\" offset=\"0\"/>").count(), 2);
+        assert_eq!(export.report.axis_changes.len(), 7);
+        assert_eq!(export.report.axis_changes[0].joint, "lift");
+        let tracker = read_back(&export.text, "tracker", "tool");
+        assert!((tracker.joints()[0].scale - 3.0).abs() < 1e-12, "{}", tracker.joints()[0].scale);
+        let difference = largest_difference_m(&tracker, &model.kinematics);
+        assert!(difference < 1e-9, "{difference:e}");
+    }
+
+    #[test]
+    fn a_plain_export_writes_a_scaled_joint_as_a_joint_and_a_mimic_stage() {
+        let (model, _, _, robot) = fitted();
+        let template = UrdfTemplate::Plain { nominal: Some((&robot, "column_arm.urdf")) };
+        let export = export_urdf(&model, template, None, &NominalTolerance::default()).unwrap();
+        assert!(export.text.contains("<limit lower=\"0.0\" upper=\"1.6666666666666667\""), "{}", export.text);
+        assert!(export.text.contains("<mimic joint=\"joint_1\" multiplier=\"2.0\" offset=\"0\"/>"), "{}", export.text);
+        let tracker = read_back(&export.text, "tracker", "tool");
+        let difference = largest_difference_m(&tracker, &model.kinematics);
+        assert!(difference < 1e-9, "{difference:e}");
+    }
+}
