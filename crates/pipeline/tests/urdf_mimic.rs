@@ -318,7 +318,7 @@ mod export {
     use poe::LocalPoe;
 
     /// A poe fit of the column arm on simulated data (noise only) and the URDF text.
-    fn fitted() -> (pipeline::CalibratedModel, pipeline::FitReport, String, RobotDescription) {
+    pub(super) fn fitted() -> (pipeline::CalibratedModel, pipeline::FitReport, String, RobotDescription) {
         let text = std::fs::read_to_string(fixture("column_arm.urdf")).unwrap();
         let robot = chain(&text, &ChainEnds::default()).description();
         let cell = simulated::simulated_cell(&robot, &Perturbation::default(), 7).unwrap();
@@ -391,4 +391,57 @@ mod export {
         let difference = largest_difference_m(&tracker, &model.kinematics);
         assert!(difference < 1e-9, "{difference:e}");
     }
+}
+
+/// A robot file whose column moves three times its joint value, like the folded column.
+const SCALED_RON: &str = "Robot(
+    name: \"column\",
+    joints: [
+        (kind: Prismatic, axis: (0.0, 0.0, 1.0), point: (0.0, 0.0, 0.0), limits_m: (0.0, 0.8), scale: 3.0),
+        (kind: Revolute, axis: (0.0, 0.0, 1.0), point: (0.0, 0.0, 1.5), limits_deg: (-180.0, 180.0)),
+    ],
+    flange: (position: (0.5, 0.0, 1.5), x_axis: (1.0, 0.0, 0.0), z_axis: (0.0, 0.0, 1.0)),
+)";
+
+#[test]
+fn a_robot_file_may_give_a_joint_scale_and_a_scale_out_of_bounds_is_refused_at_it() {
+    let robot = RobotDescription::parse(SCALED_RON, "column.ron").unwrap_or_else(|e| panic!("{e}"));
+    let flange = robot.nominal_model().unwrap().forward(&[0.5, 0.0], 0).unwrap();
+    assert!((flange.translation() - Vector3::new(0.5, 0.0, 3.0)).norm() < 1e-12, "{}", flange.translation());
+    for bad in ["0.0", "-3.0", "1e9", "inf"] {
+        let text = SCALED_RON.replace("scale: 3.0", &format!("scale: {bad}"));
+        match RobotDescription::parse(&text, "column.ron") {
+            Err(Error::RonFormat { line, column, message, .. }) => {
+                assert_eq!((line, column), position_of(&text, &format!("scale: {bad}")), "{bad}: {message}");
+                assert!(message.contains("joint 1: scale"), "{message}");
+            }
+            other => panic!("{bad}: {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn a_model_file_with_a_scale_out_of_bounds_is_refused_at_it() {
+    let (model, _, _, _) = export::fitted();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("model.ron");
+    pipeline::write_model(&path, &model).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert_eq!(text.matches("scale: 3.0").count(), 1, "written once, for joint 1 alone");
+    assert_eq!(pipeline::parse_model(&text, "model.ron").unwrap().kinematics.joints()[0].scale, 3.0);
+    let broken = text.replace("scale: 3.0", "scale: 0.0");
+    let (line, column) = position_of(&broken, "scale: 0.0");
+    match pipeline::parse_model(&broken, "model.ron") {
+        Err(Error::RonFormat { line: l, column: c, message, .. }) => {
+            assert_eq!((l, c), (line, column), "{message}");
+            assert!(message.contains("scale is 0e0"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// The 1-based line and column of the first `needle` in `text`.
+fn position_of(text: &str, needle: &str) -> (usize, usize) {
+    let before = &text[..text.find(needle).expect("the needle")];
+    (before.matches('\n').count() + 1, before.rsplit('\n').next().unwrap_or("").chars().count() + 1)
 }
