@@ -184,6 +184,9 @@ fn summarise(
     for direction in &id.unidentifiable {
         let _ = writeln!(out, "    unidentifiable: {direction}");
     }
+    for folded in &report.folded {
+        let _ = writeln!(out, "    unidentifiable (mimic joints folded): {folded}");
+    }
     let _ = writeln!(
         out,
         "  iterations: {} ({}; cost {:.6e}, gradient cosine {:.1e})",

@@ -34,6 +34,12 @@ pub struct FitReport {
     /// per iteration, why it stopped (`termination`, `converged`, `final_cost`,
     /// `gradient_cosine`), rank, condition number, the unidentifiable directions in words.
     pub identification: IdentificationReport,
+    /// The joints that stand for several URDF joints moved by one motor (mimic joints folded
+    /// into the joint they follow): what the folding made unobservable, in addition to
+    /// `identification.unidentifiable` — only the stages' summed motion is seen, not how it splits
+    /// between them.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub folded: Vec<crate::FoldedJoint>,
     /// The effects identified with the geometry, their parameters by name.
     pub effects: Vec<EffectReport>,
     /// The GP stage's report, for the GP methods: its hyperparameters.
@@ -279,6 +285,7 @@ pub fn fit(
         before,
         after,
         identification,
+        folded: robot.folded.clone(),
         effects: effect_report,
         compensation,
         auto,

@@ -39,6 +39,7 @@ mod training_range;
 mod urdf_chain;
 mod urdf_export;
 mod urdf_like;
+mod urdf_mimic;
 mod xml_outline;
 
 pub use base_frame::{NominalTolerance, axis_changes, check_nominal, in_base_frame, tracker_from_base};
@@ -70,10 +71,11 @@ pub use model_parts::Part;
 pub use outliers::{OutlierLine, list_lines};
 pub use output_file::{FileKind, MAX_SYMLINKS, OutputFile, output_target, write_file};
 pub use plausibility::{PlausibilityOptions, PlausibilityReport};
-pub use robot::{FlangeDescription, JointDescription, JointType, RobotDescription};
+pub use robot::{FlangeDescription, FoldedJoint, JointDescription, JointType, MimicStage, RobotDescription};
 pub use robot_dh::{DhTable, DhTableRow};
 pub use training_range::{OutOfRangeWarning, TrainingRange};
 pub use urdf_chain::{ChainEnds, ChainStep, StepMotion, UrdfChain, UrdfDocument};
 pub use urdf_export::{
     AxisChange, PartError, TrainingErrors, UrdfExport, UrdfExportReport, UrdfTemplate, export_urdf, write_urdf,
 };
+pub use urdf_mimic::{ChainJoint, StepMimic};

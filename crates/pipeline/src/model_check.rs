@@ -94,6 +94,14 @@ impl CalibratedModel {
             let field = if k < n { format!("kinematics.joints[{k}]") } else { format!("kinematics.tools[{}]", k - n) };
             return Err(at.value(("translation", k), field, value));
         }
+        // A scale is written only where it is not 1, so its occurrence counts those before it.
+        let scales = self.kinematics.joints().iter().map(|j| j.scale).filter(|s| *s != 1.0);
+        if let Some((k, scale)) = scales.enumerate().find(|(_, s)| !crate::robot::scale_in_bounds(*s)) {
+            let (lo, hi) = crate::robot::SCALE_BOUNDS;
+            let (line, column) = at.at("scale", k);
+            let message = format!("a joint's scale is {scale:e}, expected a finite number from {lo:e} to {hi:e}");
+            return Err(Error::RonFormat { file: file.to_owned(), line, column, message });
+        }
         if self.tools.len() != tool_count {
             return Err(at.count(("tools", 0), "tools".into(), "tool names", self.tools.len(), tool_count));
         }

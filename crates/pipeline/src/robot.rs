@@ -36,6 +36,75 @@ pub struct JointDescription {
     /// Limits of a prismatic joint, metres.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub limits_m: Option<(f64, f64)>,
+    /// Radians (metres) the joint moves per unit of its value, 1 unless given: the summed motion
+    /// of the stages one motor drives, where a URDF's mimic joints are folded into their actuated
+    /// joint ([`FoldedJoint`]). The limits are the joint value's.
+    #[serde(default = "unit_scale", skip_serializing_if = "is_unit_scale")]
+    pub scale: f64,
+}
+
+fn unit_scale() -> f64 {
+    1.0
+}
+
+#[allow(clippy::trivially_copy_pass_by_ref)] // serde's `skip_serializing_if` passes a reference
+fn is_unit_scale(scale: &f64) -> bool {
+    *scale == 1.0
+}
+
+/// The range of a joint's `scale`: no stage train moves a thousand times its motor's travel, or a
+/// thousandth of it; beyond these a scale is a typing error, and one near 0 a joint that does not move.
+pub(crate) const SCALE_BOUNDS: (f64, f64) = (1e-3, 1e3);
+
+/// Whether a scale is finite and within [`SCALE_BOUNDS`].
+pub(crate) fn scale_in_bounds(scale: f64) -> bool {
+    scale.is_finite() && (SCALE_BOUNDS.0..=SCALE_BOUNDS.1).contains(&scale)
+}
+
+/// A URDF joint that follows the actuated joint of a folded joint (`<mimic>`), as written there.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MimicStage {
+    /// The URDF joint's name.
+    pub joint: String,
+    /// Its `multiplier`.
+    pub multiplier: f64,
+    /// Its `offset` (radians or metres), folded into the fixed transforms.
+    pub offset: f64,
+}
+
+/// A joint of the description that stands for several URDF joints moved by one motor: an actuated
+/// joint and the mimic joints that follow it, separated by fixed joints only, whose motions add
+/// (parallel translations, or rotations about one line). Only the sum of their motions is seen:
+/// how it splits between the stages cannot be identified.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FoldedJoint {
+    /// The description's joint, 1-based.
+    pub joint: usize,
+    /// The actuated URDF joint: the joint value is its value.
+    pub actuated: String,
+    /// The URDF joints that follow it.
+    pub stages: Vec<MimicStage>,
+    /// The summed motion per unit of the joint value (the joint's `scale`).
+    pub scale: f64,
+}
+
+impl std::fmt::Display for FoldedJoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let stages: Vec<String> =
+            self.stages.iter().map(|s| format!("'{}' (multiplier {})", s.joint, s.multiplier)).collect();
+        write!(
+            f,
+            "joint {} is URDF joint '{}' with its mimic joint(s) {}, together moving {} times the joint value: only \
+             their summed motion is observed, how it splits between the stages (and each stage's own axis) cannot \
+             be identified; the calibration corrects the combined axis, the multipliers are kept as written",
+            self.joint,
+            self.actuated,
+            stages.join(", "),
+            self.scale
+        )
+    }
 }
 
 /// The flange at the zero configuration: its origin and two of its axes, base frame.
@@ -66,6 +135,9 @@ pub struct RobotDescription {
     /// Link masses, centres of mass and joint stiffness, for the load model.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dynamics: Option<loadsim::RobotDynamics>,
+    /// The joints that fold a URDF's mimic joints into their actuated joint (empty for a RON file).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub folded: Vec<FoldedJoint>,
 }
 
 /// The robot file as written: the kinematics as zero-configuration axes (`joints` and `flange`) or
@@ -106,7 +178,14 @@ impl RobotFile {
                 (joints, self.flange.unwrap_or(last_frame))
             }
         };
-        Ok(RobotDescription { name: self.name, joints, flange, tool: self.tool, dynamics: self.dynamics })
+        Ok(RobotDescription {
+            name: self.name,
+            joints,
+            flange,
+            tool: self.tool,
+            dynamics: self.dynamics,
+            folded: Vec::new(),
+        })
     }
 }
 
@@ -185,6 +264,13 @@ impl RobotDescription {
             let norm = Vector3::from(joint.axis).norm();
             if (norm - 1.0).abs() > UNIT_TOLERANCE {
                 return Err(at("axis", i, format!("joint {}: axis has norm {norm}, expected 1", i + 1)));
+            }
+            if !scale_in_bounds(joint.scale) {
+                let (lo, hi) = SCALE_BOUNDS;
+                let message =
+                    format!("joint {}: scale {:e} must be a finite number from {lo:e} to {hi:e}", i + 1, joint.scale);
+                let before = self.joints[..i].iter().filter(|j| j.scale != 1.0).count();
+                return Err(at("scale", before, message));
             }
             if !joint.axis.iter().chain(&joint.point).all(|v| v.is_finite()) {
                 return Err(at("axis", i, format!("joint {}: axis or point is not finite", i + 1)));
@@ -319,6 +405,9 @@ impl RobotDescription {
     /// tool point if the description has one.
     pub fn nominal_model(&self) -> Result<LocalPoe, Error> {
         let mut model = LocalPoe::from_zero_configuration(&self.joint_axes(), self.base_from_flange_zero())?;
+        for (joint, description) in model.joints_mut().iter_mut().zip(&self.joints) {
+            joint.scale = description.scale;
+        }
         if let Some(tool) = self.tool {
             let flange = model.tools()[0];
             model.set_tools(vec![flange * SE3::from_translation(Vector3::from(tool))]);

@@ -120,6 +120,7 @@ impl DhTable {
                     point: frame.translation().into(),
                     limits_deg: row.limits_deg,
                     limits_m: row.limits_m,
+                    scale: 1.0,
                 }
             })
             .collect();

@@ -6,8 +6,10 @@
 //! most movable joints on the way down from the base (or from the link the base hangs from by
 //! fixed joints); several such leaves are ambiguous and need `--tip-link`. The chain may run up
 //! through fixed joints (a base link below the root, such as the ROS-Industrial `base` frame),
-//! never through a movable joint backwards.
+//! never through a movable joint backwards. Mimic joints are folded into the joint that drives
+//! them where their motions add (`urdf_mimic.rs`).
 
+use crate::urdf_mimic::{ChainJoint, StepMimic, fold, folded_joint};
 use crate::xml_outline::{Element, Position, outline};
 use crate::{Error, FlangeDescription, JointDescription, JointType, RobotDescription};
 use lie::{SE3, SO3, Vector3};
@@ -57,6 +59,8 @@ pub struct ChainStep {
     pub from_to: SE3,
     /// Unit axis of a movable joint in `to_link`'s frame.
     pub axis: Vector3,
+    /// The joint this one follows (`<mimic>`), for a movable joint.
+    pub mimic: Option<StepMimic>,
 }
 
 /// The chain between two links of a URDF.
@@ -70,6 +74,8 @@ pub struct UrdfChain {
     pub tip_link: String,
     /// The joints from the base link to the tip link.
     pub steps: Vec<ChainStep>,
+    /// The description's joints: each actuated joint with the mimic joints folded into it.
+    pub joints: Vec<ChainJoint>,
 }
 
 /// A parsed URDF with the positions of its elements.
@@ -283,7 +289,16 @@ impl UrdfDocument {
                 format!("no movable joint between base link '{base}' and tip link '{tip}'"),
             ));
         }
-        Ok(UrdfChain { robot_name: self.robot.name.clone(), base_link: base, tip_link: tip, steps })
+        let frames = link_frames(&steps);
+        let defined = |name: &str| self.element("joint", name).is_some();
+        let joints = fold(&steps, &frames, &defined).map_err(|refusal| {
+            let name = &steps[refusal.step].joint;
+            let element = self.element("joint", name);
+            let (line, column) =
+                element.and_then(|e| e.child("mimic")).or(element).map_or(self.outline.position, |e| e.position);
+            self.at((line, column), format!("mimic joint '{name}': {}", refusal.message))
+        })?;
+        Ok(UrdfChain { robot_name: self.robot.name.clone(), base_link: base, tip_link: tip, steps, joints })
     }
 
     fn root_link(&self) -> Result<String, Error> {
@@ -362,6 +377,25 @@ impl UrdfDocument {
             return Err(refuse("origin and axis must be finite".into()));
         }
         let has_limit = self.element("joint", &joint.name).is_some_and(|e| e.child("limit").is_some());
+        let mimic = match (&joint.mimic, joint.joint_type == urdf_rs::JointType::Fixed) {
+            (Some(m), false) => {
+                let (multiplier, offset) = (m.multiplier.unwrap_or(1.0), m.offset.unwrap_or(0.0));
+                if !(multiplier.is_finite() && offset.is_finite()) {
+                    let element = self.element("joint", &joint.name).and_then(|e| e.child("mimic"));
+                    return Err(self.at(
+                        element.map_or(self.outline.position, |e| e.position),
+                        format!(
+                            "joint '{}': mimic multiplier {multiplier} and offset {offset} must be finite",
+                            joint.name
+                        ),
+                    ));
+                }
+                Some(StepMimic { joint: m.joint.clone(), multiplier, offset })
+            }
+            _ => None,
+        };
+        // A mimic joint's limits are its motor's: where it has none, it takes the followed joint's.
+        let unlimited_mimic = mimic.is_some() && !has_limit;
         let (lower, upper) = (joint.limit.lower, joint.limit.upper);
         let limits = || -> Result<(f64, f64), String> {
             if !has_limit {
@@ -391,7 +425,9 @@ impl UrdfDocument {
             T::Revolute if has_limit && lower == f64::NEG_INFINITY && upper == f64::INFINITY => {
                 StepMotion::Revolute { limits_rad: None }
             }
+            T::Revolute if unlimited_mimic => StepMotion::Revolute { limits_rad: None },
             T::Revolute => StepMotion::Revolute { limits_rad: Some(limits().map_err(refuse)?) },
+            T::Prismatic if unlimited_mimic => StepMotion::Prismatic { limits_m: (f64::NEG_INFINITY, f64::INFINITY) },
             T::Prismatic => StepMotion::Prismatic { limits_m: limits().map_err(refuse)? },
             ref other => {
                 return Err(refuse(format!(
@@ -400,9 +436,6 @@ impl UrdfDocument {
                 )));
             }
         };
-        if motion != StepMotion::Fixed && joint.mimic.is_some() {
-            return Err(refuse("mimic joints cannot be calibrated".into()));
-        }
         if motion != StepMotion::Fixed && reversed {
             return Err(refuse(format!(
                 "the chain from '{base}' to '{tip}' runs through this movable joint from child to parent; choose a base link above it"
@@ -431,6 +464,7 @@ impl UrdfDocument {
             // Scaled by its largest component before normalising: `0 -1e308 1` overflowed the norm
             // into a NaN axis (found by `cargo xtask fuzz`).
             axis: if motion == StepMotion::Fixed { Vector3::z() } else { (axis / axis.amax()).normalize() },
+            mimic,
         })
     }
 }
@@ -471,30 +505,39 @@ fn line_column(text: &str, offset: usize) -> Position {
     (line, column)
 }
 
+/// `base_from_link` at the zero configuration of every step's `to_link`, in chain order: the
+/// actuated joints at zero, the mimic joints at their offsets.
+fn link_frames(steps: &[ChainStep]) -> Vec<SE3> {
+    let mut frame = SE3::identity();
+    steps
+        .iter()
+        .map(|step| {
+            frame = frame * step.from_to * step.zero_motion();
+            frame
+        })
+        .collect()
+}
+
 impl UrdfChain {
-    /// `base_from_link` at the zero configuration of every step's `to_link`, in chain order.
+    /// `base_from_link` at the zero configuration of every step's `to_link`, in chain order (the
+    /// actuated joints at zero, the mimic joints at their offsets).
     pub fn link_frames(&self) -> Vec<SE3> {
-        let mut frame = SE3::identity();
-        self.steps
-            .iter()
-            .map(|step| {
-                frame = frame * step.from_to;
-                frame
-            })
-            .collect()
+        link_frames(&self.steps)
     }
 
-    /// Number of movable joints.
+    /// Number of joints: the movable joints but those folded into the joint they follow.
     pub fn joint_count(&self) -> usize {
-        self.steps.iter().filter(|s| s.motion != StepMotion::Fixed).count()
+        self.joints.len()
     }
 
-    /// The chain as a robot description: each movable joint's axis and a point on it (its child
+    /// The chain as a robot description: each joint's axis (the summed motion's direction, with
+    /// its `scale`, where mimic joints are folded in) and a point on it (its actuated joint's child
     /// link's origin) in the base link's frame at the zero configuration, the tip link as the flange.
     pub fn description(&self) -> RobotDescription {
         let frames = self.link_frames();
         let mut joints = Vec::new();
-        for (step, frame) in self.steps.iter().zip(&frames) {
+        for joint in &self.joints {
+            let (step, frame) = (&self.steps[joint.actuated], frames[joint.actuated]);
             let (kind, limits_deg, limits_m) = match step.motion {
                 StepMotion::Fixed => continue,
                 StepMotion::Revolute { limits_rad } => {
@@ -502,15 +545,17 @@ impl UrdfChain {
                 }
                 StepMotion::Prismatic { limits_m } => (JointType::Prismatic, None, Some(limits_m)),
             };
-            let axis = frame.rotation().act(&step.axis);
             joints.push(JointDescription {
                 kind,
-                axis: axis.into(),
+                axis: joint.direction.into(),
                 point: frame.translation().into(),
                 limits_deg,
                 limits_m,
+                scale: joint.scale,
             });
         }
+        let folded =
+            self.joints.iter().enumerate().filter_map(|(i, joint)| folded_joint(i, joint, &self.steps)).collect();
         let flange = frames.last().copied().unwrap_or_else(SE3::identity);
         let rotation = flange.rotation().matrix();
         RobotDescription {
@@ -523,6 +568,7 @@ impl UrdfChain {
             },
             tool: None,
             dynamics: None,
+            folded,
         }
     }
 }

@@ -22,7 +22,8 @@ use std::path::Path;
 #[derive(Debug, Clone, Copy)]
 pub enum UrdfTemplate<'a> {
     /// A URDF of our own: links `base_link`, `link_1` … `link_n`; joints `joint_1` … `joint_n`
-    /// with the nominal description's limits, if one is given (its base frame is used; without
+    /// (a joint of scale ≠ 1 followed by `joint_i_stage` on its axis, a mimic joint of multiplier
+    /// `scale − 1`, through a link `link_i_drive`) with the nominal description's limits, if one is given (its base frame is used; without
     /// one the base frame is the calibrated joint 1 frame and revolute joints are continuous).
     Plain {
         /// The nominal description and its file name.
@@ -262,8 +263,15 @@ fn write_plain(
         if limits.is_some() { "joint 1 as the nominal description places it" } else { "the calibrated joint 1 frame" }
     );
     let _ = writeln!(text, "<robot name=\"{}\">", escape(name));
+    // A joint that moves `scale` ≠ 1 per unit of its value (folded mimic stages) is written as a
+    // joint to an intermediate link and a mimic stage on the same axis with multiplier
+    // `scale − 1`: the motions about (along) one line add, so the pair moves as the model's joint.
+    let drive = |i: usize| format!("link_{}_drive", i + 1);
     for i in 0..=n {
         let _ = writeln!(text, "  <link name=\"{}\"/>", link(i));
+        if i < n && in_base.joints()[i].scale != 1.0 {
+            let _ = writeln!(text, "  <link name=\"{}\"/>", drive(i));
+        }
     }
     for tool in tool_links.iter().map(String::as_str).chain(["tracker"]) {
         let _ = writeln!(text, "  <link name=\"{}\"/>", escape(tool));
@@ -276,18 +284,43 @@ fn write_plain(
             (JointKind::Prismatic, Some(_)) => "prismatic",
             (JointKind::Prismatic, None) => return Err(Error::PrismaticWithoutLimits { joint: i + 1 }),
         };
+        let staged = joint.scale != 1.0;
         let _ = writeln!(
             text,
             "  <joint name=\"joint_{}\" type=\"{kind}\">\n    <parent link=\"{}\"/>\n    <child link=\"{}\"/>\n    {}\n    <axis xyz=\"0 0 1\"/>",
             i + 1,
             link(i),
-            link(i + 1),
+            if staged { drive(i) } else { link(i + 1) },
             origin_element(&joint.previous_from_joint_zero)
         );
         if let Some((lower, upper)) = bounds {
             let _ = writeln!(text, "    <limit lower=\"{lower:?}\" upper=\"{upper:?}\" effort=\"0\" velocity=\"0\"/>");
         }
         let _ = writeln!(text, "  </joint>");
+        if staged {
+            let multiplier = joint.scale - 1.0;
+            let _ = writeln!(
+                text,
+                "  <joint name=\"joint_{}_stage\" type=\"{kind}\">\n    <parent link=\"{}\"/>\n    <child link=\"{}\"/>\n    <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n    <axis xyz=\"0 0 1\"/>",
+                i + 1,
+                drive(i),
+                link(i + 1)
+            );
+            if let Some((lower, upper)) = bounds {
+                let (a, b) = (lower * multiplier, upper * multiplier);
+                let _ = writeln!(
+                    text,
+                    "    <limit lower=\"{:?}\" upper=\"{:?}\" effort=\"0\" velocity=\"0\"/>",
+                    a.min(b),
+                    a.max(b)
+                );
+            }
+            let _ = writeln!(
+                text,
+                "    <mimic joint=\"joint_{}\" multiplier=\"{multiplier:?}\" offset=\"0\"/>\n  </joint>",
+                i + 1
+            );
+        }
     }
     for (tool, link_name) in in_base.tools().iter().zip(tool_links) {
         fixed_joint(&mut text, "  ", &link(n), link_name, tool);

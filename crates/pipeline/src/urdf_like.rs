@@ -8,6 +8,11 @@
 //! `W_i(q) = P_i(q) D_i`. The calibrated link frame is `W'_i = P'_i D_i`: visuals and inertias stay
 //! on their link, the joint axis in the link frame is unchanged, and the joint origin becomes
 //! `W'_parent⁻¹ W'_i`, where fixed joints on the chain keep their nominal origins.
+//!
+//! Mimic joints folded into their actuated joint (`urdf_mimic.rs`) keep their origins, axes and
+//! `<mimic>` elements: the stages after the actuated joint's child link move with the folded
+//! joint's POE frame as `W_k(q) = P_i(q) D_k`, so the correction on the actuated joint's origin
+//! carries them exactly, and the multipliers stay as written.
 
 use crate::urdf_export::{Written, escape, fixed_joint, origin_element};
 use crate::{Error, StepMotion, UrdfChain, UrdfDocument};
@@ -27,8 +32,8 @@ fn free_link_name(document: &UrdfDocument, name: &str) -> String {
 /// Refuses a model whose joint kinds differ from the URDF chain's, at the first such `<joint>`:
 /// the written file keeps the URDF's joint types, which would not be the model's.
 pub(crate) fn check_joint_kinds(document: &UrdfDocument, chain: &UrdfChain, model: &[JointKind]) -> Result<(), Error> {
-    let movable = chain.steps.iter().filter(|s| s.motion != StepMotion::Fixed);
-    for (k, (step, &model_kind)) in movable.zip(model).enumerate() {
+    let actuated = chain.joints.iter().map(|j| &chain.steps[j.actuated]);
+    for (k, (step, &model_kind)) in actuated.zip(model).enumerate() {
         let urdf_kind = match step.motion {
             StepMotion::Prismatic { .. } => JointKind::Prismatic,
             StepMotion::Revolute { .. } | StepMotion::Fixed => JointKind::Revolute,
@@ -66,10 +71,28 @@ pub(crate) fn write_like(
     let mut calibrated_link = SE3::identity();
     let mut last: Option<(String, SE3)> = None;
     let mut joint_names = Vec::new();
+    // The description's joint of each step: its actuated joint's, or that of the joint it follows.
+    let mut joint_of: Vec<Option<usize>> = vec![None; chain.steps.len()];
+    for (i, joint) in chain.joints.iter().enumerate() {
+        for &k in std::iter::once(&joint.actuated).chain(&joint.stages) {
+            if let Some(slot) = joint_of.get_mut(k) {
+                *slot = Some(i);
+            }
+        }
+    }
     let mut movable = 0;
-    for (step, nominal_link) in chain.steps.iter().zip(&link_frames) {
+    for ((step, nominal_link), joint) in chain.steps.iter().zip(&link_frames).zip(&joint_of) {
         if step.motion == StepMotion::Fixed {
             calibrated_link = calibrated_link * step.from_to;
+            continue;
+        }
+        if step.mimic.is_some() {
+            // A stage keeps its origin; the tools hang from the last one the chain reaches.
+            calibrated_link = calibrated_link * step.from_to * step.zero_motion();
+            let Some(i) = *joint else {
+                return Err(document.error_at("joint", &step.joint, format!("joint '{}' is not folded", step.joint)));
+            };
+            last = Some((step.to_link.clone(), nominal_frames[i].inverse() * *nominal_link));
             continue;
         }
         let link_in_poe = nominal_frames[movable].inverse() * *nominal_link;

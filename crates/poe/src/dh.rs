@@ -56,7 +56,7 @@ impl LocalPoe {
             DhConvention::Standard => {
                 let mut previous = SE3::identity();
                 for row in rows {
-                    joints.push(Joint { kind: row.kind, previous_from_joint_zero: previous });
+                    joints.push(Joint::new(row.kind, previous));
                     previous = rot_z(row.theta) * trans(0.0, row.d) * trans(row.a, 0.0) * rot_x(row.alpha);
                 }
                 previous
@@ -64,7 +64,7 @@ impl LocalPoe {
             DhConvention::Modified => {
                 for row in rows {
                     let local = rot_x(row.alpha) * trans(row.a, 0.0) * rot_z(row.theta) * trans(0.0, row.d);
-                    joints.push(Joint { kind: row.kind, previous_from_joint_zero: local });
+                    joints.push(Joint::new(row.kind, local));
                 }
                 SE3::identity()
             }

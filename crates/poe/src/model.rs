@@ -65,7 +65,7 @@ impl LocalPoe {
             let y = z.cross(&x);
             let rotation = SO3::from_matrix_unchecked(Matrix3::from_columns(&[x, y, z]));
             let reference_from_joint = SE3::new(rotation, axis.point);
-            joints.push(Joint { kind: axis.kind, previous_from_joint_zero: previous.inverse() * reference_from_joint });
+            joints.push(Joint::new(axis.kind, previous.inverse() * reference_from_joint));
             previous = reference_from_joint;
         }
         Ok(Self::new(joints, vec![previous.inverse() * reference_from_flange]))
@@ -151,14 +151,14 @@ impl LocalPoe {
     }
 
     /// The joint twists in the reference frame at joint values `q` (the columns of the spatial
-    /// manipulator Jacobian): `Ad(reference_from_joint_i) s_i`, with joint `i`'s frame taken
-    /// before its own motion (which leaves its axis unchanged).
+    /// manipulator Jacobian): `Ad(reference_from_joint_i) s_i · scale_i`, with joint `i`'s frame
+    /// taken before its own motion (which leaves its axis unchanged).
     pub fn spatial_twists(&self, q: &[f64]) -> Result<Vec<Twist>, Error> {
         Ok(self
             .frames(q)?
             .iter()
             .zip(&self.joints)
-            .map(|(frame, joint)| Twist::from_vector(&(frame.adjoint() * joint.kind.local_twist().to_vector())))
+            .map(|(frame, joint)| Twist::from_vector(&(frame.adjoint() * joint.local_twist().to_vector())))
             .collect())
     }
 }

@@ -160,3 +160,42 @@ fn from_zero_configuration_refuses_a_non_unit_axis() {
         Err(poe::Error::AxisNotUnit { joint: 0, .. })
     ));
 }
+
+#[test]
+fn a_scaled_joint_moves_as_the_unscaled_joint_at_the_scaled_value() {
+    let (mut scaled, limits) = iiwa7();
+    let (plain, _) = iiwa7();
+    let scales = [1.0, 3.0, 0.5, 1.0, -2.0, 1.0, 1.25];
+    for (joint, &s) in scaled.joints_mut().iter_mut().zip(&scales) {
+        joint.scale = s;
+    }
+    let mut rng = rng(5);
+    for _ in 0..20 {
+        let q = random_q(&mut rng, &limits);
+        let moved: Vec<f64> = q.iter().zip(&scales).map(|(q, s)| q * s).collect();
+        let got = scaled.forward(&q, 0).unwrap();
+        let expected = plain.forward(&moved, 0).unwrap();
+        assert!((got.to_matrix() - expected.to_matrix()).norm() < 1e-12);
+    }
+}
+
+#[test]
+fn the_spatial_twists_of_scaled_joints_are_the_derivatives_of_the_pose() {
+    let (mut model, limits) = iiwa7();
+    for (joint, s) in model.joints_mut().iter_mut().zip([3.0, 1.0, 0.5, 2.0, 1.0, -1.5, 1.0]) {
+        joint.scale = s;
+    }
+    let mut rng = rng(6);
+    let q = random_q(&mut rng, &limits);
+    let twists = model.spatial_twists(&q).unwrap();
+    let h = 1e-6;
+    for (i, twist) in twists.iter().enumerate() {
+        let (mut up, mut down) = (q.clone(), q.clone());
+        up[i] += h;
+        down[i] -= h;
+        // Spatial velocity: log(T(q + h) T(q − h)⁻¹) / 2h.
+        let moved = model.forward(&up, 0).unwrap() * model.forward(&down, 0).unwrap().inverse();
+        let numeric = moved.log().to_vector() / (2.0 * h);
+        assert!((numeric - twist.to_vector()).norm() < 1e-7, "joint {i}: {numeric} against {}", twist.to_vector());
+    }
+}
