@@ -127,6 +127,16 @@ pub struct GpConfig {
     /// extra hyperparameters and `N` observed values. Off by default in the library; the
     /// calibration's GP stage turns it on (see `pipeline::CompensationOptions`).
     pub additive_by_bic: bool,
+    /// Also fit the paper's isotropic Eq. 5 kernel ([`crate::QuadraticKernel`]: one length scale,
+    /// a constant and a linear term) for each kernel (output or shared group) and keep it where its
+    /// closed-form leave-one-out log predictive probability (R&W Eq. 5.11) beats the searched
+    /// kernel's: a criterion that sees a kernel with many length scales overfit a few hundred
+    /// poses, which its marginal likelihood does not. With a warm-start subset the isotropic
+    /// kernel is searched there, compared on all rows at the subset's optimum, and searched on
+    /// all rows only when it wins there. Off by default in the library; the calibration's GP
+    /// stage turns it on.
+    #[serde(default)]
+    pub isotropic_by_loo: bool,
 }
 
 impl Default for GpConfig {
@@ -141,6 +151,7 @@ impl Default for GpConfig {
             jitter: JitterConfig::default(),
             parallelism: Parallelism::default(),
             additive_by_bic: false,
+            isotropic_by_loo: false,
         }
     }
 }

@@ -9,8 +9,10 @@ use crate::Error;
 use crate::cholesky::{Factor, JitterOutcome};
 use crate::config::{GpConfig, OutputMode, Parallelism};
 use crate::gram::training_covariance;
+use crate::kernel::KernelChoice;
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::lml::check_finite_outputs;
+use crate::loo::{inverse_diagonal, log_predictive};
 use crate::optimise::{OptimisationReport, finish, fit_hyperparameters, warm_stage};
 use crate::points::Points;
 use crate::scaling::{InputStandardiser, OutputNormaliser};
@@ -73,6 +75,25 @@ pub struct ComponentReport {
     /// ([`GpConfig::additive_by_bic`]; `None` when it was not made).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub additive_choice: Option<AdditiveChoice>,
+    /// The choice between the searched kernel and the paper's isotropic Eq. 5 kernel
+    /// ([`GpConfig::isotropic_by_loo`]; `None` when it was not made, as in files written before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub isotropic_choice: Option<IsotropicChoice>,
+}
+
+/// The leave-one-out choice between the searched kernel and the paper's isotropic Eq. 5 kernel.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IsotropicChoice {
+    /// Leave-one-out log predictive probability (R&W Eq. 5.11, normalised outputs, summed over the
+    /// rows and the outputs served) of the searched kernel.
+    pub searched: f64,
+    /// The same for the isotropic Eq. 5 kernel, at the hyperparameters it was compared with.
+    pub isotropic: f64,
+    /// Whether the isotropic kernel was kept (`isotropic > searched`).
+    pub kept_isotropic: bool,
+    /// Rows on which the isotropic kernel's hyperparameters compared above were searched: the
+    /// warm-start subset where the comparison there already lost, else all rows.
+    pub isotropic_search_rows: usize,
 }
 
 /// The Schwarz (BIC) choice between a kernel with an additive term and the same kernel without.
@@ -173,10 +194,11 @@ impl ExactGp {
                 jitter,
                 optimisation,
                 additive_choice: None,
+                isotropic_choice: None,
             };
             Ok::<_, Error>((component, report))
         };
-        let fit_group = |(g, cols): (usize, &Vec<usize>)| -> Result<(Component, ComponentReport), Error> {
+        let fit_searched = |(g, cols): (usize, &Vec<usize>)| -> Result<(Component, ComponentReport), Error> {
             let yg = Mat::from_fn(n, cols.len(), |i, c| yn[(i, cols[c])]);
             let start = match &how {
                 Hyperparameters::Fixed(kernels) => {
@@ -236,6 +258,46 @@ impl ExactGp {
             let (component, mut report) = if choice.kept { with } else { without };
             report.additive_choice = Some(choice);
             Ok((component, report))
+        };
+        // The paper's Eq. 5 beside the searched kernel, kept where it predicts the rows it has not
+        // seen better (leave-one-out, R&W Eq. 5.11).
+        let loo =
+            |c: &Component| -> f64 { log_predictive(c, &inverse_diagonal(c, config.parallelism.faer())).iter().sum() };
+        let fit_group = |(g, cols): (usize, &Vec<usize>)| -> Result<(Component, ComponentReport), Error> {
+            let searched = fit_searched((g, cols))?;
+            let optimised = matches!(how, Hyperparameters::Optimise(_));
+            if !config.isotropic_by_loo || !optimised || matches!(searched.1.kernel, Kernel::Quadratic(_)) {
+                return Ok(searched);
+            }
+            let yg = Mat::from_fn(n, cols.len(), |i, c| yn[(i, cols[c])]);
+            let start = Kernel::start(KernelChoice::Quadratic, xs.dim());
+            let bounds = start.default_bounds();
+            let searched_loo = loo(&searched.0);
+            let choose = |searched: (Component, ComponentReport), isotropic: (Component, ComponentReport), rows| {
+                let isotropic_loo = loo(&isotropic.0);
+                let kept_isotropic = isotropic_loo > searched_loo;
+                let choice = IsotropicChoice {
+                    searched: searched_loo,
+                    isotropic: isotropic_loo,
+                    kept_isotropic,
+                    isotropic_search_rows: rows,
+                };
+                let (component, mut report) = if kept_isotropic { isotropic } else { searched };
+                report.isotropic_choice = Some(choice);
+                (component, report)
+            };
+            let stage = warm_stage(&start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism)?;
+            if let Some(stage) = &stage {
+                // The subset's optimum compared on all rows first: a full search only when the
+                // isotropic kernel already predicts better from there.
+                let at_subset = build(stage.best_kernel(&start)?, cols, yg.as_ref(), None)?;
+                if loo(&at_subset.0) <= searched_loo {
+                    return Ok(choose(searched, at_subset, stage.rows()));
+                }
+            }
+            let o = finish(&start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism, stage)?;
+            let isotropic = build(o.kernel, cols, yg.as_ref(), Some(o.report))?;
+            Ok(choose(searched, isotropic, n))
         };
         let fitted: Vec<_> = match config.parallelism {
             Parallelism::Sequential => groups.iter().enumerate().map(fit_group).collect(),

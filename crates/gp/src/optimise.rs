@@ -147,6 +147,13 @@ impl WarmStage {
     pub(crate) fn rows(&self) -> usize {
         self.rows
     }
+
+    /// The subset's best optimum as a kernel of `start`'s family.
+    pub(crate) fn best_kernel(&self, start: &Kernel) -> Result<Kernel, Error> {
+        let minimum =
+            self.results[self.best].as_ref().ok_or(Error::OptimisationFailed { starts: self.results.len() })?;
+        start.with_log_parameters(&minimum.x)
+    }
 }
 
 /// The search's box (log-parameters), starting points and settings for `start`.
