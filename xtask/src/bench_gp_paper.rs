@@ -2,8 +2,10 @@
 //! and on the real UR10, same residuals, same run (issue 25).
 //!
 //! - Simulated campaigns of the paper's shape (`calib simulate --robot irb4400.ron --rows 600
-//!   --seed S [--full-pose]`: soft joints, payloads 1–7.5 kg, tracker noise; the first 300 poses
-//!   to train on, the other 300 to test), position only and full pose, one row per seed: the GP
+//!   --seed S [--full-pose]`: joint compliance under the arm's weight and the payload, payloads
+//!   1–7.5 kg, tracker noise; the first 300 poses to train on, the other 300 to test), and the
+//!   same with reproduce-sim's paper-like preset (joints ten times softer, loaded by the payload
+//!   alone), position only and full pose, one row per seed: the GP
 //!   stage of `poe-gp-load` against scikit-learn's `C·RBF + C + DotProduct + White` (the paper's
 //!   isotropic Eq. 5, standardised inputs, 2 restarts) on the position outputs.
 //! - The real UR10, series C, even rows → odd rows, position only and full pose: the GP stage of
@@ -22,8 +24,11 @@ use faer::Mat;
 use gp::{ExactGp, Kernel};
 use pipeline::{CompensationOptions, RobotDescription};
 
+use pipeline::simulated::paper_effects;
+
 use crate::bench_gp_residuals::{Residuals, heldout_mm, real, simulated_campaign};
 use crate::bench_gp_sklearn::{SklearnOptions, available, fit_predict};
+use crate::reproduce_sim::{Preset, robot_for};
 
 /// Arguments of `--paper`.
 #[derive(Debug, Clone, clap::Args)]
@@ -58,10 +63,18 @@ pub fn run(args: &PaperArgs, ur10_data: &std::path::Path) -> Result<String, Stri
     // (residuals, the scikit-learn kernel compared with).
     let mut sets: Vec<(Residuals, bool)> = Vec::new();
     if !args.paper_skip_simulated {
+        let file = PathBuf::from("fixtures/robots/irb4400.ron");
         let irb = robot("irb4400.ron")?;
-        for full_pose in [false, true] {
-            for &seed in &args.paper_seeds {
-                sets.push((simulated_campaign(&irb, seed, 300, 300, full_pose)?, true));
+        let paper_like = robot_for(&irb, Preset::PaperLike, &file)?;
+        let campaigns = [
+            (&irb, paper_effects(), ""),
+            (&paper_like, Preset::PaperLike.effects(), " (reproduce-sim's paper-like joints, payload only)"),
+        ];
+        for (robot, effects, label) in &campaigns {
+            for full_pose in [false, true] {
+                for &seed in &args.paper_seeds {
+                    sets.push((simulated_campaign(robot, effects, label, seed, 300, 300, full_pose)?, true));
+                }
             }
         }
     }

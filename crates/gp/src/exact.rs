@@ -13,7 +13,7 @@ use crate::kernel::KernelChoice;
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::lml::check_finite_outputs;
 use crate::loo::{inverse_diagonal, log_predictive};
-use crate::optimise::{OptimisationReport, finish, fit_hyperparameters, warm_stage};
+use crate::optimise::{OptimisationReport, finish, fit_hyperparameters, refine, warm_stage};
 use crate::points::Points;
 use crate::scaling::{InputStandardiser, OutputNormaliser};
 
@@ -172,8 +172,24 @@ impl ExactGp {
         let outputs = if config.normalise_outputs { OutputNormaliser::fit(y) } else { OutputNormaliser::identity(m) };
         let xs = inputs.apply_points(&raw);
         let yn = outputs.normalise(y);
+        let followers: Vec<Vec<usize>> =
+            if matches!(how, Hyperparameters::Optimise(_)) && config.outputs == OutputMode::Independent {
+                config.follower_groups.clone()
+            } else {
+                Vec::new()
+            };
+        let mut follows = vec![false; m];
+        for &j in followers.iter().flatten() {
+            if j >= m || follows[j] {
+                return Err(Error::InvalidConfig { field: "follower_groups", value: j as f64 });
+            }
+            follows[j] = true;
+        }
+        if followers.iter().any(Vec::is_empty) || (!followers.is_empty() && follows.iter().all(|f| *f)) {
+            return Err(Error::InvalidConfig { field: "follower_groups", value: followers.len() as f64 });
+        }
         let groups: Vec<Vec<usize>> = match config.outputs {
-            OutputMode::Independent => (0..m).map(|j| vec![j]).collect(),
+            OutputMode::Independent => (0..m).filter(|&j| !follows[j]).map(|j| vec![j]).collect(),
             OutputMode::Shared => vec![(0..m).collect()],
         };
         let search = |start: &Kernel, yg: MatRef<'_, f64>| -> Result<(Kernel, OptimisationReport), Error> {
@@ -263,8 +279,9 @@ impl ExactGp {
         // seen better (leave-one-out, R&W Eq. 5.11).
         let loo =
             |c: &Component| -> f64 { log_predictive(c, &inverse_diagonal(c, config.parallelism.faer())).iter().sum() };
-        let fit_group = |(g, cols): (usize, &Vec<usize>)| -> Result<(Component, ComponentReport), Error> {
-            let searched = fit_searched((g, cols))?;
+        let with_isotropic = |searched: (Component, ComponentReport),
+                              cols: &Vec<usize>|
+         -> Result<(Component, ComponentReport), Error> {
             let optimised = matches!(how, Hyperparameters::Optimise(_));
             if !config.isotropic_by_loo || !optimised || matches!(searched.1.kernel, Kernel::Quadratic(_)) {
                 return Ok(searched);
@@ -299,12 +316,42 @@ impl ExactGp {
             let isotropic = build(o.kernel, cols, yg.as_ref(), Some(o.report))?;
             Ok(choose(searched, isotropic, n))
         };
+        let fit_group = |(g, cols): (usize, &Vec<usize>)| with_isotropic(fit_searched((g, cols))?, cols);
         let fitted: Vec<_> = match config.parallelism {
             Parallelism::Sequential => groups.iter().enumerate().map(fit_group).collect(),
             Parallelism::Rayon => groups.par_iter().enumerate().map(fit_group).collect(),
         };
-        let (components, reports): (Vec<_>, Vec<_>) =
-            fitted.into_iter().collect::<Result<Vec<_>, _>>()?.into_iter().unzip();
+        let mut fitted = fitted.into_iter().collect::<Result<Vec<_>, _>>()?;
+        // Each follower group from the fitted kernel that explains it best, refined on all rows.
+        let leaders: Vec<Kernel> = fitted.iter().map(|(_, r)| r.kernel.clone()).collect();
+        let follow = |cols: &Vec<usize>| -> Result<(Component, ComponentReport), Error> {
+            let yg = Mat::from_fn(n, cols.len(), |i, c| yn[(i, cols[c])]);
+            let mut best: Option<(f64, &Kernel)> = None;
+            for kernel in &leaders {
+                let (component, _) =
+                    Component::build(kernel.clone(), cols.clone(), &xs, yg.as_ref(), None, config, config.parallelism)?;
+                let lml = component.log_marginal_likelihood(yg.as_ref());
+                if best.is_none_or(|(b, _)| lml > b) {
+                    best = Some((lml, kernel));
+                }
+            }
+            let start = best.map(|(_, k)| k).ok_or(Error::OptimisationFailed { starts: 0 })?;
+            // The configured box where it is the chosen kernel's (its family may differ: the
+            // isotropic kernel or the form without the additive term).
+            let bounds = config
+                .bounds
+                .clone()
+                .filter(|b| b.lower.len() == start.parameter_count())
+                .unwrap_or_else(|| start.default_bounds());
+            let o = refine(start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism)?;
+            with_isotropic(build(o.kernel, cols, yg.as_ref(), Some(o.report))?, cols)
+        };
+        let followed: Vec<_> = match config.parallelism {
+            Parallelism::Sequential => followers.iter().map(follow).collect(),
+            Parallelism::Rayon => followers.par_iter().map(follow).collect(),
+        };
+        fitted.extend(followed.into_iter().collect::<Result<Vec<_>, _>>()?);
+        let (components, reports): (Vec<_>, Vec<_>) = fitted.into_iter().unzip();
         Ok(Self {
             inputs,
             outputs,

@@ -125,3 +125,49 @@ fn model_without_isotropic_choice_still_reads() {
     let back: ExactGp = serde_json::from_str(&text).expect("read");
     assert_eq!(back.report(), model.report());
 }
+
+/// A follower group whose outputs are the first output scaled (identical once normalised) is
+/// served by one kernel, started from the first output's, and ends at that kernel's likelihood:
+/// the refinement starts at the optimum.
+#[test]
+fn follower_group_starts_from_the_leader_that_explains_it() {
+    let (x, y0) = data(6, 50, 3, 2);
+    let y = Mat::from_fn(50, 4, |i, c| match c {
+        0 | 1 => y0[(i, c)],
+        _ => y0[(i, 0)] * (c as f64) + 1.0,
+    });
+    let config = GpConfig {
+        kernel: KernelChoice::SquaredExponentialArd,
+        follower_groups: vec![vec![2, 3]],
+        ..GpConfig::default()
+    };
+    let model = ExactGp::fit(x.as_ref(), y.as_ref(), &config).expect("fit");
+    let components = &model.report().components;
+    assert_eq!(components.len(), 3);
+    let follower = components.iter().find(|c| c.outputs == vec![2, 3]).expect("one kernel serves the group");
+    let leader = components.iter().find(|c| c.outputs == vec![0]).expect("output 0 alone");
+    let search = follower.optimisation.as_ref().expect("searched");
+    assert_eq!(search.start_log_marginal_likelihoods.len(), 1, "one start: the leader's kernel");
+    // Two copies of output 0: twice its likelihood.
+    let expected = 2.0 * leader.log_marginal_likelihood;
+    assert!(
+        (follower.log_marginal_likelihood - expected).abs() < 1e-3 * expected.abs(),
+        "{} vs {expected}",
+        follower.log_marginal_likelihood
+    );
+}
+
+/// Follower groups that name a column twice, a column that does not exist, no column, or every
+/// column (no leader left) are refused.
+#[test]
+fn invalid_follower_groups_are_refused() {
+    let (x, y) = data(7, 20, 2, 3);
+    for groups in [vec![vec![1, 1]], vec![vec![3]], vec![vec![]], vec![vec![0, 1, 2]], vec![vec![1], vec![1, 2]]] {
+        let config = GpConfig { follower_groups: groups.clone(), ..GpConfig::default() };
+        let result = ExactGp::fit(x.as_ref(), y.as_ref(), &config);
+        assert!(
+            matches!(result, Err(gp::Error::InvalidConfig { field: "follower_groups", .. })),
+            "{groups:?}: {result:?}"
+        );
+    }
+}

@@ -102,6 +102,10 @@ pub struct CompensationOptions {
     pub sparse_kernel: gp::KernelChoice,
     /// Where the error twist is expressed.
     pub residual_frame: ResidualFrame,
+    /// For full-pose data, the three rotation outputs share one kernel, searched once on all rows
+    /// from the position output kernel that explains them best ([`gp::GpConfig::follower_groups`]),
+    /// instead of three searches of their own; the position outputs are fitted as `gp` says.
+    pub rotation_follows_position: bool,
 }
 
 impl Default for CompensationOptions {
@@ -182,6 +186,8 @@ impl Default for CompensationOptions {
             // n·m entries of every bound evaluation.
             sparse_kernel: gp::KernelChoice::SquaredExponentialArd,
             residual_frame: ResidualFrame::default(),
+            // UR10 series C, full pose, even rows → odd rows (issue 25): MEASURED.
+            rotation_follows_position: true,
         }
     }
 }
@@ -209,6 +215,8 @@ struct OptimiserPatch {
     function_tolerance: Option<f64>,
     #[serde(default, deserialize_with = "given")]
     warm_start_rows: Option<usize>,
+    #[serde(default, deserialize_with = "given")]
+    warm_start_curvature: Option<bool>,
 }
 
 /// The fields of [`gp::GpConfig`] an options file may set.
@@ -235,6 +243,8 @@ struct GpPatch {
     additive_by_bic: Option<bool>,
     #[serde(default, deserialize_with = "given")]
     isotropic_by_loo: Option<bool>,
+    #[serde(default, deserialize_with = "given")]
+    follower_groups: Option<Vec<Vec<usize>>>,
 }
 
 /// `gp` as an options file gives it, laid over [`CompensationOptions::default`]'s: derived
@@ -254,6 +264,7 @@ fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<
         parallelism,
         additive_by_bic,
         isotropic_by_loo,
+        follower_groups,
     } = patch;
     gp.kernel = kernel.unwrap_or(gp.kernel);
     gp.bounds = bounds.unwrap_or(gp.bounds);
@@ -264,6 +275,7 @@ fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<
     gp.parallelism = parallelism.unwrap_or(gp.parallelism);
     gp.additive_by_bic = additive_by_bic.unwrap_or(gp.additive_by_bic);
     gp.isotropic_by_loo = isotropic_by_loo.unwrap_or(gp.isotropic_by_loo);
+    gp.follower_groups = follower_groups.unwrap_or(gp.follower_groups);
     if let Some(o) = optimiser {
         let OptimiserPatch {
             restarts,
@@ -273,6 +285,7 @@ fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<
             gradient_tolerance,
             function_tolerance,
             warm_start_rows,
+            warm_start_curvature,
         } = o;
         let d = &mut gp.optimiser;
         d.restarts = restarts.unwrap_or(d.restarts);
@@ -282,6 +295,7 @@ fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<
         d.gradient_tolerance = gradient_tolerance.unwrap_or(d.gradient_tolerance);
         d.function_tolerance = function_tolerance.unwrap_or(d.function_tolerance);
         d.warm_start_rows = warm_start_rows.unwrap_or(d.warm_start_rows);
+        d.warm_start_curvature = warm_start_curvature.unwrap_or(d.warm_start_curvature);
     }
     Ok(gp)
 }
@@ -488,7 +502,11 @@ impl Compensation {
                 (GpModel::Sparse(model), report, None)
             }
             GpChoice::Exact | GpChoice::Auto => {
-                let model = gp::ExactGp::fit(x.as_ref(), y.as_ref(), &options.gp)?;
+                let mut config = options.gp.clone();
+                if data.full_pose && options.rotation_follows_position && config.follower_groups.is_empty() {
+                    config.follower_groups = vec![vec![3, 4, 5]];
+                }
+                let model = gp::ExactGp::fit(x.as_ref(), y.as_ref(), &config)?;
                 let report = GpFitReport::Exact(model.report().clone());
                 let loo = model.leave_one_out()?;
                 (GpModel::Exact(model), report, Some(loo.mean))
