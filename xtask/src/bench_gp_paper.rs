@@ -39,6 +39,9 @@ pub struct PaperArgs {
     /// Skip the simulated campaigns (UR10 only).
     #[arg(long)]
     pub paper_skip_simulated: bool,
+    /// Only the sets whose name contains one of these, separated by `;` (all when none is given).
+    #[arg(long, value_delimiter = ';')]
+    pub paper_only: Vec<String>,
     /// Kill a scikit-learn fit after this many seconds.
     #[arg(long, default_value_t = 900.0)]
     pub paper_sklearn_timeout_s: f64,
@@ -79,13 +82,18 @@ pub fn run(args: &PaperArgs, ur10_data: &std::path::Path) -> Result<String, Stri
         }
     }
     let ur10 = robot("ur10.ron")?;
-    for (name, stem) in [("UR10 C even → odd", "ur10_C"), ("UR10 C even → odd, full pose", "ur10_C_full")] {
+    for (name, stem) in [("UR10 C even → odd", "ur10_C"), ("UR10 C full pose, even → odd", "ur10_C_full")] {
         let (train, test) = (ur10_data.join(format!("{stem}_even.csv")), ur10_data.join(format!("{stem}_odd.csv")));
         if train.exists() && test.exists() {
             sets.push((real(name, &ur10, &train, Some(&test))?, false));
         } else {
             eprintln!("{}: not found, {name} skipped", train.display());
         }
+    }
+    let patterns: Vec<&str> = args.paper_only.iter().map(|p| p.trim()).filter(|p| !p.is_empty()).collect();
+    sets.retain(|(set, _)| patterns.is_empty() || patterns.iter().any(|p| set.name.contains(p)));
+    if sets.is_empty() {
+        return Err(format!("--paper-only {:?} matches no data set", args.paper_only));
     }
     let with_sklearn = available();
     if !with_sklearn {
