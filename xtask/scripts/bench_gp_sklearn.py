@@ -11,6 +11,8 @@ The caller applies the time limit (it kills this process).
 
 Kernel, as a scikit-learn user writes it for this problem:
     C * RBF(length_scale=ones(d))  [ARD]  + C  [+ C * DotProduct(sigma_0=0)]  + WhiteKernel
+or with "isotropic": true the paper's Eq. 5 as the paper's authors wrote it (one length scale):
+    C * RBF(length_scale=1.0) + C + DotProduct + WhiteKernel
 Inputs are standardised with the training mean and population std (as `gp` does); outputs are
 normalised by normalize_y=True. With "independent": true each output column gets its own GP
 (fitted in a pool of "processes" workers), otherwise one GP with shared hyperparameters serves
@@ -28,7 +30,9 @@ from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel as C, DotProduct, WhiteKernel
 
 
-def kernel(d, linear):
+def kernel(d, linear, isotropic):
+    if isotropic:
+        return C(1.0) * RBF(1.0) + C(0.1) + DotProduct() + WhiteKernel(0.01)
     k = C(1.0, (1e-3, 1e2)) * RBF(np.ones(d), (1e-2, 1e3)) + C(0.1, (1e-6, 1e2))
     if linear:
         k = k + C(0.1, (1e-6, 1e2)) * DotProduct(sigma_0=0.0, sigma_0_bounds="fixed")
@@ -36,9 +40,9 @@ def kernel(d, linear):
 
 
 def fit_predict(args):
-    xs, y, xq, linear, restarts = args
+    xs, y, xq, linear, isotropic, restarts = args
     gpr = GaussianProcessRegressor(
-        kernel(xs.shape[1], linear), alpha=1e-10, normalize_y=True, n_restarts_optimizer=restarts, random_state=0
+        kernel(xs.shape[1], linear, isotropic), alpha=1e-10, normalize_y=True, n_restarts_optimizer=restarts, random_state=0
     )
     gpr.fit(xs, y)
     t = time.perf_counter()
@@ -63,16 +67,17 @@ def main():
     std[std == 0.0] = 1.0
     xs, xq = (x - mean) / std, (x_test - mean) / std
     linear, restarts = bool(req["linear"]), int(req["restarts"])
+    isotropic = bool(req.get("isotropic", False))
     t0 = time.perf_counter()
     if req["independent"]:
-        jobs = [(xs, y[:, j], xq, linear, restarts) for j in range(y.shape[1])]
+        jobs = [(xs, y[:, j], xq, linear, isotropic, restarts) for j in range(y.shape[1])]
         with Pool(int(req["processes"])) as pool:
             parts = pool.map(fit_predict, jobs)
         prediction = np.hstack([p[0] for p in parts])
         predict_s = sum(p[1] for p in parts)
         fitted = [p[2] for p in parts]
     else:
-        prediction, predict_s, one = fit_predict((xs, y, xq, linear, restarts))
+        prediction, predict_s, one = fit_predict((xs, y, xq, linear, isotropic, restarts))
         fitted = [one]
     total = time.perf_counter() - t0
     with open(sys.argv[2], "w") as f:

@@ -7,7 +7,8 @@
 //! benches instead: `--synthetic` the older table of the exact GP on synthetic robot-like data
 //! (d = 7, six outputs, beside scikit-learn via `xtask/scripts/bench_gp_sklearn.py`, the machine's
 //! peak GFLOP/s from a faer matrix product, the sparse GP against the exact one), `--compare` and
-//! `--kernels` the real and simulated residual sets of `bench_gp_kernels`, `--lml-floor N` one
+//! `--kernels` the real and simulated residual sets of `bench_gp_kernels`, `--paper` the paper's
+//! setting and the UR10 against scikit-learn (`bench_gp_paper`), `--lml-floor N` one
 //! evaluation against the n³ flop floor.
 
 use std::path::{Path, PathBuf};
@@ -45,6 +46,13 @@ pub struct Args {
     /// Compare the candidate kernels on real and simulated residuals instead.
     #[arg(long)]
     kernels: bool,
+    /// The paper's setting and the UR10 against scikit-learn instead (`bench_gp_paper`): simulated
+    /// campaigns of the paper's shape against its isotropic Eq. 5 kernel, the UR10 series C
+    /// (position only and full pose, from `--ur10-data`) against the ARD GP.
+    #[arg(long)]
+    paper: bool,
+    #[command(flatten)]
+    paper_args: crate::bench_gp_paper::PaperArgs,
     /// Write the residual sets of `--kernels`/`--compare` to this folder as CSV (`NAME.train.csv`,
     /// `NAME.test.csv`: inputs, then outputs) instead, for other tools to read.
     #[arg(long)]
@@ -281,7 +289,11 @@ fn ours(d: &Data, n: usize, restarts: usize) -> Result<OurRow, String> {
 }
 
 fn sklearn_available() -> bool {
-    Command::new("python3").args(["-c", "import sklearn"]).output().map(|o| o.status.success()).unwrap_or(false)
+    Command::new(crate::bench_gp_sklearn::python())
+        .args(["-c", "import sklearn"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false)
 }
 
 fn sklearn(d: &Data, sizes: &[usize], restarts: usize) -> Result<Vec<SklearnRow>, String> {
@@ -304,7 +316,7 @@ fn sklearn(d: &Data, sizes: &[usize], restarts: usize) -> Result<Vec<SklearnRow>
         "upper": bounds.upper,
     });
     std::fs::write(&request, body.to_string()).map_err(|e| format!("{}: {e}", request.display()))?;
-    let status = Command::new("python3")
+    let status = Command::new(crate::bench_gp_sklearn::python())
         .arg(&script)
         .arg(&request)
         .arg(&response)
@@ -343,6 +355,14 @@ fn fmt_opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
 
 /// Runs the benchmark and prints the markdown table.
 pub fn run(args: &Args) -> Result<(), String> {
+    if args.paper {
+        let md = crate::bench_gp_paper::run(&args.paper_args, &args.kernel_args.ur10_data)?;
+        println!("{md}");
+        if let Some(path) = &args.out {
+            std::fs::write(path, &md).map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+        return Ok(());
+    }
     if args.compare {
         let md = crate::bench_gp_compare::run(&args.kernel_args, std::time::Duration::from_secs(300))?;
         println!("{md}");

@@ -41,7 +41,8 @@ pub fn run(args: &KernelArgs, timeout: Duration) -> Result<String, String> {
         let mut cells = Vec::new();
         let mut fastest = f64::INFINITY;
         for linear in [false, true] {
-            let options = SklearnOptions { linear, restarts: 1, independent: true, processes: 2, timeout };
+            let options =
+                SklearnOptions { linear, isotropic: false, restarts: 1, independent: true, processes: 2, timeout };
             let result = if with_sklearn {
                 fit_predict(&set.train.inputs, &set.train.outputs, &set.test.inputs, &options)?
             } else {

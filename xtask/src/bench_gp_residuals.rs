@@ -58,13 +58,30 @@ pub fn real(name: &str, robot: &RobotDescription, train: &Path, test: Option<&Pa
 /// A simulated campaign with the paper's effects (joint compliance under gravity and payload,
 /// tracker noise) and payloads: the first `train` poses to train on, the next `test` to test.
 pub fn simulated(robot: &RobotDescription, seed: u64, train: usize, test: usize) -> Result<Residuals, String> {
+    simulated_campaign(robot, &paper_effects(), "", seed, train, test, false)
+}
+
+/// [`simulated`] with `effects`, position only or full pose: with [`paper_effects`] the rows
+/// `calib simulate --rows TRAIN+TEST --seed SEED [--full-pose]` writes, the first `train` to train
+/// on and the rest to test. `label` goes into the name after the robot's.
+pub fn simulated_campaign(
+    robot: &RobotDescription,
+    effects: &loadsim::Effects,
+    label: &str,
+    seed: u64,
+    train: usize,
+    test: usize,
+    full_pose: bool,
+) -> Result<Residuals, String> {
     let config = GeneratorConfig { sample_count: train + test, seed, ..GeneratorConfig::default() };
     let (_, data) =
-        simulate_campaign(robot, &paper_effects(), &Perturbation::default(), &Remount::default(), &config, false)
+        simulate_campaign(robot, effects, &Perturbation::default(), &Remount::default(), &config, full_pose)
             .map_err(|e| e.to_string())?;
     let train_set = data.subset(&(0..train).collect::<Vec<_>>());
     let test_set = data.subset(&(train..train + test).collect::<Vec<_>>());
-    residuals(format!("simulated {}, seed {seed}, {train} poses", robot.name), robot, &train_set, &test_set, true)
+    let kind = if full_pose { ", full pose" } else { "" };
+    let name = format!("simulated {}{label}, seed {seed}, {train} poses{kind}", robot.name);
+    residuals(name, robot, &train_set, &test_set, true)
 }
 
 /// The shape of a real 7-axis campaign ([`payload_run_campaign`]: joints 1 and 2 moving, four

@@ -1,8 +1,12 @@
 //! The scikit-learn side of `cargo xtask bench-gp`: one fit and prediction in a python3 process
 //! (`xtask/scripts/bench_gp_sklearn.py`), killed when it passes its time limit.
+//!
+//! The interpreter is [`python`]: `$CALIB_PYTHON`, else the project's own environment
+//! `target/pyenv` (made by `python3 -m venv target/pyenv && target/pyenv/bin/pip install -r
+//! xtask/scripts/requirements.txt`), else `python3` on the path.
 
 use std::os::unix::process::CommandExt;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -13,6 +17,8 @@ use faer::Mat;
 pub struct SklearnOptions {
     /// With the `C · DotProduct` term.
     pub linear: bool,
+    /// The paper's isotropic Eq. 5 instead: `C · RBF(one length scale) + C + DotProduct + White`.
+    pub isotropic: bool,
     /// `n_restarts_optimizer`.
     pub restarts: usize,
     /// One GP per output column (in a pool of `processes` workers) rather than one for all.
@@ -37,9 +43,19 @@ pub struct SklearnResult {
     pub fitted: Vec<(String, f64)>,
 }
 
-/// `true` when `python3 -c "import sklearn"` works.
+/// The Python interpreter the comparisons run: `$CALIB_PYTHON`, else `target/pyenv/bin/python3`
+/// under the workspace when it exists, else `python3`.
+pub fn python() -> PathBuf {
+    if let Some(p) = std::env::var_os("CALIB_PYTHON") {
+        return PathBuf::from(p);
+    }
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/pyenv/bin/python3");
+    if venv.exists() { venv } else { PathBuf::from("python3") }
+}
+
+/// `true` when `python -c "import sklearn"` works.
 pub fn available() -> bool {
-    Command::new("python3").args(["-c", "import sklearn"]).output().map(|o| o.status.success()).unwrap_or(false)
+    Command::new(python()).args(["-c", "import sklearn"]).output().map(|o| o.status.success()).unwrap_or(false)
 }
 
 fn rows(m: &Mat<f64>) -> Vec<Vec<f64>> {
@@ -62,6 +78,7 @@ pub fn fit_predict(
         "y": rows(y),
         "x_test": rows(x_test),
         "linear": options.linear,
+        "isotropic": options.isotropic,
         "restarts": options.restarts,
         "independent": options.independent,
         "processes": options.processes,
@@ -70,7 +87,7 @@ pub fn fit_predict(
     let _ = std::fs::remove_file(&response);
     let start = Instant::now();
     // Its own process group, so that a timeout ends the pool's workers with it.
-    let mut child = Command::new("python3")
+    let mut child = Command::new(python())
         .process_group(0)
         .arg(&script)
         .arg(&request)

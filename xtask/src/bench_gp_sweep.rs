@@ -242,6 +242,7 @@ pub fn run(args: &SweepArgs, svg_path: Option<&Path>) -> Result<String, String> 
             let r = residuals(format!("n = {n}"), &description, &train_set, &test_set, true)?;
             let options = SklearnOptions {
                 linear: false,
+                isotropic: false,
                 restarts: 1,
                 independent: true,
                 processes: 2,

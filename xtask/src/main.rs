@@ -4,6 +4,7 @@
 mod bench_gp;
 mod bench_gp_compare;
 mod bench_gp_kernels;
+mod bench_gp_paper;
 mod bench_gp_residuals;
 mod bench_gp_sklearn;
 mod bench_gp_sweep;

@@ -174,7 +174,7 @@ pub(crate) fn workspace_root() -> PathBuf {
 }
 
 /// The robot with the preset's stiffness.
-fn robot_for(robot: &RobotDescription, preset: Preset, file: &Path) -> Result<RobotDescription, String> {
+pub(crate) fn robot_for(robot: &RobotDescription, preset: Preset, file: &Path) -> Result<RobotDescription, String> {
     let mut dynamics: RobotDynamics = robot.dynamics.clone().ok_or_else(|| {
         format!("{}: the load model needs the robot's masses and stiffness (a dynamics block)", file.display())
     })?;
@@ -218,13 +218,18 @@ fn magnitudes(
     })
 }
 
-/// Mean position error (mm) of `variant` fitted on `train`, on each of `tests`; and its training error.
+/// What one fit gave: its training error, the GP's leave-one-out error on the training rows (GP
+/// methods with the exact GP), and the mean error on each test set (mm).
+type FitResult = (f64, Option<f64>, Vec<f64>);
+
+/// Mean position error (mm) of `variant` fitted on `train`, on each of `tests`; its training error
+/// and its GP's leave-one-out error.
 fn fit_and_test(
     robot: &RobotDescription,
     variant: &Variant,
     train: &MeasurementSet,
     tests: &[&MeasurementSet],
-) -> Result<(f64, Vec<f64>), String> {
+) -> Result<FitResult, String> {
     let (model, report) = pipeline::fit(robot, train, variant.method, &variant.options)
         .map_err(|e| format!("{} on {} rows: {e}", variant.label, train.rows.len()))?;
     let errors = tests
@@ -233,7 +238,8 @@ fn fit_and_test(
             pipeline::evaluate(&model, test).map(|e| e.summary.mean_position_error_mm).map_err(|e| e.to_string())
         })
         .collect::<Result<Vec<f64>, String>>()?;
-    Ok((report.after.mean_position_error_mm, errors))
+    let loo = report.compensation.as_ref().and_then(|c| c.leave_one_out.as_ref()).map(|l| l.mean_position_error_mm);
+    Ok((report.after.mean_position_error_mm, loo, errors))
 }
 
 pub fn run(args: &Args) -> Result<(), String> {
@@ -283,7 +289,7 @@ pub fn run(args: &Args) -> Result<(), String> {
     let jobs: Vec<(usize, Option<usize>)> =
         (0..variants.len()).flat_map(|v| (0..sizes.folds).map(Some).chain([None]).map(move |f| (v, f))).collect();
     let test_refs: Vec<&MeasurementSet> = tests.iter().collect();
-    let results: Vec<(f64, Vec<f64>)> = jobs
+    let results: Vec<FitResult> = jobs
         .par_iter()
         .map(|&(v, fold)| {
             let result = match fold {
@@ -308,9 +314,10 @@ pub fn run(args: &Args) -> Result<(), String> {
                     label: variant.label,
                     paper_faithful: variant.paper_faithful,
                     beyond: variant.beyond,
-                    cv: mine[..sizes.folds].iter().map(|(_, e)| e[0]).collect(),
-                    test: mine[sizes.folds].1.clone(),
+                    cv: mine[..sizes.folds].iter().map(|(_, _, e)| e[0]).collect(),
+                    test: mine[sizes.folds].2.clone(),
                     training: mine[sizes.folds].0,
+                    leave_one_out: mine[sizes.folds].1,
                 }
             })
             .collect(),

@@ -94,6 +94,16 @@ pub enum Error {
         /// Training points available.
         available: usize,
     },
+    /// The diagonal of the inverse training covariance that leave-one-out prediction divides by
+    /// is not finite and positive at a row (a covariance too ill-conditioned for it).
+    LeaveOneOutFailed {
+        /// Size of the matrix.
+        size: usize,
+        /// The row.
+        row: usize,
+        /// The value found.
+        value: f64,
+    },
 }
 
 impl fmt::Display for Error {
@@ -135,6 +145,11 @@ impl fmt::Display for Error {
             Self::TooManyInducingPoints { requested, available } => {
                 write!(f, "{requested} inducing points requested but only {available} training points")
             }
+            Self::LeaveOneOutFailed { size, row, value } => write!(
+                f,
+                "leave-one-out prediction failed: the inverse of the {size}x{size} training covariance has \
+                 {value:e} on its diagonal at row {row}"
+            ),
         }
     }
 }

@@ -9,9 +9,11 @@ use crate::Error;
 use crate::cholesky::{Factor, JitterOutcome};
 use crate::config::{GpConfig, OutputMode, Parallelism};
 use crate::gram::training_covariance;
+use crate::kernel::KernelChoice;
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::lml::check_finite_outputs;
-use crate::optimise::{OptimisationReport, finish, fit_hyperparameters, warm_stage};
+use crate::loo::{inverse_diagonal, log_predictive};
+use crate::optimise::{OptimisationReport, finish, fit_hyperparameters, refine, warm_stage};
 use crate::points::Points;
 use crate::scaling::{InputStandardiser, OutputNormaliser};
 
@@ -73,6 +75,25 @@ pub struct ComponentReport {
     /// ([`GpConfig::additive_by_bic`]; `None` when it was not made).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub additive_choice: Option<AdditiveChoice>,
+    /// The choice between the searched kernel and the paper's isotropic Eq. 5 kernel
+    /// ([`GpConfig::isotropic_by_loo`]; `None` when it was not made, as in files written before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub isotropic_choice: Option<IsotropicChoice>,
+}
+
+/// The leave-one-out choice between the searched kernel and the paper's isotropic Eq. 5 kernel.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IsotropicChoice {
+    /// Leave-one-out log predictive probability (R&W Eq. 5.11, normalised outputs, summed over the
+    /// rows and the outputs served) of the searched kernel.
+    pub searched: f64,
+    /// The same for the isotropic Eq. 5 kernel, at the hyperparameters it was compared with.
+    pub isotropic: f64,
+    /// Whether the isotropic kernel was kept (`isotropic > searched`).
+    pub kept_isotropic: bool,
+    /// Rows on which the isotropic kernel's hyperparameters compared above were searched: the
+    /// warm-start subset where the comparison there already lost, else all rows.
+    pub isotropic_search_rows: usize,
 }
 
 /// The Schwarz (BIC) choice between a kernel with an additive term and the same kernel without.
@@ -151,8 +172,24 @@ impl ExactGp {
         let outputs = if config.normalise_outputs { OutputNormaliser::fit(y) } else { OutputNormaliser::identity(m) };
         let xs = inputs.apply_points(&raw);
         let yn = outputs.normalise(y);
+        let followers: Vec<Vec<usize>> =
+            if matches!(how, Hyperparameters::Optimise(_)) && config.outputs == OutputMode::Independent {
+                config.follower_groups.clone()
+            } else {
+                Vec::new()
+            };
+        let mut follows = vec![false; m];
+        for &j in followers.iter().flatten() {
+            if j >= m || follows[j] {
+                return Err(Error::InvalidConfig { field: "follower_groups", value: j as f64 });
+            }
+            follows[j] = true;
+        }
+        if followers.iter().any(Vec::is_empty) || (!followers.is_empty() && follows.iter().all(|f| *f)) {
+            return Err(Error::InvalidConfig { field: "follower_groups", value: followers.len() as f64 });
+        }
         let groups: Vec<Vec<usize>> = match config.outputs {
-            OutputMode::Independent => (0..m).map(|j| vec![j]).collect(),
+            OutputMode::Independent => (0..m).filter(|&j| !follows[j]).map(|j| vec![j]).collect(),
             OutputMode::Shared => vec![(0..m).collect()],
         };
         let search = |start: &Kernel, yg: MatRef<'_, f64>| -> Result<(Kernel, OptimisationReport), Error> {
@@ -173,10 +210,11 @@ impl ExactGp {
                 jitter,
                 optimisation,
                 additive_choice: None,
+                isotropic_choice: None,
             };
             Ok::<_, Error>((component, report))
         };
-        let fit_group = |(g, cols): (usize, &Vec<usize>)| -> Result<(Component, ComponentReport), Error> {
+        let fit_searched = |(g, cols): (usize, &Vec<usize>)| -> Result<(Component, ComponentReport), Error> {
             let yg = Mat::from_fn(n, cols.len(), |i, c| yn[(i, cols[c])]);
             let start = match &how {
                 Hyperparameters::Fixed(kernels) => {
@@ -237,12 +275,83 @@ impl ExactGp {
             report.additive_choice = Some(choice);
             Ok((component, report))
         };
+        // The paper's Eq. 5 beside the searched kernel, kept where it predicts the rows it has not
+        // seen better (leave-one-out, R&W Eq. 5.11).
+        let loo =
+            |c: &Component| -> f64 { log_predictive(c, &inverse_diagonal(c, config.parallelism.faer())).iter().sum() };
+        let with_isotropic = |searched: (Component, ComponentReport),
+                              cols: &Vec<usize>|
+         -> Result<(Component, ComponentReport), Error> {
+            let optimised = matches!(how, Hyperparameters::Optimise(_));
+            if !config.isotropic_by_loo || !optimised || matches!(searched.1.kernel, Kernel::Quadratic(_)) {
+                return Ok(searched);
+            }
+            let yg = Mat::from_fn(n, cols.len(), |i, c| yn[(i, cols[c])]);
+            let start = Kernel::start(KernelChoice::Quadratic, xs.dim());
+            let bounds = start.default_bounds();
+            let searched_loo = loo(&searched.0);
+            let choose = |searched: (Component, ComponentReport), isotropic: (Component, ComponentReport), rows| {
+                let isotropic_loo = loo(&isotropic.0);
+                let kept_isotropic = isotropic_loo > searched_loo;
+                let choice = IsotropicChoice {
+                    searched: searched_loo,
+                    isotropic: isotropic_loo,
+                    kept_isotropic,
+                    isotropic_search_rows: rows,
+                };
+                let (component, mut report) = if kept_isotropic { isotropic } else { searched };
+                report.isotropic_choice = Some(choice);
+                (component, report)
+            };
+            let stage = warm_stage(&start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism)?;
+            if let Some(stage) = &stage {
+                // The subset's optimum compared on all rows first: a full search only when the
+                // isotropic kernel already predicts better from there.
+                let at_subset = build(stage.best_kernel(&start)?, cols, yg.as_ref(), None)?;
+                if loo(&at_subset.0) <= searched_loo {
+                    return Ok(choose(searched, at_subset, stage.rows()));
+                }
+            }
+            let o = finish(&start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism, stage)?;
+            let isotropic = build(o.kernel, cols, yg.as_ref(), Some(o.report))?;
+            Ok(choose(searched, isotropic, n))
+        };
+        let fit_group = |(g, cols): (usize, &Vec<usize>)| with_isotropic(fit_searched((g, cols))?, cols);
         let fitted: Vec<_> = match config.parallelism {
             Parallelism::Sequential => groups.iter().enumerate().map(fit_group).collect(),
             Parallelism::Rayon => groups.par_iter().enumerate().map(fit_group).collect(),
         };
-        let (components, reports): (Vec<_>, Vec<_>) =
-            fitted.into_iter().collect::<Result<Vec<_>, _>>()?.into_iter().unzip();
+        let mut fitted = fitted.into_iter().collect::<Result<Vec<_>, _>>()?;
+        // Each follower group from the fitted kernel that explains it best, refined on all rows.
+        let leaders: Vec<Kernel> = fitted.iter().map(|(_, r)| r.kernel.clone()).collect();
+        let follow = |cols: &Vec<usize>| -> Result<(Component, ComponentReport), Error> {
+            let yg = Mat::from_fn(n, cols.len(), |i, c| yn[(i, cols[c])]);
+            let mut best: Option<(f64, &Kernel)> = None;
+            for kernel in &leaders {
+                let (component, _) =
+                    Component::build(kernel.clone(), cols.clone(), &xs, yg.as_ref(), None, config, config.parallelism)?;
+                let lml = component.log_marginal_likelihood(yg.as_ref());
+                if best.is_none_or(|(b, _)| lml > b) {
+                    best = Some((lml, kernel));
+                }
+            }
+            let start = best.map(|(_, k)| k).ok_or(Error::OptimisationFailed { starts: 0 })?;
+            // The configured box where it is the chosen kernel's (its family may differ: the
+            // isotropic kernel or the form without the additive term).
+            let bounds = config
+                .bounds
+                .clone()
+                .filter(|b| b.lower.len() == start.parameter_count())
+                .unwrap_or_else(|| start.default_bounds());
+            let o = refine(start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism)?;
+            with_isotropic(build(o.kernel, cols, yg.as_ref(), Some(o.report))?, cols)
+        };
+        let followed: Vec<_> = match config.parallelism {
+            Parallelism::Sequential => followers.iter().map(follow).collect(),
+            Parallelism::Rayon => followers.par_iter().map(follow).collect(),
+        };
+        fitted.extend(followed.into_iter().collect::<Result<Vec<_>, _>>()?);
+        let (components, reports): (Vec<_>, Vec<_>) = fitted.into_iter().unzip();
         Ok(Self {
             inputs,
             outputs,

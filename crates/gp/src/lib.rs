@@ -41,6 +41,7 @@ mod inducing;
 mod kernel;
 mod lbfgsb;
 mod lml;
+mod loo;
 mod optimise;
 mod points;
 mod predict;
@@ -52,13 +53,14 @@ pub use cholesky::{FactorOptions, JitterOutcome};
 pub use config::{GpConfig, JitterConfig, OptimiserConfig, OutputMode, Parallelism};
 pub use elbo::sparse_evidence_lower_bound;
 pub use error::Error;
-pub use exact::{AdditiveChoice, ComponentReport, ExactGp, FitReport};
+pub use exact::{AdditiveChoice, ComponentReport, ExactGp, FitReport, IsotropicChoice};
 pub use inducing::InducingSelection;
 pub use kernel::{
     AdditiveTerm, Bounds, CompositeKernel, Kernel, KernelChoice, Matern52Ard, QuadraticKernel, SquaredExponentialArd,
     StationaryShape,
 };
 pub use lml::{LmlWorkspace, LogMarginalLikelihood, log_marginal_likelihood};
+pub use loo::LeaveOneOut;
 pub use optimise::OptimisationReport;
 pub use predict::{PredictOptions, Prediction};
 pub use scaling::{InputStandardiser, OutputNormaliser};

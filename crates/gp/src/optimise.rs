@@ -147,6 +147,13 @@ impl WarmStage {
     pub(crate) fn rows(&self) -> usize {
         self.rows
     }
+
+    /// The subset's best optimum as a kernel of `start`'s family.
+    pub(crate) fn best_kernel(&self, start: &Kernel) -> Result<Kernel, Error> {
+        let minimum =
+            self.results[self.best].as_ref().ok_or(Error::OptimisationFailed { starts: self.results.len() })?;
+        start.with_log_parameters(&minimum.x)
+    }
 }
 
 /// The search's box (log-parameters), starting points and settings for `start`.
@@ -229,7 +236,21 @@ pub(crate) fn finish(
                 .as_ref()
                 .map(|m| m.x.clone())
                 .ok_or(Error::OptimisationFailed { starts: starts.len() })?;
-            let full = search_all(start, std::slice::from_ref(&from), (&lower, &upper), x, y, &settings, parallelism);
+            // The subset's curvature carried over: the likelihood is a sum over rows, so its
+            // Hessian grows about in proportion to them and each gradient change is scaled by
+            // n / s. The full search then starts with a quasi-Newton step instead of relearning
+            // the curvature down the gradient.
+            let scale = x.len() as f64 / stage.rows.max(1) as f64;
+            let pairs: Vec<lbfgsb::Pair> = match (&stage.results[stage.best], config.warm_start_curvature) {
+                (Some(m), true) => m
+                    .history
+                    .iter()
+                    .map(|p| lbfgsb::Pair { s: p.s.clone(), y: p.y.iter().map(|v| v * scale).collect() })
+                    .collect(),
+                _ => Vec::new(),
+            };
+            let mut objective = NegativeLml { start, x, y, parallelism, workspace: Workspace::default() };
+            let full = vec![lbfgsb::minimise_with(&mut objective, &from, &lower, &upper, &settings, &pairs)];
             (stage.results, stage.rows, stage.evaluations, full.into_iter().next().flatten())
         }
         None => {
@@ -261,6 +282,36 @@ pub(crate) fn finish(
         warm_start_rows: warm_rows,
         warm_start_evaluations: warm_evaluations,
         gradient_evaluations: gradients,
+    };
+    Ok(Optimised { kernel, report })
+}
+
+/// One search on all rows from `start` alone (no nested or random starts, no subset): the
+/// refinement of a kernel fitted to similar data, as [`crate::GpConfig::follower_groups`] does.
+pub(crate) fn refine(
+    start: &Kernel,
+    bounds: &Bounds,
+    x: &Points,
+    y: MatRef<'_, f64>,
+    config: &OptimiserConfig,
+    parallelism: Parallelism,
+) -> Result<Optimised, Error> {
+    let Prepared { lower, upper, settings, .. } = prepare(start, bounds, config)?;
+    let from: Vec<f64> =
+        start.log_parameters().iter().zip(&lower).zip(&upper).map(|((s, l), u)| s.clamp(*l, *u)).collect();
+    let mut objective = NegativeLml { start, x, y, parallelism, workspace: Workspace::default() };
+    let minimum = lbfgsb::minimise(&mut objective, &from, &lower, &upper, &settings)
+        .ok_or(Error::OptimisationFailed { starts: 1 })?;
+    let kernel = start.with_log_parameters(&minimum.x)?;
+    let report = OptimisationReport {
+        start_log_marginal_likelihoods: vec![Some(-minimum.f)],
+        best_start: 0,
+        iterations: minimum.iterations,
+        evaluations: minimum.evaluations,
+        converged: matches!(minimum.termination, Termination::GradientTolerance | Termination::FunctionTolerance),
+        warm_start_rows: 0,
+        warm_start_evaluations: 0,
+        gradient_evaluations: minimum.gradients,
     };
     Ok(Optimised { kernel, report })
 }
