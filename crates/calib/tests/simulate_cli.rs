@@ -216,9 +216,20 @@ fn a_lifting_column_is_written_in_metres_and_fits_back() {
     let (data, model) = (dir.path().join("column.csv"), dir.path().join("column.ron"));
     let effects = dir.path().join("effects.ron");
     std::fs::write(&effects, "(tracker_noise: Some(()))").unwrap();
-    succeeds(&["simulate", "--robot", &text(&robot), "--out", &text(&data), "--rows", "120", "--effects", &text(&effects)]);
+    succeeds(&[
+        "simulate",
+        "--robot",
+        &text(&robot),
+        "--out",
+        &text(&data),
+        "--rows",
+        "120",
+        "--effects",
+        &text(&effects),
+    ]);
     let header = std::fs::read_to_string(&data).unwrap().lines().next().unwrap().to_owned();
     assert!(header.starts_with("q1_m,q2_rad,"), "{header}");
-    let out = succeeds(&["fit", "--robot", &text(&robot), "--data", &text(&data), "--method", "poe", "--out", &text(&model)]);
+    let out =
+        succeeds(&["fit", "--robot", &text(&robot), "--data", &text(&data), "--method", "poe", "--out", &text(&model)]);
     assert!(out.contains("training error after: mean 0.0"), "{out}");
 }
