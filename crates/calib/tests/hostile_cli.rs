@@ -5,23 +5,7 @@
 use std::path::Path;
 
 mod common;
-use common::{calib, fixture, text};
-
-/// Runs a command that must succeed and returns its stdout and stderr.
-fn succeeds(args: &[&str]) -> (String, String) {
-    let out = calib(args);
-    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
-    (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
-}
-
-/// Runs a command that must fail and returns its stderr, checked to be exactly one line.
-fn fails(args: &[&str]) -> String {
-    let out = calib(args);
-    assert!(!out.status.success(), "{args:?} should fail: {}", String::from_utf8_lossy(&out.stdout));
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: not one line:\n{stderr}");
-    stderr.trim_end().to_owned()
-}
+use common::{fails, fixture, succeeds_with_stderr as succeeds, text};
 
 /// `from` with column `name` of data row `row` (1-based, or every row for 0) set to `value`.
 fn with_cell(from: &Path, to: &Path, name: &str, row: usize, value: &str) {

@@ -17,3 +17,21 @@ pub fn fixture(name: &str) -> String {
 pub fn text(path: &Path) -> String {
     path.display().to_string()
 }
+
+/// Runs a command that must succeed and returns its stdout and stderr.
+#[allow(dead_code)] // not every test file that shares this module uses it
+pub fn succeeds_with_stderr(args: &[&str]) -> (String, String) {
+    let out = calib(args);
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// Runs a command that must fail and returns its stderr, checked to be exactly one line.
+#[allow(dead_code)] // not every test file that shares this module uses it
+pub fn fails(args: &[&str]) -> String {
+    let out = calib(args);
+    assert!(!out.status.success(), "{args:?} should fail: {}", String::from_utf8_lossy(&out.stdout));
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: not one line:\n{stderr}");
+    stderr.trim_end().to_owned()
+}
