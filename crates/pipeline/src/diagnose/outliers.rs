@@ -31,7 +31,8 @@ use std::borrow::Cow;
 #[serde(default)]
 pub struct OutlierOptions {
     /// Up to this share of the rows, gross outliers are left out as errors of the data and the
-    /// diagnosis goes on; beyond it, the verdict is `unknown`. 2 %: a tracker that loses its
+    /// diagnosis goes on; beyond it they are kept, and the verdict is `unknown` unless the
+    /// selected effects bring all but this share of the rows back. 2 %: a tracker that loses its
     /// target now and then, or a mistyped value, spoils a row or two in a few hundred; six rows
     /// in three hundred, each ten robust sigmas out, are a pattern.
     pub max_left_out_fraction: f64,
