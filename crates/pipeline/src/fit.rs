@@ -1,19 +1,19 @@
 //! The fit of a method on a measurement set, and the evaluation of a fitted model.
 
-use crate::effects::{
-    AutoChoice, EffectContext, EffectCorrection, EffectReport, EffectSelection, EffectSpec, IdentifiedEffect,
-    effect_reports,
-};
+use crate::auto::AutoChoice;
 use crate::fit_options::FitOptions;
-use crate::geometric::{fit_geometry, observations};
-use crate::outliers::{OutlierLine, list_lines, without};
-use crate::{
-    CalibratedModel, Compensation, CompensationReport, Error, ErrorSummary, MeasurementSet, Method, PoseError,
-    RobotDescription, SCHEMA_VERSION, pose_error,
+use effects::{
+    EffectContext, EffectCorrection, EffectReport, EffectSelection, EffectSpec, IdentifiedEffect, effect_reports,
 };
+use errors::Error;
+use measurements::MeasurementSet;
+use measurements::{OutlierLine, list_lines, without};
+use model::geometric::{fit_geometry, observations};
+use model::{CalibratedModel, Compensation, CompensationReport, ErrorSummary, Method, SCHEMA_VERSION, evaluate};
 use poe::identify::{
     IdentificationOptions, IdentificationReport, Loss, ParameterMask, Scope, identify_with_correction,
 };
+use robot::RobotDescription;
 use serde::Serialize;
 use std::borrow::Cow;
 
@@ -39,7 +39,7 @@ pub struct FitReport {
     /// `identification.unidentifiable` — only the stages' summed motion is seen, not how it splits
     /// between them.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub folded: Vec<crate::FoldedJoint>,
+    pub folded: Vec<robot::FoldedJoint>,
     /// The effects identified with the geometry, their parameters by name.
     pub effects: Vec<EffectReport>,
     /// The GP stage's report, for the GP methods: its hyperparameters.
@@ -129,15 +129,6 @@ impl std::fmt::Display for FitWarning {
     }
 }
 
-/// Per-row errors and their summary.
-#[derive(Debug, Clone)]
-pub struct Evaluation {
-    /// One error per row, in file order.
-    pub errors: Vec<PoseError>,
-    /// Their statistics.
-    pub summary: ErrorSummary,
-}
-
 /// The effects a list names, built on the training rows.
 fn build_effects(
     specs: &[EffectSpec],
@@ -185,8 +176,8 @@ pub fn fit(
         effects: Vec::new(),
         fallback_kinematics: None,
         compensation: None,
-        training_range: crate::TrainingRange::of(&data.rows),
-        joint_limits: crate::stored_limits(&robot.limits()),
+        training_range: model::TrainingRange::of(&data.rows),
+        joint_limits: model::stored_limits(&robot.limits()),
     };
     let mut identification = geometry.report;
     let mut auto = None;
@@ -195,7 +186,7 @@ pub fn fit(
         EffectSelection::None => Vec::new(),
         EffectSelection::List(list) => list.clone(),
         EffectSelection::Auto => {
-            let choice = crate::effects::choose(robot, data, &options.effects.diagnose)?;
+            let choice = crate::auto::choose(robot, data, &options.effects.diagnose)?;
             let chosen = choice.chosen.clone();
             auto = Some(choice);
             chosen
@@ -241,10 +232,10 @@ pub fn fit(
     }
     // The check `read_model` runs, on the text `write_model` writes: a fit never hands over a
     // model that its own file would be refused for, and the cause shows here (issue 23).
-    let text = crate::model_file::model_text(&model, "the fitted model")?;
+    let text = model::model_text(&model, "the fitted model")?;
     model
         .check(&text, "the fitted model")
-        .map_err(|source| Error::FittedModelRefused { method, source: Box::new(source) })?;
+        .map_err(|source| Error::FittedModelRefused { method: method.to_string(), source: Box::new(source) })?;
     let registered = CalibratedModel {
         kinematics: geometry.registered,
         effects: Vec::new(),
@@ -294,35 +285,4 @@ pub fn fit(
         warnings,
     };
     Ok((model, report))
-}
-
-/// Evaluates a fitted model on measurements. A model fitted on positions only has no rotation
-/// errors, whatever the data holds: it never calibrated the tool's orientation, so the angle it
-/// would report is that of an uncalibrated frame, not an error of the fit.
-pub fn evaluate(model: &CalibratedModel, data: &MeasurementSet) -> Result<Evaluation, Error> {
-    let tools = tool_indices(model, data)?;
-    let predictions = model.predict(&data.rows, &tools)?;
-    let errors: Vec<PoseError> = predictions
-        .iter()
-        .zip(&data.rows)
-        .map(|(p, row)| {
-            let error = pose_error(&p.pose, row);
-            if model.full_pose { error } else { PoseError { rotation_mrad: None, ..error } }
-        })
-        .collect();
-    let summary = ErrorSummary::from_errors(&errors);
-    Ok(Evaluation { errors, summary })
-}
-
-/// The model's tool index of every row of `data`, matched by tool identifier.
-pub fn tool_indices(model: &CalibratedModel, data: &MeasurementSet) -> Result<Vec<usize>, Error> {
-    data.check_joints(&model.joint_kinds())?;
-    let column = data.tool_column.unwrap_or(1);
-    data.rows
-        .iter()
-        .map(|row| {
-            let name = data.tools.get(row.tool).map(String::as_str).unwrap_or("");
-            model.tool_index(name, &data.source, row.line, column)
-        })
-        .collect()
 }

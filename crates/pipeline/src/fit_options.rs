@@ -1,12 +1,30 @@
 //! The options of a fit, and the options file (`calib fit --options FIT.ron`) that sets any of
 //! them: unknown fields are refused at their line and column, values checked once.
 
-use crate::diagnose::DiagnoseOptions;
-use crate::effects::EffectSelection;
-use crate::{CompensationOptions, Error};
+use diagnose::DiagnoseOptions;
+use effects::EffectSelection;
+use errors::Error;
+use model::CompensationOptions;
 use poe::identify::{IdentificationOptions, Solver};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+mod selection_text {
+    use effects::EffectSelection;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(selection: &EffectSelection, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(&selection.to_string())
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<EffectSelection, D::Error> {
+        let text = String::deserialize(deserializer)?;
+        if text == "none" {
+            return Ok(EffectSelection::None);
+        }
+        text.parse().map_err(serde::de::Error::custom)
+    }
+}
 
 /// How the non-geometric effects are identified with the geometry.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -36,7 +54,7 @@ pub struct EffectOptions {
     /// Levenberg–Marquardt iterations to meet the cost or gradient criterion.
     pub max_iterations: usize,
     /// How gear series are held and faded outside the angles they were fitted on.
-    pub gear: crate::effects::GearOptions,
+    pub gear: effects::GearOptions,
     /// Thermal growth and drift are applied as fitted up to this fraction of their fitted span
     /// of `temp_c` / `t_s` beyond either end; further out the growth is held at that value (a
     /// function of the temperature) and the drift falls back to zero (issue 30: a drift
@@ -56,27 +74,10 @@ impl Default for EffectOptions {
             prior_sigma: 1e-3,
             solver: Solver::LevenbergMarquardt,
             max_iterations: 300,
-            gear: crate::effects::GearOptions::default(),
-            hold_beyond_span: 1.0,
+            gear: effects::GearOptions::default(),
+            hold_beyond_span: effects::HOLD_BEYOND_SPAN,
             diagnose: DiagnoseOptions::default(),
         }
-    }
-}
-
-mod selection_text {
-    use crate::effects::EffectSelection;
-    use serde::{Deserialize, Deserializer, Serializer};
-
-    pub fn serialize<S: Serializer>(selection: &EffectSelection, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.serialize_str(&selection.to_string())
-    }
-
-    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<EffectSelection, D::Error> {
-        let text = String::deserialize(deserializer)?;
-        if text == "none" {
-            return Ok(EffectSelection::None);
-        }
-        text.parse().map_err(serde::de::Error::custom)
     }
 }
 
@@ -125,20 +126,20 @@ impl FitOptions {
 impl FitOptions {
     /// Reads an options file (RON; every field optional, unknown fields refused).
     pub fn read(path: &Path) -> Result<Self, Error> {
-        let text = crate::ron_position::read_text(path)?;
+        let text = errors::ron_position::read_text(path)?;
         Self::parse(&text, &path.display().to_string())
     }
 
     /// Parses options from RON text and checks them; `file` names it in errors.
     pub fn parse(text: &str, file: &str) -> Result<Self, Error> {
-        let options: FitOptions = crate::ron_position::ron_options().from_str(text).map_err(|e| Error::RonFormat {
+        let options: FitOptions = errors::ron_position::ron_options().from_str(text).map_err(|e| Error::RonFormat {
             file: file.to_owned(),
             line: e.span.start.line,
             column: e.span.start.col,
             message: e.code.to_string(),
         })?;
         options.validate().map_err(|(field, message)| {
-            let (line, column) = crate::ron_position::field_position(text, field, 0);
+            let (line, column) = errors::ron_position::field_position(text, field, 0);
             Error::RonFormat { file: file.to_owned(), line, column, message }
         })?;
         Ok(options)

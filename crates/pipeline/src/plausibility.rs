@@ -11,9 +11,11 @@
 //! matrix of `R_i t` is `n I`, so the bounded solution is the unbounded one brought into the
 //! ball). The two steps alternate; each lowers the sum of squares.
 
-use crate::{Error, MeasurementSet, RobotDescription};
+use errors::Error;
 use lie::{Matrix3, Vector3};
+use measurements::MeasurementSet;
 use poe::JointKind;
+use robot::RobotDescription;
 use serde::{Deserialize, Serialize};
 
 /// The checks' settings (`FitOptions::plausibility`, the `plausibility` block of `--options`).

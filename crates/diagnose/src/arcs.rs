@@ -1,0 +1,147 @@
+//! Folds that see gaps: the held-out error of the selected effects when a contiguous arc of one
+//! moving joint's angles is left out, as a model fitted on the rest meets it.
+//!
+//! Random folds leave out rows at random; every held-out row then has training rows at nearly
+//! the same angles, and the prediction says nothing of poses past the end of the fitted angles or
+//! in a gap of them. Here each moving joint's rows are sorted by its angle and cut into `folds`
+//! arcs of equal count (the first and last are the two ends of its range); each arc is predicted
+//! by the fit of the others, as the fitted model predicts poses where it knows nothing: the series
+//! of the held-out joint's own angle is faded whole there (the model fades it in any gap wider
+//! than half its shortest period, and a prediction for poses off the training poses must not
+//! count on a gap being narrow), another joint's series is applied with the coverage weight
+//! [`GearPeriodic::held_and_weight`] computed from that fit's own training angles, and the pose
+//! is blended to the geometry fitted alone by the product of those weights (the model's
+//! `fallback` part). So the arcs measure how the geometry and the other effects carry into
+//! angles the fit never saw.
+//!
+//! A backlash side learnt from the data is taken as learnt on every row here (its per-fold
+//! versions belong to the random folds): the side is a sign per pose, and the arcs test the
+//! amplitude fitted on the other arcs.
+
+use super::design::Design;
+use super::pool::{Block, KinematicPrior, Pool, PriorOptions};
+use super::selection::{Selection, Term};
+use effects::{GearOptions, GearPeriodic, IdentifiedEffect};
+use errors::Error;
+use lie::Vector6;
+use measurements::MeasurementSet;
+use serde::{Deserialize, Serialize};
+
+/// The held-out error when arcs of one joint's angles are left out.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ArcCheck {
+    /// The 1-based joint whose arcs are left out.
+    pub joint: usize,
+    /// Mean held-out position error of the geometric model, mm.
+    pub before_mm: f64,
+    /// The same with the selected effects (faded where their fit's angles do not reach), mm.
+    pub after_mm: f64,
+    /// Largest held-out position error of the geometric model, mm.
+    pub before_max_mm: f64,
+    /// The same with the selected effects, mm.
+    pub after_max_mm: f64,
+}
+
+/// Per pose, the arc fold of each of `moving`'s joints: rows sorted by the joint's angle, cut into
+/// `folds` runs of equal count (ties kept together by the stable sort of equal angles).
+pub(crate) fn arc_folds(data: &MeasurementSet, joint: usize, folds: usize) -> Vec<usize> {
+    let n = data.rows.len();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| data.rows[a].q[joint].total_cmp(&data.rows[b].q[joint]));
+    let mut fold = vec![0; n];
+    for (position, &row) in order.iter().enumerate() {
+        fold[row] = (position * folds / n.max(1)).min(folds - 1);
+    }
+    fold
+}
+
+/// What the arc checks are computed from.
+pub(crate) struct ArcInputs<'a> {
+    pub design: &'a Design,
+    pub kinematic_prior: &'a KinematicPrior,
+    pub prior: &'a PriorOptions,
+    pub gear: &'a GearOptions,
+    pub folds: usize,
+}
+
+/// The arc check of every joint in `moving` (0-based) for the selection's effects; `columns_of`
+/// gives a term's weighted columns and prior sd.
+pub(crate) fn arc_checks(
+    inputs: &ArcInputs<'_>,
+    data: &MeasurementSet,
+    moving: &[usize],
+    terms: &[Term],
+    selection: &Selection,
+    columns_of: &dyn Fn(usize) -> (Vec<Vec<f64>>, Option<f64>),
+) -> Result<Vec<ArcCheck>, Error> {
+    // The selected terms' columns, each at the order the fit on every row uses.
+    let mut owned: Vec<(Vec<Vec<f64>>, Option<f64>)> = Vec::new();
+    let mut series: Vec<Option<(usize, u32)>> = Vec::new();
+    for step in &selection.steps {
+        let (mut columns, sd) = columns_of(step.term);
+        if let Some(h) = step.scored.order {
+            columns.truncate(2 * h as usize);
+        }
+        let gear = match &terms[step.term].model {
+            IdentifiedEffect::GearPeriodic(g) => step.scored.order.map(|h| (g.joint, h)),
+            _ => None,
+        };
+        series.push(gear);
+        owned.push((columns, sd));
+    }
+    let blocks: Vec<Block<'_>> = owned.iter().map(|(c, sd)| (c.as_slice(), *sd)).collect();
+    let kinematic = inputs.design.kinematic.ncols();
+    let width: usize = owned.iter().map(|(c, _)| c.len()).sum();
+    let all: Vec<usize> = (0..kinematic + width).collect();
+    let mut out = Vec::with_capacity(moving.len());
+    for &joint in moving {
+        let fold = arc_folds(data, joint, inputs.folds);
+        let pool = Pool::new(inputs.design, inputs.kinematic_prior, &blocks, &fold, inputs.folds, inputs.prior);
+        let mut before = Vec::with_capacity(data.rows.len());
+        let mut after = Vec::with_capacity(data.rows.len());
+        for f in 0..inputs.folds {
+            let poses = pool.fold_poses(f);
+            if poses.is_empty() {
+                continue;
+            }
+            let base = pool.solve(&[f], &all[..kinematic])?;
+            let full = if width == 0 { base.clone() } else { pool.solve(&[f], &all)? };
+            let residuals = pool.residuals(f, &all, &[base, full]);
+            // Each series' coverage as its fit on this fold's training rows records it.
+            let training: Vec<measurements::Measurement> =
+                (0..data.rows.len()).filter(|&i| fold[i] != f).map(|i| data.rows[i].clone()).collect();
+            let coverage: Vec<GearPeriodic> = series
+                .iter()
+                .flatten()
+                .map(|&(j, h)| GearPeriodic::with_options(j, (1..=h).collect(), &training, inputs.gear))
+                .collect::<Result<_, _>>()?;
+            for ((&i, b), a) in poses.iter().zip(&residuals[0]).zip(&residuals[1]) {
+                // A held-out arc of the joint's own angles is where its series knows nothing:
+                // faded whole, whatever the width of the arc (the model fades it in a gap wider
+                // than half its shortest period; an arc of a fifth of the rows may be narrower).
+                let w: f64 = coverage
+                    .iter()
+                    .map(|g| if g.joint == joint { 0.0 } else { g.held_and_weight(data.rows[i].q[g.joint]).1 })
+                    .product();
+                let blended: Vector6 = a * w + b * (1.0 - w);
+                before.push(b.fixed_rows::<3>(0).norm());
+                after.push(blended.fixed_rows::<3>(0).norm());
+            }
+        }
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64 * 1e3;
+        let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max) * 1e3;
+        out.push(ArcCheck {
+            joint: joint + 1,
+            before_mm: mean(&before),
+            after_mm: mean(&after),
+            before_max_mm: max(&before),
+            after_max_mm: max(&after),
+        });
+    }
+    Ok(out)
+}
+
+/// The mean of `value` over `arcs`; `None` without any.
+pub(crate) fn mean_of(arcs: &[ArcCheck], value: impl Fn(&ArcCheck) -> f64) -> Option<f64> {
+    (!arcs.is_empty()).then(|| arcs.iter().map(value).sum::<f64>() / arcs.len() as f64)
+}

@@ -1,0 +1,204 @@
+//! The side of a joint's backlash band, learnt from the data inside each fold: the sign of the
+//! joint's torque `τ = Y(q) π` with `π` unknown (a balancer or an unknown mass moves its zero away
+//! from where a stand-in mass model puts it).
+//!
+//! On the training rows of one fold only: start from the sign of the joint's fitted compliance
+//! deflection (proportional to the torque); then alternate: given the signs, fit the band to what
+//! the kinematics leave and flip every pose whose residual the other side explains better; given
+//! the flipped signs, refit `π` by least squares on them (a linear classifier over the torque
+//! regressors), so that the side stays a function of the torque and does not follow the noise.
+//! The held-out poses get the side that classifier gives them: nothing about them is learnt.
+
+use super::candidates::{Candidate, SideSource, columns_of};
+use super::design::Design;
+use super::pool::Pool;
+use effects::{Backlash, GearPeriodic, IdentifiedEffect, TorqueSign};
+use errors::Error;
+use measurements::MeasurementSet;
+use poe::LocalPoe;
+
+/// Alternations of the side and the classifier (the sides settle in two or three).
+const ALTERNATIONS: usize = 5;
+
+/// One joint's learnt side: a column per fold, learnt without its rows, and one on every row.
+#[derive(Debug, Clone)]
+pub(crate) struct LearntSide {
+    /// 0-based joint.
+    pub joint: usize,
+    /// Weighted column of every pose, side learnt without fold `f`'s rows.
+    pub per_fold: Vec<Vec<f64>>,
+    /// The same learnt on every row, and the effect it defines (what a fit would use).
+    pub all: Vec<f64>,
+    /// The effect learnt on every row.
+    pub model: IdentifiedEffect,
+}
+
+fn sign(x: f64) -> f64 {
+    loadsim::backlash_joint_regressor(&[x])[0]
+}
+
+/// Learns the side of `source`'s joint without the folds `left_out`; returns the effect.
+fn learn(
+    pool: &Pool,
+    source: &SideSource,
+    compliance: &Candidate,
+    compliance_columns: &[usize],
+    twist_rows: &[f64],
+    data: &MeasurementSet,
+    left_out: &[usize],
+) -> Result<IdentifiedEffect, Error> {
+    let k = twist_rows.len() / data.rows.len().max(1);
+    let scalars: Vec<Vec<f64>> =
+        data.rows.iter().map(|row| compliance.model.features(row, row.tool)).collect::<Result<_, _>>()?;
+    let train: Vec<usize> = (0..pool.folds()).filter(|f| !left_out.contains(f)).collect();
+    let torque = |theta: &[f64], i: usize| -> f64 { scalars[i].iter().zip(theta).map(|(s, t)| s * t).sum() };
+    let kinematic = pool.kinematic_columns();
+    let with: Vec<usize> = kinematic.iter().chain(compliance_columns).copied().collect();
+    let beta = pool.solve(left_out, &with)?;
+    let mut pi: Vec<f64> = beta[kinematic.len()..].to_vec();
+    let mut signs: Vec<f64> = (0..data.rows.len()).map(|i| sign(torque(&pi, i))).collect();
+    // What the kinematics alone leave on the training rows, pose by pose.
+    let beta0 = pool.solve(left_out, &kinematic)?;
+    let residual: Vec<(usize, Vec<f64>)> = train
+        .iter()
+        .flat_map(|&g| {
+            let r = pool.weighted_residual(g, &kinematic, &beta0);
+            pool.fold_poses(g)
+                .iter()
+                .enumerate()
+                .map(move |(p, &i)| (i, r[p * k..(p + 1) * k].to_vec()))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let dot = |i: usize, r: &[f64]| -> f64 { (0..k).map(|c| twist_rows[i * k + c] * r[c]).sum() };
+    for _ in 0..ALTERNATIONS {
+        let (mut numerator, mut denominator) = (0.0, 0.0);
+        for (i, r) in &residual {
+            numerator += signs[*i] * dot(*i, r);
+            denominator += (0..k).map(|c| twist_rows[i * k + c].powi(2)).sum::<f64>();
+        }
+        let band = numerator / denominator.max(f64::MIN_POSITIVE);
+        // Flipping a pose's side moves its prediction by −2 b s_i t_i: better when b s_i ⟨t_i, r_i⟩ < 0.
+        let flipped: Vec<(usize, f64)> = residual
+            .iter()
+            .map(|(i, r)| (*i, if band * signs[*i] * dot(*i, r) < 0.0 { -signs[*i] } else { signs[*i] }))
+            .collect();
+        let width = pi.len();
+        let y = nalgebra::DMatrix::from_fn(flipped.len(), width, |p, l| scalars[flipped[p].0][l]);
+        let norms: Vec<f64> = (0..width).map(|l| y.column(l).norm().max(f64::MIN_POSITIVE)).collect();
+        let scaled = nalgebra::DMatrix::from_fn(flipped.len(), width, |p, l| y[(p, l)] / norms[l]);
+        let target = nalgebra::DVector::from_iterator(flipped.len(), flipped.iter().map(|(_, s)| *s));
+        // A failed SVD keeps the sides found so far, which are a valid classifier's.
+        let Ok(solution) = scaled.svd(true, true).solve(&target, 1e-10) else {
+            break;
+        };
+        pi = solution.iter().zip(&norms).map(|(p, n)| p / n).collect();
+        let next: Vec<f64> = (0..data.rows.len()).map(|i| sign(torque(&pi, i))).collect();
+        if next == signs {
+            break;
+        }
+        signs = next;
+    }
+    let learnt = TorqueSign::Learnt {
+        load: source.load.clone(),
+        columns: source.terms.iter().map(|t| t.column).collect(),
+        coefficients: pi.iter().zip(&source.terms).map(|(c, t)| c / t.scale).collect(),
+    };
+    let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
+    Ok(IdentifiedEffect::Backlash(Backlash::new(source.joint, learnt, &data.rows, &tools)?))
+}
+
+/// The learnt side of every source joint: per fold, and on every row.
+pub(crate) fn learnt_sides(
+    pool: &Pool,
+    design: &Design,
+    model: &LocalPoe,
+    data: &MeasurementSet,
+    candidates: &[Candidate],
+    candidate_columns: &[Vec<usize>],
+    sources: &[SideSource],
+) -> Result<Vec<LearntSide>, Error> {
+    let mut out = Vec::new();
+    for source in sources {
+        let compliance = &candidates[source.compliance];
+        let columns = &candidate_columns[source.compliance];
+        // The joint's bare twist: order 0's cosine feature is 1 on every row.
+        let bare = IdentifiedEffect::GearPeriodic(GearPeriodic::new(source.joint, vec![0], &data.rows)?);
+        let twist_rows = columns_of(design, &bare, model, data)?.swap_remove(0);
+        let mut per_fold = Vec::with_capacity(pool.folds());
+        for f in 0..pool.folds() {
+            let effect = learn(pool, source, compliance, columns, &twist_rows, data, &[f])?;
+            per_fold.push(columns_of(design, &effect, model, data)?.swap_remove(0));
+        }
+        let effect = learn(pool, source, compliance, columns, &twist_rows, data, &[])?;
+        let all = columns_of(design, &effect, model, data)?.swap_remove(0);
+        let nonzero = |c: &Vec<f64>| c.iter().any(|v| v.abs() > 1e-12);
+        if nonzero(&all) && per_fold.iter().all(nonzero) {
+            out.push(LearntSide { joint: source.joint, per_fold, all, model: effect });
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::candidates::{Settings, build_candidates};
+    use super::super::design::Weights;
+    use super::super::pool::{KinematicPrior, PriorOptions};
+    use super::super::{fold_assignment, terms_of};
+    use super::*;
+    use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell};
+    use robot::RobotDescription;
+
+    #[test]
+    fn a_fold_s_learnt_side_does_not_depend_on_the_fold_s_own_rows() {
+        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron");
+        let robot = RobotDescription::read(&path).unwrap();
+        let cell = simulated_cell(&robot, &Perturbation::default(), 41).unwrap();
+        let effects = Effects {
+            backlash: Some(loadsim::Backlash::uniform(6, 3e-4)),
+            tracker_noise: Some(TrackerNoise::default()),
+            ..Effects::default()
+        };
+        let config = GeneratorConfig { sample_count: 120, seed: 41, ..GeneratorConfig::default() };
+        let data = simulate(&cell, &effects, &joint_ranges(&robot), &config, false).unwrap();
+        let blind = RobotDescription { dynamics: None, ..robot.clone() };
+        let nominal = blind.nominal_model().unwrap();
+        let model = model::geometric::fit_geometry(
+            &nominal,
+            &data,
+            poe::identify::Scope::Full,
+            &poe::identify::IdentificationOptions::default(),
+        )
+        .unwrap()
+        .model;
+        let design = Design::new(&model, &data, Weights { position_m: 1e-4, rotation_rad: 1.0 }).unwrap();
+        let settings = Settings { moving: &[], orders: &[1], series_sd: 1e-3 };
+        let (candidates, sources) = build_candidates(&blind, &model, &data, &design, &settings).unwrap();
+        assert!(!sources.is_empty());
+        let fold = fold_assignment(data.rows.len(), 5, 0);
+        let prior = PriorOptions::default();
+        let sides = |design: &Design| {
+            let (terms, blocks) = terms_of(&candidates, design.kinematic.ncols());
+            let columns: Vec<Vec<usize>> = terms.iter().map(|t| t.columns.clone()).collect();
+            let pool = Pool::new(design, &KinematicPrior::new(&nominal, &model, &prior), &blocks, &fold, 5, &prior);
+            learnt_sides(&pool, design, &model, &data, &candidates, &columns, &sources).unwrap()
+        };
+        let before = sides(&design);
+        // Other measurements on the poses of fold 0 only.
+        let mut changed = design.clone();
+        for (i, _) in fold.iter().enumerate().filter(|(_, f)| **f == 0) {
+            for r in 0..3 {
+                changed.y[3 * i + r] += if (i + r) % 2 == 0 { 40.0 } else { -40.0 };
+            }
+        }
+        let after = sides(&changed);
+        assert_eq!(before.len(), after.len());
+        let mut moved_elsewhere = false;
+        for (a, b) in before.iter().zip(&after) {
+            assert_eq!(a.per_fold[0], b.per_fold[0], "joint {}: fold 0's side saw fold 0", a.joint + 1);
+            moved_elsewhere |= a.per_fold[1] != b.per_fold[1];
+        }
+        assert!(moved_elsewhere, "the other folds learn from fold 0's rows");
+    }
+}

@@ -1,0 +1,376 @@
+//! The diagnosis as people read it: a ten-second summary, a markdown report with plots written
+//! into a folder, and the SPEC's JSON (the [`Diagnosis`] itself, serialised as it is).
+
+use super::candidates::Effect;
+use super::noise::NoiseSource;
+use super::regions::{PoseDiagnosis, Region};
+use super::{Diagnosis, svg};
+use errors::Error;
+use measurements::InputFiles;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// One candidate tried alone on top of the geometric model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CandidateScore {
+    /// The effect.
+    pub effect: Effect,
+    /// 1-based joints.
+    pub joints: Vec<usize>,
+    /// For gear periodic error: the order of the Fourier series (harmonics 1 to this), as the
+    /// cross-validation of all folds prefers it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub harmonic: Option<u32>,
+    /// Number of parameters it adds.
+    pub parameters: usize,
+    /// Cross-validated mean position error with it, mm.
+    pub heldout_after_mm: f64,
+}
+
+/// One harmonic of a selected periodic error, fitted on every row.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DominantHarmonic {
+    /// Cycles per turn of the joint.
+    pub order: u32,
+    /// Its period in the joint's angle, degrees.
+    pub period_deg: f64,
+    /// Its amplitude, µrad.
+    pub amplitude_urad: f64,
+}
+
+/// The shape of a selected periodic error, fitted on every row.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SeriesShape {
+    /// RMS of the joint error over the data (its mean removed), µrad.
+    pub rms_urad: f64,
+    /// The span of the joint's angles in the data, degrees: no period longer than this is
+    /// resolved.
+    pub range_deg: f64,
+    /// The strongest harmonics among those whose period fits in the range, largest first.
+    pub dominant: Vec<DominantHarmonic>,
+}
+
+/// An effect the selection kept.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SelectedEffect {
+    /// The effect.
+    pub effect: Effect,
+    /// 1-based joints.
+    pub joints: Vec<usize>,
+    /// For gear periodic error: the order of the Fourier series a fit on every row should use
+    /// (harmonics 1 to this).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub harmonic: Option<u32>,
+    /// For gear periodic error: the order each fold chose by cross-validation on its own rows.
+    #[serde(skip_serializing_if = "Vec::is_empty", default)]
+    pub fold_orders: Vec<u32>,
+    /// For gear periodic error: its size and strongest periods.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub shape: Option<SeriesShape>,
+    /// Cross-validated mean position error with it and every earlier selection, mm.
+    pub heldout_after_mm: f64,
+    /// Signed-rank statistic of its per-pose gain over the previous step.
+    pub z: f64,
+}
+
+fn describe(effect: Effect, joints: &[usize], harmonic: Option<u32>) -> String {
+    let mut text = effect.name().replace('_', " ");
+    if !joints.is_empty() {
+        let list: Vec<String> = joints.iter().map(usize::to_string).collect();
+        text.push_str(&format!(" on joint{} {}", if joints.len() > 1 { "s" } else { "" }, list.join(", ")));
+    }
+    if let Some(h) = harmonic {
+        text.push_str(&format!(" (harmonics 1–{h})"));
+    }
+    text
+}
+
+fn describe_selected(s: &SelectedEffect) -> String {
+    let mut text = describe(s.effect, &s.joints, s.harmonic);
+    if let Some(shape) = &s.shape {
+        text.push_str(&format!(", {:.0} µrad RMS", shape.rms_urad));
+        if shape.dominant.is_empty() {
+            text.push_str(&format!(", no period shorter than its {:.0}° range", shape.range_deg));
+        } else {
+            let periods: Vec<String> =
+                shape.dominant.iter().map(|h| format!("{:.1}° ({:.0} µrad)", h.period_deg, h.amplitude_urad)).collect();
+            text.push_str(&format!(", dominant periods {}", periods.join(", ")));
+        }
+    }
+    text
+}
+
+fn noise_source(noise: &super::NoiseFloor) -> String {
+    match noise.source {
+        NoiseSource::Given => "given".into(),
+        NoiseSource::Repeats => "from repeated poses".into(),
+        NoiseSource::TrackerDefault => {
+            format!("tracker default: {}", noise.instrument.as_deref().unwrap_or("laser tracker"))
+        }
+    }
+}
+
+fn list(joints: &[usize]) -> String {
+    joints.iter().map(usize::to_string).collect::<Vec<_>>().join(", ")
+}
+
+impl Diagnosis {
+    /// The SPEC JSON text: the diagnosis as it is, without the per-pose table.
+    pub fn to_json(&self) -> Result<String, Error> {
+        serde_json::to_string(self).map_err(|source| Error::Json { what: "diagnosis", source })
+    }
+
+    /// The region whose geometric-model error is largest, with at least 15 poses.
+    fn worst_region(&self) -> Option<&Region> {
+        self.regions
+            .iter()
+            .filter(|r| r.dimension != "component" && r.n >= 15)
+            .max_by(|a, b| a.before_mm.total_cmp(&b.before_mm))
+    }
+
+    /// A summary a person reads in ten seconds.
+    pub fn summary(&self) -> String {
+        let mut out = String::new();
+        let kind = if self.full_pose { "full pose" } else { "position only" };
+        out.push_str(&format!(
+            "{}: {} poses, {kind}, joints moving: {}\n",
+            self.robot,
+            self.n,
+            list(&self.moving_joints)
+        ));
+        let verdict = match self.verdict.effect {
+            _ if self.gross_outliers.attribution_refused => self.gross_outliers.verdict_reason().unwrap_or_default(),
+            Effect::None => "none: nothing beats the noise floor significantly".to_owned(),
+            Effect::Unknown if self.verdict.joints.is_empty() => {
+                "unknown: structure is left that no candidate explains".to_owned()
+            }
+            Effect::Unknown => format!(
+                "unknown: structure no candidate explains, in the {} of joint{} {}",
+                // A prismatic joint has a position, not an angle.
+                match self.verdict.joints.iter().filter(|j| self.prismatic_joints.contains(j)).count() {
+                    0 => "angles",
+                    n if n == self.verdict.joints.len() => "positions",
+                    _ => "angles and positions",
+                },
+                if self.verdict.joints.len() > 1 { "s" } else { "" },
+                list(&self.verdict.joints)
+            ),
+            _ => describe(self.verdict.effect, &self.verdict.joints, None),
+        };
+        out.push_str(&self.gross_outliers.summary_line().unwrap_or_default());
+        out.push_str(&format!("  verdict:        {verdict}\n"));
+        let change = |after: f64| 100.0 * (1.0 - after / self.heldout_before_mm.max(f64::MIN_POSITIVE));
+        out.push_str(&format!(
+            "  held-out error: {:.4} mm -> {:.4} mm with the verdict's effect ({:.0} % less)\n",
+            self.heldout_before_mm,
+            self.heldout_after_mm,
+            change(self.heldout_after_mm)
+        ));
+        if (self.heldout_after_selected_mm - self.heldout_after_mm).abs() > 1e-9 {
+            out.push_str(&format!(
+                "                  {:.4} mm with every selected effect ({:.0} % less)\n",
+                self.heldout_after_selected_mm,
+                change(self.heldout_after_selected_mm)
+            ));
+        }
+        if let (Some(before), Some(after)) = (self.off_poses_before_mm, self.off_poses_after_mm) {
+            let per_joint: Vec<String> =
+                self.arcs.iter().map(|a| format!("{} {:.3} -> {:.3}", a.joint, a.before_mm, a.after_mm)).collect();
+            out.push_str(&format!(
+                "  off the poses:  {before:.4} mm -> {after:.4} mm ({:.0} % less) with arcs of one joint's angles held out\n                  (the ends of its range, gaps, other configurations; per joint, mm: {})\n",
+                100.0 * (1.0 - after / before.max(f64::MIN_POSITIVE)),
+                per_joint.join(", ")
+            ));
+        }
+        for s in &self.selected {
+            out.push_str(&format!(
+                "  selected:       {} -> {:.4} mm (z = {:.1})\n",
+                describe_selected(s),
+                s.heldout_after_mm,
+                s.z
+            ));
+        }
+        if let Some(gp) = &self.explainable {
+            out.push_str(&format!(
+                "  a GP on the joint angles: {:.4} mm held out (what any smooth model could reach)",
+                gp.heldout_after_gp_mm
+            ));
+            match self.explained_fraction {
+                Some(f) => out.push_str(&format!("; the selected effects explain {:.0} % of that\n", 100.0 * f)),
+                None => out.push('\n'),
+            }
+        }
+        if let Some(r) = self.remaining.as_ref().filter(|r| r.significant) {
+            out.push_str(&format!(
+                "  left:           a GP on what the effects leave still lowers it to {:.4} mm (z = {:.1})\n",
+                r.heldout_after_gp_mm, r.z
+            ));
+        }
+        out.push_str(&format!(
+            "  noise floor:    {:.4} mm ({:.4} mm per axis, {})\n",
+            self.noise.floor_mm,
+            self.noise.sigma_mm,
+            noise_source(&self.noise)
+        ));
+        let runners: Vec<String> = self
+            .candidates
+            .iter()
+            .take(3)
+            .map(|c| format!("{} {:.4} mm", describe(c.effect, &c.joints, c.harmonic), c.heldout_after_mm))
+            .collect();
+        out.push_str(&format!("  best alone:     {}\n", runners.join("; ")));
+        if let Some(r) = self.worst_region() {
+            out.push_str(&format!(
+                "  worst region:   {} {} ({} poses): {:.4} mm -> {:.4} mm\n",
+                r.dimension, r.bin, r.n, r.before_mm, r.after_mm
+            ));
+        }
+        out
+    }
+
+    /// The plots, as `(file name, SVG text)`: held-out error against each moving joint, the
+    /// payload, the temperature and the time, before and after.
+    pub fn plots(&self) -> Vec<(String, String)> {
+        let mut plots = Vec::new();
+        let series = |key: &dyn Fn(&PoseDiagnosis) -> f64| -> Vec<svg::Series> {
+            vec![
+                svg::Series {
+                    name: "geometric model".into(),
+                    colour: "#9a9a9a",
+                    points: self.poses.iter().map(|p| (key(p), p.before_error_mm())).collect(),
+                },
+                svg::Series {
+                    name: "with the selected effects".into(),
+                    colour: "#1f6fb4",
+                    points: self.poses.iter().map(|p| (key(p), p.after_error_mm())).collect(),
+                },
+            ]
+        };
+        for &joint in &self.moving_joints {
+            let j = joint - 1;
+            let title = format!("Held-out error against joint {joint}");
+            let svg = if self.prismatic_joints.contains(&joint) {
+                svg::scatter(&title, &format!("joint {joint} (mm)"), "error (mm)", &series(&|p| p.q[j] * 1e3))
+            } else {
+                svg::scatter(&title, &format!("joint {joint} (deg)"), "error (mm)", &series(&|p| p.q[j].to_degrees()))
+            };
+            plots.push((format!("joint{joint}.svg"), svg));
+        }
+        let varies = |key: &dyn Fn(&PoseDiagnosis) -> Option<f64>| {
+            let values: Vec<f64> = self.poses.iter().filter_map(key).collect();
+            values.len() == self.poses.len() && values.iter().any(|v| *v != values[0])
+        };
+        if varies(&|p| Some(p.payload_kg)) {
+            let s = series(&|p| p.payload_kg);
+            plots.push((
+                "payload.svg".into(),
+                svg::scatter("Held-out error against payload", "payload (kg)", "error (mm)", &s),
+            ));
+        }
+        if varies(&|p| p.temp_c) {
+            let s = series(&|p| p.temp_c.unwrap_or(0.0));
+            plots.push((
+                "temperature.svg".into(),
+                svg::scatter("Held-out error against temperature", "temperature (°C)", "error (mm)", &s),
+            ));
+        }
+        if varies(&|p| p.t_s) {
+            let s = series(&|p| p.t_s.unwrap_or(0.0) / 3600.0);
+            plots.push(("time.svg".into(), svg::scatter("Held-out error against time", "time (h)", "error (mm)", &s)));
+        }
+        plots
+    }
+
+    /// The markdown report; `plots` are the file names of [`Diagnosis::plots`], relative to it.
+    pub fn markdown(&self, plots: &[String]) -> String {
+        let mut out = format!("# Diagnosis: {}\n\n```\n{}```\n\n", self.robot, self.summary());
+        out.push_str("## Which effect\n\nEvery candidate alone on top of the geometric model, cross-validated ");
+        out.push_str(&format!(
+            "({} poses; a step is kept when its signed-rank z exceeds {:.2}):\n\n",
+            self.n, self.critical_z
+        ));
+        out.push_str("| candidate | parameters | held-out mean error (mm) |\n| --- | ---: | ---: |\n");
+        out.push_str(&format!("| geometric model alone | 0 | {:.4} |\n", self.heldout_before_mm));
+        for c in &self.candidates {
+            out.push_str(&format!(
+                "| {} | {} | {:.4} |\n",
+                describe(c.effect, &c.joints, c.harmonic),
+                c.parameters,
+                c.heldout_after_mm
+            ));
+        }
+        out.push_str("\nSelected, in order:\n\n");
+        if self.selected.is_empty() {
+            out.push_str("- nothing\n");
+        }
+        for s in &self.selected {
+            out.push_str(&format!("- {}: {:.4} mm (z = {:.1})", describe_selected(s), s.heldout_after_mm, s.z));
+            if !s.fold_orders.is_empty() {
+                out.push_str(&format!("; orders chosen inside the folds: {:?}", s.fold_orders));
+            }
+            out.push('\n');
+        }
+        for (title, check) in [
+            ("the geometric model's residual", &self.explainable),
+            ("what the selected effects leave", &self.remaining),
+        ] {
+            if let Some(gp) = check {
+                out.push_str(&format!(
+                    "\nA cross-validated GP on {title}: {:.4} mm held out (z = {:.1}, {:.0} % less{}). Length scales (input standard deviations): {}.\n",
+                    gp.heldout_after_gp_mm,
+                    gp.z,
+                    100.0 * gp.gain,
+                    if gp.significant { ", significant" } else { "" },
+                    gp.length_scales
+                        .iter()
+                        .map(|s| format!("{:?} {:.2}", s.input, s.length_scale))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+            }
+        }
+        out.push_str(&format!(
+            "\n## Where\n\nHeld-out position error by region (mm), noise floor {:.4} mm ({}).\n\n",
+            self.noise.floor_mm,
+            noise_source(&self.noise)
+        ));
+        out.push_str("| by | group | poses | geometric model | with the selected effects | before / floor |\n| --- | --- | ---: | ---: | ---: | ---: |\n");
+        for r in &self.regions {
+            out.push_str(&format!(
+                "| {} | {} | {} | {:.4} | {:.4} | {:.1} |\n",
+                r.dimension,
+                r.bin,
+                r.n,
+                r.before_mm,
+                r.after_mm,
+                r.before_mm / self.noise.floor_mm.max(f64::MIN_POSITIVE)
+            ));
+        }
+        if !plots.is_empty() {
+            out.push_str("\n## Plots\n\n");
+            for p in plots {
+                out.push_str(&format!("![{p}]({p})\n\n"));
+            }
+        }
+        out
+    }
+
+    /// Writes the report folder: `diagnosis.md` and its SVG plots (the folder is made if need
+    /// be), each file atomically ([`measurements::write_file`]). Every file is checked against `inputs`
+    /// (as the output of `option`) before the first is written, so a refusal writes nothing.
+    /// Returns the path of `diagnosis.md`.
+    pub fn write_report(&self, folder: &Path, option: &'static str, inputs: &InputFiles) -> Result<PathBuf, Error> {
+        let plots = self.plots();
+        let names: Vec<String> = plots.iter().map(|(name, _)| name.clone()).collect();
+        let markdown = folder.join("diagnosis.md");
+        for path in names.iter().map(|name| folder.join(name)).chain([markdown.clone()]) {
+            inputs.check_output(option, &path)?;
+        }
+        std::fs::create_dir_all(folder).map_err(|source| Error::Io { path: folder.display().to_string(), source })?;
+        for (name, svg) in &plots {
+            measurements::write_file(&folder.join(name), svg.as_bytes())?;
+        }
+        measurements::write_file(&markdown, self.markdown(&names).as_bytes())?;
+        Ok(markdown)
+    }
+}

@@ -1,0 +1,107 @@
+//! Backlash: a joint sits at one side of its dead band or the other, following the sign of the
+//! torque it carries, `δq_j = b_j sign(τ_j)` (`loadsim::backlash_joint_regressor`).
+
+use super::{LoadFrame, Regressor, rms_scales};
+use crate::Direction;
+use errors::Error;
+use loadsim::{Payload, RobotDynamics};
+use measurements::Measurement;
+use serde::{Deserialize, Serialize};
+
+/// Where the sign of the joint's torque comes from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TorqueSign {
+    /// The measured torque (`tauN_nm`).
+    Measured,
+    /// The static torque of a mass model (the robot file's, or a stand-in):
+    /// `loadsim::static_torque`.
+    Stated {
+        /// Gravity and the nominal arm.
+        load: LoadFrame,
+        /// The masses (and balancer) that give the torque.
+        dynamics: RobotDynamics,
+    },
+    /// A torque learnt from the data as a combination of the gravity-torque regressors of the
+    /// joint's row (`LoadFrame::regressors`): `Σ_l coefficients_l · regressor_{columns_l}`.
+    Learnt {
+        /// Gravity and the nominal arm.
+        load: LoadFrame,
+        /// Columns of the joint's regressor row (4 per link, `4n` the payload's).
+        columns: Vec<usize>,
+        /// Their coefficients.
+        coefficients: Vec<f64>,
+    },
+}
+
+/// Backlash of one joint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Backlash {
+    /// 0-based joint.
+    pub joint: usize,
+    /// The torque whose sign selects the side.
+    pub sign: TorqueSign,
+    /// The sign is divided by this (its RMS on the training poses, 1 where it vanishes).
+    pub scale: Vec<f64>,
+    /// The half band, rad per unit of the scaled sign.
+    pub theta: Vec<f64>,
+}
+
+fn sign(x: f64) -> f64 {
+    loadsim::backlash_joint_regressor(&[x])[0]
+}
+
+impl Backlash {
+    /// Backlash of `joint` (1-based) whose side is set by `sign`, scaled on the training rows.
+    pub fn new(joint: usize, sign: TorqueSign, rows: &[Measurement], tools: &[usize]) -> Result<Self, Error> {
+        let mut model = Self { joint, sign, scale: vec![1.0], theta: vec![0.0] };
+        let raw: Vec<Vec<f64>> =
+            rows.iter().zip(tools).map(|(row, &tool)| model.features(row, tool)).collect::<Result<_, _>>()?;
+        model.scale = rms_scales(&raw);
+        Ok(model)
+    }
+
+    /// The torque of the joint at one row, whose sign is the feature.
+    pub fn torque(&self, row: &Measurement, tool: usize) -> Result<f64, Error> {
+        let j = self.joint;
+        let missing = Error::EffectJoint { joint: j + 1, joint_count: row.q.len() };
+        match &self.sign {
+            TorqueSign::Measured => match &row.torques_nm {
+                Some(tau) => tau.get(j).copied().ok_or(missing),
+                None => Err(Error::EffectNeedsColumn { line: row.line, effect: "backlash", column: "tau1_nm" }),
+            },
+            TorqueSign::Stated { load, dynamics } => {
+                let payload = Payload::at_tool(row.payload_kg);
+                let torque = loadsim::static_torque(&load.base_model, dynamics, &row.q, tool, &payload)?;
+                torque.get(j).copied().ok_or(missing)
+            }
+            TorqueSign::Learnt { load, columns, coefficients } => {
+                let regressors = load.regressors(row, tool)?;
+                let row = regressors.get(j).ok_or(missing)?;
+                Ok(columns.iter().zip(coefficients).map(|(&c, k)| row.get(c).copied().unwrap_or(0.0) * k).sum())
+            }
+        }
+    }
+}
+
+impl Regressor for Backlash {
+    fn directions(&self) -> Vec<Direction> {
+        vec![Direction::Joint(self.joint)]
+    }
+
+    fn features(&self, row: &Measurement, tool: usize) -> Result<Vec<f64>, Error> {
+        Ok(vec![sign(self.torque(row, tool)?) / self.scale[0]])
+    }
+
+    fn theta(&self) -> &[f64] {
+        &self.theta
+    }
+
+    fn theta_mut(&mut self) -> &mut Vec<f64> {
+        &mut self.theta
+    }
+
+    fn parameter_names(&self) -> Vec<String> {
+        vec![format!("joint {} half band", self.joint + 1)]
+    }
+}

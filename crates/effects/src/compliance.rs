@@ -1,0 +1,226 @@
+//! Joint compliance: each joint turns by `δq_j = c_j τ_j` under the torque it carries (the paper's
+//! ref. \[15\]; `loadsim::compliance_deflection`). With measured torques (`tauN_nm`) that is one
+//! parameter per joint. Without them the gravity torque is linear in the links' unknown mass
+//! moments, `τ_j = Y_j(q) π + τ_payload,j(q, m)` (`loadsim::gravity_regressor`), so the deflection
+//! is linear in the products `c_j π_l` and in `c_j`: one parameter per entry of `Y`'s row `j` that
+//! is not zero on every row, and one for the payload; no masses needed.
+
+use super::{LoadFrame, Regressor, rms_scales};
+
+use crate::Direction;
+use errors::Error;
+use measurements::Measurement;
+use serde::{Deserialize, Serialize};
+
+/// Which torque drives the deflection.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ComplianceTorque {
+    /// The measured joint torques of each row (`tauN_nm`), as they are.
+    Measured,
+    /// The measured joint torques as the gravity-torque regressors explain them: each joint's
+    /// `tauN_nm` fitted on the training rows by least squares over its row of `Y(q)` and the
+    /// payload's torque ([`TorqueFit`]). The torque without the sensor's noise (0.5 N·m on an
+    /// iiwa-class sensor moves a 5000 N·m/rad joint by 0.1 mrad), and one that needs no torque
+    /// column to predict with (eval, compensate).
+    Modelled {
+        /// Gravity and the nominal arm.
+        load: LoadFrame,
+        /// One fit per joint, in joint order.
+        fits: Vec<TorqueFit>,
+    },
+    /// The gravity-torque regressors of the nominal arm, with the payload's torque.
+    GravityRegressor(LoadFrame),
+}
+
+/// A joint's torque as a combination of its gravity-torque regressors.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TorqueFit {
+    /// Columns of the joint's regressor row (4 per link, `4n` the payload's).
+    pub columns: Vec<usize>,
+    /// Their coefficients, N·m per unit of the regressor.
+    pub coefficients: Vec<f64>,
+}
+
+impl TorqueFit {
+    /// Fits joint `joint`'s measured torque on `rows` over the regressor columns that are not
+    /// zero on every row (SVD least squares, directions below 1e-10 of the largest dropped: the
+    /// regressor columns of neighbouring links are often exactly collinear).
+    fn new(load: &LoadFrame, joint: usize, rows: &[Measurement], tools: &[usize]) -> Result<Self, Error> {
+        let mut regressors = Vec::with_capacity(rows.len());
+        let mut measured = Vec::with_capacity(rows.len());
+        for (row, &tool) in rows.iter().zip(tools) {
+            let all = load.regressors(row, tool)?;
+            regressors.push(all.get(joint).cloned().unwrap_or_default());
+            let tau = row.torques_nm.as_ref().and_then(|t| t.get(joint)).copied().ok_or(Error::EffectNeedsColumn {
+                line: row.line,
+                effect: "joint_compliance",
+                column: "tau1_nm",
+            })?;
+            measured.push(tau);
+        }
+        let width = regressors.first().map_or(0, Vec::len);
+        let columns: Vec<usize> =
+            (0..width).filter(|&c| regressors.iter().any(|r| r.get(c).is_some_and(|v| v.abs() > 1e-12))).collect();
+        if columns.is_empty() || rows.is_empty() {
+            // Gravity never loads this joint (a vertical first axis): no torque to model.
+            return Ok(Self { columns: Vec::new(), coefficients: Vec::new() });
+        }
+        let norms: Vec<f64> = columns
+            .iter()
+            .map(|&c| regressors.iter().map(|r| r[c] * r[c]).sum::<f64>().sqrt().max(f64::MIN_POSITIVE))
+            .collect();
+        let a = nalgebra::DMatrix::from_fn(rows.len(), columns.len(), |i, k| regressors[i][columns[k]] / norms[k]);
+        let b = nalgebra::DVector::from_vec(measured);
+        let coefficients = match a.svd(true, true).solve(&b, 1e-10) {
+            Ok(x) => x.iter().zip(&norms).map(|(x, n)| x / n).collect(),
+            Err(_) => vec![0.0; columns.len()],
+        };
+        Ok(Self { columns, coefficients })
+    }
+
+    fn torque(&self, regressor_row: &[f64]) -> f64 {
+        self.columns
+            .iter()
+            .zip(&self.coefficients)
+            .map(|(&c, k)| regressor_row.get(c).copied().unwrap_or(0.0) * k)
+            .sum()
+    }
+}
+
+/// One parameter: one joint's deflection per unit of one torque regressor.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ComplianceTerm {
+    /// 0-based joint whose deflection the term drives.
+    pub joint: usize,
+    /// Column of the gravity regressor `Y` (4 per link), or `4n` for the payload torque; 0 for a
+    /// measured torque.
+    pub column: usize,
+    /// The regressor is divided by this (its RMS on the training poses), so that the parameters
+    /// are comparable in size: each is the joint's deflection, rad, at an RMS torque.
+    pub scale: f64,
+}
+
+/// Joint compliance, identified with the geometry.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct JointCompliance {
+    /// The torque that drives the deflection.
+    pub torque: ComplianceTorque,
+    /// The parameters' meaning.
+    pub terms: Vec<ComplianceTerm>,
+    /// Their values: radians of deflection per unit of the scaled regressor.
+    pub theta: Vec<f64>,
+}
+
+impl JointCompliance {
+    /// The terms of `joints` (0-based) seen on `rows` driven by `torque`: every regressor that is
+    /// not zero on every row.
+    pub fn new(
+        torque: ComplianceTorque,
+        joints: &[usize],
+        rows: &[Measurement],
+        tools: &[usize],
+    ) -> Result<Self, Error> {
+        let mut model = Self { torque, terms: Vec::new(), theta: Vec::new() };
+        let raw: Vec<Vec<Vec<f64>>> =
+            rows.iter().zip(tools).map(|(row, &tool)| model.torques(row, tool)).collect::<Result<_, _>>()?;
+        for &joint in joints {
+            let width = raw.first().and_then(|r| r.get(joint)).map_or(0, Vec::len);
+            for column in 0..width {
+                let values: Vec<Vec<f64>> = raw.iter().map(|r| vec![r[joint][column]]).collect();
+                // Columns that vanish on every pose (joint 1's vertical axis, a payload of zero
+                // throughout) carry nothing.
+                if values.iter().any(|v| v[0].abs() > 1e-12) {
+                    let scale = rms_scales(&values)[0];
+                    model.terms.push(ComplianceTerm { joint, column, scale });
+                }
+            }
+        }
+        model.theta = vec![0.0; model.terms.len()];
+        Ok(model)
+    }
+
+    /// Joint compliance driven by the measured torques as the gravity-torque regressors explain
+    /// them ([`ComplianceTorque::Modelled`]), one parameter per joint of `joints` whose modelled
+    /// torque is not zero on every row.
+    pub fn modelled(load: LoadFrame, joints: &[usize], rows: &[Measurement], tools: &[usize]) -> Result<Self, Error> {
+        let n = load.base_model.joint_count();
+        let fits = (0..n).map(|j| TorqueFit::new(&load, j, rows, tools)).collect::<Result<_, _>>()?;
+        Self::new(ComplianceTorque::Modelled { load, fits }, joints, rows, tools)
+    }
+
+    /// The torque regressors of one row, joint by joint (one column for a measured or modelled
+    /// torque).
+    fn torques(&self, row: &Measurement, tool: usize) -> Result<Vec<Vec<f64>>, Error> {
+        match &self.torque {
+            ComplianceTorque::Modelled { load, fits } => {
+                let regressors = load.regressors(row, tool)?;
+                Ok(fits.iter().zip(&regressors).map(|(fit, r)| vec![fit.torque(r)]).collect())
+            }
+            ComplianceTorque::Measured => match &row.torques_nm {
+                Some(tau) => Ok(tau.iter().map(|t| vec![*t]).collect()),
+                None => Err(Error::EffectNeedsColumn { line: row.line, effect: "joint_compliance", column: "tau1_nm" }),
+            },
+            ComplianceTorque::GravityRegressor(load) => load.regressors(row, tool),
+        }
+    }
+
+    /// The 0-based joints the terms act on, ascending.
+    pub fn joints(&self) -> Vec<usize> {
+        let mut joints: Vec<usize> = self.terms.iter().map(|t| t.joint).collect();
+        joints.dedup();
+        joints
+    }
+}
+
+impl Regressor for JointCompliance {
+    fn directions(&self) -> Vec<Direction> {
+        self.terms.iter().map(|t| Direction::Joint(t.joint)).collect()
+    }
+
+    fn features(&self, row: &Measurement, tool: usize) -> Result<Vec<f64>, Error> {
+        let torques = self.torques(row, tool)?;
+        self.terms
+            .iter()
+            .map(|t| {
+                let value = torques
+                    .get(t.joint)
+                    .and_then(|r| r.get(t.column))
+                    .copied()
+                    .ok_or(Error::EffectJoint { joint: t.joint + 1, joint_count: torques.len() })?;
+                Ok(value / t.scale)
+            })
+            .collect()
+    }
+
+    fn theta(&self) -> &[f64] {
+        &self.theta
+    }
+
+    fn theta_mut(&mut self) -> &mut Vec<f64> {
+        &mut self.theta
+    }
+
+    fn parameter_names(&self) -> Vec<String> {
+        let links = match &self.torque {
+            ComplianceTorque::GravityRegressor(load) => Some(load.base_model.joint_count()),
+            _ => None,
+        };
+        self.terms
+            .iter()
+            .map(|t| match links {
+                Some(n) if t.column == 4 * n => format!("joint {} x payload torque", t.joint + 1),
+                Some(_) => {
+                    const MOMENT: [&str; 4] = ["m", "m c_x", "m c_y", "m c_z"];
+                    format!(
+                        "joint {} x gravity torque of link {} {}",
+                        t.joint + 1,
+                        t.column / 4 + 1,
+                        MOMENT[t.column % 4]
+                    )
+                }
+                None => format!("joint {} x torque", t.joint + 1),
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,122 @@
+//! Drift: the robot's placement in the tracker frame moves at a constant twist rate, `exp(t ξ̂) T`
+//! (`loadsim::BaseDrift`, `loadsim::drift_regressor`): six parameters, `(v, ω)`.
+
+use super::{Regressor, check_column_varies, rms_scales};
+use crate::Direction;
+use errors::Error;
+use measurements::Measurement;
+use serde::{Deserialize, Serialize};
+
+/// Linear drift of the placement with `t_s`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TimeDrift {
+    /// The time at which the geometry holds (the training rows' mean), s.
+    pub reference_s: f64,
+    /// `Δt` is divided by this (its RMS on the training poses), s; six equal entries.
+    pub scale: Vec<f64>,
+    /// The twist per unit of the scaled `Δt`, `(v, ω)`: metres and radians.
+    pub theta: Vec<f64>,
+    /// `[min, max]` of `t_s` on the training rows widened by `EffectOptions::hold_beyond_span` of
+    /// its width at either end, s: outside it the drift falls back to zero (the geometry's own
+    /// placement), so that a term fitted within one session is never carried on as a straight
+    /// line into another (issue 30). Absent in older model files: applied as fitted, everywhere.
+    #[serde(default)]
+    pub fitted_span: Option<[f64; 2]>,
+}
+
+impl TimeDrift {
+    /// A drift linear in `t_s`, scaled on the training rows, applied up to `hold_beyond_span` of
+    /// their time span beyond either end.
+    pub fn new(rows: &[Measurement], hold_beyond_span: f64) -> Result<Self, Error> {
+        let times: Vec<f64> = rows
+            .iter()
+            .map(|r| r.t_s.ok_or(Error::EffectNeedsColumn { line: r.line, effect: "time_drift", column: "t_s" }))
+            .collect::<Result<_, _>>()?;
+        check_column_varies(&times, rows, "time_drift", "t_s")?;
+        let reference_s = times.iter().sum::<f64>() / times.len().max(1) as f64;
+        let raw: Vec<Vec<f64>> = times.iter().map(|t| vec![t - reference_s; 6]).collect();
+        Ok(Self {
+            reference_s,
+            scale: rms_scales(&raw),
+            theta: vec![0.0; 6],
+            fitted_span: super::span_of(&times, hold_beyond_span),
+        })
+    }
+}
+
+impl Regressor for TimeDrift {
+    fn directions(&self) -> Vec<Direction> {
+        (0..6).map(Direction::Component).collect()
+    }
+
+    fn features(&self, row: &Measurement, _tool: usize) -> Result<Vec<f64>, Error> {
+        let t = row.t_s.ok_or(Error::EffectNeedsColumn { line: row.line, effect: "time_drift", column: "t_s" })?;
+        // Past the span (and its margin) the drift falls back to the placement the geometry holds:
+        // a later session starts from a placement of its own, which no line from this one knows.
+        if self.fitted_span.is_some_and(|[low, high]| !(low..=high).contains(&t)) {
+            return Ok(vec![0.0; self.scale.len()]);
+        }
+        Ok(self.scale.iter().map(|s| (t - self.reference_s) / s).collect())
+    }
+
+    fn theta(&self) -> &[f64] {
+        &self.theta
+    }
+
+    fn theta_mut(&mut self) -> &mut Vec<f64> {
+        &mut self.theta
+    }
+
+    fn parameter_names(&self) -> Vec<String> {
+        ["v_x", "v_y", "v_z", "w_x", "w_y", "w_z"].iter().map(|c| format!("drift {c}")).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Thermal;
+
+    fn row(t_s: f64, temp_c: f64) -> Measurement {
+        Measurement {
+            line: 0,
+            q: vec![0.0],
+            position: lie::Vector3::zeros(),
+            orientation: None,
+            payload_kg: 0.0,
+            tool: 0,
+            temp_c: Some(temp_c),
+            t_s: Some(t_s),
+            torques_nm: None,
+        }
+    }
+
+    /// Issue 30: a drift fitted over one 73-minute session was applied as a straight line eight
+    /// days later. Outside the fitted span the time and the temperature are held at its ends.
+    #[test]
+    fn a_drift_and_a_thermal_growth_are_held_at_the_ends_of_the_span_they_were_fitted_on() {
+        let session: Vec<Measurement> = (0..50).map(|i| row(f64::from(i) * 88.0, 20.0 + f64::from(i) * 0.05)).collect();
+        let drift = TimeDrift::new(&session, 0.0).unwrap();
+        let thermal = Thermal::new(&session, 0.0).unwrap();
+        assert_eq!(drift.fitted_span, Some([0.0, 49.0 * 88.0]));
+        let end = session.last().unwrap();
+        let week_later = row(8.0 * 86_400.0, 9.0);
+        assert_eq!(drift.features(&week_later, 0).unwrap(), vec![0.0; 6]);
+        assert_ne!(drift.features(end, 0).unwrap(), vec![0.0; 6]);
+        assert_eq!(thermal.features(&week_later, 0).unwrap(), thermal.features(&session[0], 0).unwrap());
+        // Inside the span nothing changes.
+        let inside = row(1000.0, 21.0);
+        let raw = (1000.0 - drift.reference_s) / drift.scale[0];
+        assert_eq!(drift.features(&inside, 0).unwrap()[0], raw);
+        // With a margin of one span, half a span past the end is still the line; two spans past
+        // it, nothing.
+        let margin = TimeDrift::new(&session, 1.0).unwrap();
+        let width = 49.0 * 88.0;
+        let at = |t: f64| margin.features(&row(t, 20.0), 0).unwrap()[0];
+        assert_eq!(at(1.5 * width), (1.5 * width - margin.reference_s) / margin.scale[0]);
+        assert_eq!(at(3.0 * width), 0.0);
+        // A model file written before the span was recorded applies the line as it did.
+        let old = TimeDrift { fitted_span: None, ..drift.clone() };
+        assert!(old.features(&week_later, 0).unwrap()[0] > 100.0);
+    }
+}

@@ -1,0 +1,423 @@
+//! Non-geometric effects, each defined once as its regressor: per row, one scalar feature per
+//! parameter, times the twist that parameter moves the pose along ([`Direction`]: a joint's
+//! spatial twist, a fixed left twist, or the arm's thermal growth). The pose error is, to first
+//! order, `y ≈ Σ_l θ_l f_l(row) c_l(q)`, and the effect moves a pose by `exp((Σ_l θ_l f_l c_l)^) T`.
+//!
+//! The same definition gives the diagnosis's candidate columns (`diagnose/candidates.rs`), the
+//! fit's [`poe::identify::PoseCorrection`] (module `correction`), and the calibrated model's
+//! prediction ([`IdentifiedEffect::twist`], applied by `model::Part`): what the diagnosis predicts is what the fit does.
+#![deny(missing_docs)]
+
+/// The default of the fit's `EffectOptions::hold_beyond_span`, also what the diagnosis uses: thermal
+/// growth and drift are applied as fitted up to this fraction of their fitted span beyond either
+/// end, held (growth) or faded to zero (drift) further out. 1: a linear term is trusted as far
+/// beyond its data as the data reaches (issue 30; see `EffectOptions::hold_beyond_span`).
+pub const HOLD_BEYOND_SPAN: f64 = 1.0;
+
+mod backlash;
+mod check;
+mod compliance;
+mod correction;
+mod direction;
+mod drift;
+mod gear;
+mod load_frame;
+mod report;
+mod spec;
+mod thermal;
+
+pub use backlash::{Backlash, TorqueSign};
+pub use compliance::{ComplianceTerm, ComplianceTorque, JointCompliance, TorqueFit};
+pub use direction::Direction;
+pub use drift::TimeDrift;
+pub use gear::{GearOptions, GearPeriodic};
+pub use load_frame::LoadFrame;
+pub use report::effect_reports;
+pub use report::{EffectReport, ParameterReport};
+pub use spec::{EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS};
+pub use thermal::Thermal;
+
+pub use check::{EffectFault, FaultKind, check_effects};
+pub use correction::EffectCorrection;
+pub use direction::RowTwists;
+
+use errors::Error;
+use lie::Vector6;
+use measurements::Measurement;
+use poe::LocalPoe;
+use robot::RobotDescription;
+use serde::{Deserialize, Serialize};
+
+/// An effect as linear in its parameters.
+pub trait Regressor {
+    /// The twist of each parameter.
+    fn directions(&self) -> Vec<Direction>;
+    /// The scaled feature of each parameter at one row (`tool`: the model's tool index).
+    fn features(&self, row: &Measurement, tool: usize) -> Result<Vec<f64>, Error>;
+    /// The parameters' values.
+    fn theta(&self) -> &[f64];
+    /// The parameters' values, to set after a fit.
+    fn theta_mut(&mut self) -> &mut Vec<f64>;
+    /// A name for each parameter, for reports (1-based joints).
+    fn parameter_names(&self) -> Vec<String>;
+}
+
+/// The RMS of each feature over `rows` (one `Vec` per row), 1 where a feature is zero throughout,
+/// so that a scaled parameter is the effect's size at a typical row.
+pub fn rms_scales(rows: &[Vec<f64>]) -> Vec<f64> {
+    let width = rows.first().map_or(0, Vec::len);
+    (0..width)
+        .map(|l| {
+            let mean_sq = rows.iter().map(|r| r[l] * r[l]).sum::<f64>() / rows.len().max(1) as f64;
+            if mean_sq > 0.0 && mean_sq.is_finite() { mean_sq.sqrt() } else { 1.0 }
+        })
+        .collect()
+}
+
+/// Refuses a column with one value on every row: an effect linear in its deviation from the mean
+/// would see zero everywhere and its parameters would be unobservable.
+pub fn check_column_varies(
+    values: &[f64],
+    rows: &[Measurement],
+    effect: &'static str,
+    column: &'static str,
+) -> Result<(), Error> {
+    match values.first() {
+        Some(&value) if values.iter().all(|&v| v == value) => Err(Error::EffectColumnConstant {
+            effect,
+            column,
+            value,
+            rows: values.len(),
+            lines: [rows.first().map_or(0, |r| r.line), rows.last().map_or(0, |r| r.line)],
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// Whether every row has measured joint torques.
+pub fn has_torques(rows: &[Measurement]) -> bool {
+    !rows.is_empty() && rows.iter().all(|r| r.torques_nm.is_some())
+}
+
+/// An effect of a calibrated model, with its identified parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IdentifiedEffect {
+    /// Joint compliance.
+    JointCompliance(JointCompliance),
+    /// Periodic error of one joint in its own angle.
+    GearPeriodic(GearPeriodic),
+    /// Backlash of one joint.
+    Backlash(Backlash),
+    /// Thermal growth with `temp_c`.
+    Thermal(Thermal),
+    /// Drift with `t_s`.
+    TimeDrift(TimeDrift),
+}
+
+/// What the effects of a fit are built from: the robot (for gravity and masses) and the
+/// calibrated kinematics (where the arm and its tools are; the payload hangs from the tools).
+#[derive(Debug, Clone, Copy)]
+pub struct EffectContext<'a> {
+    /// The robot description.
+    pub robot: &'a RobotDescription,
+    /// The calibrated kinematics (reference frame: the tracker).
+    pub kinematics: &'a LocalPoe,
+    /// How gear series fade outside their fitted angles.
+    pub gear: GearOptions,
+    /// [`pipeline::EffectOptions::hold_beyond_span`].
+    pub hold_beyond_span: f64,
+}
+
+impl EffectContext<'_> {
+    /// The load frame, its tools placed from `rows` (`tools`: each row's model tool).
+    pub fn load_frame(&self, rows: &[Measurement], tools: &[usize]) -> Result<LoadFrame, Error> {
+        LoadFrame::new(self.robot, self.kinematics, rows, tools)
+    }
+
+    fn check_joint(&self, spec: &EffectSpec) -> Result<usize, Error> {
+        let joint_count = self.robot.joint_count();
+        match spec.joint() {
+            Some(joint) if joint == 0 || joint > joint_count => Err(Error::EffectJoint { joint, joint_count }),
+            Some(joint)
+                if matches!(spec, EffectSpec::GearPeriodic { .. })
+                    && self.robot.joints[joint - 1].kind == robot::JointType::Prismatic =>
+            {
+                Err(Error::EffectJointKind { effect: "gear_periodic", joint })
+            }
+            Some(joint) => Ok(joint - 1),
+            None => Ok(0),
+        }
+    }
+}
+
+impl IdentifiedEffect {
+    /// The effect `spec` names, its features scaled on `rows` (`tools`: each row's model tool),
+    /// its parameters at zero. Backlash takes the sign of the measured torque where every row has
+    /// one, of the robot's static torque otherwise (its mass model, or a stand-in).
+    pub fn new(
+        spec: &EffectSpec,
+        context: &EffectContext<'_>,
+        rows: &[Measurement],
+        tools: &[usize],
+    ) -> Result<Self, Error> {
+        let joint = context.check_joint(spec)?;
+        Ok(match *spec {
+            EffectSpec::JointCompliance => {
+                let joints: Vec<usize> = (0..context.robot.joint_count()).collect();
+                let load = context.load_frame(rows, tools)?;
+                IdentifiedEffect::JointCompliance(if has_torques(rows) {
+                    JointCompliance::modelled(load, &joints, rows, tools)?
+                } else {
+                    JointCompliance::new(ComplianceTorque::GravityRegressor(load), &joints, rows, tools)?
+                })
+            }
+            EffectSpec::GearPeriodic { harmonics, .. } => IdentifiedEffect::GearPeriodic(GearPeriodic::with_options(
+                joint,
+                (1..=harmonics).collect(),
+                rows,
+                &context.gear,
+            )?),
+            EffectSpec::Backlash { .. } => {
+                let sign = if has_torques(rows) {
+                    TorqueSign::Measured
+                } else {
+                    let dynamics = context.robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(context.robot));
+                    TorqueSign::Stated { load: context.load_frame(rows, tools)?, dynamics }
+                };
+                IdentifiedEffect::Backlash(Backlash::new(joint, sign, rows, tools)?)
+            }
+            EffectSpec::Thermal => IdentifiedEffect::Thermal(Thermal::new(rows, context.hold_beyond_span)?),
+            EffectSpec::TimeDrift => IdentifiedEffect::TimeDrift(TimeDrift::new(rows, context.hold_beyond_span)?),
+        })
+    }
+
+    fn regressor(&self) -> &dyn Regressor {
+        match self {
+            IdentifiedEffect::JointCompliance(e) => e,
+            IdentifiedEffect::GearPeriodic(e) => e,
+            IdentifiedEffect::Backlash(e) => e,
+            IdentifiedEffect::Thermal(e) => e,
+            IdentifiedEffect::TimeDrift(e) => e,
+        }
+    }
+
+    fn regressor_mut(&mut self) -> &mut dyn Regressor {
+        match self {
+            IdentifiedEffect::JointCompliance(e) => e,
+            IdentifiedEffect::GearPeriodic(e) => e,
+            IdentifiedEffect::Backlash(e) => e,
+            IdentifiedEffect::Thermal(e) => e,
+            IdentifiedEffect::TimeDrift(e) => e,
+        }
+    }
+
+    /// The SPEC name of the effect (`joint_compliance`, `gear_periodic`, …).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            IdentifiedEffect::JointCompliance(_) => "joint_compliance",
+            IdentifiedEffect::GearPeriodic(_) => "gear_periodic",
+            IdentifiedEffect::Backlash(_) => "backlash",
+            IdentifiedEffect::Thermal(_) => "thermal",
+            IdentifiedEffect::TimeDrift(_) => "time_drift",
+        }
+    }
+
+    /// The gear series of an effect known only near the angles it was fitted on (see
+    /// [`GearPeriodic::covers`]); `None` for other effects.
+    pub fn angle_coverage(&self) -> Option<&GearPeriodic> {
+        match self {
+            IdentifiedEffect::GearPeriodic(e) if e.fitted_range.is_some() => Some(e),
+            _ => None,
+        }
+    }
+
+    /// How fully the effect applies at `row`: 1 on the joint angles it was fitted on, fading to 0
+    /// outside them (a gear series, [`GearPeriodic::held_and_weight`]); 1 for every other effect.
+    pub fn coverage_weight(&self, row: &Measurement) -> f64 {
+        match self {
+            IdentifiedEffect::GearPeriodic(g) => row.q.get(g.joint).map_or(1.0, |&q| g.held_and_weight(q).1),
+            _ => 1.0,
+        }
+    }
+
+    /// The standard deviation of what the effect leaves uncorrected at `row`, per component of
+    /// the pose error `(v, ω)` at the tool point `point` (m, rad): a gear series faded out of its
+    /// fitted angles leaves a joint error of [`GearPeriodic::faded_sigma`] along the joint's
+    /// twist; zero elsewhere and for every other effect.
+    pub fn sigma(
+        &self,
+        kinematics: &LocalPoe,
+        row: &Measurement,
+        tool: usize,
+        point: &lie::Vector3,
+    ) -> Result<Vector6, Error> {
+        let IdentifiedEffect::GearPeriodic(g) = self else { return Ok(Vector6::zeros()) };
+        let Some(&q) = row.q.get(g.joint) else { return Ok(Vector6::zeros()) };
+        let sigma = g.faded_sigma(q);
+        if sigma == 0.0 {
+            return Ok(Vector6::zeros());
+        }
+        let twist = RowTwists::new(kinematics, &row.q, tool).twist(Direction::Joint(g.joint))?;
+        let w = lie::Vector3::new(twist[3], twist[4], twist[5]);
+        let v = lie::Vector3::new(twist[0], twist[1], twist[2]) + w.cross(point);
+        Ok(Vector6::new(v.x.abs(), v.y.abs(), v.z.abs(), w.x.abs(), w.y.abs(), w.z.abs()) * sigma)
+    }
+
+    /// Whether the effect can report a [`IdentifiedEffect::sigma`] (a gear series that recorded
+    /// its RMS).
+    pub fn has_sigma(&self) -> bool {
+        matches!(self, IdentifiedEffect::GearPeriodic(g) if g.fitted_rms_rad.is_some() && g.taper_rad.is_some())
+    }
+
+    /// The 1-based joints the effect acts on (empty for thermal growth and drift).
+    pub fn joints(&self) -> Vec<usize> {
+        match self {
+            IdentifiedEffect::JointCompliance(e) => e.joints().into_iter().map(|j| j + 1).collect(),
+            IdentifiedEffect::GearPeriodic(e) => vec![e.joint + 1],
+            IdentifiedEffect::Backlash(e) => vec![e.joint + 1],
+            IdentifiedEffect::Thermal(_) | IdentifiedEffect::TimeDrift(_) => Vec::new(),
+        }
+    }
+
+    /// A name for reports: the SPEC item where there is one (`gear_periodic:1:24`), with what
+    /// drives it.
+    pub fn label(&self) -> String {
+        match self {
+            IdentifiedEffect::JointCompliance(e) => match e.torque {
+                ComplianceTorque::Measured => "joint_compliance (measured torques)".into(),
+                ComplianceTorque::Modelled { .. } => {
+                    "joint_compliance (measured torques, modelled on the gravity regressors)".into()
+                }
+                ComplianceTorque::GravityRegressor(_) => "joint_compliance (gravity-torque regressors)".into(),
+            },
+            IdentifiedEffect::GearPeriodic(e) => {
+                let consecutive = e.orders.iter().enumerate().all(|(k, &h)| h as usize == k + 1);
+                match (consecutive, e.orders.last()) {
+                    (true, Some(last)) => format!("gear_periodic:{}:{last}", e.joint + 1),
+                    _ => format!("gear_periodic:{} (harmonics {:?})", e.joint + 1, e.orders),
+                }
+            }
+            IdentifiedEffect::Backlash(e) => {
+                let source = match e.sign {
+                    TorqueSign::Measured => "measured torque",
+                    TorqueSign::Stated { .. } => "static torque of the mass model",
+                    TorqueSign::Learnt { .. } => "torque learnt from the data",
+                };
+                format!("backlash:{} (sign of the {source})", e.joint + 1)
+            }
+            IdentifiedEffect::Thermal(_) => "thermal".into(),
+            IdentifiedEffect::TimeDrift(_) => "time_drift".into(),
+        }
+    }
+
+    /// Number of parameters.
+    pub fn parameter_count(&self) -> usize {
+        self.regressor().theta().len()
+    }
+
+    /// The identified parameters (scaled: the effect's size at a typical training row).
+    pub fn theta(&self) -> &[f64] {
+        self.regressor().theta()
+    }
+
+    /// Sets the identified parameters after a fit (scaled, as [`IdentifiedEffect::theta`]).
+    pub fn set_theta(&mut self, theta: &[f64]) {
+        let own = self.regressor_mut().theta_mut();
+        own.clear();
+        own.extend_from_slice(theta);
+    }
+
+    /// A name for each parameter (1-based joints), for reports.
+    pub fn parameter_names(&self) -> Vec<String> {
+        self.regressor().parameter_names()
+    }
+
+    /// Each parameter's prior standard deviation relative to the effects' common one (1 but for
+    /// a gear series' higher harmonics, [`GearPeriodic::prior_scale`]).
+    pub fn prior_scale(&self) -> Vec<f64> {
+        match self {
+            IdentifiedEffect::GearPeriodic(g) => g.prior_scale(),
+            _ => vec![1.0; self.parameter_count()],
+        }
+    }
+
+    /// The twist of each parameter.
+    pub fn directions(&self) -> Vec<Direction> {
+        self.regressor().directions()
+    }
+
+    /// The scaled features of one row.
+    pub fn features(&self, row: &Measurement, tool: usize) -> Result<Vec<f64>, Error> {
+        self.regressor().features(row, tool)
+    }
+
+    /// The twist the effect adds at one row under `kinematics`: `Σ_l θ_l f_l c_l`.
+    pub fn twist(&self, kinematics: &LocalPoe, row: &Measurement, tool: usize) -> Result<Vector6, Error> {
+        let mut twists = RowTwists::new(kinematics, &row.q, tool);
+        self.twist_with(&mut twists, row, tool)
+    }
+
+    fn twist_with(&self, twists: &mut RowTwists<'_>, row: &Measurement, tool: usize) -> Result<Vector6, Error> {
+        let features = self.features(row, tool)?;
+        let mut total = Vector6::zeros();
+        for ((direction, f), t) in self.directions().into_iter().zip(features).zip(self.theta()) {
+            if *t != 0.0 && f != 0.0 {
+                total += twists.twist(direction)? * (f * t);
+            }
+        }
+        Ok(total)
+    }
+
+    /// The twist per unit of each parameter at every row: `[parameter][row]`, for the diagnosis.
+    pub fn parameter_twists(
+        &self,
+        kinematics: &LocalPoe,
+        rows: &[Measurement],
+        tools: &[usize],
+    ) -> Result<Vec<Vec<Vector6>>, Error> {
+        let directions = self.directions();
+        let mut out = vec![Vec::with_capacity(rows.len()); directions.len()];
+        for (row, &tool) in rows.iter().zip(tools) {
+            let features = self.features(row, tool)?;
+            let mut twists = RowTwists::new(kinematics, &row.q, tool);
+            for (l, (direction, f)) in directions.iter().zip(features).enumerate() {
+                out[l].push(twists.twist(*direction)? * f);
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// A stand-in mass model where the robot file gives none, used only for the *sign* of the static
+/// torque (backlash): each link a slender bar from its joint's axis point to the next one's, 50 kg
+/// per metre, so that the torque's sign follows where the arm's weight lies, which depends on the
+/// geometry far more than on the masses.
+pub fn stand_in_dynamics(robot: &RobotDescription) -> loadsim::RobotDynamics {
+    let mut points: Vec<lie::Vector3> = robot.joints.iter().map(|j| lie::Vector3::from(j.point)).collect();
+    points.push(lie::Vector3::from(robot.flange.position));
+    let links = points
+        .windows(2)
+        .map(|w| loadsim::LinkInertia {
+            mass_kg: 50.0 * (w[1] - w[0]).norm().max(0.05),
+            com_m: ((w[0] + w[1]) * 0.5).into(),
+        })
+        .collect();
+    loadsim::RobotDynamics {
+        links,
+        stiffness_nm_per_rad: vec![1.0; robot.joint_count()],
+        counterbalance: None,
+        gravity_m_per_s2: loadsim::FLOOR_GRAVITY_M_PER_S2,
+    }
+}
+
+/// `[min, max]` of `values` widened by `beyond` times its width at either end; `None` when empty.
+pub fn span_of(values: &[f64], beyond: f64) -> Option<[f64; 2]> {
+    let span = values.iter().fold(None, |span, &v| Some(span.map_or([v, v], |[a, b]: [f64; 2]| [a.min(v), b.max(v)])));
+    span.map(|[low, high]| [low - beyond * (high - low), high + beyond * (high - low)])
+}
+
+/// `value` held inside `span` (unchanged without one).
+pub fn held_in(value: f64, span: Option<[f64; 2]>) -> f64 {
+    span.map_or(value, |[low, high]| value.clamp(low, high))
+}

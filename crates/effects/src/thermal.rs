@@ -1,0 +1,68 @@
+//! Thermal growth: every link but the base placement grows by `α ΔT` with the temperature
+//! (`loadsim::ThermalGrowth`, one coefficient for the whole arm, `loadsim::thermal_regressor`).
+
+use super::{Regressor, check_column_varies, rms_scales};
+use crate::Direction;
+use errors::Error;
+use measurements::Measurement;
+use serde::{Deserialize, Serialize};
+
+/// Thermal growth of the arm with `temp_c`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Thermal {
+    /// The temperature at which the geometry holds (the training rows' mean), °C.
+    pub reference_c: f64,
+    /// `ΔT` is divided by this (its RMS on the training poses), K.
+    pub scale: Vec<f64>,
+    /// The strain per unit of the scaled `ΔT`.
+    pub theta: Vec<f64>,
+    /// `[min, max]` of `temp_c` on the training rows widened by `EffectOptions::hold_beyond_span`
+    /// of its width at either end, °C: outside it the temperature is held at the nearer end, so that a term fitted within one session is never carried on as a straight
+    /// line (issue 30). Absent in older model files: applied as fitted, everywhere.
+    #[serde(default)]
+    pub fitted_span: Option<[f64; 2]>,
+}
+
+impl Thermal {
+    /// A growth linear in `temp_c`, scaled on the training rows, held beyond `hold_beyond_span` of
+    /// their temperature span past either end.
+    pub fn new(rows: &[Measurement], hold_beyond_span: f64) -> Result<Self, Error> {
+        let temps: Vec<f64> = rows
+            .iter()
+            .map(|r| r.temp_c.ok_or(Error::EffectNeedsColumn { line: r.line, effect: "thermal", column: "temp_c" }))
+            .collect::<Result<_, _>>()?;
+        check_column_varies(&temps, rows, "thermal", "temp_c")?;
+        let reference_c = temps.iter().sum::<f64>() / temps.len().max(1) as f64;
+        let raw: Vec<Vec<f64>> = temps.iter().map(|t| vec![t - reference_c]).collect();
+        Ok(Self {
+            reference_c,
+            scale: rms_scales(&raw),
+            theta: vec![0.0],
+            fitted_span: super::span_of(&temps, hold_beyond_span),
+        })
+    }
+}
+
+impl Regressor for Thermal {
+    fn directions(&self) -> Vec<Direction> {
+        vec![Direction::LinkGrowth]
+    }
+
+    fn features(&self, row: &Measurement, _tool: usize) -> Result<Vec<f64>, Error> {
+        let t = row.temp_c.ok_or(Error::EffectNeedsColumn { line: row.line, effect: "thermal", column: "temp_c" })?;
+        let t = super::held_in(t, self.fitted_span);
+        Ok(vec![(t - self.reference_c) / self.scale[0]])
+    }
+
+    fn theta(&self) -> &[f64] {
+        &self.theta
+    }
+
+    fn theta_mut(&mut self) -> &mut Vec<f64> {
+        &mut self.theta
+    }
+
+    fn parameter_names(&self) -> Vec<String> {
+        vec!["link strain".into()]
+    }
+}

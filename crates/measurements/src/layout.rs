@@ -1,0 +1,333 @@
+//! The header of a measurement file: which column holds which quantity, in which unit, checked
+//! against the robot's joints before a single row is read.
+
+use super::ColumnMap;
+use errors::Error;
+use poe::JointKind;
+use std::collections::HashSet;
+
+/// A quantity the SPEC names, with the factor that turns its unit into SI.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Quantity {
+    /// `q<k>_rad|deg|m|mm`: joint `k` (1-based; `usize::MAX` when the digits overflow).
+    Joint {
+        index: usize,
+        kind: JointKind,
+        scale: f64,
+    },
+    /// `x_mm`, `y_m`, …: axis 0, 1, 2.
+    Position {
+        axis: usize,
+        scale: f64,
+    },
+    /// `qw`, `qx`, `qy`, `qz`: component 0…3.
+    Quaternion(usize),
+    /// `rx_deg`, `ry_rad`, …: axis 0, 1, 2 (SPEC v2).
+    Euler {
+        axis: usize,
+        scale: f64,
+    },
+    Payload,
+    Tool,
+    Temperature,
+    Time,
+    /// `tau<k>_nm`.
+    Torque(usize),
+}
+
+/// `q3_rad` → `Some((3, "rad"))` for the prefix `q`. Digits too many for a `usize` give
+/// `usize::MAX`, so that the header check refuses the column rather than ignoring it.
+fn indexed_name<'a>(name: &'a str, prefix: &str) -> Option<(usize, &'a str)> {
+    let rest = name.strip_prefix(prefix)?;
+    let (digits, unit) = rest.split_once('_')?;
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) || digits.starts_with('0') {
+        return None;
+    }
+    Some((digits.parse().unwrap_or(usize::MAX), unit))
+}
+
+/// The quantity a SPEC column name stands for; `None` for any other name.
+pub(crate) fn quantity(name: &str) -> Option<Quantity> {
+    let axis = |c: u8| (c - b'x') as usize;
+    Some(match name {
+        "x_mm" | "y_mm" | "z_mm" => Quantity::Position { axis: axis(name.as_bytes()[0]), scale: 1e-3 },
+        "x_m" | "y_m" | "z_m" => Quantity::Position { axis: axis(name.as_bytes()[0]), scale: 1.0 },
+        "qw" => Quantity::Quaternion(0),
+        "qx" | "qy" | "qz" => Quantity::Quaternion(1 + axis(name.as_bytes()[1])),
+        "rx_deg" | "ry_deg" | "rz_deg" => Quantity::Euler { axis: axis(name.as_bytes()[1]), scale: 1f64.to_radians() },
+        "rx_rad" | "ry_rad" | "rz_rad" => Quantity::Euler { axis: axis(name.as_bytes()[1]), scale: 1.0 },
+        "payload_kg" => Quantity::Payload,
+        "tool" => Quantity::Tool,
+        "temp_c" => Quantity::Temperature,
+        "t_s" => Quantity::Time,
+        _ => {
+            if let Some((index, unit)) = indexed_name(name, "q") {
+                let (kind, scale) = match unit {
+                    "rad" => (JointKind::Revolute, 1.0),
+                    "deg" => (JointKind::Revolute, 1f64.to_radians()),
+                    "m" => (JointKind::Prismatic, 1.0),
+                    "mm" => (JointKind::Prismatic, 1e-3),
+                    _ => return None,
+                };
+                Quantity::Joint { index, kind, scale }
+            } else {
+                match indexed_name(name, "tau") {
+                    Some((index, "nm")) => Quantity::Torque(index),
+                    _ => return None,
+                }
+            }
+        }
+    })
+}
+
+/// How a cell's number is turned into SI.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Column {
+    /// 0-based field index.
+    pub index: usize,
+    pub scale: f64,
+}
+
+/// The orientation columns of full-pose data.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum OrientationColumns {
+    Quaternion([Column; 4]),
+    /// `R = Rx(rx) · Ry(ry) · Rz(rz)`.
+    Euler([Column; 3]),
+}
+
+/// Where each quantity is in the header, checked.
+#[derive(Debug)]
+pub(crate) struct Layout {
+    /// Joint `k` is `joints[k - 1]`, with the kind its unit says.
+    pub joints: Vec<(Column, JointKind)>,
+    /// `None` when the file has no position columns (joint files for `calib predict`).
+    pub position: Option<[Column; 3]>,
+    pub orientation: Option<OrientationColumns>,
+    pub payload: Option<Column>,
+    pub tool: Option<usize>,
+    pub temp: Option<Column>,
+    pub time: Option<Column>,
+    pub torques: Vec<Column>,
+    /// The names of the columns not used.
+    pub ignored: Vec<String>,
+    /// Names as the rest of the reader refers to them: the SPEC name of a mapped column.
+    pub names: Vec<String>,
+}
+
+/// What the header is checked against.
+pub(crate) struct Expectation<'a> {
+    pub file: &'a str,
+    /// The robot's joints, when known.
+    pub joints: Option<&'a [JointKind]>,
+    /// Whether the position columns must be there.
+    pub positions: bool,
+    pub columns: &'a ColumnMap,
+}
+
+/// The SPEC name of joint `k`'s column for a joint of `kind`.
+fn joint_name(k: usize, kind: JointKind) -> String {
+    match kind {
+        JointKind::Revolute => format!("q{k}_rad"),
+        JointKind::Prismatic => format!("q{k}_m"),
+    }
+}
+
+impl Layout {
+    /// Reads and checks the header. Allocates only in proportion to the header's length: a column
+    /// named `q99999999999_rad` is refused, never used as a size.
+    pub fn from_header(header: &csv::StringRecord, expect: &Expectation<'_>) -> Result<Self, Error> {
+        let file = expect.file;
+        let width = header.len();
+        let at_end = |name: String| Error::MissingColumn { file: file.to_owned(), line: 1, column: width + 1, name };
+        let mut names: Vec<String> = Vec::with_capacity(width);
+        // Sets, not scans of the lists: a header of 400,000 columns took minutes when each name was
+        // compared with every earlier one (found by `cargo xtask fuzz`).
+        let mut seen: HashSet<String> = HashSet::with_capacity(width);
+        let (mut joint_numbers, mut torque_numbers) = (HashSet::new(), HashSet::new());
+        let mut joints: Vec<(usize, Column, JointKind)> = Vec::new();
+        let mut torques: Vec<(usize, Column)> = Vec::new();
+        let mut position = [None; 3];
+        let mut quaternion = [None; 4];
+        let mut euler = [None; 3];
+        let (mut payload, mut tool, mut temp, mut time) = (None, None, None, None);
+        let mut ignored = Vec::new();
+        for (index, raw) in header.iter().enumerate() {
+            let raw = raw.trim();
+            let name = expect.columns.target_of(raw).unwrap_or(raw).to_owned();
+            let duplicate =
+                || Error::DuplicateColumn { file: file.to_owned(), line: 1, column: index + 1, name: name.clone() };
+            if !seen.insert(name.clone()) {
+                return Err(duplicate());
+            }
+            let column = |scale| Column { index, scale };
+            let fresh = match quantity(&name) {
+                Some(Quantity::Joint { index: k, kind, scale }) => {
+                    joints.push((k, column(scale), kind));
+                    joint_numbers.insert(k)
+                }
+                Some(Quantity::Torque(k)) => {
+                    torques.push((k, column(1.0)));
+                    torque_numbers.insert(k)
+                }
+                Some(Quantity::Position { axis, scale }) => position[axis].replace(column(scale)).is_none(),
+                Some(Quantity::Quaternion(k)) => quaternion[k].replace(column(1.0)).is_none(),
+                Some(Quantity::Euler { axis, scale }) => euler[axis].replace(column(scale)).is_none(),
+                Some(Quantity::Payload) => payload.replace(column(1.0)).is_none(),
+                Some(Quantity::Tool) => tool.replace(index).is_none(),
+                Some(Quantity::Temperature) => temp.replace(column(1.0)).is_none(),
+                Some(Quantity::Time) => time.replace(column(1.0)).is_none(),
+                None => {
+                    ignored.push(name.clone());
+                    true
+                }
+            };
+            if !fresh {
+                return Err(duplicate());
+            }
+            names.push(name);
+        }
+        for (target, mapped) in expect.columns.entries() {
+            if !header.iter().any(|h| h.trim() == mapped) {
+                return Err(Error::MappedHeaderMissing {
+                    file: file.to_owned(),
+                    line: 1,
+                    column: width + 1,
+                    target: target.clone(),
+                    header: mapped.clone(),
+                });
+            }
+        }
+
+        let joints = check_joints(joints, expect, width)?;
+        let n = joints.len();
+        torques.sort_by_key(|(k, _)| *k);
+        if let Some((k, c)) = torques.iter().find(|(k, _)| *k > n) {
+            return Err(Error::ColumnBeyondJoints {
+                file: file.to_owned(),
+                line: 1,
+                column: c.index + 1,
+                name: names[c.index].clone(),
+                index: *k,
+                joints: n,
+            });
+        }
+        if !torques.is_empty()
+            && let Some(k) = (1..=n).find(|k| torques.get(k - 1).is_none_or(|(j, _)| j != k))
+        {
+            return Err(at_end(format!("tau{k}_nm")));
+        }
+
+        let any_position = position.iter().any(Option::is_some);
+        let position = match position {
+            [Some(x), Some(y), Some(z)] => Some([x, y, z]),
+            _ if expect.positions || any_position => {
+                let k = position.iter().position(Option::is_none).unwrap_or(0);
+                return Err(at_end(["x_mm", "y_mm", "z_mm"][k].into()));
+            }
+            _ => None,
+        };
+        let orientation = orientation(quaternion, euler, &names, file, width)?;
+        Ok(Self {
+            joints,
+            position,
+            orientation,
+            payload,
+            tool,
+            temp,
+            time,
+            torques: torques.into_iter().map(|(_, c)| c).collect(),
+            ignored,
+            names,
+        })
+    }
+}
+
+/// The joint columns in order, checked: numbered 1…n without gaps, n the robot's joint count
+/// when known, each unit one that fits its joint's kind.
+fn check_joints(
+    mut found: Vec<(usize, Column, JointKind)>,
+    expect: &Expectation<'_>,
+    width: usize,
+) -> Result<Vec<(Column, JointKind)>, Error> {
+    let file = expect.file;
+    found.sort_by_key(|(k, _, _)| *k);
+    let count = found.len();
+    if let Some(kinds) = expect.joints {
+        let expected = kinds.len();
+        let beyond = found.iter().find(|(k, _, _)| *k > expected);
+        if count != expected || beyond.is_some() {
+            let column = beyond.map_or(width + 1, |(_, c, _)| c.index + 1);
+            return Err(Error::JointCountMismatch { file: file.to_owned(), line: 1, column, found: count, expected });
+        }
+    }
+    let kind_of = |k: usize| expect.joints.and_then(|kinds| kinds.get(k - 1)).copied().unwrap_or(JointKind::Revolute);
+    if count == 0 {
+        return Err(Error::MissingColumn {
+            file: file.to_owned(),
+            line: 1,
+            column: width + 1,
+            name: joint_name(1, kind_of(1)),
+        });
+    }
+    if let Some(k) = (1..=count).find(|&k| found[k - 1].0 != k) {
+        return Err(Error::MissingColumn {
+            file: file.to_owned(),
+            line: 1,
+            column: width + 1,
+            name: joint_name(k, kind_of(k)),
+        });
+    }
+    if let Some(kinds) = expect.joints {
+        for ((k, column, kind), robot) in found.iter().zip(kinds) {
+            if kind != robot {
+                return Err(Error::JointUnit {
+                    file: file.to_owned(),
+                    line: 1,
+                    column: column.index + 1,
+                    joint: *k,
+                    kind: *robot,
+                });
+            }
+        }
+    }
+    Ok(found.into_iter().map(|(_, c, kind)| (c, kind)).collect())
+}
+
+/// The orientation columns: a full quaternion or three Euler angles, never both.
+fn orientation(
+    quaternion: [Option<Column>; 4],
+    euler: [Option<Column>; 3],
+    names: &[String],
+    file: &str,
+    width: usize,
+) -> Result<Option<OrientationColumns>, Error> {
+    let missing =
+        |name: &str| Error::MissingColumn { file: file.to_owned(), line: 1, column: width + 1, name: name.into() };
+    let any_quaternion = quaternion.iter().flatten().next();
+    let any_euler = euler.iter().flatten().next();
+    if let (Some(q), Some(e)) = (any_quaternion, any_euler) {
+        let later = if e.index > q.index { e } else { q };
+        let earlier = if e.index > q.index { q } else { e };
+        return Err(Error::OrientationTwice {
+            file: file.to_owned(),
+            line: 1,
+            column: later.index + 1,
+            name: names[later.index].clone(),
+            other: names[earlier.index].clone(),
+        });
+    }
+    match (quaternion, euler) {
+        ([Some(w), Some(x), Some(y), Some(z)], _) => Ok(Some(OrientationColumns::Quaternion([w, x, y, z]))),
+        (_, [Some(x), Some(y), Some(z)]) => Ok(Some(OrientationColumns::Euler([x, y, z]))),
+        _ if any_quaternion.is_some() => {
+            let k = quaternion.iter().position(Option::is_none).unwrap_or(0);
+            Err(missing(["qw", "qx", "qy", "qz"][k]))
+        }
+        _ if any_euler.is_some() => {
+            let k = euler.iter().position(Option::is_none).unwrap_or(0);
+            Err(missing(["rx_deg", "ry_deg", "rz_deg"][k]))
+        }
+        _ => Ok(None),
+    }
+}

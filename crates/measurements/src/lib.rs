@@ -1,0 +1,405 @@
+//! The measurement CSV of the SPEC: one row per measured pose, columns found by name, the unit in
+//! the name. Every refusal names the file, the line and the column.
+//!
+//! `layout` reads the header, `dialect` the numbers (`,`/`.` or a tracker's `;`/`,`),
+//! `column_map` the `--columns` renaming, `row` the cells of one row, `writer` writes a set back
+//! as SPEC CSV.
+
+mod column_map;
+mod dialect;
+mod input_files;
+mod layout;
+mod outliers;
+mod output_file;
+mod row;
+mod writer;
+pub use input_files::InputFiles;
+pub use outliers::{OutlierLine, list_lines, without};
+pub use output_file::{FileKind, MAX_SYMLINKS, OutputFile, output_target, write_file};
+
+pub use column_map::{ColumnMap, ColumnMapFault};
+pub use dialect::{Decimal, DecimalFault, Delimiter, Dialect};
+pub use writer::{CsvColumns, MeasurementWriter};
+
+use errors::Error;
+use layout::{Expectation, Layout, OrientationColumns};
+use lie::{SO3, Vector3};
+use poe::JointKind;
+use row::{JOINT_ANGLE_RANGE, JOINT_TRAVEL_RANGE, POSITION_RANGE, Row, syntax_error};
+use serde::Serialize;
+use std::collections::HashMap;
+use std::fmt;
+use std::io::Read;
+use std::path::Path;
+
+/// One measured pose, SI units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measurement {
+    /// 1-based line of the row in its file (0 for rows made in memory).
+    pub line: u64,
+    /// Joint values, radians (metres for a prismatic joint).
+    pub q: Vec<f64>,
+    /// Measured tool point, tracker frame, metres.
+    pub position: Vector3,
+    /// Measured tool orientation, tracker frame (full-pose data only).
+    pub orientation: Option<SO3>,
+    /// Payload carried at the tool, kg.
+    pub payload_kg: f64,
+    /// Index into [`MeasurementSet::tools`].
+    pub tool: usize,
+    /// Temperature, °C.
+    pub temp_c: Option<f64>,
+    /// Time, seconds from any origin.
+    pub t_s: Option<f64>,
+    /// Measured joint torques, N·m.
+    pub torques_nm: Option<Vec<f64>>,
+}
+
+/// A joint column as the file names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct JointColumn {
+    /// 1-based column in the file.
+    pub column: usize,
+    /// The kind of joint its unit fits: revolute for `_rad`/`_deg`, prismatic for `_m`/`_mm`.
+    pub kind: JointKind,
+    /// The unit its name gives: `rad`, `deg`, `m` or `mm` (the plausibility check's hint
+    /// "degrees under `_rad`?" needs it).
+    pub unit: &'static str,
+}
+
+/// How a file was written, as the reader found it (reported by the CLI in one line).
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
+pub struct FileFormat {
+    /// Field separator and decimal mark.
+    pub dialect: Dialect,
+    /// Whether the orientation came from Euler angles (`R = Rx·Ry·Rz`) rather than a quaternion.
+    pub euler_angles: bool,
+    /// Columns renamed by a column map: `(SPEC name, header)`.
+    pub mapped_columns: Vec<(String, String)>,
+}
+
+impl fmt::Display for FileFormat {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.dialect)?;
+        if self.euler_angles {
+            write!(f, "; orientation from Euler angles (R = Rx·Ry·Rz)")?;
+        }
+        if !self.mapped_columns.is_empty() {
+            write!(f, "; {} columns named by --columns", self.mapped_columns.len())?;
+        }
+        Ok(())
+    }
+}
+
+/// The rows of one measurement file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasurementSet {
+    /// Where the rows come from (a path), for messages.
+    pub source: String,
+    /// Number of joint columns.
+    pub joint_count: usize,
+    /// Whether every row has an orientation.
+    pub full_pose: bool,
+    /// Tool identifiers in order of first appearance. `""` is the default tool: every row of a
+    /// file without a `tool` column, and every blank `tool` cell (SPEC v2).
+    pub tools: Vec<String>,
+    /// 1-based column of `tool` in the file, if it has one.
+    pub tool_column: Option<usize>,
+    /// The rows, in file order.
+    pub rows: Vec<Measurement>,
+    /// Columns found but not used, by name.
+    pub ignored_columns: Vec<String>,
+    /// Whether the rows carry measured positions ([`read_configurations`] may read sets without).
+    pub positions_measured: bool,
+    /// The joint columns, base first, as the file names them (empty for sets made in memory).
+    pub joint_columns: Vec<JointColumn>,
+    /// The unit the position columns name, `mm` or `m` (`None` for sets made in memory).
+    pub position_unit: Option<&'static str>,
+    /// How the file was written.
+    pub format: FileFormat,
+}
+
+/// What a measurement file is read against.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ReadOptions {
+    /// The robot's joints, base first: their count is checked against the joint columns, and
+    /// each column's unit against its joint's kind (an angle unit on a prismatic joint is
+    /// refused). `None` reads any number of joints.
+    pub joints: Option<Vec<JointKind>>,
+    /// Other headers mapped onto the SPEC's names (`--columns`).
+    pub columns: ColumnMap,
+}
+
+impl ReadOptions {
+    /// Reading for a robot with these joints.
+    pub fn for_joints(joints: Vec<JointKind>) -> Self {
+        Self { joints: Some(joints), columns: ColumnMap::default() }
+    }
+
+    /// The same, with a column map.
+    pub fn with_columns(self, columns: ColumnMap) -> Self {
+        Self { columns, ..self }
+    }
+}
+
+/// Reads a measurement file.
+pub fn read_measurements(path: &Path, options: &ReadOptions) -> Result<MeasurementSet, Error> {
+    let file = path.display().to_string();
+    let reader = std::fs::File::open(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+    parse(reader, &file, options, true)
+}
+
+/// Parses measurements from any reader; `file` names the source in errors.
+pub fn parse_measurements<R: Read>(reader: R, file: &str, options: &ReadOptions) -> Result<MeasurementSet, Error> {
+    parse(reader, file, options, true)
+}
+
+/// Reads joint configurations to predict poses for: the measurement CSV in which the position
+/// columns may be left out (then [`MeasurementSet::positions_measured`] is false and every
+/// position is zero). Every other rule of the format holds.
+pub fn read_configurations(path: &Path, options: &ReadOptions) -> Result<MeasurementSet, Error> {
+    let file = path.display().to_string();
+    let reader = std::fs::File::open(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+    parse(reader, &file, options, false)
+}
+
+/// The cells of a file as written (trimmed), header and rows, beside its parsed rows: what a
+/// command that passes unused columns on needs (`calib compensate`).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Cells {
+    /// The header's names.
+    pub header: Vec<String>,
+    /// Each row's cells, in the order of [`MeasurementSet::rows`].
+    pub rows: Vec<Vec<String>>,
+}
+
+/// [`read_configurations`], with every cell as written.
+pub fn read_configurations_with_cells(path: &Path, options: &ReadOptions) -> Result<(MeasurementSet, Cells), Error> {
+    let file = path.display().to_string();
+    let reader = std::fs::File::open(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+    let mut cells = Cells::default();
+    let set = parse_keeping(reader, &file, options, false, Some(&mut cells))?;
+    Ok((set, cells))
+}
+
+fn parse<R: Read>(
+    reader: R,
+    file: &str,
+    options: &ReadOptions,
+    positions_required: bool,
+) -> Result<MeasurementSet, Error> {
+    parse_keeping(reader, file, options, positions_required, None)
+}
+
+fn parse_keeping<R: Read>(
+    mut reader: R,
+    file: &str,
+    options: &ReadOptions,
+    positions_required: bool,
+    mut cells: Option<&mut Cells>,
+) -> Result<MeasurementSet, Error> {
+    let mut bytes = Vec::new();
+    reader.read_to_end(&mut bytes).map_err(|source| Error::Io { path: file.to_owned(), source })?;
+    let body = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
+    let mut dialect = Dialect::from_header_line(body);
+    let mut csv = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .delimiter(dialect.delimiter.byte())
+        .trim(csv::Trim::All)
+        .from_reader(body);
+    let delimiter = dialect.delimiter;
+    let header = csv.headers().map_err(|e| syntax_error(&e, file, delimiter))?.clone();
+    if header.is_empty() || (header.len() == 1 && header[0].is_empty()) {
+        return Err(Error::EmptyFile { file: file.to_owned() });
+    }
+    let expect = Expectation {
+        file,
+        joints: options.joints.as_deref(),
+        positions: positions_required,
+        columns: &options.columns,
+    };
+    let layout = Layout::from_header(&header, &expect)?;
+    if let Some(cells) = cells.as_deref_mut() {
+        cells.header = header.iter().map(str::to_owned).collect();
+    }
+    let mut tools: Vec<String> = Vec::new();
+    // Each tool's index by name: a file whose every row names another tool stays linear.
+    let mut tool_index: HashMap<String, usize> = HashMap::new();
+    let mut rows = Vec::new();
+    let mut record = csv::StringRecord::new();
+    loop {
+        match csv.read_record(&mut record) {
+            Ok(true) => {}
+            Ok(false) => break,
+            Err(e) => return Err(syntax_error(&e, file, delimiter)),
+        }
+        let line = record.position().map_or(0, |p| p.line());
+        let mut row = Row { record: &record, line, file, names: &layout.names, dialect: &mut dialect };
+        let q = layout
+            .joints
+            .iter()
+            .map(|&(c, kind)| {
+                let range = match kind {
+                    JointKind::Revolute => JOINT_ANGLE_RANGE,
+                    JointKind::Prismatic => JOINT_TRAVEL_RANGE,
+                };
+                row.bounded_numbers(&[c], range).map(|v| v[0])
+            })
+            .collect::<Result<Vec<f64>, Error>>()?;
+        let position = match layout.position {
+            Some(c) => {
+                let p = row.bounded_numbers(&c, POSITION_RANGE)?;
+                Vector3::new(p[0], p[1], p[2])
+            }
+            None => Vector3::zeros(),
+        };
+        let orientation = layout.orientation.as_ref().map(|c| row.orientation(c)).transpose()?;
+        let payload_kg = match layout.payload {
+            Some(c) => {
+                let value = row.number(c)?;
+                if value < 0.0 {
+                    return Err(Error::NegativePayload { file: file.to_owned(), line, column: c.index + 1, value });
+                }
+                value
+            }
+            None => 0.0,
+        };
+        let temp_c = layout.temp.map(|c| row.number(c)).transpose()?;
+        let t_s = layout.time.map(|c| row.number(c)).transpose()?;
+        let torques_nm = if layout.torques.is_empty() { None } else { Some(row.numbers(&layout.torques)?) };
+        let tool_name = layout.tool.and_then(|i| record.get(i)).unwrap_or("");
+        let tool = *tool_index.entry(tool_name.to_owned()).or_insert_with(|| {
+            tools.push(tool_name.to_owned());
+            tools.len() - 1
+        });
+        rows.push(Measurement { line, q, position, orientation, payload_kg, tool, temp_c, t_s, torques_nm });
+        if let Some(cells) = cells.as_deref_mut() {
+            cells.rows.push(record.iter().map(str::to_owned).collect());
+        }
+    }
+    if rows.is_empty() {
+        return Err(Error::EmptyFile { file: file.to_owned() });
+    }
+    Ok(MeasurementSet {
+        source: file.to_owned(),
+        joint_count: layout.joints.len(),
+        full_pose: layout.orientation.is_some(),
+        tools,
+        tool_column: layout.tool.map(|i| i + 1),
+        rows,
+        ignored_columns: layout.ignored,
+        positions_measured: layout.position.is_some(),
+        joint_columns: layout
+            .joints
+            .iter()
+            .map(|(c, kind)| JointColumn { column: c.index + 1, kind: *kind, unit: joint_unit(*kind, c.scale) })
+            .collect(),
+        position_unit: layout.position.map(|[x, _, _]| if x.scale == 1.0 { "m" } else { "mm" }),
+        format: FileFormat {
+            dialect,
+            euler_angles: matches!(layout.orientation, Some(OrientationColumns::Euler(_))),
+            mapped_columns: options
+                .columns
+                .entries()
+                .iter()
+                .filter(|(_, h)| header.iter().any(|c| c.trim() == h))
+                .cloned()
+                .collect(),
+        },
+    })
+}
+
+/// The unit a joint column's name gives, from the factor that turns it into SI.
+fn joint_unit(kind: JointKind, scale: f64) -> &'static str {
+    match (kind, scale == 1.0) {
+        (JointKind::Revolute, true) => "rad",
+        (JointKind::Revolute, false) => "deg",
+        (JointKind::Prismatic, true) => "m",
+        (JointKind::Prismatic, false) => "mm",
+    }
+}
+
+impl MeasurementSet {
+    /// A set made in memory (simulation, splits); `source` names it in messages.
+    pub fn from_rows(source: &str, rows: Vec<Measurement>, tools: Vec<String>) -> Self {
+        let joint_count = rows.first().map_or(0, |r| r.q.len());
+        let full_pose = !rows.is_empty() && rows.iter().all(|r| r.orientation.is_some());
+        let tools = if tools.is_empty() { vec![String::new()] } else { tools };
+        Self {
+            source: source.to_owned(),
+            joint_count,
+            full_pose,
+            tools,
+            tool_column: None,
+            rows,
+            ignored_columns: vec![],
+            positions_measured: true,
+            joint_columns: vec![],
+            position_unit: None,
+            format: FileFormat::default(),
+        }
+    }
+
+    /// One line saying what the reader found: rows, separators, orientation, mapped and ignored
+    /// columns (the CLI prints it).
+    pub fn read_summary(&self) -> String {
+        let mut line = format!("read {}: {} rows, {}", self.source, self.rows.len(), self.format);
+        if !self.ignored_columns.is_empty() {
+            line.push_str(&format!("; ignored columns: {}", self.ignored_columns.join(", ")));
+        }
+        line
+    }
+
+    /// Refuses a set whose joint columns do not match a robot's `joints`.
+    pub fn check_joint_count(&self, joints: usize) -> Result<(), Error> {
+        if self.joint_count == joints {
+            return Ok(());
+        }
+        Err(Error::JointCountMismatch {
+            file: self.source.clone(),
+            line: 1,
+            column: 1,
+            found: self.joint_count,
+            expected: joints,
+        })
+    }
+
+    /// Refuses a set whose joint columns do not match a robot's joints: their count, and each
+    /// column's unit against its joint's kind (for sets read from a file).
+    pub fn check_joints(&self, kinds: &[JointKind]) -> Result<(), Error> {
+        self.check_joint_count(kinds.len())?;
+        for (k, (column, kind)) in self.joint_columns.iter().zip(kinds).enumerate() {
+            if column.kind != *kind {
+                return Err(Error::JointUnit {
+                    file: self.source.clone(),
+                    line: 1,
+                    column: column.column,
+                    joint: k + 1,
+                    kind: *kind,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The rows at `indices`, as a set of their own (same tools).
+    pub fn subset(&self, indices: &[usize]) -> Self {
+        Self { rows: indices.iter().map(|&i| self.rows[i].clone()).collect(), ..self.clone_empty() }
+    }
+
+    fn clone_empty(&self) -> Self {
+        Self {
+            source: self.source.clone(),
+            joint_count: self.joint_count,
+            full_pose: self.full_pose,
+            tools: self.tools.clone(),
+            tool_column: self.tool_column,
+            rows: Vec::new(),
+            ignored_columns: self.ignored_columns.clone(),
+            positions_measured: self.positions_measured,
+            joint_columns: self.joint_columns.clone(),
+            position_unit: self.position_unit,
+            format: self.format.clone(),
+        }
+    }
+}

@@ -1,0 +1,257 @@
+//! A calibrated model: the identified kinematics, the effects identified with them, the optional
+//! GP compensation, and prediction by walking them in order (module `model_parts`).
+
+use crate::model_parts::{Part, Walk};
+use crate::{Method, PoseError};
+use effects::IdentifiedEffect;
+use errors::Error;
+use lie::SE3;
+use measurements::Measurement;
+use poe::LocalPoe;
+use serde::{Deserialize, Serialize};
+
+/// What `calib fit` produces and `calib eval` / `calib predict` use.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CalibratedModel {
+    /// Version of this file layout ([`crate::SCHEMA_VERSION`]).
+    pub schema_version: u32,
+    /// Name of the robot description the fit started from.
+    pub robot: String,
+    /// The method that produced the model.
+    pub method: Method,
+    /// Whether the model was fitted on full-pose data (otherwise orientation is not calibrated).
+    pub full_pose: bool,
+    /// Tool identifiers, in the order of the kinematic model's tools.
+    pub tools: Vec<String>,
+    /// The identified local POE model; its reference frame is the tracker frame.
+    pub kinematics: LocalPoe,
+    /// Non-geometric effects identified with the geometry (`calib fit --effects`), applied after
+    /// it and before the GP, in one left exponential of the sum of their twists.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub effects: Vec<IdentifiedEffect>,
+    /// The geometry fitted alone, before the effects were identified with it: outside the joint
+    /// angles an effect was fitted on, the model blends to it ([`Part::Fallback`]), so that where
+    /// the effects know nothing the model is no worse than the geometric fit. Absent in files
+    /// written before it was kept (the fitted geometry is then used everywhere).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback_kinematics: Option<LocalPoe>,
+    /// The GP compensation of the residual (methods `poe-gp`, `poe-gp-load`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compensation: Option<crate::Compensation>,
+    /// The range of every input the model was fitted on: the check on reading probes the model
+    /// inside it. Files written before it existed have none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub training_range: Option<crate::TrainingRange>,
+    /// The robot description's joint limits, SI (`None` for a joint without): `eval`, `predict`
+    /// and `compensate` count rows beyond them. Files written before they were kept have none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joint_limits: Vec<Option<[f64; 2]>>,
+}
+
+/// A predicted tool pose and, where a GP is part of the model, its standard deviation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PredictedPose {
+    /// `tracker_from_tool`.
+    pub pose: SE3,
+    /// GP standard deviation of the six pose-error components `(v, ω)` (metres, radians).
+    pub std: Option<[f64; 6]>,
+}
+
+impl CalibratedModel {
+    /// Number of joints of the robot.
+    pub fn joint_count(&self) -> usize {
+        self.kinematics.joint_count()
+    }
+
+    /// The kinds of the joints, base first.
+    pub fn joint_kinds(&self) -> Vec<poe::JointKind> {
+        self.kinematics.joints().iter().map(|j| j.kind).collect()
+    }
+
+    /// Index of a tool by its identifier. `""` is the default tool (a blank `tool` cell, or a
+    /// file without the column), matched like any other name, as in the fit (SPEC v2); an
+    /// identifier the model was not fitted with is refused.
+    pub fn tool_index(&self, name: &str, file: &str, line: u64, column: usize) -> Result<usize, Error> {
+        self.tools.iter().position(|t| t == name).ok_or_else(|| Error::UnknownTool {
+            file: file.to_owned(),
+            line,
+            column,
+            tool: name.to_owned(),
+            known: self.tools.clone(),
+        })
+    }
+
+    /// The parts of the model in the order they apply: the geometry, each effect, the GP.
+    pub fn parts(&self) -> Vec<Part<'_>> {
+        let mut parts = vec![Part::Geometry(&self.kinematics)];
+        parts.extend(self.effects.iter().map(Part::Effect));
+        if !self.effects.is_empty() {
+            parts.extend(self.fallback_kinematics.iter().map(Part::Fallback));
+        }
+        parts.extend(self.compensation.iter().map(Part::GaussianProcess));
+        parts
+    }
+
+    /// The model without part `index` of [`CalibratedModel::parts`] (the geometry, index 0, stays:
+    /// everything else applies to it).
+    pub fn without_part(&self, index: usize) -> CalibratedModel {
+        let mut model = self.clone();
+        let effects = self.effects.len();
+        let fallback = usize::from(self.fallback_kinematics.is_some() && effects > 0);
+        if (1..=effects).contains(&index) {
+            model.effects.remove(index - 1);
+        } else if fallback == 1 && index == effects + 1 {
+            model.fallback_kinematics = None;
+        } else if index == effects + fallback + 1 {
+            model.compensation = None;
+        }
+        model
+    }
+
+    /// The model without its non-geometric parts (effects, the GP): the geometry alone, which is
+    /// what a URDF can hold (`calib export`).
+    pub fn geometry_only(&self) -> CalibratedModel {
+        CalibratedModel { effects: Vec::new(), fallback_kinematics: None, compensation: None, ..self.clone() }
+    }
+
+    /// The names of the parts a URDF cannot hold, in the order they apply.
+    pub fn non_geometric_parts(&self) -> Vec<String> {
+        self.parts().iter().filter(|p| !p.in_urdf()).map(Part::name).collect()
+    }
+
+    /// The poses of the geometry and the effects, before any GP.
+    pub fn geometric_poses(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<SE3>, Error> {
+        let mut walk = Walk::new(rows, tools);
+        for part in self.parts().iter().filter(|p| !matches!(p, Part::GaussianProcess(_))) {
+            part.apply(&mut walk)?;
+        }
+        walk.flush();
+        Ok(walk.poses)
+    }
+
+    /// Predicts the tool pose of rows of a measurement set by applying every part in turn; the
+    /// GP is placed before the POE model as in the paper's Eq. 9: `T = exp(ĝ(q, m)) · T_POE(q)`.
+    pub fn predict(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<PredictedPose>, Error> {
+        let mut walk = Walk::new(rows, tools);
+        for part in self.parts() {
+            part.apply(&mut walk)?;
+        }
+        walk.flush();
+        Ok(match walk.standard_deviations() {
+            Some(std) => {
+                walk.poses.into_iter().zip(std).map(|(pose, s)| PredictedPose { pose, std: Some(s) }).collect()
+            }
+            None => walk.poses.into_iter().map(|pose| PredictedPose { pose, std: None }).collect(),
+        })
+    }
+}
+
+/// Rows at which an effect of the model is used outside the joint angles it was fitted on: there
+/// the model extrapolates, and its error on them is not what the fit measured.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ExtrapolationWarning {
+    /// The effect, as reports name it (`gear_periodic:1:48`).
+    pub effect: String,
+    /// The 1-based joint.
+    pub joint: usize,
+    /// The joint's smallest and largest angle on the training poses, rad.
+    pub fitted_range_rad: [f64; 2],
+    /// The gaps inside that range where no training pose was (wider than half the series'
+    /// shortest period), rad.
+    pub gaps_rad: Vec<[f64; 2]>,
+    /// How many of the rows put the joint outside that range or in a gap.
+    pub rows_outside: usize,
+    /// How many rows there are.
+    pub rows: usize,
+    /// The file line of the first of them.
+    pub first_line: u64,
+}
+
+impl std::fmt::Display for ExtrapolationWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let [low, high] = self.fitted_range_rad;
+        write!(
+            f,
+            "{} of {} rows (the first at line {}) put joint {} outside the angles its {} effect was fitted on \
+             ({:.4} … {:.4} rad{}): there the model extrapolates, and may be worse than without the effect",
+            self.rows_outside,
+            self.rows,
+            self.first_line,
+            self.joint,
+            self.effect,
+            low,
+            high,
+            match self.gaps_rad.len() {
+                0 => String::new(),
+                1 => ", less one gap".to_owned(),
+                k => format!(", less {k} gaps"),
+            }
+        )
+    }
+}
+
+impl CalibratedModel {
+    /// Whether predictions carry a standard deviation: a GP, or an effect that reports what it
+    /// leaves uncorrected where it fades out.
+    pub fn predicts_std(&self) -> bool {
+        self.compensation.is_some() || self.effects.iter().any(IdentifiedEffect::has_sigma)
+    }
+
+    /// One warning per input (joint, payload, temperature, time) that some of `rows` put outside
+    /// the range the model was fitted on; none for model files that do not record it.
+    pub fn outside_training_range(&self, rows: &[Measurement]) -> Vec<crate::OutOfRangeWarning> {
+        let prismatic: Vec<bool> = self.joint_kinds().iter().map(|k| *k == poe::JointKind::Prismatic).collect();
+        self.training_range.as_ref().map_or_else(Vec::new, |range| range.outside(rows, &prismatic))
+    }
+
+    /// One warning per joint that some of `rows` put beyond the robot's limits; none for model
+    /// files that do not keep them.
+    pub fn beyond_joint_limits(&self, rows: &[Measurement]) -> Vec<crate::BeyondLimitsWarning> {
+        let prismatic: Vec<bool> = self.joint_kinds().iter().map(|k| *k == poe::JointKind::Prismatic).collect();
+        crate::beyond_limits(&self.joint_limits, &prismatic, rows)
+    }
+
+    /// Whether any effect records the joint angles it was fitted on.
+    pub fn records_coverage(&self) -> bool {
+        self.effects.iter().any(|e| e.angle_coverage().is_some())
+    }
+
+    /// Whether `row` lies within the angles every effect was fitted on.
+    pub fn covers(&self, row: &Measurement) -> bool {
+        self.effects
+            .iter()
+            .filter_map(IdentifiedEffect::angle_coverage)
+            .all(|gear| row.q.get(gear.joint).is_none_or(|&q| gear.covers(q)))
+    }
+
+    /// One warning per effect that `rows` use outside the joint angles it was fitted on.
+    pub fn extrapolation(&self, rows: &[Measurement]) -> Vec<ExtrapolationWarning> {
+        self.effects
+            .iter()
+            .filter_map(|effect| {
+                let gear = effect.angle_coverage()?;
+                let (joint, [low, high]) = (gear.joint, gear.fitted_range?);
+                let outside: Vec<&Measurement> =
+                    rows.iter().filter(|r| r.q.get(joint).is_some_and(|&q| !gear.covers(q))).collect();
+                let first = outside.first()?;
+                Some(ExtrapolationWarning {
+                    effect: effect.label(),
+                    joint: joint + 1,
+                    fitted_range_rad: [low, high],
+                    gaps_rad: if gear.taper_rad.is_some() { gear.turn_gaps.clone() } else { gear.fitted_gaps.clone() },
+                    rows_outside: outside.len(),
+                    rows: rows.len(),
+                    first_line: first.line,
+                })
+            })
+            .collect()
+    }
+}
+
+/// The error of a prediction against a measured row.
+pub fn pose_error(predicted: &SE3, row: &Measurement) -> PoseError {
+    PoseError {
+        position_mm: (row.position - predicted.translation()).norm() * 1e3,
+        rotation_mrad: row.orientation.map(|measured| (measured * predicted.rotation().inverse()).log().norm() * 1e3),
+    }
+}

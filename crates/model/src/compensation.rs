@@ -1,0 +1,570 @@
+//! Step 2 of the paper (Section III-B): a Gaussian process on the pose error the geometric model
+//! leaves, with the joint values (and the payload) as inputs, placed before the POE model
+//! (Eq. 9): `T = G(q, m) · T_POE(q)`.
+
+use errors::Error;
+use faer::Mat;
+use lie::{SE3, Twist, Vector3, Vector6};
+use measurements::{Measurement, MeasurementSet};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::str::FromStr;
+
+/// Where the error twist of Eq. 8 is expressed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ResidualFrame {
+    /// At the tool point: `ε = log(P⁻¹ T' T⁻¹ P)^∨` with `P` the translation to the modelled tool
+    /// point, and `G = P exp(ĝ) P⁻¹`. The same twist as Eq. 8 seen from the tool, so that its `v`
+    /// part is the position error and does not carry the orientation error times the lever arm
+    /// to the tracker (metres): each GP output then sees one physical error.
+    #[default]
+    ToolPoint,
+    /// In the tracker frame, exactly the paper's Eq. 8: `ε = log(T' T⁻¹)^∨`, `G = exp(ĝ)`.
+    Tracker,
+}
+
+/// Which Gaussian process the GP stage fits (`calib fit --gp`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GpChoice {
+    /// The exact GP: `O(n³)` time, `O(n²)` memory.
+    Exact,
+    /// The sparse variational GP (VFE) with inducing inputs: `O(n m²)` time, `O(n m)` memory.
+    Sparse,
+    /// Exact up to [`CompensationOptions::sparse_above_rows`] training rows, sparse beyond.
+    #[default]
+    Auto,
+}
+
+impl GpChoice {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Exact => "exact",
+            Self::Sparse => "sparse",
+            Self::Auto => "auto",
+        }
+    }
+}
+
+impl fmt::Display for GpChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A `--gp` value that is not `exact`, `sparse` or `auto`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnknownGpChoice {
+    /// The name given.
+    pub name: String,
+}
+
+impl fmt::Display for UnknownGpChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "unknown GP '{}': expected one of exact, sparse, auto", self.name)
+    }
+}
+
+impl std::error::Error for UnknownGpChoice {}
+
+impl FromStr for GpChoice {
+    type Err = UnknownGpChoice;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        [Self::Exact, Self::Sparse, Self::Auto]
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| UnknownGpChoice { name: s.to_owned() })
+    }
+}
+
+/// Options of the GP stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct CompensationOptions {
+    /// The exact Gaussian process (and the kernel, outputs, scaling and optimiser of both). Read
+    /// from an options file field by field onto this stage's default, so that `gp: (optimiser:
+    /// (max_iterations: 100))` changes that one field and keeps the stage's kernel and search.
+    #[serde(deserialize_with = "onto_default_gp")]
+    pub gp: gp::GpConfig,
+    /// Exact, sparse, or chosen by the number of training rows.
+    pub method: GpChoice,
+    /// With [`GpChoice::Auto`], the sparse GP above this many training rows.
+    pub sparse_above_rows: usize,
+    /// The sparse GP (its `gp` field is replaced by [`CompensationOptions::gp`], but for the
+    /// outputs and the kernel, which [`CompensationOptions::sparse_outputs`] and
+    /// [`CompensationOptions::sparse_kernel`] set).
+    pub sparse: gp::SparseConfig,
+    /// One kernel for all outputs or one each, in the sparse GP.
+    pub sparse_outputs: gp::OutputMode,
+    /// The covariance family of the sparse GP.
+    pub sparse_kernel: gp::KernelChoice,
+    /// Where the error twist is expressed.
+    pub residual_frame: ResidualFrame,
+    /// For full-pose data, the three rotation outputs share one kernel, searched once on all rows
+    /// from the position output kernel that explains them best ([`gp::GpConfig::follower_groups`]),
+    /// instead of three searches of their own; the position outputs are fitted as `gp` says.
+    pub rotation_follows_position: bool,
+}
+
+impl Default for CompensationOptions {
+    fn default() -> Self {
+        // ARD squared exponential plus a first-order additive term (one one-dimensional squared
+        // exponential per input) rather than the paper's Eq. 5 kernel: on the UR10 data (series
+        // C, 1387 training poses, position only, even rows → odd rows) the paper's kernel left
+        // 0.307 mm held out, SE-ARD 0.205 mm and SE-ARD + additive 0.136 mm; the additive term
+        // learns a joint's periodic gear error from the poses that move that joint, which the
+        // joint ARD term cannot (docs/results/bench-gp.md has the other data sets). The default
+        // start and the kernel's nested start (additive term nearly off), searched on a 500-row
+        // warm-start subset; no random restarts: over the 8 data sets of `bench-gp --kernels`
+        // (24 searches) a random start never reached the best likelihood, and they cost a third
+        // of the search at 300 poses.
+        //
+        // The search stops when an iteration raises the log marginal likelihood by less than
+        // 1e-5 of itself (≈ 0.005 nats on these data, far below the ~1 nat that separates models
+        // in a likelihood-ratio sense) instead of scipy's 2.2e-9, and keeps 20 curvature pairs
+        // (the default kernel's parameter count on six joints, so nearly full BFGS) instead of
+        // 10. Chosen with `bench-gp --kernels --search-seeds 0,1,2,3,4,5` (8 sets, 6 searches
+        // each, the held-out error's mean ± half its spread; docs/results/gp-kernel.md): against
+        // memory 10 / 1e-6 the fit time summed over the sets fell 18.0 → 10.7 s (UR10 C 10.3 →
+        // 6.4 s), every set's mean held-out error stayed within its seed spread (UR10 C 0.1362 →
+        // 0.1361, B 0.2622 → 0.2600, the simulated sets within 0.0005 mm), and the likelihood
+        // reached fell by 4.3 nats summed over the 24 searches. 1e-5 with memory 10 lost 20 nats
+        // and memory 30 lost 15; 3e-6 with memory 20 took 13.0 s.
+        let optimiser = gp::OptimiserConfig {
+            restarts: 0,
+            warm_start_rows: 500,
+            memory: 20,
+            function_tolerance: 1e-5,
+            ..gp::OptimiserConfig::default()
+        };
+        Self {
+            gp: gp::GpConfig {
+                kernel: gp::KernelChoice::Composite {
+                    shape: gp::StationaryShape::SquaredExponential,
+                    constant: false,
+                    linear: false,
+                    additive: true,
+                },
+                optimiser,
+                // The additive term only where the data pay for it: per output, the kernel with
+                // and without it are both searched (on the warm-start subset when there is one,
+                // then only the chosen one on all rows) and the additive term is kept when it
+                // raises the log marginal likelihood by more than the Schwarz penalty ½ · 2d · ln N
+                // (≈ 34 nats for 6 joints and 300 poses). No threshold of ours: BIC's own. On the 8
+                // sets of `bench-gp --kernels` the additive term raised the full-data likelihood
+                // by 229–1634 nats (3 outputs summed) on the UR10 series, where it cuts the
+                // held-out error by a quarter to a third, and by 6–27 nats on the simulated ones,
+                // where SE-ARD alone is as good or better held out on average (iiwa payload runs
+                // seed 1: 0.0454 against 0.0461 mm; docs/results/gp-kernel.md).
+                additive_by_bic: true,
+                // The paper's isotropic Eq. 5 kernel beside it, per output, kept where its
+                // closed-form leave-one-out log predictive probability is higher (issue 25): on
+                // 300 simulated poses with payloads (IRB 4400, soft joints) the ARD kernel's
+                // length scales, fitted by marginal likelihood, overfit and lost up to 11 % held
+                // out to scikit-learn's C·RBF + C + DotProduct + White; on the UR10 series the ARD
+                // kernel wins by half. Decided on the warm-start subset's optimum where there is
+                // one, so the isotropic kernel is searched on all rows only where it wins there.
+                isotropic_by_loo: true,
+                ..gp::GpConfig::default()
+            },
+            method: GpChoice::default(),
+            // One exact evaluation with its gradient costs n³ flops: 64 GFLOP at n = 4000, about
+            // 3 s on 2 cores at faer's measured rate (docs/results/bench-gp.md), so a search of
+            // 50 evaluations takes minutes; the sparse GP with 500 inducing points takes seconds
+            // there and is within a few percent of the exact error (bench-gp's sweep).
+            sparse_above_rows: 4000,
+            sparse: gp::SparseConfig::default(),
+            // A kernel per output: on 100,000 simulated IRB 4400 poses with payloads (seed 7,
+            // tested on 3000 more) shared hyperparameters left 0.105 mm in 31 s, one kernel per
+            // output 0.073 mm in 52 s (the exact GP on the first 3000 poses: 0.075 mm).
+            sparse_outputs: gp::OutputMode::Independent,
+            // SE-ARD, not the exact GP's additive kernel: on the same 100,000 poses the additive
+            // term left 0.0730 mm against 0.0729 mm and took 219 s against 84 s (both under load
+            // ≈ 4): its d one-dimensional kernels cost d more exponentials for each of the
+            // n·m entries of every bound evaluation.
+            sparse_kernel: gp::KernelChoice::SquaredExponentialArd,
+            residual_frame: ResidualFrame::default(),
+            // Off: on UR10 series C, full pose, even rows → odd rows (issue 25), the shared
+            // rotation kernel cut the GP's CPU time from 25.9 to 17.5 s but made the held-out
+            // rotation error 22 % worse (0.302 → 0.368 mrad); accuracy first.
+            rotation_follows_position: false,
+        }
+    }
+}
+
+/// A field given in an options file, or `None` when it was left out.
+fn given<'de, D: serde::Deserializer<'de>, T: Deserialize<'de>>(deserializer: D) -> Result<Option<T>, D::Error> {
+    T::deserialize(deserializer).map(Some)
+}
+
+/// The fields of [`gp::OptimiserConfig`] an options file may set.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OptimiserPatch {
+    #[serde(default, deserialize_with = "given")]
+    restarts: Option<usize>,
+    #[serde(default, deserialize_with = "given")]
+    seed: Option<u64>,
+    #[serde(default, deserialize_with = "given")]
+    max_iterations: Option<usize>,
+    #[serde(default, deserialize_with = "given")]
+    memory: Option<usize>,
+    #[serde(default, deserialize_with = "given")]
+    gradient_tolerance: Option<f64>,
+    #[serde(default, deserialize_with = "given")]
+    function_tolerance: Option<f64>,
+    #[serde(default, deserialize_with = "given")]
+    warm_start_rows: Option<usize>,
+    #[serde(default, deserialize_with = "given")]
+    warm_start_curvature: Option<bool>,
+}
+
+/// The fields of [`gp::GpConfig`] an options file may set.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GpPatch {
+    #[serde(default, deserialize_with = "given")]
+    kernel: Option<gp::KernelChoice>,
+    #[serde(default, deserialize_with = "given")]
+    bounds: Option<Option<gp::Bounds>>,
+    #[serde(default, deserialize_with = "given")]
+    outputs: Option<gp::OutputMode>,
+    #[serde(default, deserialize_with = "given")]
+    standardise_inputs: Option<bool>,
+    #[serde(default, deserialize_with = "given")]
+    normalise_outputs: Option<bool>,
+    #[serde(default, deserialize_with = "given")]
+    optimiser: Option<OptimiserPatch>,
+    #[serde(default, deserialize_with = "given")]
+    jitter: Option<gp::JitterConfig>,
+    #[serde(default, deserialize_with = "given")]
+    parallelism: Option<gp::Parallelism>,
+    #[serde(default, deserialize_with = "given")]
+    additive_by_bic: Option<bool>,
+    #[serde(default, deserialize_with = "given")]
+    isotropic_by_loo: Option<bool>,
+    #[serde(default, deserialize_with = "given")]
+    follower_groups: Option<Vec<Vec<usize>>>,
+}
+
+/// `gp` as an options file gives it, laid over [`CompensationOptions::default`]'s: derived
+/// `#[serde(default)]` would fill the fields left out from [`gp::GpConfig::default`] (the
+/// library's kernel, three restarts, no warm start) and silently change the fit.
+fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<gp::GpConfig, D::Error> {
+    let patch = GpPatch::deserialize(deserializer)?;
+    let mut gp = CompensationOptions::default().gp;
+    let GpPatch {
+        kernel,
+        bounds,
+        outputs,
+        standardise_inputs,
+        normalise_outputs,
+        optimiser,
+        jitter,
+        parallelism,
+        additive_by_bic,
+        isotropic_by_loo,
+        follower_groups,
+    } = patch;
+    gp.kernel = kernel.unwrap_or(gp.kernel);
+    gp.bounds = bounds.unwrap_or(gp.bounds);
+    gp.outputs = outputs.unwrap_or(gp.outputs);
+    gp.standardise_inputs = standardise_inputs.unwrap_or(gp.standardise_inputs);
+    gp.normalise_outputs = normalise_outputs.unwrap_or(gp.normalise_outputs);
+    gp.jitter = jitter.unwrap_or(gp.jitter);
+    gp.parallelism = parallelism.unwrap_or(gp.parallelism);
+    gp.additive_by_bic = additive_by_bic.unwrap_or(gp.additive_by_bic);
+    gp.isotropic_by_loo = isotropic_by_loo.unwrap_or(gp.isotropic_by_loo);
+    gp.follower_groups = follower_groups.unwrap_or(gp.follower_groups);
+    if let Some(o) = optimiser {
+        let OptimiserPatch {
+            restarts,
+            seed,
+            max_iterations,
+            memory,
+            gradient_tolerance,
+            function_tolerance,
+            warm_start_rows,
+            warm_start_curvature,
+        } = o;
+        let d = &mut gp.optimiser;
+        d.restarts = restarts.unwrap_or(d.restarts);
+        d.seed = seed.unwrap_or(d.seed);
+        d.max_iterations = max_iterations.unwrap_or(d.max_iterations);
+        d.memory = memory.unwrap_or(d.memory);
+        d.gradient_tolerance = gradient_tolerance.unwrap_or(d.gradient_tolerance);
+        d.function_tolerance = function_tolerance.unwrap_or(d.function_tolerance);
+        d.warm_start_rows = warm_start_rows.unwrap_or(d.warm_start_rows);
+        d.warm_start_curvature = warm_start_curvature.unwrap_or(d.warm_start_curvature);
+    }
+    Ok(gp)
+}
+
+impl CompensationOptions {
+    /// The GP that `rows` training rows get.
+    pub fn choice_for(&self, rows: usize) -> GpChoice {
+        match self.method {
+            GpChoice::Auto if rows > self.sparse_above_rows => GpChoice::Sparse,
+            GpChoice::Auto => GpChoice::Exact,
+            other => other,
+        }
+    }
+}
+
+/// The fitted GP of the stage: exact or sparse.
+///
+/// Stored untagged, so that model files written before the sparse GP existed (an exact GP in the
+/// `gp` field) still read.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum GpModel {
+    /// The sparse variational GP.
+    Sparse(gp::SparseGp),
+    /// The exact GP.
+    Exact(gp::ExactGp),
+}
+
+impl GpModel {
+    /// Number of inputs.
+    pub fn input_dim(&self) -> usize {
+        match self {
+            Self::Exact(g) => g.input_dim(),
+            Self::Sparse(g) => g.input_dim(),
+        }
+    }
+
+    /// Number of outputs.
+    pub fn output_count(&self) -> usize {
+        match self {
+            Self::Exact(g) => g.output_count(),
+            Self::Sparse(g) => g.output_count(),
+        }
+    }
+
+    /// Every kernel of the GP (one per group of outputs).
+    pub fn kernels(&self) -> Vec<&gp::Kernel> {
+        match self {
+            Self::Exact(g) => g.report().components.iter().map(|c| &c.kernel).collect(),
+            Self::Sparse(g) => g.report().components.iter().map(|c| &c.kernel).collect(),
+        }
+    }
+
+    /// The mean of each input over the training rows (the GP's input standardisation).
+    pub fn input_mean(&self) -> &[f64] {
+        match self {
+            Self::Exact(g) => &g.input_standardiser().mean,
+            Self::Sparse(g) => &g.input_standardiser().mean,
+        }
+    }
+
+    /// Which one it is.
+    pub fn choice(&self) -> GpChoice {
+        match self {
+            Self::Exact(_) => GpChoice::Exact,
+            Self::Sparse(_) => GpChoice::Sparse,
+        }
+    }
+
+    /// Posterior mean and variance at the rows of `x`.
+    pub fn predict(&self, x: faer::MatRef<'_, f64>) -> Result<gp::Prediction, gp::Error> {
+        match self {
+            Self::Exact(g) => g.predict(x),
+            Self::Sparse(g) => g.predict(x),
+        }
+    }
+}
+
+/// What the GP's fit reported.
+#[derive(Debug, Clone, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GpFitReport {
+    /// The exact GP's report.
+    Exact(gp::FitReport),
+    /// The sparse GP's report.
+    Sparse(gp::SparseFitReport),
+}
+
+impl GpFitReport {
+    /// The output columns whose kernel's hyperparameter search stopped on its iteration limit or a
+    /// failed line search rather than on a tolerance, with the iterations it ran. For the sparse GP
+    /// that is the exact search on its subset: the bound's search that refines it runs a fixed
+    /// budget ([`gp::SparseConfig::bound_iterations`]) and its outcome stays in the report.
+    pub fn unconverged(&self) -> Vec<(Vec<usize>, usize)> {
+        let exact = |c: &gp::ComponentReport| match &c.optimisation {
+            Some(o) if !o.converged => Some((c.outputs.clone(), o.iterations)),
+            _ => None,
+        };
+        match self {
+            Self::Exact(r) => r.components.iter().filter_map(exact).collect(),
+            Self::Sparse(r) => r.components.iter().filter_map(|c| c.subset_fit.as_ref().and_then(exact)).collect(),
+        }
+    }
+}
+
+/// A fitted GP compensation, stored in the model file.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Compensation {
+    /// Whether the payload is an input (method `poe-gp-load`, Eq. 12).
+    pub with_payload: bool,
+    /// Six outputs (a twist) for full-pose data, three (the position error) otherwise.
+    pub full_pose: bool,
+    /// Where the error twist is expressed.
+    pub residual_frame: ResidualFrame,
+    /// The GP: inputs `(q_1 … q_n[, m])`, outputs the error components.
+    pub gp: GpModel,
+}
+
+/// What the GP stage reports.
+#[derive(Debug, Clone, Serialize)]
+pub struct CompensationReport {
+    /// The GP's own report (hyperparameters, log marginal likelihood or bound, jitter).
+    pub gp: GpFitReport,
+    /// The training error of the model had the GP not seen each row: every row corrected by the
+    /// GP's closed-form leave-one-out prediction (R&W Eqs. 5.10–5.12; hyperparameters and the
+    /// geometry as fitted on all rows). A GP interpolates its training poses, so the training
+    /// error after it says little; this says what it does on a pose it has not seen. `None` for
+    /// the sparse GP, which has no closed form.
+    pub leave_one_out: Option<crate::ErrorSummary>,
+}
+
+fn inputs(rows: &[Measurement], with_payload: bool) -> Mat<f64> {
+    let n = rows.first().map_or(0, |r| r.q.len());
+    let d = n + usize::from(with_payload);
+    Mat::from_fn(rows.len(), d, |i, c| if c < n { rows[i].q[c] } else { rows[i].payload_kg })
+}
+
+/// The error of one row against the model's pose, as the GP's output vector.
+fn error_vector(model_pose: &SE3, row: &Measurement, frame: ResidualFrame) -> Vector6 {
+    match row.orientation {
+        None => {
+            let d = row.position - model_pose.translation();
+            Vector6::new(d.x, d.y, d.z, 0.0, 0.0, 0.0)
+        }
+        Some(rotation) => {
+            let measured = SE3::new(rotation, row.position);
+            let error = measured * model_pose.inverse();
+            match frame {
+                ResidualFrame::Tracker => error.log().to_vector(),
+                ResidualFrame::ToolPoint => {
+                    let p = SE3::from_translation(model_pose.translation());
+                    (p.inverse() * error * p).log().to_vector()
+                }
+            }
+        }
+    }
+}
+
+/// What the GP learns: its inputs `(q_1 … q_n[, m])` and the error the geometric model leaves
+/// (Eq. 8), one row per measurement.
+#[derive(Debug, Clone)]
+pub struct ResidualSet {
+    /// `n × (joints [+ 1])`: joint values, then the payload (kg) when it is an input.
+    pub inputs: Mat<f64>,
+    /// `n × 3` (position only: the position error, m) or `n × 6` (full pose: the error twist).
+    pub outputs: Mat<f64>,
+}
+
+impl ResidualSet {
+    /// The error that the model poses `poses` (one per row) leave on `data`, expressed in `frame`.
+    pub fn new(poses: &[SE3], data: &MeasurementSet, with_payload: bool, frame: ResidualFrame) -> Self {
+        let outputs = if data.full_pose { 6 } else { 3 };
+        let mut y = Mat::<f64>::zeros(data.rows.len(), outputs);
+        for (i, (row, pose)) in data.rows.iter().zip(poses).enumerate() {
+            let e = error_vector(pose, row, frame);
+            for c in 0..outputs {
+                y[(i, c)] = e[c];
+            }
+        }
+        Self { inputs: inputs(&data.rows, with_payload), outputs: y }
+    }
+}
+
+impl Compensation {
+    /// Fits the GP to the error that the model poses `poses` (one per row) leave on `data`.
+    pub fn fit(
+        poses: &[SE3],
+        data: &MeasurementSet,
+        with_payload: bool,
+        options: &CompensationOptions,
+    ) -> Result<(Self, CompensationReport), Error> {
+        let ResidualSet { inputs: x, outputs: y } = ResidualSet::new(poses, data, with_payload, options.residual_frame);
+        let (gp, report, leave_one_out) = match options.choice_for(x.nrows()) {
+            GpChoice::Sparse => {
+                let inducing_points = options.sparse.inducing_points.min(x.nrows());
+                let gp = gp::GpConfig {
+                    outputs: options.sparse_outputs,
+                    kernel: options.sparse_kernel,
+                    ..options.gp.clone()
+                };
+                let config = gp::SparseConfig { gp, inducing_points, ..options.sparse.clone() };
+                let model = gp::SparseGp::fit(x.as_ref(), y.as_ref(), &config)?;
+                let report = GpFitReport::Sparse(model.report().clone());
+                (GpModel::Sparse(model), report, None)
+            }
+            GpChoice::Exact | GpChoice::Auto => {
+                let mut config = options.gp.clone();
+                if data.full_pose && options.rotation_follows_position && config.follower_groups.is_empty() {
+                    config.follower_groups = vec![vec![3, 4, 5]];
+                }
+                let model = gp::ExactGp::fit(x.as_ref(), y.as_ref(), &config)?;
+                let report = GpFitReport::Exact(model.report().clone());
+                let loo = model.leave_one_out()?;
+                (GpModel::Exact(model), report, Some(loo.mean))
+            }
+        };
+        let compensation = Self { with_payload, full_pose: data.full_pose, residual_frame: options.residual_frame, gp };
+        let leave_one_out = leave_one_out.map(|mean| {
+            let errors: Vec<crate::PoseError> = poses
+                .iter()
+                .zip(&data.rows)
+                .enumerate()
+                .map(|(i, (pose, row))| {
+                    let g = Vector6::from_fn(|c, _| if c < mean.ncols() { mean[(i, c)] } else { 0.0 });
+                    let error = crate::pose_error(&(compensation.correction(pose, &g) * *pose), row);
+                    if data.full_pose { error } else { crate::PoseError { rotation_mrad: None, ..error } }
+                })
+                .collect();
+            crate::ErrorSummary::from_errors(&errors)
+        });
+        Ok((compensation, CompensationReport { gp: report, leave_one_out }))
+    }
+
+    /// `G` for the GP's output `g` at a model pose: a translation for position-only data, else the
+    /// twist's exponential, at the tool point or in the tracker frame as the residuals were taken.
+    fn correction(&self, pose: &SE3, g: &Vector6) -> SE3 {
+        if !self.full_pose {
+            return SE3::from_translation(Vector3::new(g[0], g[1], g[2]));
+        }
+        let exp = Twist::from_vector(g).exp();
+        match self.residual_frame {
+            ResidualFrame::Tracker => exp,
+            ResidualFrame::ToolPoint => {
+                let p = SE3::from_translation(pose.translation());
+                p * exp * p.inverse()
+            }
+        }
+    }
+
+    /// The correction of every row: `G(q, m)` to put before the model pose, and the GP's standard
+    /// deviation of each error component `(v, ω)` (m, rad; zeros where not modelled).
+    pub fn predict(&self, rows: &[Measurement], model_poses: &[SE3]) -> Result<Vec<(SE3, [f64; 6])>, Error> {
+        let prediction = self.gp.predict(inputs(rows, self.with_payload).as_ref())?;
+        let outputs = prediction.mean.ncols();
+        Ok(model_poses
+            .iter()
+            .enumerate()
+            .map(|(i, pose)| {
+                let mut g = Vector6::zeros();
+                let mut std = [0.0; 6];
+                for c in 0..outputs {
+                    g[c] = prediction.mean[(i, c)];
+                    std[c] = prediction.variance[(i, c)].max(0.0).sqrt();
+                }
+                (self.correction(pose, &g), std)
+            })
+            .collect())
+    }
+}

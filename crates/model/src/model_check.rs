@@ -1,0 +1,226 @@
+//! The internal consistency of a calibrated model, checked once when its file is read: an edited or
+//! corrupt file is refused at the field at fault, never left to panic on an index (or to be
+//! silently truncated by a `zip`) in `eval` or `predict`. One function, so that each new part of a
+//! model adds its checks here.
+
+use crate::model_parts::{Part, Walk};
+use crate::{CalibratedModel, Method};
+use errors::Error;
+use errors::ron_position::field_position;
+use measurements::Measurement;
+use robot::{MAX_TRANSLATION_M, bad_translation};
+
+/// Where a field is in the file's text, and the error makers that use it.
+struct Located<'a> {
+    text: &'a str,
+    file: &'a str,
+}
+
+impl Located<'_> {
+    fn at(&self, field: &str, index: usize) -> (usize, usize) {
+        field_position(self.text, field, index)
+    }
+
+    fn count(&self, at: (&str, usize), field: String, what: &'static str, found: usize, expected: usize) -> Error {
+        let (line, column) = self.at(at.0, at.1);
+        Error::ModelCount { file: self.file.to_owned(), line, column, field, what, found, expected }
+    }
+
+    fn not_finite(&self, at: (&str, usize), field: String, value: f64) -> Error {
+        let (line, column) = self.at(at.0, at.1);
+        Error::NotFinite { file: self.file.to_owned(), line, column, field, value }
+    }
+
+    /// A value that is not finite, or finite and beyond [`robot::MAX_TRANSLATION_M`].
+    fn value(&self, at: (&str, usize), field: String, value: f64) -> Error {
+        if !value.is_finite() {
+            return self.not_finite(at, field, value);
+        }
+        let (line, column) = self.at(at.0, at.1);
+        Error::ModelValue { file: self.file.to_owned(), line, column, field, value, limit: MAX_TRANSLATION_M }
+    }
+
+    fn part(&self, field: &str, message: String) -> Error {
+        let (line, column) = self.at(field, 0);
+        Error::RonFormat { file: self.file.to_owned(), line, column, message }
+    }
+}
+
+/// How many times `field:` occurs before the first `part:` (so that a field of the part can be
+/// located by its occurrence within it).
+fn occurrences_before(text: &str, field: &str, part: &str) -> usize {
+    let start = field_position(text, part, 0);
+    (0..)
+        .take_while(|&k| {
+            let position = field_position(text, field, k);
+            position != (1, 1) && position < start
+        })
+        .count()
+}
+
+/// The widest a GP hyperparameter of a model file may be, as a factor either way of 1: the GP
+/// works on standardised inputs and normalised outputs, and its search box is far narrower (gp's
+/// default bounds span 1e-9 to 1e3). Like [`robot::MAX_TRANSLATION_M`] a sanity bound on a file, not a
+/// tuning constant: a signal variance of 1e200 is finite, predicts finite poses at any row, and is
+/// still a corrupt file.
+pub(crate) const MAX_HYPERPARAMETER_DECADES: f64 = 100.0;
+
+impl CalibratedModel {
+    /// Checks that the parts of the model fit together: the kinematics' joint and tool counts,
+    /// the tool names, the effects' joints, indices and values, the GP's input and output
+    /// dimensions. `text` is the file the model was read from, `file` its name, for positions.
+    pub fn check(&self, text: &str, file: &str) -> Result<(), Error> {
+        let at = Located { text, file };
+        let n = self.kinematics.joint_count();
+        let tool_count = self.kinematics.tool_count();
+        if n == 0 {
+            return Err(at.count(("joints", 0), "kinematics.joints".into(), "joints", 0, 1));
+        }
+        // Translations appear in the file in this order: the joints', then the tools'.
+        let transforms = self.kinematics.joints().iter().map(|j| j.previous_from_joint_zero);
+        if let Some((k, value)) = bad_translation(transforms.chain(self.kinematics.tools().iter().copied())) {
+            let field = if k < n { format!("kinematics.joints[{k}]") } else { format!("kinematics.tools[{}]", k - n) };
+            return Err(at.value(("translation", k), field, value));
+        }
+        // A scale is written only where it is not 1, so its occurrence counts those before it.
+        let scales = self.kinematics.joints().iter().map(|j| j.scale).filter(|s| *s != 1.0);
+        if let Some((k, scale)) = scales.enumerate().find(|(_, s)| !robot::scale_in_bounds(*s)) {
+            let (lo, hi) = robot::SCALE_BOUNDS;
+            let (line, column) = at.at("scale", k);
+            let message = format!("a joint's scale is {scale:e}, expected a finite number from {lo:e} to {hi:e}");
+            return Err(Error::RonFormat { file: file.to_owned(), line, column, message });
+        }
+        if self.tools.len() != tool_count {
+            return Err(at.count(("tools", 0), "tools".into(), "tool names", self.tools.len(), tool_count));
+        }
+        if let Some(k) = (1..self.tools.len()).find(|&k| self.tools[..k].contains(&self.tools[k])) {
+            return Err(at.part("tools", format!("tools: the name '{}' is given twice", self.tools[k])));
+        }
+        if self.method.uses_gp() != self.compensation.is_some() {
+            let has = if self.compensation.is_some() { "has a" } else { "has no" };
+            return Err(at.part("method", format!("method {} but the model {has} GP compensation", self.method)));
+        }
+        effects::check_effects(&self.effects, n, tool_count, &|field, occurrence| {
+            let before = occurrences_before(text, field, "effects");
+            at.at(field, before + occurrence)
+        })
+        .map_err(|fault| fault.into_error(file))?;
+        if let Some(compensation) = &self.compensation {
+            if compensation.with_payload != (self.method == Method::PoeGpLoad) {
+                let message =
+                    format!("compensation.with_payload is {} for method {}", compensation.with_payload, self.method);
+                return Err(at.part("with_payload", message));
+            }
+            if compensation.full_pose != self.full_pose {
+                let message = format!(
+                    "compensation.full_pose is {}, the model's full_pose {}",
+                    compensation.full_pose, self.full_pose
+                );
+                return Err(at.part("compensation", message));
+            }
+            let inputs = n + usize::from(compensation.with_payload);
+            if compensation.gp.input_dim() != inputs {
+                let found = compensation.gp.input_dim();
+                return Err(at.count(("gp", 0), "compensation.gp".into(), "inputs", found, inputs));
+            }
+            let bound = 10f64.powf(MAX_HYPERPARAMETER_DECADES);
+            let hyperparameters = compensation.gp.kernels().into_iter().flat_map(|k| k.parameters());
+            if let Some(value) = hyperparameters.into_iter().find(|p| !(p.abs() <= bound && p.abs() >= 1.0 / bound)) {
+                let message = format!(
+                    "compensation.gp: a kernel hyperparameter is {value:e}, outside 1e-{MAX_HYPERPARAMETER_DECADES} to \
+                     1e{MAX_HYPERPARAMETER_DECADES} (the GP works on standardised data; an edited or corrupt file)"
+                );
+                return Err(at.part("kernel", message));
+            }
+            let outputs = if self.full_pose { 6 } else { 3 };
+            if compensation.gp.output_count() != outputs {
+                let found = compensation.gp.output_count();
+                return Err(at.count(("gp", 0), "compensation.gp".into(), "outputs", found, outputs));
+            }
+        }
+        self.check_values(&at)
+    }
+
+    /// The rows the walk probes, and how to say where they are: inside the ranges the model was
+    /// fitted on (the centre and both corners); for a file without them, the GP's training mean
+    /// where there is a GP, otherwise every joint at 0 and at 1 rad or 1 m (payload, torques,
+    /// temperature and time at 0 where not recorded).
+    fn probe_rows(&self) -> (Vec<Measurement>, &'static str) {
+        if let Some(range) = &self.training_range {
+            return (range.probe_rows(), "at the centre or a corner of the ranges it was fitted on");
+        }
+        let n = self.kinematics.joint_count();
+        let row = |q: Vec<f64>, payload_kg: f64| Measurement {
+            line: 0,
+            q,
+            position: lie::Vector3::zeros(),
+            orientation: None,
+            payload_kg,
+            tool: 0,
+            temp_c: Some(0.0),
+            t_s: Some(0.0),
+            torques_nm: Some(vec![0.0; n]),
+        };
+        match &self.compensation {
+            Some(compensation) => {
+                let mean = compensation.gp.input_mean();
+                let payload = if compensation.with_payload { mean.get(n).copied().unwrap_or(0.0) } else { 0.0 };
+                (vec![row(mean[..n.min(mean.len())].to_vec(), payload)], "at the mean of the GP's training inputs")
+            }
+            None => (vec![row(vec![0.0; n], 0.0), row(vec![1.0; n], 0.0)], "with every joint at 0 or 1"),
+        }
+    }
+
+    /// Walks the parts at rows where the model was fitted ([`Self::probe_rows`]) and refuses the
+    /// first part that makes a number non-finite or puts the tool beyond [`robot::MAX_TRANSLATION_M`].
+    /// The checks above bound what they can name; this catches any finite but absurd value they
+    /// leave (1e308 in the GP's training outputs, a feature scale of 1e-320) that would make
+    /// predictions NaN or kilometres off, and names the part. A sound model passes: the rows are
+    /// inside what it was fitted on (issue 23: at every joint 1 rad, a GP fitted with the wrist
+    /// within 2 mrad of zero extrapolated beyond a kilometre and a sound model was refused).
+    fn check_values(&self, at: &Located<'_>) -> Result<(), Error> {
+        if let Some(range) = &self.training_range
+            && let Some((name, index, value)) = range.fault(self.kinematics.joint_count(), MAX_TRANSLATION_M)
+        {
+            let message = format!(
+                "training_range.{name}[{index}]: {value:e} is not a range of finite values, smallest first, one per \
+                 joint, joint values within ±{MAX_TRANSLATION_M:e} (an edited or corrupt file)"
+            );
+            return Err(at.part("training_range", message));
+        }
+        if let Some((index, value)) =
+            crate::joint_limits::limits_fault(&self.joint_limits, self.kinematics.joint_count())
+        {
+            let message = format!(
+                "joint_limits[{index}]: {value:e} is not a range of finite values, smallest first, one per joint \
+                 (an edited or corrupt file)"
+            );
+            return Err(at.part("joint_limits", message));
+        }
+        let (rows, where_) = self.probe_rows();
+        let tools = vec![0; rows.len()];
+        let mut walk = Walk::new(&rows, &tools);
+        for (k, part) in self.parts().iter().enumerate() {
+            let applied = part.apply(&mut walk);
+            if applied.is_ok() && walk.is_bounded(MAX_TRANSLATION_M) {
+                continue;
+            }
+            let field = match part {
+                Part::Geometry(_) => "kinematics",
+                Part::Effect(_) => "effects",
+                Part::Fallback(_) => "fallback_kinematics",
+                Part::GaussianProcess(_) => "compensation",
+            };
+            let why = applied
+                .err()
+                .map_or("a pose that is not finite or beyond a kilometre".to_owned(), |e| format!("'{e}'"));
+            let message = format!(
+                "{field}: part {k} ({}) gives {why} {where_}: a value in it is out of range \
+                 (an edited or corrupt file)",
+                part.name()
+            );
+            return Err(at.part(field, message));
+        }
+        Ok(())
+    }
+}

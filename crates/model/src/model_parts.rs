@@ -1,0 +1,184 @@
+//! A calibrated model as a sequence of parts: the geometry, then the named effects, then the GP.
+//! Each part applies itself to the poses of a set of rows ([`Part::apply`]); prediction, the fit's
+//! "after" report, export (what a URDF cannot hold) and compensation all walk the same sequence, so
+//! a new kind of part is one new variant here.
+//!
+//! The effects move a pose by one left exponential of the sum of their twists, exactly as the
+//! identification models them (`poe::identify::PoseCorrection`): each effect adds its twist to the
+//! rows' pending twist, and the pending twist is applied before the GP reads the poses and at the
+//! end.
+
+use crate::Compensation;
+use effects::IdentifiedEffect;
+use errors::Error;
+use lie::{SE3, Twist, Vector6};
+use measurements::Measurement;
+use poe::LocalPoe;
+
+/// One part of a calibrated model, in the order the parts apply.
+#[derive(Debug, Clone, Copy)]
+pub enum Part<'a> {
+    /// The identified local POE kinematics (reference frame: the tracker).
+    Geometry(&'a LocalPoe),
+    /// A non-geometric effect identified with the geometry.
+    Effect(&'a IdentifiedEffect),
+    /// The geometry fitted alone, before the effects: where an effect fades out (outside the
+    /// joint angles it was fitted on) the pose blends from the geometry-and-effects fit to this
+    /// one, so that far from the training angles the model is the plain geometric fit.
+    Fallback(&'a LocalPoe),
+    /// The Gaussian-process compensation of what is left.
+    GaussianProcess(&'a Compensation),
+}
+
+impl<'a> Part<'a> {
+    /// The part's name in reports: `geometry`, the effect's label, `gaussian_process`.
+    pub fn name(&self) -> String {
+        match self {
+            Part::Geometry(_) => "geometry".into(),
+            Part::Effect(effect) => effect.label(),
+            Part::Fallback(_) => "geometry_fallback".into(),
+            Part::GaussianProcess(_) => "gaussian_process".into(),
+        }
+    }
+
+    /// Whether a URDF can hold the part: the geometry, and the fallback geometry, which changes
+    /// nothing on the joint angles the effects were fitted on (a URDF holds one geometry; the
+    /// exported one is the geometry fitted with the effects).
+    pub fn in_urdf(&self) -> bool {
+        matches!(self, Part::Geometry(_) | Part::Fallback(_))
+    }
+
+    /// Applies the part to the state of a walk over `rows`.
+    pub(crate) fn apply(&self, walk: &mut Walk<'a>) -> Result<(), Error> {
+        match *self {
+            Part::Geometry(kinematics) => {
+                walk.kinematics = Some(kinematics);
+                walk.poses = walk
+                    .rows
+                    .iter()
+                    .zip(walk.tools)
+                    .map(|(row, &tool)| kinematics.forward(&row.q, tool))
+                    .collect::<Result<_, _>>()?;
+                walk.pending = vec![Vector6::zeros(); walk.rows.len()];
+                walk.coverage = vec![1.0; walk.rows.len()];
+            }
+            Part::Effect(effect) => {
+                let kinematics = walk.kinematics.ok_or(Error::PartOrder { part: "effect" })?;
+                for (((pending, coverage), row), &tool) in
+                    walk.pending.iter_mut().zip(&mut walk.coverage).zip(walk.rows).zip(walk.tools)
+                {
+                    *pending += effect.twist(kinematics, row, tool)?;
+                    *coverage *= effect.coverage_weight(row);
+                }
+                if effect.has_sigma() {
+                    let variance = walk.effect_variance.get_or_insert_with(|| vec![[0.0; 6]; walk.rows.len()]);
+                    for (((variance, pose), row), &tool) in
+                        variance.iter_mut().zip(&walk.poses).zip(walk.rows).zip(walk.tools)
+                    {
+                        let sigma = effect.sigma(kinematics, row, tool, &pose.translation())?;
+                        for (v, s) in variance.iter_mut().zip(sigma.iter()) {
+                            *v += s * s;
+                        }
+                    }
+                }
+            }
+            Part::Fallback(fallback) => {
+                walk.flush();
+                for (((pose, coverage), row), &tool) in
+                    walk.poses.iter_mut().zip(&walk.coverage).zip(walk.rows).zip(walk.tools)
+                {
+                    if *coverage < 1.0 {
+                        // T = exp(w · log(T_e T_g⁻¹)) T_g: the geometry alone at w = 0.
+                        let alone = fallback.forward(&row.q, tool)?;
+                        let towards = (*pose * alone.inverse()).log().to_vector() * *coverage;
+                        *pose = Twist::from_vector(&towards).exp() * alone;
+                    }
+                }
+            }
+            Part::GaussianProcess(compensation) => {
+                walk.flush();
+                let corrections = compensation.predict(walk.rows, &walk.poses)?;
+                let mut std = Vec::with_capacity(corrections.len());
+                for (pose, (g, s)) in walk.poses.iter_mut().zip(corrections) {
+                    *pose = g * *pose;
+                    std.push(s);
+                }
+                walk.std = Some(std);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The state of a walk over the parts: the poses so far, the effects' pending twist, the GP's
+/// standard deviations.
+#[derive(Debug)]
+pub(crate) struct Walk<'a> {
+    rows: &'a [Measurement],
+    tools: &'a [usize],
+    kinematics: Option<&'a LocalPoe>,
+    pub(crate) poses: Vec<SE3>,
+    pending: Vec<Vector6>,
+    /// How far each row lies within the angles every effect so far was fitted on: the product
+    /// of their [`IdentifiedEffect::coverage_weight`]s.
+    coverage: Vec<f64>,
+    /// The variance each row's effects leave uncorrected where they fade out, per component
+    /// (`None` when no effect reports one).
+    pub(crate) effect_variance: Option<Vec<[f64; 6]>>,
+    pub(crate) std: Option<Vec<[f64; 6]>>,
+}
+
+impl<'a> Walk<'a> {
+    pub(crate) fn new(rows: &'a [Measurement], tools: &'a [usize]) -> Self {
+        Self {
+            rows,
+            tools,
+            kinematics: None,
+            poses: Vec::new(),
+            pending: Vec::new(),
+            coverage: Vec::new(),
+            effect_variance: None,
+            std: None,
+        }
+    }
+
+    /// Whether every number of the walk so far (poses, pending twists, GP deviations) is finite,
+    /// and every pose within `reach` metres of the reference frame.
+    pub(crate) fn is_bounded(&self, reach: f64) -> bool {
+        let pose = |p: &SE3| {
+            p.translation().iter().all(|v| v.abs() <= reach) && p.rotation().matrix().iter().all(|v| v.is_finite())
+        };
+        self.poses.iter().all(pose)
+            && self.pending.iter().all(|t| t.iter().all(|v| v.is_finite()))
+            && self.std.iter().flatten().all(|s| s.iter().all(|v| v.is_finite()))
+    }
+
+    /// The standard deviation of each row's pose: the GP's and the faded effects', in
+    /// quadrature (independent sources); `None` when neither is part of the model.
+    pub(crate) fn standard_deviations(&self) -> Option<Vec<[f64; 6]>> {
+        match (&self.std, &self.effect_variance) {
+            (None, None) => None,
+            (Some(std), None) => Some(std.clone()),
+            (std, Some(variance)) => Some(
+                variance
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| {
+                        let gp = std.as_ref().map_or([0.0; 6], |s| s[i]);
+                        std::array::from_fn(|k| (gp[k] * gp[k] + v[k]).sqrt())
+                    })
+                    .collect(),
+            ),
+        }
+    }
+
+    /// Applies the effects' pending twists: `exp(Σ twists) · pose`.
+    pub(crate) fn flush(&mut self) {
+        for (pose, pending) in self.poses.iter_mut().zip(&mut self.pending) {
+            if *pending != Vector6::zeros() {
+                *pose = Twist::from_vector(pending).exp() * *pose;
+                *pending = Vector6::zeros();
+            }
+        }
+    }
+}

@@ -1,0 +1,173 @@
+//! The range of every input a model was fitted on, recorded in the model file (issue 23): the
+//! check on reading walks the parts at rows inside it, where a sound model is sound, instead of at
+//! joint values it may never have seen (every joint at 1 rad refused a sound GP fitted with the
+//! wrist held within 2 mrad of zero). Model files written before it existed have none and read.
+
+use measurements::Measurement;
+use serde::{Deserialize, Serialize};
+
+/// Smallest and largest value of each input over the training rows.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrainingRange {
+    /// Per joint, `[min, max]` (radians or metres).
+    pub q: Vec<[f64; 2]>,
+    /// `[min, max]` of the payload, kg.
+    pub payload_kg: [f64; 2],
+    /// `[min, max]` of the temperature, °C, where every row had one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temp_c: Option<[f64; 2]>,
+    /// `[min, max]` of the time, s, where every row had one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub t_s: Option<[f64; 2]>,
+    /// Per joint, `[min, max]` of the measured torque, N·m, where every row had them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub torques_nm: Option<Vec<[f64; 2]>>,
+}
+
+fn span(values: impl Iterator<Item = f64>) -> [f64; 2] {
+    values.fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], v| [lo.min(v), hi.max(v)])
+}
+
+fn spans<'a>(rows: impl Iterator<Item = &'a [f64]> + Clone, n: usize) -> Vec<[f64; 2]> {
+    (0..n).map(|j| span(rows.clone().map(|r| r[j]))).collect()
+}
+
+impl TrainingRange {
+    /// The ranges of `rows` (`None` for no rows); optional inputs only where every row has them.
+    pub fn of(rows: &[Measurement]) -> Option<Self> {
+        let n = rows.first()?.q.len();
+        let all = |f: fn(&Measurement) -> Option<f64>| rows.iter().map(f).collect::<Option<Vec<f64>>>();
+        let torques: Option<Vec<&[f64]>> =
+            rows.iter().map(|r| r.torques_nm.as_deref().filter(|t| t.len() == n)).collect();
+        Some(Self {
+            q: spans(rows.iter().map(|r| r.q.as_slice()), n),
+            payload_kg: span(rows.iter().map(|r| r.payload_kg)),
+            temp_c: all(|r| r.temp_c).map(|v| span(v.into_iter())),
+            t_s: all(|r| r.t_s).map(|v| span(v.into_iter())),
+            torques_nm: torques.map(|t| spans(t.into_iter(), n)),
+        })
+    }
+
+    /// The first range that is not finite, reversed, of the wrong length, or (for a joint)
+    /// beyond `limit`: its field name, index and the offending value.
+    pub(crate) fn fault(&self, joints: usize, limit: f64) -> Option<(&'static str, usize, f64)> {
+        if self.q.len() != joints {
+            return Some(("q", self.q.len(), self.q.len() as f64));
+        }
+        if let Some(t) = &self.torques_nm
+            && t.len() != joints
+        {
+            return Some(("torques_nm", t.len(), t.len() as f64));
+        }
+        let bad = |r: &[f64; 2], bound: f64| {
+            r.iter().copied().find(|v| !v.is_finite() || v.abs() > bound).or((r[0] > r[1]).then_some(r[0]))
+        };
+        let lists: [(&'static str, &[[f64; 2]], f64); 2] =
+            [("q", &self.q, limit), ("torques_nm", self.torques_nm.as_deref().unwrap_or(&[]), f64::MAX)];
+        for (name, list, bound) in lists {
+            if let Some((k, v)) = list.iter().enumerate().find_map(|(k, r)| bad(r, bound).map(|v| (k, v))) {
+                return Some((name, k, v));
+            }
+        }
+        let single = [("payload_kg", Some(self.payload_kg)), ("temp_c", self.temp_c), ("t_s", self.t_s)];
+        single.into_iter().find_map(|(name, r)| r.and_then(|r| bad(&r, f64::MAX)).map(|v| (name, 0, v)))
+    }
+
+    /// Rows inside the ranges at which a model is probed: the centre of every range, and the
+    /// corners where every input is at its smallest and at its largest (tool 0, no measured pose).
+    pub(crate) fn probe_rows(&self) -> Vec<Measurement> {
+        let at = |pick: fn(&[f64; 2]) -> f64| Measurement {
+            line: 0,
+            q: self.q.iter().map(pick).collect(),
+            position: lie::Vector3::zeros(),
+            orientation: None,
+            payload_kg: pick(&self.payload_kg),
+            tool: 0,
+            temp_c: Some(self.temp_c.as_ref().map_or(0.0, pick)),
+            t_s: Some(self.t_s.as_ref().map_or(0.0, pick)),
+            torques_nm: Some(match &self.torques_nm {
+                Some(t) => t.iter().map(pick).collect(),
+                None => vec![0.0; self.q.len()],
+            }),
+        };
+        vec![at(|r| 0.5 * (r[0] + r[1])), at(|r| r[0]), at(|r| r[1])]
+    }
+}
+
+/// Rows that put an input outside the range the model was fitted on: there every part of the
+/// model (geometry, effects, GP) answers for poses it never saw, and its error is not what the
+/// fit measured. One per input that some row leaves.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OutOfRangeWarning {
+    /// The input: `joint 3`, `payload_kg`, `temp_c` or `t_s`.
+    pub input: String,
+    /// Its unit: `rad`, `m` (a prismatic joint), `kg`, `°C`, `s`.
+    pub unit: &'static str,
+    /// Its smallest and largest value on the training rows.
+    pub fitted: [f64; 2],
+    /// How many rows lie outside.
+    pub rows_outside: usize,
+    /// How many rows there are.
+    pub rows: usize,
+    /// The file line of the first of them.
+    pub first_line: u64,
+}
+
+impl std::fmt::Display for OutOfRangeWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let [low, high] = self.fitted;
+        write!(
+            f,
+            "{} of {} rows (the first at line {}) put {} outside the range the model was fitted on \
+             ({low:.4} … {high:.4} {}): there the model answers for inputs it never saw",
+            self.rows_outside, self.rows, self.first_line, self.input, self.unit
+        )
+    }
+}
+
+impl TrainingRange {
+    /// One warning per input that some of `rows` put outside its fitted range (`prismatic[j]`:
+    /// whether joint `j` is prismatic, for its unit).
+    pub fn outside(&self, rows: &[Measurement], prismatic: &[bool]) -> Vec<OutOfRangeWarning> {
+        type Pick<'a> = Box<dyn Fn(&Measurement) -> Option<f64> + 'a>;
+        let mut inputs: Vec<(String, &'static str, [f64; 2], Pick<'_>)> = self
+            .q
+            .iter()
+            .enumerate()
+            .map(|(j, &range)| {
+                let unit = if prismatic.get(j).copied().unwrap_or(false) { "m" } else { "rad" };
+                (
+                    format!("joint {}", j + 1),
+                    unit,
+                    range,
+                    Box::new(move |r: &Measurement| r.q.get(j).copied()) as Pick<'_>,
+                )
+            })
+            .collect();
+        inputs.push(("payload_kg".into(), "kg", self.payload_kg, Box::new(|r: &Measurement| Some(r.payload_kg))));
+        if let Some(range) = self.temp_c {
+            inputs.push(("temp_c".into(), "°C", range, Box::new(|r: &Measurement| r.temp_c)));
+        }
+        if let Some(range) = self.t_s {
+            inputs.push(("t_s".into(), "s", range, Box::new(|r: &Measurement| r.t_s)));
+        }
+        inputs
+            .into_iter()
+            .filter_map(|(input, unit, fitted, pick)| {
+                let [low, high] = fitted;
+                let outside: Vec<&Measurement> =
+                    rows.iter().filter(|r| pick(r).is_some_and(|v| v < low || v > high)).collect();
+                let first = outside.first()?;
+                Some(OutOfRangeWarning {
+                    input,
+                    unit,
+                    fitted,
+                    rows_outside: outside.len(),
+                    rows: rows.len(),
+                    first_line: first.line,
+                })
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,82 @@
+//! `--effects auto`: the effects `calib diagnose` selects on the training data, as a list the fit
+//! identifies (its `selected` effects, with their joints and harmonic orders).
+
+use diagnose::{DiagnoseOptions, Effect, SelectedEffect, Verdict, diagnose};
+use effects::EffectSpec;
+use errors::Error;
+use measurements::MeasurementSet;
+use robot::RobotDescription;
+use serde::Serialize;
+
+/// What `auto` chose and why.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AutoChoice {
+    /// The diagnosis's verdict on the training data.
+    pub verdict: Verdict,
+    /// The effects its selection kept, in order, with the cross-validated error after each.
+    pub selected: Vec<SelectedEffect>,
+    /// Cross-validated mean position error of the geometric model on the training data, mm.
+    pub heldout_before_mm: f64,
+    /// The same with every selected effect: the prediction for poses like the training poses, mm.
+    #[serde(default)]
+    pub heldout_after_mm: f64,
+    /// The diagnosis's prediction off the training poses (arcs of each moving joint held out),
+    /// without and with the selected effects, mm.
+    #[serde(default)]
+    pub off_poses_mm: Option<[f64; 2]>,
+    /// The effects the fit identifies.
+    #[serde(serialize_with = "as_text")]
+    pub chosen: Vec<EffectSpec>,
+}
+
+fn as_text<S: serde::Serializer>(specs: &[EffectSpec], serializer: S) -> Result<S::Ok, S::Error> {
+    serializer.collect_seq(specs.iter().map(ToString::to_string))
+}
+
+/// The list the fit identifies for a diagnosis's selection: compliance once for every joint it
+/// names (the fit's `joint_compliance` covers every joint), gear error per joint at the highest
+/// order selected (the series runs from harmonic 1), backlash per joint, thermal growth, drift.
+pub fn effects_of(selected: &[SelectedEffect]) -> Vec<EffectSpec> {
+    let mut specs: Vec<EffectSpec> = Vec::new();
+    for s in selected {
+        let new: Vec<EffectSpec> = match s.effect {
+            Effect::JointCompliance => vec![EffectSpec::JointCompliance],
+            Effect::GearPeriodic => s
+                .joints
+                .iter()
+                .map(|&joint| EffectSpec::GearPeriodic { joint, harmonics: s.harmonic.unwrap_or(1).max(1) })
+                .collect(),
+            Effect::Backlash => s.joints.iter().map(|&joint| EffectSpec::Backlash { joint }).collect(),
+            Effect::Thermal => vec![EffectSpec::Thermal],
+            Effect::TimeDrift => vec![EffectSpec::TimeDrift],
+            Effect::None | Effect::Unknown => Vec::new(),
+        };
+        for spec in new {
+            match (specs.iter_mut().find(|s| same_parameters(s, &spec)), spec) {
+                (Some(EffectSpec::GearPeriodic { harmonics, .. }), EffectSpec::GearPeriodic { harmonics: h, .. }) => {
+                    *harmonics = (*harmonics).max(h);
+                }
+                (Some(_), _) => {}
+                (None, spec) => specs.push(spec),
+            }
+        }
+    }
+    specs
+}
+
+fn same_parameters(a: &EffectSpec, b: &EffectSpec) -> bool {
+    std::mem::discriminant(a) == std::mem::discriminant(b) && a.joint() == b.joint()
+}
+
+/// Runs the diagnosis on the training data and returns what its selection keeps.
+pub fn choose(robot: &RobotDescription, data: &MeasurementSet, options: &DiagnoseOptions) -> Result<AutoChoice, Error> {
+    let diagnosis = diagnose(robot, data, options)?;
+    Ok(AutoChoice {
+        chosen: effects_of(&diagnosis.selected),
+        verdict: diagnosis.verdict,
+        selected: diagnosis.selected,
+        heldout_before_mm: diagnosis.heldout_before_mm,
+        heldout_after_mm: diagnosis.heldout_after_selected_mm,
+        off_poses_mm: diagnosis.off_poses_before_mm.zip(diagnosis.off_poses_after_mm).map(|(b, a)| [b, a]),
+    })
+}

@@ -1,0 +1,592 @@
+//! A URDF as a robot description (SPEC version 2, `--robot arm.urdf`): the kinematic chain from a
+//! base link to a tip link, fixed joints folded in, turned exactly into zero-configuration axes.
+//!
+//! The file is parsed by `urdf-rs`; its [`xml_outline`](crate::xml_outline) gives every refusal
+//! its line and column. The base link defaults to the one root link; the tip to the leaf with the
+//! most movable joints on the way down from the base (or from the link the base hangs from by
+//! fixed joints); several such leaves are ambiguous and need `--tip-link`. The chain may run up
+//! through fixed joints (a base link below the root, such as the ROS-Industrial `base` frame),
+//! never through a movable joint backwards. Mimic joints are folded into the joint that drives
+//! them where their motions add (`urdf_mimic.rs`).
+
+use crate::urdf_mimic::{ChainJoint, StepMimic, fold, folded_joint};
+use crate::xml_outline::{Element, Position, outline};
+use crate::{FlangeDescription, JointDescription, JointType, RobotDescription};
+use errors::Error;
+use lie::{SE3, SO3, Vector3};
+use std::collections::{HashMap, HashSet};
+use std::path::Path;
+
+/// Which links the chain runs between; `None` picks the only candidate or refuses.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct ChainEnds {
+    /// The link whose frame is the robot's base frame (`--base-link`).
+    pub base_link: Option<String>,
+    /// The link whose frame is the flange (`--tip-link`).
+    pub tip_link: Option<String>,
+}
+
+/// How a step of the chain moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepMotion {
+    /// A fixed joint, folded into the neighbouring transforms.
+    Fixed,
+    /// A revolute joint with its limits (radians), or a continuous one (`None`).
+    Revolute {
+        /// Lower and upper limit, radians.
+        limits_rad: Option<(f64, f64)>,
+    },
+    /// A prismatic joint with its limits, metres.
+    Prismatic {
+        /// Lower and upper limit, metres.
+        limits_m: (f64, f64),
+    },
+}
+
+/// One joint on the chain, in the direction from the base link to the tip link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainStep {
+    /// The URDF joint's name.
+    pub joint: String,
+    /// The link the step leaves.
+    pub from_link: String,
+    /// The link the step reaches.
+    pub to_link: String,
+    /// Whether the step runs the joint from its child to its parent (fixed joints only).
+    pub reversed: bool,
+    /// Fixed, revolute or prismatic.
+    pub motion: StepMotion,
+    /// `from_link_from_to_link` at zero joint value.
+    pub from_to: SE3,
+    /// Unit axis of a movable joint in `to_link`'s frame.
+    pub axis: Vector3,
+    /// The joint this one follows (`<mimic>`), for a movable joint.
+    pub mimic: Option<StepMimic>,
+}
+
+/// The chain between two links of a URDF.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UrdfChain {
+    /// The `<robot name>`.
+    pub robot_name: String,
+    /// The base link.
+    pub base_link: String,
+    /// The tip link.
+    pub tip_link: String,
+    /// The joints from the base link to the tip link.
+    pub steps: Vec<ChainStep>,
+    /// The description's joints: each actuated joint with the mimic joints folded into it.
+    pub joints: Vec<ChainJoint>,
+}
+
+/// A parsed URDF with the positions of its elements.
+#[derive(Debug, Clone)]
+pub struct UrdfDocument {
+    file: String,
+    text: String,
+    robot: urdf_rs::Robot,
+    outline: Element,
+    /// Indices looked up by name, so that every walk of the tree stays linear in its size (a
+    /// file of 100,000 links took minutes with scans of the lists; found by `cargo xtask fuzz`).
+    index: NameIndex,
+}
+
+/// The links, joints and top-level elements of a URDF by name.
+#[derive(Debug, Clone, Default)]
+struct NameIndex {
+    links: HashSet<String>,
+    /// Child link → the joint (index into `robot.joints`) it hangs from.
+    parent_joint: HashMap<String, usize>,
+    /// Parent link → the joints below it, in file order.
+    child_joints: HashMap<String, Vec<usize>>,
+    /// `(element name, name attribute)` → index among the outline's children (the first one).
+    elements: HashMap<(String, String), usize>,
+}
+
+/// Largest allowed `|axis|` below which a joint axis counts as zero.
+const ZERO_AXIS: f64 = 1e-9;
+
+impl UrdfDocument {
+    /// Reads and checks a URDF file.
+    pub fn read(path: &Path) -> Result<Self, Error> {
+        let file = path.display().to_string();
+        // Bytes that are not UTF-8 are refused at their line and column, like a RON file's.
+        let text = errors::ron_position::read_text(path)?;
+        Self::parse(&text, &file)
+    }
+
+    /// Parses and checks a URDF; `file` names it in errors.
+    pub fn parse(text: &str, file: &str) -> Result<Self, Error> {
+        let at = |(line, column): Position, message: String| Error::UrdfFormat {
+            file: file.to_owned(),
+            line,
+            column,
+            message,
+        };
+        let root = outline(text).map_err(|e| at(e.position, e.message))?;
+        if root.name != "robot" {
+            return Err(at(root.position, format!("the root element is <{}>, a URDF's is <robot>", root.name)));
+        }
+        if let Some(xacro) = find(&root, &|e| {
+            e.name.starts_with("xacro:") || e.attributes.iter().any(|(n, _)| n.starts_with("xmlns:xacro"))
+        }) {
+            return Err(at(xacro.position, "a xacro file: expand it first (`xacro arm.urdf.xacro > arm.urdf`)".into()));
+        }
+        let robot = urdf_rs::read_from_string(text).map_err(|e| {
+            let message = e.to_string();
+            // The XML parser's own position where it gives one; else urdf-rs quotes the offending
+            // value in brackets where it can: find it in the text.
+            let quoted = || {
+                let (_, rest) = message.split_once('[')?;
+                let (quoted, _) = rest.split_once(']')?;
+                text.find(quoted).map(|offset| line_column(text, offset))
+            };
+            let position = parser_position(&message, text).or_else(quoted).unwrap_or(root.position);
+            at(position, format!("URDF: {message}"))
+        })?;
+        let mut document =
+            Self { file: file.to_owned(), text: text.to_owned(), robot, outline: root, index: NameIndex::default() };
+        document.check_structure()?;
+        Ok(document)
+    }
+
+    /// The file name used in messages.
+    pub fn file(&self) -> &str {
+        &self.file
+    }
+
+    /// The text as read.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// The root element `<robot>`.
+    pub fn root(&self) -> &Element {
+        &self.outline
+    }
+
+    /// The parsed robot.
+    pub fn robot(&self) -> &urdf_rs::Robot {
+        &self.robot
+    }
+
+    /// The top-level element `<kind name="name">` of the outline.
+    pub fn element(&self, kind: &str, name: &str) -> Option<&Element> {
+        let index = self.index.elements.get(&(kind.to_owned(), name.to_owned()))?;
+        self.outline.children.get(*index)
+    }
+
+    /// An error at the element `<kind name="name">` (or at `<robot>` if there is none).
+    pub fn error_at(&self, kind: &str, name: &str, message: String) -> Error {
+        let (line, column) = self.element(kind, name).map_or(self.outline.position, |e| e.position);
+        Error::UrdfFormat { file: self.file.clone(), line, column, message }
+    }
+
+    /// Checks names (present, unique, joints naming defined links, one parent per link) and
+    /// builds the name index.
+    fn check_structure(&mut self) -> Result<(), Error> {
+        let mut index = NameIndex::default();
+        for (k, element) in self.outline.children.iter().enumerate() {
+            let kind = element.name.as_str();
+            if !matches!(kind, "link" | "joint") {
+                if let Some(name) = element.attribute("name") {
+                    index.elements.entry((kind.to_owned(), name.to_owned())).or_insert(k);
+                }
+                continue;
+            }
+            let Some(name) = element.attribute("name") else {
+                return Err(self.at(element.position, format!("<{kind}> has no name")));
+            };
+            if index.elements.insert((kind.to_owned(), name.to_owned()), k).is_some() {
+                return Err(self.at(element.position, format!("a second {kind} named '{name}'")));
+            }
+        }
+        index.links = self.robot.links.iter().map(|l| l.name.clone()).collect();
+        for (j, (joint, element)) in
+            self.robot.joints.iter().zip(self.outline.children.iter().filter(|e| e.name == "joint")).enumerate()
+        {
+            for link in [&joint.parent.link, &joint.child.link] {
+                if !index.links.contains(link) {
+                    return Err(self.at(
+                        element.position,
+                        format!("joint '{}' names link '{link}', which is not defined", joint.name),
+                    ));
+                }
+            }
+            if let Some(other) = index.parent_joint.insert(joint.child.link.clone(), j) {
+                let other = &self.robot.joints[other].name;
+                return Err(self.at(
+                    element.position,
+                    format!("link '{}' is the child of joints '{other}' and '{}'", joint.child.link, joint.name),
+                ));
+            }
+            index.child_joints.entry(joint.parent.link.clone()).or_default().push(j);
+        }
+        self.index = index;
+        Ok(())
+    }
+
+    fn at(&self, (line, column): Position, message: String) -> Error {
+        Error::UrdfFormat { file: self.file.clone(), line, column, message }
+    }
+
+    /// The joint of which `link` is the child.
+    fn parent_joint(&self, link: &str) -> Option<&urdf_rs::Joint> {
+        self.index.parent_joint.get(link).and_then(|&j| self.robot.joints.get(j))
+    }
+
+    fn link_exists(&self, link: &str, flag: &str) -> Result<(), Error> {
+        if self.index.links.contains(link) {
+            return Ok(());
+        }
+        let known: Vec<&str> = self.robot.links.iter().map(|l| l.name.as_str()).collect();
+        Err(self.at(self.outline.position, format!("{flag}: no link named '{link}' (links: {})", known.join(", "))))
+    }
+
+    /// The chain between the links `ends` names (or the only candidates).
+    pub fn chain(&self, ends: &ChainEnds) -> Result<UrdfChain, Error> {
+        let base = match &ends.base_link {
+            Some(base) => {
+                self.link_exists(base, "--base-link")?;
+                base.clone()
+            }
+            None => self.root_link()?,
+        };
+        let tip = match &ends.tip_link {
+            Some(tip) => {
+                self.link_exists(tip, "--tip-link")?;
+                tip.clone()
+            }
+            None => self.deepest_leaf(&self.fixed_top(&base), &base)?,
+        };
+        // Ancestors of each end, nearest first, as (link, joint above it).
+        let up = |from: &str| {
+            let mut path = vec![from.to_owned()];
+            let mut on_path: HashSet<String> = path.iter().cloned().collect();
+            while let Some(joint) = self.parent_joint(path.last().map_or("", String::as_str)) {
+                if !on_path.insert(joint.parent.link.clone()) {
+                    break;
+                }
+                path.push(joint.parent.link.clone());
+            }
+            (path, on_path)
+        };
+        let ((from_base, _), (from_tip, tip_links)) = (up(&base), up(&tip));
+        let Some(meet) = from_base.iter().position(|l| tip_links.contains(l)) else {
+            return Err(self.error_at("link", &tip, format!("no chain joins base link '{base}' and tip link '{tip}'")));
+        };
+        let down = from_tip.iter().position(|l| *l == from_base[meet]).unwrap_or(0);
+        let mut steps = Vec::new();
+        for link in &from_base[..meet] {
+            steps.push(self.step(link, true, &base, &tip)?);
+        }
+        for link in from_tip[..down].iter().rev() {
+            steps.push(self.step(link, false, &base, &tip)?);
+        }
+        if steps.iter().all(|s| s.motion == StepMotion::Fixed) {
+            return Err(self.error_at(
+                "link",
+                &tip,
+                format!("no movable joint between base link '{base}' and tip link '{tip}'"),
+            ));
+        }
+        let frames = link_frames(&steps);
+        let defined = |name: &str| self.element("joint", name).is_some();
+        let joints = fold(&steps, &frames, &defined).map_err(|refusal| {
+            let name = &steps[refusal.step].joint;
+            let element = self.element("joint", name);
+            let (line, column) =
+                element.and_then(|e| e.child("mimic")).or(element).map_or(self.outline.position, |e| e.position);
+            self.at((line, column), format!("mimic joint '{name}': {}", refusal.message))
+        })?;
+        Ok(UrdfChain { robot_name: self.robot.name.clone(), base_link: base, tip_link: tip, steps, joints })
+    }
+
+    fn root_link(&self) -> Result<String, Error> {
+        let roots: Vec<&str> =
+            self.robot.links.iter().map(|l| l.name.as_str()).filter(|l| self.parent_joint(l).is_none()).collect();
+        match roots.as_slice() {
+            [root] => Ok((*root).to_owned()),
+            [] => Err(self.at(self.outline.position, "no root link: every link is a joint's child (a loop)".into())),
+            [_, second, ..] => Err(self.error_at(
+                "link",
+                second,
+                format!("several root links ({}): choose the base with --base-link", roots.join(", ")),
+            )),
+        }
+    }
+
+    /// The highest link reached from `link` up through fixed joints: the chain may start there.
+    fn fixed_top(&self, link: &str) -> String {
+        let mut top = link.to_owned();
+        let mut seen = HashSet::from([top.clone()]);
+        while let Some(joint) = self.parent_joint(&top).filter(|j| j.joint_type == urdf_rs::JointType::Fixed) {
+            if !seen.insert(joint.parent.link.clone()) {
+                break;
+            }
+            top = joint.parent.link.clone();
+        }
+        top
+    }
+
+    /// The leaf below `top` with the most movable joints on the way (`base` names the chain's
+    /// base in messages).
+    fn deepest_leaf(&self, top: &str, base: &str) -> Result<String, Error> {
+        let mut leaves: Vec<(String, usize)> = Vec::new();
+        let mut visited: HashSet<String> = HashSet::new();
+        let mut stack = vec![(top.to_owned(), 0usize)];
+        while let Some((link, movable)) = stack.pop() {
+            // A loop of joints (no root) would otherwise be walked for ever.
+            if !visited.insert(link.clone()) {
+                continue;
+            }
+            let below = self.index.child_joints.get(&link).map_or(&[][..], Vec::as_slice);
+            let children: Vec<&urdf_rs::Joint> = below.iter().filter_map(|&j| self.robot.joints.get(j)).collect();
+            if children.is_empty() {
+                leaves.push((link, movable));
+            }
+            for joint in children.into_iter().rev() {
+                let moves = usize::from(joint.joint_type != urdf_rs::JointType::Fixed);
+                stack.push((joint.child.link.clone(), movable + moves));
+            }
+        }
+        let most = leaves.iter().map(|(_, m)| *m).max().unwrap_or(0);
+        let best: Vec<&str> = leaves.iter().filter(|(_, m)| *m == most).map(|(l, _)| l.as_str()).collect();
+        match best.as_slice() {
+            _ if most == 0 => Err(self.error_at("link", base, format!("no movable joint below base link '{base}'"))),
+            [tip] => Ok((*tip).to_owned()),
+            _ => Err(self.error_at(
+                "link",
+                base,
+                format!(
+                    "ambiguous chain: leaves {} below base link '{base}' each have {most} movable joints; choose one with --tip-link",
+                    best.join(", ")
+                ),
+            )),
+        }
+    }
+
+    /// The step through the joint above `link`, forward (`link` is its child) or reversed.
+    fn step(&self, link: &str, reversed: bool, base: &str, tip: &str) -> Result<ChainStep, Error> {
+        let joint = self
+            .parent_joint(link)
+            .ok_or_else(|| self.error_at("link", link, format!("link '{link}' has no parent joint")))?;
+        let refuse =
+            |message: String| self.error_at("joint", &joint.name, format!("joint '{}': {message}", joint.name));
+        let numbers = joint.origin.xyz.iter().chain(joint.origin.rpy.iter());
+        if !numbers.chain(joint.axis.xyz.iter()).all(|v| v.is_finite()) {
+            return Err(refuse("origin and axis must be finite".into()));
+        }
+        let has_limit = self.element("joint", &joint.name).is_some_and(|e| e.child("limit").is_some());
+        let mimic = match (&joint.mimic, joint.joint_type == urdf_rs::JointType::Fixed) {
+            (Some(m), false) => {
+                let (multiplier, offset) = (m.multiplier.unwrap_or(1.0), m.offset.unwrap_or(0.0));
+                if !(multiplier.is_finite() && offset.is_finite()) {
+                    let element = self.element("joint", &joint.name).and_then(|e| e.child("mimic"));
+                    return Err(self.at(
+                        element.map_or(self.outline.position, |e| e.position),
+                        format!(
+                            "joint '{}': mimic multiplier {multiplier} and offset {offset} must be finite",
+                            joint.name
+                        ),
+                    ));
+                }
+                Some(StepMimic { joint: m.joint.clone(), multiplier, offset })
+            }
+            _ => None,
+        };
+        // A mimic joint's limits are its motor's: where it has none, it takes the followed joint's.
+        let unlimited_mimic = mimic.is_some() && !has_limit;
+        let (lower, upper) = (joint.limit.lower, joint.limit.upper);
+        let limits = || -> Result<(f64, f64), String> {
+            if !has_limit {
+                return Err("a <limit lower=.. upper=..> is required".into());
+            }
+            if !(lower.is_finite() && upper.is_finite() && lower < upper) {
+                return Err(format!("limits lower {lower} upper {upper} must be finite and increasing"));
+            }
+            let kind = if joint.joint_type == urdf_rs::JointType::Prismatic {
+                crate::JointType::Prismatic
+            } else {
+                crate::JointType::Revolute
+            };
+            let (bound, unit) = crate::description::limit_bound(kind);
+            if lower.abs().max(upper.abs()) > bound {
+                return Err(format!(
+                    "limits lower {lower:e} upper {upper:e} reach beyond ±{bound:e} {unit}, further than any joint moves"
+                ));
+            }
+            Ok((lower, upper))
+        };
+        use urdf_rs::JointType as T;
+        let motion = match joint.joint_type {
+            T::Fixed => StepMotion::Fixed,
+            T::Continuous => StepMotion::Revolute { limits_rad: None },
+            // URDF 1.2 leaves out limits to mean none: both infinite.
+            T::Revolute if has_limit && lower == f64::NEG_INFINITY && upper == f64::INFINITY => {
+                StepMotion::Revolute { limits_rad: None }
+            }
+            T::Revolute if unlimited_mimic => StepMotion::Revolute { limits_rad: None },
+            T::Revolute => StepMotion::Revolute { limits_rad: Some(limits().map_err(refuse)?) },
+            T::Prismatic if unlimited_mimic => StepMotion::Prismatic { limits_m: (f64::NEG_INFINITY, f64::INFINITY) },
+            T::Prismatic => StepMotion::Prismatic { limits_m: limits().map_err(refuse)? },
+            ref other => {
+                return Err(refuse(format!(
+                    "{} joints cannot be calibrated (only revolute, continuous, prismatic and fixed); choose the chain's ends with --base-link/--tip-link",
+                    format!("{other:?}").to_lowercase()
+                )));
+            }
+        };
+        if motion != StepMotion::Fixed && reversed {
+            return Err(refuse(format!(
+                "the chain from '{base}' to '{tip}' runs through this movable joint from child to parent; choose a base link above it"
+            )));
+        }
+        let axis = Vector3::from(*joint.axis.xyz);
+        if motion != StepMotion::Fixed && axis.norm() < ZERO_AXIS {
+            return Err(refuse("the axis is zero".into()));
+        }
+        // Each angle brought into one turn first: the rotation is the same, and an angle such as
+        // 1e308 no longer overflows the exponential map into NaN (found by `cargo xtask fuzz`).
+        let [roll, pitch, yaw] = joint.origin.rpy.map(|a| a.rem_euclid(std::f64::consts::TAU));
+        let origin = SE3::new(SO3::from_rpy(roll, pitch, yaw), Vector3::from(*joint.origin.xyz));
+        let (from_link, to_link) = if reversed {
+            (joint.child.link.clone(), joint.parent.link.clone())
+        } else {
+            (joint.parent.link.clone(), joint.child.link.clone())
+        };
+        Ok(ChainStep {
+            joint: joint.name.clone(),
+            from_link,
+            to_link,
+            reversed,
+            motion,
+            from_to: if reversed { origin.inverse() } else { origin },
+            // Scaled by its largest component before normalising: `0 -1e308 1` overflowed the norm
+            // into a NaN axis (found by `cargo xtask fuzz`).
+            axis: if motion == StepMotion::Fixed { Vector3::z() } else { (axis / axis.amax()).normalize() },
+            mimic,
+        })
+    }
+}
+
+/// The first element, depth first, that `matches`.
+fn find<'a>(element: &'a Element, matches: &dyn Fn(&Element) -> bool) -> Option<&'a Element> {
+    if matches(element) {
+        return Some(element);
+    }
+    element.children.iter().find_map(|c| find(c, matches))
+}
+
+/// The position an XML parser's message gives, 1-based, if it is inside `text`: serde-xml-rs
+/// writes `Line: 3, Column: 22` (1-based), xml-rs `Syntax: 1:684587` (0-based row and column).
+fn parser_position(message: &str, text: &str) -> Option<Position> {
+    let number = |s: &str| -> Option<usize> {
+        let digits: String = s.chars().take_while(char::is_ascii_digit).collect();
+        digits.parse().ok()
+    };
+    let position = if let Some((_, rest)) = message.split_once("Line: ") {
+        let line = number(rest)?;
+        let (_, rest) = rest.split_once("Column: ")?;
+        (line, number(rest)?)
+    } else {
+        let (_, rest) = message.split_once("Syntax: ")?;
+        let (row, rest) = rest.split_once(':')?;
+        (number(row)? + 1, number(rest)? + 1)
+    };
+    let lines = text.lines().count().max(1);
+    (position.0 >= 1 && position.0 <= lines && position.1 >= 1).then_some(position)
+}
+
+/// 1-based line and column of a byte offset.
+fn line_column(text: &str, offset: usize) -> Position {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+/// `base_from_link` at the zero configuration of every step's `to_link`, in chain order: the
+/// actuated joints at zero, the mimic joints at their offsets.
+fn link_frames(steps: &[ChainStep]) -> Vec<SE3> {
+    let mut frame = SE3::identity();
+    steps
+        .iter()
+        .map(|step| {
+            frame = frame * step.from_to * step.zero_motion();
+            frame
+        })
+        .collect()
+}
+
+impl UrdfChain {
+    /// `base_from_link` at the zero configuration of every step's `to_link`, in chain order (the
+    /// actuated joints at zero, the mimic joints at their offsets).
+    pub fn link_frames(&self) -> Vec<SE3> {
+        link_frames(&self.steps)
+    }
+
+    /// Number of joints: the movable joints but those folded into the joint they follow.
+    pub fn joint_count(&self) -> usize {
+        self.joints.len()
+    }
+
+    /// The chain as a robot description: each joint's axis (the summed motion's direction, with
+    /// its `scale`, where mimic joints are folded in) and a point on it (its actuated joint's child
+    /// link's origin) in the base link's frame at the zero configuration, the tip link as the flange.
+    pub fn description(&self) -> RobotDescription {
+        let frames = self.link_frames();
+        let mut joints = Vec::new();
+        for joint in &self.joints {
+            let (step, frame) = (&self.steps[joint.actuated], frames[joint.actuated]);
+            let (kind, limits_deg, limits_m) = match step.motion {
+                StepMotion::Fixed => continue,
+                StepMotion::Revolute { limits_rad } => {
+                    (JointType::Revolute, limits_rad.map(|(lo, hi)| (lo.to_degrees(), hi.to_degrees())), None)
+                }
+                StepMotion::Prismatic { limits_m } => (JointType::Prismatic, None, Some(limits_m)),
+            };
+            joints.push(JointDescription {
+                kind,
+                axis: joint.direction.into(),
+                point: frame.translation().into(),
+                limits_deg,
+                limits_m,
+                scale: joint.scale,
+            });
+        }
+        let folded =
+            self.joints.iter().enumerate().filter_map(|(i, joint)| folded_joint(i, joint, &self.steps)).collect();
+        let flange = frames.last().copied().unwrap_or_else(SE3::identity);
+        let rotation = flange.rotation().matrix();
+        RobotDescription {
+            name: self.robot_name.clone(),
+            joints,
+            flange: FlangeDescription {
+                position: flange.translation().into(),
+                x_axis: rotation.column(0).into_owned().into(),
+                z_axis: rotation.column(2).into_owned().into(),
+            },
+            tool: None,
+            dynamics: None,
+            folded,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parser_position;
+
+    #[test]
+    fn the_xml_parsers_positions_are_read_in_either_form_and_only_inside_the_text() {
+        let text = "<robot>\n  <link/>\n  <link/>\n</robot>";
+        assert_eq!(
+            parser_position("Parse error; Line: 3, Column: 22, Reason: Found invalid entity", text),
+            Some((3, 22))
+        );
+        assert_eq!(parser_position("URDF: Syntax: 1:6 This document is larger", text), Some((2, 7)));
+        assert_eq!(parser_position("Syntax: 9:6 beyond the end", text), None);
+        assert_eq!(parser_position("custom: missing field `name`", text), None);
+    }
+}
