@@ -28,7 +28,8 @@ use pipeline::simulated::paper_effects;
 
 use crate::bench_gp_residuals::{Residuals, heldout_mm, real, simulated_campaign};
 use crate::bench_gp_sklearn::{SklearnOptions, available, fit_predict};
-use crate::reproduce_sim::{Preset, robot_for};
+use crate::reproduce_sim::robot_for;
+use crate::reproduce_sim_params::Preset;
 
 /// Arguments of `--paper`.
 #[derive(Debug, Clone, clap::Args)]

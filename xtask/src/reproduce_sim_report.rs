@@ -2,8 +2,8 @@
 //! SPEC JSON, and the console summary.
 
 use crate::box_plot::BoxStatistics;
-use crate::reproduce_sim::{PAPER_LIKE_SOFTENING, Preset};
 use crate::reproduce_sim_params::Params;
+use crate::reproduce_sim_params::{PAPER_LIKE_SOFTENING, Preset, list};
 use serde::Serialize;
 use std::fmt::Write;
 
@@ -402,9 +402,4 @@ counts as far away however close its joint angles are."
     }
     out.push('\n');
     out
-}
-
-/// `a, b, c` with trailing zeros trimmed.
-pub fn list(values: &[f64]) -> String {
-    values.iter().map(|v| format!("{v}")).collect::<Vec<_>>().join(", ")
 }

@@ -7,6 +7,7 @@ mod inverse;
 mod joint_targets;
 mod urdf_export;
 mod urdf_like;
+mod urdf_text;
 
 pub use inverse::{InverseOptions, PoseTarget, Solved, TargetStatus, solve_targets};
 pub use joint_targets::{

@@ -10,6 +10,7 @@
 //! data.
 
 use crate::urdf_like::{check_joint_kinds, write_like};
+use crate::urdf_text::{Written, escape, fixed_joint, origin_element};
 use errors::Error;
 use lie::SE3;
 use measurements::MeasurementSet;
@@ -197,17 +198,6 @@ pub fn write_urdf(path: &Path, export: &UrdfExport) -> Result<(), Error> {
     measurements::write_file(path, export.text.as_bytes())
 }
 
-/// What a writer produced.
-pub(crate) struct Written {
-    pub text: String,
-    pub robot: String,
-    pub base_link: String,
-    pub tracker_link: String,
-    pub tool_links: Vec<String>,
-    /// The movable joints' names, base first.
-    pub joint_names: Vec<String>,
-}
-
 /// `tool` for the default tool, `tool_<name>` for the others (characters a link name should not
 /// have become `_`), made unique.
 fn tool_link_names(tools: &[String]) -> Vec<String> {
@@ -225,29 +215,6 @@ fn tool_link_names(tools: &[String]) -> Vec<String> {
         names.push(name);
     }
     names
-}
-
-/// Text for an XML attribute value.
-pub(crate) fn escape(text: &str) -> String {
-    text.replace('&', "&amp;").replace('"', "&quot;").replace('<', "&lt;").replace('>', "&gt;")
-}
-
-/// `<origin xyz=".." rpy=".."/>` of a transform, every number written to round-trip exactly.
-pub(crate) fn origin_element(pose: &SE3) -> String {
-    let t = pose.translation();
-    let [r, p, y] = pose.rotation().to_rpy();
-    format!("<origin xyz=\"{:?} {:?} {:?}\" rpy=\"{r:?} {p:?} {y:?}\"/>", t.x, t.y, t.z)
-}
-
-/// A fixed joint from `parent` to a new link `child`.
-pub(crate) fn fixed_joint(text: &mut String, indent: &str, parent: &str, child: &str, origin: &SE3) {
-    let _ = writeln!(
-        text,
-        "{indent}<joint name=\"{p}-{c}\" type=\"fixed\">\n{indent}  <parent link=\"{p}\"/>\n{indent}  <child link=\"{c}\"/>\n{indent}  {}\n{indent}</joint>",
-        origin_element(origin),
-        p = escape(parent),
-        c = escape(child)
-    );
 }
 
 fn write_plain(

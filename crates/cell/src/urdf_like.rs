@@ -14,7 +14,7 @@
 //! joint's POE frame as `W_k(q) = P_i(q) D_k`, so the correction on the actuated joint's origin
 //! carries them exactly, and the multipliers stay as written.
 
-use crate::urdf_export::{Written, escape, fixed_joint, origin_element};
+use crate::urdf_text::{Written, escape, fixed_joint, origin_element};
 use errors::Error;
 use lie::SE3;
 use poe::{JointKind, LocalPoe};

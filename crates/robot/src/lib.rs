@@ -6,10 +6,12 @@
 mod base_frame;
 mod bounds;
 mod description;
+mod read;
 mod robot_check;
 mod robot_dh;
 mod urdf_chain;
 mod urdf_mimic;
+mod urdf_steps;
 pub mod xml_outline;
 pub use bounds::{MAX_TRANSLATION_M, bad_translation};
 
@@ -19,5 +21,6 @@ pub use description::{
     scale_in_bounds,
 };
 pub use robot_dh::{DhTable, DhTableRow};
-pub use urdf_chain::{ChainEnds, ChainStep, StepMotion, UrdfChain, UrdfDocument};
-pub use urdf_mimic::{ChainJoint, StepMimic};
+pub use urdf_chain::{ChainEnds, UrdfChain, UrdfDocument};
+pub use urdf_mimic::ChainJoint;
+pub use urdf_steps::{ChainStep, StepMimic, StepMotion};

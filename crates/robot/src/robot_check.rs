@@ -130,6 +130,14 @@ pub(crate) fn check_chain(robot: &RobotDescription, text: Option<&str>, file: &s
     })
 }
 
+impl RobotDescription {
+    /// The common axis direction of a planar chain (every revolute axis parallel to it, every
+    /// prismatic joint across it): its tool moves in a plane. `None` for a spatial chain.
+    pub fn planar_direction(&self) -> Option<[f64; 3]> {
+        planar_direction(self)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -9,7 +9,8 @@
 //! never through a movable joint backwards. Mimic joints are folded into the joint that drives
 //! them where their motions add (`urdf_mimic.rs`).
 
-use crate::urdf_mimic::{ChainJoint, StepMimic, fold, folded_joint};
+use crate::urdf_mimic::{ChainJoint, fold, folded_joint};
+use crate::urdf_steps::{ChainStep, StepMimic, StepMotion};
 use crate::xml_outline::{Element, Position, outline};
 use crate::{FlangeDescription, JointDescription, JointType, RobotDescription};
 use errors::Error;
@@ -24,44 +25,6 @@ pub struct ChainEnds {
     pub base_link: Option<String>,
     /// The link whose frame is the flange (`--tip-link`).
     pub tip_link: Option<String>,
-}
-
-/// How a step of the chain moves.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum StepMotion {
-    /// A fixed joint, folded into the neighbouring transforms.
-    Fixed,
-    /// A revolute joint with its limits (radians), or a continuous one (`None`).
-    Revolute {
-        /// Lower and upper limit, radians.
-        limits_rad: Option<(f64, f64)>,
-    },
-    /// A prismatic joint with its limits, metres.
-    Prismatic {
-        /// Lower and upper limit, metres.
-        limits_m: (f64, f64),
-    },
-}
-
-/// One joint on the chain, in the direction from the base link to the tip link.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ChainStep {
-    /// The URDF joint's name.
-    pub joint: String,
-    /// The link the step leaves.
-    pub from_link: String,
-    /// The link the step reaches.
-    pub to_link: String,
-    /// Whether the step runs the joint from its child to its parent (fixed joints only).
-    pub reversed: bool,
-    /// Fixed, revolute or prismatic.
-    pub motion: StepMotion,
-    /// `from_link_from_to_link` at zero joint value.
-    pub from_to: SE3,
-    /// Unit axis of a movable joint in `to_link`'s frame.
-    pub axis: Vector3,
-    /// The joint this one follows (`<mimic>`), for a movable joint.
-    pub mimic: Option<StepMimic>,
 }
 
 /// The chain between two links of a URDF.

@@ -12,21 +12,9 @@
 //! mimic on a parallel but offset axis, a mimic of a joint off the chain, a movable joint between
 //! the stages, a revolute stage on a prismatic joint) does not commute and is refused.
 
-use crate::urdf_chain::{ChainStep, StepMotion};
+use crate::urdf_steps::{ChainStep, StepMotion};
 use crate::{FoldedJoint, MimicStage};
 use lie::{SE3, SO3, Vector3};
-
-/// A `<mimic>` element as the URDF writes it (multiplier 1 and offset 0 where left out, as the
-/// URDF specification says).
-#[derive(Debug, Clone, PartialEq)]
-pub struct StepMimic {
-    /// The joint it follows.
-    pub joint: String,
-    /// Its value is `multiplier · q + offset`, `q` the followed joint's value.
-    pub multiplier: f64,
-    /// Radians or metres.
-    pub offset: f64,
-}
 
 /// One joint of the description: an actuated joint of the chain and the mimic joints folded into it.
 #[derive(Debug, Clone, PartialEq)]

@@ -6,7 +6,7 @@
 //! from a smaller model's solution (the new parameters at zero) can only end below it.
 
 use super::normal::{Normal, gradient_cosine};
-use super::solver::{Problem, Solved, State, cost, record};
+use super::problem::{Problem, Solved, State, cost, record};
 use super::{IterationRecord, Termination};
 use crate::Error;
 

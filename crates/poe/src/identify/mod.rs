@@ -4,6 +4,7 @@ mod correction;
 mod levenberg;
 mod normal;
 mod options;
+mod problem;
 mod reduced;
 mod redundancy;
 mod registration;

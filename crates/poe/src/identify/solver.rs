@@ -2,15 +2,13 @@
 //! (Section III-A-2), or Levenberg–Marquardt with a prior (`levenberg.rs`). Both stop only on a
 //! stated criterion and say which ([`Termination`]).
 
-use super::correction::{Corrected, PoseCorrection};
+use super::correction::PoseCorrection;
 use super::levenberg::{continue_damped, levenberg_marquardt};
-use super::reduced::Reduced;
+use super::problem::{Problem, Solved, State, cost, record};
 use super::redundancy::find_redundancies;
-use super::residual::{ResidualStats, linearise_reduced, residuals, row_errors};
+use super::residual::row_errors;
 use super::robust::{self, RobustReport};
-use super::{
-    DampingFallback, IdentificationOptions, IdentificationReport, IterationRecord, Observation, ParameterMask, Solver,
-};
+use super::{DampingFallback, IdentificationOptions, IdentificationReport, Observation, ParameterMask, Solver};
 use super::{Termination, normal};
 use crate::{Error, LocalPoe};
 
@@ -23,89 +21,6 @@ pub struct Identification {
     pub correction: Vec<f64>,
     /// Iterations, identifiability and the unidentifiable directions.
     pub report: IdentificationReport,
-}
-
-pub(super) fn cost(y: &[f64]) -> f64 {
-    y.iter().map(|v| v * v).sum()
-}
-
-/// The problem being solved: what is free, what is observed, how rows are weighted.
-pub(super) struct Problem<'a> {
-    pub observations: &'a [Observation],
-    pub free: Vec<usize>,
-    pub correction: Option<&'a dyn PoseCorrection>,
-    pub options: &'a IdentificationOptions,
-    /// The robust loss's weight of each observation's position and orientation rows (empty: 1).
-    pub row_weights: Vec<[f64; 2]>,
-}
-
-/// A point of the parameter space: the model, the correction's θ, and the accumulated steps
-/// (the deviation from the start that a prior penalises).
-#[derive(Clone)]
-pub(super) struct State {
-    pub model: LocalPoe,
-    pub theta: Vec<f64>,
-    pub deviation: Vec<f64>,
-}
-
-impl Problem<'_> {
-    pub(super) fn parameter_count(&self) -> usize {
-        self.free.len() + self.correction.map_or(0, |c| c.parameter_count())
-    }
-
-    fn corrected<'b>(&'b self, theta: &'b [f64]) -> Option<Corrected<'b>> {
-        self.correction.map(|correction| Corrected { correction, theta })
-    }
-
-    /// The state after a step of every parameter (free kinematic ones first).
-    pub(super) fn step(&self, state: &State, step: &[f64]) -> State {
-        let layout = state.model.layout();
-        let mut full = vec![0.0; layout.len()];
-        for (&index, &value) in self.free.iter().zip(step) {
-            full[index] = value;
-        }
-        let mut model = state.model.clone();
-        model.apply_update(&full);
-        let theta = state.theta.iter().zip(&step[self.free.len()..]).map(|(t, s)| t + s).collect();
-        let deviation = state.deviation.iter().zip(step).map(|(d, s)| d + s).collect();
-        State { model, theta, deviation }
-    }
-
-    /// The weighted residual of a state and its errors.
-    pub(super) fn residuals(&self, state: &State) -> Result<(Vec<f64>, ResidualStats), Error> {
-        residuals(&state.model, self.observations, self.corrected(&state.theta), &self.row_weights, self.options)
-    }
-
-    /// The weighted Jacobian (free columns, then the correction's) and residual, reduced to their
-    /// QR triangle, and the errors.
-    pub(super) fn linearise(&self, state: &State) -> Result<(Reduced, ResidualStats), Error> {
-        linearise_reduced(
-            &state.model,
-            self.observations,
-            &self.free,
-            self.corrected(&state.theta),
-            &self.row_weights,
-            self.options,
-        )
-    }
-}
-
-pub(super) fn record(stats: ResidualStats, step_norm: f64, cost: f64) -> IterationRecord {
-    IterationRecord { rms_position_m: stats.rms_position_m, rms_rotation_rad: stats.rms_rotation_rad, step_norm, cost }
-}
-
-/// What a solver returns to [`identify_with_correction`].
-pub(super) struct Solved {
-    pub state: State,
-    /// The last linearisation, reduced.
-    pub a: Reduced,
-    pub iterations: Vec<IterationRecord>,
-    pub termination: Termination,
-    pub final_cost: f64,
-    pub gradient_cosine: f64,
-    pub held_at_prior: Vec<usize>,
-    /// Where the pseudo-inverse iteration handed over to damped steps, if it did.
-    pub damping_fallback: Option<DampingFallback>,
 }
 
 /// Identifies the free parameters of `initial` from `observations` by iterating
