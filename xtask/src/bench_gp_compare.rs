@@ -6,7 +6,7 @@ use std::fmt::Write;
 use std::time::{Duration, Instant};
 
 use gp::ExactGp;
-use pipeline::CompensationOptions;
+use pipeline::ResidualGpOptions;
 
 use crate::bench_gp_kernels::{KernelArgs, data_sets};
 use crate::bench_gp_residuals::heldout_mm;
@@ -28,7 +28,7 @@ pub fn run(args: &KernelArgs, timeout: Duration) -> Result<String, String> {
     let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for set in &sets {
         eprintln!("{} …", set.name);
-        let config = CompensationOptions::default().gp;
+        let config = ResidualGpOptions::default().gp;
         let t = Instant::now();
         let model = ExactGp::fit(set.train.inputs.as_ref(), set.train.outputs.as_ref(), &config)
             .map_err(|e| format!("{}: {e}", set.name))?;

@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use gp::{ExactGp, Kernel, KernelChoice, OutputMode, StationaryShape};
 use indicatif::{ProgressBar, ProgressStyle};
-use pipeline::{CompensationOptions, RobotDescription};
+use pipeline::{ResidualGpOptions, RobotDescription};
 
 use crate::bench_gp_residuals::{Residuals, heldout_mm, real, simulated, simulated_payload_runs};
 
@@ -203,7 +203,7 @@ pub fn run(args: &KernelArgs) -> Result<String, String> {
             let (mut errors, mut seconds, mut lml) = (Vec::new(), 0.0, 0.0);
             for &seed in seeds {
                 bar.set_message(format!("{} / {name} / seed {seed}", set.name));
-                let mut config = CompensationOptions::default().gp;
+                let mut config = ResidualGpOptions::default().gp;
                 config.kernel = *choice;
                 config.outputs = *outputs;
                 config.optimiser.seed = seed;

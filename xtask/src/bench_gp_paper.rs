@@ -22,7 +22,7 @@ use std::time::{Duration, Instant};
 
 use faer::Mat;
 use gp::{ExactGp, Kernel};
-use pipeline::{CompensationOptions, RobotDescription};
+use pipeline::{ResidualGpOptions, RobotDescription};
 
 use pipeline::simulated::paper_effects;
 
@@ -113,7 +113,7 @@ pub fn run(args: &PaperArgs, ur10_data: &std::path::Path) -> Result<String, Stri
     let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|");
     for (set, isotropic) in &sets {
         eprintln!("{} …", set.name);
-        let config = CompensationOptions::default().gp;
+        let config = ResidualGpOptions::default().gp;
         let t = Instant::now();
         let model = ExactGp::fit(set.train.inputs.as_ref(), set.train.outputs.as_ref(), &config)
             .map_err(|e| format!("{}: {e}", set.name))?;

@@ -17,7 +17,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use loadsim::{Effects, GeneratorConfig, JointCompliance, RobotDynamics, SimulatedCell};
 use pipeline::effects::EffectSelection;
 use pipeline::simulated::{Perturbation, joint_ranges, simulate, simulated_cell};
-use pipeline::{CompensationOptions, FitOptions, MeasurementSet, Method, ResidualFrame, RobotDescription};
+use pipeline::{FitOptions, MeasurementSet, Method, ResidualFrame, ResidualGpOptions, RobotDescription};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -59,17 +59,17 @@ pub struct Args {
 /// run in parallel.
 fn variants(sizes: &Sizes) -> Vec<Variant> {
     let mut ours = FitOptions::default();
-    ours.compensation.gp.optimiser.restarts = 1;
-    ours.compensation.gp.parallelism = Parallelism::Sequential;
+    ours.residual_gp.gp.optimiser.restarts = 1;
+    ours.residual_gp.gp.parallelism = Parallelism::Sequential;
     let paper = FitOptions {
-        compensation: CompensationOptions {
+        residual_gp: ResidualGpOptions {
             gp: gp::GpConfig {
                 kernel: KernelChoice::Quadratic,
                 outputs: OutputMode::Shared,
-                ..ours.compensation.gp.clone()
+                ..ours.residual_gp.gp.clone()
             },
             residual_frame: ResidualFrame::Tracker,
-            ..CompensationOptions::default()
+            ..ResidualGpOptions::default()
         },
         ..ours.clone()
     };
@@ -175,7 +175,7 @@ fn fit_and_test(
             pipeline::evaluate(&model, test).map(|e| e.summary.mean_position_error_mm).map_err(|e| e.to_string())
         })
         .collect::<Result<Vec<f64>, String>>()?;
-    let loo = report.compensation.as_ref().and_then(|c| c.leave_one_out.as_ref()).map(|l| l.mean_position_error_mm);
+    let loo = report.residual_gp.as_ref().and_then(|c| c.leave_one_out.as_ref()).map(|l| l.mean_position_error_mm);
     Ok((report.after.mean_position_error_mm, loo, errors))
 }
 

@@ -14,7 +14,7 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use pipeline::diagnose::{DiagnoseOptions, Diagnosis, diagnose};
 use pipeline::effects::{EffectSelection, effects_of};
-use pipeline::{CompensationOptions, FitOptions, MeasurementSet, Method, ResidualFrame, RobotDescription};
+use pipeline::{FitOptions, MeasurementSet, Method, ResidualFrame, ResidualGpOptions, RobotDescription};
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -107,10 +107,10 @@ fn bar(len: usize) -> ProgressBar {
 
 /// The methods table (position only and full pose).
 fn methods(args: &Args, robot: &RobotDescription) -> Result<String> {
-    let paper = CompensationOptions {
+    let paper = ResidualGpOptions {
         gp: gp::GpConfig { kernel: gp::KernelChoice::Quadratic, ..gp::GpConfig::default() },
         residual_frame: ResidualFrame::Tracker,
-        ..CompensationOptions::default()
+        ..ResidualGpOptions::default()
     };
     let variants: Vec<(String, Method, FitOptions)> = vec![
         ("base-tool".into(), Method::BaseTool, FitOptions::default()),
@@ -120,7 +120,7 @@ fn methods(args: &Args, robot: &RobotDescription) -> Result<String> {
         (
             "poe-gp, paper's kernel (Eq. 5) and frame (Eq. 8)".into(),
             Method::PoeGp,
-            FitOptions { compensation: paper, ..FitOptions::default() },
+            FitOptions { residual_gp: paper, ..FitOptions::default() },
         ),
     ];
     let progress = bar(2 * variants.len());

@@ -71,7 +71,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         options.plausibility.force = true;
     }
     if let Some(choice) = args.gp {
-        options.compensation.method = choice;
+        options.residual_gp.method = choice;
     }
     let (model, report) = pipeline::fit(&robot, &data, args.method, &options)?;
     pipeline::write_model(&args.out, &model)?;
@@ -111,7 +111,7 @@ fn summarise(
     errors(out, "training error after", &report.after);
     // Beside the training error, which a GP that interpolates its poses drives to nothing: the
     // same rows, each corrected by the GP fitted without it (closed form, issue 25).
-    if let Some(loo) = report.compensation.as_ref().and_then(|c| c.leave_one_out.as_ref()) {
+    if let Some(loo) = report.residual_gp.as_ref().and_then(|c| c.leave_one_out.as_ref()) {
         errors(out, "GP leave-one-out error (each row predicted without it)", loo);
     }
     let id = &report.identification;
@@ -160,7 +160,7 @@ fn summarise(
             let _ = writeln!(out, "    held at the prior, the data barely sees them: {}", held.join(", "));
         }
     }
-    if let (Some(compensation), Some(gp)) = (&model.compensation, &report.compensation) {
+    if let (Some(residual_gp), Some(gp)) = (&model.residual_gp, &report.residual_gp) {
         let kernels = match &gp.gp {
             pipeline::GpFitReport::Exact(r) => r.components.len(),
             pipeline::GpFitReport::Sparse(r) => r.components.len(),
@@ -197,7 +197,7 @@ fn summarise(
         let _ = writeln!(
             out,
             "  GP: {}, {kernels} kernel(s), hyperparameter search met its tolerance for {converged} of {kernels}{additive}{isotropic}",
-            compensation.gp.choice()
+            residual_gp.gp.choice()
         );
     }
     for direction in &id.unidentifiable {

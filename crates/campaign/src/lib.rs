@@ -10,11 +10,12 @@
 //! `−τ_static` plus noise, see [`TorqueSensorNoise`]). [`payload_run_campaign`] is the shape of
 //! a real 7-axis campaign; [`simulate_campaign`] draws cell and data in one call:
 //!
-//! ```no_run
-//! use pipeline::RobotDescription;
-//! use pipeline::simulated::{Perturbation, Remount, paper_effects, payload_run_campaign, simulate_campaign};
+//! ```
+//! # let fixture = |name: &str| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name);
+//! use robot::RobotDescription;
+//! use campaign::{Perturbation, Remount, paper_effects, payload_run_campaign, simulate_campaign};
 //!
-//! let robot = RobotDescription::read(std::path::Path::new("fixtures/robots/iiwa7.ron")).unwrap();
+//! let robot = RobotDescription::read(&fixture("iiwa7.ron")).unwrap();
 //! let config = payload_run_campaign(300, 1);
 //! let (cell, data) =
 //!     simulate_campaign(&robot, &paper_effects(), &Perturbation::default(), &Remount::default(), &config, true)
@@ -26,6 +27,7 @@
 //!
 //! The loadsim types a caller needs to configure a campaign are re-exported here, so that the
 //! `calib` binary depends on this crate alone.
+#![deny(missing_docs)]
 
 mod effects_file;
 

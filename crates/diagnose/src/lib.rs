@@ -15,6 +15,20 @@
 //!    is `unknown` with the joints the GP found the structure in (modules `structure`, `verdict`).
 //! 4. *How far*: held-out error before and after, against a noise floor from repeated poses, the
 //!    user, or the instrument class (module `noise`), overall and per region.
+//!
+//! ```
+//! # let fixture = |name: &str| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name);
+//! let robot = robot::RobotDescription::read(&fixture("irb4400.ron"))?;
+//! let config = campaign::GeneratorConfig { sample_count: 150, seed: 1, ..Default::default() };
+//! let (_, data) = campaign::simulate_campaign(
+//!     &robot, &campaign::paper_effects(), &campaign::Perturbation::default(), &campaign::Remount::default(), &config, true,
+//! )?;
+//! let diagnosis = diagnose::diagnose(&robot, &data, &diagnose::DiagnoseOptions::default())?;
+//! println!("{:?}: {:.3} mm -> {:.3} mm", diagnosis.verdict.effect, diagnosis.heldout_before_mm, diagnosis.heldout_after_mm);
+//! assert!(diagnosis.heldout_after_selected_mm <= diagnosis.heldout_before_mm);
+//! # Ok::<(), errors::Error>(())
+//! ```
+#![deny(missing_docs)]
 
 mod arcs;
 mod candidates;

@@ -31,7 +31,7 @@ type FoldProducts = (Mat<f64>, Vec<f64>, Mat<f64>, Vec<f64>);
 pub struct PriorOptions {
     /// Prior standard deviation of each translation parameter of the local frames between joints
     /// (joint 2 on), about the nominal model (the robot file), m. 1 mm: the tolerances a serial
-    /// arm is built to (the simulated arm's perturbation, `pipeline::simulated::Perturbation`;
+    /// arm is built to (the simulated arm's perturbation, `campaign::Perturbation`;
     /// Nubiola & Bonev 2013 measure an uncalibrated IRB 1600 at 0.97 mm mean): no fold can put a
     /// link further from its drawing than that without rows that say so. Centred on the nominal,
     /// not on the fit to every row, so that a fold's prior holds nothing of the rows it is scored

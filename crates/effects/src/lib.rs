@@ -6,6 +6,13 @@
 //! The same definition gives the diagnosis's candidate columns (`diagnose/candidates.rs`), the
 //! fit's [`poe::identify::PoseCorrection`] (module `correction`), and the calibrated model's
 //! prediction ([`IdentifiedEffect::twist`], applied by `model::Part`): what the diagnosis predicts is what the fit does.
+//!
+//! ```
+//! use effects::EffectSelection;
+//! let selection: EffectSelection = "gear_periodic:2:8,thermal".parse().unwrap();
+//! assert_eq!(selection.to_string(), "gear_periodic:2:8,thermal");
+//! assert!("gear_periodic:2".parse::<EffectSelection>().is_err()); // the harmonics are missing
+//! ```
 #![deny(missing_docs)]
 
 /// The default of the fit's `EffectOptions::hold_beyond_span`, also what the diagnosis uses: thermal
@@ -125,7 +132,7 @@ pub struct EffectContext<'a> {
     pub kinematics: &'a LocalPoe,
     /// How gear series fade outside their fitted angles.
     pub gear: GearOptions,
-    /// [`pipeline::EffectOptions::hold_beyond_span`].
+    /// `EffectOptions::hold_beyond_span` (the fit's options).
     pub hold_beyond_span: f64,
 }
 

@@ -4,6 +4,19 @@
 //! `layout` reads the header, `dialect` the numbers (`,`/`.` or a tracker's `;`/`,`),
 //! `column_map` the `--columns` renaming, `row` the cells of one row, `writer` writes a set back
 //! as SPEC CSV.
+//!
+//! ```
+//! use measurements::{ReadOptions, parse_measurements};
+//! let csv = "q1_rad,q2_rad,x_mm,y_mm,z_mm\n0.1,0.2,1000,0,500\n0.3,-0.1,990,12,510\n";
+//! let data = parse_measurements(csv.as_bytes(), "poses.csv", &ReadOptions::default())?;
+//! assert_eq!(data.rows.len(), 2);
+//! assert!((data.rows[0].position.x - 1.0).abs() < 1e-12); // SI inside: metres
+//! let bad = "q1_rad,x_mm,y_mm,z_mm\n0.1,abc,0,0\n";
+//! let error = parse_measurements(bad.as_bytes(), "poses.csv", &ReadOptions::default()).unwrap_err();
+//! assert!(error.to_string().starts_with("poses.csv:2:2:"), "{error}");
+//! # Ok::<(), errors::Error>(())
+//! ```
+#![deny(missing_docs)]
 
 mod column_map;
 mod dialect;

@@ -1,5 +1,5 @@
 //! A calibrated model: the identified kinematics, the effects identified with them, the optional
-//! GP compensation, and prediction by walking them in order (module `model_parts`).
+//! residual GP, and prediction by walking them in order (module `model_parts`).
 
 use crate::model_parts::{Part, Walk};
 use crate::{Method, PoseError};
@@ -35,9 +35,9 @@ pub struct CalibratedModel {
     /// written before it was kept (the fitted geometry is then used everywhere).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fallback_kinematics: Option<LocalPoe>,
-    /// The GP compensation of the residual (methods `poe-gp`, `poe-gp-load`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub compensation: Option<crate::Compensation>,
+    /// The GP on the residual, step 2 (methods `poe-gp`, `poe-gp-load`); `compensation` in the file.
+    #[serde(default, skip_serializing_if = "Option::is_none", rename = "compensation")]
+    pub residual_gp: Option<crate::ResidualGp>,
     /// The range of every input the model was fitted on: the check on reading probes the model
     /// inside it. Files written before it existed have none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -88,7 +88,7 @@ impl CalibratedModel {
         if !self.effects.is_empty() {
             parts.extend(self.fallback_kinematics.iter().map(Part::Fallback));
         }
-        parts.extend(self.compensation.iter().map(Part::GaussianProcess));
+        parts.extend(self.residual_gp.iter().map(Part::GaussianProcess));
         parts
     }
 
@@ -103,7 +103,7 @@ impl CalibratedModel {
         } else if fallback == 1 && index == effects + 1 {
             model.fallback_kinematics = None;
         } else if index == effects + fallback + 1 {
-            model.compensation = None;
+            model.residual_gp = None;
         }
         model
     }
@@ -111,7 +111,7 @@ impl CalibratedModel {
     /// The model without its non-geometric parts (effects, the GP): the geometry alone, which is
     /// what a URDF can hold (`calib export`).
     pub fn geometry_only(&self) -> CalibratedModel {
-        CalibratedModel { effects: Vec::new(), fallback_kinematics: None, compensation: None, ..self.clone() }
+        CalibratedModel { effects: Vec::new(), fallback_kinematics: None, residual_gp: None, ..self.clone() }
     }
 
     /// The names of the parts a URDF cannot hold, in the order they apply.
@@ -194,7 +194,7 @@ impl CalibratedModel {
     /// Whether predictions carry a standard deviation: a GP, or an effect that reports what it
     /// leaves uncorrected where it fades out.
     pub fn predicts_std(&self) -> bool {
-        self.compensation.is_some() || self.effects.iter().any(IdentifiedEffect::has_sigma)
+        self.residual_gp.is_some() || self.effects.iter().any(IdentifiedEffect::has_sigma)
     }
 
     /// One warning per input (joint, payload, temperature, time) that some of `rows` put outside

@@ -96,8 +96,8 @@ impl CalibratedModel {
         if let Some(k) = (1..self.tools.len()).find(|&k| self.tools[..k].contains(&self.tools[k])) {
             return Err(at.part("tools", format!("tools: the name '{}' is given twice", self.tools[k])));
         }
-        if self.method.uses_gp() != self.compensation.is_some() {
-            let has = if self.compensation.is_some() { "has a" } else { "has no" };
+        if self.method.uses_gp() != self.residual_gp.is_some() {
+            let has = if self.residual_gp.is_some() { "has a" } else { "has no" };
             return Err(at.part("method", format!("method {} but the model {has} GP compensation", self.method)));
         }
         effects::check_effects(&self.effects, n, tool_count, &|field, occurrence| {
@@ -105,26 +105,26 @@ impl CalibratedModel {
             at.at(field, before + occurrence)
         })
         .map_err(|fault| fault.into_error(file))?;
-        if let Some(compensation) = &self.compensation {
-            if compensation.with_payload != (self.method == Method::PoeGpLoad) {
+        if let Some(residual_gp) = &self.residual_gp {
+            if residual_gp.with_payload != (self.method == Method::PoeGpLoad) {
                 let message =
-                    format!("compensation.with_payload is {} for method {}", compensation.with_payload, self.method);
+                    format!("compensation.with_payload is {} for method {}", residual_gp.with_payload, self.method);
                 return Err(at.part("with_payload", message));
             }
-            if compensation.full_pose != self.full_pose {
+            if residual_gp.full_pose != self.full_pose {
                 let message = format!(
                     "compensation.full_pose is {}, the model's full_pose {}",
-                    compensation.full_pose, self.full_pose
+                    residual_gp.full_pose, self.full_pose
                 );
                 return Err(at.part("compensation", message));
             }
-            let inputs = n + usize::from(compensation.with_payload);
-            if compensation.gp.input_dim() != inputs {
-                let found = compensation.gp.input_dim();
+            let inputs = n + usize::from(residual_gp.with_payload);
+            if residual_gp.gp.input_dim() != inputs {
+                let found = residual_gp.gp.input_dim();
                 return Err(at.count(("gp", 0), "compensation.gp".into(), "inputs", found, inputs));
             }
             let bound = 10f64.powf(MAX_HYPERPARAMETER_DECADES);
-            let hyperparameters = compensation.gp.kernels().into_iter().flat_map(|k| k.parameters());
+            let hyperparameters = residual_gp.gp.kernels().into_iter().flat_map(|k| k.parameters());
             if let Some(value) = hyperparameters.into_iter().find(|p| !(p.abs() <= bound && p.abs() >= 1.0 / bound)) {
                 let message = format!(
                     "compensation.gp: a kernel hyperparameter is {value:e}, outside 1e-{MAX_HYPERPARAMETER_DECADES} to \
@@ -133,8 +133,8 @@ impl CalibratedModel {
                 return Err(at.part("kernel", message));
             }
             let outputs = if self.full_pose { 6 } else { 3 };
-            if compensation.gp.output_count() != outputs {
-                let found = compensation.gp.output_count();
+            if residual_gp.gp.output_count() != outputs {
+                let found = residual_gp.gp.output_count();
                 return Err(at.count(("gp", 0), "compensation.gp".into(), "outputs", found, outputs));
             }
         }
@@ -161,10 +161,10 @@ impl CalibratedModel {
             t_s: Some(0.0),
             torques_nm: Some(vec![0.0; n]),
         };
-        match &self.compensation {
-            Some(compensation) => {
-                let mean = compensation.gp.input_mean();
-                let payload = if compensation.with_payload { mean.get(n).copied().unwrap_or(0.0) } else { 0.0 };
+        match &self.residual_gp {
+            Some(residual_gp) => {
+                let mean = residual_gp.gp.input_mean();
+                let payload = if residual_gp.with_payload { mean.get(n).copied().unwrap_or(0.0) } else { 0.0 };
                 (vec![row(mean[..n.min(mean.len())].to_vec(), payload)], "at the mean of the GP's training inputs")
             }
             None => (vec![row(vec![0.0; n], 0.0), row(vec![1.0; n], 0.0)], "with every joint at 0 or 1"),

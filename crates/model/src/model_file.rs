@@ -68,7 +68,7 @@ pub fn parse_model(text: &str, file: &str) -> Result<CalibratedModel, Error> {
 
 /// The version-1 layout: the same model with joint compliance as its only possible effect.
 mod version_1 {
-    use crate::{CalibratedModel, Compensation, Method, SCHEMA_VERSION};
+    use crate::{CalibratedModel, Method, ResidualGp, SCHEMA_VERSION};
     use effects::{ComplianceTerm, ComplianceTorque, IdentifiedEffect, JointCompliance, LoadFrame};
     use poe::LocalPoe;
     use serde::Deserialize;
@@ -92,8 +92,8 @@ mod version_1 {
         kinematics: LocalPoe,
         #[serde(default)]
         joint_compliance: Option<Compliance>,
-        #[serde(default)]
-        compensation: Option<Compensation>,
+        #[serde(default, rename = "compensation")]
+        residual_gp: Option<ResidualGp>,
     }
 
     impl From<Model> for CalibratedModel {
@@ -119,7 +119,7 @@ mod version_1 {
                 kinematics: v1.kinematics,
                 effects,
                 fallback_kinematics: None,
-                compensation: v1.compensation,
+                residual_gp: v1.residual_gp,
                 training_range: None,
                 joint_limits: Vec::new(),
             }

@@ -1,6 +1,6 @@
 //! A calibrated model as a sequence of parts: the geometry, then the named effects, then the GP.
 //! Each part applies itself to the poses of a set of rows ([`Part::apply`]); prediction, the fit's
-//! "after" report, export (what a URDF cannot hold) and compensation all walk the same sequence, so
+//! "after" report, export (what a URDF cannot hold) and joint-target compensation all walk the same sequence, so
 //! a new kind of part is one new variant here.
 //!
 //! The effects move a pose by one left exponential of the sum of their twists, exactly as the
@@ -8,7 +8,7 @@
 //! rows' pending twist, and the pending twist is applied before the GP reads the poses and at the
 //! end.
 
-use crate::Compensation;
+use crate::ResidualGp;
 use effects::IdentifiedEffect;
 use errors::Error;
 use lie::{SE3, Twist, Vector6};
@@ -26,8 +26,8 @@ pub enum Part<'a> {
     /// joint angles it was fitted on) the pose blends from the geometry-and-effects fit to this
     /// one, so that far from the training angles the model is the plain geometric fit.
     Fallback(&'a LocalPoe),
-    /// The Gaussian-process compensation of what is left.
-    GaussianProcess(&'a Compensation),
+    /// The residual GP: what is left, step 2.
+    GaussianProcess(&'a ResidualGp),
 }
 
 impl<'a> Part<'a> {
@@ -95,9 +95,9 @@ impl<'a> Part<'a> {
                     }
                 }
             }
-            Part::GaussianProcess(compensation) => {
+            Part::GaussianProcess(residual_gp) => {
                 walk.flush();
-                let corrections = compensation.predict(walk.rows, &walk.poses)?;
+                let corrections = residual_gp.predict(walk.rows, &walk.poses)?;
                 let mut std = Vec::with_capacity(corrections.len());
                 for (pose, (g, s)) in walk.poses.iter_mut().zip(corrections) {
                     *pose = g * *pose;

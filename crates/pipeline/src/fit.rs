@@ -9,7 +9,7 @@ use errors::Error;
 use measurements::MeasurementSet;
 use measurements::{OutlierLine, list_lines, without};
 use model::geometric::{fit_geometry, observations};
-use model::{CalibratedModel, Compensation, CompensationReport, ErrorSummary, Method, SCHEMA_VERSION, evaluate};
+use model::{CalibratedModel, ErrorSummary, Method, ResidualGp, ResidualGpReport, SCHEMA_VERSION, evaluate};
 use poe::identify::{
     IdentificationOptions, IdentificationReport, Loss, ParameterMask, Scope, identify_with_correction,
 };
@@ -43,8 +43,8 @@ pub struct FitReport {
     /// The effects identified with the geometry, their parameters by name.
     pub effects: Vec<EffectReport>,
     /// The GP stage's report, for the GP methods: its hyperparameters.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub compensation: Option<CompensationReport>,
+    #[serde(skip_serializing_if = "Option::is_none", rename = "compensation")]
+    pub residual_gp: Option<ResidualGpReport>,
     /// What `--effects auto` chose and why.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub auto: Option<AutoChoice>,
@@ -81,7 +81,7 @@ pub enum FitWarning {
         min_redundancy: f64,
     },
     /// The GP's hyperparameter search stopped before a tolerance was met for some outputs: the
-    /// compensation is usable but its hyperparameters are not at the likelihood's optimum.
+    /// residual GP is usable but its hyperparameters are not at the likelihood's optimum.
     GpSearchNotConverged {
         /// Output columns (0–2 position, 3–5 rotation) of the kernels concerned.
         outputs: Vec<usize>,
@@ -114,7 +114,7 @@ impl std::fmt::Display for FitWarning {
             FitWarning::GpSearchNotConverged { outputs, iterations } => write!(
                 f,
                 "the GP's hyperparameter search for output(s) {outputs:?} stopped after {iterations} iterations \
-                 without meeting its tolerance: the compensation may be less accurate than it could be; check it on \
+                 without meeting its tolerance: the residual GP may be less accurate than it could be; check it on \
                  held-out data"
             ),
             FitWarning::GrossOutliers { rows, threshold_sigmas, left_out } => write!(
@@ -175,7 +175,7 @@ pub fn fit(
         kinematics: geometry.model,
         effects: Vec::new(),
         fallback_kinematics: None,
-        compensation: None,
+        residual_gp: None,
         training_range: model::TrainingRange::of(&data.rows),
         joint_limits: model::stored_limits(&robot.limits()),
     };
@@ -218,7 +218,7 @@ pub fn fit(
     }
     let outliers = OutlierLine::of(&identification.robust, data);
     let left_out = identification.robust.loss == Loss::Huber && !outliers.is_empty();
-    let mut compensation = None;
+    let mut residual_gp = None;
     if method.uses_gp() {
         let with_payload = method == Method::PoeGpLoad;
         // The GP learns what the geometry leaves on the rows the geometry was fitted to: an
@@ -226,9 +226,9 @@ pub fn fit(
         let kept = if left_out { Cow::Owned(without(data, &identification.robust)) } else { Cow::Borrowed(data) };
         let tools: Vec<usize> = kept.rows.iter().map(|r| r.tool).collect();
         let poses = model.geometric_poses(&kept.rows, &tools)?;
-        let (fitted, report) = Compensation::fit(&poses, &kept, with_payload, &options.compensation)?;
-        model.compensation = Some(fitted);
-        compensation = Some(report);
+        let (fitted, report) = ResidualGp::fit(&poses, &kept, with_payload, &options.residual_gp)?;
+        model.residual_gp = Some(fitted);
+        residual_gp = Some(report);
     }
     // The check `read_model` runs, on the text `write_model` writes: a fit never hands over a
     // model that its own file would be refused for, and the cause shows here (issue 23).
@@ -240,7 +240,7 @@ pub fn fit(
         kinematics: geometry.registered,
         effects: Vec::new(),
         fallback_kinematics: None,
-        compensation: None,
+        residual_gp: None,
         ..model.clone()
     };
     let before = evaluate(&registered, data)?.summary;
@@ -260,7 +260,7 @@ pub fn fit(
             left_out,
         });
     }
-    if let Some(report) = &compensation {
+    if let Some(report) = &residual_gp {
         let unconverged = report.gp.unconverged();
         if !unconverged.is_empty() {
             warnings.push(FitWarning::GpSearchNotConverged {
@@ -278,7 +278,7 @@ pub fn fit(
         identification,
         folded: robot.folded.clone(),
         effects: effect_report,
-        compensation,
+        residual_gp,
         auto,
         plausibility: findings.report,
         outliers,

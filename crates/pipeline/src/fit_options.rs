@@ -4,7 +4,7 @@
 use diagnose::DiagnoseOptions;
 use effects::EffectSelection;
 use errors::Error;
-use model::CompensationOptions;
+use model::ResidualGpOptions;
 use poe::identify::{IdentificationOptions, Solver};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -87,8 +87,10 @@ impl Default for EffectOptions {
 pub struct FitOptions {
     /// The geometric identification.
     pub identification: IdentificationOptions,
-    /// The Gaussian-process compensation (methods `poe-gp`, `poe-gp-load`).
-    pub compensation: CompensationOptions,
+    /// The GP on the residual, step 2 (methods `poe-gp`, `poe-gp-load`); `compensation` in an
+    /// options file, the word of the SPEC's first versions.
+    #[serde(rename = "compensation")]
+    pub residual_gp: ResidualGpOptions,
     /// Non-geometric effects identified with the geometry, before any GP. Beyond the paper.
     pub effects: EffectOptions,
     /// Warn when the residual rows per identifiable parameter fall below this. 3, from the
@@ -107,7 +109,7 @@ impl Default for FitOptions {
     fn default() -> Self {
         Self {
             identification: IdentificationOptions::default(),
-            compensation: CompensationOptions::default(),
+            residual_gp: ResidualGpOptions::default(),
             effects: EffectOptions::default(),
             min_redundancy: 3.0,
             plausibility: crate::PlausibilityOptions::default(),
@@ -160,7 +162,7 @@ impl FitOptions {
                 format!("min_redundancy is {value}, expected a finite number of at least 1"),
             ));
         }
-        if let Err(gp::Error::InvalidConfig { field, value }) = self.compensation.gp.validate() {
+        if let Err(gp::Error::InvalidConfig { field, value }) = self.residual_gp.gp.validate() {
             // The field's own name, where the file gives it (`function_tolerance:` for
             // `optimiser.function_tolerance`).
             let last = field.rsplit('.').next().unwrap_or(field);
@@ -199,8 +201,8 @@ mod tests {
     #[test]
     fn a_gp_field_given_alone_keeps_the_stages_kernel_and_search() {
         let options = FitOptions::parse("(compensation: (gp: (optimiser: (max_iterations: 100))))", "fit.ron").unwrap();
-        let default = CompensationOptions::default().gp;
-        let gp = &options.compensation.gp;
+        let default = ResidualGpOptions::default().gp;
+        let gp = &options.residual_gp.gp;
         assert_eq!(gp.optimiser.max_iterations, 100);
         assert_eq!(gp.kernel, default.kernel);
         assert_eq!((gp.optimiser.restarts, gp.optimiser.warm_start_rows), (0, 500));
@@ -212,9 +214,9 @@ mod tests {
     fn every_gp_field_can_be_given_and_reads_back() {
         // A field added to gp::GpConfig or OptimiserConfig without a patch field fails here.
         let mut options = FitOptions::default();
-        options.compensation.gp.optimiser.seed = 9;
-        options.compensation.gp.kernel = gp::KernelChoice::Matern52Ard;
-        options.compensation.gp.bounds = Some(gp::Kernel::start(gp::KernelChoice::Matern52Ard, 3).default_bounds());
+        options.residual_gp.gp.optimiser.seed = 9;
+        options.residual_gp.gp.kernel = gp::KernelChoice::Matern52Ard;
+        options.residual_gp.gp.bounds = Some(gp::Kernel::start(gp::KernelChoice::Matern52Ard, 3).default_bounds());
         let text = ron::ser::to_string(&options).unwrap();
         assert_eq!(FitOptions::parse(&text, "fit.ron").unwrap(), options, "{text}");
     }

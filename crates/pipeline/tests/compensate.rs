@@ -122,7 +122,7 @@ fn pose_targets_from_a_seed_are_reached_on_the_seeds_branch() {
 #[test]
 fn a_gp_model_with_payload_is_compensated_through_its_whole_prediction() {
     let (_, model, _) = fitted(Method::PoeGpLoad, simulated::paper_effects(), false, vec![0.0, 5.0, 10.0]);
-    assert!(model.compensation.is_some());
+    assert!(model.residual_gp.is_some());
     let q = vec![0.2, 0.4, -0.2, 0.5, 0.7, 0.1];
     let pose = predicted(&model, &q, 0.0);
     let targets: Vec<PoseTarget> = [0.0, 10.0]

@@ -71,8 +71,8 @@ fn a_gp_search_stopped_by_its_iteration_limit_is_reported_not_passed_off_as_conv
     let data = loaded_data(&robot, 120, false, 21);
     let warned = |max_iterations: usize, method: pipeline::GpChoice| {
         let mut options = FitOptions::default();
-        options.compensation.gp.optimiser.max_iterations = max_iterations;
-        options.compensation.method = method;
+        options.residual_gp.gp.optimiser.max_iterations = max_iterations;
+        options.residual_gp.method = method;
         let (_, report) = pipeline::fit(&robot, &data, Method::PoeGpLoad, &options).unwrap();
         report.warnings.iter().find_map(|w| match w {
             pipeline::FitWarning::GpSearchNotConverged { outputs, iterations } => Some((outputs.clone(), *iterations)),
@@ -101,11 +101,11 @@ fn fit_report_gives_the_gp_leave_one_out_error_near_the_held_out_error() {
         // The shared rotation kernel is off by default (it cost rotation accuracy on the UR10):
         // switched on here so that its grouping is tested too.
         let mut options = FitOptions::default();
-        options.compensation.rotation_follows_position = true;
+        options.residual_gp.rotation_follows_position = true;
         let (model, report) = pipeline::fit(&robot, &train, Method::PoeGpLoad, &options).unwrap();
         let held_out = pipeline::evaluate(&model, &test).unwrap().summary.mean_position_error_mm;
-        let compensation = report.compensation.as_ref().expect("a GP method reports its GP");
-        let loo = compensation.leave_one_out.as_ref().expect("the exact GP has a leave-one-out error");
+        let residual_gp = report.residual_gp.as_ref().expect("a GP method reports its GP");
+        let loo = residual_gp.leave_one_out.as_ref().expect("the exact GP has a leave-one-out error");
         let training = report.after.mean_position_error_mm;
         eprintln!(
             "seed {seed} full pose {full_pose}: training {training:.4}, leave-one-out {:.4}, held out {held_out:.4} mm",
@@ -120,7 +120,7 @@ fn fit_report_gives_the_gp_leave_one_out_error_near_the_held_out_error() {
             loo.mean_position_error_mm
         );
         assert_eq!(loo.mean_rotation_error_mrad.is_some(), full_pose);
-        if let pipeline::GpFitReport::Exact(gp) = &compensation.gp {
+        if let pipeline::GpFitReport::Exact(gp) = &residual_gp.gp {
             let groups: Vec<&Vec<usize>> = gp.components.iter().map(|c| &c.outputs).collect();
             let expected: Vec<Vec<usize>> = if full_pose {
                 vec![vec![0], vec![1], vec![2], vec![3, 4, 5]]

@@ -87,8 +87,8 @@ fn a_gp_of_the_wrong_dimensions_is_refused() {
     let (position_only, _) = fitted(false);
     let (mut full_pose, _) = fitted(true);
     // A full-pose model with the position-only GP: 3 outputs where 6 are needed.
-    full_pose.compensation = position_only.compensation.clone();
-    full_pose.compensation.as_mut().unwrap().full_pose = true;
+    full_pose.residual_gp = position_only.residual_gp.clone();
+    full_pose.residual_gp.as_mut().unwrap().full_pose = true;
     let (error, message) = refused(&text_of(&full_pose));
     assert!(matches!(error, Error::ModelCount { what: "outputs", found: 3, expected: 6, .. }), "{message}");
     // The payload input dropped from the method but not from the GP.
@@ -97,7 +97,7 @@ fn a_gp_of_the_wrong_dimensions_is_refused() {
     let (_, message) = refused(&text_of(&model));
     assert!(message.contains("with_payload is true for method poe-gp"), "{message}");
     let mut model = position_only;
-    model.compensation.as_mut().unwrap().with_payload = false;
+    model.residual_gp.as_mut().unwrap().with_payload = false;
     model.method = Method::PoeGp;
     let (error, message) = refused(&text_of(&model));
     assert!(matches!(error, Error::ModelCount { what: "inputs", found: 7, expected: 6, .. }), "{message}");
@@ -106,7 +106,7 @@ fn a_gp_of_the_wrong_dimensions_is_refused() {
 #[test]
 fn a_gp_method_without_a_gp_is_refused() {
     let (mut model, _) = fitted(false);
-    model.compensation = None;
+    model.residual_gp = None;
     let (_, message) = refused(&text_of(&model));
     assert!(message.contains("method poe-gp-load but the model has no GP compensation"), "{message}");
 }
@@ -135,7 +135,8 @@ struct Version1 {
     tools: Vec<String>,
     kinematics: poe::LocalPoe,
     joint_compliance: Option<Version1Compliance>,
-    compensation: Option<pipeline::Compensation>,
+    #[serde(rename = "compensation")]
+    residual_gp: Option<pipeline::ResidualGp>,
 }
 
 #[derive(serde::Serialize)]
@@ -166,7 +167,7 @@ fn a_version_1_file_with_joint_compliance_reads_and_predicts_as_before() {
             terms: compliance.terms.clone(),
             theta: compliance.theta.clone(),
         }),
-        compensation: model.compensation.clone(),
+        residual_gp: model.residual_gp.clone(),
     };
     let text = ron::ser::to_string_pretty(&old, ron::ser::PrettyConfig::default()).unwrap();
     assert!(text.contains("joint_compliance:") && !text.contains("effects:"), "{text}");
@@ -259,7 +260,7 @@ fn a_vanishing_feature_scale_is_refused_not_left_to_predict_nan() {
 #[test]
 fn gp_training_data_that_overflow_its_weights_are_refused() {
     let (model, text) = fitted(false);
-    assert!(model.compensation.is_some());
+    assert!(model.residual_gp.is_some());
     let at = text.find("training_outputs: [").unwrap();
     let first = at + text[at..].find(|c: char| c == '-' || c.is_ascii_digit()).unwrap();
     let end = first + text[first..].find(',').unwrap();

@@ -1,6 +1,21 @@
 //! The robot: its description (joint axes, types, limits, flange, tools, load data), read from the
 //! robot RON, a standard or modified DH table, or a URDF chain between two links (mimic joints folded),
 //! checked once where it is read, and the base-frame geometry of a fitted model.
+//!
+//! ```
+//! # let fixture = |name: &str| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name);
+//! let robot = robot::RobotDescription::read(&fixture("ur10.ron"))?;
+//! assert_eq!(robot.joint_count(), 6);
+//! let nominal = robot.nominal_model()?; // the local POE model of the nominal kinematics
+//! assert_eq!(nominal.joint_count(), 6);
+//! // The same arm as a URDF, the chain from its root link to its deepest leaf.
+//! let urdf = robot::RobotDescription::read(&fixture("ur10.urdf"))?;
+//! assert_eq!(urdf.joint_count(), 6);
+//! // What is not a robot is refused at its file, line and column.
+//! let error = robot::RobotDescription::parse("(name: \"arm\", joints: [])", "arm.ron").unwrap_err();
+//! assert!(error.to_string().starts_with("arm.ron:1:"), "{error}");
+//! # Ok::<(), errors::Error>(())
+//! ```
 #![deny(missing_docs)]
 
 mod base_frame;

@@ -32,7 +32,7 @@ pub enum GpChoice {
     Exact,
     /// The sparse variational GP (VFE) with inducing inputs: `O(n m²)` time, `O(n m)` memory.
     Sparse,
-    /// Exact up to [`CompensationOptions::sparse_above_rows`] training rows, sparse beyond.
+    /// Exact up to [`ResidualGpOptions::sparse_above_rows`] training rows, sparse beyond.
     #[default]
     Auto,
 }
@@ -83,7 +83,7 @@ impl FromStr for GpChoice {
 /// Options of the GP stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
-pub struct CompensationOptions {
+pub struct ResidualGpOptions {
     /// The exact Gaussian process (and the kernel, outputs, scaling and optimiser of both). Read
     /// from an options file field by field onto this stage's default, so that `gp: (optimiser:
     /// (max_iterations: 100))` changes that one field and keeps the stage's kernel and search.
@@ -93,9 +93,9 @@ pub struct CompensationOptions {
     pub method: GpChoice,
     /// With [`GpChoice::Auto`], the sparse GP above this many training rows.
     pub sparse_above_rows: usize,
-    /// The sparse GP (its `gp` field is replaced by [`CompensationOptions::gp`], but for the
-    /// outputs and the kernel, which [`CompensationOptions::sparse_outputs`] and
-    /// [`CompensationOptions::sparse_kernel`] set).
+    /// The sparse GP (its `gp` field is replaced by [`ResidualGpOptions::gp`], but for the
+    /// outputs and the kernel, which [`ResidualGpOptions::sparse_outputs`] and
+    /// [`ResidualGpOptions::sparse_kernel`] set).
     pub sparse: gp::SparseConfig,
     /// One kernel for all outputs or one each, in the sparse GP.
     pub sparse_outputs: gp::OutputMode,
@@ -109,7 +109,7 @@ pub struct CompensationOptions {
     pub rotation_follows_position: bool,
 }
 
-impl Default for CompensationOptions {
+impl Default for ResidualGpOptions {
     fn default() -> Self {
         // ARD squared exponential plus a first-order additive term (one one-dimensional squared
         // exponential per input) rather than the paper's Eq. 5 kernel: on the UR10 data (series
@@ -250,12 +250,12 @@ struct GpPatch {
     follower_groups: Option<Vec<Vec<usize>>>,
 }
 
-/// `gp` as an options file gives it, laid over [`CompensationOptions::default`]'s: derived
+/// `gp` as an options file gives it, laid over [`ResidualGpOptions::default`]'s: derived
 /// `#[serde(default)]` would fill the fields left out from [`gp::GpConfig::default`] (the
 /// library's kernel, three restarts, no warm start) and silently change the fit.
 fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<gp::GpConfig, D::Error> {
     let patch = GpPatch::deserialize(deserializer)?;
-    let mut gp = CompensationOptions::default().gp;
+    let mut gp = ResidualGpOptions::default().gp;
     let GpPatch {
         kernel,
         bounds,
@@ -303,7 +303,7 @@ fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<
     Ok(gp)
 }
 
-impl CompensationOptions {
+impl ResidualGpOptions {
     /// The GP that `rows` training rows get.
     pub fn choice_for(&self, rows: usize) -> GpChoice {
         match self.method {
@@ -404,9 +404,9 @@ impl GpFitReport {
     }
 }
 
-/// A fitted GP compensation, stored in the model file.
+/// A fitted residual GP, stored in the model file.
 #[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Compensation {
+pub struct ResidualGp {
     /// Whether the payload is an input (method `poe-gp-load`, Eq. 12).
     pub with_payload: bool,
     /// Six outputs (a twist) for full-pose data, three (the position error) otherwise.
@@ -419,7 +419,7 @@ pub struct Compensation {
 
 /// What the GP stage reports.
 #[derive(Debug, Clone, Serialize)]
-pub struct CompensationReport {
+pub struct ResidualGpReport {
     /// The GP's own report (hyperparameters, log marginal likelihood or bound, jitter).
     pub gp: GpFitReport,
     /// The training error of the model had the GP not seen each row: every row corrected by the
@@ -482,14 +482,14 @@ impl ResidualSet {
     }
 }
 
-impl Compensation {
+impl ResidualGp {
     /// Fits the GP to the error that the model poses `poses` (one per row) leave on `data`.
     pub fn fit(
         poses: &[SE3],
         data: &MeasurementSet,
         with_payload: bool,
-        options: &CompensationOptions,
-    ) -> Result<(Self, CompensationReport), Error> {
+        options: &ResidualGpOptions,
+    ) -> Result<(Self, ResidualGpReport), Error> {
         let ResidualSet { inputs: x, outputs: y } = ResidualSet::new(poses, data, with_payload, options.residual_frame);
         let (gp, report, leave_one_out) = match options.choice_for(x.nrows()) {
             GpChoice::Sparse => {
@@ -515,7 +515,7 @@ impl Compensation {
                 (GpModel::Exact(model), report, Some(loo.mean))
             }
         };
-        let compensation = Self { with_payload, full_pose: data.full_pose, residual_frame: options.residual_frame, gp };
+        let residual_gp = Self { with_payload, full_pose: data.full_pose, residual_frame: options.residual_frame, gp };
         let leave_one_out = leave_one_out.map(|mean| {
             let errors: Vec<crate::PoseError> = poses
                 .iter()
@@ -523,13 +523,13 @@ impl Compensation {
                 .enumerate()
                 .map(|(i, (pose, row))| {
                     let g = Vector6::from_fn(|c, _| if c < mean.ncols() { mean[(i, c)] } else { 0.0 });
-                    let error = crate::pose_error(&(compensation.correction(pose, &g) * *pose), row);
+                    let error = crate::pose_error(&(residual_gp.correction(pose, &g) * *pose), row);
                     if data.full_pose { error } else { crate::PoseError { rotation_mrad: None, ..error } }
                 })
                 .collect();
             crate::ErrorSummary::from_errors(&errors)
         });
-        Ok((compensation, CompensationReport { gp: report, leave_one_out }))
+        Ok((residual_gp, ResidualGpReport { gp: report, leave_one_out }))
     }
 
     /// `G` for the GP's output `g` at a model pose: a translation for position-only data, else the
