@@ -12,7 +12,6 @@ use crate::gram::training_covariance;
 use crate::kernel::KernelChoice;
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::lml::check_finite_outputs;
-use crate::loo::{inverse_diagonal, log_predictive};
 use crate::optimise::{OptimisationReport, finish, fit_hyperparameters, refine, warm_stage};
 use crate::points::Points;
 use crate::scaling::{InputStandardiser, OutputNormaliser};
@@ -278,7 +277,7 @@ impl ExactGp {
         // The paper's Eq. 5 beside the searched kernel, kept where it predicts the rows it has not
         // seen better (leave-one-out, R&W Eq. 5.11).
         let loo =
-            |c: &Component| -> f64 { log_predictive(c, &inverse_diagonal(c, config.parallelism.faer())).iter().sum() };
+            |c: &Component| -> f64 { c.log_predictive(&c.inverse_diagonal(config.parallelism.faer())).iter().sum() };
         let with_isotropic = |searched: (Component, ComponentReport),
                               cols: &Vec<usize>|
          -> Result<(Component, ComponentReport), Error> {
@@ -423,6 +422,35 @@ pub(crate) fn validate_training_data(x: MatRef<'_, f64>, y: MatRef<'_, f64>) -> 
 }
 
 impl Component {
+    /// `[K⁻¹]ᵢᵢ` for every row: the squared column norms of `L⁻¹`.
+    pub(crate) fn inverse_diagonal(&self, par: faer::Par) -> Vec<f64> {
+        let component = self;
+        let n = component.alpha.nrows();
+        let mut inverse = Mat::<f64>::identity(n, n);
+        component.factor.solve_lower_in_place(inverse.as_mut(), par);
+        // L⁻¹ is lower triangular: column i has entries from row i down.
+        (0..n).map(|i| (i..n).map(|k| inverse[(k, i)] * inverse[(k, i)]).sum()).collect()
+    }
+
+    /// Per served output, the log predictive probability of Eq. 5.11 summed over rows, for the
+    /// normalised outputs the component was built on.
+    pub(crate) fn log_predictive(&self, diagonal: &[f64]) -> Vec<f64> {
+        let component = self;
+        let ln_2pi = (2.0 * std::f64::consts::PI).ln();
+        (0..component.alpha.ncols())
+            .map(|c| {
+                diagonal
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &kii)| {
+                        let residual = component.alpha[(i, c)] / kii;
+                        0.5 * kii.ln() - 0.5 * residual * residual * kii - 0.5 * ln_2pi
+                    })
+                    .sum()
+            })
+            .collect()
+    }
+
     /// Factors the kernel matrix (with jitter escalation, or with exactly `fixed_jitter`) and solves
     /// for the weights.
     pub(crate) fn build(

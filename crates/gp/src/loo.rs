@@ -13,7 +13,7 @@
 use faer::Mat;
 
 use crate::Error;
-use crate::exact::{Component, ExactGp};
+use crate::exact::ExactGp;
 
 /// Leave-one-out predictions of every training row, in the original output units.
 #[derive(Debug, Clone)]
@@ -28,33 +28,6 @@ pub struct LeaveOneOut {
     pub log_predictive: Vec<f64>,
 }
 
-/// `[K⁻¹]ᵢᵢ` for every row: the squared column norms of `L⁻¹`.
-pub(crate) fn inverse_diagonal(component: &Component, par: faer::Par) -> Vec<f64> {
-    let n = component.alpha.nrows();
-    let mut inverse = Mat::<f64>::identity(n, n);
-    component.factor.solve_lower_in_place(inverse.as_mut(), par);
-    // L⁻¹ is lower triangular: column i has entries from row i down.
-    (0..n).map(|i| (i..n).map(|k| inverse[(k, i)] * inverse[(k, i)]).sum()).collect()
-}
-
-/// Per served output, the log predictive probability of Eq. 5.11 summed over rows, for the
-/// normalised outputs the component was built on.
-pub(crate) fn log_predictive(component: &Component, diagonal: &[f64]) -> Vec<f64> {
-    let ln_2pi = (2.0 * std::f64::consts::PI).ln();
-    (0..component.alpha.ncols())
-        .map(|c| {
-            diagonal
-                .iter()
-                .enumerate()
-                .map(|(i, &kii)| {
-                    let residual = component.alpha[(i, c)] / kii;
-                    0.5 * kii.ln() - 0.5 * residual * residual * kii - 0.5 * ln_2pi
-                })
-                .sum()
-        })
-        .collect()
-}
-
 impl ExactGp {
     /// Every training row predicted from the others in closed form (R&W Eqs. 5.10–5.12), the
     /// hyperparameters kept: what the training error hides when the GP interpolates.
@@ -65,11 +38,11 @@ impl ExactGp {
         let mut variance = Mat::zeros(n, m);
         let mut log_predictive_all = vec![0.0; m];
         for c in &self.components {
-            let diagonal = inverse_diagonal(c, par);
+            let diagonal = c.inverse_diagonal(par);
             if let Some(row) = diagonal.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
                 return Err(Error::LeaveOneOutFailed { size: n, row, value: diagonal[row] });
             }
-            let lp = log_predictive(c, &diagonal);
+            let lp = c.log_predictive(&diagonal);
             for (k, &out) in c.outputs.iter().enumerate() {
                 let (mu, s) = (self.outputs.mean[out], self.outputs.scale[out]);
                 log_predictive_all[out] = lp[k];

@@ -121,3 +121,10 @@ impl Mul for SE3 {
         self.compose(&rhs)
     }
 }
+
+impl Twist {
+    /// The exponential map to SE(3).
+    pub fn exp(&self) -> SE3 {
+        SE3::exp(self)
+    }
+}

@@ -1,6 +1,6 @@
 //! se(3): twists, the tangent space of SE(3), ordered `(v, ω)`.
 
-use crate::{Matrix4, Matrix6, SE3, SO3, Vector3, Vector6};
+use crate::{Matrix4, Matrix6, SO3, Vector3, Vector6};
 use serde::{Deserialize, Serialize};
 use std::ops::{Add, Mul, Neg, Sub};
 
@@ -56,11 +56,6 @@ impl Twist {
         m.fixed_view_mut::<3, 3>(0, 3).copy_from(&SO3::hat(&self.v));
         m.fixed_view_mut::<3, 3>(3, 3).copy_from(&w);
         m
-    }
-
-    /// The exponential map to SE(3).
-    pub fn exp(&self) -> SE3 {
-        SE3::exp(self)
     }
 }
 

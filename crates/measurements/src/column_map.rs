@@ -1,7 +1,7 @@
 //! `--columns NAME=HEADER,…`: any other header mapped onto the SPEC's column names (SPEC v2), so
 //! that a tracker export is read as it comes. Units stay explicit: the target names carry them.
 
-use super::layout::quantity;
+use super::quantity::quantity;
 pub use errors::ColumnMapFault;
 use errors::Error;
 use std::fmt;

@@ -24,6 +24,7 @@ mod input_files;
 mod layout;
 mod outliers;
 mod output_file;
+mod quantity;
 mod row;
 mod writer;
 pub use input_files::InputFiles;

@@ -1,8 +1,8 @@
 //! A calibrated model: the identified kinematics, the effects identified with them, the optional
 //! residual GP, and prediction by walking them in order (module `model_parts`).
 
+use crate::Method;
 use crate::model_parts::{Part, Walk};
-use crate::{Method, PoseError};
 use effects::IdentifiedEffect;
 use errors::Error;
 use lie::SE3;
@@ -245,13 +245,5 @@ impl CalibratedModel {
                 })
             })
             .collect()
-    }
-}
-
-/// The error of a prediction against a measured row.
-pub fn pose_error(predicted: &SE3, row: &Measurement) -> PoseError {
-    PoseError {
-        position_mm: (row.position - predicted.translation()).norm() * 1e3,
-        rotation_mrad: row.orientation.map(|measured| (measured * predicted.rotation().inverse()).log().norm() * 1e3),
     }
 }

@@ -43,11 +43,11 @@ mod residual_gp;
 mod training_range;
 pub use evaluate::{Evaluation, evaluate, tool_indices};
 
-pub use calibrated::{CalibratedModel, ExtrapolationWarning, PredictedPose, pose_error};
+pub use calibrated::{CalibratedModel, ExtrapolationWarning, PredictedPose};
 pub use eval_report::{CoverageSplit, EvalReport, ORIENTATIONS_NOT_EVALUATED};
 pub use joint_limits::{BeyondLimitsWarning, beyond_limits, stored_limits};
 pub use method::{Method, UnknownMethod};
-pub use metrics::{ErrorSummary, PoseError};
+pub use metrics::{ErrorSummary, PoseError, pose_error};
 pub use model_file::{SCHEMA_VERSION, model_text, parse_model, read_model, write_model};
 pub use model_parts::Part;
 pub use residual_gp::{

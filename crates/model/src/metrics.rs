@@ -1,5 +1,7 @@
 //! Accuracy metrics of a calibrated model on measurements.
 
+use lie::SE3;
+use measurements::Measurement;
 use serde::{Deserialize, Serialize};
 
 /// The error of one measured pose: distance and rotation angle between measured and predicted.
@@ -56,6 +58,14 @@ impl ErrorSummary {
             mean_rotation_error_mrad: full_pose.then(|| rotations.iter().sum::<f64>() / count),
             max_rotation_error_mrad: full_pose.then(|| rotations.iter().copied().fold(0.0, f64::max)),
         }
+    }
+}
+
+/// The error of a prediction against a measured row.
+pub fn pose_error(predicted: &SE3, row: &Measurement) -> PoseError {
+    PoseError {
+        position_mm: (row.position - predicted.translation()).norm() * 1e3,
+        rotation_mrad: row.orientation.map(|measured| (measured * predicted.rotation().inverse()).log().norm() * 1e3),
     }
 }
 
