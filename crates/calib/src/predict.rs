@@ -41,43 +41,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     for warning in model.beyond_joint_limits(&data.rows) {
         eprintln!("warning: {warning}");
     }
-    let stdout = std::io::stdout();
-    let mut out = csv::Writer::from_writer(stdout.lock());
-    // The GP's standard deviation, and that of what the effects leave where they fade out.
-    let gp = model.predicts_std();
-    let mut header: Vec<&str> = vec!["line", "x_mm", "y_mm", "z_mm"];
-    if model.full_pose {
-        header.extend(["qw", "qx", "qy", "qz"]);
-    }
-    if gp {
-        header.extend(["std_x_mm", "std_y_mm", "std_z_mm"]);
-        if model.full_pose {
-            header.extend(["std_rx_mrad", "std_ry_mrad", "std_rz_mrad"]);
-        }
-    }
-    if data.positions_measured {
-        header.push("error_mm");
-    }
-    out.write_record(&header)?;
-    for (row, prediction) in data.rows.iter().zip(&predictions) {
-        let p = prediction.pose.translation() * 1e3;
-        let mut record =
-            vec![row.line.to_string(), format!("{:.6}", p.x), format!("{:.6}", p.y), format!("{:.6}", p.z)];
-        if model.full_pose {
-            record.extend(prediction.pose.rotation().to_quaternion().iter().map(|v| format!("{v:.9}")));
-        }
-        if let Some(std) = prediction.std {
-            record.extend(std[..3].iter().map(|s| format!("{:.6}", s * 1e3)));
-            if model.full_pose {
-                record.extend(std[3..].iter().map(|s| format!("{:.6}", s * 1e3)));
-            }
-        }
-        if data.positions_measured {
-            record.push(format!("{:.6}", (row.position - prediction.pose.translation()).norm() * 1e3));
-        }
-        out.write_record(&record)?;
-    }
-    out.flush()?;
+    pipeline::write_predictions(std::io::stdout().lock(), "stdout", &model, &data, &predictions)?;
     std::io::stdout().flush()?;
     eprintln!("{}", data.read_summary());
     Ok(())

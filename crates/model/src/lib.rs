@@ -39,9 +39,11 @@ mod metrics;
 mod model_check;
 mod model_file;
 mod model_parts;
+mod predictions;
 mod residual_gp;
 mod training_range;
 pub use evaluate::{Evaluation, evaluate, tool_indices};
+pub use predictions::write_predictions;
 
 pub use calibrated::{CalibratedModel, ExtrapolationWarning, PredictedPose};
 pub use eval_report::{CoverageSplit, EvalReport, ORIENTATIONS_NOT_EVALUATED};
