@@ -15,6 +15,7 @@ mod blind_check_cases;
 mod box_plot;
 mod compensate_check;
 mod convert_ur10;
+mod deps;
 mod fuzz;
 mod fuzz_inputs;
 mod fuzz_seeds;
@@ -65,6 +66,8 @@ enum Command {
     Fuzz(fuzz::Args),
     /// The Rust version Cargo.lock needs, checked against Cargo.toml and the README.
     Msrv(msrv::Args),
+    /// The crate graph with lines per crate; fails on a crate above the line budget or a circle of crates or modules.
+    Deps(deps::Args),
     /// One fuzz worker (started by `fuzz`).
     #[command(hide = true)]
     FuzzWorker(fuzz_worker::Args),
@@ -89,6 +92,7 @@ fn main() -> ExitCode {
         Command::CompensateCheck(args) => compensate_check::run(args).map_err(|e| format!("{e:#}")),
         Command::Fuzz(args) => fuzz::run(args).map_err(|e| format!("{e:#}")),
         Command::Msrv(args) => msrv::run(args).map_err(|e| format!("{e:#}")),
+        Command::Deps(args) => deps::run(args).map_err(|e| format!("{e:#}")),
         Command::FuzzWorker(args) => fuzz_worker::run(args).map_err(|e| format!("{e:#}")),
     };
     match result {

@@ -39,7 +39,6 @@ mod exact;
 mod gram;
 mod inducing;
 mod kernel;
-mod lbfgsb;
 mod lml;
 mod loo;
 mod optimise;

@@ -17,9 +17,9 @@ use crate::Error;
 use crate::config::{OptimiserConfig, Parallelism};
 use crate::inducing::random_indices;
 use crate::kernel::{Bounds, Kernel};
-use crate::lbfgsb::{self, Objective, Settings, Termination};
 use crate::lml::{Workspace, evaluate_gradient, evaluate_value};
 use crate::points::Points;
+use lbfgsb::{Objective, Settings, Termination};
 
 /// What the hyperparameter search did, for one kernel.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -24,10 +24,10 @@ use crate::exact::{ComponentReport, ExactGp, validate_training_data};
 use crate::gram::{cross_covariance, full_covariance, prior_variances, training_covariance};
 use crate::inducing::{InducingSelection, random_indices, select_inducing};
 use crate::kernel::Kernel;
-use crate::lbfgsb::{self, Objective, Settings, Termination};
 use crate::points::Points;
 use crate::predict::{PredictOptions, Prediction};
 use crate::scaling::{InputStandardiser, OutputNormaliser};
+use lbfgsb::{Objective, Settings, Termination};
 
 /// Configuration of the sparse approximation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

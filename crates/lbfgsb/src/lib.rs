@@ -7,12 +7,16 @@
 //! the Fortran L-BFGS-B need a Fortran toolchain. The tests check it on bounded quadratics with a
 //! known answer and on the Rosenbrock function.
 
+#![deny(missing_docs)]
+
 use std::collections::VecDeque;
 
 /// Stopping rules and memory.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Settings {
+pub struct Settings {
+    /// Curvature pairs kept.
     pub memory: usize,
+    /// Most iterations.
     pub max_iterations: usize,
     /// On `max |P(x − g) − x|`, scipy's `pgtol`.
     pub gradient_tolerance: f64,
@@ -22,23 +26,31 @@ pub(crate) struct Settings {
 
 /// Why the iteration stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Termination {
+pub enum Termination {
+    /// The projected gradient met `gradient_tolerance`.
     GradientTolerance,
+    /// The relative decrease met `function_tolerance`.
     FunctionTolerance,
+    /// `max_iterations` were taken.
     MaxIterations,
+    /// No step along the projected path decreased the objective.
     LineSearchFailed,
 }
 
 /// The best point found.
 #[derive(Debug, Clone)]
-pub(crate) struct Minimum {
+pub struct Minimum {
+    /// The point.
     pub x: Vec<f64>,
+    /// The objective there.
     pub f: f64,
+    /// Iterations taken.
     pub iterations: usize,
     /// Objective values computed (every trial point of the line searches).
     pub evaluations: usize,
     /// Gradients computed (accepted points only).
     pub gradients: usize,
+    /// Why it stopped.
     pub termination: Termination,
     /// The curvature pairs held at the end, oldest first: a later search near this point can start
     /// from them ([`minimise_with`]).
@@ -47,8 +59,10 @@ pub(crate) struct Minimum {
 
 /// One curvature pair: a step `s` and the change `y` of the gradient along it.
 #[derive(Debug, Clone)]
-pub(crate) struct Pair {
+pub struct Pair {
+    /// The step.
     pub s: Vec<f64>,
+    /// The gradient's change along it.
     pub y: Vec<f64>,
 }
 
@@ -105,7 +119,7 @@ fn direction(g: &[f64], free: &[bool], history: &VecDeque<Pair>) -> Vec<f64> {
 
 /// A function to minimise, evaluated in two stages so that a line search that rejects a trial
 /// point does not pay for its gradient.
-pub(crate) trait Objective {
+pub trait Objective {
     /// `f(x)`, or `None` where it cannot be evaluated (e.g. a failed factorisation).
     fn value(&mut self, x: &[f64]) -> Option<f64>;
     /// `∇f` at the point of the last `value` call that returned `Some`.
@@ -121,7 +135,7 @@ pub(crate) struct Joint<F> {
 
 #[cfg(test)]
 impl<F: FnMut(&[f64]) -> Option<(f64, Vec<f64>)>> Joint<F> {
-    pub(crate) fn new(f: F) -> Self {
+    pub fn new(f: F) -> Self {
         Self { f, gradient: None }
     }
 }
@@ -142,7 +156,7 @@ impl<F: FnMut(&[f64]) -> Option<(f64, Vec<f64>)>> Objective for Joint<F> {
 ///
 /// Where the objective cannot be evaluated the line search backtracks. Returns `None` only if the
 /// (projected) start itself cannot be evaluated.
-pub(crate) fn minimise(
+pub fn minimise(
     objective: &mut impl Objective,
     start: &[f64],
     lower: &[f64],
@@ -157,7 +171,7 @@ pub(crate) fn minimise(
 /// quasi-Newton step rather than one down the gradient. Pairs from an earlier search of a similar
 /// function (the same likelihood on a subset of the rows, its `y` scaled to the full data) make
 /// the search start with that function's curvature.
-pub(crate) fn minimise_with(
+pub fn minimise_with(
     objective: &mut impl Objective,
     start: &[f64],
     lower: &[f64],

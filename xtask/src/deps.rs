@@ -1,0 +1,296 @@
+//! `cargo xtask deps`: the workspace's crate graph with the lines of each crate, and the checks
+//! issue 24 asks to keep true: no crate above a line budget, no circle between crates, and no
+//! module of a crate (or of xtask) that imports a module importing it back.
+//!
+//! A module's imports are its `crate::…` and `super::…` paths outside `#[cfg(test)]` blocks and
+//! comments, resolved to the longest module prefix; a name the crate root re-exports
+//! (`pub use module::{Name}`) resolves to the module that defines it, so a circle through the
+//! root's re-exports is found too.
+
+use anyhow::{Context, Result, bail};
+use regex::Regex;
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// Print the crate graph with lines per crate; fail on a module or crate circle or an oversized crate.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The most lines of Rust a crate's `src/` may hold. 5,000: issue 24's bound, where `pipeline`
+    /// had grown to 12,200 lines holding six concerns.
+    #[arg(long, default_value_t = 5000)]
+    max_lines: usize,
+}
+
+/// One crate of the workspace (or xtask).
+struct Crate {
+    name: String,
+    src: PathBuf,
+    /// Workspace crates it depends on (normal dependencies).
+    depends_on: BTreeSet<String>,
+    lines: usize,
+}
+
+pub fn run(args: &Args) -> Result<()> {
+    let root = crate::reproduce_sim::workspace_root();
+    let crates = workspace_crates(&root)?;
+    let names: BTreeSet<String> = crates.iter().map(|c| c.name.clone()).collect();
+    let mut failures = Vec::new();
+
+    println!("| crate | lines | depends on (workspace) |");
+    println!("| --- | ---: | --- |");
+    for c in &crates {
+        let deps: Vec<&str> = c.depends_on.iter().filter(|d| names.contains(*d)).map(String::as_str).collect();
+        println!("| `{}` | {} | {} |", c.name, c.lines, deps.join(", "));
+        if c.name != "xtask" && c.lines > args.max_lines {
+            failures.push(format!("crate {} has {} lines (at most {})", c.name, c.lines, args.max_lines));
+        }
+    }
+
+    let graph: BTreeMap<String, BTreeSet<String>> = crates
+        .iter()
+        .map(|c| (c.name.clone(), c.depends_on.iter().filter(|d| names.contains(*d)).cloned().collect()))
+        .collect();
+    for circle in circles(&graph) {
+        failures.push(format!("crates import each other: {}", circle.join(" <-> ")));
+    }
+    for c in &crates {
+        let modules = read_modules(&c.src)?;
+        for circle in circles(&module_graph(&modules)) {
+            failures.push(format!("{}: modules import each other: {}", c.name, circle.join(" <-> ")));
+        }
+    }
+    if failures.is_empty() {
+        println!("\nno crate above {} lines; no circle between crates or between the modules of one", args.max_lines);
+        return Ok(());
+    }
+    for failure in &failures {
+        eprintln!("{failure}");
+    }
+    bail!("{} problem(s) in the crate structure", failures.len())
+}
+
+/// Every member under `crates/`, and xtask, with its workspace dependencies and lines.
+fn workspace_crates(root: &Path) -> Result<Vec<Crate>> {
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(root.join("crates"))
+        .context("reading crates/")?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.join("Cargo.toml").is_file())
+        .collect();
+    dirs.sort();
+    dirs.push(root.join("xtask"));
+    let name_line = Regex::new(r#"(?m)^name\s*=\s*"([^"]+)""#)?;
+    let dependency = Regex::new(r"(?m)^([A-Za-z0-9_-]+)(?:\.workspace\s*=\s*true|\s*=)")?;
+    dirs.iter()
+        .map(|dir| {
+            let manifest = std::fs::read_to_string(dir.join("Cargo.toml"))
+                .with_context(|| format!("reading {}", dir.join("Cargo.toml").display()))?;
+            let name = name_line
+                .captures(&manifest)
+                .map(|c| c[1].to_owned())
+                .with_context(|| format!("{}: no package name", dir.display()))?;
+            // The `[dependencies]` section only: dev-dependencies may point anywhere.
+            let section = manifest.split("\n[").find(|s| s.starts_with("dependencies]")).unwrap_or("");
+            let depends_on = dependency.captures_iter(section).map(|c| c[1].to_owned()).collect();
+            let src = dir.join("src");
+            let lines = rust_files(&src)?
+                .iter()
+                .map(|f| std::fs::read_to_string(f).map(|t| t.lines().count()))
+                .sum::<std::io::Result<usize>>()?;
+            Ok(Crate { name, src, depends_on, lines })
+        })
+        .collect()
+}
+
+fn rust_files(dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).with_context(|| format!("reading {}", d.display()))? {
+            let path = entry?.path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    Ok(files)
+}
+
+/// Each module's path (`identify::solver`; the crate root is `""`) and its code without tests
+/// and comments.
+fn read_modules(src: &Path) -> Result<BTreeMap<String, String>> {
+    let comment = Regex::new(r"//[^\n]*")?;
+    rust_files(src)?
+        .into_iter()
+        .map(|file| {
+            let relative = file.strip_prefix(src)?.with_extension("");
+            let mut parts: Vec<String> = relative.iter().map(|p| p.to_string_lossy().into_owned()).collect();
+            if parts.last().is_some_and(|p| p == "mod" || p == "lib" || p == "main") {
+                parts.pop();
+            }
+            let text = std::fs::read_to_string(&file)?;
+            let code = text.split("#[cfg(test)]").next().unwrap_or("");
+            Ok((parts.join("::"), comment.replace_all(code, "").into_owned()))
+        })
+        .collect()
+}
+
+/// Which module imports which.
+fn module_graph(modules: &BTreeMap<String, String>) -> BTreeMap<String, BTreeSet<String>> {
+    let crate_path = Regex::new(r"crate::((?:\w+::)*\w+)").expect("a valid pattern");
+    let crate_group = Regex::new(r"use crate::\{([^;]*)\};").expect("a valid pattern");
+    let super_path = Regex::new(r"super::((?:\w+::)*\w+)").expect("a valid pattern");
+    let super_group = Regex::new(r"use super::\{([^;]*)\};").expect("a valid pattern");
+    let path = Regex::new(r"\w+(?:::\w+)*").expect("a valid pattern");
+    let re_export = Regex::new(r"pub(?:\(crate\))? use (\w+)::(\{[^;]*?\}|\w+);").expect("a valid pattern");
+    let word = Regex::new(r"\w+").expect("a valid pattern");
+
+    // Names the crate root re-exports, and the module each comes from.
+    let mut exported: BTreeMap<String, String> = BTreeMap::new();
+    if let Some(root) = modules.get("") {
+        for c in re_export.captures_iter(root) {
+            if modules.contains_key(&c[1]) {
+                for name in word.find_iter(&c[2]) {
+                    exported.insert(name.as_str().to_owned(), c[1].to_owned());
+                }
+            }
+        }
+    }
+    let mut graph = BTreeMap::new();
+    for (module, code) in modules {
+        let parent = module.rsplit_once("::").map_or("", |(p, _)| p);
+        let from_super = |p: &str| if parent.is_empty() { p.to_owned() } else { format!("{parent}::{p}") };
+        let mut paths: Vec<String> = crate_path.captures_iter(code).map(|c| c[1].to_owned()).collect();
+        for group in crate_group.captures_iter(code) {
+            paths.extend(path.find_iter(&group[1]).map(|m| m.as_str().to_owned()));
+        }
+        if !module.is_empty() {
+            paths.extend(super_path.captures_iter(code).map(|c| from_super(&c[1])));
+            for group in super_group.captures_iter(code) {
+                paths.extend(path.find_iter(&group[1]).map(|m| from_super(m.as_str())));
+            }
+        }
+        let mut targets = BTreeSet::new();
+        for p in paths {
+            let segments: Vec<&str> = p.split("::").collect();
+            let found = (1..=segments.len())
+                .rev()
+                .map(|k| segments[..k].join("::"))
+                .find(|candidate| modules.contains_key(candidate))
+                .or_else(|| exported.get(segments[0]).cloned());
+            if let Some(target) = found
+                && !target.is_empty()
+                && target != *module
+                && !module.starts_with(&format!("{target}::"))
+            {
+                targets.insert(target);
+            }
+        }
+        graph.insert(module.clone(), targets);
+    }
+    graph
+}
+
+/// The strongly connected components of more than one node (Tarjan), each sorted.
+fn circles(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
+    struct State<'a> {
+        graph: &'a BTreeMap<String, BTreeSet<String>>,
+        index: BTreeMap<&'a str, usize>,
+        low: BTreeMap<&'a str, usize>,
+        stack: Vec<&'a str>,
+        on_stack: BTreeSet<&'a str>,
+        next: usize,
+        found: Vec<Vec<String>>,
+    }
+    fn visit<'a>(s: &mut State<'a>, v: &'a str) {
+        s.index.insert(v, s.next);
+        s.low.insert(v, s.next);
+        s.next += 1;
+        s.stack.push(v);
+        s.on_stack.insert(v);
+        let graph = s.graph;
+        for w in graph.get(v).into_iter().flatten() {
+            let w = w.as_str();
+            if !s.index.contains_key(w) {
+                visit(s, w);
+                let low = s.low[v].min(s.low[w]);
+                s.low.insert(v, low);
+            } else if s.on_stack.contains(w) {
+                let low = s.low[v].min(s.index[w]);
+                s.low.insert(v, low);
+            }
+        }
+        if s.low[v] == s.index[v] {
+            let mut component = Vec::new();
+            while let Some(w) = s.stack.pop() {
+                s.on_stack.remove(w);
+                component.push(w.to_owned());
+                if w == v {
+                    break;
+                }
+            }
+            if component.len() > 1 {
+                component.sort();
+                s.found.push(component);
+            }
+        }
+    }
+    let mut state = State {
+        graph,
+        index: BTreeMap::new(),
+        low: BTreeMap::new(),
+        stack: Vec::new(),
+        on_stack: BTreeSet::new(),
+        next: 0,
+        found: Vec::new(),
+    };
+    for v in graph.keys() {
+        if !state.index.contains_key(v.as_str()) {
+            visit(&mut state, v);
+        }
+    }
+    state.found
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn modules(items: &[(&str, &str)]) -> BTreeMap<String, String> {
+        items.iter().map(|(m, code)| ((*m).to_owned(), (*code).to_owned())).collect()
+    }
+
+    #[test]
+    fn a_circle_through_the_roots_re_exports_is_found() {
+        let m = modules(&[
+            ("", "mod a; mod b; pub use a::Alpha; pub use b::{Beta};"),
+            ("a", "use crate::Beta; pub struct Alpha;"),
+            ("b", "use crate::a::Alpha; pub struct Beta;"),
+        ]);
+        assert_eq!(circles(&module_graph(&m)), vec![vec!["a".to_owned(), "b".to_owned()]]);
+    }
+
+    #[test]
+    fn a_chain_and_a_child_using_its_parent_are_not_circles() {
+        let m = modules(&[
+            ("", "mod a; mod b; pub use a::Alpha;"),
+            ("a", "pub struct Alpha;"),
+            ("b", "use crate::Alpha; mod c;"),
+            ("b::c", "use super::Something;"),
+        ]);
+        assert!(circles(&module_graph(&m)).is_empty());
+    }
+
+    #[test]
+    fn super_paths_resolve_against_the_parent() {
+        let m = modules(&[
+            ("", "mod p;"),
+            ("p", "mod x; mod y;"),
+            ("p::x", "use super::y::Y;"),
+            ("p::y", "use super::x::X;"),
+        ]);
+        assert_eq!(circles(&module_graph(&m)), vec![vec!["p::x".to_owned(), "p::y".to_owned()]]);
+    }
+}
