@@ -6,6 +6,7 @@ mod diagnose;
 mod eval;
 mod export;
 mod fit;
+mod plan;
 mod predict;
 mod register;
 mod robot_args;
@@ -32,6 +33,7 @@ enum Command {
     Export(export::Args),
     Compensate(compensate::Args),
     Register(register::Args),
+    Plan(plan::Args),
 }
 
 fn main() -> ExitCode {
@@ -66,6 +68,7 @@ fn main() -> ExitCode {
         Command::Export(args) => export::run(&args),
         Command::Compensate(args) => compensate::run(&args),
         Command::Register(args) => register::run(&args),
+        Command::Plan(args) => plan::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -10,6 +10,8 @@ pub enum Error {
     Pipeline(pipeline::Error),
     /// A kinematics error from `poe`.
     Kinematics(poe::Error),
+    /// The candidate generator's error.
+    Generator(loadsim::Error),
     /// Too few poses for what is re-fitted: `rows` residual rows for `parameters` parameters,
     /// `needed` rows wanted (or too few poses of one tool).
     TooFewPoses {
@@ -80,6 +82,7 @@ impl fmt::Display for Error {
         match self {
             Error::Pipeline(e) => write!(f, "{e}"),
             Error::Kinematics(e) => write!(f, "{e}"),
+            Error::Generator(e) => write!(f, "{e}"),
             Error::TooFewPoses { what, poses, needed_poses, rows, parameters } => write!(
                 f,
                 "too few poses for {what}: {poses} poses ({rows} residual rows) for {parameters} re-fitted \
@@ -122,5 +125,11 @@ impl From<pipeline::Error> for Error {
 impl From<poe::Error> for Error {
     fn from(e: poe::Error) -> Self {
         Error::Kinematics(e)
+    }
+}
+
+impl From<loadsim::Error> for Error {
+    fn from(e: loadsim::Error) -> Self {
+        Error::Generator(e)
     }
 }

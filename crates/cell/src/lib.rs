@@ -32,13 +32,23 @@
 //! ```
 #![deny(missing_docs)]
 
+mod candidates;
+mod coverage;
+mod design;
 mod error;
+mod information;
 mod model_text;
+mod plan;
 mod register;
 pub mod registration;
 mod report;
 
 pub use error::Error;
+pub use candidates::{CandidateSet, file_candidates, generated_candidates, write_chosen_rows, write_generated_rows};
+pub use coverage::AxisCoverage;
+pub use design::Criterion;
+pub use information::Candidate;
 pub use model_text::checked_model_text;
+pub use plan::{Checkpoint, Plan, PlanOptions, PlanReport, measuring_order, plan};
 pub use register::{Refit, RegisterOptions, Registered, register};
 pub use report::{FrameChange, RegisterReport, RegisterWarning, RegisteredTool, Verdict};
