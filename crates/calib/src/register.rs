@@ -35,7 +35,10 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    pipeline::InputFiles::new().with("--model", &args.model).with("--data", &args.data).check_output("--out", &args.out)?;
+    pipeline::InputFiles::new()
+        .with("--model", &args.model)
+        .with("--data", &args.data)
+        .check_output("--out", &args.out)?;
     let model = pipeline::read_model(&args.model)?;
     let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
     let data = pipeline::read_measurements(&args.data, &options)?;

@@ -112,8 +112,7 @@ fn register_carries_a_model_to_a_moved_tracker() {
     assert!(stdout.contains("\"verdict\":\"consistent\""), "{stdout}");
     assert!((json_number(&stdout, "angle_deg") - 90.0).abs() < 0.05, "{stdout}");
     let eval = |model: &Path, data: &Path| {
-        let (json, _) =
-            succeeds_with_stderr(&["eval", "--model", &text(model), "--data", &text(data), "--json"]);
+        let (json, _) = succeeds_with_stderr(&["eval", "--model", &text(model), "--data", &text(data), "--json"]);
         json_number(&json, "mean_position_error_mm")
     };
     let before = eval(&model, &original_rest);
@@ -143,11 +142,8 @@ fn register_refuses_a_new_tool_unless_tools_are_refitted() {
     let few = dir.path().join("few.csv");
     moved(&data, &few, 150..170);
     let content = std::fs::read_to_string(&few).unwrap();
-    let tooled: Vec<String> = content
-        .lines()
-        .enumerate()
-        .map(|(i, l)| format!("{l},{}", if i == 0 { "tool" } else { "probe2" }))
-        .collect();
+    let tooled: Vec<String> =
+        content.lines().enumerate().map(|(i, l)| format!("{l},{}", if i == 0 { "tool" } else { "probe2" })).collect();
     std::fs::write(&few, tooled.join("\n") + "\n").unwrap();
     let out = dir.path().join("moved.ron");
     let message = fails(&["register", "--model", &text(&model), "--data", &text(&few), "--out", &text(&out)]);
@@ -224,8 +220,11 @@ fn plan_writes_chosen_candidate_rows_unchanged() {
 fn plan_refuses_more_poses_than_candidates_with_the_counts() {
     let dir = tempfile::tempdir().unwrap();
     let candidates = dir.path().join("candidates.csv");
-    std::fs::write(&candidates, "q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad\n0.1,0.2,0.3,0.4,0.5,0.6\n0.2,0.1,0.0,0.4,0.5,0.6\n")
-        .unwrap();
+    std::fs::write(
+        &candidates,
+        "q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad\n0.1,0.2,0.3,0.4,0.5,0.6\n0.2,0.1,0.0,0.4,0.5,0.6\n",
+    )
+    .unwrap();
     let chosen = dir.path().join("chosen.csv");
     let message = fails(&[
         "plan",

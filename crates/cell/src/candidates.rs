@@ -1,8 +1,8 @@
 //! The candidates of `calib plan`: read from a measurement-like CSV (every cell kept, so that the
 //! chosen rows are written unchanged), or generated within the robot's joint limits.
 
-use crate::information::Candidate;
 use crate::Error;
+use crate::information::Candidate;
 use pipeline::{CalibratedModel, Cells, MeasurementSet, RobotDescription};
 use poe::{JointKind, LocalPoe};
 use std::io::Write;
@@ -55,7 +55,11 @@ pub fn file_candidates(
     let candidates = set
         .rows
         .iter()
-        .map(|r| Candidate { q: r.q.clone(), tool: tool_of.get(r.tool).copied().unwrap_or(0), payload_kg: r.payload_kg })
+        .map(|r| Candidate {
+            q: r.q.clone(),
+            tool: tool_of.get(r.tool).copied().unwrap_or(0),
+            payload_kg: r.payload_kg,
+        })
         .collect();
     Ok(CandidateSet { model: kinematics, candidates, unknown_tools })
 }

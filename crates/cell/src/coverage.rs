@@ -23,10 +23,8 @@ impl Axis {
         let low = values.iter().copied().fold(f64::INFINITY, f64::min);
         let high = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let width = (high - low) / bins as f64;
-        let bin = values
-            .iter()
-            .map(|v| if width > 0.0 { (((v - low) / width) as usize).min(bins - 1) } else { 0 })
-            .collect();
+        let bin =
+            values.iter().map(|v| if width > 0.0 { (((v - low) / width) as usize).min(bins - 1) } else { 0 }).collect();
         Self { name, bin, bins }
     }
 
@@ -68,8 +66,8 @@ pub fn cover(design: &mut Design<'_>, axes: &[Axis]) -> usize {
         let mut swapped = false;
         for axis in axes {
             let present = axis.present();
-            for bin in 0..axis.bins {
-                if !present[bin] || axis.counts(design.chosen())[bin] > 0 {
+            for (bin, &present) in present.iter().enumerate() {
+                if !present || axis.counts(design.chosen())[bin] > 0 {
                     continue;
                 }
                 let Some((incoming, _)) = design.best(|c| axis.bin[c] == bin) else { continue };

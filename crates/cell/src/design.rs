@@ -34,6 +34,20 @@ fn cholesky(m: &mut [f64], k: usize) -> Option<f64> {
     Some(log_det)
 }
 
+/// `a · b` in four running sums, which the compiler can keep in vector registers (one sum is a
+/// chain of dependent additions it may not reorder): the candidates' update is these products.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut sums = [0.0; 4];
+    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = a4.remainder().iter().zip(b4.remainder()).map(|(x, y)| x * y).sum();
+    for (x, y) in a4.zip(b4) {
+        for l in 0..4 {
+            sums[l] += x[l] * y[l];
+        }
+    }
+    (sums[0] + sums[1]) + (sums[2] + sums[3]) + tail
+}
+
 /// `log det(I + sign · G)` of a `k × k` block, `-∞` where not positive definite.
 fn log_det_shifted(g: &[f64], k: usize, sign: f64) -> f64 {
     let mut m = [0.0; 36];
@@ -381,12 +395,20 @@ impl<'a> Design<'a> {
             (Vec::new(), [0.0; 36])
         };
         let rows = self.rows;
+        // Wᵀ and Zᵀ (k × r), so that every product below is a dot product of contiguous rows.
+        let transpose = |x: &[f64]| -> Vec<f64> {
+            if x.is_empty() {
+                return Vec::new();
+            }
+            (0..k * r).map(|at| x[(at % r) * k + at / r]).collect()
+        };
+        let (wt, zt) = (transpose(&w), transpose(&z));
         let update_one = |c: usize, g: &mut [f64], f: Option<&mut [f64]>| {
             let a = rows.rows(c);
             let mut h = [0.0; 36];
             for i in 0..k {
                 for j in 0..k {
-                    h[i * k + j] = (0..r).map(|m| a[i * r + m] * w[m * k + j]).sum();
+                    h[i * k + j] = dot(&a[i * r..(i + 1) * r], &wt[j * r..(j + 1) * r]);
                 }
             }
             for i in 0..k {
@@ -399,7 +421,7 @@ impl<'a> Design<'a> {
                 let mut e = [0.0; 36];
                 for i in 0..k {
                     for j in 0..k {
-                        e[i * k + j] = (0..r).map(|m| a[i * r + m] * z[m * k + j]).sum();
+                        e[i * k + j] = dot(&a[i * r..(i + 1) * r], &zt[j * r..(j + 1) * r]);
                     }
                 }
                 let mut ht = [0.0; 36];
@@ -410,7 +432,8 @@ impl<'a> Design<'a> {
                 }
                 for i in 0..k {
                     for j in 0..k {
-                        let cross: f64 = (0..k).map(|m| h[i * k + m] * e[j * k + m] + e[i * k + m] * h[j * k + m]).sum();
+                        let cross: f64 =
+                            (0..k).map(|m| h[i * k + m] * e[j * k + m] + e[i * k + m] * h[j * k + m]).sum();
                         let quad: f64 = (0..k).map(|m| ht[i * k + m] * h[j * k + m]).sum();
                         f[i * k + j] += -sign * cross + quad;
                     }
@@ -429,11 +452,7 @@ impl<'a> Design<'a> {
     }
 
     fn refresh_with(&mut self, s: usize, sign: f64) {
-        if sign > 0.0 {
-            self.in_design[s] = true;
-        } else {
-            self.in_design[s] = false;
-        }
+        self.in_design[s] = sign > 0.0;
         self.refresh();
     }
 
@@ -484,7 +503,8 @@ impl<'a> Design<'a> {
     /// and its largest value.
     pub fn predicted_variance(&self, rows: usize) -> (f64, f64) {
         let k = self.rows.k;
-        let traces: Vec<f64> = (0..self.rows.len()).map(|c| (0..rows).map(|i| self.variance(c)[i * k + i]).sum()).collect();
+        let traces: Vec<f64> =
+            (0..self.rows.len()).map(|c| (0..rows).map(|i| self.variance(c)[i * k + i]).sum()).collect();
         let mean = traces.iter().sum::<f64>() / traces.len().max(1) as f64;
         (mean, traces.iter().copied().fold(0.0, f64::max))
     }

@@ -65,7 +65,11 @@ pub struct RowWeights {
 }
 
 /// Builds every candidate's reduced rows.
-pub fn candidate_rows(model: &LocalPoe, candidates: &[Candidate], weights: &RowWeights) -> Result<CandidateRows, Error> {
+pub fn candidate_rows(
+    model: &LocalPoe,
+    candidates: &[Candidate],
+    weights: &RowWeights,
+) -> Result<CandidateRows, Error> {
     let kind = if weights.rotation_rad.is_some() { RowKind::PointAndRotation } else { RowKind::Position };
     let k = kind.rows();
     let p = model.layout().len();

@@ -43,10 +43,10 @@ mod register;
 pub mod registration;
 mod report;
 
-pub use error::Error;
 pub use candidates::{CandidateSet, file_candidates, generated_candidates, write_chosen_rows, write_generated_rows};
 pub use coverage::AxisCoverage;
 pub use design::Criterion;
+pub use error::Error;
 pub use information::Candidate;
 pub use model_text::checked_model_text;
 pub use plan::{Checkpoint, Plan, PlanOptions, PlanReport, measuring_order, plan};

@@ -7,9 +7,10 @@ use pipeline::CalibratedModel;
 /// `pipeline::parse_model` (every check a reader runs), so that no file is written that a reader
 /// refuses; `file` names it in errors.
 pub fn checked_model_text(model: &CalibratedModel, file: &str) -> Result<String, Error> {
-    let mut text = ron::ser::to_string_pretty(model, ron::ser::PrettyConfig::default().depth_limit(6)).map_err(|e| {
-        pipeline::Error::RonFormat { file: file.to_owned(), line: 1, column: 1, message: e.to_string() }
-    })?;
+    let mut text =
+        ron::ser::to_string_pretty(model, ron::ser::PrettyConfig::default().depth_limit(6)).map_err(|e| {
+            pipeline::Error::RonFormat { file: file.to_owned(), line: 1, column: 1, message: e.to_string() }
+        })?;
     text.push('\n');
     pipeline::parse_model(&text, file)?;
     Ok(text)

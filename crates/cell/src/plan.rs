@@ -6,10 +6,10 @@
 //! the shortest joint move next); reported with the predicted error at the chosen count and at a
 //! few others, so that the user sees where more poses stop paying.
 
+use crate::Error;
 use crate::coverage::{Axis, AxisCoverage, cover, coverage};
 use crate::design::{Criterion, Design};
 use crate::information::{Candidate, RowWeights, candidate_rows};
-use crate::Error;
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
 
@@ -204,7 +204,13 @@ pub struct Plan {
     pub report: PlanReport,
 }
 
-fn checkpoint(design: &Design<'_>, directions: usize, chosen: bool, options: &PlanOptions, full_pose: bool) -> Checkpoint {
+fn checkpoint(
+    design: &Design<'_>,
+    directions: usize,
+    chosen: bool,
+    options: &PlanOptions,
+    full_pose: bool,
+) -> Checkpoint {
     let (mean, max) = design.predicted_variance(3);
     let sigma = options.position_noise_mm;
     Checkpoint {
@@ -319,17 +325,17 @@ pub fn measuring_order(candidates: &[Candidate], chosen: &[usize]) -> Vec<usize>
     for group in groups {
         let mut left: Vec<usize> = sorted.iter().copied().filter(|&c| key(c) == group).collect();
         let mut current = match order.last() {
-            Some(&last) => left
-                .iter()
-                .copied()
-                .min_by(|&a, &b| distance(last, a).total_cmp(&distance(last, b)))
-                .unwrap_or(left[0]),
+            Some(&last) => {
+                left.iter().copied().min_by(|&a, &b| distance(last, a).total_cmp(&distance(last, b))).unwrap_or(left[0])
+            }
             None => left[0],
         };
         while !left.is_empty() {
             left.retain(|&c| c != current);
             order.push(current);
-            if let Some(next) = left.iter().copied().min_by(|&a, &b| distance(current, a).total_cmp(&distance(current, b))) {
+            if let Some(next) =
+                left.iter().copied().min_by(|&a, &b| distance(current, a).total_cmp(&distance(current, b)))
+            {
                 current = next;
             }
         }
@@ -376,7 +382,8 @@ mod tests {
             rank_tolerance: options.rank_tolerance,
         };
         let rows = candidate_rows(model, all, &weights).unwrap();
-        let prior = options.prior_fraction * rows.a.iter().map(|v| v * v).sum::<f64>() / all.len() as f64 / rows.r as f64;
+        let prior =
+            options.prior_fraction * rows.a.iter().map(|v| v * v).sum::<f64>() / all.len() as f64 / rows.r as f64;
         let mut design = Design::new(&rows, prior, Criterion::D);
         for &c in chosen {
             design.add(c);

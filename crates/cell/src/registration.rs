@@ -208,8 +208,12 @@ pub fn register_rows(
 }
 
 fn start(rows: &[RegistrationRow], unknowns: Unknowns, options: &RegistrationOptions) -> Registration {
-    let mut fit =
-        Registration { frame: SE3::identity(), tools: vec![SE3::identity(); unknowns.tools], iterations: 0, rms_m: 0.0 };
+    let mut fit = Registration {
+        frame: SE3::identity(),
+        tools: vec![SE3::identity(); unknowns.tools],
+        iterations: 0,
+        rms_m: 0.0,
+    };
     let rounds = if unknowns.frame && unknowns.tools > 0 { options.alternations.max(1) } else { 1 };
     for _ in 0..rounds {
         if unknowns.frame {
@@ -229,7 +233,12 @@ fn start(rows: &[RegistrationRow], unknowns: Unknowns, options: &RegistrationOpt
             }
             let point = mine
                 .iter()
-                .map(|r| r.predicted.rotation().inverse().act(&(inverse.transform_point(&r.point) - r.predicted.translation())))
+                .map(|r| {
+                    r.predicted
+                        .rotation()
+                        .inverse()
+                        .act(&(inverse.transform_point(&r.point) - r.predicted.translation()))
+                })
                 .sum::<Vector3>()
                 / mine.len() as f64;
             let rotation = if unknowns.tool_rotations {
@@ -248,7 +257,11 @@ fn start(rows: &[RegistrationRow], unknowns: Unknowns, options: &RegistrationOpt
 }
 
 /// Residual rows of one row: the point (m), then the weighted rotation `w log(R Rₘᵀ)` where measured.
-fn row_residual(row: &RegistrationRow, fit: &Registration, options: &RegistrationOptions) -> (Vector3, Option<Vector3>) {
+fn row_residual(
+    row: &RegistrationRow,
+    fit: &Registration,
+    options: &RegistrationOptions,
+) -> (Vector3, Option<Vector3>) {
     let pose = fit.pose(row);
     let point = pose.translation() - row.point;
     let rotation = row.rotation.map(|m| (pose.rotation() * m.inverse()).log() * options.rotation_weight_m_per_rad);
@@ -366,7 +379,11 @@ mod tests {
 
     fn random_pose(rng: &mut ChaCha8Rng, reach: f64) -> SE3 {
         let w = Vector3::new(rng.random_range(-1.5..1.5), rng.random_range(-1.5..1.5), rng.random_range(-1.5..1.5));
-        let t = Vector3::new(rng.random_range(-reach..reach), rng.random_range(-reach..reach), rng.random_range(0.0..reach));
+        let t = Vector3::new(
+            rng.random_range(-reach..reach),
+            rng.random_range(-reach..reach),
+            rng.random_range(0.0..reach),
+        );
         SE3::new(SO3::exp(&w), t)
     }
 
@@ -375,8 +392,12 @@ mod tests {
         (0..count)
             .map(|i| {
                 let slot = (tools > 0).then(|| i % tools);
-                let mut row =
-                    RegistrationRow { predicted: random_pose(&mut rng, 1.0), point: Vector3::zeros(), rotation: None, slot };
+                let mut row = RegistrationRow {
+                    predicted: random_pose(&mut rng, 1.0),
+                    point: Vector3::zeros(),
+                    rotation: None,
+                    slot,
+                };
                 let pose = truth.pose(&row);
                 row.point = pose.translation();
                 row.rotation = full_pose.then(|| pose.rotation());
@@ -426,6 +447,17 @@ mod tests {
     }
 
     #[test]
+    fn recovers_a_known_frame_and_a_new_tool_point_from_positions() {
+        let tool = SE3::from_translation(Vector3::new(0.06, -0.05, 0.06));
+        let truth = Registration { frame: moved(), tools: vec![tool], iterations: 0, rms_m: 0.0 };
+        let data = rows(&truth, 20, false, 1, 6);
+        let unknowns = Unknowns { frame: true, tools: 1, tool_rotations: false };
+        let fit = register_rows(&data, unknowns, &RegistrationOptions::default()).unwrap();
+        assert!((fit.frame * truth.frame.inverse()).log().to_vector().norm() < 1e-9, "{fit:?}");
+        assert!((fit.tools[0].translation() - tool.translation()).norm() < 1e-9);
+    }
+
+    #[test]
     fn collinear_points_are_refused_as_undetermined() {
         let data: Vec<RegistrationRow> = (0..10)
             .map(|i| {
@@ -446,7 +478,9 @@ mod tests {
             iterations: 0,
             rms_m: 0.0,
         };
-        let data = rows(&truth, 5, true, 1, 4);
+        let mut data = rows(&truth, 5, true, 1, 4);
+        // Position-only rows too, where the tool's rotation is not a parameter.
+        data.extend(rows(&truth, 3, false, 1, 7));
         // Linearise away from the solution, where the rotation residuals are not small.
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let at = Registration {

@@ -1,9 +1,11 @@
 //! What `calib register` reports (`--json`: [`RegisterReport`], additive to the SPEC's JSON).
 
+use crate::Error;
 use crate::register::{Refit, RegisterOptions};
 use crate::registration::Registration;
-use crate::Error;
-use pipeline::{BeyondLimitsWarning, CalibratedModel, ErrorSummary, ExtrapolationWarning, MeasurementSet, OutOfRangeWarning};
+use pipeline::{
+    BeyondLimitsWarning, CalibratedModel, ErrorSummary, ExtrapolationWarning, MeasurementSet, OutOfRangeWarning,
+};
 use serde::Serialize;
 use std::fmt;
 
@@ -27,6 +29,10 @@ pub enum RegisterWarning {
     DriftInOldFrame,
     /// Position-only data gave a new tool its point only: its orientation is that of the model's first tool.
     NewToolOrientationUnknown,
+    /// The model was fitted on positions only, so it knows the flange's orientation only as far
+    /// as its tool point shows it: a new or moved tool point is predicted with that orientation's
+    /// error times the offset (millimetres for a 10 cm offset on the simulated IRB 4400).
+    PositionModelToolPoint,
     /// The model was fitted on positions only: the data's orientations were not used.
     OrientationsIgnored,
 }
@@ -41,6 +47,11 @@ impl fmt::Display for RegisterWarning {
             Self::NewToolOrientationUnknown => {
                 "position-only data fix a new tool's point only: its orientation is taken as the model's first \
                  tool's, and predicted orientations for it are not calibrated"
+            }
+            Self::PositionModelToolPoint => {
+                "the model was fitted on positions only and knows the flange's orientation only as far as its tool \
+                 point shows it: a new or moved tool point is predicted with that orientation's error times the \
+                 offset; calibrate with full poses (or with this tool) to carry tools over"
             }
             Self::OrientationsIgnored => {
                 "the model was fitted on positions only: the data's orientations were not used"

@@ -520,8 +520,13 @@ impl Compensation {
                 (GpModel::Exact(model), report, Some(loo.mean))
             }
         };
-        let compensation =
-            Self { with_payload, full_pose: data.full_pose, residual_frame: options.residual_frame, gp, moved_by: None };
+        let compensation = Self {
+            with_payload,
+            full_pose: data.full_pose,
+            residual_frame: options.residual_frame,
+            gp,
+            moved_by: None,
+        };
         let leave_one_out = leave_one_out.map(|mean| {
             let errors: Vec<crate::PoseError> = poses
                 .iter()
@@ -564,7 +569,8 @@ impl Compensation {
             _ => SE3::new(moved.rotation(), Vector3::zeros()).adjoint(),
         };
         let carried = adjoint * g;
-        let deviations = std::array::from_fn(|c| (0..6).map(|k| (adjoint[(c, k)] * std[k]).powi(2)).sum::<f64>().sqrt());
+        let deviations =
+            std::array::from_fn(|c| (0..6).map(|k| (adjoint[(c, k)] * std[k]).powi(2)).sum::<f64>().sqrt());
         (carried, deviations)
     }
 
