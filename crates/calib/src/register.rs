@@ -50,8 +50,12 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     if args.json {
         println!("{}", serde_json::to_string(report)?);
         eprintln!("{}", data.read_summary());
-        for line in report.lines().iter().skip(1).filter(|l| l.contains("warning") || l.contains("robot")) {
-            eprintln!("{}", line.trim_start());
+        eprintln!("{}", report.verdict_line());
+        let warnings = report.out_of_range.iter().map(ToString::to_string);
+        let warnings = warnings.chain(report.extrapolation.iter().map(ToString::to_string));
+        let warnings = warnings.chain(report.beyond_joint_limits.iter().map(ToString::to_string));
+        for warning in warnings.chain(report.warnings.iter().map(ToString::to_string)) {
+            eprintln!("warning: {warning}");
         }
     } else {
         println!("{}", data.read_summary());
