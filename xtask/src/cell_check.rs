@@ -123,6 +123,7 @@ fn scipy_reference(
     data: &MeasurementSet,
     path: &Path,
     picked: &[usize],
+    rotation_weight: f64,
 ) -> Result<Option<f64>> {
     let tools = pipeline::tool_indices(model, data)?;
     let predicted = model.predict(&data.rows, &tools)?;
@@ -143,6 +144,7 @@ fn scipy_reference(
         .arg(&file)
         .arg(path)
         .arg(lines.join(","))
+        .arg(rotation_weight.to_string())
         .output();
     let _ = std::fs::remove_dir_all(&dir);
     let Ok(out) = out else { return Ok(None) };
@@ -160,7 +162,7 @@ fn register_ur10(args: &Args, md: &mut String) -> Result<()> {
         "\n## UR10: fitted on series C, registered on 30 random rows of series D\n\n`poe` on all rows of C; its \
          held-out error (`poe` on the even rows of C, tested on the odd rows) is given as `--heldout-mm`. Registration \
          re-fits the base only; the SciPy column re-fits the same transform with `scipy.optimize.least_squares` on \
-         the same predictions (`xtask/scripts/register_scipy.py`).\n"
+         the same predictions and with the rotation weight registration ended with (`xtask/scripts/register_scipy.py`).\n"
     );
     let _ = writeln!(
         md,
@@ -188,7 +190,8 @@ fn register_ur10(args: &Args, md: &mut String) -> Result<()> {
             let registered =
                 cell::register(&model, &d.subset(&picked), refit, Some(heldout), &RegisterOptions::default())?;
             let ours = mean_error(&registered.model, &d.subset(&rest))?;
-            let reference = scipy_reference(&model, &d, &d_path, &picked)?;
+            let weight = registered.report.rotation_weight_m_per_rad;
+            let reference = scipy_reference(&model, &d, &d_path, &picked, weight)?;
             let _ = writeln!(
                 md,
                 "| {label} | {seed} | {heldout:.4} | {:.4} | {:?} | {ours:.4} | {} | {} |",

@@ -31,6 +31,15 @@ pub struct RegistrationOptions {
     /// Largest over smallest singular value of the column-scaled Jacobian beyond which the poses
     /// are said not to determine the parameters (1e8: half the digits of a double left).
     pub max_condition: f64,
+    /// Rounds of variance-component estimation (Helmert; Koch, *Parameter Estimation and
+    /// Hypothesis Testing in Linear Models*, 1999, §3.6) on full-pose rows: the rotation weight
+    /// re-set to the ratio of the position and rotation residuals' RMS, so that each kind counts
+    /// by what the model actually leaves in it, and the fit repeated. Two: the ratio settles
+    /// within a few per cent after the first. Zero keeps `rotation_weight_m_per_rad`.
+    pub weight_rounds: usize,
+    /// The estimated weight stays within this factor of `rotation_weight_m_per_rad` (100: a
+    /// model a hundred times worse in one kind than the other is not one to register).
+    pub max_weight_change: f64,
 }
 
 impl Default for RegistrationOptions {
@@ -41,6 +50,8 @@ impl Default for RegistrationOptions {
             max_iterations: 100,
             step_tolerance: 1e-12,
             max_condition: 1e8,
+            weight_rounds: 2,
+            max_weight_change: 100.0,
         }
     }
 }
@@ -52,6 +63,7 @@ impl RegistrationOptions {
             ("rotation_weight_m_per_rad", self.rotation_weight_m_per_rad),
             ("step_tolerance", self.step_tolerance),
             ("max_condition", self.max_condition),
+            ("max_weight_change", self.max_weight_change),
         ];
         for (field, value) in positive {
             if !(value.is_finite() && value > 0.0) {
@@ -112,6 +124,8 @@ pub struct Registration {
     pub iterations: usize,
     /// Weighted RMS residual per row component at the end, m.
     pub rms_m: f64,
+    /// The rotation rows' weight of the final fit, m/rad.
+    pub rotation_weight_m_per_rad: f64,
 }
 
 impl Registration {
@@ -145,14 +159,48 @@ fn kabsch(from: &[Vector3], to: &[Vector3]) -> SE3 {
     SE3::new(r, ct - r.act(&cf))
 }
 
-/// Fits the unknowns to the rows.
+/// Fits the unknowns to the rows: the closed-form start, Levenberg–Marquardt, and with rotation
+/// rows [`RegistrationOptions::weight_rounds`] re-weightings.
 pub fn register_rows(
     rows: &[RegistrationRow],
     unknowns: Unknowns,
     options: &RegistrationOptions,
 ) -> Result<Registration, Error> {
     options.validate()?;
-    let mut fit = start(rows, unknowns, options);
+    let mut options = *options;
+    let mut fit = solve(rows, unknowns, &options, start(rows, unknowns, &options))?;
+    if rows.iter().any(|r| r.rotation.is_some()) && rows.iter().any(|r| r.rotation.is_none()) {
+        // Mixed rows: no shared scale to estimate against.
+        return Ok(fit);
+    }
+    let initial = options.rotation_weight_m_per_rad;
+    for _ in 0..options.weight_rounds {
+        let (mut position, mut rotation, mut count) = (0.0, 0.0, 0usize);
+        for row in rows {
+            let pose = fit.pose(row);
+            let Some(measured) = row.rotation else { continue };
+            position += (pose.translation() - row.point).norm_squared();
+            rotation += (pose.rotation() * measured.inverse()).log().norm_squared();
+            count += 1;
+        }
+        if count == 0 || rotation <= 0.0 || position <= 0.0 {
+            break;
+        }
+        let bound = options.max_weight_change;
+        options.rotation_weight_m_per_rad = (position / rotation).sqrt().clamp(initial / bound, initial * bound);
+        fit = solve(rows, unknowns, &options, fit)?;
+    }
+    Ok(fit)
+}
+
+/// Levenberg–Marquardt from `fit`.
+fn solve(
+    rows: &[RegistrationRow],
+    unknowns: Unknowns,
+    options: &RegistrationOptions,
+    mut fit: Registration,
+) -> Result<Registration, Error> {
+    fit.rotation_weight_m_per_rad = options.rotation_weight_m_per_rad;
     let parameters = unknowns.count();
     if parameters == 0 {
         fit.rms_m = rms(rows, &fit, options);
@@ -213,6 +261,7 @@ fn start(rows: &[RegistrationRow], unknowns: Unknowns, options: &RegistrationOpt
         tools: vec![SE3::identity(); unknowns.tools],
         iterations: 0,
         rms_m: 0.0,
+        rotation_weight_m_per_rad: options.rotation_weight_m_per_rad,
     };
     let rounds = if unknowns.frame && unknowns.tools > 0 { options.alternations.max(1) } else { 1 };
     for _ in 0..rounds {
@@ -412,7 +461,8 @@ mod tests {
 
     #[test]
     fn recovers_a_known_frame_from_positions() {
-        let truth = Registration { frame: moved(), tools: vec![], iterations: 0, rms_m: 0.0 };
+        let truth =
+            Registration { frame: moved(), tools: vec![], iterations: 0, rms_m: 0.0, rotation_weight_m_per_rad: 1.0 };
         let data = rows(&truth, 8, false, 0, 1);
         let unknowns = Unknowns { frame: true, tools: 0, tool_rotations: false };
         let fit = register_rows(&data, unknowns, &RegistrationOptions::default()).unwrap();
@@ -426,7 +476,13 @@ mod tests {
             SE3::new(SO3::exp(&Vector3::new(0.2, 0.0, 0.5)), Vector3::new(0.05, -0.1, 0.25)),
             SE3::new(SO3::exp(&Vector3::new(0.0, 0.4, 0.0)), Vector3::new(-0.2, 0.02, 0.1)),
         ];
-        let truth = Registration { frame: moved(), tools: tools.clone(), iterations: 0, rms_m: 0.0 };
+        let truth = Registration {
+            frame: moved(),
+            tools: tools.clone(),
+            iterations: 0,
+            rms_m: 0.0,
+            rotation_weight_m_per_rad: 1.0,
+        };
         let data = rows(&truth, 12, true, 2, 2);
         let unknowns = Unknowns { frame: true, tools: 2, tool_rotations: true };
         let fit = register_rows(&data, unknowns, &RegistrationOptions::default()).unwrap();
@@ -439,7 +495,13 @@ mod tests {
     #[test]
     fn recovers_a_tool_point_from_positions_with_the_frame_held() {
         let tool = SE3::from_translation(Vector3::new(0.3, 0.1, -0.2));
-        let truth = Registration { frame: SE3::identity(), tools: vec![tool], iterations: 0, rms_m: 0.0 };
+        let truth = Registration {
+            frame: SE3::identity(),
+            tools: vec![tool],
+            iterations: 0,
+            rms_m: 0.0,
+            rotation_weight_m_per_rad: 1.0,
+        };
         let data = rows(&truth, 4, false, 1, 3);
         let unknowns = Unknowns { frame: false, tools: 1, tool_rotations: false };
         let fit = register_rows(&data, unknowns, &RegistrationOptions::default()).unwrap();
@@ -449,7 +511,13 @@ mod tests {
     #[test]
     fn recovers_a_known_frame_and_a_new_tool_point_from_positions() {
         let tool = SE3::from_translation(Vector3::new(0.06, -0.05, 0.06));
-        let truth = Registration { frame: moved(), tools: vec![tool], iterations: 0, rms_m: 0.0 };
+        let truth = Registration {
+            frame: moved(),
+            tools: vec![tool],
+            iterations: 0,
+            rms_m: 0.0,
+            rotation_weight_m_per_rad: 1.0,
+        };
         let data = rows(&truth, 20, false, 1, 6);
         let unknowns = Unknowns { frame: true, tools: 1, tool_rotations: false };
         let fit = register_rows(&data, unknowns, &RegistrationOptions::default()).unwrap();
@@ -477,6 +545,7 @@ mod tests {
             tools: vec![SE3::new(SO3::exp(&Vector3::new(0.1, 0.2, 0.3)), Vector3::new(0.1, 0.0, 0.2))],
             iterations: 0,
             rms_m: 0.0,
+            rotation_weight_m_per_rad: 1.0,
         };
         let mut data = rows(&truth, 5, true, 1, 4);
         // Position-only rows too, where the tool's rotation is not a parameter.

@@ -101,8 +101,10 @@ pub struct RegisterReport {
     pub frame: FrameChange,
     /// The re-fitted tools.
     pub tools: Vec<RegisteredTool>,
-    /// Levenberg–Marquardt iterations.
+    /// Levenberg–Marquardt iterations (of the last re-weighting).
     pub iterations: usize,
+    /// The rotation rows' weight the fit ended with (variance-component estimate), m/rad.
+    pub rotation_weight_m_per_rad: f64,
     /// The registered model's errors on the poses (every part of the model applied).
     pub residual: ErrorSummary,
     /// The mean position residual made unbiased for the fitted parameters, `× √(r / (r − p))`, mm:
@@ -160,6 +162,7 @@ impl RegisterReport {
             },
             tools,
             iterations: fit.iterations,
+            rotation_weight_m_per_rad: fit.rotation_weight_m_per_rad,
             residual: evaluation.summary,
             residual_unbiased_mm,
             model_heldout_mm: heldout_mm,
