@@ -13,6 +13,7 @@ mod bench_memory;
 mod blind_check;
 mod blind_check_cases;
 mod box_plot;
+mod cell_check;
 mod compensate_check;
 mod convert_ur10;
 mod deps;
@@ -68,6 +69,8 @@ enum Command {
     Msrv(msrv::Args),
     /// The crate graph with lines per crate; fails on a crate above the line budget or a circle of crates or modules.
     Deps(deps::Args),
+    /// Issue 26: `calib register` and `calib plan` on the real UR10 and simulated truth; print a table.
+    CellCheck(cell_check::Args),
     /// One fuzz worker (started by `fuzz`).
     #[command(hide = true)]
     FuzzWorker(fuzz_worker::Args),
@@ -88,6 +91,7 @@ fn main() -> ExitCode {
         Command::ConvertUr10(args) => convert_ur10::run(args).map_err(|e| format!("{e:#}")),
         Command::BlindCheck(args) => blind_check::run(args).map_err(|e| format!("{e:#}")),
         Command::Ur10(args) => ur10::run(args).map_err(|e| format!("{e:#}")),
+        Command::CellCheck(args) => cell_check::run(args).map_err(|e| format!("{e:#}")),
         Command::UrdfCheck(args) => urdf_check::run(args).map_err(|e| format!("{e:#}")),
         Command::CompensateCheck(args) => compensate_check::run(args).map_err(|e| format!("{e:#}")),
         Command::Fuzz(args) => fuzz::run(args).map_err(|e| format!("{e:#}")),

@@ -25,7 +25,7 @@ const DIAGNOSIS_HEADING: &str = "## Diagnosis";
 /// CPU time this process has used so far (all threads, user and system), s: fields 14 and 15 of
 /// `/proc/self/stat`, in clock ticks of 1/100 s (Linux's USER_HZ on every architecture it
 /// exports to user space); NaN where that file cannot be read.
-fn process_cpu_seconds() -> f64 {
+pub(crate) fn process_cpu_seconds() -> f64 {
     let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else { return f64::NAN };
     // The command name (field 2) is in parentheses and may hold spaces: count from after it.
     let Some(after) = stat.rfind(')').map(|at| &stat[at + 1..]) else { return f64::NAN };

@@ -6,7 +6,9 @@ mod diagnose;
 mod eval;
 mod export;
 mod fit;
+mod plan;
 mod predict;
+mod register;
 mod robot_args;
 mod simulate;
 
@@ -30,6 +32,8 @@ enum Command {
     Simulate(simulate::Args),
     Export(export::Args),
     Compensate(compensate::Args),
+    Register(register::Args),
+    Plan(plan::Args),
 }
 
 fn main() -> ExitCode {
@@ -63,6 +67,8 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(&args),
         Command::Export(args) => export::run(&args),
         Command::Compensate(args) => compensate::run(&args),
+        Command::Register(args) => register::run(&args),
+        Command::Plan(args) => plan::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

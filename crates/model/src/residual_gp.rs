@@ -415,6 +415,12 @@ pub struct ResidualGp {
     pub residual_frame: ResidualFrame,
     /// The GP: inputs `(q_1 … q_n[, m])`, outputs the error components.
     pub gp: GpModel,
+    /// `model_frame_from_fit_frame`: where the reference frame moved since the GP was fitted
+    /// (`calib register`, crate `cell`). The GP's outputs are in the frame it was fitted in and
+    /// are carried into the model's by this transform's adjoint (its rotation alone for the
+    /// tool-point frame and position-only outputs), which is exact. Absent: not moved.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub moved_by: Option<SE3>,
 }
 
 /// What the GP stage reports.
@@ -515,7 +521,13 @@ impl ResidualGp {
                 (GpModel::Exact(model), report, Some(loo.mean))
             }
         };
-        let residual_gp = Self { with_payload, full_pose: data.full_pose, residual_frame: options.residual_frame, gp };
+        let residual_gp = Self {
+            with_payload,
+            full_pose: data.full_pose,
+            residual_frame: options.residual_frame,
+            gp,
+            moved_by: None,
+        };
         let leave_one_out = leave_one_out.map(|mean| {
             let errors: Vec<crate::PoseError> = poses
                 .iter()
@@ -548,6 +560,21 @@ impl ResidualGp {
         }
     }
 
+    /// The GP's output `g` and its deviations carried from the frame it was fitted in to the
+    /// model's ([`ResidualGp::moved_by`]): `X exp(ĝ) X⁻¹ = exp((Ad_X g)^)` in the tracker frame;
+    /// at the tool point, `X P = P' R` with `P'` the translation to the moved point, so only the
+    /// rotation acts. Deviations as those of independent components, `σ'² = Σ_k A_ck² σ_k²`.
+    fn carried(&self, moved: &SE3, g: &Vector6, std: &[f64; 6]) -> (Vector6, [f64; 6]) {
+        let adjoint = match (self.full_pose, self.residual_frame) {
+            (true, ResidualFrame::Tracker) => moved.adjoint(),
+            _ => SE3::new(moved.rotation(), Vector3::zeros()).adjoint(),
+        };
+        let carried = adjoint * g;
+        let deviations =
+            std::array::from_fn(|c| (0..6).map(|k| (adjoint[(c, k)] * std[k]).powi(2)).sum::<f64>().sqrt());
+        (carried, deviations)
+    }
+
     /// The correction of every row: `G(q, m)` to put before the model pose, and the GP's standard
     /// deviation of each error component `(v, ω)` (m, rad; zeros where not modelled).
     pub fn predict(&self, rows: &[Measurement], model_poses: &[SE3]) -> Result<Vec<(SE3, [f64; 6])>, Error> {
@@ -562,6 +589,9 @@ impl ResidualGp {
                 for c in 0..outputs {
                     g[c] = prediction.mean[(i, c)];
                     std[c] = prediction.variance[(i, c)].max(0.0).sqrt();
+                }
+                if let Some(moved) = self.moved_by {
+                    (g, std) = self.carried(&moved, &g, &std);
                 }
                 (self.correction(pose, &g), std)
             })

@@ -1,0 +1,124 @@
+//! `calib plan`: the poses worth measuring, chosen from candidates (crate `cell`).
+
+use crate::robot_args::RobotArgs;
+use pipeline::{ColumnMap, ReadOptions};
+use std::path::PathBuf;
+
+/// Choose the poses that determine the identification best, covering every moving joint's range.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    robot: RobotArgs,
+    /// A calibrated model (RON): plan with its geometry and tools (else the robot's nominal model).
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Candidate configurations (the measurement CSV; position columns may be left out; every
+    /// column is kept). Without it, candidates are drawn within the robot's joint limits.
+    #[arg(long)]
+    candidates: Option<PathBuf>,
+    /// How many poses to choose.
+    #[arg(long)]
+    poses: usize,
+    /// The chosen rows, unchanged, in the order to measure them (CSV); never one of the inputs.
+    #[arg(long)]
+    out: PathBuf,
+    /// Plan for full-pose measurements (a model fitted on full poses implies it).
+    #[arg(long)]
+    full_pose: bool,
+    /// Candidates drawn without --candidates.
+    #[arg(long, default_value_t = 5000)]
+    generate: usize,
+    /// Seed of the drawn candidates.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// The criterion: i (the mean predicted variance over the candidates; the default) or d (log det).
+    #[arg(long, value_parser = parse_criterion)]
+    criterion: Option<cell::Criterion>,
+    /// Tracker position noise per axis, mm: scales the predicted errors.
+    #[arg(long)]
+    noise_mm: Option<f64>,
+    /// Every planning setting (RON, `cell::PlanOptions`: criterion, noise, bins, exchanges…);
+    /// --criterion and --noise-mm override it.
+    #[arg(long)]
+    options: Option<PathBuf>,
+    /// Other headers mapped onto the SPEC's column names: NAME=HEADER,….
+    #[arg(long)]
+    columns: Option<ColumnMap>,
+    /// Print the report as one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    pipeline::InputFiles::new()
+        .with("--robot", &args.robot.robot)
+        .with_optional("--model", args.model.as_deref())
+        .with_optional("--candidates", args.candidates.as_deref())
+        .with_optional("--options", args.options.as_deref())
+        .check_output("--out", &args.out)?;
+    let robot = args.robot.read()?;
+    let model = args.model.as_deref().map(pipeline::read_model).transpose()?;
+    let full_pose = args.full_pose || model.as_ref().is_some_and(|m| m.full_pose);
+    let mut options = match &args.options {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            cell::PlanOptions::parse(&text, &path.display().to_string())?
+        }
+        None => cell::PlanOptions::default(),
+    };
+    options.criterion = args.criterion.unwrap_or(options.criterion);
+    options.position_noise_mm = args.noise_mm.unwrap_or(options.position_noise_mm);
+    options.validate()?;
+    let started = std::time::Instant::now();
+    let mut notes = Vec::new();
+    let (set, file) = match &args.candidates {
+        Some(path) => {
+            let kinds = robot.nominal_model()?.joints().iter().map(|j| j.kind).collect();
+            let read = ReadOptions::for_joints(kinds).with_columns(args.columns.clone().unwrap_or_default());
+            let (data, cells) = pipeline::read_configurations_with_cells(path, &read)?;
+            notes.push(data.read_summary());
+            (cell::file_candidates(&data, &robot, model.as_ref())?, Some((cells, data.format.dialect.delimiter.byte())))
+        }
+        None => {
+            notes.push(format!("drew {} candidates within the joint limits (seed {})", args.generate, args.seed));
+            (cell::generated_candidates(&robot, model.as_ref(), args.generate, args.seed)?, None)
+        }
+    };
+    for tool in &set.unknown_tools {
+        notes.push(format!("warning: tool '{tool}' is not in the model: planned with its first tool"));
+    }
+    let plan = cell::plan(&set.model, &set.candidates, args.poses, full_pose, &options)?;
+    let seconds = started.elapsed().as_secs_f64();
+    let mut out = pipeline::OutputFile::create(&args.out)?;
+    match &file {
+        Some((cells, delimiter)) => cell::write_chosen_rows(&mut out, cells, *delimiter, &plan.order)?,
+        None => {
+            let kinds: Vec<_> = set.model.joints().iter().map(|j| j.kind).collect();
+            cell::write_generated_rows(&mut out, &kinds, &set.candidates, &plan.order)?;
+        }
+    }
+    out.finish()?;
+    if args.json {
+        println!("{}", serde_json::to_string(&plan.report)?);
+        for note in &notes {
+            eprintln!("{note}");
+        }
+    } else {
+        for note in &notes {
+            println!("{note}");
+        }
+        for line in plan.report.lines() {
+            println!("{line}");
+        }
+        println!("planned in {seconds:.2} s; wrote {} rows to {}", plan.order.len(), args.out.display());
+    }
+    Ok(())
+}
+
+fn parse_criterion(s: &str) -> Result<cell::Criterion, String> {
+    match s {
+        "d" | "D" => Ok(cell::Criterion::D),
+        "i" | "I" => Ok(cell::Criterion::I),
+        other => Err(format!("unknown criterion '{other}': expected d or i")),
+    }
+}

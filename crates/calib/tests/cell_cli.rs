@@ -1,0 +1,263 @@
+//! `calib register` and `calib plan` end to end (issue 26, crate `cell`).
+
+use std::path::{Path, PathBuf};
+
+mod common;
+use common::{fails, fixture, succeeds_with_stderr, text};
+
+/// A simulated full-pose IRB 4400 data set of `rows` rows and a `poe` model fitted on its first
+/// 150 rows: (data, model).
+fn setup(dir: &Path, rows: usize) -> (PathBuf, PathBuf) {
+    let data = dir.join("sim.csv");
+    let train = dir.join("train.csv");
+    let model = dir.join("poe.ron");
+    let rows = rows.to_string();
+    succeeds_with_stderr(&[
+        "simulate",
+        "--robot",
+        &fixture("irb4400.ron"),
+        "--out",
+        &text(&data),
+        "--rows",
+        &rows,
+        "--seed",
+        "4",
+        "--full-pose",
+    ]);
+    let content = std::fs::read_to_string(&data).unwrap();
+    let lines: Vec<&str> = content.lines().collect();
+    std::fs::write(&train, lines[..151].join("\n") + "\n").unwrap();
+    succeeds_with_stderr(&[
+        "fit",
+        "--robot",
+        &fixture("irb4400.ron"),
+        "--data",
+        &text(&train),
+        "--method",
+        "poe",
+        "--out",
+        &text(&model),
+    ]);
+    (data, model)
+}
+
+/// Hamilton product `a ⊗ b` of quaternions `(w, x, y, z)`.
+fn product(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
+/// Rows `range` of a full-pose CSV seen from a tracker moved by a quarter turn about z and
+/// `(2.5, −1.0, 0.3)` m: `p' = R p + t`, `q' = q_R ⊗ q`.
+fn moved(data: &Path, out: &Path, range: std::ops::Range<usize>) {
+    let content = std::fs::read_to_string(data).unwrap();
+    let mut lines = content.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let at = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (x, y, z, qw) = (at("x_mm"), at("y_mm"), at("z_mm"), at("qw"));
+    let half = std::f64::consts::FRAC_PI_4;
+    let turn = [half.cos(), 0.0, 0.0, half.sin()];
+    let mut text = header.join(",") + "\n";
+    for line in lines.skip(range.start).take(range.len()) {
+        let mut cells: Vec<String> = line.split(',').map(str::to_owned).collect();
+        let v = |i: usize| cells[i].parse::<f64>().unwrap();
+        let (px, py, pz) = (v(x), v(y), v(z));
+        let q = product(turn, [v(qw), v(qw + 1), v(qw + 2), v(qw + 3)]);
+        cells[x] = (-py + 2500.0).to_string();
+        cells[y] = (px - 1000.0).to_string();
+        cells[z] = (pz + 300.0).to_string();
+        for k in 0..4 {
+            cells[qw + k] = q[k].to_string();
+        }
+        text += &(cells.join(",") + "\n");
+    }
+    std::fs::write(out, text).unwrap();
+}
+
+fn json_number(json: &str, key: &str) -> f64 {
+    let start = json.find(&format!("\"{key}\":")).unwrap_or_else(|| panic!("{key} in {json}")) + key.len() + 3;
+    let end = json[start..].find([',', '}']).unwrap() + start;
+    json[start..end].parse().unwrap()
+}
+
+#[test]
+fn register_carries_a_model_to_a_moved_tracker() {
+    let dir = tempfile::tempdir().unwrap();
+    let (data, model) = setup(dir.path(), 400);
+    let few = dir.path().join("few.csv");
+    let rest = dir.path().join("rest.csv");
+    let original_rest = dir.path().join("original_rest.csv");
+    moved(&data, &few, 150..175);
+    moved(&data, &rest, 200..400);
+    let content = std::fs::read_to_string(&data).unwrap();
+    let lines: Vec<&str> = content.lines().collect();
+    std::fs::write(&original_rest, [&lines[..1], &lines[201..401]].concat().join("\n") + "\n").unwrap();
+    let out = dir.path().join("moved.ron");
+    let (stdout, _) = succeeds_with_stderr(&[
+        "register",
+        "--model",
+        &text(&model),
+        "--data",
+        &text(&few),
+        "--out",
+        &text(&out),
+        "--heldout-mm",
+        "1.0",
+        "--json",
+    ]);
+    assert!(stdout.contains("\"verdict\":\"consistent\""), "{stdout}");
+    assert!((json_number(&stdout, "angle_deg") - 90.0).abs() < 0.05, "{stdout}");
+    let eval = |model: &Path, data: &Path| {
+        let (json, _) = succeeds_with_stderr(&["eval", "--model", &text(model), "--data", &text(data), "--json"]);
+        json_number(&json, "mean_position_error_mm")
+    };
+    let before = eval(&model, &original_rest);
+    let after = eval(&out, &rest);
+    assert!(after < 1.2 * before, "registered {after} mm against the original's {before} mm");
+    // The model as it was cannot be used on the moved data.
+    assert!(eval(&model, &rest) > 1000.0);
+}
+
+#[test]
+fn register_refuses_too_few_poses_with_the_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let (data, model) = setup(dir.path(), 160);
+    let few = dir.path().join("few.csv");
+    moved(&data, &few, 150..152);
+    let out = dir.path().join("moved.ron");
+    let message = fails(&["register", "--model", &text(&model), "--data", &text(&few), "--out", &text(&out)]);
+    assert!(message.contains("2 poses (12 residual rows) for 6 re-fitted parameters"), "{message}");
+    assert!(message.contains("at least 3 poses"), "{message}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn register_refuses_a_new_tool_unless_tools_are_refitted() {
+    let dir = tempfile::tempdir().unwrap();
+    let (data, model) = setup(dir.path(), 170);
+    let few = dir.path().join("few.csv");
+    moved(&data, &few, 150..170);
+    let content = std::fs::read_to_string(&few).unwrap();
+    let tooled: Vec<String> =
+        content.lines().enumerate().map(|(i, l)| format!("{l},{}", if i == 0 { "tool" } else { "probe2" })).collect();
+    std::fs::write(&few, tooled.join("\n") + "\n").unwrap();
+    let out = dir.path().join("moved.ron");
+    let message = fails(&["register", "--model", &text(&model), "--data", &text(&few), "--out", &text(&out)]);
+    assert!(message.contains("tool 'probe2' is not in the model"), "{message}");
+    assert!(message.contains(":2:"), "{message}");
+    let (stdout, _) = succeeds_with_stderr(&[
+        "register",
+        "--model",
+        &text(&model),
+        "--data",
+        &text(&few),
+        "--out",
+        &text(&out),
+        "--refit",
+        "base,tools",
+    ]);
+    assert!(stdout.contains("tool 'probe2' (new)"), "{stdout}");
+    assert!(std::fs::read_to_string(&out).unwrap().contains("\"probe2\""));
+}
+
+#[test]
+fn register_never_overwrites_its_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let (data, model) = setup(dir.path(), 180);
+    let before = std::fs::read(&model).unwrap();
+    let few = dir.path().join("few.csv");
+    moved(&data, &few, 150..180);
+    let message = fails(&["register", "--model", &text(&model), "--data", &text(&few), "--out", &text(&model)]);
+    assert!(message.contains("--out"), "{message}");
+    assert_eq!(std::fs::read(&model).unwrap(), before);
+}
+
+#[test]
+fn plan_writes_chosen_candidate_rows_unchanged() {
+    let dir = tempfile::tempdir().unwrap();
+    let candidates = dir.path().join("candidates.csv");
+    succeeds_with_stderr(&[
+        "simulate",
+        "--robot",
+        &fixture("irb4400.ron"),
+        "--out",
+        &text(&candidates),
+        "--rows",
+        "300",
+        "--seed",
+        "5",
+    ]);
+    let chosen = dir.path().join("chosen.csv");
+    let (stdout, _) = succeeds_with_stderr(&[
+        "plan",
+        "--robot",
+        &fixture("irb4400.ron"),
+        "--candidates",
+        &text(&candidates),
+        "--poses",
+        "20",
+        "--out",
+        &text(&chosen),
+        "--json",
+    ]);
+    assert_eq!(json_number(&stdout, "poses"), 20.0);
+    assert!(stdout.contains("\"checkpoints\""), "{stdout}");
+    let input = std::fs::read_to_string(&candidates).unwrap();
+    let output = std::fs::read_to_string(&chosen).unwrap();
+    let (input_lines, output_lines): (Vec<&str>, Vec<&str>) = (input.lines().collect(), output.lines().collect());
+    assert_eq!(output_lines[0], input_lines[0]);
+    assert_eq!(output_lines.len(), 21);
+    for line in &output_lines[1..] {
+        assert!(input_lines[1..].contains(line), "{line} is not a candidate row as written");
+    }
+}
+
+#[test]
+fn plan_refuses_more_poses_than_candidates_with_the_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let candidates = dir.path().join("candidates.csv");
+    std::fs::write(
+        &candidates,
+        "q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad\n0.1,0.2,0.3,0.4,0.5,0.6\n0.2,0.1,0.0,0.4,0.5,0.6\n",
+    )
+    .unwrap();
+    let chosen = dir.path().join("chosen.csv");
+    let message = fails(&[
+        "plan",
+        "--robot",
+        &fixture("irb4400.ron"),
+        "--candidates",
+        &text(&candidates),
+        "--poses",
+        "3",
+        "--out",
+        &text(&chosen),
+    ]);
+    assert!(message.contains("3 poses asked for but only 2 candidates"), "{message}");
+    assert!(!chosen.exists());
+}
+
+#[test]
+fn plan_without_candidates_draws_them_within_the_limits() {
+    let dir = tempfile::tempdir().unwrap();
+    let chosen = dir.path().join("chosen.csv");
+    let (stdout, _) = succeeds_with_stderr(&[
+        "plan",
+        "--robot",
+        &fixture("ur10.ron"),
+        "--poses",
+        "12",
+        "--generate",
+        "400",
+        "--out",
+        &text(&chosen),
+    ]);
+    assert!(stdout.contains("drew 400 candidates"), "{stdout}");
+    let output = std::fs::read_to_string(&chosen).unwrap();
+    assert!(output.starts_with("q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad\n"));
+    assert_eq!(output.lines().count(), 13);
+}
