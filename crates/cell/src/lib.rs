@@ -86,6 +86,7 @@ mod joint_targets;
 mod model_text;
 mod plan;
 mod register;
+mod register_options;
 pub mod registration;
 mod report;
 mod urdf_export;
@@ -104,7 +105,8 @@ pub use joint_targets::{
 };
 pub use model_text::checked_model_text;
 pub use plan::{Checkpoint, Plan, PlanOptions, PlanReport, measuring_order, plan};
-pub use register::{Refit, RegisterOptions, Registered, register};
+pub use register::{Registered, register};
+pub use register_options::{Refit, RegisterOptions};
 pub use report::{FrameChange, RegisterReport, RegisterWarning, RegisteredTool, Verdict};
 pub use urdf_export::{
     AxisChange, PartError, TrainingErrors, UrdfExport, UrdfExportReport, UrdfTemplate, export_urdf, write_urdf,

@@ -1,7 +1,7 @@
 //! What `calib register` reports (`--json`: [`RegisterReport`], additive to the SPEC's JSON).
 
 use crate::Error;
-use crate::register::{Refit, RegisterOptions};
+use crate::register_options::{Refit, RegisterOptions};
 use crate::registration::Registration;
 use measurements::MeasurementSet;
 use model::{BeyondLimitsWarning, CalibratedModel, ErrorSummary, ExtrapolationWarning, OutOfRangeWarning};
