@@ -7,6 +7,7 @@ mod eval;
 mod export;
 mod fit;
 mod predict;
+mod report;
 mod robot_args;
 mod simulate;
 
@@ -30,6 +31,7 @@ enum Command {
     Simulate(simulate::Args),
     Export(export::Args),
     Compensate(compensate::Args),
+    Report(report::Args),
 }
 
 fn main() -> ExitCode {
@@ -63,6 +65,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(&args),
         Command::Export(args) => export::run(&args),
         Command::Compensate(args) => compensate::run(&args),
+        Command::Report(args) => report::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
