@@ -21,6 +21,7 @@ mod fuzz_seeds;
 mod fuzz_worker;
 mod hostile;
 mod msrv;
+mod report_browser_check;
 mod reproduce_sim;
 mod reproduce_sim_params;
 mod reproduce_sim_report;
@@ -65,6 +66,8 @@ enum Command {
     Fuzz(fuzz::Args),
     /// The Rust version Cargo.lock needs, checked against Cargo.toml and the README.
     Msrv(msrv::Args),
+    /// Render calibration reports in headless Chromium: a screenshot each, fail on console messages (not in CI).
+    ReportBrowserCheck(report_browser_check::Args),
     /// One fuzz worker (started by `fuzz`).
     #[command(hide = true)]
     FuzzWorker(fuzz_worker::Args),
@@ -89,6 +92,7 @@ fn main() -> ExitCode {
         Command::CompensateCheck(args) => compensate_check::run(args).map_err(|e| format!("{e:#}")),
         Command::Fuzz(args) => fuzz::run(args).map_err(|e| format!("{e:#}")),
         Command::Msrv(args) => msrv::run(args).map_err(|e| format!("{e:#}")),
+        Command::ReportBrowserCheck(args) => report_browser_check::run(&args).map_err(|e| format!("{e:#}")),
         Command::FuzzWorker(args) => fuzz_worker::run(args).map_err(|e| format!("{e:#}")),
     };
     match result {

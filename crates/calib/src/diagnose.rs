@@ -50,7 +50,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         args
         .report
         .as_deref()
-        .map(|folder| report::write_diagnosis_report(&diagnosis, folder, "--report", &inputs))
+        .map(|folder| ::report::write_diagnosis_report(&diagnosis, folder, "--report", &inputs))
         .transpose()?;
     if args.json {
         println!("{}", diagnosis.to_json()?);

@@ -48,7 +48,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let diagnosis = train.as_ref().map(|t| diagnose(&robot, t, &DiagnoseOptions::default())).transpose()?;
     let model_file = args.model.display().to_string();
     let robot_file = args.robot.robot.display().to_string();
-    let report_inputs = report::ReportInputs {
+    let report_inputs = ::report::ReportInputs {
         model: &model,
         model_file: &model_file,
         robot: &robot,
@@ -56,9 +56,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         data: &data,
         training: train.as_ref(),
     };
-    let built = report::Report::build(&report_inputs, diagnosis, &report::ReportOptions::default())?;
+    let built = ::report::Report::build(&report_inputs, diagnosis, &::report::ReportOptions::default())?;
     let written = std::time::Instant::now();
-    let html = report::render_html(&built)?;
+    let html = ::report::render_html(&built)?;
     pipeline::write_file(&args.out, html.as_bytes())?;
     eprintln!("{}", data.read_summary());
     println!(
