@@ -15,7 +15,7 @@
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! let robot = RobotDescription::read(std::path::Path::new(concat!(
 //!     env!("CARGO_MANIFEST_DIR"),
-//!     "/../../fixtures/robots/ur10.ron"
+//!     "/../../fixtures/robots/irb4400.ron"
 //! )))?;
 //! let cell = simulated_cell(&robot, &Perturbation::default(), 1)?;
 //! let config = |seed| loadsim::GeneratorConfig { sample_count: 60, seed, ..Default::default() };
@@ -26,7 +26,7 @@
 //!     model: &model,
 //!     model_file: "model.ron",
 //!     robot: &robot,
-//!     robot_file: "ur10.ron",
+//!     robot_file: "irb4400.ron",
 //!     data: &test,
 //!     training: Some(&train),
 //! };

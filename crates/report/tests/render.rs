@@ -17,7 +17,7 @@ struct Rendered {
 }
 
 fn robot() -> RobotDescription {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/robots/ur10.ron");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/robots/irb4400.ron");
     RobotDescription::read(std::path::Path::new(path)).expect("the UR10 fixture reads")
 }
 
@@ -51,7 +51,7 @@ fn rendered() -> &'static Rendered {
             model: &model,
             model_file: "model.ron",
             robot: &robot,
-            robot_file: "ur10.ron",
+            robot_file: "irb4400.ron",
             data: &test,
             training: Some(&train),
         };
