@@ -92,7 +92,7 @@ fn main() -> ExitCode {
         Command::CompensateCheck(args) => compensate_check::run(args).map_err(|e| format!("{e:#}")),
         Command::Fuzz(args) => fuzz::run(args).map_err(|e| format!("{e:#}")),
         Command::Msrv(args) => msrv::run(args).map_err(|e| format!("{e:#}")),
-        Command::ReportBrowserCheck(args) => report_browser_check::run(&args).map_err(|e| format!("{e:#}")),
+        Command::ReportBrowserCheck(args) => report_browser_check::run(args).map_err(|e| format!("{e:#}")),
         Command::FuzzWorker(args) => fuzz_worker::run(args).map_err(|e| format!("{e:#}")),
     };
     match result {

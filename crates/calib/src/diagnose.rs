@@ -46,8 +46,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let options =
         DiagnoseOptions { folds: args.folds, seed: args.seed, noise_mm: args.noise_mm, ..DiagnoseOptions::default() };
     let diagnosis = diagnose(&robot, &data, &options)?;
-    let report =
-        args
+    let report = args
         .report
         .as_deref()
         .map(|folder| ::report::write_diagnosis_report(&diagnosis, folder, "--report", &inputs))

@@ -28,8 +28,10 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let mut inputs =
-        pipeline::InputFiles::new().with("--model", &args.model).with("--robot", &args.robot.robot).with("--data", &args.data);
+    let mut inputs = pipeline::InputFiles::new()
+        .with("--model", &args.model)
+        .with("--robot", &args.robot.robot)
+        .with("--data", &args.data);
     if let Some(train) = &args.train {
         inputs = inputs.with("--train", train);
     }

@@ -41,7 +41,8 @@ fn the_report_refuses_to_write_over_its_data() {
     let data = simulated(dir.path(), 60, 6);
     let robot = fixture("irb4400.ron");
     let before = std::fs::read(&data).unwrap();
-    let err = fails(&["report", "--model", "none.ron", "--robot", &robot, "--data", &text(&data), "--out", &text(&data)]);
+    let err =
+        fails(&["report", "--model", "none.ron", "--robot", &robot, "--data", &text(&data), "--out", &text(&data)]);
     assert!(err.contains("--out"), "{err}");
     assert_eq!(std::fs::read(&data).unwrap(), before);
 }
@@ -51,7 +52,8 @@ fn the_diagnosis_folder_has_its_plots_its_markdown_and_the_page() {
     let dir = tempfile::tempdir().unwrap();
     let data = simulated(dir.path(), 150, 7);
     let folder = dir.path().join("diag");
-    let out = calib(&["diagnose", "--robot", &fixture("irb4400.ron"), "--data", &text(&data), "--report", &text(&folder)]);
+    let out =
+        calib(&["diagnose", "--robot", &fixture("irb4400.ron"), "--data", &text(&data), "--report", &text(&folder)]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let markdown = std::fs::read_to_string(folder.join("diagnosis.md")).unwrap();
     let page = std::fs::read_to_string(folder.join("diagnosis.html")).unwrap();
@@ -59,7 +61,10 @@ fn the_diagnosis_folder_has_its_plots_its_markdown_and_the_page() {
         let name = format!("joint{j}.svg");
         let svg = std::fs::read_to_string(folder.join(&name)).unwrap();
         assert!(svg.starts_with("<svg") && svg.contains("Held-out error against joint"), "{name}");
-        assert!(markdown.contains(&format!("![{name}]({name})")) && page.contains(&format!("<figcaption>{name}</figcaption>")));
+        assert!(
+            markdown.contains(&format!("![{name}]({name})"))
+                && page.contains(&format!("<figcaption>{name}</figcaption>"))
+        );
     }
     assert!(page.contains("<section id=\"diagnosis\">"));
 }

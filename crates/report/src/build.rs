@@ -235,11 +235,9 @@ fn robot_summary(robot: &RobotDescription, file: &str) -> RobotSummary {
             .joints
             .iter()
             .map(|j| match j.kind {
-                JointType::Prismatic => JointSummary {
-                    kind: "prismatic",
-                    limits: j.limits_m.map(|(a, b)| [a * 1e3, b * 1e3]),
-                    unit: "mm",
-                },
+                JointType::Prismatic => {
+                    JointSummary { kind: "prismatic", limits: j.limits_m.map(|(a, b)| [a * 1e3, b * 1e3]), unit: "mm" }
+                }
                 _ => JointSummary { kind: "revolute", limits: j.limits_deg.map(|(a, b)| [a, b]), unit: "deg" },
             })
             .collect(),
@@ -312,12 +310,15 @@ fn gear_curve(
     EffectCurve { joint: gear.joint + 1, angle_deg, error_urad, sigma_urad, training_deg, test_deg, fitted_deg }
 }
 
+/// The GP's kind, its input scales and its kernels with the outputs each serves.
+type GpParts<'a> = (&'static str, &'a [f64], Vec<(&'a [usize], &'a gp::Kernel)>);
+
 fn gp_view(gp: &GpModel, with_payload: bool, joints: usize) -> GpView {
     let mut inputs: Vec<String> = (1..=joints).map(|j| format!("q{j}")).collect();
     if with_payload {
         inputs.push("payload".into());
     }
-    let (kind, scale, components): (&str, &[f64], Vec<(&[usize], &gp::Kernel)>) = match gp {
+    let (kind, scale, components): GpParts<'_> = match gp {
         GpModel::Exact(g) => (
             "exact",
             &g.input_standardiser().scale,

@@ -192,7 +192,9 @@ pub fn workspace(rows: &[RowError]) -> Result<String, Error> {
             chart.configure_mesh().x_desc("x (m)").y_desc(name).draw().map_err(|e| e.to_string())?;
             chart
                 .draw_series(
-                    order.iter().map(|r| Circle::new((coordinate(r, 0), coordinate(r, k)), 3, colour(r.after_mm).filled())),
+                    order
+                        .iter()
+                        .map(|r| Circle::new((coordinate(r, 0), coordinate(r, k)), 3, colour(r.after_mm).filled())),
                 )
                 .map_err(|e| e.to_string())?;
         }
@@ -269,14 +271,19 @@ pub fn effect_curve(label: &str, curve: &EffectCurve) -> Result<String, Error> {
         if !curve.training_deg.is_empty() {
             chart
                 .draw_series(
-                    curve.training_deg.iter().map(|&a| PathElement::new(vec![(a, y1), (a, y1 - tick)], TRAINING.mix(0.6))),
+                    curve
+                        .training_deg
+                        .iter()
+                        .map(|&a| PathElement::new(vec![(a, y1), (a, y1 - tick)], TRAINING.mix(0.6))),
                 )
                 .map_err(|e| e.to_string())?
                 .label("training angles")
                 .legend(|(x, y)| PathElement::new(vec![(x + 6, y - 5), (x + 6, y + 5)], TRAINING));
         }
         chart
-            .draw_series(curve.test_deg.iter().map(|&a| PathElement::new(vec![(a, y0), (a, y0 + tick)], BLACK.mix(0.4))))
+            .draw_series(
+                curve.test_deg.iter().map(|&a| PathElement::new(vec![(a, y0), (a, y0 + tick)], BLACK.mix(0.4))),
+            )
             .map_err(|e| e.to_string())?
             .label("test angles")
             .legend(|(x, y)| PathElement::new(vec![(x + 6, y - 5), (x + 6, y + 5)], BLACK.mix(0.5)));

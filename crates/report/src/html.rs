@@ -2,9 +2,9 @@
 //! printable). Every number a test compares carries its full value in a `data-value` attribute
 //! next to the rounded text, under a `data-key` naming it.
 
+use crate::Error;
 use crate::content::{ErrorStats, GroupedErrors, Report};
 use crate::figures;
-use crate::Error;
 use pipeline::diagnose::Diagnosis;
 use std::fmt::Write;
 
@@ -52,9 +52,9 @@ fn optional_cell(key: &str, value: Option<f64>, decimals: usize) -> String {
 pub fn render_html(report: &Report) -> Result<String, Error> {
     let mut out = String::with_capacity(1 << 20);
     let title = format!("Calibration report: {} ({})", report.robot.name, report.model.method);
-    let _ = write!(
+    let _ = writeln!(
         out,
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}</style></head><body>\n<h1>{}</h1>\n",
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}</style></head><body>\n<h1>{}</h1>",
         escape(&title),
         escape(&title)
     );
@@ -93,7 +93,7 @@ pub fn render_html(report: &Report) -> Result<String, Error> {
 
 fn open(out: &mut String, id: &str) {
     let heading = SECTIONS.iter().find(|(i, _)| *i == id).map_or(id, |(_, h)| h);
-    let _ = write!(out, "<section id=\"{id}\"><h2>{heading}</h2>\n");
+    let _ = writeln!(out, "<section id=\"{id}\"><h2>{heading}</h2>");
 }
 
 fn card(out: &mut String, key: &str, label: &str, value: f64, unit: &str, sub: &str) {
@@ -113,10 +113,38 @@ fn summary(out: &mut String, r: &Report) {
             |b| format!("before calibration: {:.3} mm", pick(&b.groups.all)),
         )
     };
-    card(out, "card.mean", "Mean position error", after.summary.mean_position_error_mm, "mm", &before_sub(|s| s.summary.mean_position_error_mm));
-    card(out, "card.rms", "RMS position error", after.summary.rms_position_error_mm, "mm", &before_sub(|s| s.summary.rms_position_error_mm));
-    card(out, "card.p95", "95 % of poses within", after.p95_position_error_mm, "mm", &before_sub(|s| s.p95_position_error_mm));
-    card(out, "card.max", "Largest position error", after.summary.max_position_error_mm, "mm", &before_sub(|s| s.summary.max_position_error_mm));
+    card(
+        out,
+        "card.mean",
+        "Mean position error",
+        after.summary.mean_position_error_mm,
+        "mm",
+        &before_sub(|s| s.summary.mean_position_error_mm),
+    );
+    card(
+        out,
+        "card.rms",
+        "RMS position error",
+        after.summary.rms_position_error_mm,
+        "mm",
+        &before_sub(|s| s.summary.rms_position_error_mm),
+    );
+    card(
+        out,
+        "card.p95",
+        "95 % of poses within",
+        after.p95_position_error_mm,
+        "mm",
+        &before_sub(|s| s.p95_position_error_mm),
+    );
+    card(
+        out,
+        "card.max",
+        "Largest position error",
+        after.summary.max_position_error_mm,
+        "mm",
+        &before_sub(|s| s.summary.max_position_error_mm),
+    );
     if let Some(rotation) = after.summary.mean_rotation_error_mrad {
         card(out, "card.rotation", "Mean rotation error", rotation, "mrad", "full-pose data");
     }
@@ -141,18 +169,35 @@ fn summary(out: &mut String, r: &Report) {
     }
     out.push_str("</p>\n");
     if !r.warnings.is_empty() {
-        let _ = write!(out, "<div class=\"warn\">{} warning(s): see <a href=\"#warnings\">Warnings</a>.</div>\n", r.warnings.len());
+        let _ = writeln!(
+            out,
+            "<div class=\"warn\">{} warning(s): see <a href=\"#warnings\">Warnings</a>.</div>",
+            r.warnings.len()
+        );
     }
     out.push_str("</section>\n");
 }
 
 fn robot(out: &mut String, r: &Report) {
     open(out, "robot");
-    let _ = write!(out, "<p><b>{}</b> from <code>{}</code>, {} joints.</p>", escape(&r.robot.name), escape(&r.robot.file), r.robot.joints.len());
+    let _ = write!(
+        out,
+        "<p><b>{}</b> from <code>{}</code>, {} joints.</p>",
+        escape(&r.robot.name),
+        escape(&r.robot.file),
+        r.robot.joints.len()
+    );
     out.push_str("<table><tr><th>joint</th><th class=\"l\">kind</th><th>lower limit</th><th>upper limit</th></tr>");
     for (k, j) in r.robot.joints.iter().enumerate() {
         let limit = |i: usize| j.limits.map_or_else(|| "–".to_owned(), |l| format!("{:.1} {}", l[i], j.unit));
-        let _ = write!(out, "<tr><td>{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td></tr>", k + 1, j.kind, limit(0), limit(1));
+        let _ = write!(
+            out,
+            "<tr><td>{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td></tr>",
+            k + 1,
+            j.kind,
+            limit(0),
+            limit(1)
+        );
     }
     out.push_str("</table></section>\n");
 }
@@ -165,7 +210,13 @@ fn data_table(out: &mut String, title: &str, d: &crate::content::DataSummary, un
         d.rows,
         if d.full_pose { "full pose (position and orientation)" } else { "position only" },
         d.payloads.iter().map(|(kg, n)| format!("{kg} kg ({n} rows)")).collect::<Vec<_>>().join(", "),
-        escape(&d.tools.iter().map(|(t, n)| format!("{} ({n} rows)", if t.is_empty() { "default" } else { t })).collect::<Vec<_>>().join(", "))
+        escape(
+            &d.tools
+                .iter()
+                .map(|(t, n)| format!("{} ({n} rows)", if t.is_empty() { "default" } else { t }))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
     );
     out.push_str("<table><tr><th>joint</th><th>smallest</th><th>largest</th></tr>");
     for (k, [a, b]) in d.joint_ranges.iter().enumerate() {
@@ -193,13 +244,24 @@ fn method(out: &mut String, r: &Report) {
         "<p>Method <b>{}</b>, fitted on {} (tools: {}). The model applies, in order: {}.</p>",
         escape(&r.model.method),
         if r.model.full_pose { "full poses" } else { "positions only" },
-        escape(&r.model.tools.iter().map(|t| if t.is_empty() { "default" } else { t.as_str() }).collect::<Vec<_>>().join(", ")),
+        escape(
+            &r.model
+                .tools
+                .iter()
+                .map(|t| if t.is_empty() { "default" } else { t.as_str() })
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
         escape(&r.model.parts.join(" → "))
     );
-    let _ = write!(
+    let _ = writeln!(
         out,
-        "<p>Effects: {}. Gaussian process: {}.</p></section>\n",
-        if r.effects.is_empty() { "none".to_owned() } else { escape(&r.effects.iter().map(|e| e.label.as_str()).collect::<Vec<_>>().join(", ")) },
+        "<p>Effects: {}. Gaussian process: {}.</p></section>",
+        if r.effects.is_empty() {
+            "none".to_owned()
+        } else {
+            escape(&r.effects.iter().map(|e| e.label.as_str()).collect::<Vec<_>>().join(", "))
+        },
         r.gp.as_ref().map_or("none".to_owned(), |g| format!("{} GP on {}", g.kind, g.inputs.join(", ")))
     );
 }
@@ -292,20 +354,25 @@ fn iso9283(out: &mut String, r: &Report) {
     open(out, "iso9283");
     let iso = &r.iso9283;
     out.push_str("<table><tr><th class=\"l\"></th><th>mean over poses (mm)</th><th>largest (mm)</th></tr>");
-    let _ = write!(out, "<tr><td class=\"l\">position accuracy AP</td>{}{}</tr>", cell("iso.ap_mean_mm", iso.ap_mean_mm, 4), cell("iso.ap_max_mm", iso.ap_max_mm, 4));
+    let _ = write!(
+        out,
+        "<tr><td class=\"l\">position accuracy AP</td>{}{}</tr>",
+        cell("iso.ap_mean_mm", iso.ap_mean_mm, 4),
+        cell("iso.ap_max_mm", iso.ap_max_mm, 4)
+    );
     match (iso.rp_mean_mm, iso.rp_max_mm) {
         (Some(mean), Some(max)) => {
             let _ = write!(out, "<tr><td class=\"l\">position repeatability RP</td>{}{}</tr>", cell("iso.rp_mean_mm", mean, 4), cell("iso.rp_max_mm", max, 4));
         }
         _ => out.push_str("<tr><td class=\"l\">position repeatability RP</td><td colspan=\"2\" class=\"l\">not measured: no pose of the data is repeated</td></tr>"),
     }
-    let _ = write!(
+    let _ = writeln!(
         out,
         "</table><p class=\"how\">How: ISO 9283:1998 §7.2.1 and §7.2.2, with the calibrated model's prediction from the \
          measured joint values as the command and the measured position as the attained one. Rows whose joint values \
          agree within {} rad are one pose measured again: {} poses, {} of them repeated. Per pose, AP = |x̄ − x_c|, the \
          distance of the attained positions' barycentre from the command; RP = l̄ + 3 S_l, l = |x − x̄|, with S_l the \
-         sample standard deviation of l.</p></section>\n",
+         sample standard deviation of l.</p></section>",
         iso.options.same_pose_rad, iso.poses, iso.repeated_poses
     );
 }
@@ -326,7 +393,8 @@ fn effects(out: &mut String, r: &Report) -> Result<(), Error> {
                      ticks: training angles (top, with <code>--train</code>) and test angles (bottom).</p>",
                 );
             }
-            None => out.push_str("<p class=\"how\">Not a function of one joint's angle alone: its parameters are listed.</p>"),
+            None => out
+                .push_str("<p class=\"how\">Not a function of one joint's angle alone: its parameters are listed.</p>"),
         }
         let shown = e.parameters.iter().take(24);
         out.push_str("<table><tr><th class=\"l\">parameter</th><th>value</th></tr>");
@@ -334,7 +402,11 @@ fn effects(out: &mut String, r: &Report) -> Result<(), Error> {
             let _ = write!(out, "<tr><td class=\"l\">{}</td><td>{value:.4e}</td></tr>", escape(name));
         }
         if e.parameters.len() > 24 {
-            let _ = write!(out, "<tr><td class=\"l\" colspan=\"2\">… {} more in the model file</td></tr>", e.parameters.len() - 24);
+            let _ = write!(
+                out,
+                "<tr><td class=\"l\" colspan=\"2\">… {} more in the model file</td></tr>",
+                e.parameters.len() - 24
+            );
         }
         out.push_str("</table>");
     }
@@ -348,21 +420,31 @@ fn gp(out: &mut String, r: &Report) {
         out.push_str("<p>The model has no Gaussian process.</p></section>\n");
         return;
     };
-    let _ = write!(out, "<p>An {} GP on the inputs {}. Length scales in standard deviations of each input over the training rows (a long length scale: the error barely changes with that input).</p>", g.kind, g.inputs.join(", "));
+    let _ = write!(
+        out,
+        "<p>An {} GP on the inputs {}. Length scales in standard deviations of each input over the training rows (a long length scale: the error barely changes with that input).</p>",
+        g.kind,
+        g.inputs.join(", ")
+    );
     out.push_str("<table><tr><th class=\"l\">outputs</th><th class=\"l\">kernel</th>");
     for input in &g.inputs {
         let _ = write!(out, "<th>{input}</th>");
     }
     out.push_str("</tr><tr><td class=\"l\" colspan=\"2\">one standard deviation of the input</td>");
     for (k, s) in g.input_scale.iter().enumerate() {
-        let unit = if g.inputs.get(k).is_some_and(|i| i == "payload") { format!("{s:.3} kg") } else { format!("{:.1}°", s.to_degrees()) };
+        let unit = if g.inputs.get(k).is_some_and(|i| i == "payload") {
+            format!("{s:.3} kg")
+        } else {
+            format!("{:.1}°", s.to_degrees())
+        };
         let _ = write!(out, "<td>{unit}</td>");
     }
     out.push_str("</tr>");
     for k in &g.kernels {
         let names = ["x", "y", "z", "rx", "ry", "rz"];
         let outputs: Vec<&str> = k.outputs.iter().map(|&o| names.get(o).copied().unwrap_or("?")).collect();
-        let _ = write!(out, "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td>", outputs.join(", "), escape(&k.family));
+        let _ =
+            write!(out, "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td>", outputs.join(", "), escape(&k.family));
         for (i, l) in k.length_scales.iter().enumerate() {
             let _ = write!(out, "<td data-key=\"gp.{}.{i}\" data-value=\"{l}\">{l:.3}</td>", outputs.join(""));
         }
@@ -401,11 +483,19 @@ fn worst(out: &mut String, r: &Report) {
         );
         for (j, q) in row.q.iter().enumerate() {
             let prismatic = r.robot.joints.get(j).is_some_and(|d| d.unit == "mm");
-            let _ = if prismatic { write!(out, "<td>{:.2} mm</td>", q * 1e3) } else { write!(out, "<td>{:.2}°</td>", q.to_degrees()) };
+            let _ = if prismatic {
+                write!(out, "<td>{:.2} mm</td>", q * 1e3)
+            } else {
+                write!(out, "<td>{:.2}°</td>", q.to_degrees())
+            };
         }
         out.push_str("</tr>");
     }
-    let _ = write!(out, "</table><p class=\"how\">Lines of <code>{}</code>, largest position error after calibration first.</p></section>\n", escape(&r.data.source));
+    let _ = writeln!(
+        out,
+        "</table><p class=\"how\">Lines of <code>{}</code>, largest position error after calibration first.</p></section>",
+        escape(&r.data.source)
+    );
 }
 
 /// The verdict in words.
@@ -424,7 +514,14 @@ pub(crate) fn diagnosis_section(out: &mut String, d: &Diagnosis, plots: &[(Strin
         "<div class=\"cards\"><div class=\"card\"><div class=\"s\">Verdict</div><div class=\"v\" data-key=\"diagnosis.verdict\">{}</div></div>",
         escape(&verdict(d))
     );
-    card(out, "diagnosis.heldout_before_mm", "Held-out error, geometric model", d.heldout_before_mm, "mm", "cross-validated mean");
+    card(
+        out,
+        "diagnosis.heldout_before_mm",
+        "Held-out error, geometric model",
+        d.heldout_before_mm,
+        "mm",
+        "cross-validated mean",
+    );
     card(
         out,
         "diagnosis.heldout_after_selected_mm",

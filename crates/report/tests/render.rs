@@ -40,8 +40,7 @@ fn rendered() -> &'static Rendered {
         let cell = campaign_cell(&robot, &Perturbation::default(), &Remount::default(), &train_config).unwrap();
         let ranges = joint_ranges(&robot);
         let train = simulate(&cell, &effects, &ranges, &train_config, false).unwrap();
-        let test: MeasurementSet =
-            simulate(&cell, &effects, &ranges, &payload_run_campaign(120, 12), false).unwrap();
+        let test: MeasurementSet = simulate(&cell, &effects, &ranges, &payload_run_campaign(120, 12), false).unwrap();
         let mut options = FitOptions::default();
         options.effects.selection = EffectSelection::List(vec![EffectSpec::GearPeriodic { joint: 2, harmonics: 2 }]);
         let (model, _) = pipeline::fit(&robot, &train, Method::PoeGp, &options).unwrap();
