@@ -268,22 +268,21 @@ pub fn effect_curve(label: &str, curve: &EffectCurve) -> Result<String, Error> {
             .label("joint error applied")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 12, y)], AFTER.stroke_width(2)));
         let tick = 0.05 * (y1 - y0);
+        // One tick per pixel of the ~560-pixel plot: a campaign's 1,400 angles drawn as at most
+        // 560 marks, the same picture in a third of the bytes.
+        let distinct = |angles: &[f64]| distinct_at(angles, (x1 - x0) / 560.0);
+        let (training, test) = (distinct(&curve.training_deg), distinct(&curve.test_deg));
         if !curve.training_deg.is_empty() {
             chart
                 .draw_series(
-                    curve
-                        .training_deg
-                        .iter()
-                        .map(|&a| PathElement::new(vec![(a, y1), (a, y1 - tick)], TRAINING.mix(0.6))),
+                    training.iter().map(|&a| PathElement::new(vec![(a, y1), (a, y1 - tick)], TRAINING.mix(0.6))),
                 )
                 .map_err(|e| e.to_string())?
                 .label("training angles")
                 .legend(|(x, y)| PathElement::new(vec![(x + 6, y - 5), (x + 6, y + 5)], TRAINING));
         }
         chart
-            .draw_series(
-                curve.test_deg.iter().map(|&a| PathElement::new(vec![(a, y0), (a, y0 + tick)], BLACK.mix(0.4))),
-            )
+            .draw_series(test.iter().map(|&a| PathElement::new(vec![(a, y0), (a, y0 + tick)], BLACK.mix(0.4))))
             .map_err(|e| e.to_string())?
             .label("test angles")
             .legend(|(x, y)| PathElement::new(vec![(x + 6, y - 5), (x + 6, y + 5)], BLACK.mix(0.5)));
@@ -295,4 +294,41 @@ pub fn effect_curve(label: &str, curve: &EffectCurve) -> Result<String, Error> {
             .draw()
             .map_err(|e| e.to_string())
     })
+}
+
+/// `values` rounded to multiples of `step`, each once, ascending.
+fn distinct_at(values: &[f64], step: f64) -> Vec<f64> {
+    let step = if step > 0.0 && step.is_finite() { step } else { 1.0 };
+    let mut out: Vec<f64> = values.iter().filter(|v| v.is_finite()).map(|v| (v / step).round() * step).collect();
+    out.sort_by(f64::total_cmp);
+    out.dedup();
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_closer_than_a_step_are_drawn_once() {
+        assert_eq!(distinct_at(&[1.0, 1.04, 2.0, f64::NAN, 0.96], 0.1), vec![1.0, 2.0]);
+    }
+
+    #[test]
+    fn viridis_runs_from_purple_to_yellow_and_clamps() {
+        assert_eq!(viridis(0.0), RGBColor(68, 1, 84));
+        assert_eq!(viridis(1.0), RGBColor(253, 231, 37));
+        assert_eq!(viridis(7.0), viridis(1.0));
+        assert_eq!(viridis(f64::NAN), viridis(0.0));
+    }
+
+    #[test]
+    fn a_scatter_plot_is_svg_with_every_finite_point() {
+        let series =
+            [Series { name: "a <b>".into(), after: true, points: vec![(0.0, 1.0), (1.0, 2.0), (f64::NAN, 1.0)] }];
+        let svg = scatter("t & u", "x", "y", &series).unwrap();
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        assert_eq!(svg.matches("<circle").count(), 2 + 1, "two points and one legend marker");
+        assert!(svg.contains("a &lt;b&gt;") && svg.contains("t &amp; u"), "text is escaped");
+    }
 }

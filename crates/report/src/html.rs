@@ -31,7 +31,7 @@ table{border-collapse:collapse;margin:.6em 0}td,th{border:1px solid #ddd;padding
 th{background:#f4f4f4}td.l,th.l{text-align:left}.cards{display:flex;flex-wrap:wrap;gap:.8em}\
 .card{border:1px solid #ccc;border-radius:6px;padding:.6em 1em;min-width:12em}.card .v{font-size:1.7em;font-weight:bold}\
 .card .s{color:#666;font-size:.9em}.warn{background:#fff4e0;border-left:4px solid #e09000;padding:.4em .8em;margin:.4em 0}\
-.ok{color:#2a7a2a}svg{max-width:100%;height:auto}pre{background:#f7f7f7;padding:.6em;overflow-x:auto;font-size:.85em}\
+.ok{color:#2a7a2a}svg{width:100%;max-width:880px;height:auto}#workspace svg{max-width:100%}pre{background:#f7f7f7;padding:.6em;overflow-x:auto;font-size:.85em}\
 p.how{color:#555;font-size:.92em}@media print{body{max-width:none}section{break-inside:avoid-page}h2{break-after:avoid}}";
 
 /// Escapes text for HTML.
@@ -372,7 +372,9 @@ fn iso9283(out: &mut String, r: &Report) {
          measured joint values as the command and the measured position as the attained one. Rows whose joint values \
          agree within {} rad are one pose measured again: {} poses, {} of them repeated. Per pose, AP = |x̄ − x_c|, the \
          distance of the attained positions' barycentre from the command; RP = l̄ + 3 S_l, l = |x − x̄|, with S_l the \
-         sample standard deviation of l.</p></section>",
+         sample standard deviation of l. ISO 9283 drives to the pose in consecutive cycles; a campaign's \
+         repeated rows may be hours apart, so this RP also holds what drifted between them (temperature, the \
+         tracker's placement).</p></section>",
         iso.options.same_pose_rad, iso.poses, iso.repeated_poses
     );
 }
@@ -456,7 +458,13 @@ fn gp(out: &mut String, r: &Report) {
 fn workspace(out: &mut String, r: &Report) -> Result<(), Error> {
     open(out, "workspace");
     out.push_str(&figures::workspace(&r.rows)?);
-    out.push_str("<p class=\"how\">Each test pose at its measured tool point in the tracker frame, coloured by its position error after calibration; the worst are drawn on top.</p></section>\n");
+    let _ = writeln!(
+        out,
+        "<p class=\"how\">Each test pose at its measured tool point in the tracker frame, coloured by its position \
+         error after calibration from 0 mm (dark purple) to the largest, {:.3} mm (yellow); the worst are drawn on \
+         top.</p></section>",
+        r.after_groups.all.summary.max_position_error_mm
+    );
     Ok(())
 }
 
@@ -534,12 +542,18 @@ pub(crate) fn diagnosis_section(out: &mut String, d: &Diagnosis, plots: &[(Strin
     out.push_str("</div>");
     let left = match &d.remaining {
         Some(gp) if gp.significant => format!(
-            "What is left: a GP on what the effects leave still lowers the held-out error to {:.4} mm (z = {:.1}): structure no listed effect explains.",
-            gp.heldout_after_gp_mm, gp.z
+            "What is left: a GP on what the selected effects leave still lowers the held-out error to {:.4} mm \
+             (z = {:.1}, {:.0} % less): structure no listed effect explains.",
+            gp.heldout_after_gp_mm,
+            gp.z,
+            100.0 * gp.gain
         ),
         Some(gp) => format!(
-            "What is left: no significant structure (a GP on it reaches {:.4} mm, z = {:.1}); the rest is at the noise floor's scale.",
-            gp.heldout_after_gp_mm, gp.z
+            "What is left: a GP on what the selected effects leave reaches {:.4} mm held out (z = {:.1}, {:.0} % \
+             less), below the diagnosis's threshold for structure that no listed effect explains.",
+            gp.heldout_after_gp_mm,
+            gp.z,
+            100.0 * gp.gain
         ),
         None => "What is left: not checked by a GP.".to_owned(),
     };
@@ -549,9 +563,10 @@ pub(crate) fn diagnosis_section(out: &mut String, d: &Diagnosis, plots: &[(Strin
         let joints: Vec<String> = c.joints.iter().map(ToString::to_string).collect();
         let _ = write!(
             out,
-            "<tr><td class=\"l\">{} {}</td><td>{}</td><td>{:.4}</td></tr>",
+            "<tr><td class=\"l\">{} {}{}</td><td>{}</td><td>{:.4}</td></tr>",
             c.effect.name().replace('_', " "),
             joints.join(", "),
+            c.harmonic.map_or_else(String::new, |h| format!(" (harmonics 1–{h})")),
             c.parameters,
             c.heldout_after_mm
         );
