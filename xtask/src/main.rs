@@ -23,6 +23,7 @@ mod fuzz_seeds;
 mod fuzz_worker;
 mod hostile;
 mod msrv;
+mod report_browser_check;
 mod reproduce_sim;
 mod reproduce_sim_params;
 mod reproduce_sim_report;
@@ -71,6 +72,8 @@ enum Command {
     Deps(deps::Args),
     /// Issue 26: `calib register` and `calib plan` on the real UR10 and simulated truth; print a table.
     CellCheck(cell_check::Args),
+    /// Render calibration reports in headless Chromium: a screenshot each, fail on console messages (not in CI).
+    ReportBrowserCheck(report_browser_check::Args),
     /// One fuzz worker (started by `fuzz`).
     #[command(hide = true)]
     FuzzWorker(fuzz_worker::Args),
@@ -97,6 +100,7 @@ fn main() -> ExitCode {
         Command::Fuzz(args) => fuzz::run(args).map_err(|e| format!("{e:#}")),
         Command::Msrv(args) => msrv::run(args).map_err(|e| format!("{e:#}")),
         Command::Deps(args) => deps::run(args).map_err(|e| format!("{e:#}")),
+        Command::ReportBrowserCheck(args) => report_browser_check::run(args).map_err(|e| format!("{e:#}")),
         Command::FuzzWorker(args) => fuzz_worker::run(args).map_err(|e| format!("{e:#}")),
     };
     match result {

@@ -371,7 +371,8 @@ pub fn run(args: &Args) -> Result<()> {
     }
     progress.finish_and_clear();
     if let Some(first) = checked.first() {
-        first.diagnosis.write_report(&args.out.join("ur10-diagnosis"), "--out", &pipeline::InputFiles::new())?;
+        let folder = args.out.join("ur10-diagnosis");
+        report::write_diagnosis_report(&first.diagnosis, &folder, "--out", &pipeline::InputFiles::new())?;
     }
     let section = diagnosis_section(args, &checked);
     let path = args.out.join("ur10.md");

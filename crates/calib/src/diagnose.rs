@@ -46,8 +46,11 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let options =
         DiagnoseOptions { folds: args.folds, seed: args.seed, noise_mm: args.noise_mm, ..DiagnoseOptions::default() };
     let diagnosis = diagnose(&robot, &data, &options)?;
-    let report =
-        args.report.as_deref().map(|folder| diagnosis.write_report(folder, "--report", &inputs)).transpose()?;
+    let report = args
+        .report
+        .as_deref()
+        .map(|folder| ::report::write_diagnosis_report(&diagnosis, folder, "--report", &inputs))
+        .transpose()?;
     if args.json {
         println!("{}", diagnosis.to_json()?);
         eprintln!("{}", data.read_summary());

@@ -9,6 +9,7 @@ mod fit;
 mod plan;
 mod predict;
 mod register;
+mod report;
 mod robot_args;
 mod simulate;
 
@@ -34,6 +35,7 @@ enum Command {
     Compensate(compensate::Args),
     Register(register::Args),
     Plan(plan::Args),
+    Report(report::Args),
 }
 
 fn main() -> ExitCode {
@@ -69,6 +71,7 @@ fn main() -> ExitCode {
         Command::Compensate(args) => compensate::run(&args),
         Command::Register(args) => register::run(&args),
         Command::Plan(args) => plan::run(&args),
+        Command::Report(args) => report::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,9 +6,7 @@ use super::noise::NoiseSource;
 use super::regions::{PoseDiagnosis, Region};
 use super::{Diagnosis, svg};
 use errors::Error;
-use measurements::InputFiles;
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
 
 /// One candidate tried alone on top of the geometric model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -353,24 +351,5 @@ impl Diagnosis {
             }
         }
         out
-    }
-
-    /// Writes the report folder: `diagnosis.md` and its SVG plots (the folder is made if need
-    /// be), each file atomically ([`measurements::write_file`]). Every file is checked against `inputs`
-    /// (as the output of `option`) before the first is written, so a refusal writes nothing.
-    /// Returns the path of `diagnosis.md`.
-    pub fn write_report(&self, folder: &Path, option: &'static str, inputs: &InputFiles) -> Result<PathBuf, Error> {
-        let plots = self.plots();
-        let names: Vec<String> = plots.iter().map(|(name, _)| name.clone()).collect();
-        let markdown = folder.join("diagnosis.md");
-        for path in names.iter().map(|name| folder.join(name)).chain([markdown.clone()]) {
-            inputs.check_output(option, &path)?;
-        }
-        std::fs::create_dir_all(folder).map_err(|source| Error::Io { path: folder.display().to_string(), source })?;
-        for (name, svg) in &plots {
-            measurements::write_file(&folder.join(name), svg.as_bytes())?;
-        }
-        measurements::write_file(&markdown, self.markdown(&names).as_bytes())?;
-        Ok(markdown)
     }
 }
