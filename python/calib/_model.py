@@ -43,7 +43,9 @@ def fit(
         force: fit data that the plausibility checks refuse, with a warning (``--force``).
 
     Returns:
-        The model; ``model.report`` is the :class:`FitReport` (``calib fit --json``).
+        The model; ``model.report`` is the :class:`FitReport` (``calib fit --json``). The model
+        is the one its file holds (written and read back, as ``calib fit`` then ``calib eval``
+        see it), so that ``eval`` and ``predict`` give the CLI's numbers to the last bit.
     """
     data = _measurements(data, robot)
     options_path = options if is_path(options) else None

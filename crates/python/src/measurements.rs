@@ -9,7 +9,7 @@
 use crate::error::{argument, to_py};
 use crate::model::Model;
 use crate::robot::Robot;
-use numpy::{PyArrayMethods, PyArray1, PyArray2, PyReadonlyArray1};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pipeline::{ColumnMap, MeasurementSet, ReadOptions};
 use pyo3::prelude::*;
 use std::path::PathBuf;
@@ -32,7 +32,10 @@ fn read_options(py: Python<'_>, against: Option<&Bound<'_, PyAny>>, columns: Col
         model.get().model.joint_kinds()
     } else {
         let _ = py;
-        return Err(argument("robot", "expected a calib Robot or Model (whose joints the columns are checked against)"));
+        return Err(argument(
+            "robot",
+            "expected a calib Robot or Model (whose joints the columns are checked against)",
+        ));
     };
     Ok(ReadOptions::for_joints(kinds).with_columns(columns))
 }
@@ -225,9 +228,14 @@ pub(crate) fn matrix<'py>(py: Python<'py>, rows: Vec<Vec<f64>>, width: usize) ->
 
 /// The columns as SPEC CSV text: header, then one record per row; numbers in Rust's shortest
 /// round-trip form.
-fn columns_csv(numeric: &[(String, Vec<f64>)], text: &[(String, Vec<String>)], rows: usize) -> Result<Vec<u8>, csv::Error> {
+fn columns_csv(
+    numeric: &[(String, Vec<f64>)],
+    text: &[(String, Vec<String>)],
+    rows: usize,
+) -> Result<Vec<u8>, csv::Error> {
     let mut out = csv::Writer::from_writer(Vec::new());
-    let header: Vec<&str> = numeric.iter().map(|(n, _)| n.as_str()).chain(text.iter().map(|(n, _)| n.as_str())).collect();
+    let header: Vec<&str> =
+        numeric.iter().map(|(n, _)| n.as_str()).chain(text.iter().map(|(n, _)| n.as_str())).collect();
     out.write_record(&header)?;
     let mut record: Vec<String> = Vec::with_capacity(header.len());
     for i in 0..rows {
