@@ -82,7 +82,8 @@ class Model:
         return cls(_calib.Model.load(path))
 
     def save(self, path: PathLike) -> None:
-        """Writes the model file (RON), as ``calib fit --out`` writes it."""
+        """Writes the model file (RON); for a model fitted in this session, byte for byte the file
+        ``calib fit --out`` writes."""
         self._core.save(path)
 
     def __repr__(self) -> str:

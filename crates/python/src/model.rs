@@ -16,7 +16,12 @@ use std::path::{Path, PathBuf};
 #[pyclass(module = "calib._calib", frozen)]
 #[derive(Debug, Clone)]
 pub struct Model {
+    /// The model as its file holds it: what predictions use.
     pub(crate) model: CalibratedModel,
+    /// For a model fitted in this session, the fit's own: what `save` writes, the bytes
+    /// `calib fit --out` writes (the file's text does not read back to the same bits, so a
+    /// model read back and written again differs from it in the last digits).
+    pub(crate) fitted: Option<CalibratedModel>,
     /// Where it was read from or fitted, for messages.
     pub(crate) name: String,
 }
@@ -58,15 +63,16 @@ pub fn fit(
         options.compensation.method = gp.parse::<GpChoice>().map_err(|e| argument("gp", e))?;
     }
     let (robot, data) = (&robot.description, &data.set);
-    let (model, report) = py
+    let ((model, fitted), report) = py
         .detach(|| {
-            let (model, report) = pipeline::fit(robot, data, method, &options)?;
-            Ok::<_, pipeline::Error>((as_its_file_holds(&model)?, report))
+            let (fitted, report) = pipeline::fit(robot, data, method, &options)?;
+            Ok::<_, pipeline::Error>(((as_its_file_holds(&fitted)?, fitted), report))
         })
         .map_err(to_py)?;
     let json = serde_json::to_string(&report).map_err(|e| argument("report", e))?;
     let warnings = report.warnings.iter().map(ToString::to_string).collect();
-    Ok((Model { model, name: format!("the {method} model fitted on {}", data.source) }, json, warnings))
+    let name = format!("the {method} model fitted on {}", data.source);
+    Ok((Model { model, fitted: Some(fitted), name }, json, warnings))
 }
 
 /// The model as its file holds it: written and read back, as `calib fit` then `calib eval` do.
@@ -91,13 +97,14 @@ impl Model {
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
         let model = py.detach(|| pipeline::read_model(&path)).map_err(to_py)?;
-        Ok(Self { model, name: path.display().to_string() })
+        Ok(Self { model, fitted: None, name: path.display().to_string() })
     }
 
     /// Writes the model file (RON) as `calib fit --out` does (atomically; never over a symbolic
     /// link's target without following it).
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        py.detach(|| pipeline::write_model(&path, &self.model)).map_err(to_py)
+        let model = self.fitted.as_ref().unwrap_or(&self.model);
+        py.detach(|| pipeline::write_model(&path, model)).map_err(to_py)
     }
 
     /// The method that produced the model.
