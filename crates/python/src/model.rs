@@ -1,0 +1,380 @@
+//! `Model` and `fit`: what `calib fit`, `eval`, `predict` and `compensate` do, on the same
+//! pipeline calls in the same order as `crates/calib/src/{fit,eval,predict,compensate}.rs`.
+
+use crate::error::{argument, to_py};
+use crate::robot::Robot;
+use crate::types::{Measurements, Model, matrix};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
+use pipeline::effects::EffectSelection;
+use pipeline::{
+    CalibratedModel, CompensateOptions, EvalReport, FitOptions, GpChoice, Measurement, Method, PredictedPose,
+};
+use pyo3::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Fits `method` to `data` for `robot` as `calib fit` does: options from a RON file or JSON text,
+/// then `effects`, `force` and `gp` over them, as the CLI's flags go over `--options`. Returns the
+/// model, the fit report as the JSON text `calib fit --json` prints, and its warnings in words.
+#[pyfunction]
+#[pyo3(signature = (robot, data, method, effects=None, gp=None, options_path=None, options_json=None, force=false))]
+#[allow(clippy::too_many_arguments)]
+pub fn fit(
+    py: Python<'_>,
+    robot: &Robot,
+    data: &Measurements,
+    method: &str,
+    effects: Option<&str>,
+    gp: Option<&str>,
+    options_path: Option<PathBuf>,
+    options_json: Option<&str>,
+    force: bool,
+) -> PyResult<(Model, String, Vec<String>)> {
+    let method: Method = method.parse().map_err(|e| argument("method", e))?;
+    let mut options = match (&options_path, options_json) {
+        (Some(path), _) => FitOptions::read(path).map_err(to_py)?,
+        (None, Some(json)) => {
+            let options: FitOptions = serde_json::from_str(json).map_err(|e| argument("options", e))?;
+            options.validate().map_err(|(_, message)| argument("options", message))?;
+            options
+        }
+        (None, None) => FitOptions::default(),
+    };
+    if let Some(effects) = effects {
+        options.effects.selection = effects.parse::<EffectSelection>().map_err(to_py)?;
+    }
+    if force {
+        options.plausibility.force = true;
+    }
+    if let Some(gp) = gp {
+        options.residual_gp.method = gp.parse::<GpChoice>().map_err(|e| argument("gp", e))?;
+    }
+    let (robot, data) = (&robot.description, &data.set);
+    let ((model, fitted), report) = py
+        .detach(|| {
+            let (fitted, report) = pipeline::fit(robot, data, method, &options)?;
+            Ok::<_, pipeline::Error>(((as_its_file_holds(&fitted)?, fitted), report))
+        })
+        .map_err(to_py)?;
+    let json = serde_json::to_string(&report).map_err(|e| argument("report", e))?;
+    let warnings = report.warnings.iter().map(ToString::to_string).collect();
+    let name = format!("the {method} model fitted on {}", data.source);
+    Ok((Model { model, fitted: Some(fitted), name }, json, warnings))
+}
+
+/// The model as its file holds it: written and read back, as `calib fit` then `calib eval` do.
+/// The file does not keep every bit of the fitted model (predictions moved by ~1e-12 mm on the
+/// test campaign), and the CLI only ever uses the file: so the package's numbers are the CLI's
+/// to the last bit.
+fn as_its_file_holds(model: &CalibratedModel) -> Result<CalibratedModel, pipeline::Error> {
+    let io = |source| pipeline::Error::Io { path: "a temporary model file".into(), source };
+    let folder = tempfile::tempdir().map_err(io)?;
+    let path = folder.path().join("model.ron");
+    pipeline::write_model(&path, model)?;
+    pipeline::read_model(&path)
+}
+
+/// What `predict` returns: poses, their standard deviations where the model has them, warnings.
+type Predicted<'py> = (Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray2<f64>>>, Vec<String>);
+
+#[pymethods]
+impl Model {
+    /// Reads a model file (RON, from `calib fit` or `Model.save`), with the checks `calib eval`
+    /// runs on it.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let model = py.detach(|| pipeline::read_model(&path)).map_err(to_py)?;
+        Ok(Self { model, fitted: None, name: path.display().to_string() })
+    }
+
+    /// Writes the model file (RON) as `calib fit --out` does (atomically; never over a symbolic
+    /// link's target without following it).
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let model = self.fitted.as_ref().unwrap_or(&self.model);
+        py.detach(|| pipeline::write_model(&path, model)).map_err(to_py)
+    }
+
+    /// The method that produced the model.
+    #[getter]
+    fn method(&self) -> String {
+        self.model.method.to_string()
+    }
+
+    /// The robot's name.
+    #[getter]
+    fn robot(&self) -> String {
+        self.model.robot.clone()
+    }
+
+    /// Whether the model was fitted on full poses (otherwise orientation is not calibrated).
+    #[getter]
+    fn full_pose(&self) -> bool {
+        self.model.full_pose
+    }
+
+    /// Tool identifiers (`""` the default tool).
+    #[getter]
+    fn tools(&self) -> Vec<String> {
+        self.model.tools.clone()
+    }
+
+    /// Number of joints.
+    #[getter]
+    fn joint_count(&self) -> usize {
+        self.model.joint_count()
+    }
+
+    /// Whether predictions carry a standard deviation.
+    #[getter]
+    fn predicts_std(&self) -> bool {
+        self.model.predicts_std()
+    }
+
+    /// The parts a URDF cannot hold (effects, the GP), in the order they apply.
+    #[getter]
+    fn non_geometric_parts(&self) -> Vec<String> {
+        self.model.non_geometric_parts()
+    }
+
+    /// `calib eval --json`: the report's JSON text, the position error of each row (mm), the
+    /// rotation error of each row (mrad; `None` unless data and model are full pose) and the
+    /// warnings the CLI prints.
+    #[allow(clippy::type_complexity)]
+    fn eval<'py>(
+        &self,
+        py: Python<'py>,
+        data: &Measurements,
+    ) -> PyResult<(String, Bound<'py, PyArray1<f64>>, Option<Bound<'py, PyArray1<f64>>>, Vec<String>)> {
+        let (model, set) = (&self.model, &data.set);
+        let (evaluation, report) = py
+            .detach(|| {
+                let evaluation = pipeline::evaluate(model, set)?;
+                let report = EvalReport::new(model, set, &evaluation);
+                Ok::<_, pipeline::Error>((evaluation, report))
+            })
+            .map_err(to_py)?;
+        let finite = |e: &pipeline::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
+        if let Some((row, _)) = set.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
+            return Err(crate::error::CalibError::new_err(non_finite(&self.name, &set.source, row.line)));
+        }
+        let mut warnings = Vec::new();
+        if report.orientations_not_evaluated {
+            warnings.push(pipeline::ORIENTATIONS_NOT_EVALUATED.to_owned());
+        }
+        warnings.extend(report.warnings.iter().map(ToString::to_string));
+        warnings.extend(report.out_of_range.iter().map(ToString::to_string));
+        warnings.extend(report.beyond_joint_limits.iter().map(ToString::to_string));
+        let json = serde_json::to_string(&report).map_err(|e| argument("report", e))?;
+        let position = PyArray1::from_vec(py, evaluation.errors.iter().map(|e| e.position_mm).collect());
+        let rotation: Option<Vec<f64>> = evaluation.errors.iter().map(|e| e.rotation_mrad).collect();
+        Ok((json, position, rotation.map(|r| PyArray1::from_vec(py, r)), warnings))
+    }
+
+    /// `calib predict` on a measurement set (tools matched by name, as the CLI matches them).
+    fn predict_set<'py>(&self, py: Python<'py>, data: &Measurements) -> PyResult<Predicted<'py>> {
+        let (model, set) = (&self.model, &data.set);
+        let tools = pipeline::tool_indices(model, set).map_err(to_py)?;
+        self.predict_rows(py, &set.rows, &tools, &set.source)
+    }
+
+    /// `calib predict` on arrays: `q` `(n, joints)` rad (m), and per row `payload_kg`, the tool
+    /// identifier, `temp_c`, `t_s` and `torques_nm` `(n, joints)` where the model needs them.
+    /// Row `i` is named line `i + 2` in messages, as in the CSV of the same rows.
+    #[pyo3(signature = (q, payload_kg=None, tools=None, temp_c=None, t_s=None, torques_nm=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn predict<'py>(
+        &self,
+        py: Python<'py>,
+        q: PyReadonlyArray2<'py, f64>,
+        payload_kg: Option<PyReadonlyArray1<'py, f64>>,
+        tools: Option<Vec<String>>,
+        temp_c: Option<PyReadonlyArray1<'py, f64>>,
+        t_s: Option<PyReadonlyArray1<'py, f64>>,
+        torques_nm: Option<PyReadonlyArray2<'py, f64>>,
+    ) -> PyResult<Predicted<'py>> {
+        let q = q.as_array();
+        let (n, joints) = q.dim();
+        if joints != self.model.joint_count() {
+            return Err(argument("q", format!("{joints} columns, the model has {} joints", self.model.joint_count())));
+        }
+        let column = |name: &str, values: Option<PyReadonlyArray1<'py, f64>>| -> PyResult<Option<Vec<f64>>> {
+            let Some(values) = values else { return Ok(None) };
+            let values = values.as_array().to_vec();
+            if values.len() != n {
+                return Err(argument(name, format!("{} values for {n} rows", values.len())));
+            }
+            Ok(Some(values))
+        };
+        let payload = column("payload_kg", payload_kg)?;
+        let temp = column("temp_c", temp_c)?;
+        let time = column("t_s", t_s)?;
+        let torques = torques_nm.map(|t| t.as_array().to_owned());
+        if let Some(t) = &torques
+            && t.dim() != (n, joints)
+        {
+            return Err(argument("torques_nm", format!("shape {:?}, expected ({n}, {joints})", t.dim())));
+        }
+        if let Some(tools) = &tools
+            && tools.len() != n
+        {
+            return Err(argument("tools", format!("{} values for {n} rows", tools.len())));
+        }
+        let source = "predict";
+        let line = |i: usize| i as u64 + 2;
+        let mut rows = Vec::with_capacity(n);
+        let mut indices = Vec::with_capacity(n);
+        for i in 0..n {
+            let row_q: Vec<f64> = q.row(i).to_vec();
+            let payload = payload.as_ref().map_or(0.0, |p| p[i]);
+            let extra = [payload, temp.as_ref().map_or(0.0, |t| t[i]), time.as_ref().map_or(0.0, |t| t[i])];
+            let torque_row = torques.as_ref().map(|t| t.row(i).to_vec()).unwrap_or_default();
+            if let Some(bad) = row_q.iter().chain(&extra).chain(&torque_row).find(|v| !v.is_finite()) {
+                return Err(argument("q", format!("row {i} has {bad}: every value must be finite")));
+            }
+            if payload < 0.0 {
+                return Err(argument("payload_kg", format!("row {i} has {payload} kg: a payload is not negative")));
+            }
+            let tool_name = tools.as_ref().map_or("", |t| t[i].as_str());
+            indices.push(self.model.tool_index(tool_name, source, line(i), 0).map_err(to_py)?);
+            rows.push(Measurement {
+                line: line(i),
+                q: row_q,
+                position: lie::Vector3::zeros(),
+                orientation: None,
+                payload_kg: payload,
+                tool: 0,
+                temp_c: temp.as_ref().map(|t| t[i]),
+                t_s: time.as_ref().map(|t| t[i]),
+                torques_nm: torques.as_ref().map(|t| t.row(i).to_vec()),
+            });
+        }
+        self.predict_rows(py, &rows, &indices, source)
+    }
+
+    /// `calib compensate`: targets rewritten so that the model reaches what they mean. Returns the
+    /// CSV text the CLI prints, the compensated joints `(n, joints)` (NaN where a row is refused),
+    /// residuals (mm, mrad; NaN where none), each row's status, the summary (JSON) and warnings.
+    #[pyo3(signature = (targets, robot=None, frame="tracker", columns=None))]
+    #[allow(clippy::type_complexity)]
+    fn compensate<'py>(
+        &self,
+        py: Python<'py>,
+        targets: PathBuf,
+        robot: Option<&Robot>,
+        frame: &str,
+        columns: Option<Vec<(String, String)>>,
+    ) -> PyResult<(
+        String,
+        Bound<'py, PyArray2<f64>>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<f64>>,
+        Vec<String>,
+        String,
+        Vec<String>,
+    )> {
+        let frame: pipeline::TargetFrame = frame.parse().map_err(|e| argument("frame", e))?;
+        let columns = match columns {
+            Some(pairs) if !pairs.is_empty() => {
+                let text: Vec<String> =
+                    pairs.iter().map(|(n, h)| format!("{n}=\"{}\"", h.replace('"', "\"\""))).collect();
+                text.join(",").parse::<pipeline::ColumnMap>().map_err(|e| argument("columns", e))?
+            }
+            _ => pipeline::ColumnMap::default(),
+        };
+        let model = &self.model;
+        let robot_ref = robot.map(|r| (&r.description, r.path.as_str()));
+        let (file, solved, summary, csv) = py
+            .detach(|| {
+                let file = pipeline::read_targets(&targets, model, columns)?;
+                let (solved, summary) =
+                    pipeline::compensate(model, &file, robot_ref, frame, &CompensateOptions::default())?;
+                let mut csv = Vec::new();
+                pipeline::write_compensated(&mut csv, &file, &solved)
+                    .map_err(|source| pipeline::Error::Io { path: "the compensated targets".into(), source })?;
+                Ok::<_, pipeline::Error>((file, solved, summary, csv))
+            })
+            .map_err(to_py)?;
+        let n = model.joint_count();
+        let q: Vec<Vec<f64>> =
+            solved.iter().map(|s| if s.status.is_ok() { s.q.clone() } else { vec![f64::NAN; n] }).collect();
+        let residual_mm = PyArray1::from_vec(py, solved.iter().map(|s| s.residual_m * 1e3).collect());
+        let residual_mrad =
+            PyArray1::from_vec(py, solved.iter().map(|s| s.residual_rad.map_or(f64::NAN, |r| r * 1e3)).collect());
+        let status = solved.iter().map(|s| s.status.to_string()).collect();
+        let mut warnings: Vec<String> = model.extrapolation(&file.set.rows).iter().map(ToString::to_string).collect();
+        warnings.extend(model.outside_training_range(&file.set.rows).iter().map(ToString::to_string));
+        warnings.extend(model.beyond_joint_limits(&file.set.rows).iter().map(ToString::to_string));
+        let summary = serde_json::to_string(&summary).map_err(|e| argument("summary", e))?;
+        let csv = String::from_utf8_lossy(&csv).into_owned();
+        Ok((csv, matrix(py, q, n)?, residual_mm, residual_mrad, status, summary, warnings))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Model({} of {:?}, {} joints, from {})",
+            self.model.method,
+            self.model.robot,
+            self.model.joint_count(),
+            self.name
+        )
+    }
+}
+
+impl Model {
+    /// The prediction of `rows` as `calib predict` makes it: poses `[x_mm, y_mm, z_mm]` and, for a
+    /// full-pose model, `qw, qx, qy, qz`; standard deviations in mm (and mrad); the refusal of a
+    /// non-finite pose; the warnings.
+    fn predict_rows<'py>(
+        &self,
+        py: Python<'py>,
+        rows: &[Measurement],
+        tools: &[usize],
+        source: &str,
+    ) -> PyResult<Predicted<'py>> {
+        let model = &self.model;
+        let (predictions, warnings) = py
+            .detach(|| {
+                let predictions = model.predict(rows, tools)?;
+                let mut warnings: Vec<String> = model.extrapolation(rows).iter().map(ToString::to_string).collect();
+                warnings.extend(model.outside_training_range(rows).iter().map(ToString::to_string));
+                warnings.extend(model.beyond_joint_limits(rows).iter().map(ToString::to_string));
+                Ok::<_, pipeline::Error>((predictions, warnings))
+            })
+            .map_err(to_py)?;
+        let finite = |p: &PredictedPose| {
+            let pose = p.pose;
+            pose.translation().iter().chain(pose.rotation().matrix().iter()).all(|v| v.is_finite())
+        };
+        if let Some(row) = rows.iter().zip(&predictions).find_map(|(row, p)| (!finite(p)).then_some(row)) {
+            return Err(crate::error::CalibError::new_err(non_finite(&self.name, source, row.line)));
+        }
+        let full = model.full_pose;
+        let width = if full { 7 } else { 3 };
+        let mut poses = Vec::with_capacity(predictions.len() * width);
+        let mut sigma = Vec::with_capacity(predictions.len() * (width - 1));
+        for p in &predictions {
+            poses.extend((p.pose.translation() * 1e3).iter());
+            if full {
+                poses.extend(p.pose.rotation().to_quaternion());
+            }
+            if let Some(std) = p.std {
+                sigma.extend(std[..if full { 6 } else { 3 }].iter().map(|s| s * 1e3));
+            }
+        }
+        let n = predictions.len();
+        let poses = PyArray1::from_vec(py, poses).reshape([n, width])?;
+        let sigma = if model.predicts_std() && sigma.len() == n * (width - 1) {
+            Some(PyArray1::from_vec(py, sigma).reshape([n, width - 1])?)
+        } else {
+            None
+        };
+        Ok((poses, sigma, warnings))
+    }
+}
+
+/// The refusal of a model that predicts a non-finite pose (the CLI's words).
+fn non_finite(model: &str, data: &str, line: u64) -> String {
+    format!(
+        "{}: the model predicts a non-finite pose for line {line} of {data}: a value in the model file is beyond any real range",
+        Path::new(model).display()
+    )
+}

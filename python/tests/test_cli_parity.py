@@ -1,0 +1,209 @@
+"""The package gives the CLI's numbers: each test runs the `calib` binary and the package on the
+same files and compares. JSON floats are printed in shortest round-trip form, so `==` on the
+parsed objects is equality to the last bit."""
+
+from __future__ import annotations
+
+import csv
+import io
+import threading
+
+import numpy as np
+import pytest
+
+import calib
+from conftest import ROBOT
+
+
+@pytest.fixture(scope="module")
+def robot() -> calib.Robot:
+    return calib.Robot.load(ROBOT)
+
+
+def test_simulate_writes_the_file_the_cli_writes(cli, robot, tmp_path):
+    theirs, ours = tmp_path / "cli.csv", tmp_path / "py.csv"
+    cli.run("simulate", "--robot", ROBOT, "--rows", "50", "--seed", "9", "--full-pose", "--torques", "--out", theirs)
+    data = calib.simulate(robot, rows=50, seed=9, full_pose=True, torques=True, out=ours)
+    assert ours.read_bytes() == theirs.read_bytes()
+    assert len(data) == 50 and data.full_pose
+    np.testing.assert_array_equal(data.q, calib.Measurements.read(theirs).q)
+
+
+@pytest.mark.parametrize("method,effects", [("poe", "none"), ("poe-gp-load", "joint_compliance")])
+def test_fit_report_and_model_file_equal_the_clis(cli, robot, campaign, tmp_path, method, effects):
+    theirs = tmp_path / "cli.ron"
+    report = cli.json(
+        "fit", "--robot", ROBOT, "--data", campaign["train"], "--method", method,
+        "--effects", effects, "--out", theirs, "--json",
+    )
+    model = calib.fit(robot, calib.Measurements.read(campaign["train"]), method=method, effects=effects)
+    assert model.report.as_dict() == report
+    assert model.report.after.mean_position_error_mm == report["after"]["mean_position_error_mm"]
+    ours = tmp_path / "py.ron"
+    model.save(ours)
+    assert ours.read_text() == theirs.read_text()
+
+
+def test_eval_equals_cli_eval_json(cli, robot, campaign, tmp_path):
+    path = tmp_path / "m.ron"
+    cli.run("fit", "--robot", ROBOT, "--data", campaign["train"], "--method", "poe-gp", "--out", path)
+    theirs = cli.json("eval", "--model", path, "--data", campaign["test"], "--json")
+    report = calib.Model.load(path).eval(campaign["test"])
+    assert report.as_dict() == theirs
+    assert report.n == 100 and report.mean_position_error_mm == theirs["mean_position_error_mm"]
+    errors = report.position_errors_mm
+    assert errors.shape == (100,)
+    assert np.mean(errors) == pytest.approx(theirs["mean_position_error_mm"], rel=1e-12)
+    assert np.max(errors) == theirs["max_position_error_mm"]
+
+
+def test_predict_equals_cli_predict_and_arrays_equal_a_set(cli, robot, campaign, tmp_path):
+    path = tmp_path / "m.ron"
+    cli.run("fit", "--robot", ROBOT, "--data", campaign["train"], "--method", "poe-gp-load", "--out", path)
+    printed = list(csv.DictReader(io.StringIO(cli.run("predict", "--model", path, "--data", campaign["test"]).stdout)))
+    model = calib.Model.load(path)
+    data = calib.Measurements.read(campaign["test"])
+    poses, sigma = model.predict(data.q, payload=data.payload_kg)
+    assert poses.shape == (100, 7) and sigma.shape == (100, 6)
+    keys = ["x_mm", "y_mm", "z_mm", "qw", "qx", "qy", "qz"]
+    theirs = np.array([[float(row[k]) for k in keys] for row in printed])
+    # The CLI prints 6 decimals of mm and 9 of a quaternion.
+    np.testing.assert_allclose(poses[:, :3], theirs[:, :3], rtol=0, atol=5.1e-7)
+    np.testing.assert_allclose(poses[:, 3:], theirs[:, 3:], rtol=0, atol=5.1e-10)
+    std_keys = ["std_x_mm", "std_y_mm", "std_z_mm", "std_rx_mrad", "std_ry_mrad", "std_rz_mrad"]
+    np.testing.assert_allclose(sigma, [[float(r[k]) for k in std_keys] for r in printed], rtol=0, atol=5.1e-7)
+    from_set, sigma_set = model.predict(data)
+    np.testing.assert_array_equal(from_set, poses)
+    np.testing.assert_array_equal(sigma_set, sigma)
+    # The payload matters to a poe-gp-load model: a wrong one must change the answer.
+    other, _ = model.predict(data.q, payload=data.payload_kg + 5.0)
+    assert np.max(np.abs(other[:, :3] - poses[:, :3])) > 1e-6
+
+
+def test_arrays_give_the_fit_of_the_file(robot, campaign):
+    data = calib.Measurements.read(campaign["train"])
+    arrays = calib.Measurements.from_arrays(
+        data.q, data.positions_mm, data.quaternions, payload_kg=data.payload_kg,
+        temp_c=data.temp_c, t_s=data.t_s,
+    )
+    assert len(arrays) == len(data) and arrays.full_pose and arrays.lines[0] == 2
+    from_file = calib.fit(robot, data, method="poe", effects=None).report.after
+    from_arrays = calib.fit(robot, arrays, method="poe", effects=None).report.after
+    # Positions went mm -> text -> m: equal to the last bit or two.
+    assert from_arrays.mean_position_error_mm == pytest.approx(from_file.mean_position_error_mm, abs=1e-9)
+    assert from_arrays.mean_rotation_error_mrad == pytest.approx(from_file.mean_rotation_error_mrad, abs=1e-9)
+
+
+def test_a_dataframe_reads_as_its_columns(robot, campaign):
+    pd = pytest.importorskip("pandas")
+    frame = pd.read_csv(campaign["train"])
+    data = calib.Measurements(frame)
+    np.testing.assert_array_equal(data.q, calib.Measurements.read(campaign["train"]).q)
+
+
+def test_refusals_keep_file_line_and_column(cli, robot, campaign, tmp_path):
+    lines = campaign["train"].read_text().splitlines()
+    header = lines[0].split(",")
+    row = lines[3].split(",")
+    row[header.index("y_mm")] = "abc"
+    bad = tmp_path / "bad.csv"
+    bad.write_text("\n".join([lines[0], lines[1], lines[2], ",".join(row)]) + "\n")
+    column = header.index("y_mm") + 1
+    with pytest.raises(calib.CalibError) as caught:
+        calib.Measurements.read(bad)
+    message = str(caught.value)
+    assert f"{bad}:4:{column}:" in message
+    assert message in cli.run("fit", "--robot", ROBOT, "--data", bad, "--method", "poe",
+                              "--out", tmp_path / "m.ron", check=False).stderr
+
+
+def test_arrays_name_the_line_of_a_bad_value(robot):
+    q = np.zeros((5, 6))
+    positions = np.ones((5, 3))
+    positions[2, 1] = np.nan
+    with pytest.raises(calib.CalibError, match=r"^arrays:4:\d+:"):
+        calib.Measurements.from_arrays(q, positions)
+    with pytest.raises(calib.CalibError, match="joint"):
+        calib.Measurements.from_arrays(np.zeros((5, 5)), np.ones((5, 3)), robot=robot)
+
+
+def test_a_missing_file_is_file_not_found(tmp_path):
+    with pytest.raises(FileNotFoundError, match="nowhere.csv"):
+        calib.Measurements.read(tmp_path / "nowhere.csv")
+    with pytest.raises(FileNotFoundError):
+        calib.Robot.load(tmp_path / "nowhere.ron")
+
+
+def test_bad_arguments_are_refused_by_name(robot, campaign):
+    data = calib.Measurements.read(campaign["train"])
+    with pytest.raises(ValueError, match="method"):
+        calib.fit(robot, data, method="poe+gp")
+    with pytest.raises(calib.CalibError, match="joint 9"):
+        calib.fit(robot, data, method="poe", effects="gear_periodic:9:2")
+    with pytest.raises(ValueError, match="max_iterations"):
+        calib.fit(robot, data, method="poe", effects=None, options={"identification": {"max_iterations": 0}})
+
+
+def test_options_mapping_goes_where_the_ron_file_goes(cli, robot, campaign, tmp_path):
+    ron = tmp_path / "fit.ron"
+    ron.write_text("(identification: (max_iterations: 3))")
+    theirs = cli.json("fit", "--robot", ROBOT, "--data", campaign["train"], "--method", "poe",
+                      "--options", ron, "--out", tmp_path / "m.ron", "--json")
+    train = calib.Measurements.read(campaign["train"])
+    from_dict = calib.fit(robot, train, method="poe", effects=None,
+                          options={"identification": {"max_iterations": 3}})
+    from_file = calib.fit(robot, train, method="poe", effects=None, options=ron)
+    assert from_dict.report.as_dict() == theirs == from_file.report.as_dict()
+
+
+def test_diagnose_equals_cli_diagnose_json(cli, robot, campaign):
+    theirs = cli.json("diagnose", "--robot", ROBOT, "--data", campaign["whole"], "--json")
+    diagnosis = calib.diagnose(robot, campaign["whole"])
+    assert diagnosis.as_dict() == theirs
+    assert diagnosis.effect == theirs["verdict"]["effect"]
+    assert diagnosis.predicted_shrink == pytest.approx(
+        1 - theirs["heldout_after_selected_mm"] / theirs["heldout_before_mm"])
+    assert "verdict:" in diagnosis.summary
+
+
+def test_compensate_prints_what_the_cli_prints(cli, robot, campaign, tmp_path):
+    path = tmp_path / "m.ron"
+    cli.run("fit", "--robot", ROBOT, "--data", campaign["train"], "--method", "poe", "--out", path)
+    data = calib.Measurements.read(campaign["test"])
+    targets = tmp_path / "targets.csv"
+    with open(targets, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow([f"q{k}_rad" for k in range(1, 7)])
+        for row in data.q[:20]:
+            w.writerow([repr(float(v)) for v in row])
+    theirs = cli.run("compensate", "--model", path, "--targets", targets, "--robot", ROBOT).stdout
+    result = calib.Model.load(path).compensate(targets, robot=robot)
+    assert result.csv == theirs
+    assert result.q.shape == (20, 6) and result.ok.all()
+    from_columns = calib.Model.load(path).compensate(
+        {f"q{k + 1}_rad": data.q[:20, k] for k in range(6)}, robot=robot)
+    np.testing.assert_array_equal(from_columns.q, result.q)
+
+
+def test_the_gil_is_released_during_a_fit(robot, campaign):
+    data = calib.Measurements.read(campaign["whole"])
+    done = {}
+    worker = threading.Thread(target=lambda: done.setdefault("m", calib.fit(robot, data, method="poe-gp", effects=None)))
+    ticks = 0
+    worker.start()
+    while worker.is_alive():
+        ticks += 1
+    worker.join()
+    assert "m" in done
+    # Held, the GIL would stop this thread for the whole fit (a few ticks at most).
+    assert ticks > 1000, ticks
+
+
+def test_a_saved_model_predicts_as_the_fitted_one(robot, campaign, tmp_path):
+    model = calib.fit(robot, campaign["train"], method="poe", effects=None)
+    model.save(tmp_path / "m.ron")
+    q = calib.Measurements.read(campaign["test"]).q
+    np.testing.assert_array_equal(calib.Model.load(tmp_path / "m.ron").predict(q)[0], model.predict(q)[0])
+    assert model.predict(q[0])[0].shape == (1, 7)
+    with pytest.raises(ValueError, match="joints"):
+        model.predict(q[:, :5])
