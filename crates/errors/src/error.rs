@@ -581,6 +581,24 @@ pub enum Error {
         /// The joint count.
         joints: usize,
     },
+    /// Measured positions that leave a plane, for a planar chain (whose tool moves in one): the
+    /// data of another robot, or a joint axis wrong in the robot file.
+    PlanarChainData {
+        /// The measurement file.
+        file: String,
+        /// The robot's name.
+        robot: String,
+        /// The direction every revolute axis is parallel to.
+        direction: [f64; 3],
+        /// The joint count.
+        joints: usize,
+        /// RMS distance of the measured positions from their best plane, mm.
+        out_of_plane_mm: f64,
+        /// RMS distance of the measured positions from their centroid, mm.
+        spread_mm: f64,
+        /// Refused above this ratio of the two (`PlausibilityOptions::planar_ratio`).
+        ratio: f64,
+    },
     /// An output path that starts a chain of more symbolic links than are followed (a loop).
     OutputSymlinkChain {
         /// The path as given.
@@ -866,6 +884,17 @@ impl fmt::Display for Error {
                  ones slide across it), so the tool moves in a plane and 3-D positions cannot be drawn for it; \
                  check the joint axes"
             ),
+            Error::PlanarChainData { file, robot, direction: [a, b, c], joints, out_of_plane_mm, spread_mm, ratio } => {
+                write!(
+                    f,
+                    "{file}: the positions leave a plane, but {robot}'s chain is planar: all {joints} joints turn about \
+                     axes parallel to ({a}, {b}, {c}), so its tool moves in a plane; the positions lie {out_of_plane_mm:.1} mm \
+                     RMS off their best plane, {:.1} % of their {spread_mm:.1} mm spread (accepted: {:.1} %): the data of \
+                     another robot, or a joint axis wrong in the robot file?",
+                    100.0 * out_of_plane_mm / spread_mm,
+                    100.0 * ratio
+                )
+            }
             Error::OutputSymlinkChain { path, links } => {
                 write!(f, "{path}: more than {links} symbolic links in a row (a loop?): refusing to write there")
             }

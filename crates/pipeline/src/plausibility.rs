@@ -58,6 +58,14 @@ pub struct PlausibilityOptions {
     /// moving at 200 (1.09 mm against 1.09 mm). Each iteration is one pass over the rows, without
     /// forward kinematics.
     pub max_iterations: usize,
+    /// For a planar chain (every revolute axis parallel, every prismatic one across them): refuse
+    /// the data when the measured positions lie further from their best plane (RMS) than this
+    /// fraction of their spread: 0.05. A planar arm's axes are parallel to machining tolerance,
+    /// a tenth of a milliradian to a milliradian, which tilts its plane of motion by that
+    /// fraction of its reach at most; 0.05 (2.9°) is far beyond that, and far below the spread of
+    /// 3-D data, which leaves any plane by a third of its spread or more (the fixtures' simulated
+    /// campaigns, the UR10's real series).
+    pub planar_ratio: f64,
 }
 
 impl Default for PlausibilityOptions {
@@ -71,6 +79,7 @@ impl Default for PlausibilityOptions {
             limit_margin_rad: 2f64.to_radians(),
             limit_margin_m: 0.002,
             max_iterations: 500,
+            planar_ratio: 0.05,
         }
     }
 }
@@ -92,6 +101,7 @@ impl PlausibilityOptions {
             ("max_tool_offset_m", self.max_tool_offset_m, 0.0, false),
             ("limit_margin_rad", self.limit_margin_rad, 0.0, true),
             ("limit_margin_m", self.limit_margin_m, 0.0, true),
+            ("planar_ratio", self.planar_ratio, 0.0, false),
         ];
         for (field, value, lowest, inclusive) in bounded {
             if !(value.is_finite() && (value > lowest || (inclusive && value == lowest))) {
@@ -127,6 +137,9 @@ pub struct PlausibilityReport {
     pub rotation_rms_mm: f64,
     /// RMS residual of the best reflection, mm.
     pub reflection_rms_mm: f64,
+    /// For a planar chain only: the measured positions' RMS distance from their best plane, mm.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub out_of_plane_mm: Option<f64>,
 }
 
 /// The checks' measurements and what they refuse, in order: joint limits, scale, handedness.
@@ -162,6 +175,23 @@ pub(crate) fn check(
         flanges.push((pose.rotation().matrix(), pose.translation()));
     }
     let measured: Vec<Vector3> = data.rows.iter().map(|r| r.position).collect();
+    // A planar chain's tool moves in a plane: data that leave every plane are another robot's,
+    // and fit it with the axes tilted to reach them (refused first: it explains the rest).
+    let planar = robot.planar_direction().map(|direction| (direction, out_of_plane(&measured)));
+    if let Some((direction, out_of_plane)) = planar {
+        let spread = spread(&measured);
+        if out_of_plane > options.planar_ratio * spread {
+            refusals.push(Error::PlanarChainData {
+                file: data.source.clone(),
+                robot: robot.name.clone(),
+                direction,
+                joints: robot.joint_count(),
+                out_of_plane_mm: out_of_plane * 1e3,
+                spread_mm: spread * 1e3,
+                ratio: options.planar_ratio,
+            });
+        }
+    }
     let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
     let tool_count = data.tools.len().max(1 + tools.iter().copied().max().unwrap_or(0));
     let problem = Alignment { flanges: &flanges, tools: &tools, measured: &measured, tool_count, options };
@@ -176,6 +206,7 @@ pub(crate) fn check(
         scale_ratio,
         rotation_rms_mm: rotation.rms * 1e3,
         reflection_rms_mm: reflection.rms * 1e3,
+        out_of_plane_mm: planar.map(|(_, distance)| distance * 1e3),
     };
     let (lo, hi) = options.scale_band;
     if let Some(ratio) = scale_ratio
@@ -258,6 +289,16 @@ fn spread(points: &[Vector3]) -> f64 {
     let n = points.len() as f64;
     let centroid = points.iter().sum::<Vector3>() / n;
     (points.iter().map(|p| (p - centroid).norm_squared()).sum::<f64>() / n).sqrt()
+}
+
+/// RMS distance of the points from their best plane (least squares: the square root of the
+/// smallest eigenvalue of their covariance).
+fn out_of_plane(points: &[Vector3]) -> f64 {
+    let n = points.len() as f64;
+    let centroid = points.iter().sum::<Vector3>() / n;
+    let covariance = points.iter().map(|p| (p - centroid) * (p - centroid).transpose()).sum::<Matrix3>() / n;
+    let smallest = covariance.symmetric_eigenvalues().min();
+    smallest.max(0.0).sqrt()
 }
 
 /// The alternating alignment of the nominal tool points with the measured points.
