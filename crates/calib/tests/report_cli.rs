@@ -68,3 +68,43 @@ fn the_diagnosis_folder_has_its_plots_its_markdown_and_the_page() {
     }
     assert!(page.contains("<section id=\"diagnosis\">"));
 }
+
+#[test]
+fn the_model_keeps_its_robot_and_the_fit_s_warnings_so_the_report_needs_neither_robot_nor_fit_output() {
+    let dir = tempfile::tempdir().unwrap();
+    // 15 position-only rows for a full POE fit: few rows per parameter, which the fit warns of.
+    let (train, test) = (simulated(dir.path(), 15, 8), simulated(dir.path(), 60, 9));
+    let model = dir.path().join("model.ron");
+    let robot = fixture("irb4400.ron");
+    let fit = ["fit", "--robot", &robot, "--data", &text(&train), "--method", "poe", "--out", &text(&model)];
+    let (printed, _) = succeeds_with_stderr(&fit);
+    let warning = printed.lines().find(|l| l.contains("warning:")).unwrap_or_else(|| panic!("no warning: {printed}"));
+    let kept = std::fs::read_to_string(&model).unwrap();
+    assert!(kept.contains("fit_warnings: Some([") && kept.contains("robot_description: Some("), "{kept}");
+    let out = dir.path().join("report.html");
+    let report = ["report", "--model", &text(&model), "--data", &text(&test), "--out", &text(&out)];
+    succeeds_with_stderr(&report);
+    let html = std::fs::read_to_string(&out).unwrap();
+    let section = html.split("<h3>From the fit</h3>").nth(1).unwrap().split("<h3>").next().unwrap();
+    let said = warning.split("warning:").nth(1).unwrap().trim();
+    let first_words: String = said.chars().take(40).collect();
+    assert!(section.contains(&first_words), "{first_words:?} not in {section}");
+    assert!(html.contains(&format!("{} (as the model keeps it)", text(&model))), "the robot's source");
+
+    // A model written before both were kept: the report asks for --robot, and then says that the
+    // fit's warnings are not in the file.
+    let older = dir.path().join("older.ron");
+    let cut = kept.find("    fit_warnings:").unwrap();
+    std::fs::write(&older, format!("{})\n", &kept[..cut])).unwrap();
+    let report = ["report", "--model", &text(&older), "--data", &text(&test), "--out", &text(&out)];
+    let refused = fails(&report);
+    assert!(
+        refused.contains("older.ron: the model does not keep its robot description")
+            && refused.contains("give --robot"),
+        "{refused}"
+    );
+    let with_robot = [&report[..], &["--robot", &robot]].concat();
+    succeeds_with_stderr(&with_robot);
+    let html = std::fs::read_to_string(&out).unwrap();
+    assert!(html.contains("This model file was written before the fit's own warnings"), "no note on the older file");
+}

@@ -22,6 +22,8 @@
 //!     residual_gp: None,
 //!     training_range: None,
 //!     joint_limits: Vec::new(),
+//!     fit_warnings: None,
+//!     robot_description: None,
 //! };
 //! // Joint values that reach five poses the model predicts, from seeds 0.02 rad off.
 //! let rows = &data.rows[..5];

@@ -46,6 +46,18 @@ pub struct CalibratedModel {
     /// and `compensate` count rows beyond them. Files written before they were kept have none.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub joint_limits: Vec<Option<[f64; 2]>>,
+    /// The fit's own warnings, as `calib fit` printed them (few rows per parameter, gross
+    /// outliers, a fit forced past the plausibility check, a GP search stopped early), so that a
+    /// report written later shows them: empty when it gave none. `None` in files written before
+    /// they were kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fit_warnings: Option<Vec<String>>,
+    /// The robot description the fit started from (its nominal geometry, limits and masses), so
+    /// that the model alone can say what the robot did before calibration. Last in the file, so
+    /// the checks' field positions above are not moved by its fields. Files written before it was
+    /// kept have none (a command that needs it then asks for `--robot`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robot_description: Option<robot::RobotDescription>,
 }
 
 /// A predicted tool pose and, where a GP is part of the model, its standard deviation.

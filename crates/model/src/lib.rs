@@ -22,6 +22,8 @@
 //!     residual_gp: None,
 //!     training_range: None,
 //!     joint_limits: Vec::new(),
+//!     fit_warnings: None,
+//!     robot_description: Some(robot.clone()),
 //! };
 //! let evaluation = model::evaluate(&model, &data)?;
 //! assert!(evaluation.summary.mean_position_error_mm < 0.01); // no noise, no effect: the geometry is all

@@ -65,6 +65,34 @@ fn occurrences_before(text: &str, field: &str, part: &str) -> usize {
 /// still a corrupt file.
 pub(crate) const MAX_HYPERPARAMETER_DECADES: f64 = 100.0;
 
+/// The robot description a model carries: valid as a robot file would be (its checks, on the
+/// description written out again), with the model's joints. Refused at `robot_description`.
+fn check_robot(robot: &robot::RobotDescription, model: &CalibratedModel, at: &Located<'_>) -> Result<(), Error> {
+    let field = "robot_description";
+    // Its own text, from the field on, so that the robot's checks point into the model file.
+    let (line, _) = at.at(field, 0);
+    let start: usize = at.text.split_inclusive('\n').take(line - 1).map(str::len).sum();
+    match robot.check_kept(&at.text[start.min(at.text.len())..], at.file) {
+        Ok(()) => {}
+        Err(Error::RonFormat { file, line: relative, column, message }) => {
+            let message = format!("robot_description is not a valid robot: {message}");
+            return Err(Error::RonFormat { file, line: line + relative - 1, column, message });
+        }
+        Err(e) => return Err(at.part(field, format!("robot_description is not a valid robot: {e}"))),
+    }
+    let kinds = robot.joint_kinds();
+    if kinds != model.joint_kinds() {
+        let (found, expected) = (kinds.len(), model.joint_count());
+        if found != expected {
+            return Err(at.count((field, 0), field.into(), "joints", found, expected));
+        }
+        return Err(
+            at.part(field, "robot_description: its joint kinds are not the kinematics' (another robot?)".into())
+        );
+    }
+    Ok(())
+}
+
 impl CalibratedModel {
     /// Checks that the parts of the model fit together: the kinematics' joint and tool counts,
     /// the tool names, the effects' joints, indices and values, the GP's input and output
@@ -99,6 +127,9 @@ impl CalibratedModel {
         if self.method.uses_gp() != self.residual_gp.is_some() {
             let has = if self.residual_gp.is_some() { "has a" } else { "has no" };
             return Err(at.part("method", format!("method {} but the model {has} GP compensation", self.method)));
+        }
+        if let Some(robot) = &self.robot_description {
+            check_robot(robot, self, &at)?;
         }
         effects::check_effects(&self.effects, n, tool_count, &|field, occurrence| {
             let before = occurrences_before(text, field, "effects");

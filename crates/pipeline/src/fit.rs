@@ -178,6 +178,8 @@ pub fn fit(
         residual_gp: None,
         training_range: model::TrainingRange::of(&data.rows),
         joint_limits: model::stored_limits(&robot.limits()),
+        fit_warnings: Some(Vec::new()),
+        robot_description: Some(robot.clone()),
     };
     let mut identification = geometry.report;
     let mut auto = None;
@@ -269,6 +271,7 @@ pub fn fit(
             });
         }
     }
+    model.fit_warnings = Some(warnings.iter().map(ToString::to_string).collect());
     let report = FitReport {
         method,
         n: data.rows.len(),

@@ -279,3 +279,24 @@ fn an_absurd_effect_coefficient_is_refused_at_its_field() {
     let (error, message) = refused(&text_of(&model));
     assert!(matches!(error, Error::ModelValue { ref field, .. } if field == "effects[1].theta[0]"), "{message}");
 }
+
+/// `text` with the first `from` after `robot_description:` replaced by `to`.
+fn in_robot(text: &str, from: &str, to: &str) -> String {
+    let start = text.find("robot_description:").expect("the model keeps its robot");
+    format!("{}{}", &text[..start], text[start..].replacen(from, to, 1))
+}
+
+#[test]
+fn the_robot_a_model_keeps_is_checked_as_a_robot_file_and_against_the_kinematics() {
+    let (model, text) = fitted(false);
+    assert_eq!(model.robot_description, Some(irb4400()), "the robot the fit started from");
+    let (_, message) = refused(&in_robot(&text, "axis: (0.0,", "axis: (5.0,"));
+    assert!(message.contains("robot_description is not a valid robot") && message.contains("norm"), "{message}");
+    let prismatic = in_robot(&text, "kind: Revolute", "kind: Prismatic");
+    let (_, message) =
+        refused(&in_robot(&prismatic, "limits_deg: Some((-165.0, 165.0))", "limits_m: Some((0.0, 1.0))"));
+    assert!(message.contains("its joint kinds are not the kinematics'"), "{message}");
+    let line: usize = message.split(':').nth(1).unwrap().parse().unwrap();
+    let field_line = 1 + text[..text.find("robot_description:").unwrap()].matches('\n').count();
+    assert_eq!(line, field_line, "{message}");
+}

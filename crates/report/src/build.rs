@@ -112,6 +112,7 @@ impl Report {
             effects: model.effects.iter().map(|e| effect_view(e, data, inputs.training, options)).collect(),
             gp: model.residual_gp.as_ref().map(|c| gp_view(&c.gp, c.with_payload, model.joint_count())),
             warnings: warnings(model, &eval),
+            fit_warnings: model.fit_warnings.clone(),
             eval,
             diagnosis,
         })
@@ -353,7 +354,8 @@ fn warnings(model: &CalibratedModel, eval: &EvalReport) -> Vec<String> {
     if eval.orientations_not_evaluated {
         out.push(pipeline::ORIENTATIONS_NOT_EVALUATED.to_owned());
     }
-    if let Some(residual_gp) = &model.residual_gp {
+    // A model that keeps the fit's warnings says this itself, among them.
+    if let Some(residual_gp) = model.residual_gp.as_ref().filter(|_| model.fit_warnings.is_none()) {
         let converged = |o: &Option<gp::OptimisationReport>| o.as_ref().is_none_or(|o| o.converged);
         let unconverged: Vec<&[usize]> = match &residual_gp.gp {
             GpModel::Exact(g) => {

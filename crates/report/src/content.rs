@@ -32,8 +32,11 @@ pub struct Report {
     pub effects: Vec<EffectView>,
     /// The GP's length scales per input, where the model has a GP.
     pub gp: Option<GpView>,
-    /// What the user should know before trusting the numbers.
+    /// What the user should know before trusting the numbers: the evaluation's.
     pub warnings: Vec<String>,
+    /// The fit's own warnings, as the model file keeps them (`None`: a model written before they
+    /// were kept).
+    pub fit_warnings: Option<Vec<String>>,
     /// The diagnosis of the training data, when it was given.
     #[serde(skip)]
     pub diagnosis: Option<Diagnosis>,

@@ -14,6 +14,16 @@ const AFTER: RGBColor = RGBColor(0x1f, 0x6f, 0xb4);
 const TRAINING: RGBColor = RGBColor(0xd9, 0x6c, 0x1e);
 
 const FONT: &str = "sans-serif";
+/// Tick labels and legend text, px of a 640-pixel-wide chart (shown at up to 880 px: 14 to 19 px
+/// on the page, the body text's size).
+const LABEL: u32 = 14;
+/// Axis names.
+const DESC: u32 = 15;
+/// Tick labels and axis names of the 1100-pixel-wide workspace figure, shown at the page's width
+/// (about 0.65 of its pixels on a laptop screen: 12 px on the page).
+const WIDE_LABEL: u32 = 18;
+/// Its plot titles.
+const WIDE_CAPTION: u32 = 20;
 
 /// Viridis (van der Walt & Smith, matplotlib 2.0's default: perceptually uniform, legible in grey
 /// and to the colour-blind) at `t` in [0, 1], linear between nine of its samples.
@@ -82,15 +92,23 @@ fn svg(
 pub fn scatter(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Result<String, Error> {
     let (x0, x1) = span(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)), (0.0, 1.0));
     let (_, y1) = span(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)).chain([0.0]), (0.0, 1.0));
-    svg(title, (640, 400), |root| {
-        let mut chart = ChartBuilder::on(root)
+    svg(title, (820, 400), |root| {
+        let (plot, legend) = root.split_horizontally(640);
+        let mut chart = ChartBuilder::on(&plot)
             .caption(title, (FONT, 16))
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(60)
             .build_cartesian_2d(x0..x1, 0.0..y1 * 1.05)
             .map_err(|e| e.to_string())?;
-        chart.configure_mesh().x_desc(x_label).y_desc(y_label).draw().map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .label_style((FONT, LABEL))
+            .axis_desc_style((FONT, DESC))
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .draw()
+            .map_err(|e| e.to_string())?;
         for s in series {
             let colour = if s.after { AFTER } else { BEFORE };
             chart
@@ -100,17 +118,11 @@ pub fn scatter(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> 
                         .filter(|(x, y)| x.is_finite() && y.is_finite())
                         .map(|&p| Circle::new(p, 2, colour.mix(0.55).filled())),
                 )
-                .map_err(|e| e.to_string())?
-                .label(s.name.as_str())
-                .legend(move |(x, y)| Circle::new((x + 8, y), 4, colour.filled()));
+                .map_err(|e| e.to_string())?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.3))
-            .draw()
-            .map_err(|e| e.to_string())
+        let entries: Vec<(&str, Glyph)> =
+            series.iter().map(|s| (s.name.as_str(), Glyph::Dot(if s.after { AFTER } else { BEFORE }.into()))).collect();
+        side_legend(&legend, &entries)
     })
 }
 
@@ -138,7 +150,14 @@ pub fn histogram(before: Option<&[f64]>, after: &[f64]) -> Result<String, Error>
             .y_label_area_size(60)
             .build_cartesian_2d(0.0..top, 0.0..peak as f64 * 1.08)
             .map_err(|e| e.to_string())?;
-        chart.configure_mesh().x_desc("position error (mm)").y_desc("rows").draw().map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .label_style((FONT, LABEL))
+            .axis_desc_style((FONT, DESC))
+            .x_desc("position error (mm)")
+            .y_desc("rows")
+            .draw()
+            .map_err(|e| e.to_string())?;
         let mut bars = |counts: &[usize], colour: RGBColor, name: &str| -> Result<(), String> {
             chart
                 .draw_series(counts.iter().enumerate().filter(|(_, c)| **c > 0).map(|(k, &c)| {
@@ -157,6 +176,7 @@ pub fn histogram(before: Option<&[f64]>, after: &[f64]) -> Result<String, Error>
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperRight)
+            .label_font((FONT, LABEL))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK.mix(0.3))
             .draw()
@@ -174,7 +194,7 @@ pub fn workspace(rows: &[RowError]) -> Result<String, Error> {
     order.sort_by(|a, b| a.after_mm.total_cmp(&b.after_mm));
     let coordinate = |r: &RowError, k: usize| r.position_m[k];
     svg("workspace", (1100, 440), |root| {
-        let (plots, bar) = root.split_horizontally(1020);
+        let (plots, bar) = root.split_horizontally(990);
         let halves = plots.split_evenly((1, 2));
         for (area, (k, name)) in halves.iter().zip([(1, "y (m)"), (2, "z (m)")]) {
             let (x0, x1) = span(rows.iter().map(|r| coordinate(r, 0)), (0.0, 1.0));
@@ -183,13 +203,20 @@ pub fn workspace(rows: &[RowError]) -> Result<String, Error> {
             let ((x0, x1), (y0, y1)) = (pad(x0, x1), pad(y0, y1));
             let title = if k == 1 { "From above (tracker x–y)" } else { "From the side (tracker x–z)" };
             let mut chart = ChartBuilder::on(area)
-                .caption(title, (FONT, 15))
+                .caption(title, (FONT, WIDE_CAPTION))
                 .margin(10)
-                .x_label_area_size(40)
-                .y_label_area_size(55)
+                .x_label_area_size(50)
+                .y_label_area_size(75)
                 .build_cartesian_2d(x0..x1, y0..y1)
                 .map_err(|e| e.to_string())?;
-            chart.configure_mesh().x_desc("x (m)").y_desc(name).draw().map_err(|e| e.to_string())?;
+            chart
+                .configure_mesh()
+                .label_style((FONT, WIDE_LABEL))
+                .axis_desc_style((FONT, WIDE_LABEL))
+                .x_desc("x (m)")
+                .y_desc(name)
+                .draw()
+                .map_err(|e| e.to_string())?;
             chart
                 .draw_series(
                     order
@@ -201,13 +228,15 @@ pub fn workspace(rows: &[RowError]) -> Result<String, Error> {
         let mut scale = ChartBuilder::on(&bar)
             .margin_top(40)
             .margin_bottom(50)
-            .y_label_area_size(45)
+            .y_label_area_size(80)
             .build_cartesian_2d(0.0..1.0, 0.0..e_max)
             .map_err(|e| e.to_string())?;
         scale
             .configure_mesh()
             .disable_x_mesh()
             .disable_x_axis()
+            .label_style((FONT, WIDE_LABEL))
+            .axis_desc_style((FONT, WIDE_LABEL))
             .y_desc("error (mm)")
             .draw()
             .map_err(|e| e.to_string())?;
@@ -230,8 +259,9 @@ pub fn effect_curve(label: &str, curve: &EffectCurve) -> Result<String, Error> {
     let (y0, y1) = span(band.flat_map(|(e, s)| [e - s, e + s]).chain([0.0]), (-1.0, 1.0));
     let pad = 0.12 * (y1 - y0);
     let (y0, y1) = (y0 - pad, y1 + pad);
-    svg(label, (640, 360), |root| {
-        let mut chart = ChartBuilder::on(root)
+    svg(label, (820, 360), |root| {
+        let (plot, legend) = root.split_horizontally(640);
+        let mut chart = ChartBuilder::on(&plot)
             .caption(format!("{label}: joint {} error", curve.joint), (FONT, 15))
             .margin(12)
             .x_label_area_size(40)
@@ -240,6 +270,8 @@ pub fn effect_curve(label: &str, curve: &EffectCurve) -> Result<String, Error> {
             .map_err(|e| e.to_string())?;
         chart
             .configure_mesh()
+            .label_style((FONT, LABEL))
+            .axis_desc_style((FONT, DESC))
             .x_desc(format!("joint {} angle (deg)", curve.joint))
             .y_desc("joint error (µrad)")
             .draw()
@@ -286,14 +318,49 @@ pub fn effect_curve(label: &str, curve: &EffectCurve) -> Result<String, Error> {
             .map_err(|e| e.to_string())?
             .label("test angles")
             .legend(|(x, y)| PathElement::new(vec![(x + 6, y - 5), (x + 6, y + 5)], BLACK.mix(0.5)));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.3))
-            .draw()
-            .map_err(|e| e.to_string())
+        let mut entries = vec![
+            ("fitted angles", Glyph::Box(AFTER.mix(0.15))),
+            ("± σ left uncorrected", Glyph::Box(AFTER.mix(0.25))),
+            ("joint error applied", Glyph::Line(AFTER.into())),
+        ];
+        if !curve.training_deg.is_empty() {
+            entries.push(("training angles (top)", Glyph::Tick(TRAINING.into())));
+        }
+        entries.push(("test angles (bottom)", Glyph::Tick(BLACK.mix(0.5))));
+        side_legend(&legend, &entries)
     })
+}
+
+/// How a legend entry is drawn.
+enum Glyph {
+    /// A filled box (an area, a band).
+    Box(RGBAColor),
+    /// A thick horizontal line (a curve).
+    Line(RGBAColor),
+    /// A short vertical tick (marks along an axis).
+    Tick(RGBAColor),
+    /// A dot (points).
+    Dot(RGBAColor),
+}
+
+/// A legend drawn beside the plot (in `area`, right of it) so that it never hides the data.
+fn side_legend(
+    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    entries: &[(&str, Glyph)],
+) -> Result<(), String> {
+    let top = 40;
+    for (k, (name, glyph)) in entries.iter().enumerate() {
+        let y = top + 24 * k as i32;
+        let drawn = match *glyph {
+            Glyph::Box(c) => area.draw(&Rectangle::new([(6, y - 6), (20, y + 6)], c.filled())),
+            Glyph::Line(c) => area.draw(&PathElement::new(vec![(4, y), (22, y)], c.stroke_width(2))),
+            Glyph::Tick(c) => area.draw(&PathElement::new(vec![(13, y - 7), (13, y + 7)], c.stroke_width(2))),
+            Glyph::Dot(c) => area.draw(&Circle::new((13, y), 4, c.filled())),
+        };
+        drawn.map_err(|e| e.to_string())?;
+        area.draw(&Text::new(name.to_string(), (28, y - 8), (FONT, LABEL))).map_err(|e| e.to_string())?;
+    }
+    Ok(())
 }
 
 /// `values` rounded to multiples of `step`, each once, ascending.

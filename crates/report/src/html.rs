@@ -168,12 +168,9 @@ fn summary(out: &mut String, r: &Report) {
         let _ = write!(out, " Diagnosis of the training data: <b>{}</b>.", escape(&verdict(d)));
     }
     out.push_str("</p>\n");
-    if !r.warnings.is_empty() {
-        let _ = writeln!(
-            out,
-            "<div class=\"warn\">{} warning(s): see <a href=\"#warnings\">Warnings</a>.</div>",
-            r.warnings.len()
-        );
+    let count = r.warnings.len() + r.fit_warnings.as_ref().map_or(0, Vec::len);
+    if count > 0 {
+        let _ = writeln!(out, "<div class=\"warn\">{count} warning(s): see <a href=\"#warnings\">Warnings</a>.</div>");
     }
     out.push_str("</section>\n");
 }
@@ -268,16 +265,28 @@ fn method(out: &mut String, r: &Report) {
 
 fn warnings(out: &mut String, r: &Report) {
     open(out, "warnings");
+    out.push_str("<h3>From the fit</h3>");
+    match &r.fit_warnings {
+        Some(fit) if fit.is_empty() => out.push_str("<p class=\"ok\">No warning from the fit.</p>"),
+        Some(fit) => {
+            for w in fit {
+                let _ = write!(out, "<div class=\"warn\">{}</div>", escape(w));
+            }
+        }
+        None => out.push_str(
+            "<p class=\"how\">This model file was written before the fit's own warnings (few rows per parameter, gross \
+             outliers, a fit forced past the plausibility check) were kept in it: see <code>calib fit --json</code>'s \
+             <code>warnings</code>.</p>",
+        ),
+    }
+    out.push_str("<h3>From the evaluation</h3>");
     if r.warnings.is_empty() {
         out.push_str("<p class=\"ok\">No warning from the evaluation.</p>");
     }
     for w in &r.warnings {
         let _ = write!(out, "<div class=\"warn\">{}</div>", escape(w));
     }
-    out.push_str(
-        "<p class=\"how\">The identification's own warnings (few rows per parameter, gross outliers, a fit forced past \
-         the plausibility check) are not stored in the model file: see <code>calib fit --json</code>'s <code>warnings</code>.</p></section>\n",
-    );
+    out.push_str("</section>\n");
 }
 
 fn stats_row(out: &mut String, key: &str, label: &str, s: &ErrorStats) {

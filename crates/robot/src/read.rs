@@ -106,6 +106,13 @@ impl RobotDescription {
         Ok(robot)
     }
 
+    /// The checks [`RobotDescription::parse`] runs, on a description kept inside another file (a
+    /// model file's `robot_description`): `text` is that file's text from the description on,
+    /// `file` its name; positions are counted from the start of `text`.
+    pub fn check_kept(&self, text: &str, file: &str) -> Result<(), Error> {
+        self.validate(text, file)
+    }
+
     fn validate(&self, text: &str, file: &str) -> Result<(), Error> {
         let at = |field: &str, index: usize, message: String| {
             let (line, column) = field_position(text, field, index);
