@@ -4,7 +4,7 @@
 //! model files written by `calib fit`'s writer for every kind of part, and effects files.
 
 use anyhow::{Context, Result};
-use pipeline::effects::{EffectSelection, EffectSpec};
+use pipeline::effects::{EffectKind, EffectSelection, EffectSpec};
 use pipeline::simulated::{self, Effects, GeneratorConfig, JointCoupling, Perturbation, Remount};
 use pipeline::{FitOptions, MeasurementSet, Method, RobotDescription};
 use poe::JointKind;
@@ -202,11 +202,11 @@ fn model_seeds(folder: &Path) -> Result<Vec<Seed>> {
     };
     let small = position.subset(&(0..30).collect::<Vec<_>>());
     let every_effect = [
-        EffectSpec::JointCompliance,
-        EffectSpec::GearPeriodic { joint: 2, harmonics: 3 },
-        EffectSpec::Backlash { joint: 3 },
-        EffectSpec::Thermal,
-        EffectSpec::TimeDrift,
+        EffectSpec::new(EffectKind::JointCompliance),
+        EffectSpec::gear_periodic(2, 3),
+        EffectSpec::on_joint(EffectKind::Backlash, 3),
+        EffectSpec::new(EffectKind::Thermal),
+        EffectSpec::new(EffectKind::TimeDrift),
     ];
     Ok(vec![
         Seed::file("poe, position only", "ron", model_text(&fit(&position, Method::Poe, &[])?, folder)?),
@@ -250,8 +250,8 @@ fn effects_list_seeds() -> Vec<Seed> {
 fn options_seeds() -> Result<Vec<Seed>> {
     let pretty = ron::ser::PrettyConfig::default();
     let every = FitOptions::default().with_effects(EffectSelection::List(vec![
-        EffectSpec::JointCompliance,
-        EffectSpec::GearPeriodic { joint: 1, harmonics: 8 },
+        EffectSpec::new(EffectKind::JointCompliance),
+        EffectSpec::gear_periodic(1, 8),
     ]));
     let mut seeds = Vec::new();
     for (name, options) in [("the defaults", FitOptions::default()), ("with effects", every)] {

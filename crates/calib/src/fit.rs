@@ -1,6 +1,6 @@
 //! `calib fit`: fit a calibration method to measurements and write the model.
 
-use pipeline::effects::{EffectSelection, EffectSpec};
+use pipeline::effects::{EffectKind, EffectSelection, EffectSpec};
 use pipeline::{ErrorSummary, FitOptions, FitReport, Method, ReadOptions};
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -64,7 +64,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     };
     match (&args.effects, args.joint_compliance) {
         (Some(selection), _) => options.effects.selection = selection.clone(),
-        (None, true) => options.effects.selection = EffectSelection::List(vec![EffectSpec::JointCompliance]),
+        (None, true) => {
+            options.effects.selection = EffectSelection::List(vec![EffectSpec::new(EffectKind::JointCompliance)])
+        }
         (None, false) => {}
     }
     if args.force {

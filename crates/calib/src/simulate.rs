@@ -187,16 +187,5 @@ fn shape_lines(config: &GeneratorConfig) -> Vec<String> {
 
 /// The names of the effects that are on, as the RON file spells them.
 fn effect_names(effects: &simulated::Effects) -> Vec<&'static str> {
-    [
-        ("compliance", effects.compliance.is_some()),
-        ("backlash", effects.backlash.is_some()),
-        ("periodic", effects.periodic.is_some()),
-        ("thermal", effects.thermal.is_some()),
-        ("drift", effects.drift.is_some()),
-        ("tracker_noise", effects.tracker_noise.is_some()),
-        ("coupling", effects.coupling.is_some()),
-    ]
-    .into_iter()
-    .filter_map(|(name, on)| on.then_some(name))
-    .collect()
+    simulated::EffectKind::ALL.iter().filter(|&&kind| effects.is_on(kind)).map(|kind| kind.simulated_field()).collect()
 }

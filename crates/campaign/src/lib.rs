@@ -45,8 +45,8 @@ pub use effects_file::{
     MAX_TEMPERATURE_C, check_effects, parse_effects, read_effects,
 };
 pub use loadsim::{
-    CouplingFactor, CouplingTerm, Effects, GeneratorConfig, JointCompliance, JointCoupling, JointRange, Sample,
-    SimulatedCell, TorqueSensorNoise, TrackerNoise,
+    CouplingFactor, CouplingTerm, EffectKind, Effects, GeneratorConfig, JointCompliance, JointCoupling, JointRange,
+    Sample, SimulatedCell, TorqueSensorNoise, TrackerNoise,
 };
 
 /// How far the true robot is from its nominal model: every constant transform of the local POE

@@ -12,8 +12,8 @@
 
 use super::design::Design;
 use effects::{
-    Backlash, ComplianceTerm, ComplianceTorque, EffectContext, GearPeriodic, IdentifiedEffect, JointCompliance,
-    LoadFrame, Thermal, TimeDrift, TorqueSign, has_torques, stand_in_dynamics,
+    CandidateContext, CandidateModel, ComplianceTerm, ComplianceTorque, EffectContext, EffectKind, IdentifiedEffect,
+    LoadFrame, has_torques, stand_in_dynamics,
 };
 use errors::Error;
 use measurements::MeasurementSet;
@@ -22,40 +22,55 @@ use rayon::prelude::*;
 use robot::RobotDescription;
 use serde::{Deserialize, Serialize};
 
-/// An effect a verdict can name (the SPEC's `verdict.effect`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Effect {
-    /// Joint compliance under gravity and payload.
-    JointCompliance,
-    /// Backlash following the sign of the static torque.
-    Backlash,
-    /// A smooth periodic error of a joint's own angle (gear or encoder), of any order.
-    GearPeriodic,
-    /// Thermal growth of the links with `temp_c`.
-    Thermal,
-    /// Drift of the robot's placement with `t_s`.
-    TimeDrift,
-    /// Nothing beats the noise floor.
-    None,
-    /// Structure remains that no candidate explains.
-    Unknown,
+/// Generates [`Effect`] from the identified kinds of `loadsim::effect_kinds!`, and `None` and
+/// `Unknown`.
+macro_rules! verdict_effect {
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident, )* }
+     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident, )* }) => {
+        /// An effect a verdict can name (the SPEC's `verdict.effect`): every kind the fit
+        /// identifies, in the list's order, then `None` and `Unknown`.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+        #[serde(rename_all = "snake_case")]
+        pub enum Effect {
+            $( $(#[$doc])* $kind, )*
+            /// Nothing beats the noise floor.
+            None,
+            /// Structure remains that no candidate explains.
+            Unknown,
+        }
+
+        impl Effect {
+            /// The SPEC name.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $( Effect::$kind => EffectKind::$kind.name(), )*
+                    Effect::None => "none",
+                    Effect::Unknown => "unknown",
+                }
+            }
+
+            /// The kind of effect it names (`None` for `None` and `Unknown`).
+            pub fn kind(self) -> Option<EffectKind> {
+                match self {
+                    $( Effect::$kind => Some(EffectKind::$kind), )*
+                    Effect::None | Effect::Unknown => None,
+                }
+            }
+        }
+
+        impl From<EffectKind> for Effect {
+            /// The verdict that names `kind`; `Unknown` for a kind no candidate models.
+            fn from(kind: EffectKind) -> Self {
+                match kind {
+                    $( EffectKind::$kind => Effect::$kind, )*
+                    _ => Effect::Unknown,
+                }
+            }
+        }
+    };
 }
 
-impl Effect {
-    /// The SPEC name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Effect::JointCompliance => "joint_compliance",
-            Effect::Backlash => "backlash",
-            Effect::GearPeriodic => "gear_periodic",
-            Effect::Thermal => "thermal",
-            Effect::TimeDrift => "time_drift",
-            Effect::None => "none",
-            Effect::Unknown => "unknown",
-        }
-    }
-}
+loadsim::effect_kinds!(verdict_effect);
 
 /// One candidate: an effect on some joints, as weighted columns of the linearised problem.
 #[derive(Debug, Clone)]
@@ -97,12 +112,6 @@ pub(crate) struct SideSource {
     pub load: LoadFrame,
 }
 
-/// One candidate before it is numbered: the effect, its columns, its prior, its series orders.
-type Built = (IdentifiedEffect, Vec<Vec<f64>>, Option<f64>, Option<Vec<u32>>);
-/// One joint's candidates, and where among them its gravity-regressor compliance is (with its
-/// terms), for the learnt backlash side.
-type JointCandidates = (Vec<Built>, Option<(usize, Vec<ComplianceTerm>)>);
-
 /// The weighted columns of an effect's regressor at every measurement.
 pub(crate) fn columns_of(
     design: &Design,
@@ -125,11 +134,14 @@ pub(crate) fn columns_of(
         .collect())
 }
 
-/// Builds every candidate the data can support: compliance (gravity-torque regressors, and
-/// measured torques where the data has them), backlash with a stated or measured side, and a
-/// Fourier series per moving joint; thermal growth when the temperature varies by more than
-/// 0.2 K; drift when time varies. Also returns, per joint with gravity torque, what its learnt
-/// backlash side is learnt from (it is learnt inside each fold, once the pool exists).
+/// Builds every candidate the data can support, each kind's own (`effects::CandidateModel`:
+/// compliance from the gravity-torque regressors and, with measured torques, from them; backlash
+/// with a stated or measured side; a Fourier series per moving revolute joint; thermal growth;
+/// drift; and whatever a new kind offers), per joint in joint order, then those of no joint. A
+/// candidate without columns, or offered only where its columns are not all zero and zero
+/// throughout, is left out. Also returns, per joint with a gravity-regressor compliance candidate,
+/// what its learnt backlash side is learnt from (it is learnt inside each fold, once the pool
+/// exists).
 pub(crate) fn build_candidates(
     robot: &RobotDescription,
     model: &LocalPoe,
@@ -149,112 +161,58 @@ pub(crate) fn build_candidates(
     }
     .load_frame(&data.rows, &tools)?;
     let dynamics = robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(robot));
-    let measured = has_torques(&data.rows);
-    let nonzero = |columns: &[Vec<f64>]| columns.iter().flatten().any(|v| v.abs() > 1e-12);
-    let columns = |effect: &IdentifiedEffect| columns_of(design, effect, model, data);
-    let mut candidates = Vec::new();
-    let mut sides = Vec::new();
-    let mut push = |effect: IdentifiedEffect, columns: Vec<Vec<f64>>, prior_sd: Option<f64>, orders| {
-        candidates.push(Candidate {
-            effect: effect_of(&effect),
-            joints: effect.joints(),
-            columns,
-            prior_sd,
-            orders,
-            model: effect,
-        });
-        candidates.len() - 1
+    let context = CandidateContext {
+        robot,
+        rows: &data.rows,
+        tools: &tools,
+        load: &load,
+        dynamics: &dynamics,
+        measured: has_torques(&data.rows),
+        moving: settings.moving,
+        longest_order: settings.orders.iter().copied().max().unwrap_or(1),
     };
-    let longest = settings.orders.iter().copied().max().unwrap_or(1);
+    let nonzero = |columns: &[Vec<f64>]| columns.iter().flatten().any(|v| v.abs() > 1e-12);
+    let with_columns = |offered: Vec<CandidateModel>| -> Result<Vec<Candidate>, Error> {
+        let mut kept = Vec::new();
+        for offer in offered {
+            let columns = columns_of(design, &offer.effect, model, data)?;
+            if columns.is_empty() || (offer.only_if_nonzero && !nonzero(&columns)) {
+                continue;
+            }
+            kept.push(Candidate {
+                effect: Effect::from(offer.effect.effect_kind()),
+                joints: offer.effect.joints(),
+                columns,
+                prior_sd: offer.series.then_some(settings.series_sd),
+                orders: offer.series.then(|| settings.orders.to_vec()),
+                model: offer.effect,
+            });
+        }
+        Ok(kept)
+    };
     // Each joint's candidates are independent: built in parallel, then numbered in joint order,
     // so the candidate list (and everything after it) is the same on any number of threads.
-    let per_joint: Vec<JointCandidates> = (0..n)
+    let per_joint: Vec<Vec<Candidate>> = (0..n)
         .into_par_iter()
-        .map(|j| -> Result<JointCandidates, Error> {
-            let mut built: Vec<Built> = Vec::new();
-            let mut side = None;
-            // Compliance: δq_j = c_j τ_j, τ_j = Y_j(q) π + payload torque, π unknown: one column per
-            // entry of Y's row j (the products c_j π_l), and one for the payload (c_j itself).
-            let gravity = ComplianceTorque::GravityRegressor(load.clone());
-            let compliance = JointCompliance::new(gravity, &[j], &data.rows, &tools)?;
-            let terms = compliance.terms.clone();
-            let compliance = IdentifiedEffect::JointCompliance(compliance);
-            let compliance_columns = columns(&compliance)?;
-            // Backlash: δq_j = b_j sign(τ_j), the sign from the robot's mass model or a stand-in.
-            let stated = TorqueSign::Stated { load: load.clone(), dynamics: dynamics.clone() };
-            let stated = IdentifiedEffect::Backlash(Backlash::new(j, stated, &data.rows, &tools)?);
-            let stated_columns = columns(&stated)?;
-            if nonzero(&stated_columns) {
-                built.push((stated, stated_columns, None, None));
-            }
-            if !compliance_columns.is_empty() {
-                // A balancer or an unknown mass moves the torque's zero: the side is also learnt.
-                side = Some((built.len(), terms));
-                built.push((compliance, compliance_columns, None, None));
-            }
-            if measured {
-                // Measured torques (SPEC `tauN_nm`): δq_j = c_j τ_j with τ_j the measured torque as
-                // the gravity regressors explain it (the sensor's noise left out, as the fit does),
-                // and the band's side from the measured torque's sign.
-                let compliance = JointCompliance::modelled(load.clone(), &[j], &data.rows, &tools)?;
-                if !compliance.terms.is_empty() {
-                    let effect = IdentifiedEffect::JointCompliance(compliance);
-                    let effect_columns = columns(&effect)?;
-                    built.push((effect, effect_columns, None, None));
-                }
-                let backlash = IdentifiedEffect::Backlash(Backlash::new(j, TorqueSign::Measured, &data.rows, &tools)?);
-                let backlash_columns = columns(&backlash)?;
-                if nonzero(&backlash_columns) {
-                    built.push((backlash, backlash_columns, None, None));
-                }
-            }
-            // A series of the joint's angle: a revolute joint's only (on a linear axis the period
-            // of a screw or rack is a length, which this series has no parameter for).
-            if settings.moving.contains(&j) && robot.joints[j].kind == robot::JointType::Revolute {
-                let gear = IdentifiedEffect::GearPeriodic(GearPeriodic::new(j, (1..=longest).collect(), &data.rows)?);
-                let gear_columns = columns(&gear)?;
-                built.push((gear, gear_columns, Some(settings.series_sd), Some(settings.orders.to_vec())));
-            }
-            Ok((built, side))
-        })
+        .map(|j| with_columns(IdentifiedEffect::joint_candidates(&context, j)?))
         .collect::<Result<_, _>>()?;
-    for (j, (built, side)) in per_joint.into_iter().enumerate() {
-        let indices: Vec<usize> = built
-            .into_iter()
-            .map(|(effect, columns, prior_sd, orders)| push(effect, columns, prior_sd, orders))
-            .collect();
-        if let Some((at, terms)) = side {
-            sides.push(SideSource { joint: j, compliance: indices[at], terms, load: load.clone() });
+    let mut candidates = Vec::new();
+    let mut sides = Vec::new();
+    for (j, built) in per_joint.into_iter().enumerate() {
+        // A balancer or an unknown mass moves the torque's zero: the backlash side is also learnt,
+        // from the joint's gravity-regressor compliance.
+        let side = built.iter().position(|c| {
+            matches!(&c.model, IdentifiedEffect::JointCompliance(jc)
+                if matches!(jc.torque, ComplianceTorque::GravityRegressor(_)))
+        });
+        if let Some(at) = side
+            && let IdentifiedEffect::JointCompliance(jc) = &built[at].model
+        {
+            let terms = jc.terms.clone();
+            sides.push(SideSource { joint: j, compliance: candidates.len() + at, terms, load: load.clone() });
         }
+        candidates.extend(built);
     }
-    if let Some(temps) = data.rows.iter().map(|r| r.temp_c).collect::<Option<Vec<f64>>>() {
-        let (low, high) = temps.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| (a.min(t), b.max(t)));
-        if high - low > 0.2 {
-            // One expansion coefficient for the whole arm: every link but the tracker-to-base
-            // placement grows by α ΔT.
-            let thermal = IdentifiedEffect::Thermal(Thermal::new(&data.rows, effects::HOLD_BEYOND_SPAN)?);
-            let thermal_columns = columns(&thermal)?;
-            push(thermal, thermal_columns, None, None);
-        }
-    }
-    if let Some(times) = data.rows.iter().map(|r| r.t_s).collect::<Option<Vec<f64>>>() {
-        let mean = times.iter().sum::<f64>() / data.rows.len() as f64;
-        if times.iter().any(|t| (t - mean).abs() > 1.0) {
-            let drift = IdentifiedEffect::TimeDrift(TimeDrift::new(&data.rows, effects::HOLD_BEYOND_SPAN)?);
-            let drift_columns = columns(&drift)?;
-            push(drift, drift_columns, None, None);
-        }
-    }
+    candidates.extend(with_columns(IdentifiedEffect::global_candidates(&context)?)?);
     Ok((candidates, sides))
-}
-
-/// The verdict name of an effect.
-fn effect_of(effect: &IdentifiedEffect) -> Effect {
-    match effect {
-        IdentifiedEffect::JointCompliance(_) => Effect::JointCompliance,
-        IdentifiedEffect::GearPeriodic(_) => Effect::GearPeriodic,
-        IdentifiedEffect::Backlash(_) => Effect::Backlash,
-        IdentifiedEffect::Thermal(_) => Effect::Thermal,
-        IdentifiedEffect::TimeDrift(_) => Effect::TimeDrift,
-    }
 }

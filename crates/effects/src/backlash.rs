@@ -3,6 +3,12 @@
 
 use super::{LoadFrame, Regressor, rms_scales};
 use crate::Direction;
+use crate::check::{Cursor, EffectFault, FaultKind};
+use crate::term::{EffectTerm, NewEffect};
+use crate::{
+    Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect, has_torques,
+    stand_in_dynamics,
+};
 use errors::Error;
 use loadsim::{Payload, RobotDynamics};
 use measurements::Measurement;
@@ -103,5 +109,108 @@ impl Regressor for Backlash {
 
     fn parameter_names(&self) -> Vec<String> {
         vec![format!("joint {} half band", self.joint + 1)]
+    }
+}
+
+impl EffectTerm for Backlash {
+    fn label(&self) -> String {
+        let source = match self.sign {
+            TorqueSign::Measured => "measured torque",
+            TorqueSign::Stated { .. } => "static torque of the mass model",
+            TorqueSign::Learnt { .. } => "torque learnt from the data",
+        };
+        format!("backlash:{} (sign of the {source})", self.joint + 1)
+    }
+
+    fn joints(&self) -> Vec<usize> {
+        vec![self.joint + 1]
+    }
+
+    fn check(&self, cursor: &Cursor<'_>, n: usize, tools: usize) -> Result<(), EffectFault> {
+        cursor.joint("joint", 0, "joint".into(), self.joint, n)?;
+        cursor.count("scale", self.scale.len(), 1)?;
+        cursor.count("theta", self.theta.len(), 1)?;
+        match &self.sign {
+            TorqueSign::Measured => {}
+            TorqueSign::Stated { load, dynamics } => {
+                cursor.load(load, n, tools)?;
+                dynamics.validate(n).map_err(|_| {
+                    let kind = FaultKind::Count { what: "links", found: dynamics.links.len(), expected: n };
+                    cursor.fault("dynamics", 0, "sign.dynamics".into(), kind)
+                })?;
+            }
+            TorqueSign::Learnt { load, columns, coefficients } => {
+                cursor.load(load, n, tools)?;
+                if let Some(k) = columns.iter().position(|&c| c > 4 * n) {
+                    let kind = FaultKind::Index { index: columns[k], limit: 4 * n + 1 };
+                    return Err(cursor.fault("columns", 0, format!("columns[{k}]"), kind));
+                }
+                cursor.count("coefficients", coefficients.len(), columns.len())?;
+                cursor.finite("coefficients", coefficients, false)?;
+            }
+        }
+        cursor.finite("scale", &self.scale, true)
+    }
+
+    fn count_fields(&self, add: &mut dyn FnMut(&'static str, usize)) {
+        add("joint", 1);
+        add("scale", 1);
+        match &self.sign {
+            TorqueSign::Measured => {}
+            TorqueSign::Stated { .. } => {
+                add("base_model", 1);
+                add("gravity_m_per_s2", 1);
+            }
+            TorqueSign::Learnt { .. } => {
+                add("base_model", 1);
+                add("gravity_m_per_s2", 1);
+                add("columns", 1);
+                add("coefficients", 1);
+            }
+        }
+    }
+}
+
+impl NewEffect for Backlash {
+    const ARGUMENTS: &'static [Argument] = &[Argument::Joint];
+
+    /// The sign of the measured torque where every row has one, of the robot's static torque
+    /// otherwise (its mass model, or a stand-in).
+    fn build(
+        spec: &EffectSpec,
+        context: &EffectContext<'_>,
+        rows: &[Measurement],
+        tools: &[usize],
+    ) -> Result<Self, Error> {
+        let joint = spec.joint_index()?;
+        let sign = if has_torques(rows) {
+            TorqueSign::Measured
+        } else {
+            let dynamics = context.robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(context.robot));
+            TorqueSign::Stated { load: context.load_frame(rows, tools)?, dynamics }
+        };
+        Backlash::new(joint, sign, rows, tools)
+    }
+
+    /// `δq_j = b_j sign(τ_j)`: the sign of the stated (or stand-in) static torque, first among the
+    /// joint's candidates; with measured torques also their sign, fourth. Each only where the
+    /// sign changes somewhere (a learnt side is the diagnosis's own, module `learnt_side`).
+    fn joint_candidates(context: &CandidateContext<'_>, joint: usize) -> Result<Vec<CandidateModel>, Error> {
+        let stated = TorqueSign::Stated { load: context.load.clone(), dynamics: context.dynamics.clone() };
+        let mut out = vec![CandidateModel {
+            only_if_nonzero: true,
+            ..CandidateModel::plain(
+                IdentifiedEffect::Backlash(Backlash::new(joint, stated, context.rows, context.tools)?),
+                0,
+            )
+        }];
+        if context.measured {
+            let measured = Backlash::new(joint, TorqueSign::Measured, context.rows, context.tools)?;
+            out.push(CandidateModel {
+                only_if_nonzero: true,
+                ..CandidateModel::plain(IdentifiedEffect::Backlash(measured), 3)
+            });
+        }
+        Ok(out)
     }
 }

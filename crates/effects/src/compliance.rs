@@ -6,6 +6,9 @@
 //! is not zero on every row, and one for the payload; no masses needed.
 
 use super::{LoadFrame, Regressor, rms_scales};
+use crate::check::{Cursor, EffectFault, FaultKind};
+use crate::term::{EffectTerm, NewEffect};
+use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect, has_torques};
 
 use crate::Direction;
 use errors::Error;
@@ -222,5 +225,125 @@ impl Regressor for JointCompliance {
                 None => format!("joint {} x torque", t.joint + 1),
             })
             .collect()
+    }
+}
+
+impl EffectTerm for JointCompliance {
+    fn label(&self) -> String {
+        match self.torque {
+            ComplianceTorque::Measured => "joint_compliance (measured torques)".into(),
+            ComplianceTorque::Modelled { .. } => {
+                "joint_compliance (measured torques, modelled on the gravity regressors)".into()
+            }
+            ComplianceTorque::GravityRegressor(_) => "joint_compliance (gravity-torque regressors)".into(),
+        }
+    }
+
+    fn joints(&self) -> Vec<usize> {
+        JointCompliance::joints(self).into_iter().map(|j| j + 1).collect()
+    }
+
+    fn check(&self, cursor: &Cursor<'_>, n: usize, tools: usize) -> Result<(), EffectFault> {
+        match &self.torque {
+            ComplianceTorque::Measured => {}
+            ComplianceTorque::GravityRegressor(load) => cursor.load(load, n, tools)?,
+            ComplianceTorque::Modelled { load, fits } => {
+                cursor.load(load, n, tools)?;
+                cursor.count("fits", fits.len(), n)?;
+                for (k, fit) in fits.iter().enumerate() {
+                    if let Some(m) = fit.columns.iter().position(|&c| c > 4 * n) {
+                        let kind = FaultKind::Index { index: fit.columns[m], limit: 4 * n + 1 };
+                        return Err(cursor.fault("columns", k, format!("fits[{k}].columns[{m}]"), kind));
+                    }
+                    if fit.coefficients.len() != fit.columns.len() {
+                        let kind = FaultKind::Count {
+                            what: "values",
+                            found: fit.coefficients.len(),
+                            expected: fit.columns.len(),
+                        };
+                        return Err(cursor.fault("coefficients", k, format!("fits[{k}].coefficients"), kind));
+                    }
+                    if let Some(&value) = fit.coefficients.iter().find(|v| !v.is_finite()) {
+                        let kind = FaultKind::NotFinite { value };
+                        return Err(cursor.fault("coefficients", k, format!("fits[{k}].coefficients"), kind));
+                    }
+                }
+            }
+        }
+        // A regressor row holds 4 columns per link and the payload's: 4n + 1; a measured or
+        // modelled torque has one.
+        let width = if matches!(self.torque, ComplianceTorque::GravityRegressor(_)) { 4 * n + 1 } else { 1 };
+        for (k, term) in self.terms.iter().enumerate() {
+            cursor.joint("joint", k, format!("terms[{k}].joint"), term.joint, n)?;
+            if term.column >= width {
+                let kind = FaultKind::Index { index: term.column, limit: width };
+                return Err(cursor.fault("column", k, format!("terms[{k}].column"), kind));
+            }
+            if !(term.scale.is_finite() && term.scale > 0.0) {
+                let kind = FaultKind::NotFinite { value: term.scale };
+                return Err(cursor.fault("scale", k, format!("terms[{k}].scale"), kind));
+            }
+        }
+        cursor.count("theta", self.theta.len(), self.terms.len())
+    }
+
+    fn count_fields(&self, add: &mut dyn FnMut(&'static str, usize)) {
+        add("joint", self.terms.len());
+        add("column", self.terms.len());
+        add("scale", self.terms.len());
+        match &self.torque {
+            ComplianceTorque::Measured => {}
+            ComplianceTorque::GravityRegressor(_) => {
+                add("base_model", 1);
+                add("gravity_m_per_s2", 1);
+            }
+            ComplianceTorque::Modelled { fits, .. } => {
+                add("base_model", 1);
+                add("gravity_m_per_s2", 1);
+                add("fits", 1);
+                add("columns", fits.len());
+                add("coefficients", fits.len());
+            }
+        }
+    }
+}
+
+impl NewEffect for JointCompliance {
+    const ARGUMENTS: &'static [Argument] = &[];
+
+    /// Every joint, through measured torques where every row has them, the gravity-torque
+    /// regressors otherwise.
+    fn build(
+        _spec: &EffectSpec,
+        context: &EffectContext<'_>,
+        rows: &[Measurement],
+        tools: &[usize],
+    ) -> Result<Self, Error> {
+        let joints: Vec<usize> = (0..context.robot.joint_count()).collect();
+        let load = context.load_frame(rows, tools)?;
+        if has_torques(rows) {
+            JointCompliance::modelled(load, &joints, rows, tools)
+        } else {
+            JointCompliance::new(ComplianceTorque::GravityRegressor(load), &joints, rows, tools)
+        }
+    }
+
+    /// `δq_j = c_j τ_j`, `τ_j = Y_j(q) π + payload torque`, `π` unknown: one column per entry of
+    /// `Y`'s row `j` (the products `c_j π_l`) and one for the payload (`c_j` itself), second among
+    /// the joint's candidates; with measured torques also the torque as the gravity regressors
+    /// explain it (the sensor's noise left out, as the fit does), third.
+    fn joint_candidates(context: &CandidateContext<'_>, joint: usize) -> Result<Vec<CandidateModel>, Error> {
+        let gravity = ComplianceTorque::GravityRegressor(context.load.clone());
+        let mut out = vec![CandidateModel::plain(
+            IdentifiedEffect::JointCompliance(JointCompliance::new(gravity, &[joint], context.rows, context.tools)?),
+            1,
+        )];
+        if context.measured {
+            let modelled = JointCompliance::modelled(context.load.clone(), &[joint], context.rows, context.tools)?;
+            if !modelled.terms.is_empty() {
+                out.push(CandidateModel::plain(IdentifiedEffect::JointCompliance(modelled), 2));
+            }
+        }
+        Ok(out)
     }
 }

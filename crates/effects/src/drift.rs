@@ -3,6 +3,9 @@
 
 use super::{Regressor, check_column_varies, rms_scales};
 use crate::Direction;
+use crate::check::{Cursor, EffectFault};
+use crate::term::{EffectTerm, NewEffect};
+use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect};
 use errors::Error;
 use measurements::Measurement;
 use serde::{Deserialize, Serialize};
@@ -69,6 +72,54 @@ impl Regressor for TimeDrift {
 
     fn parameter_names(&self) -> Vec<String> {
         ["v_x", "v_y", "v_z", "w_x", "w_y", "w_z"].iter().map(|c| format!("drift {c}")).collect()
+    }
+}
+
+impl EffectTerm for TimeDrift {
+    fn label(&self) -> String {
+        "time_drift".into()
+    }
+
+    fn joints(&self) -> Vec<usize> {
+        Vec::new()
+    }
+
+    fn check(&self, cursor: &Cursor<'_>, _n: usize, _tools: usize) -> Result<(), EffectFault> {
+        cursor.finite("reference_s", &[self.reference_s], false)?;
+        cursor.count("scale", self.scale.len(), 6)?;
+        cursor.count("theta", self.theta.len(), 6)?;
+        cursor.finite("scale", &self.scale, true)
+    }
+
+    fn count_fields(&self, add: &mut dyn FnMut(&'static str, usize)) {
+        add("reference_s", 1);
+        add("scale", 1);
+    }
+}
+
+impl NewEffect for TimeDrift {
+    const ARGUMENTS: &'static [Argument] = &[];
+
+    fn build(
+        _spec: &EffectSpec,
+        context: &EffectContext<'_>,
+        rows: &[Measurement],
+        _tools: &[usize],
+    ) -> Result<Self, Error> {
+        TimeDrift::new(rows, context.hold_beyond_span)
+    }
+
+    /// Where every row has `t_s` and some row lies more than 1 s from their mean.
+    fn global_candidates(context: &CandidateContext<'_>) -> Result<Vec<CandidateModel>, Error> {
+        let Some(times) = context.rows.iter().map(|r| r.t_s).collect::<Option<Vec<f64>>>() else {
+            return Ok(Vec::new());
+        };
+        let mean = times.iter().sum::<f64>() / context.rows.len() as f64;
+        if !times.iter().any(|t| (t - mean).abs() > 1.0) {
+            return Ok(Vec::new());
+        }
+        let drift = TimeDrift::new(context.rows, crate::HOLD_BEYOND_SPAN)?;
+        Ok(vec![CandidateModel::plain(IdentifiedEffect::TimeDrift(drift), 0)])
     }
 }
 

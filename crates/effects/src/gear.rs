@@ -14,6 +14,9 @@
 
 use super::{Regressor, rms_scales};
 use crate::Direction;
+use crate::check::{Cursor, EffectFault, FaultKind};
+use crate::term::{EffectTerm, NewEffect};
+use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect, MAX_HARMONICS};
 use errors::Error;
 use measurements::Measurement;
 use serde::{Deserialize, Serialize};
@@ -272,6 +275,135 @@ impl Regressor for GearPeriodic {
     fn parameter_names(&self) -> Vec<String> {
         let j = self.joint + 1;
         self.orders.iter().flat_map(|h| [format!("cos({h} q{j})"), format!("sin({h} q{j})")]).collect()
+    }
+}
+
+impl EffectTerm for GearPeriodic {
+    fn label(&self) -> String {
+        let consecutive = self.orders.iter().enumerate().all(|(k, &h)| h as usize == k + 1);
+        match (consecutive, self.orders.last()) {
+            (true, Some(last)) => format!("gear_periodic:{}:{last}", self.joint + 1),
+            _ => format!("gear_periodic:{} (harmonics {:?})", self.joint + 1, self.orders),
+        }
+    }
+
+    fn joints(&self) -> Vec<usize> {
+        vec![self.joint + 1]
+    }
+
+    fn check(&self, cursor: &Cursor<'_>, n: usize, _tools: usize) -> Result<(), EffectFault> {
+        cursor.joint("joint", 0, "joint".into(), self.joint, n)?;
+        if let Some(k) = self.orders.iter().position(|&h| h > MAX_HARMONICS) {
+            let kind = FaultKind::Index { index: self.orders[k] as usize, limit: MAX_HARMONICS as usize + 1 };
+            return Err(cursor.fault("orders", 0, format!("orders[{k}]"), kind));
+        }
+        cursor.count("scale", self.scale.len(), 2 * self.orders.len())?;
+        cursor.count("theta", self.theta.len(), 2 * self.orders.len())?;
+        cursor.finite("scale", &self.scale, true)?;
+        if let Some([low, high]) = self.fitted_range {
+            cursor.finite("fitted_range", &[low, high], false)?;
+            if low > high {
+                let kind = FaultKind::Order { low, high };
+                return Err(cursor.fault("fitted_range", 0, "fitted_range".into(), kind));
+            }
+        }
+        for (k, &[a, b]) in self.fitted_gaps.iter().enumerate() {
+            cursor.finite("fitted_gaps", &[a, b], false)?;
+            if a > b {
+                let kind = FaultKind::Order { low: a, high: b };
+                return Err(cursor.fault("fitted_gaps", 0, format!("fitted_gaps[{k}]"), kind));
+            }
+        }
+        // The turn's gaps lie within [0, 4π): a gap starts inside the turn and the one across 2π
+        // ends within the next.
+        for (k, &[a, b]) in self.turn_gaps.iter().enumerate() {
+            cursor.finite("turn_gaps", &[a, b], false)?;
+            if a > b || a < 0.0 || b > 2.0 * std::f64::consts::TAU {
+                let kind = FaultKind::Order { low: a, high: b };
+                return Err(cursor.fault("turn_gaps", 0, format!("turn_gaps[{k}]"), kind));
+            }
+        }
+        if let Some(taper) = self.taper_rad {
+            cursor.finite("taper_rad", &[taper], true)?;
+        }
+        if !self.mean.is_empty() {
+            cursor.count("mean", self.mean.len(), 2 * self.orders.len())?;
+            cursor.finite("mean", &self.mean, false)?;
+        }
+        if let Some(rms) = self.fitted_rms_rad {
+            cursor.finite("fitted_rms_rad", &[rms], false)?;
+            if rms < 0.0 {
+                let kind = FaultKind::Order { low: 0.0, high: rms };
+                return Err(cursor.fault("fitted_rms_rad", 0, "fitted_rms_rad".into(), kind));
+            }
+        }
+        if !(0.0..=4.0).contains(&self.roughness_order) {
+            let kind = FaultKind::Value { value: self.roughness_order, limit: 4.0 };
+            return Err(cursor.fault("roughness_order", 0, "roughness_order".into(), kind));
+        }
+        Ok(())
+    }
+
+    fn count_fields(&self, add: &mut dyn FnMut(&'static str, usize)) {
+        add("joint", 1);
+        add("orders", 1);
+        add("scale", 1);
+        add("fitted_range", usize::from(self.fitted_range.is_some()));
+        add("fitted_gaps", usize::from(!self.fitted_gaps.is_empty()));
+        add("turn_gaps", usize::from(!self.turn_gaps.is_empty()));
+        add("taper_rad", usize::from(self.taper_rad.is_some()));
+        add("mean", usize::from(!self.mean.is_empty()));
+        add("fitted_rms_rad", usize::from(self.fitted_rms_rad.is_some()));
+        add("roughness_order", 1);
+    }
+
+    /// 1 on the joint angles it was fitted on, fading to 0 outside them
+    /// ([`GearPeriodic::held_and_weight`]).
+    fn coverage_weight(&self, row: &Measurement) -> f64 {
+        row.q.get(self.joint).map_or(1.0, |&q| self.held_and_weight(q).1)
+    }
+
+    /// [`GearPeriodic::faded_sigma`] along the joint's twist.
+    fn uncovered(&self, row: &Measurement) -> Option<(Direction, f64)> {
+        row.q.get(self.joint).map(|&q| (Direction::Joint(self.joint), self.faded_sigma(q)))
+    }
+
+    fn has_sigma(&self) -> bool {
+        self.fitted_rms_rad.is_some() && self.taper_rad.is_some()
+    }
+
+    fn prior_scale(&self) -> Vec<f64> {
+        GearPeriodic::prior_scale(self)
+    }
+}
+
+impl NewEffect for GearPeriodic {
+    const ARGUMENTS: &'static [Argument] = &[Argument::Joint, Argument::Harmonics];
+
+    /// Harmonics `1..=harmonics` of a revolute joint (on a linear axis the period of a screw or
+    /// rack is a length, which this series has no parameter for), faded as `context.gear` says.
+    fn build(
+        spec: &EffectSpec,
+        context: &EffectContext<'_>,
+        rows: &[Measurement],
+        _tools: &[usize],
+    ) -> Result<Self, Error> {
+        let joint = spec.joint_index()?;
+        if context.robot.joints[joint].kind == robot::JointType::Prismatic {
+            return Err(Error::EffectJointKind { effect: "gear_periodic", joint: joint + 1 });
+        }
+        let harmonics = spec.required_harmonics()?;
+        GearPeriodic::with_options(joint, (1..=harmonics).collect(), rows, &context.gear)
+    }
+
+    /// A series of the joint's own angle up to the diagnosis's longest order, for a revolute
+    /// joint that moves; last among the joint's candidates.
+    fn joint_candidates(context: &CandidateContext<'_>, joint: usize) -> Result<Vec<CandidateModel>, Error> {
+        if !context.moving.contains(&joint) || context.robot.joints[joint].kind != robot::JointType::Revolute {
+            return Ok(Vec::new());
+        }
+        let gear = GearPeriodic::new(joint, (1..=context.longest_order).collect(), context.rows)?;
+        Ok(vec![CandidateModel { series: true, ..CandidateModel::plain(IdentifiedEffect::GearPeriodic(gear), 4) }])
     }
 }
 

@@ -7,6 +7,14 @@
 //! fit's [`poe::identify::PoseCorrection`] (module `correction`), and the calibrated model's
 //! prediction ([`IdentifiedEffect::twist`], applied by `model::Part`): what the diagnosis predicts is what the fit does.
 //!
+//! An effect is one file: its type implements [`Regressor`] and the crate's `EffectTerm` (label,
+//! joints, its checks in a model file, coverage) and `NewEffect` (the [`Argument`]s of its
+//! `--effects` item, how the fit builds it, its [`CandidateModel`]s for the diagnosis), module
+//! `term`. [`IdentifiedEffect`] is generated from the one list of kinds, `loadsim::effect_kinds!`
+//! ([`EffectKind`]), a variant per identified kind holding the type of the same name; the
+//! `--effects` parser ([`EffectSpec`]) reads the kinds' names and arguments from it. Adding an
+//! effect: one line in that list, one file here (docs/ARCHITECTURE.md, "Adding an effect").
+//!
 //! ```
 //! use effects::EffectSelection;
 //! let selection: EffectSelection = "gear_periodic:2:8,thermal".parse().unwrap();
@@ -31,6 +39,7 @@ mod gear;
 mod load_frame;
 mod report;
 mod spec;
+mod term;
 mod thermal;
 
 pub use backlash::{Backlash, TorqueSign};
@@ -39,9 +48,11 @@ pub use direction::Direction;
 pub use drift::TimeDrift;
 pub use gear::{GearOptions, GearPeriodic};
 pub use load_frame::LoadFrame;
+pub use loadsim::EffectKind;
 pub use report::effect_reports;
 pub use report::{EffectReport, ParameterReport};
-pub use spec::{EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS};
+pub use spec::{Argument, EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS};
+pub use term::{CandidateContext, CandidateModel};
 pub use thermal::Thermal;
 
 pub use check::{EffectFault, FaultKind, check_effects};
@@ -54,6 +65,7 @@ use measurements::Measurement;
 use poe::LocalPoe;
 use robot::RobotDescription;
 use serde::{Deserialize, Serialize};
+use term::{EffectTerm, NewEffect};
 
 /// An effect as linear in its parameters.
 pub trait Regressor {
@@ -106,21 +118,93 @@ pub fn has_torques(rows: &[Measurement]) -> bool {
     !rows.is_empty() && rows.iter().all(|r| r.torques_nm.is_some())
 }
 
-/// An effect of a calibrated model, with its identified parameters.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum IdentifiedEffect {
-    /// Joint compliance.
-    JointCompliance(JointCompliance),
-    /// Periodic error of one joint in its own angle.
-    GearPeriodic(GearPeriodic),
-    /// Backlash of one joint.
-    Backlash(Backlash),
-    /// Thermal growth with `temp_c`.
-    Thermal(Thermal),
-    /// Drift with `t_s`.
-    TimeDrift(TimeDrift),
+/// Generates [`IdentifiedEffect`] from the identified kinds of `loadsim::effect_kinds!`: a variant
+/// per kind holding the type of the same name, every method delegated to its `EffectTerm` /
+/// `NewEffect` (module `term`).
+macro_rules! identified_effect {
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident, )* }
+     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident, )* }) => {
+        /// An effect of a calibrated model, with its identified parameters: one variant per
+        /// identified kind of `loadsim::effect_kinds!`, holding the type of the same name,
+        /// written in model files under the kind's SPEC name.
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+        #[serde(rename_all = "snake_case")]
+        pub enum IdentifiedEffect {
+            $( $(#[$doc])* $kind($kind), )*
+        }
+
+        impl IdentifiedEffect {
+            /// The kind of the effect.
+            pub fn effect_kind(&self) -> EffectKind {
+                match self {
+                    $( IdentifiedEffect::$kind(_) => EffectKind::$kind, )*
+                }
+            }
+
+            fn term(&self) -> &dyn EffectTerm {
+                match self {
+                    $( IdentifiedEffect::$kind(e) => e, )*
+                }
+            }
+
+            fn term_mut(&mut self) -> &mut dyn EffectTerm {
+                match self {
+                    $( IdentifiedEffect::$kind(e) => e, )*
+                }
+            }
+
+            /// What the `--effects` item of `kind` takes after its name (none for a kind the fit
+            /// does not identify).
+            pub fn arguments(kind: EffectKind) -> &'static [Argument] {
+                match kind {
+                    $( EffectKind::$kind => <$kind as NewEffect>::ARGUMENTS, )*
+                    _ => &[],
+                }
+            }
+
+            fn build(
+                spec: &EffectSpec,
+                context: &EffectContext<'_>,
+                rows: &[Measurement],
+                tools: &[usize],
+            ) -> Result<Self, Error> {
+                match spec.kind {
+                    $( EffectKind::$kind => {
+                        <$kind as NewEffect>::build(spec, context, rows, tools).map(IdentifiedEffect::$kind)
+                    } )*
+                    _ => Err(Error::EffectList {
+                        column: 1,
+                        text: spec.to_string(),
+                        fault: EffectListFault::UnknownEffect,
+                    }),
+                }
+            }
+
+            /// The diagnosis's candidates on 0-based joint `joint`, every kind's, in their
+            /// [`CandidateModel::order`] (the list's order among equals).
+            pub fn joint_candidates(
+                context: &CandidateContext<'_>,
+                joint: usize,
+            ) -> Result<Vec<CandidateModel>, Error> {
+                let mut all = Vec::new();
+                $( all.extend(<$kind as NewEffect>::joint_candidates(context, joint)?); )*
+                all.sort_by_key(|c| c.order);
+                Ok(all)
+            }
+
+            /// The diagnosis's candidates that concern no one joint, every kind's, in their
+            /// [`CandidateModel::order`] (the list's order among equals).
+            pub fn global_candidates(context: &CandidateContext<'_>) -> Result<Vec<CandidateModel>, Error> {
+                let mut all = Vec::new();
+                $( all.extend(<$kind as NewEffect>::global_candidates(context)?); )*
+                all.sort_by_key(|c| c.order);
+                Ok(all)
+            }
+        }
+    };
 }
+
+loadsim::effect_kinds!(identified_effect);
 
 /// What the effects of a fit are built from: the robot (for gravity and masses) and the
 /// calibrated kinematics (where the arm and its tools are; the payload hangs from the tools).
@@ -141,21 +225,6 @@ impl EffectContext<'_> {
     pub fn load_frame(&self, rows: &[Measurement], tools: &[usize]) -> Result<LoadFrame, Error> {
         LoadFrame::new(self.robot, self.kinematics, rows, tools)
     }
-
-    fn check_joint(&self, spec: &EffectSpec) -> Result<usize, Error> {
-        let joint_count = self.robot.joint_count();
-        match spec.joint() {
-            Some(joint) if joint == 0 || joint > joint_count => Err(Error::EffectJoint { joint, joint_count }),
-            Some(joint)
-                if matches!(spec, EffectSpec::GearPeriodic { .. })
-                    && self.robot.joints[joint - 1].kind == robot::JointType::Prismatic =>
-            {
-                Err(Error::EffectJointKind { effect: "gear_periodic", joint })
-            }
-            Some(joint) => Ok(joint - 1),
-            None => Ok(0),
-        }
-    }
 }
 
 impl IdentifiedEffect {
@@ -168,66 +237,20 @@ impl IdentifiedEffect {
         rows: &[Measurement],
         tools: &[usize],
     ) -> Result<Self, Error> {
-        let joint = context.check_joint(spec)?;
-        Ok(match *spec {
-            EffectSpec::JointCompliance => {
-                let joints: Vec<usize> = (0..context.robot.joint_count()).collect();
-                let load = context.load_frame(rows, tools)?;
-                IdentifiedEffect::JointCompliance(if has_torques(rows) {
-                    JointCompliance::modelled(load, &joints, rows, tools)?
-                } else {
-                    JointCompliance::new(ComplianceTorque::GravityRegressor(load), &joints, rows, tools)?
-                })
-            }
-            EffectSpec::GearPeriodic { harmonics, .. } => IdentifiedEffect::GearPeriodic(GearPeriodic::with_options(
-                joint,
-                (1..=harmonics).collect(),
-                rows,
-                &context.gear,
-            )?),
-            EffectSpec::Backlash { .. } => {
-                let sign = if has_torques(rows) {
-                    TorqueSign::Measured
-                } else {
-                    let dynamics = context.robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(context.robot));
-                    TorqueSign::Stated { load: context.load_frame(rows, tools)?, dynamics }
-                };
-                IdentifiedEffect::Backlash(Backlash::new(joint, sign, rows, tools)?)
-            }
-            EffectSpec::Thermal => IdentifiedEffect::Thermal(Thermal::new(rows, context.hold_beyond_span)?),
-            EffectSpec::TimeDrift => IdentifiedEffect::TimeDrift(TimeDrift::new(rows, context.hold_beyond_span)?),
-        })
+        let joint_count = context.robot.joint_count();
+        if let Some(joint) = spec.joint.filter(|&j| j == 0 || j > joint_count) {
+            return Err(Error::EffectJoint { joint, joint_count });
+        }
+        Self::build(spec, context, rows, tools)
     }
 
-    fn regressor(&self) -> &dyn Regressor {
-        match self {
-            IdentifiedEffect::JointCompliance(e) => e,
-            IdentifiedEffect::GearPeriodic(e) => e,
-            IdentifiedEffect::Backlash(e) => e,
-            IdentifiedEffect::Thermal(e) => e,
-            IdentifiedEffect::TimeDrift(e) => e,
-        }
-    }
-
-    fn regressor_mut(&mut self) -> &mut dyn Regressor {
-        match self {
-            IdentifiedEffect::JointCompliance(e) => e,
-            IdentifiedEffect::GearPeriodic(e) => e,
-            IdentifiedEffect::Backlash(e) => e,
-            IdentifiedEffect::Thermal(e) => e,
-            IdentifiedEffect::TimeDrift(e) => e,
-        }
+    fn regressor(&self) -> &dyn EffectTerm {
+        self.term()
     }
 
     /// The SPEC name of the effect (`joint_compliance`, `gear_periodic`, …).
     pub fn kind(&self) -> &'static str {
-        match self {
-            IdentifiedEffect::JointCompliance(_) => "joint_compliance",
-            IdentifiedEffect::GearPeriodic(_) => "gear_periodic",
-            IdentifiedEffect::Backlash(_) => "backlash",
-            IdentifiedEffect::Thermal(_) => "thermal",
-            IdentifiedEffect::TimeDrift(_) => "time_drift",
-        }
+        self.effect_kind().name()
     }
 
     /// The gear series of an effect known only near the angles it was fitted on (see
@@ -242,10 +265,7 @@ impl IdentifiedEffect {
     /// How fully the effect applies at `row`: 1 on the joint angles it was fitted on, fading to 0
     /// outside them (a gear series, [`GearPeriodic::held_and_weight`]); 1 for every other effect.
     pub fn coverage_weight(&self, row: &Measurement) -> f64 {
-        match self {
-            IdentifiedEffect::GearPeriodic(g) => row.q.get(g.joint).map_or(1.0, |&q| g.held_and_weight(q).1),
-            _ => 1.0,
-        }
+        self.term().coverage_weight(row)
     }
 
     /// The standard deviation of what the effect leaves uncorrected at `row`, per component of
@@ -259,13 +279,11 @@ impl IdentifiedEffect {
         tool: usize,
         point: &lie::Vector3,
     ) -> Result<Vector6, Error> {
-        let IdentifiedEffect::GearPeriodic(g) = self else { return Ok(Vector6::zeros()) };
-        let Some(&q) = row.q.get(g.joint) else { return Ok(Vector6::zeros()) };
-        let sigma = g.faded_sigma(q);
+        let Some((direction, sigma)) = self.term().uncovered(row) else { return Ok(Vector6::zeros()) };
         if sigma == 0.0 {
             return Ok(Vector6::zeros());
         }
-        let twist = RowTwists::new(kinematics, &row.q, tool).twist(Direction::Joint(g.joint))?;
+        let twist = RowTwists::new(kinematics, &row.q, tool).twist(direction)?;
         let w = lie::Vector3::new(twist[3], twist[4], twist[5]);
         let v = lie::Vector3::new(twist[0], twist[1], twist[2]) + w.cross(point);
         Ok(Vector6::new(v.x.abs(), v.y.abs(), v.z.abs(), w.x.abs(), w.y.abs(), w.z.abs()) * sigma)
@@ -274,48 +292,18 @@ impl IdentifiedEffect {
     /// Whether the effect can report a [`IdentifiedEffect::sigma`] (a gear series that recorded
     /// its RMS).
     pub fn has_sigma(&self) -> bool {
-        matches!(self, IdentifiedEffect::GearPeriodic(g) if g.fitted_rms_rad.is_some() && g.taper_rad.is_some())
+        self.term().has_sigma()
     }
 
     /// The 1-based joints the effect acts on (empty for thermal growth and drift).
     pub fn joints(&self) -> Vec<usize> {
-        match self {
-            IdentifiedEffect::JointCompliance(e) => e.joints().into_iter().map(|j| j + 1).collect(),
-            IdentifiedEffect::GearPeriodic(e) => vec![e.joint + 1],
-            IdentifiedEffect::Backlash(e) => vec![e.joint + 1],
-            IdentifiedEffect::Thermal(_) | IdentifiedEffect::TimeDrift(_) => Vec::new(),
-        }
+        self.term().joints()
     }
 
     /// A name for reports: the SPEC item where there is one (`gear_periodic:1:24`), with what
     /// drives it.
     pub fn label(&self) -> String {
-        match self {
-            IdentifiedEffect::JointCompliance(e) => match e.torque {
-                ComplianceTorque::Measured => "joint_compliance (measured torques)".into(),
-                ComplianceTorque::Modelled { .. } => {
-                    "joint_compliance (measured torques, modelled on the gravity regressors)".into()
-                }
-                ComplianceTorque::GravityRegressor(_) => "joint_compliance (gravity-torque regressors)".into(),
-            },
-            IdentifiedEffect::GearPeriodic(e) => {
-                let consecutive = e.orders.iter().enumerate().all(|(k, &h)| h as usize == k + 1);
-                match (consecutive, e.orders.last()) {
-                    (true, Some(last)) => format!("gear_periodic:{}:{last}", e.joint + 1),
-                    _ => format!("gear_periodic:{} (harmonics {:?})", e.joint + 1, e.orders),
-                }
-            }
-            IdentifiedEffect::Backlash(e) => {
-                let source = match e.sign {
-                    TorqueSign::Measured => "measured torque",
-                    TorqueSign::Stated { .. } => "static torque of the mass model",
-                    TorqueSign::Learnt { .. } => "torque learnt from the data",
-                };
-                format!("backlash:{} (sign of the {source})", e.joint + 1)
-            }
-            IdentifiedEffect::Thermal(_) => "thermal".into(),
-            IdentifiedEffect::TimeDrift(_) => "time_drift".into(),
-        }
+        self.term().label()
     }
 
     /// Number of parameters.
@@ -330,7 +318,7 @@ impl IdentifiedEffect {
 
     /// Sets the identified parameters after a fit (scaled, as [`IdentifiedEffect::theta`]).
     pub fn set_theta(&mut self, theta: &[f64]) {
-        let own = self.regressor_mut().theta_mut();
+        let own = self.term_mut().theta_mut();
         own.clear();
         own.extend_from_slice(theta);
     }
@@ -343,10 +331,7 @@ impl IdentifiedEffect {
     /// Each parameter's prior standard deviation relative to the effects' common one (1 but for
     /// a gear series' higher harmonics, [`GearPeriodic::prior_scale`]).
     pub fn prior_scale(&self) -> Vec<f64> {
-        match self {
-            IdentifiedEffect::GearPeriodic(g) => g.prior_scale(),
-            _ => vec![1.0; self.parameter_count()],
-        }
+        self.term().prior_scale()
     }
 
     /// The twist of each parameter.
@@ -427,4 +412,24 @@ pub fn span_of(values: &[f64], beyond: f64) -> Option<[f64; 2]> {
 /// `value` held inside `span` (unchanged without one).
 pub fn held_in(value: f64, span: Option<[f64; 2]>) -> f64 {
     span.map_or(value, |[low, high]| value.clamp(low, high))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn model_files_name_each_effect_by_its_kind() {
+        let thermal = IdentifiedEffect::Thermal(Thermal {
+            reference_c: 20.0,
+            scale: vec![1.0],
+            theta: vec![0.0],
+            fitted_span: None,
+        });
+        let text = ron::to_string(&thermal).unwrap();
+        assert!(text.starts_with("thermal("), "{text}");
+        assert_eq!(thermal.effect_kind(), EffectKind::Thermal);
+        assert_eq!(thermal.kind(), "thermal");
+        assert!(EffectKind::IDENTIFIED.iter().all(|&k| IdentifiedEffect::arguments(k).len() <= 2));
+    }
 }

@@ -1,62 +1,100 @@
 //! `--effects LIST|auto` (SPEC v2): which non-geometric effects a fit identifies with the
 //! geometry. Items are `joint_compliance`, `gear_periodic:JOINT:HARMONICS`, `backlash:JOINT`,
 //! `thermal` and `time_drift`, comma separated; joints are 1-based. A bad item is refused with its
-//! position in the argument and what is wrong with it.
+//! position in the argument and what is wrong with it. The names are those of
+//! [`EffectKind::IDENTIFIED`] and each kind's arguments its `NewEffect::ARGUMENTS` (module `term`),
+//! so a new effect is parsed and printed without a change here.
 
+use crate::IdentifiedEffect;
 use errors::Error;
+use loadsim::EffectKind;
 use std::fmt;
 use std::str::FromStr;
 
 pub use errors::{EffectListFault, MAX_HARMONICS};
 
-/// One effect of an `--effects` list, as the user names it.
+/// What an `--effects` item takes after its name, in order (`gear_periodic:JOINT:HARMONICS`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum EffectSpec {
-    /// Every joint gives under its torque: measured torques (`tauN_nm`) where the data has them,
-    /// the gravity-torque regressors otherwise.
-    JointCompliance,
-    /// A periodic error of one joint in its own angle: harmonics `1..=harmonics`.
-    GearPeriodic {
-        /// 1-based joint.
-        joint: usize,
-        /// Highest harmonic order.
-        harmonics: u32,
-    },
-    /// A dead band of one joint that follows the sign of its torque.
-    Backlash {
-        /// 1-based joint.
-        joint: usize,
-    },
-    /// Every link grows with `temp_c`.
-    Thermal,
-    /// The robot's placement drifts linearly with `t_s`.
-    TimeDrift,
+pub enum Argument {
+    /// A 1-based joint, at least 1 ([`EffectListFault::Joint`] otherwise).
+    Joint,
+    /// The highest harmonic order of a series, `1..=MAX_HARMONICS` ([`EffectListFault::Harmonics`]).
+    Harmonics,
+}
+
+/// One effect of an `--effects` list, as the user names it: a kind the fit identifies and the
+/// arguments its item takes ([`EffectSpec::arguments`], in that order after the name).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct EffectSpec {
+    /// The kind (one of [`EffectKind::IDENTIFIED`]).
+    pub kind: EffectKind,
+    /// The 1-based joint, for a kind that takes one.
+    pub joint: Option<usize>,
+    /// The highest harmonic order (harmonics `1..=harmonics`), for a kind that takes it.
+    pub harmonics: Option<u32>,
 }
 
 impl EffectSpec {
+    /// An item of `kind` with no arguments (`joint_compliance`, `thermal`, `time_drift`).
+    pub fn new(kind: EffectKind) -> Self {
+        Self { kind, joint: None, harmonics: None }
+    }
+
+    /// An item of `kind` on 1-based joint `joint` (`backlash:JOINT`).
+    pub fn on_joint(kind: EffectKind, joint: usize) -> Self {
+        Self { joint: Some(joint), ..Self::new(kind) }
+    }
+
+    /// A gear series of 1-based joint `joint` with harmonics `1..=harmonics`.
+    pub fn gear_periodic(joint: usize, harmonics: u32) -> Self {
+        Self { harmonics: Some(harmonics), ..Self::on_joint(EffectKind::GearPeriodic, joint) }
+    }
+
     /// The 1-based joint the item names, if any.
     pub fn joint(&self) -> Option<usize> {
-        match *self {
-            EffectSpec::GearPeriodic { joint, .. } | EffectSpec::Backlash { joint } => Some(joint),
-            _ => None,
-        }
+        self.joint
+    }
+
+    /// What the item takes after its name, in order.
+    pub fn arguments(&self) -> &'static [Argument] {
+        IdentifiedEffect::arguments(self.kind)
     }
 
     /// Whether two items fit the same parameters (the same effect on the same joint).
-    fn overlaps(&self, other: &EffectSpec) -> bool {
-        std::mem::discriminant(self) == std::mem::discriminant(other) && self.joint() == other.joint()
+    pub fn overlaps(&self, other: &EffectSpec) -> bool {
+        self.kind == other.kind && self.joint == other.joint
     }
 }
 
 impl fmt::Display for EffectSpec {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match *self {
-            EffectSpec::JointCompliance => f.write_str("joint_compliance"),
-            EffectSpec::GearPeriodic { joint, harmonics } => write!(f, "gear_periodic:{joint}:{harmonics}"),
-            EffectSpec::Backlash { joint } => write!(f, "backlash:{joint}"),
-            EffectSpec::Thermal => f.write_str("thermal"),
-            EffectSpec::TimeDrift => f.write_str("time_drift"),
+        f.write_str(self.kind.name())?;
+        for argument in self.arguments() {
+            match (argument, self.joint, self.harmonics) {
+                (Argument::Joint, Some(joint), _) => write!(f, ":{joint}")?,
+                (Argument::Harmonics, _, Some(harmonics)) => write!(f, ":{harmonics}")?,
+                _ => {}
+            }
         }
+        Ok(())
+    }
+}
+
+impl EffectSpec {
+    /// The 0-based joint of an item that takes one (refused as a missing argument otherwise).
+    pub(crate) fn joint_index(&self) -> Result<usize, Error> {
+        self.joint.map(|j| j - 1).ok_or_else(|| self.missing())
+    }
+
+    /// The harmonics of an item that takes them.
+    pub(crate) fn required_harmonics(&self) -> Result<u32, Error> {
+        self.harmonics.ok_or_else(|| self.missing())
+    }
+
+    fn missing(&self) -> Error {
+        let expected = self.arguments().len();
+        let found = usize::from(self.joint.is_some()) + usize::from(self.harmonics.is_some());
+        Error::EffectList { column: 1, text: self.to_string(), fault: EffectListFault::Arguments { expected, found } }
     }
 }
 
@@ -97,39 +135,31 @@ impl fmt::Display for EffectSelection {
 
 fn parse_item(item: &str) -> Result<EffectSpec, EffectListFault> {
     let mut parts = item.split(':');
-    let name = parts.next().unwrap_or("");
+    let name = parts.next().unwrap_or("").trim();
     let arguments: Vec<&str> = parts.collect();
-    let expect = |expected: usize| {
-        if arguments.len() == expected {
-            Ok(())
-        } else {
-            Err(EffectListFault::Arguments { expected, found: arguments.len() })
-        }
+    let kind = match EffectKind::from_name(name) {
+        Some(kind) if kind.is_identified() => kind,
+        _ if name.is_empty() => return Err(EffectListFault::Empty),
+        _ => return Err(EffectListFault::UnknownEffect),
     };
-    let joint = |text: &str| match text.trim().parse::<usize>() {
-        Ok(j) if j >= 1 => Ok(j),
-        _ => Err(EffectListFault::Joint),
-    };
-    match name.trim() {
-        "joint_compliance" => expect(0).map(|()| EffectSpec::JointCompliance),
-        "thermal" => expect(0).map(|()| EffectSpec::Thermal),
-        "time_drift" => expect(0).map(|()| EffectSpec::TimeDrift),
-        "backlash" => {
-            expect(1)?;
-            Ok(EffectSpec::Backlash { joint: joint(arguments[0])? })
-        }
-        "gear_periodic" => {
-            expect(2)?;
-            let joint = joint(arguments[0])?;
-            let harmonics = match arguments[1].trim().parse::<u32>() {
-                Ok(h) if (1..=MAX_HARMONICS).contains(&h) => h,
-                _ => return Err(EffectListFault::Harmonics),
-            };
-            Ok(EffectSpec::GearPeriodic { joint, harmonics })
-        }
-        "" => Err(EffectListFault::Empty),
-        _ => Err(EffectListFault::UnknownEffect),
+    let mut spec = EffectSpec::new(kind);
+    let expected = spec.arguments();
+    if arguments.len() != expected.len() {
+        return Err(EffectListFault::Arguments { expected: expected.len(), found: arguments.len() });
     }
+    for (argument, text) in expected.iter().zip(arguments) {
+        match argument {
+            Argument::Joint => match text.trim().parse::<usize>() {
+                Ok(j) if j >= 1 => spec.joint = Some(j),
+                _ => return Err(EffectListFault::Joint),
+            },
+            Argument::Harmonics => match text.trim().parse::<u32>() {
+                Ok(h) if (1..=MAX_HARMONICS).contains(&h) => spec.harmonics = Some(h),
+                _ => return Err(EffectListFault::Harmonics),
+            },
+        }
+    }
+    Ok(spec)
 }
 
 impl FromStr for EffectSelection {
@@ -190,12 +220,12 @@ mod tests {
         assert_eq!(
             selection,
             EffectSelection::List(vec![
-                EffectSpec::JointCompliance,
-                EffectSpec::GearPeriodic { joint: 1, harmonics: 24 },
-                EffectSpec::GearPeriodic { joint: 2, harmonics: 24 },
-                EffectSpec::Backlash { joint: 2 },
-                EffectSpec::Thermal,
-                EffectSpec::TimeDrift,
+                EffectSpec::new(EffectKind::JointCompliance),
+                EffectSpec::gear_periodic(1, 24),
+                EffectSpec::gear_periodic(2, 24),
+                EffectSpec::on_joint(EffectKind::Backlash, 2),
+                EffectSpec::new(EffectKind::Thermal),
+                EffectSpec::new(EffectKind::TimeDrift),
             ])
         );
         assert_eq!(selection.to_string(), text);
@@ -237,5 +267,24 @@ mod tests {
     fn different_joints_of_one_effect_are_not_duplicates() {
         let selection: EffectSelection = "backlash:1,backlash:2,gear_periodic:1:3".parse().unwrap();
         assert_eq!(selection.listed().len(), 3);
+    }
+
+    #[test]
+    fn every_identified_kind_is_an_item_and_no_other_kind_is() {
+        for &kind in EffectKind::IDENTIFIED {
+            let spec = EffectSpec { kind, joint: Some(2), harmonics: Some(3) };
+            let text: String = std::iter::once(kind.name().to_owned())
+                .chain(spec.arguments().iter().map(|a| match a {
+                    Argument::Joint => ":2".to_owned(),
+                    Argument::Harmonics => ":3".to_owned(),
+                }))
+                .collect();
+            let parsed: EffectSelection = text.parse().unwrap();
+            assert_eq!(parsed.listed()[0].kind, kind, "{text}");
+            assert_eq!(parsed.to_string(), text);
+        }
+        for &kind in EffectKind::ALL.iter().filter(|k| !k.is_identified()) {
+            assert_eq!(fault_of(kind.name()).2, EffectListFault::UnknownEffect, "{kind:?}");
+        }
     }
 }

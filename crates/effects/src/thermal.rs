@@ -3,6 +3,9 @@
 
 use super::{Regressor, check_column_varies, rms_scales};
 use crate::Direction;
+use crate::check::{Cursor, EffectFault};
+use crate::term::{EffectTerm, NewEffect};
+use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect};
 use errors::Error;
 use measurements::Measurement;
 use serde::{Deserialize, Serialize};
@@ -64,5 +67,54 @@ impl Regressor for Thermal {
 
     fn parameter_names(&self) -> Vec<String> {
         vec!["link strain".into()]
+    }
+}
+
+impl EffectTerm for Thermal {
+    fn label(&self) -> String {
+        "thermal".into()
+    }
+
+    fn joints(&self) -> Vec<usize> {
+        Vec::new()
+    }
+
+    fn check(&self, cursor: &Cursor<'_>, _n: usize, _tools: usize) -> Result<(), EffectFault> {
+        cursor.finite("reference_c", &[self.reference_c], false)?;
+        cursor.count("scale", self.scale.len(), 1)?;
+        cursor.count("theta", self.theta.len(), 1)?;
+        cursor.finite("scale", &self.scale, true)
+    }
+
+    fn count_fields(&self, add: &mut dyn FnMut(&'static str, usize)) {
+        add("reference_c", 1);
+        add("scale", 1);
+    }
+}
+
+impl NewEffect for Thermal {
+    const ARGUMENTS: &'static [Argument] = &[];
+
+    fn build(
+        _spec: &EffectSpec,
+        context: &EffectContext<'_>,
+        rows: &[Measurement],
+        _tools: &[usize],
+    ) -> Result<Self, Error> {
+        Thermal::new(rows, context.hold_beyond_span)
+    }
+
+    /// One expansion coefficient for the whole arm (every link but the tracker-to-base placement
+    /// grows by `α ΔT`), where every row has `temp_c` and it varies by more than 0.2 K.
+    fn global_candidates(context: &CandidateContext<'_>) -> Result<Vec<CandidateModel>, Error> {
+        let Some(temps) = context.rows.iter().map(|r| r.temp_c).collect::<Option<Vec<f64>>>() else {
+            return Ok(Vec::new());
+        };
+        let (low, high) = temps.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| (a.min(t), b.max(t)));
+        if high - low <= 0.2 {
+            return Ok(Vec::new());
+        }
+        let thermal = Thermal::new(context.rows, crate::HOLD_BEYOND_SPAN)?;
+        Ok(vec![CandidateModel::plain(IdentifiedEffect::Thermal(thermal), 0)])
     }
 }

@@ -1,5 +1,6 @@
 //! All effects together: which are on, and the forward model from commanded joint values to the
-//! measured tool pose.
+//! measured tool pose. [`Effects::only`] and [`Effects::is_on`] are generated with
+//! [`crate::EffectKind`] from the one list of kinds (module `kinds`).
 
 use crate::{
     Backlash, BaseDrift, Error, JointBacklash, JointCompliance, JointCoupling, PeriodicError, PoseContext,
@@ -9,40 +10,6 @@ use crate::{
 use lie::SE3;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
-
-/// The kinds of effect, named as in the `calib diagnose` JSON (project SPEC).
-#[non_exhaustive]
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum EffectKind {
-    /// Joint compliance under gravity and payload.
-    JointCompliance,
-    /// Backlash following the sign of the static torque.
-    Backlash,
-    /// Periodic transmission error of the gears.
-    GearPeriodic,
-    /// Thermal growth of the links.
-    Thermal,
-    /// Drift of the base placement over time.
-    TimeDrift,
-    /// Tracker measurement noise.
-    TrackerNoise,
-    /// A joint error driven by other joints' angles; no candidate of the diagnosis models it.
-    Coupling,
-}
-
-impl EffectKind {
-    /// Every kind, in a fixed order.
-    pub const ALL: [EffectKind; 7] = [
-        EffectKind::JointCompliance,
-        EffectKind::Backlash,
-        EffectKind::GearPeriodic,
-        EffectKind::Thermal,
-        EffectKind::TimeDrift,
-        EffectKind::TrackerNoise,
-        EffectKind::Coupling,
-    ];
-}
 
 /// Which effects act and with which parameters; `None` switches an effect off. The default has
 /// none: the measured pose is then the geometric model's.
@@ -119,34 +86,6 @@ impl Effects {
             drift: Some(BaseDrift::default()),
             tracker_noise: Some(TrackerNoise::default()),
             coupling: None,
-        }
-    }
-
-    /// These effects with only `kind` left on (with its parameters here; off if it is off here).
-    pub fn only(&self, kind: EffectKind) -> Self {
-        let mut alone = Effects::default();
-        match kind {
-            EffectKind::JointCompliance => alone.compliance = self.compliance,
-            EffectKind::Backlash => alone.backlash = self.backlash.clone(),
-            EffectKind::GearPeriodic => alone.periodic = self.periodic.clone(),
-            EffectKind::Thermal => alone.thermal = self.thermal.clone(),
-            EffectKind::TimeDrift => alone.drift = self.drift,
-            EffectKind::TrackerNoise => alone.tracker_noise = self.tracker_noise,
-            EffectKind::Coupling => alone.coupling = self.coupling.clone(),
-        }
-        alone
-    }
-
-    /// Whether `kind` is on.
-    pub fn is_on(&self, kind: EffectKind) -> bool {
-        match kind {
-            EffectKind::JointCompliance => self.compliance.is_some(),
-            EffectKind::Backlash => self.backlash.is_some(),
-            EffectKind::GearPeriodic => self.periodic.is_some(),
-            EffectKind::Thermal => self.thermal.is_some(),
-            EffectKind::TimeDrift => self.drift.is_some(),
-            EffectKind::TrackerNoise => self.tracker_noise.is_some(),
-            EffectKind::Coupling => self.coupling.is_some(),
         }
     }
 

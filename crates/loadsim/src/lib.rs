@@ -50,6 +50,7 @@ mod error;
 mod generator;
 mod gravity;
 mod gravity_regressor;
+mod kinds;
 mod periodic;
 mod regressor;
 mod singularity;
@@ -64,7 +65,7 @@ pub use counterbalance::Counterbalance;
 pub use coupling::{CouplingFactor, CouplingTerm, JointCoupling};
 pub use drift::BaseDrift;
 pub use dynamics::{FLOOR_GRAVITY_M_PER_S2, LinkInertia, RobotDynamics, tilted_base_gravity};
-pub use effects::{EffectKind, Effects, JointOffsets};
+pub use effects::{Effects, JointOffsets};
 pub use error::Error;
 pub use generator::{
     GeneratorConfig, JointRange, Sample, TemperatureProfile, generate, generate_each, sample_configurations,
@@ -74,6 +75,7 @@ pub use gravity::{
     potential_energy, static_torque,
 };
 pub use gravity_regressor::gravity_regressor;
+pub use kinds::EffectKind;
 pub use periodic::{Harmonic, PeriodicError, periodic_joint_regressor};
 pub use regressor::{
     EffectParameter, RegressorColumn, backlash_regressor, compliance_regressor, drift_regressor, periodic_regressor,

@@ -53,6 +53,20 @@ pub enum EffectParameter {
     },
 }
 
+impl EffectParameter {
+    /// The kind of effect the parameter belongs to.
+    pub fn kind(&self) -> crate::EffectKind {
+        use crate::EffectKind;
+        match self {
+            EffectParameter::Compliance { .. } => EffectKind::JointCompliance,
+            EffectParameter::Backlash { .. } => EffectKind::Backlash,
+            EffectParameter::PeriodicCos { .. } | EffectParameter::PeriodicSin { .. } => EffectKind::GearPeriodic,
+            EffectParameter::ThermalExpansion { .. } => EffectKind::Thermal,
+            EffectParameter::DriftRate { .. } => EffectKind::TimeDrift,
+        }
+    }
+}
+
 /// One column of an effect's linearisation: the pose error per unit of one parameter.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RegressorColumn {

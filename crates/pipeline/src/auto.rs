@@ -1,8 +1,8 @@
 //! `--effects auto`: the effects `calib diagnose` selects on the training data, as a list the fit
 //! identifies (its `selected` effects, with their joints and harmonic orders).
 
-use diagnose::{DiagnoseOptions, Effect, SelectedEffect, Verdict, diagnose};
-use effects::EffectSpec;
+use diagnose::{DiagnoseOptions, SelectedEffect, Verdict, diagnose};
+use effects::{Argument, EffectSpec};
 use errors::Error;
 use measurements::MeasurementSet;
 use robot::RobotDescription;
@@ -33,39 +33,37 @@ fn as_text<S: serde::Serializer>(specs: &[EffectSpec], serializer: S) -> Result<
     serializer.collect_seq(specs.iter().map(ToString::to_string))
 }
 
-/// The list the fit identifies for a diagnosis's selection: compliance once for every joint it
-/// names (the fit's `joint_compliance` covers every joint), gear error per joint at the highest
-/// order selected (the series runs from harmonic 1), backlash per joint, thermal growth, drift.
+/// The list the fit identifies for a diagnosis's selection, read from each kind's arguments: one
+/// item per joint the selection names for a kind that takes a joint (backlash, gear error), one
+/// item for a kind that does not (compliance: the fit's `joint_compliance` covers every joint;
+/// thermal growth, drift), a series at the highest order selected for it (the series runs from
+/// harmonic 1).
 pub fn effects_of(selected: &[SelectedEffect]) -> Vec<EffectSpec> {
     let mut specs: Vec<EffectSpec> = Vec::new();
     for s in selected {
-        let new: Vec<EffectSpec> = match s.effect {
-            Effect::JointCompliance => vec![EffectSpec::JointCompliance],
-            Effect::GearPeriodic => s
-                .joints
-                .iter()
-                .map(|&joint| EffectSpec::GearPeriodic { joint, harmonics: s.harmonic.unwrap_or(1).max(1) })
-                .collect(),
-            Effect::Backlash => s.joints.iter().map(|&joint| EffectSpec::Backlash { joint }).collect(),
-            Effect::Thermal => vec![EffectSpec::Thermal],
-            Effect::TimeDrift => vec![EffectSpec::TimeDrift],
-            Effect::None | Effect::Unknown => Vec::new(),
+        let Some(kind) = s.effect.kind() else { continue };
+        let mut template = EffectSpec::new(kind);
+        let arguments = template.arguments();
+        if arguments.contains(&Argument::Harmonics) {
+            template.harmonics = Some(s.harmonic.unwrap_or(1).max(1));
+        }
+        let new: Vec<EffectSpec> = if arguments.contains(&Argument::Joint) {
+            s.joints.iter().map(|&joint| EffectSpec { joint: Some(joint), ..template }).collect()
+        } else {
+            vec![template]
         };
         for spec in new {
-            match (specs.iter_mut().find(|s| same_parameters(s, &spec)), spec) {
-                (Some(EffectSpec::GearPeriodic { harmonics, .. }), EffectSpec::GearPeriodic { harmonics: h, .. }) => {
-                    *harmonics = (*harmonics).max(h);
+            match specs.iter_mut().find(|s| s.overlaps(&spec)) {
+                Some(old) => {
+                    if let (Some(a), Some(b)) = (old.harmonics, spec.harmonics) {
+                        old.harmonics = Some(a.max(b));
+                    }
                 }
-                (Some(_), _) => {}
-                (None, spec) => specs.push(spec),
+                None => specs.push(spec),
             }
         }
     }
     specs
-}
-
-fn same_parameters(a: &EffectSpec, b: &EffectSpec) -> bool {
-    std::mem::discriminant(a) == std::mem::discriminant(b) && a.joint() == b.joint()
 }
 
 /// Runs the diagnosis on the training data and returns what its selection keeps.

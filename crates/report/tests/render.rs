@@ -42,7 +42,7 @@ fn rendered() -> &'static Rendered {
         let train = simulate(&cell, &effects, &ranges, &train_config, false).unwrap();
         let test: MeasurementSet = simulate(&cell, &effects, &ranges, &payload_run_campaign(120, 12), false).unwrap();
         let mut options = FitOptions::default();
-        options.effects.selection = EffectSelection::List(vec![EffectSpec::GearPeriodic { joint: 2, harmonics: 2 }]);
+        options.effects.selection = EffectSelection::List(vec![EffectSpec::gear_periodic(2, 2)]);
         let (model, _) = pipeline::fit(&robot, &train, Method::PoeGp, &options).unwrap();
         let diagnosis = diagnose(&robot, &train, &DiagnoseOptions::default()).unwrap();
         let diagnosis_plot_names = diagnosis.plots().into_iter().map(|(name, _)| name).collect();

@@ -1,0 +1,146 @@
+//! The one list of effect kinds, shared by the simulator ([`crate::Effects`]), the fit and the
+//! model file (`effects::IdentifiedEffect`), the diagnosis (`diagnose::Effect`) and the command
+//! line (`--effects`, `calib simulate`). Everything that enumerates the kinds is generated from
+//! [`effect_kinds!`](crate::effect_kinds), so that adding an effect is one line here plus the
+//! effect's own files (see docs/ARCHITECTURE.md, "Adding an effect").
+
+/// Calls the macro `$callback` with the list of effect kinds, in a fixed order:
+///
+/// ```text
+/// identified { $( #[doc] Kind "spec_name" simulated_field, )* }
+/// simulated { $( #[doc] Kind "spec_name" simulated_field, )* }
+/// ```
+///
+/// `identified` kinds have a regressor in the `effects` crate (a type named `Kind` implementing
+/// its `EffectTerm`), are an item of `--effects` and a candidate the diagnosis can name;
+/// `simulated` kinds exist only in the simulator. `spec_name` is the SPEC's name (serde, the
+/// `--effects` item, the diagnosis JSON); `simulated_field` is the field of [`crate::Effects`] (and of
+/// the effects file of `calib simulate`) that switches the kind on in a simulation.
+///
+/// ```
+/// macro_rules! names {
+///     (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident, )* }
+///      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident, )* }) => {
+///         [$($name),*]
+///     };
+/// }
+/// let identified = loadsim::effect_kinds!(names);
+/// assert_eq!(identified[0], "joint_compliance");
+/// ```
+#[macro_export]
+macro_rules! effect_kinds {
+    ($callback:ident) => {
+        $callback! {
+            identified {
+                /// Joint compliance under gravity and payload.
+                JointCompliance "joint_compliance" compliance,
+                /// Backlash following the sign of the static torque.
+                Backlash "backlash" backlash,
+                /// A periodic error of a joint in its own angle (gear or encoder).
+                GearPeriodic "gear_periodic" periodic,
+                /// Thermal growth of the links with `temp_c`.
+                Thermal "thermal" thermal,
+                /// Drift of the robot's placement with `t_s`.
+                TimeDrift "time_drift" drift,
+            }
+            simulated {
+                /// Tracker measurement noise.
+                TrackerNoise "tracker_noise" tracker_noise,
+                /// A joint error driven by other joints' angles; no candidate of the diagnosis models it.
+                Coupling "coupling" coupling,
+            }
+        }
+    };
+}
+
+macro_rules! effect_kind_enum {
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident, )* }
+     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident, )* }) => {
+        /// The kinds of effect, named as in the SPEC (`--effects`, the model file, the `calib
+        /// diagnose` JSON), generated from [`effect_kinds!`](crate::effect_kinds).
+        #[non_exhaustive]
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+        #[serde(rename_all = "snake_case")]
+        pub enum EffectKind {
+            $( $(#[$doc])* $kind, )*
+            $( $(#[$sdoc])* $skind, )*
+        }
+
+        impl EffectKind {
+            /// Every kind, in the list's order.
+            pub const ALL: &'static [EffectKind] = &[$(EffectKind::$kind,)* $(EffectKind::$skind,)*];
+
+            /// The kinds the fit identifies and the diagnosis can name, in the list's order.
+            pub const IDENTIFIED: &'static [EffectKind] = &[$(EffectKind::$kind,)*];
+
+            /// The SPEC name (`joint_compliance`, `gear_periodic`, …).
+            pub fn name(self) -> &'static str {
+                match self {
+                    $( EffectKind::$kind => $name, )*
+                    $( EffectKind::$skind => $sname, )*
+                }
+            }
+
+            /// The kind of a SPEC name.
+            pub fn from_name(name: &str) -> Option<EffectKind> {
+                Self::ALL.iter().copied().find(|k| k.name() == name)
+            }
+
+            /// Whether the fit identifies this kind (it has a regressor in `effects`).
+            pub fn is_identified(self) -> bool {
+                Self::IDENTIFIED.contains(&self)
+            }
+
+            /// The field of [`Effects`] (and of `calib simulate`'s effects file) that holds it.
+            pub fn simulated_field(self) -> &'static str {
+                match self {
+                    $( EffectKind::$kind => stringify!($field), )*
+                    $( EffectKind::$skind => stringify!($sfield), )*
+                }
+            }
+        }
+
+        impl Effects {
+            /// These effects with only `kind` left on (with its parameters here; off if it is off here).
+            pub fn only(&self, kind: EffectKind) -> Self {
+                let mut alone = Effects::default();
+                match kind {
+                    $( EffectKind::$kind => alone.$field = self.$field.clone(), )*
+                    $( EffectKind::$skind => alone.$sfield = self.$sfield.clone(), )*
+                }
+                alone
+            }
+
+            /// Whether `kind` is on.
+            pub fn is_on(&self, kind: EffectKind) -> bool {
+                match kind {
+                    $( EffectKind::$kind => self.$field.is_some(), )*
+                    $( EffectKind::$skind => self.$sfield.is_some(), )*
+                }
+            }
+        }
+    };
+}
+
+use crate::Effects;
+use serde::{Deserialize, Serialize};
+
+effect_kinds!(effect_kind_enum);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_serde_names_are_the_spec_names_and_read_back() {
+        for &kind in EffectKind::ALL {
+            let text = ron::to_string(&kind).unwrap();
+            assert_eq!(text, kind.name());
+            assert_eq!(ron::from_str::<EffectKind>(&text).unwrap(), kind);
+            assert_eq!(EffectKind::from_name(kind.name()), Some(kind));
+        }
+        assert_eq!(EffectKind::from_name("gear"), None);
+        assert!(EffectKind::GearPeriodic.is_identified() && !EffectKind::Coupling.is_identified());
+        assert_eq!(EffectKind::GearPeriodic.simulated_field(), "periodic");
+    }
+}
