@@ -103,6 +103,8 @@ pub struct FitOptions {
     /// and `force`, which turns their refusals into warnings.
     #[serde(default)]
     pub plausibility: crate::PlausibilityOptions,
+    /// The prior toward the nominal geometry and how its strength is chosen (issue 30).
+    pub nominal_prior: crate::NominalPriorOptions,
 }
 
 impl Default for FitOptions {
@@ -113,6 +115,7 @@ impl Default for FitOptions {
             effects: EffectOptions::default(),
             min_redundancy: 3.0,
             plausibility: crate::PlausibilityOptions::default(),
+            nominal_prior: crate::NominalPriorOptions::default(),
         }
     }
 }
@@ -183,6 +186,7 @@ impl FitOptions {
             ));
         }
         self.plausibility.validate()?;
+        self.nominal_prior.validate()?;
         let prior = self.effects.prior_sigma;
         if prior.is_nan() || prior <= 0.0 {
             return Err((
