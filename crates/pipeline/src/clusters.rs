@@ -37,8 +37,8 @@ pub struct BranchJoint {
 /// The rows of one configuration cluster.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Cluster {
-    /// The branch of every branch joint: `joint 3 +, joint 5 −` (`+`: an even number of singular
-    /// angles at or below the joint's angle in `[-180°, 180°)`).
+    /// The branch of every branch joint, as the span of its angles between two singular ones:
+    /// `joint 3 0…180°, joint 5 -180…0°`.
     pub label: String,
     /// Its rows, by index into the data.
     #[serde(skip)]
@@ -90,8 +90,21 @@ pub(crate) fn branch_joints(
     if n != 6 || rows.is_empty() {
         return Ok(Vec::new());
     }
-    let probes: Vec<&[f64]> =
-        (0..options.probes).map(|p| rows[p * rows.len() / options.probes].q.as_slice()).collect();
+    // One probe from each of `probes` consecutive stretches of the rows: the one farthest from
+    // a singular pose (largest |det|), so that no other factor's zero, nor rounding, hides the
+    // sign changes (a pose at a wrist singularity has a determinant of rounding noise).
+    let mut probes: Vec<&[f64]> = Vec::with_capacity(options.probes);
+    for p in 0..options.probes.min(rows.len()) {
+        let stretch = &rows[p * rows.len() / options.probes..((p + 1) * rows.len() / options.probes).max(p + 1)];
+        let mut best: Option<(f64, &[f64])> = None;
+        for row in stretch {
+            let size = determinant(model, &row.q)?.abs();
+            if best.is_none_or(|(b, _)| size > b) {
+                best = Some((size, row.q.as_slice()));
+            }
+        }
+        probes.extend(best.map(|(_, q)| q));
+    }
     let mut joints = Vec::new();
     for j in 0..n {
         if model.joints()[j].kind != JointKind::Revolute {
@@ -123,6 +136,16 @@ fn branch(joint: &BranchJoint, q: f64) -> bool {
     joint.singular_deg.iter().filter(|&&s| s <= q).count() % 2 == 0
 }
 
+/// A branch in words: with two singular angles `a < b`, `a…b°` or `b…a+360°`; with more, the
+/// parity of the singular angles below the joint's angle.
+fn side(joint: &BranchJoint, even: bool) -> String {
+    match joint.singular_deg[..] {
+        [a, b] if even => format!("{:.0}…{:.0}°", b, a + 360.0),
+        [a, b] => format!("{a:.0}…{b:.0}°"),
+        _ => (if even { "even" } else { "odd" }).to_owned(),
+    }
+}
+
 /// The rows grouped by their pattern of branches, largest cluster first (ties by label).
 pub(crate) fn clusters(joints: &[BranchJoint], rows: &[Measurement]) -> Vec<Cluster> {
     let mut groups: std::collections::BTreeMap<Vec<bool>, Vec<usize>> = std::collections::BTreeMap::new();
@@ -136,11 +159,8 @@ pub(crate) fn clusters(joints: &[BranchJoint], rows: &[Measurement]) -> Vec<Clus
             let label = if joints.is_empty() {
                 "all rows".to_owned()
             } else {
-                let parts: Vec<String> = joints
-                    .iter()
-                    .zip(&key)
-                    .map(|(j, &even)| format!("joint {} {}", j.joint, if even { '+' } else { '−' }))
-                    .collect();
+                let parts: Vec<String> =
+                    joints.iter().zip(&key).map(|(j, &even)| format!("joint {} {}", j.joint, side(j, even))).collect();
                 parts.join(", ")
             };
             Cluster { label, n: rows.len(), rows }
@@ -175,11 +195,14 @@ mod tests {
 
     #[test]
     fn a_ur10s_branches_are_the_elbow_and_the_wrist_at_zero_and_half_a_turn() {
-        let rows: Vec<Measurement> = (0..8)
-            .map(|k| {
-                let t = k as f64;
+        // The first row at the wrist's singularity: its determinant is rounding noise, with
+        // hundreds of sign changes of joint 3 (as row 0 of the UR10's series B, even rows); the
+        // scan probes the other row of its stretch.
+        let rows: Vec<Measurement> = std::iter::once(row([0.2, -0.6, -1.0, -1.5, 0.0, 0.3]))
+            .chain((1..16).map(|k| {
+                let t = 0.5 * k as f64;
                 row([0.3 * t - 1.0, -0.2 * t - 0.5, 0.25 * t - 1.1, 0.4 * t - 2.0, 0.3 * t - 1.3, 0.1 * t])
-            })
+            }))
             .collect();
         let options = ScanOptions { steps: 720, probes: 8, tolerance_rad: 1e-2 };
         let joints = branch_joints(&ur10(), &rows, options).unwrap();

@@ -94,7 +94,10 @@ impl NominalPriorOptions {
             }
         }
         if self.scan_steps < 8 {
-            return Err(("scan_steps", format!("nominal_prior.scan_steps is {}, expected at least 8", self.scan_steps)));
+            return Err((
+                "scan_steps",
+                format!("nominal_prior.scan_steps is {}, expected at least 8", self.scan_steps),
+            ));
         }
         if self.scan_probes < 2 {
             let probes = self.scan_probes;
@@ -193,7 +196,8 @@ pub fn choose(
     if !prior.choose {
         return Ok(PriorChoice::without(Vec::new(), Vec::new(), "switched off (nominal_prior.choose)".into()));
     }
-    let scan = ScanOptions { steps: prior.scan_steps, probes: prior.scan_probes, tolerance_rad: prior.scan_tolerance_rad };
+    let scan =
+        ScanOptions { steps: prior.scan_steps, probes: prior.scan_probes, tolerance_rad: prior.scan_tolerance_rad };
     let branch_joints = clusters::branch_joints(nominal, &data.rows, scan)?;
     let found = clusters::clusters(&branch_joints, &data.rows);
     if branch_joints.is_empty() {
@@ -221,22 +225,20 @@ pub fn choose(
         .filter_map(|cluster| {
             let held: std::collections::BTreeSet<usize> = cluster.rows.iter().copied().collect();
             let train: Vec<usize> = (0..data.rows.len()).filter(|i| !held.contains(i)).collect();
-            let tools_known = cluster.rows.iter().all(|&i| train.iter().any(|&t| data.rows[t].tool == data.rows[i].tool));
+            let tools_known =
+                cluster.rows.iter().all(|&i| train.iter().any(|&t| data.rows[t].tool == data.rows[i].tool));
             tools_known.then(|| (cluster.label.clone(), data.subset(&train), data.subset(&cluster.rows)))
         })
         .collect();
-    let sigmas: Vec<Option<(f64, f64)>> = prior
-        .translations_m
-        .iter()
-        .map(|&t| t.is_finite().then_some((t, t / prior.length_m)))
-        .collect();
-    let work: Vec<(usize, usize)> =
-        (0..splits.len()).flat_map(|s| (0..sigmas.len()).map(move |c| (s, c))).collect();
+    let sigmas: Vec<Option<(f64, f64)>> =
+        prior.translations_m.iter().map(|&t| t.is_finite().then_some((t, t / prior.length_m))).collect();
+    let work: Vec<(usize, usize)> = (0..splits.len()).flat_map(|s| (0..sigmas.len()).map(move |c| (s, c))).collect();
     let results: Vec<Option<(f64, f64)>> = work
         .par_iter()
         .map(|&(s, c)| {
             let (_, train, test) = &splits[s];
-            let fitted = calibrate_placed_with_prior(nominal, &observations(train), Scope::Full, sigmas[c], identification);
+            let fitted =
+                calibrate_placed_with_prior(nominal, &observations(train), Scope::Full, sigmas[c], identification);
             fitted.ok().and_then(|(_, fit)| heldout(&fit.model, test, identification).ok())
         })
         .collect();
@@ -245,9 +247,10 @@ pub fn choose(
     let usable: Vec<usize> =
         (0..splits.len()).filter(|&s| (0..sigmas.len()).all(|c| results[s * sigmas.len() + c].is_some())).collect();
     if usable.is_empty() {
-        let reason = "no configuration cluster could be held out (a tool only it carries, or too few rows without it): \
+        let reason =
+            "no configuration cluster could be held out (a tool only it carries, or too few rows without it): \
                       the fit as without a prior"
-            .to_owned();
+                .to_owned();
         return Ok(PriorChoice::without(branch_joints, found, reason));
     }
     let candidates: Vec<PriorCandidate> = sigmas
@@ -264,10 +267,9 @@ pub fn choose(
             }
         })
         .collect();
-    let best = candidates
-        .iter()
-        .enumerate()
-        .fold(0, |best, (c, candidate)| if candidate.heldout_score < candidates[best].heldout_score { c } else { best });
+    let best = candidates.iter().enumerate().fold(0, |best, (c, candidate)| {
+        if candidate.heldout_score < candidates[best].heldout_score { c } else { best }
+    });
     let held_out: Vec<String> = usable.iter().map(|&s| splits[s].0.clone()).collect();
     let unprior = candidates.iter().find(|c| c.translation_m.is_none());
     let reason = format!(

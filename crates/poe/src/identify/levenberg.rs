@@ -20,9 +20,11 @@ fn prior_weights(problem: &Problem<'_>) -> Vec<f64> {
         None => problem
             .free
             .iter()
-            .map(|&index| {
-                if index % 6 < 3 { 1.0 / options.prior_translation_m } else { 1.0 / options.prior_rotation_rad }
-            })
+            .map(
+                |&index| {
+                    if index % 6 < 3 { 1.0 / options.prior_translation_m } else { 1.0 / options.prior_rotation_rad }
+                },
+            )
             .collect(),
     };
     if let Some(correction) = problem.correction {
