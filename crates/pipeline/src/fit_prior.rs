@@ -114,10 +114,11 @@ pub struct PriorCandidate {
     pub translation_m: Option<f64>,
     /// σ of a link's rotation, rad (`null`: no prior).
     pub rotation_rad: Option<f64>,
-    /// The RMS position error on each held-out cluster, mm, averaged over the clusters.
+    /// The RMS position error over the held-out rows (each row held out once, with its
+    /// cluster), mm.
     pub heldout_rms_position_mm: f64,
     /// The criterion: the RMS of the weighted residual (position over `position_sigma_m`,
-    /// rotation over `rotation_sigma_rad`) on each held-out cluster, averaged over the clusters.
+    /// rotation over `rotation_sigma_rad`) over the held-out rows.
     pub heldout_score: f64,
 }
 
@@ -130,7 +131,8 @@ pub struct PriorChoice {
     pub clusters: Vec<Cluster>,
     /// The clusters held out in turn (labels).
     pub held_out: Vec<String>,
-    /// Every candidate with its held-out error (empty where nothing was held out).
+    /// Every candidate with its held-out error (empty where nothing was held out); the chosen one
+    /// is the first within one standard error of the lowest (`choose`).
     pub candidates: Vec<PriorCandidate>,
     /// The chosen σ of a link's translation, m (`null`: no prior, the plain least-squares fit).
     pub translation_m: Option<f64>,
@@ -174,19 +176,29 @@ impl std::fmt::Display for PriorChoice {
     }
 }
 
-/// The weighted RMS residual of a model on `data` (the identification's criterion), and its RMS
-/// position error in mm.
-fn heldout(model: &LocalPoe, data: &MeasurementSet, options: &IdentificationOptions) -> Result<(f64, f64), Error> {
-    let stats = evaluate(model, &observations(data))?;
-    let rotation = stats.rms_rotation_rad.map_or(0.0, |r| r / options.rotation_sigma_rad);
-    let score = ((stats.rms_position_m / options.position_sigma_m).powi(2) + rotation.powi(2)).sqrt();
-    Ok((score, stats.rms_position_m * 1e3))
+/// Per row of `data`, the squared weighted residual of a model (position over
+/// `position_sigma_m`, rotation over `rotation_sigma_rad`: the identification's criterion) and
+/// the squared position error in mm².
+fn heldout(model: &LocalPoe, data: &MeasurementSet, options: &IdentificationOptions) -> Result<Vec<(f64, f64)>, Error> {
+    observations(data)
+        .chunks(1)
+        .map(|row| {
+            let stats = evaluate(model, row)?;
+            let rotation = stats.rms_rotation_rad.map_or(0.0, |r| r / options.rotation_sigma_rad);
+            let loss = (stats.rms_position_m / options.position_sigma_m).powi(2) + rotation.powi(2);
+            Ok((loss, (stats.rms_position_m * 1e3).powi(2)))
+        })
+        .collect()
 }
 
 /// Chooses the prior's strength for a fit of `scope` on `data` (issue 30): each candidate of
 /// `prior.translations_m` is fitted with each configuration cluster held out in turn and judged on
-/// it; the lowest mean held-out criterion wins (the first listed on a tie, so no prior before
-/// any). With fewer than two clusters of `min_cluster_share`, no prior.
+/// it, every row once. The candidate with the lowest mean held-out criterion is the best; the one
+/// chosen is the first listed (the weakest prior, none first) whose mean is within one standard
+/// error of the best's (the standard error of the rows' paired differences): Breiman's one
+/// standard error rule (Breiman et al. 1984, §3.4.3), so that a difference the held-out rows cannot
+/// tell from noise does not change the fit. With fewer than two clusters of `min_cluster_share`,
+/// no prior.
 pub fn choose(
     nominal: &LocalPoe,
     data: &MeasurementSet,
@@ -233,7 +245,7 @@ pub fn choose(
     let sigmas: Vec<Option<(f64, f64)>> =
         prior.translations_m.iter().map(|&t| t.is_finite().then_some((t, t / prior.length_m))).collect();
     let work: Vec<(usize, usize)> = (0..splits.len()).flat_map(|s| (0..sigmas.len()).map(move |c| (s, c))).collect();
-    let results: Vec<Option<(f64, f64)>> = work
+    let results: Vec<Option<Vec<(f64, f64)>>> = work
         .par_iter()
         .map(|&(s, c)| {
             let (_, train, test) = &splits[s];
@@ -243,7 +255,7 @@ pub fn choose(
         })
         .collect();
     // A fold that some candidate could not fit (too few rows, a refused start) is left out for
-    // every candidate, so that all are judged on the same folds.
+    // every candidate, so that all are judged on the same rows.
     let usable: Vec<usize> =
         (0..splits.len()).filter(|&s| (0..sigmas.len()).all(|c| results[s * sigmas.len() + c].is_some())).collect();
     if usable.is_empty() {
@@ -253,37 +265,45 @@ pub fn choose(
                 .to_owned();
         return Ok(PriorChoice::without(branch_joints, found, reason));
     }
+    // Every held-out row of every usable fold, per candidate, in the same order.
+    let rows: Vec<Vec<(f64, f64)>> = (0..sigmas.len())
+        .map(|c| usable.iter().flat_map(|&s| results[s * sigmas.len() + c].clone().unwrap_or_default()).collect())
+        .collect();
+    let n = rows[0].len().max(1) as f64;
     let candidates: Vec<PriorCandidate> = sigmas
         .iter()
-        .enumerate()
-        .map(|(c, sigma)| {
-            let per_fold: Vec<(f64, f64)> = usable.iter().filter_map(|&s| results[s * sigmas.len() + c]).collect();
-            let k = per_fold.len() as f64;
-            PriorCandidate {
-                translation_m: sigma.map(|s| s.0),
-                rotation_rad: sigma.map(|s| s.1),
-                heldout_rms_position_mm: per_fold.iter().map(|r| r.1).sum::<f64>() / k,
-                heldout_score: per_fold.iter().map(|r| r.0).sum::<f64>() / k,
-            }
+        .zip(&rows)
+        .map(|(sigma, rows)| PriorCandidate {
+            translation_m: sigma.map(|s| s.0),
+            rotation_rad: sigma.map(|s| s.1),
+            heldout_rms_position_mm: (rows.iter().map(|r| r.1).sum::<f64>() / n).sqrt(),
+            heldout_score: (rows.iter().map(|r| r.0).sum::<f64>() / n).sqrt(),
         })
         .collect();
     let best = candidates.iter().enumerate().fold(0, |best, (c, candidate)| {
         if candidate.heldout_score < candidates[best].heldout_score { c } else { best }
     });
+    let within_one_error = |c: usize| {
+        let d: Vec<f64> = rows[c].iter().zip(&rows[best]).map(|(a, b)| a.0 - b.0).collect();
+        let mean = d.iter().sum::<f64>() / n;
+        let variance = d.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        mean <= (variance / n).sqrt()
+    };
+    let chosen = (0..candidates.len()).find(|&c| within_one_error(c)).unwrap_or(best);
     let held_out: Vec<String> = usable.iter().map(|&s| splits[s].0.clone()).collect();
     let unprior = candidates.iter().find(|c| c.translation_m.is_none());
     let reason = format!(
         "{} configuration clusters held out in turn: held-out RMS {:.4} mm{}",
         held_out.len(),
-        candidates[best].heldout_rms_position_mm,
+        candidates[chosen].heldout_rms_position_mm,
         unprior.map_or(String::new(), |u| format!(", {:.4} mm without a prior", u.heldout_rms_position_mm))
     );
     Ok(PriorChoice {
         branch_joints,
         clusters: found,
         held_out,
-        translation_m: candidates[best].translation_m,
-        rotation_rad: candidates[best].rotation_rad,
+        translation_m: candidates[chosen].translation_m,
+        rotation_rad: candidates[chosen].rotation_rad,
         candidates,
         reason,
     })
