@@ -122,6 +122,9 @@ fn summarise(
         "  identifiable: {} of {} free parameters, condition number {:.3e}",
         id.rank, id.free_parameters, id.condition_number
     );
+    if let Some(prior) = &report.nominal_prior {
+        let _ = writeln!(out, "  {prior}");
+    }
     if let Some(auto) = &report.auto {
         let chosen: Vec<String> = auto.chosen.iter().map(ToString::to_string).collect();
         let _ = writeln!(

@@ -47,3 +47,19 @@ pub fn fit_geometry(
     let (registered, identification) = poe::identify::calibrate_placed(nominal, &observations, scope, options)?;
     Ok(GeometricFit { model: identification.model, registered, report: identification.report })
 }
+
+/// [`fit_geometry`] with the full identification under a prior toward the placed nominal model
+/// (issue 30): `prior` is the standard deviation of a link's translation (m) and rotation (rad)
+/// about it; `None` is [`fit_geometry`].
+pub fn fit_geometry_with_prior(
+    nominal: &LocalPoe,
+    data: &MeasurementSet,
+    scope: Scope,
+    prior: Option<(f64, f64)>,
+    options: &IdentificationOptions,
+) -> Result<GeometricFit, Error> {
+    let observations = observations(data);
+    let (registered, identification) =
+        poe::identify::calibrate_placed_with_prior(nominal, &observations, scope, prior, options)?;
+    Ok(GeometricFit { model: identification.model, registered, report: identification.report })
+}

@@ -8,10 +8,10 @@ use effects::{
 use errors::Error;
 use measurements::MeasurementSet;
 use measurements::{OutlierLine, list_lines, without};
-use model::geometric::{fit_geometry, observations};
+use model::geometric::{fit_geometry_with_prior, observations};
 use model::{CalibratedModel, ErrorSummary, Method, ResidualGp, ResidualGpReport, SCHEMA_VERSION, evaluate};
 use poe::identify::{
-    IdentificationOptions, IdentificationReport, Loss, ParameterMask, Scope, identify_with_correction,
+    IdentificationOptions, IdentificationReport, KinematicPrior, Loss, ParameterMask, Scope, identify_with_prior,
 };
 use robot::RobotDescription;
 use serde::Serialize;
@@ -45,6 +45,11 @@ pub struct FitReport {
     /// The GP stage's report, for the GP methods: its hyperparameters.
     #[serde(skip_serializing_if = "Option::is_none", rename = "compensation")]
     pub residual_gp: Option<ResidualGpReport>,
+    /// The prior toward the nominal geometry (issue 30): the configuration clusters of the data,
+    /// each candidate strength's error on them held out, the chosen one and why (absent for
+    /// `base-tool`, which identifies no link).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nominal_prior: Option<crate::PriorChoice>,
     /// What `--effects auto` chose and why.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub auto: Option<AutoChoice>,
@@ -165,7 +170,12 @@ pub fn fit(
     }
     let nominal = robot.nominal_model()?;
     let scope = if method == Method::BaseTool { Scope::BaseTool } else { Scope::Full };
-    let geometry = fit_geometry(&nominal, data, scope, &options.identification)?;
+    let nominal_prior = match scope {
+        Scope::Full => Some(crate::choose_prior(&nominal, data, &options.identification, &options.nominal_prior)?),
+        Scope::BaseTool => None,
+    };
+    let prior_sigmas = nominal_prior.as_ref().and_then(crate::PriorChoice::chosen);
+    let geometry = fit_geometry_with_prior(&nominal, data, scope, prior_sigmas, &options.identification)?;
     let mut model = CalibratedModel {
         schema_version: SCHEMA_VERSION,
         robot: robot.name.clone(),
@@ -205,8 +215,17 @@ pub fn fit(
             max_iterations: options.effects.max_iterations,
             ..options.identification.clone()
         };
-        let fitted =
-            identify_with_correction(&model.kinematics, &observations(data), &mask, Some(&correction), &id_options)?;
+        // The effects are fitted under the same prior, about the same placed nominal model, as
+        // the geometry alone: otherwise they would free what it held.
+        let prior = prior_sigmas.map(|(t, r)| KinematicPrior::on_links(geometry.registered.clone(), t, r));
+        let fitted = identify_with_prior(
+            &model.kinematics,
+            &observations(data),
+            &mask,
+            Some(&correction),
+            prior.as_ref(),
+            &id_options,
+        )?;
         EffectCorrection::distribute(&mut effects, &fitted.correction);
         for effect in &mut effects {
             if let IdentifiedEffect::GearPeriodic(gear) = effect {
@@ -282,6 +301,7 @@ pub fn fit(
         folded: robot.folded.clone(),
         effects: effect_report,
         residual_gp,
+        nominal_prior,
         auto,
         plausibility: findings.report,
         outliers,

@@ -103,6 +103,8 @@ pub struct FitOptions {
     /// and `force`, which turns their refusals into warnings.
     #[serde(default)]
     pub plausibility: crate::PlausibilityOptions,
+    /// The prior toward the nominal geometry and how its strength is chosen (issue 30).
+    pub nominal_prior: crate::NominalPriorOptions,
 }
 
 impl Default for FitOptions {
@@ -113,6 +115,7 @@ impl Default for FitOptions {
             effects: EffectOptions::default(),
             min_redundancy: 3.0,
             plausibility: crate::PlausibilityOptions::default(),
+            nominal_prior: crate::NominalPriorOptions::default(),
         }
     }
 }
@@ -183,6 +186,7 @@ impl FitOptions {
             ));
         }
         self.plausibility.validate()?;
+        self.nominal_prior.validate()?;
         let prior = self.effects.prior_sigma;
         if prior.is_nan() || prior <= 0.0 {
             return Err((
@@ -230,6 +234,20 @@ mod tests {
         let error = FitOptions::parse("(plausibility: (\n  reflection_ratio: 2.0))", "fit.ron").unwrap_err();
         let message = error.to_string();
         assert!(message.contains("fit.ron:2:3") && message.contains("reflection_ratio is 2"), "{message}");
+    }
+
+    #[test]
+    fn the_nominal_prior_block_can_be_given_and_a_bad_value_is_refused_at_its_field() {
+        let options =
+            FitOptions::parse("(nominal_prior: (choose: false, translations_m: [inf, 1e-4]))", "fit.ron").unwrap();
+        assert!(!options.nominal_prior.choose);
+        assert_eq!(options.nominal_prior.translations_m, [f64::INFINITY, 1e-4]);
+        assert_eq!(options.nominal_prior.length_m, crate::NominalPriorOptions::default().length_m);
+        let error = FitOptions::parse("(nominal_prior: (\n  min_cluster_share: 0.9))", "fit.ron").unwrap_err();
+        let message = error.to_string();
+        assert!(message.contains("fit.ron:2:3") && message.contains("min_cluster_share is 0.9"), "{message}");
+        let error = FitOptions::parse("(nominal_prior: (translations_m: [0.0]))", "fit.ron").unwrap_err();
+        assert!(error.to_string().contains("translations_m"), "{error}");
     }
 
     #[test]

@@ -7,12 +7,16 @@
 #![deny(missing_docs)]
 
 mod auto;
+mod clusters;
 mod fit;
 mod fit_options;
+mod fit_prior;
 mod plausibility;
 
+pub use clusters::{BranchJoint, Cluster};
 pub use fit::{FitReport, FitWarning, fit};
 pub use fit_options::{EffectOptions, FitOptions};
+pub use fit_prior::{NominalPriorOptions, PriorCandidate, PriorChoice, choose as choose_prior};
 pub use plausibility::{PlausibilityOptions, PlausibilityReport};
 
 pub use cell::*;

@@ -10,14 +10,23 @@ use super::problem::{Problem, Solved, State, cost, record};
 use super::{IterationRecord, Termination};
 use crate::Error;
 
-/// The prior weight `1/σ` of every parameter: kinematic blocks are `(v, ω)` sextuples.
+/// The prior weight `1/σ` of every parameter: kinematic blocks are `(v, ω)` sextuples, held by
+/// the problem's [`super::KinematicPrior`] where it has one, else by the options' prior about the
+/// start.
 fn prior_weights(problem: &Problem<'_>) -> Vec<f64> {
     let options = problem.options;
-    let mut weights: Vec<f64> = problem
-        .free
-        .iter()
-        .map(|&index| if index % 6 < 3 { 1.0 / options.prior_translation_m } else { 1.0 / options.prior_rotation_rad })
-        .collect();
+    let mut weights: Vec<f64> = match problem.prior {
+        Some(prior) => prior.weights(&problem.free),
+        None => problem
+            .free
+            .iter()
+            .map(
+                |&index| {
+                    if index % 6 < 3 { 1.0 / options.prior_translation_m } else { 1.0 / options.prior_rotation_rad }
+                },
+            )
+            .collect(),
+    };
     if let Some(correction) = problem.correction {
         weights.extend((0..correction.parameter_count()).map(|l| 1.0 / correction.prior_sigma(l)));
     }

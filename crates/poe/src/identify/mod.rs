@@ -4,6 +4,7 @@ mod correction;
 mod levenberg;
 mod normal;
 mod options;
+mod prior;
 mod problem;
 mod reduced;
 mod redundancy;
@@ -16,12 +17,13 @@ mod termination;
 
 pub use correction::PoseCorrection;
 pub use options::{IdentificationOptions, Observation, ParameterMask, Solver, Target};
+pub use prior::KinematicPrior;
 pub use redundancy::Redundancy;
 pub use registration::register;
 pub use report::{DampingFallback, IdentificationReport, IterationRecord};
 pub use residual::ResidualStats;
 pub use robust::{KindScale, Loss, OutlierRow, RobustOptions, RobustReport, huber_loss, huber_weight, median};
-pub use solver::{Identification, identify, identify_with_correction};
+pub use solver::{Identification, identify, identify_with_correction, identify_with_prior};
 pub use termination::Termination;
 
 use crate::{Error, LocalPoe};
@@ -68,6 +70,31 @@ pub fn calibrate_placed(
             identify(&base_tool.model, observations, &mask, options)?
         }
     };
+    Ok((placed, fit))
+}
+
+/// [`calibrate_placed`] with the full identification under a prior about the base-tool stage's
+/// model (the nominal geometry at its fitted base and tool placement): `prior` gives the
+/// standard deviations of the links' local transforms, translation in metres and rotation in
+/// radians ([`KinematicPrior::on_links`]); `None` is [`calibrate_placed`]. The base-tool stage
+/// itself is fitted without the prior.
+pub fn calibrate_placed_with_prior(
+    nominal: &LocalPoe,
+    observations: &[Observation],
+    scope: Scope,
+    prior: Option<(f64, f64)>,
+    options: &IdentificationOptions,
+) -> Result<(LocalPoe, Identification), Error> {
+    let Some((translation_m, rotation_rad)) = prior.filter(|_| scope == Scope::Full) else {
+        return calibrate_placed(nominal, observations, scope, options);
+    };
+    let registered = register(nominal, observations)?;
+    let base_tool_mask = ParameterMask::base_tool(registered.layout());
+    let base_tool = identify(&registered, observations, &base_tool_mask, options)?;
+    let placed = base_tool.model.clone();
+    let prior = KinematicPrior::on_links(placed.clone(), translation_m, rotation_rad);
+    let mask = ParameterMask::all(placed.layout());
+    let fit = identify_with_prior(&placed, observations, &mask, None, Some(&prior), options)?;
     Ok((placed, fit))
 }
 

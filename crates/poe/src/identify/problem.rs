@@ -2,6 +2,7 @@
 //! pseudo-inverse, `levenberg.rs` with damping and a prior), its state, and what a solver returns.
 
 use super::correction::{Corrected, PoseCorrection};
+use super::prior::KinematicPrior;
 use super::reduced::Reduced;
 use super::residual::{ResidualStats, linearise_reduced, residuals};
 use super::{DampingFallback, IdentificationOptions, IterationRecord, Observation, Termination};
@@ -19,10 +20,13 @@ pub(super) struct Problem<'a> {
     pub options: &'a IdentificationOptions,
     /// The robust loss's weight of each observation's position and orientation rows (empty: 1).
     pub row_weights: Vec<[f64; 2]>,
+    /// A prior on the kinematic parameters about its own centre (`prior.rs`); `None`: the
+    /// options' prior about the start, if any.
+    pub prior: Option<&'a KinematicPrior>,
 }
 
 /// A point of the parameter space: the model, the correction's θ, and the accumulated steps
-/// (the deviation from the start that a prior penalises).
+/// (the deviation from the start, or from a [`KinematicPrior`]'s centre, that a prior penalises).
 #[derive(Clone)]
 pub(super) struct State {
     pub model: LocalPoe,

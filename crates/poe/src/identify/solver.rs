@@ -4,6 +4,7 @@
 
 use super::correction::PoseCorrection;
 use super::levenberg::{continue_damped, levenberg_marquardt};
+use super::prior::KinematicPrior;
 use super::problem::{Problem, Solved, State, cost, record};
 use super::redundancy::find_redundancies;
 use super::residual::row_errors;
@@ -47,22 +48,42 @@ pub fn identify_with_correction(
     correction: Option<&dyn PoseCorrection>,
     options: &IdentificationOptions,
 ) -> Result<Identification, Error> {
+    identify_with_prior(initial, observations, mask, correction, None, options)
+}
+
+/// [`identify_with_correction`] under a [`KinematicPrior`] (a maximum a posteriori fit): the
+/// kinematic parameters it names are held about its centre, whatever `initial` is, by
+/// Levenberg–Marquardt whatever `options.solver` says (the pseudo-inverse has no prior); the
+/// options' own prior about the start is then not used. `None`: [`identify_with_correction`].
+pub fn identify_with_prior(
+    initial: &LocalPoe,
+    observations: &[Observation],
+    mask: &ParameterMask,
+    correction: Option<&dyn PoseCorrection>,
+    prior: Option<&KinematicPrior>,
+    options: &IdentificationOptions,
+) -> Result<Identification, Error> {
     options.validate()?;
+    if let Some(prior) = prior {
+        prior.validate(initial)?;
+    }
     let layout = initial.layout();
     if mask.flags().len() != layout.len() {
         return Err(Error::MaskLength { given: mask.flags().len(), expected: layout.len() });
     }
-    let mut problem = Problem { observations, free: mask.free_indices(), correction, options, row_weights: Vec::new() };
+    let mut problem =
+        Problem { observations, free: mask.free_indices(), correction, options, row_weights: Vec::new(), prior };
     let rows = super::residual::row_count(observations);
     let parameters = problem.parameter_count();
     if rows < parameters {
         return Err(Error::TooFewObservations { observations: observations.len(), rows, parameters });
     }
-    let start = State {
-        model: initial.clone(),
-        theta: vec![0.0; correction.map_or(0, |c| c.parameter_count())],
-        deviation: vec![0.0; parameters],
+    let theta = vec![0.0; correction.map_or(0, |c| c.parameter_count())];
+    let deviation = match prior {
+        Some(prior) => prior.deviation(initial, &problem.free).into_iter().chain(theta.iter().copied()).collect(),
+        None => vec![0.0; parameters],
     };
+    let start = State { model: initial.clone(), theta, deviation };
     let (solved, robust) = reweighted(&mut problem, start)?;
     let svd = normal::Decomposition::new(&solved.a, solved.iterations.len())?;
     let smax = svd.singular_values.first().copied().unwrap_or(0.0);
@@ -98,7 +119,8 @@ pub fn identify_with_correction(
 
 fn solve(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
     match problem.options.solver {
-        Solver::PseudoInverse => gauss_newton(problem, start),
+        Solver::PseudoInverse if problem.prior.is_none() => gauss_newton(problem, start),
+        Solver::PseudoInverse => levenberg_marquardt(problem, start),
         Solver::LevenbergMarquardt => levenberg_marquardt(problem, start),
     }
 }

@@ -1,0 +1,310 @@
+//! The prior toward the nominal geometry (issue 30): how strongly the identification holds the
+//! links' local transforms at the nominal model (at its fitted base and tool placement), chosen
+//! by cross-validation that holds out whole configuration clusters (`clusters.rs`). Where the data
+//! lies on one branch of the arm, a fit on it cannot say how it does on another, and nothing is
+//! changed: the fit is the plain least-squares one, and the report says why.
+
+use crate::clusters::{self, BranchJoint, Cluster, ScanOptions};
+use errors::Error;
+use measurements::MeasurementSet;
+use model::geometric::observations;
+use poe::LocalPoe;
+use poe::identify::{IdentificationOptions, Scope, calibrate_placed_with_prior, evaluate};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Options of the prior toward the nominal geometry (`nominal_prior` in a fit options file).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct NominalPriorOptions {
+    /// Choose the prior's strength by cross-validation across configuration clusters; `false`:
+    /// never a prior (the paper's plain least squares).
+    pub choose: bool,
+    /// The candidate standard deviations of a link's translation about the nominal, metres; `inf`
+    /// is no prior. The rotation's is the translation's over `length_m`. From 10 mm (a link
+    /// error far beyond any industrial arm's tolerances: no prior in effect) down to 10 µm (the
+    /// nominal geometry itself, placed), half a decade apart.
+    pub translations_m: Vec<f64>,
+    /// The length that turns a translation σ into a rotation σ (`σ_rot = σ_trans / length_m`): a
+    /// rotation that moves a point at this distance as much as the translation. 1 m, the reach
+    /// of the arms calibrated here (UR10 1.3 m, IRB 4400 1.96 m, iiwa 0.8 m).
+    pub length_m: f64,
+    /// A cluster is held out on its own only when it holds at least this share of the rows (its
+    /// rows always train otherwise): a fold's error over a handful of poses near a singular angle
+    /// says little. 5 %: on the UR10's series B, 17 of 1,495 rows lie just past the wrist's
+    /// singular angle, and are no branch of their own.
+    pub min_cluster_share: f64,
+    /// Angles of a joint over a turn at which the Jacobian's determinant is evaluated to find its
+    /// singular angles: 720, half a degree apart (a sign change is located between two of them by
+    /// linear interpolation, far closer than `scan_tolerance_rad`).
+    pub scan_steps: usize,
+    /// Rows, spread over the data, at which a joint's singular angles must agree for the joint to
+    /// separate branches: 8 (the shoulder's singular angles move by tens of degrees between any
+    /// two poses of a campaign; the elbow's and the wrist's do not move at all).
+    pub scan_probes: usize,
+    /// How closely they must agree, rad: 0.01 (0.6°; the interpolation error on a 0.5° grid is
+    /// below 0.01°).
+    pub scan_tolerance_rad: f64,
+}
+
+impl Default for NominalPriorOptions {
+    fn default() -> Self {
+        Self {
+            choose: true,
+            translations_m: vec![f64::INFINITY, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5],
+            length_m: 1.0,
+            min_cluster_share: 0.05,
+            scan_steps: 720,
+            scan_probes: 8,
+            scan_tolerance_rad: 0.01,
+        }
+    }
+}
+
+impl NominalPriorOptions {
+    /// Checks every value once: the field's name and what was expected.
+    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+        if self.translations_m.is_empty() || self.translations_m.iter().any(|t| t.is_nan() || *t <= 0.0) {
+            return Err((
+                "translations_m",
+                format!(
+                    "nominal_prior.translations_m is {:?}, expected at least one number above 0 (inf for no prior)",
+                    self.translations_m
+                ),
+            ));
+        }
+        let checks: [(&'static str, f64, bool, &str); 3] = [
+            ("length_m", self.length_m, self.length_m.is_finite() && self.length_m > 0.0, "a finite number above 0"),
+            (
+                "min_cluster_share",
+                self.min_cluster_share,
+                self.min_cluster_share > 0.0 && self.min_cluster_share <= 0.5,
+                "a number above 0 and at most 0.5",
+            ),
+            (
+                "scan_tolerance_rad",
+                self.scan_tolerance_rad,
+                self.scan_tolerance_rad.is_finite() && self.scan_tolerance_rad > 0.0,
+                "a finite number above 0",
+            ),
+        ];
+        for (name, value, ok, expected) in checks {
+            if !ok {
+                return Err((name, format!("nominal_prior.{name} is {value}, expected {expected}")));
+            }
+        }
+        if self.scan_steps < 8 {
+            return Err((
+                "scan_steps",
+                format!("nominal_prior.scan_steps is {}, expected at least 8", self.scan_steps),
+            ));
+        }
+        if self.scan_probes < 2 {
+            let probes = self.scan_probes;
+            return Err(("scan_probes", format!("nominal_prior.scan_probes is {probes}, expected at least 2")));
+        }
+        Ok(())
+    }
+}
+
+/// One candidate strength and its held-out error across the clusters.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PriorCandidate {
+    /// σ of a link's translation, m (`null`: no prior).
+    pub translation_m: Option<f64>,
+    /// σ of a link's rotation, rad (`null`: no prior).
+    pub rotation_rad: Option<f64>,
+    /// The RMS position error over the held-out rows (each row held out once, with its
+    /// cluster), mm.
+    pub heldout_rms_position_mm: f64,
+    /// The criterion: the RMS of the weighted residual (position over `position_sigma_m`,
+    /// rotation over `rotation_sigma_rad`) over the held-out rows.
+    pub heldout_score: f64,
+}
+
+/// What the fit chose for the prior toward the nominal geometry, and why.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PriorChoice {
+    /// The joints whose singular angles separate branches of the arm.
+    pub branch_joints: Vec<BranchJoint>,
+    /// The data's configuration clusters, largest first.
+    pub clusters: Vec<Cluster>,
+    /// The clusters held out in turn (labels).
+    pub held_out: Vec<String>,
+    /// Every candidate with its held-out error (empty where nothing was held out); the chosen one
+    /// is the first within one standard error of the lowest (`choose`).
+    pub candidates: Vec<PriorCandidate>,
+    /// The chosen σ of a link's translation, m (`null`: no prior, the plain least-squares fit).
+    pub translation_m: Option<f64>,
+    /// The chosen σ of a link's rotation, rad (`null`: no prior).
+    pub rotation_rad: Option<f64>,
+    /// Why.
+    pub reason: String,
+}
+
+impl PriorChoice {
+    /// The chosen standard deviations, translation (m) and rotation (rad); `None`: no prior.
+    pub fn chosen(&self) -> Option<(f64, f64)> {
+        self.translation_m.zip(self.rotation_rad)
+    }
+
+    fn without(branch_joints: Vec<BranchJoint>, clusters: Vec<Cluster>, reason: String) -> Self {
+        Self {
+            branch_joints,
+            clusters,
+            held_out: Vec::new(),
+            candidates: Vec::new(),
+            translation_m: None,
+            rotation_rad: None,
+            reason,
+        }
+    }
+}
+
+impl std::fmt::Display for PriorChoice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.chosen() {
+            Some((t, r)) => write!(
+                f,
+                "prior toward the nominal geometry: σ {:.3} mm / {:.3} mrad per link ({})",
+                t * 1e3,
+                r * 1e3,
+                self.reason
+            ),
+            None => write!(f, "prior toward the nominal geometry: none ({})", self.reason),
+        }
+    }
+}
+
+/// Per row of `data`, the squared weighted residual of a model (position over
+/// `position_sigma_m`, rotation over `rotation_sigma_rad`: the identification's criterion) and
+/// the squared position error in mm².
+fn heldout(model: &LocalPoe, data: &MeasurementSet, options: &IdentificationOptions) -> Result<Vec<(f64, f64)>, Error> {
+    observations(data)
+        .chunks(1)
+        .map(|row| {
+            let stats = evaluate(model, row)?;
+            let rotation = stats.rms_rotation_rad.map_or(0.0, |r| r / options.rotation_sigma_rad);
+            let loss = (stats.rms_position_m / options.position_sigma_m).powi(2) + rotation.powi(2);
+            Ok((loss, (stats.rms_position_m * 1e3).powi(2)))
+        })
+        .collect()
+}
+
+/// Chooses the prior's strength for a fit of `scope` on `data` (issue 30): each candidate of
+/// `prior.translations_m` is fitted with each configuration cluster held out in turn and judged on
+/// it, every row once. The candidate with the lowest mean held-out criterion is the best; the one
+/// chosen is the first listed (the weakest prior, none first) whose mean is within one standard
+/// error of the best's (the standard error of the rows' paired differences): Breiman's one
+/// standard error rule (Breiman et al. 1984, §3.4.3), so that a difference the held-out rows cannot
+/// tell from noise does not change the fit. With fewer than two clusters of `min_cluster_share`,
+/// no prior.
+pub fn choose(
+    nominal: &LocalPoe,
+    data: &MeasurementSet,
+    identification: &IdentificationOptions,
+    prior: &NominalPriorOptions,
+) -> Result<PriorChoice, Error> {
+    if !prior.choose {
+        return Ok(PriorChoice::without(Vec::new(), Vec::new(), "switched off (nominal_prior.choose)".into()));
+    }
+    let scan =
+        ScanOptions { steps: prior.scan_steps, probes: prior.scan_probes, tolerance_rad: prior.scan_tolerance_rad };
+    let branch_joints = clusters::branch_joints(nominal, &data.rows, scan)?;
+    let found = clusters::clusters(&branch_joints, &data.rows);
+    if branch_joints.is_empty() {
+        let reason = if nominal.joint_count() == 6 {
+            "no joint's singular angles separate branches of the arm: one configuration cluster".to_owned()
+        } else {
+            format!("{} joints, not 6: the branches are not found, one configuration cluster", nominal.joint_count())
+        };
+        return Ok(PriorChoice::without(branch_joints, found, reason));
+    }
+    let least = (prior.min_cluster_share * data.rows.len() as f64).ceil() as usize;
+    let folds: Vec<&Cluster> = found.iter().filter(|c| c.n >= least).collect();
+    if folds.len() < 2 {
+        let reason = format!(
+            "one configuration cluster of at least {:.0} % of the rows ({}): nothing to hold out, the fit as without a prior",
+            100.0 * prior.min_cluster_share,
+            found.first().map_or("no rows".into(), |c| c.label.clone())
+        );
+        return Ok(PriorChoice::without(branch_joints, found, reason));
+    }
+    // Each fold trains on every other row; a fold whose rows carry a tool no other row carries
+    // cannot be predicted and is not held out.
+    let splits: Vec<(String, MeasurementSet, MeasurementSet)> = folds
+        .iter()
+        .filter_map(|cluster| {
+            let held: std::collections::BTreeSet<usize> = cluster.rows.iter().copied().collect();
+            let train: Vec<usize> = (0..data.rows.len()).filter(|i| !held.contains(i)).collect();
+            let tools_known =
+                cluster.rows.iter().all(|&i| train.iter().any(|&t| data.rows[t].tool == data.rows[i].tool));
+            tools_known.then(|| (cluster.label.clone(), data.subset(&train), data.subset(&cluster.rows)))
+        })
+        .collect();
+    let sigmas: Vec<Option<(f64, f64)>> =
+        prior.translations_m.iter().map(|&t| t.is_finite().then_some((t, t / prior.length_m))).collect();
+    let work: Vec<(usize, usize)> = (0..splits.len()).flat_map(|s| (0..sigmas.len()).map(move |c| (s, c))).collect();
+    let results: Vec<Option<Vec<(f64, f64)>>> = work
+        .par_iter()
+        .map(|&(s, c)| {
+            let (_, train, test) = &splits[s];
+            let fitted =
+                calibrate_placed_with_prior(nominal, &observations(train), Scope::Full, sigmas[c], identification);
+            fitted.ok().and_then(|(_, fit)| heldout(&fit.model, test, identification).ok())
+        })
+        .collect();
+    // A fold that some candidate could not fit (too few rows, a refused start) is left out for
+    // every candidate, so that all are judged on the same rows.
+    let usable: Vec<usize> =
+        (0..splits.len()).filter(|&s| (0..sigmas.len()).all(|c| results[s * sigmas.len() + c].is_some())).collect();
+    if usable.is_empty() {
+        let reason =
+            "no configuration cluster could be held out (a tool only it carries, or too few rows without it): \
+                      the fit as without a prior"
+                .to_owned();
+        return Ok(PriorChoice::without(branch_joints, found, reason));
+    }
+    // Every held-out row of every usable fold, per candidate, in the same order.
+    let rows: Vec<Vec<(f64, f64)>> = (0..sigmas.len())
+        .map(|c| usable.iter().flat_map(|&s| results[s * sigmas.len() + c].clone().unwrap_or_default()).collect())
+        .collect();
+    let n = rows[0].len().max(1) as f64;
+    let candidates: Vec<PriorCandidate> = sigmas
+        .iter()
+        .zip(&rows)
+        .map(|(sigma, rows)| PriorCandidate {
+            translation_m: sigma.map(|s| s.0),
+            rotation_rad: sigma.map(|s| s.1),
+            heldout_rms_position_mm: (rows.iter().map(|r| r.1).sum::<f64>() / n).sqrt(),
+            heldout_score: (rows.iter().map(|r| r.0).sum::<f64>() / n).sqrt(),
+        })
+        .collect();
+    let best = candidates.iter().enumerate().fold(0, |best, (c, candidate)| {
+        if candidate.heldout_score < candidates[best].heldout_score { c } else { best }
+    });
+    let within_one_error = |c: usize| {
+        let d: Vec<f64> = rows[c].iter().zip(&rows[best]).map(|(a, b)| a.0 - b.0).collect();
+        let mean = d.iter().sum::<f64>() / n;
+        let variance = d.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        mean <= (variance / n).sqrt()
+    };
+    let chosen = (0..candidates.len()).find(|&c| within_one_error(c)).unwrap_or(best);
+    let held_out: Vec<String> = usable.iter().map(|&s| splits[s].0.clone()).collect();
+    let unprior = candidates.iter().find(|c| c.translation_m.is_none());
+    let reason = format!(
+        "{} configuration clusters held out in turn: held-out RMS {:.4} mm{}",
+        held_out.len(),
+        candidates[chosen].heldout_rms_position_mm,
+        unprior.map_or(String::new(), |u| format!(", {:.4} mm without a prior", u.heldout_rms_position_mm))
+    );
+    Ok(PriorChoice {
+        branch_joints,
+        clusters: found,
+        held_out,
+        translation_m: candidates[chosen].translation_m,
+        rotation_rad: candidates[chosen].rotation_rad,
+        candidates,
+        reason,
+    })
+}
