@@ -46,6 +46,11 @@ pub struct CalibratedModel {
     /// and `compensate` count rows beyond them. Files written before they were kept have none.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub joint_limits: Vec<Option<[f64; 2]>>,
+    /// The fit's estimate of its own held-out error ([`crate::HeldoutEstimate`]): what `calib
+    /// register` judges a registration's residual against. Files written before it was kept, and
+    /// fits that cannot estimate it (the sparse GP), have none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heldout: Option<crate::HeldoutEstimate>,
 }
 
 /// A predicted tool pose and, where a GP is part of the model, its standard deviation.
@@ -105,13 +110,21 @@ impl CalibratedModel {
         } else if index == effects + fallback + 1 {
             model.residual_gp = None;
         }
+        // The estimate was of the whole model.
+        model.heldout = None;
         model
     }
 
     /// The model without its non-geometric parts (effects, the GP): the geometry alone, which is
     /// what a URDF can hold (`calib export`).
     pub fn geometry_only(&self) -> CalibratedModel {
-        CalibratedModel { effects: Vec::new(), fallback_kinematics: None, residual_gp: None, ..self.clone() }
+        CalibratedModel {
+            effects: Vec::new(),
+            fallback_kinematics: None,
+            residual_gp: None,
+            heldout: None,
+            ..self.clone()
+        }
     }
 
     /// The names of the parts a URDF cannot hold, in the order they apply.

@@ -9,7 +9,10 @@ use errors::Error;
 use measurements::MeasurementSet;
 use measurements::{OutlierLine, list_lines, without};
 use model::geometric::{fit_geometry, observations};
-use model::{CalibratedModel, ErrorSummary, Method, ResidualGp, ResidualGpReport, SCHEMA_VERSION, evaluate};
+use model::{
+    CalibratedModel, ErrorSummary, HeldoutEstimate, HeldoutSource, Method, ResidualGp, ResidualGpReport, SCHEMA_VERSION,
+    evaluate,
+};
 use poe::identify::{
     IdentificationOptions, IdentificationReport, Loss, ParameterMask, Scope, identify_with_correction,
 };
@@ -178,6 +181,7 @@ pub fn fit(
         residual_gp: None,
         training_range: model::TrainingRange::of(&data.rows),
         joint_limits: model::stored_limits(&robot.limits()),
+        heldout: None,
     };
     let mut identification = geometry.report;
     let mut auto = None;
@@ -245,6 +249,7 @@ pub fn fit(
     };
     let before = evaluate(&registered, data)?.summary;
     let after = evaluate(&model, data)?.summary;
+    model.heldout = heldout_estimate(&after, &identification, residual_gp.as_ref(), auto.as_ref());
     if identification.redundancy() < options.min_redundancy {
         warnings.push(FitWarning::LowRedundancy {
             residual_rows: identification.residual_rows,
@@ -285,4 +290,24 @@ pub fn fit(
         warnings,
     };
     Ok((model, report))
+}
+
+/// The fit's estimate of its held-out error, kept in the model (`calib register` judges against
+/// it): the exact GP's leave-one-out error where there is a GP (`None` for the sparse GP, whose
+/// training error says nothing of new poses), else the diagnosis's cross-validated error for
+/// `--effects auto`, else the training error corrected for the identifiable parameters.
+fn heldout_estimate(
+    after: &ErrorSummary,
+    identification: &IdentificationReport,
+    residual_gp: Option<&ResidualGpReport>,
+    auto: Option<&AutoChoice>,
+) -> Option<HeldoutEstimate> {
+    if let Some(gp) = residual_gp {
+        let loo = gp.leave_one_out.as_ref()?;
+        return HeldoutEstimate::new(loo.mean_position_error_mm, HeldoutSource::GpLeaveOneOut);
+    }
+    if let Some(auto) = auto {
+        return HeldoutEstimate::new(auto.heldout_after_mm, HeldoutSource::EffectsCrossValidated);
+    }
+    HeldoutEstimate::degrees_of_freedom(after.mean_position_error_mm, identification.residual_rows, identification.rank)
 }
