@@ -255,15 +255,6 @@ fn register_simulated(args: &Args, md: &mut String) -> Result<()> {
             let refit = Refit { base: true, tools: new };
             let registered = cell::register(&model, &few, refit, Some(before), &RegisterOptions::default())?;
             let after = mean_error(&registered.model, &moved_test)?;
-            // Diagnostics: 200 poses (the registration's own error nearly gone) and the rotation weight held.
-            let many = renamed(simulated::simulate(moved, &effects, &ranges, &config(200, 4), full_pose)?);
-            let floor = cell::register(&model, &many, refit, Some(before), &RegisterOptions::default())?;
-            let floor = mean_error(&floor.model, &moved_test)?;
-            let mut held = RegisterOptions::default();
-            held.registration.weight_rounds = 0;
-            let held = cell::register(&model, &few, refit, Some(before), &held)?;
-            let held = mean_error(&held.model, &moved_test)?;
-            eprintln!("DIAG seed {seed} full {full_pose} new {new}: 20 {after:.4} 200 {floor:.4} held-weight {held:.4} before {before:.4} w {:.3}", registered.report.rotation_weight_m_per_rad);
             let warnings: Vec<String> = registered.report.warnings.iter().map(|w| format!("{w:?}")).collect();
             let _ = writeln!(
                 md,

@@ -110,7 +110,7 @@ pub use plan::{Checkpoint, Plan, PlanOptions, PlanReport, measuring_order, plan}
 pub use register::{Registered, register};
 pub use register_options::{Refit, RegisterOptions};
 pub use report::{FrameChange, HeldoutFrom, RegisterReport, RegisterWarning, RegisteredTool, Verdict};
-pub use wrap::{WrappedJoint, wrapped};
 pub use urdf_export::{
     AxisChange, PartError, TrainingErrors, UrdfExport, UrdfExportReport, UrdfTemplate, export_urdf, write_urdf,
 };
+pub use wrap::{WrappedJoint, wrapped};

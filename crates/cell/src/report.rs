@@ -2,8 +2,8 @@
 
 use crate::Error;
 use crate::register_options::{Refit, RegisterOptions};
-use crate::wrap::WrappedJoint;
 use crate::registration::Registration;
+use crate::wrap::WrappedJoint;
 use measurements::MeasurementSet;
 use model::{
     BeyondLimitsWarning, CalibratedModel, ErrorSummary, ExtrapolationWarning, HeldoutSource, OutOfRangeWarning,

@@ -1,8 +1,9 @@
 //! Revolute angles taken modulo 2π for the model's coverage (issue 26): a joint whose limits span
 //! more than a turn reaches the same link positions at `q` and `q ± 2π`, so poses measured one
 //! turn away from the training poses (UR10 series D's joint 1 against C's) are where the model
-//! was fitted once the turn is taken off. Only where the limits allow the other turn, and only
-//! where the wrapped angle lies inside the fitted range and the given one does not.
+//! was fitted once the turn is taken off. Only where the limits allow the other turn, only for a
+//! joint that turns its frame by its angle (scale 1), and only where the wrapped angle lies inside
+//! the fitted range and the given one does not.
 
 use measurements::Measurement;
 use model::CalibratedModel;
@@ -48,10 +49,11 @@ pub fn wrapped(model: &CalibratedModel, rows: &[Measurement]) -> (Vec<Measuremen
     let mut out = rows.to_vec();
     let mut report = Vec::new();
     let Some(range) = &model.training_range else { return (out, report) };
-    let kinds = model.joint_kinds();
-    for (j, kind) in kinds.iter().enumerate() {
+    for (j, joint) in model.kinematics.joints().iter().enumerate() {
         let (Some(Some([lo, hi])), Some(&[low, high])) = (model.joint_limits.get(j), range.q.get(j)) else { continue };
-        if *kind != poe::JointKind::Revolute || hi - lo <= TAU {
+        // A joint that turns its frame by `scale · q` with `scale ≠ 1` (stages of one motor) is
+        // not the same a turn away.
+        if joint.kind != poe::JointKind::Revolute || joint.scale != 1.0 || hi - lo <= TAU {
             continue;
         }
         let mut turns = Vec::new();

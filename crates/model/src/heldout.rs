@@ -11,9 +11,8 @@ pub enum HeldoutSource {
     /// The exact GP's closed-form leave-one-out prediction on every training row (the
     /// hyperparameters and the geometry as fitted on all rows).
     GpLeaveOneOut,
-    /// `--effects auto`: the diagnosis's cross-validated prediction with the selected effects.
-    EffectsCrossValidated,
-    /// The training error corrected for the identifiable parameters `p` among the residual rows
+    /// The training error corrected for the identifiable parameters `p` (the effects' among them)
+    /// among the residual rows
     /// `r`: `× √((r + p) / (r − p))`, the ratio of the expected held-out and training mean squares
     /// of linear least squares (`σ²(1 + p/r)` against `σ²(1 − p/r)`).
     DegreesOfFreedom,
@@ -23,7 +22,6 @@ impl std::fmt::Display for HeldoutSource {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
             Self::GpLeaveOneOut => "the GP's leave-one-out error",
-            Self::EffectsCrossValidated => "the diagnosis's cross-validated error with the selected effects",
             Self::DegreesOfFreedom => "the training error corrected for the fitted parameters",
         })
     }
