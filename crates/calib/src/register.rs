@@ -20,7 +20,8 @@ pub struct Args {
     #[arg(long, default_value = "base")]
     refit: cell::Refit,
     /// The model's own held-out mean position error, mm (e.g. `calib eval` on rows it was not
-    /// fitted on): the residual is judged against it.
+    /// fitted on): the residual is judged against it. Default: the fit's estimate kept in the
+    /// model file (models written before it was kept have none).
     #[arg(long)]
     heldout_mm: Option<f64>,
     /// The residual-to-held-out ratio above which the robot is said to have changed.
@@ -51,6 +52,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         println!("{}", serde_json::to_string(report)?);
         eprintln!("{}", data.read_summary());
         eprintln!("{}", report.verdict_line());
+        for note in &report.wrapped {
+            eprintln!("note: {note}");
+        }
         let warnings = report.out_of_range.iter().map(ToString::to_string);
         let warnings = warnings.chain(report.extrapolation.iter().map(ToString::to_string));
         let warnings = warnings.chain(report.beyond_joint_limits.iter().map(ToString::to_string));

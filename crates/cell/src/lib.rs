@@ -22,6 +22,7 @@
 //!     residual_gp: None,
 //!     training_range: None,
 //!     joint_limits: Vec::new(),
+//!     heldout: None,
 //!     fit_warnings: None,
 //!     robot_description: None,
 //! };
@@ -94,6 +95,7 @@ mod report;
 mod urdf_export;
 mod urdf_like;
 mod urdf_text;
+mod wrap;
 
 pub use candidates::{CandidateSet, file_candidates, generated_candidates, write_chosen_rows, write_generated_rows};
 pub use coverage::AxisCoverage;
@@ -109,7 +111,8 @@ pub use model_text::checked_model_text;
 pub use plan::{Checkpoint, Plan, PlanOptions, PlanReport, measuring_order, plan};
 pub use register::{Registered, register};
 pub use register_options::{Refit, RegisterOptions};
-pub use report::{FrameChange, RegisterReport, RegisterWarning, RegisteredTool, Verdict};
+pub use report::{FrameChange, HeldoutFrom, RegisterReport, RegisterWarning, RegisteredTool, Verdict};
 pub use urdf_export::{
     AxisChange, PartError, TrainingErrors, UrdfExport, UrdfExportReport, UrdfTemplate, export_urdf, write_urdf,
 };
+pub use wrap::{WrappedJoint, wrapped};

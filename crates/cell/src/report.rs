@@ -3,8 +3,11 @@
 use crate::Error;
 use crate::register_options::{Refit, RegisterOptions};
 use crate::registration::Registration;
+use crate::wrap::WrappedJoint;
 use measurements::MeasurementSet;
-use model::{BeyondLimitsWarning, CalibratedModel, ErrorSummary, ExtrapolationWarning, OutOfRangeWarning};
+use model::{
+    BeyondLimitsWarning, CalibratedModel, ErrorSummary, ExtrapolationWarning, HeldoutSource, OutOfRangeWarning,
+};
 use serde::Serialize;
 use std::fmt;
 
@@ -109,8 +112,11 @@ pub struct RegisterReport {
     /// The mean position residual made unbiased for the fitted parameters, `× √(r / (r − p))`, mm:
     /// what it compares with a held-out error.
     pub residual_unbiased_mm: f64,
-    /// The model's own held-out mean position error, mm, as given.
+    /// The model's own held-out mean position error, mm: as given, else the fit's estimate in
+    /// the model file.
     pub model_heldout_mm: Option<f64>,
+    /// Where `model_heldout_mm` came from.
+    pub heldout_from: Option<HeldoutFrom>,
     /// `residual_unbiased_mm / model_heldout_mm`.
     pub ratio: Option<f64>,
     /// The ratio above which the robot is said to have changed ([`RegisterOptions::changed_ratio`]).
@@ -123,29 +129,58 @@ pub struct RegisterReport {
     pub extrapolation: Vec<ExtrapolationWarning>,
     /// Poses beyond the robot's joint limits.
     pub beyond_joint_limits: Vec<BeyondLimitsWarning>,
+    /// Joints whose angles were taken modulo 2π into the fitted range (the model was applied,
+    /// and the coverage judged, at the wrapped angles).
+    pub wrapped: Vec<WrappedJoint>,
     /// Other warnings.
     pub warnings: Vec<RegisterWarning>,
 }
 
+/// Where the held-out error judged against came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HeldoutFrom {
+    /// `--heldout-mm`.
+    Given,
+    /// The fit's own estimate, kept in the model file.
+    ModelFile(HeldoutSource),
+}
+
+/// A held-out error and where it came from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Heldout {
+    pub mm: f64,
+    pub from: HeldoutFrom,
+}
+
+/// What the registration re-fitted and found.
+pub(crate) struct Fitted<'a> {
+    pub refit: Refit,
+    pub parameters: usize,
+    pub fit: &'a Registration,
+    pub tools: Vec<RegisteredTool>,
+}
+
 impl RegisterReport {
-    #[allow(clippy::too_many_arguments)] // one call site, each argument a different fact
     pub(crate) fn new(
         registered: &CalibratedModel,
         data: &MeasurementSet,
-        refit: Refit,
-        parameters: usize,
-        fit: &Registration,
-        tools: Vec<RegisteredTool>,
-        heldout_mm: Option<f64>,
+        fitted: Fitted<'_>,
+        heldout: Option<Heldout>,
         options: &RegisterOptions,
+        wrapped: Vec<WrappedJoint>,
         warnings: Vec<RegisterWarning>,
     ) -> Result<Self, Error> {
+        let Fitted { refit, parameters, fit, tools } = fitted;
+        // A held-out error that is not a positive finite number is no reference.
+        let heldout = heldout.filter(|h| h.mm.is_finite() && h.mm > 0.0);
+        let heldout_mm = heldout.map(|h| h.mm);
         let evaluation = model::evaluate(registered, data)?;
         let full_pose = data.full_pose && registered.full_pose;
         let residual_rows = data.rows.len() * if full_pose { 6 } else { 3 };
         let dof = residual_rows.saturating_sub(parameters).max(1) as f64;
         let residual_unbiased_mm = evaluation.summary.mean_position_error_mm * (residual_rows as f64 / dof).sqrt();
-        let ratio = heldout_mm.filter(|h| *h > 0.0).map(|h| residual_unbiased_mm / h);
+        let ratio = heldout_mm.map(|h| residual_unbiased_mm / h);
         let t = fit.frame.translation() * 1e3;
         let w = fit.frame.rotation().log();
         Ok(Self {
@@ -165,32 +200,39 @@ impl RegisterReport {
             residual: evaluation.summary,
             residual_unbiased_mm,
             model_heldout_mm: heldout_mm,
+            heldout_from: heldout.map(|h| h.from),
             ratio,
             changed_ratio: options.changed_ratio,
             verdict: Verdict::of(ratio, options.changed_ratio),
             out_of_range: registered.outside_training_range(&data.rows),
             extrapolation: registered.extrapolation(&data.rows),
             beyond_joint_limits: registered.beyond_joint_limits(&data.rows),
+            wrapped,
             warnings,
         })
     }
 
     /// The verdict in words, one line.
     pub fn verdict_line(&self) -> String {
+        let from = match self.heldout_from {
+            Some(HeldoutFrom::ModelFile(source)) => format!(", the fit's estimate: {source}"),
+            _ => String::new(),
+        };
         match (self.verdict, self.model_heldout_mm, self.ratio) {
             (Verdict::RobotChanged, Some(h), Some(r)) => format!(
-                "the residual ({:.4} mm, unbiased) is {r:.2}× the model's held-out error ({h:.4} mm), above \
+                "the residual ({:.4} mm, unbiased) is {r:.2}× the model's held-out error ({h:.4} mm{from}), above \
                  {:.2}×: the robot itself has changed: re-calibrate",
                 self.residual_unbiased_mm, self.changed_ratio
             ),
             (Verdict::Consistent, Some(h), Some(r)) => format!(
-                "the residual ({:.4} mm, unbiased) is {r:.2}× the model's held-out error ({h:.4} mm), within \
+                "the residual ({:.4} mm, unbiased) is {r:.2}× the model's held-out error ({h:.4} mm{from}), within \
                  {:.2}×: the model carries over",
                 self.residual_unbiased_mm, self.changed_ratio
             ),
             _ => format!(
-                "the residual is {:.4} mm (unbiased); no held-out error of the model was given (--heldout-mm), so \
-                 whether the robot itself changed is unknown",
+                "the residual is {:.4} mm (unbiased); no held-out error of the model was given (--heldout-mm) and the \
+                 model file holds none (written before it was kept, or a sparse GP), so whether the robot itself \
+                 changed is unknown",
                 self.residual_unbiased_mm
             ),
         }
@@ -249,6 +291,7 @@ impl RegisterReport {
                     .into(),
             );
         }
+        lines.extend(self.wrapped.iter().map(|w| format!("  note: {w}")));
         lines.extend(self.out_of_range.iter().map(|w| format!("  warning: {w}")));
         lines.extend(self.extrapolation.iter().map(|w| format!("  warning: {w}")));
         lines.extend(self.beyond_joint_limits.iter().map(|w| format!("  warning: {w}")));

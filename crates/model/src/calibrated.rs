@@ -46,6 +46,11 @@ pub struct CalibratedModel {
     /// and `compensate` count rows beyond them. Files written before they were kept have none.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub joint_limits: Vec<Option<[f64; 2]>>,
+    /// The fit's estimate of its own held-out error ([`crate::HeldoutEstimate`]): what `calib
+    /// register` judges a registration's residual against. Files written before it was kept, and
+    /// fits that cannot estimate it (the sparse GP), have none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heldout: Option<crate::HeldoutEstimate>,
     /// The fit's own warnings, as `calib fit` printed them (few rows per parameter, gross
     /// outliers, a fit forced past the plausibility check, a GP search stopped early), so that a
     /// report written later shows them: empty when it gave none. `None` in files written before
@@ -117,13 +122,21 @@ impl CalibratedModel {
         } else if index == effects + fallback + 1 {
             model.residual_gp = None;
         }
+        // The estimate was of the whole model.
+        model.heldout = None;
         model
     }
 
     /// The model without its non-geometric parts (effects, the GP): the geometry alone, which is
     /// what a URDF can hold (`calib export`).
     pub fn geometry_only(&self) -> CalibratedModel {
-        CalibratedModel { effects: Vec::new(), fallback_kinematics: None, residual_gp: None, ..self.clone() }
+        CalibratedModel {
+            effects: Vec::new(),
+            fallback_kinematics: None,
+            residual_gp: None,
+            heldout: None,
+            ..self.clone()
+        }
     }
 
     /// The names of the parts a URDF cannot hold, in the order they apply.

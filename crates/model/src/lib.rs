@@ -22,6 +22,7 @@
 //!     residual_gp: None,
 //!     training_range: None,
 //!     joint_limits: Vec::new(),
+//!     heldout: None,
 //!     fit_warnings: None,
 //!     robot_description: Some(robot.clone()),
 //! };
@@ -35,6 +36,7 @@ mod calibrated;
 mod eval_report;
 mod evaluate;
 pub mod geometric;
+mod heldout;
 mod joint_limits;
 mod method;
 mod metrics;
@@ -49,6 +51,7 @@ pub use predictions::write_predictions;
 
 pub use calibrated::{CalibratedModel, ExtrapolationWarning, PredictedPose};
 pub use eval_report::{CoverageSplit, EvalReport, ORIENTATIONS_NOT_EVALUATED};
+pub use heldout::{HeldoutEstimate, HeldoutSource};
 pub use joint_limits::{BeyondLimitsWarning, beyond_limits, stored_limits};
 pub use method::{Method, UnknownMethod};
 pub use metrics::{ErrorSummary, PoseError, pose_error};

@@ -122,6 +122,7 @@ mod version_1 {
                 residual_gp: v1.residual_gp,
                 training_range: None,
                 joint_limits: Vec::new(),
+                heldout: None,
                 fit_warnings: None,
                 robot_description: None,
             }

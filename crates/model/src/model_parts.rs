@@ -97,7 +97,7 @@ impl<'a> Part<'a> {
             }
             Part::GaussianProcess(residual_gp) => {
                 walk.flush();
-                let corrections = residual_gp.predict(walk.rows, &walk.poses)?;
+                let corrections = residual_gp.predict(walk.rows, &walk.poses, walk.tools)?;
                 let mut std = Vec::with_capacity(corrections.len());
                 for (pose, (g, s)) in walk.poses.iter_mut().zip(corrections) {
                     *pose = g * *pose;

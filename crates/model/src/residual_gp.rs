@@ -421,6 +421,13 @@ pub struct ResidualGp {
     /// tool-point frame and position-only outputs), which is exact. Absent: not moved.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub moved_by: Option<SE3>,
+    /// Per model tool, the point (in that tool's frame, m) about which a tool-point correction
+    /// applies: where `calib register` carried a tool (`tool = reference · D`), the reference
+    /// tool's point `D⁻¹ · 0`, so that the registered model predicts `G P_ref · D`, as the
+    /// registration fitted it, and the GP's orientation correction reaches the new point through
+    /// its lever arm. Empty, or `None` for a tool: the tool's own point. Absent in older files.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub tool_points: Vec<Option<Vector3>>,
 }
 
 /// What the GP stage reports.
@@ -527,6 +534,7 @@ impl ResidualGp {
             residual_frame: options.residual_frame,
             gp,
             moved_by: None,
+            tool_points: Vec::new(),
         };
         let leave_one_out = leave_one_out.map(|mean| {
             let errors: Vec<crate::PoseError> = poses
@@ -547,6 +555,11 @@ impl ResidualGp {
     /// `G` for the GP's output `g` at a model pose: a translation for position-only data, else the
     /// twist's exponential, at the tool point or in the tracker frame as the residuals were taken.
     fn correction(&self, pose: &SE3, g: &Vector6) -> SE3 {
+        self.correction_about(pose, g, None)
+    }
+
+    /// [`ResidualGp::correction`] with the tool point taken at `point` of the pose's frame.
+    fn correction_about(&self, pose: &SE3, g: &Vector6, point: Option<Vector3>) -> SE3 {
         if !self.full_pose {
             return SE3::from_translation(Vector3::new(g[0], g[1], g[2]));
         }
@@ -554,7 +567,7 @@ impl ResidualGp {
         match self.residual_frame {
             ResidualFrame::Tracker => exp,
             ResidualFrame::ToolPoint => {
-                let p = SE3::from_translation(pose.translation());
+                let p = SE3::from_translation(point.map_or_else(|| pose.translation(), |u| pose.transform_point(&u)));
                 p * exp * p.inverse()
             }
         }
@@ -576,8 +589,14 @@ impl ResidualGp {
     }
 
     /// The correction of every row: `G(q, m)` to put before the model pose, and the GP's standard
-    /// deviation of each error component `(v, ω)` (m, rad; zeros where not modelled).
-    pub fn predict(&self, rows: &[Measurement], model_poses: &[SE3]) -> Result<Vec<(SE3, [f64; 6])>, Error> {
+    /// deviation of each error component `(v, ω)` (m, rad; zeros where not modelled). `tools`:
+    /// each row's model tool ([`ResidualGp::tool_points`]).
+    pub fn predict(
+        &self,
+        rows: &[Measurement],
+        model_poses: &[SE3],
+        tools: &[usize],
+    ) -> Result<Vec<(SE3, [f64; 6])>, Error> {
         let prediction = self.gp.predict(inputs(rows, self.with_payload).as_ref())?;
         let outputs = prediction.mean.ncols();
         Ok(model_poses
@@ -593,7 +612,8 @@ impl ResidualGp {
                 if let Some(moved) = self.moved_by {
                     (g, std) = self.carried(&moved, &g, &std);
                 }
-                (self.correction(pose, &g), std)
+                let point = tools.get(i).and_then(|&t| self.tool_points.get(t).copied().flatten());
+                (self.correction_about(pose, &g, point), std)
             })
             .collect())
     }
