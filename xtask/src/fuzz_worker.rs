@@ -203,14 +203,13 @@ fn use_model(model: &pipeline::CalibratedModel) -> Outcome {
     let rows: Vec<Measurement> = (0..4)
         .map(|k| Measurement {
             line: k + 2,
-            q: (0..n).map(|j| 0.1 * (k as f64 + 1.0) * ((j % 3) as f64 - 1.0)).collect(),
-            position: lie::Vector3::zeros(),
-            orientation: None,
             payload_kg: 2.0,
-            tool: 0,
             temp_c: Some(20.0),
             t_s: Some(k as f64),
-            torques_nm: None,
+            ..Measurement::at(
+                (0..n).map(|j| 0.1 * (k as f64 + 1.0) * ((j % 3) as f64 - 1.0)).collect(),
+                lie::Vector3::zeros(),
+            )
         })
         .collect();
     let indices: Vec<usize> = (0..rows.len()).map(|k| k % tools.max(1)).collect();

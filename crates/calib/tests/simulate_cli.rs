@@ -1,20 +1,10 @@
 //! `calib simulate` through the binary: its CSV feeds `calib fit` and `calib eval`, and bad input
 //! gets one line on stderr and a non-zero exit.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn calib(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_calib")).args(args).output().expect("the calib binary runs")
-}
-
-fn irb4400() -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron").display().to_string()
-}
-
-fn text(path: &Path) -> String {
-    path.display().to_string()
-}
+use common::{calib, fixture, text};
+use std::path::Path;
 
 fn succeeds(args: &[&str]) -> String {
     let out = calib(args);
@@ -45,7 +35,7 @@ fn held_out_mm(model: &Path, data: &Path) -> f64 {
 fn simulated_data_round_trips_through_fit_and_eval_and_poe_beats_base_tool() {
     let dir = tempfile::tempdir().unwrap();
     let (all, train, test) = (dir.path().join("all.csv"), dir.path().join("train.csv"), dir.path().join("test.csv"));
-    let robot = irb4400();
+    let robot = fixture("irb4400.ron");
     succeeds(&["simulate", "--robot", &robot, "--out", &text(&all), "--rows", "160", "--seed", "3", "--full-pose"]);
     let header = std::fs::read_to_string(&all).unwrap().lines().next().unwrap().to_owned();
     for column in ["q6_rad", "x_mm", "qw", "payload_kg"] {
@@ -70,7 +60,7 @@ fn without_compliance_poe_leaves_only_the_tracker_noise() {
     let [effects, all, train, test] =
         ["effects.ron", "all.csv", "train.csv", "test.csv"].map(|name| dir.path().join(name));
     std::fs::write(&effects, "// tracker noise alone\n(tracker_noise: ())\n").unwrap();
-    let robot = irb4400();
+    let robot = fixture("irb4400.ron");
     let out = succeeds(&[
         "simulate",
         "--robot",
@@ -113,7 +103,7 @@ fn refused(args: &[&str], needle: &str) {
 fn bad_arguments_and_files_are_refused_with_one_line() {
     let dir = tempfile::tempdir().unwrap();
     let out = text(&dir.path().join("out.csv"));
-    let robot = irb4400();
+    let robot = fixture("irb4400.ron");
     refused(&["simulate", "--robot", &robot, "--out", &out, "--rows", "many"], "many");
     refused(&["simulate", "--robot", &robot, "--out", &out, "--rows", "0"], "--rows");
     refused(&["simulate", "--robot", &robot, "--out", &out, "--payloads", "1,-2"], "payloads");
@@ -122,10 +112,6 @@ fn bad_arguments_and_files_are_refused_with_one_line() {
     std::fs::write(&effects, "(\n  compliance: (),\n  tracker_nosie: (),\n)\n").unwrap();
     refused(&["simulate", "--robot", &robot, "--out", &out, "--effects", &text(&effects)], "tracker_nosie");
     assert!(!Path::new(&out).exists(), "nothing is written when the input is refused");
-}
-
-fn iiwa7() -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/iiwa7.ron").display().to_string()
 }
 
 /// The rows of a CSV as maps from header to cell.
@@ -143,7 +129,7 @@ fn a_seven_axis_payload_run_campaign_writes_fixed_joints_a_tool_per_run_and_torq
     let out = succeeds(&[
         "simulate",
         "--robot",
-        &iiwa7(),
+        &fixture("iiwa7.ron"),
         "--out",
         &text(&all),
         "--rows",
@@ -185,7 +171,17 @@ fn a_seven_axis_payload_run_campaign_writes_fixed_joints_a_tool_per_run_and_torq
     assert!(mean_abs(2) > 20.0 && mean_abs(1) < 1.0, "τ2 {} τ1 {}", mean_abs(2), mean_abs(1));
     // The file reads back and fits, each run's tool its own.
     let model = dir.path().join("poe.ron");
-    succeeds(&["fit", "--robot", &iiwa7(), "--data", &text(&all), "--method", "poe", "--out", &text(&model)]);
+    succeeds(&[
+        "fit",
+        "--robot",
+        &fixture("iiwa7.ron"),
+        "--data",
+        &text(&all),
+        "--method",
+        "poe",
+        "--out",
+        &text(&model),
+    ]);
     let fitted = std::fs::read_to_string(&model).unwrap();
     assert!(["tool1", "tool2", "tool3", "tool4"].iter().all(|t| fitted.contains(t)), "the model keeps a tool per run");
 }
@@ -194,7 +190,7 @@ fn a_seven_axis_payload_run_campaign_writes_fixed_joints_a_tool_per_run_and_torq
 fn campaign_shape_arguments_that_do_not_fit_are_refused_with_one_line() {
     let dir = tempfile::tempdir().unwrap();
     let out = text(&dir.path().join("out.csv"));
-    let robot = iiwa7();
+    let robot = fixture("iiwa7.ron");
     let base = ["simulate", "--robot", robot.as_str(), "--out", out.as_str()];
     let with = |extra: &[&'static str]| -> Vec<&str> { base.iter().copied().chain(extra.iter().copied()).collect() };
     refused(&with(&["--moving-joints", "0,2"]), "numbered from 1");
@@ -202,7 +198,7 @@ fn campaign_shape_arguments_that_do_not_fit_are_refused_with_one_line() {
     refused(&with(&["--fixed-jitter-mrad", "2"]), "--moving-joints");
     refused(&with(&["--moving-joints", "1,2", "--fixed-jitter-mrad=-1"]), "--fixed-jitter-mrad");
     refused(&with(&["--torque-sigma-nm", "1"]), "--torques");
-    let bare = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/ur10.ron").display().to_string();
+    let bare = fixture("ur10.ron");
     refused(&["simulate", "--robot", &bare, "--out", &out, "--torques"], "dynamics");
     assert!(!Path::new(&out).exists(), "nothing is written when the input is refused");
 }
@@ -212,24 +208,13 @@ fn campaign_shape_arguments_that_do_not_fit_are_refused_with_one_line() {
 #[test]
 fn a_lifting_column_is_written_in_metres_and_fits_back() {
     let dir = tempfile::tempdir().unwrap();
-    let robot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/column_ur10.ron");
+    let robot = fixture("column_ur10.ron");
     let (data, model) = (dir.path().join("column.csv"), dir.path().join("column.ron"));
     let effects = dir.path().join("effects.ron");
     std::fs::write(&effects, "(tracker_noise: Some(()))").unwrap();
-    succeeds(&[
-        "simulate",
-        "--robot",
-        &text(&robot),
-        "--out",
-        &text(&data),
-        "--rows",
-        "120",
-        "--effects",
-        &text(&effects),
-    ]);
+    succeeds(&["simulate", "--robot", &robot, "--out", &text(&data), "--rows", "120", "--effects", &text(&effects)]);
     let header = std::fs::read_to_string(&data).unwrap().lines().next().unwrap().to_owned();
     assert!(header.starts_with("q1_m,q2_rad,"), "{header}");
-    let out =
-        succeeds(&["fit", "--robot", &text(&robot), "--data", &text(&data), "--method", "poe", "--out", &text(&model)]);
+    let out = succeeds(&["fit", "--robot", &robot, "--data", &text(&data), "--method", "poe", "--out", &text(&model)]);
     assert!(out.contains("training error after: mean 0.0"), "{out}");
 }

@@ -211,11 +211,6 @@ mod tests {
     use super::*;
     use loadsim::{JointCompliance, TrackerNoise};
 
-    fn irb4400() -> RobotDescription {
-        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron");
-        RobotDescription::read(&path).unwrap()
-    }
-
     #[test]
     fn an_effects_file_with_a_typo_is_refused_at_its_line() {
         let good = parse_effects("(compliance: (payload_only: true), tracker_noise: ())", "e.ron").unwrap();
@@ -247,7 +242,7 @@ mod tests {
 
     #[test]
     fn effect_values_the_robot_cannot_take_are_refused_at_their_entry() {
-        let robot = irb4400();
+        let robot = testkit::robot("irb4400.ron");
         let check = |text: &str| parse_effects(text, "e.ron").and_then(|e| check_effects(&e, &robot, text, "e.ron"));
         check("(periodic: (harmonics: [(joint_index: 1, order: 2.0, amplitude_rad: 1e-5, phase_rad: 0.0)]))").unwrap();
         for (text, position, words) in [
@@ -295,7 +290,7 @@ mod tests {
 
     #[test]
     fn effects_that_need_the_dynamics_are_refused_for_a_robot_without() {
-        let mut robot = irb4400();
+        let mut robot = testkit::robot("irb4400.ron");
         robot.dynamics = None;
         let text = "(\n  compliance: ())";
         let effects = parse_effects(text, "e.ron").unwrap();

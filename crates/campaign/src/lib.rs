@@ -344,14 +344,9 @@ pub fn simulate_to_csv<W: std::io::Write>(
 mod tests {
     use super::*;
 
-    fn irb4400() -> RobotDescription {
-        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron");
-        RobotDescription::read(&path).unwrap()
-    }
-
     #[test]
     fn a_seeded_cell_is_reproducible_and_off_nominal_by_the_perturbation() {
-        let robot = irb4400();
+        let robot = testkit::robot("irb4400.ron");
         let perturbation = Perturbation::default();
         let a = simulated_cell(&robot, &perturbation, 7).unwrap();
         assert_eq!(a, simulated_cell(&robot, &perturbation, 7).unwrap());
@@ -368,7 +363,7 @@ mod tests {
 
     #[test]
     fn simulated_rows_carry_payload_and_orientation_only_for_full_pose() {
-        let robot = irb4400();
+        let robot = testkit::robot("irb4400.ron");
         let cell = simulated_cell(&robot, &Perturbation::default(), 1).unwrap();
         let config = GeneratorConfig { sample_count: 5, ..GeneratorConfig::default() };
         for full_pose in [false, true] {
@@ -381,7 +376,7 @@ mod tests {
 
     #[test]
     fn a_simulation_that_overflows_is_refused_not_written() {
-        let robot = irb4400();
+        let robot = testkit::robot("irb4400.ron");
         let cell = simulated_cell(&robot, &Perturbation::default(), 1).unwrap();
         let config = GeneratorConfig { sample_count: 3, ..GeneratorConfig::default() };
         let noise = TrackerNoise { transverse_sigma_per_m: 1e308, ..TrackerNoise::default() };
@@ -392,8 +387,7 @@ mod tests {
 
     #[test]
     fn a_payload_run_campaign_has_a_remounted_tool_per_run_fixed_joints_and_torques() {
-        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/iiwa7.ron");
-        let robot = RobotDescription::read(&path).unwrap();
+        let robot = testkit::robot("iiwa7.ron");
         let config = payload_run_campaign(40, 2);
         let (cell, data) =
             simulate_campaign(&robot, &paper_effects(), &Perturbation::default(), &Remount::default(), &config, true)
@@ -422,14 +416,11 @@ mod tests {
 
     #[test]
     fn streamed_rows_are_the_bytes_of_the_set_written_whole() {
-        let iiwa = RobotDescription::read(
-            &std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/iiwa7.ron"),
-        )
-        .unwrap();
+        let iiwa = testkit::robot("iiwa7.ron");
         // Plain, a tool per run with torques, and fewer rows than runs (some runs without a row).
         let cases = [
-            (irb4400(), GeneratorConfig { sample_count: 7, ..GeneratorConfig::default() }, true),
-            (irb4400(), GeneratorConfig { sample_count: 7, ..GeneratorConfig::default() }, false),
+            (testkit::robot("irb4400.ron"), GeneratorConfig { sample_count: 7, ..GeneratorConfig::default() }, true),
+            (testkit::robot("irb4400.ron"), GeneratorConfig { sample_count: 7, ..GeneratorConfig::default() }, false),
             (iiwa.clone(), payload_run_campaign(9, 3), true),
             (iiwa, payload_run_campaign(3, 3), false),
         ];
@@ -463,7 +454,7 @@ mod tests {
 
     #[test]
     fn a_streamed_simulation_that_overflows_is_refused_at_its_row() {
-        let robot = irb4400();
+        let robot = testkit::robot("irb4400.ron");
         let cell = simulated_cell(&robot, &Perturbation::default(), 1).unwrap();
         let config = GeneratorConfig { sample_count: 3, ..GeneratorConfig::default() };
         let noise = TrackerNoise { transverse_sigma_per_m: 1e308, ..TrackerNoise::default() };

@@ -97,6 +97,8 @@ pub(crate) struct Settings<'a> {
     pub orders: &'a [u32],
     /// Prior standard deviation of each scaled Fourier parameter, rad.
     pub series_sd: f64,
+    /// When the temperature and the time vary enough for their effects.
+    pub inputs: effects::CandidateOptions,
 }
 
 /// What a learnt backlash side of one joint is learnt from (module `learnt_side`).
@@ -170,6 +172,7 @@ pub(crate) fn build_candidates(
         measured: has_torques(&data.rows),
         moving: settings.moving,
         longest_order: settings.orders.iter().copied().max().unwrap_or(1),
+        options: settings.inputs,
     };
     let nonzero = |columns: &[Vec<f64>]| columns.iter().flatten().any(|v| v.abs() > 1e-12);
     let with_columns = |offered: Vec<CandidateModel>| -> Result<Vec<Candidate>, Error> {

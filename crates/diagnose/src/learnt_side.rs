@@ -152,8 +152,7 @@ mod tests {
 
     #[test]
     fn a_fold_s_learnt_side_does_not_depend_on_the_fold_s_own_rows() {
-        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron");
-        let robot = RobotDescription::read(&path).unwrap();
+        let robot = testkit::robot("irb4400.ron");
         let cell = simulated_cell(&robot, &Perturbation::default(), 41).unwrap();
         let effects = Effects {
             backlash: Some(loadsim::Backlash::uniform(6, 3e-4)),
@@ -173,7 +172,8 @@ mod tests {
         .unwrap()
         .model;
         let design = Design::new(&model, &data, Weights { position_m: 1e-4, rotation_rad: 1.0 }).unwrap();
-        let settings = Settings { moving: &[], orders: &[1], series_sd: 1e-3 };
+        let settings =
+            Settings { moving: &[], orders: &[1], series_sd: 1e-3, inputs: effects::CandidateOptions::default() };
         let (candidates, sources) = build_candidates(&blind, &model, &data, &design, &settings).unwrap();
         assert!(!sources.is_empty());
         let fold = fold_assignment(data.rows.len(), 5, 0);

@@ -103,6 +103,8 @@ pub struct DiagnoseOptions {
     pub verdict: VerdictOptions,
     /// When gross outliers stop the attribution (module `outliers`).
     pub outliers: OutlierOptions,
+    /// When the temperature and the time vary enough to offer thermal growth and drift.
+    pub candidates: effects::CandidateOptions,
 }
 
 impl Default for DiagnoseOptions {
@@ -119,6 +121,7 @@ impl Default for DiagnoseOptions {
             structure: StructureOptions::default(),
             verdict: VerdictOptions::default(),
             outliers: OutlierOptions::default(),
+            candidates: effects::CandidateOptions::default(),
         }
     }
 }
@@ -152,6 +155,15 @@ impl DiagnoseOptions {
         ];
         for (field, value) in fractions {
             if !(0.0..1.0).contains(&value) {
+                return Err(Error::DiagnoseOption { field, value });
+            }
+        }
+        let at_least_zero: [(&'static str, f64); 2] = [
+            ("candidates.thermal_min_span_k", self.candidates.thermal_min_span_k),
+            ("candidates.drift_min_offset_s", self.candidates.drift_min_offset_s),
+        ];
+        for (field, value) in at_least_zero {
+            if !(value.is_finite() && value >= 0.0) {
                 return Err(Error::DiagnoseOption { field, value });
             }
         }
@@ -397,6 +409,7 @@ pub fn diagnose(
         moving: &moving,
         orders: &options.selection.series_orders,
         series_sd: options.prior.series_rad,
+        inputs: options.candidates,
     };
     let (candidates, sides) = candidates::build_candidates(robot, &model, data, &design, &settings)?;
     let (mut terms, blocks) = terms_of(&candidates, design.kinematic.ncols());

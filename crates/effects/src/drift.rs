@@ -109,13 +109,14 @@ impl NewEffect for TimeDrift {
         TimeDrift::new(rows, context.hold_beyond_span)
     }
 
-    /// Where every row has `t_s` and some row lies more than 1 s from their mean.
+    /// Where every row has `t_s` and some row lies more than `CandidateOptions::drift_min_offset_s`
+    /// from their mean.
     fn global_candidates(context: &CandidateContext<'_>) -> Result<Vec<CandidateModel>, Error> {
         let Some(times) = context.rows.iter().map(|r| r.t_s).collect::<Option<Vec<f64>>>() else {
             return Ok(Vec::new());
         };
         let mean = times.iter().sum::<f64>() / context.rows.len() as f64;
-        if !times.iter().any(|t| (t - mean).abs() > 1.0) {
+        if !times.iter().any(|t| (t - mean).abs() > context.options.drift_min_offset_s) {
             return Ok(Vec::new());
         }
         let drift = TimeDrift::new(context.rows, crate::HOLD_BEYOND_SPAN)?;
@@ -129,17 +130,7 @@ mod tests {
     use crate::Thermal;
 
     fn row(t_s: f64, temp_c: f64) -> Measurement {
-        Measurement {
-            line: 0,
-            q: vec![0.0],
-            position: lie::Vector3::zeros(),
-            orientation: None,
-            payload_kg: 0.0,
-            tool: 0,
-            temp_c: Some(temp_c),
-            t_s: Some(t_s),
-            torques_nm: None,
-        }
+        Measurement { temp_c: Some(temp_c), t_s: Some(t_s), ..Measurement::at(vec![0.0], lie::Vector3::zeros()) }
     }
 
     /// Issue 30: a drift fitted over one 73-minute session was applied as a straight line eight

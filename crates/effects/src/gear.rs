@@ -413,20 +413,7 @@ mod tests {
     use std::f64::consts::{PI, TAU};
 
     fn rows(angles: &[f64]) -> Vec<Measurement> {
-        angles
-            .iter()
-            .map(|&q| Measurement {
-                line: 0,
-                q: vec![q],
-                position: lie::Vector3::zeros(),
-                orientation: None,
-                payload_kg: 0.0,
-                tool: 0,
-                temp_c: None,
-                t_s: None,
-                torques_nm: None,
-            })
-            .collect()
+        angles.iter().map(|&q| Measurement::at(vec![q], lie::Vector3::zeros())).collect()
     }
 
     /// `n` angles evenly from `low` to `high`.

@@ -52,7 +52,7 @@ pub use loadsim::EffectKind;
 pub use report::effect_reports;
 pub use report::{EffectReport, ParameterReport};
 pub use spec::{Argument, EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS};
-pub use term::{CandidateContext, CandidateModel};
+pub use term::{CandidateContext, CandidateModel, CandidateOptions};
 pub use thermal::Thermal;
 
 pub use check::{EffectFault, FaultKind, check_effects};

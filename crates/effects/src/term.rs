@@ -9,6 +9,7 @@ use crate::{Argument, Direction, EffectContext, EffectSpec, IdentifiedEffect, Lo
 use errors::Error;
 use measurements::Measurement;
 use robot::RobotDescription;
+use serde::{Deserialize, Serialize};
 
 /// What the diagnosis builds its candidates from.
 #[derive(Debug, Clone, Copy)]
@@ -29,6 +30,32 @@ pub struct CandidateContext<'a> {
     pub moving: &'a [usize],
     /// The highest order a Fourier series may take.
     pub longest_order: u32,
+    /// When an input is too constant for an effect driven by it.
+    pub options: CandidateOptions,
+}
+
+/// When the diagnosis offers the effects driven by the row's temperature and time: an input that
+/// barely varies cannot identify a coefficient on it. Validated once, by the diagnosis's options
+/// (`DiagnoseOptions::validate`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CandidateOptions {
+    /// Thermal growth is a candidate only where every row has `temp_c` and it spans more than
+    /// this, K. 0.2 K: the value since the first diagnosis (commit 2f15dff), not fitted to any
+    /// data set. Over 0.2 K steel (11.5e-6 /K) grows a 2 m arm by 4.6 µm, under the tracker's
+    /// 5 µm line-of-sight noise (`loadsim::TrackerNoise`), so a smaller span identifies noise.
+    pub thermal_min_span_k: f64,
+    /// Drift is a candidate only where every row has `t_s` and some row lies more than this from
+    /// their mean, s. 1 s: the value since the first diagnosis (commit 2f15dff), not fitted to
+    /// any data set; a robot takes seconds to reach and settle at a pose, so rows all within a
+    /// second of their mean are one moment (a constant or rounded stamp), not a session that drifts.
+    pub drift_min_offset_s: f64,
+}
+
+impl Default for CandidateOptions {
+    fn default() -> Self {
+        Self { thermal_min_span_k: 0.2, drift_min_offset_s: 1.0 }
+    }
 }
 
 /// A candidate an effect offers the diagnosis: the effect with its parameters at zero.

@@ -105,13 +105,14 @@ impl NewEffect for Thermal {
     }
 
     /// One expansion coefficient for the whole arm (every link but the tracker-to-base placement
-    /// grows by `α ΔT`), where every row has `temp_c` and it varies by more than 0.2 K.
+    /// grows by `α ΔT`), where every row has `temp_c` and it spans more than
+    /// `CandidateOptions::thermal_min_span_k`.
     fn global_candidates(context: &CandidateContext<'_>) -> Result<Vec<CandidateModel>, Error> {
         let Some(temps) = context.rows.iter().map(|r| r.temp_c).collect::<Option<Vec<f64>>>() else {
             return Ok(Vec::new());
         };
         let (low, high) = temps.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| (a.min(t), b.max(t)));
-        if high - low <= 0.2 {
+        if high - low <= context.options.thermal_min_span_k {
             return Ok(Vec::new());
         }
         let thermal = Thermal::new(context.rows, crate::HOLD_BEYOND_SPAN)?;

@@ -69,6 +69,26 @@ pub struct Measurement {
     pub torques_nm: Option<Vec<f64>>,
 }
 
+impl Measurement {
+    /// A row made in memory (a test's, or a configuration to predict at): joints `q` and the
+    /// position `position` (tracker frame, m), every other field at its neutral value: line 0, no
+    /// orientation, no payload, tool 0, no temperature, time or torques. Set the others with
+    /// struct update syntax, e.g. `Measurement { payload_kg: 5.0, ..Measurement::at(q, p) }`.
+    pub fn at(q: Vec<f64>, position: Vector3) -> Self {
+        Self {
+            line: 0,
+            q,
+            position,
+            orientation: None,
+            payload_kg: 0.0,
+            tool: 0,
+            temp_c: None,
+            t_s: None,
+            torques_nm: None,
+        }
+    }
+}
+
 /// A joint column as the file names it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct JointColumn {

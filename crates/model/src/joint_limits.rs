@@ -95,17 +95,7 @@ mod tests {
     use super::*;
 
     fn row(line: u64, q: [f64; 2]) -> Measurement {
-        Measurement {
-            line,
-            q: q.to_vec(),
-            position: lie::Vector3::zeros(),
-            orientation: None,
-            payload_kg: 0.0,
-            tool: 0,
-            temp_c: None,
-            t_s: None,
-            torques_nm: None,
-        }
+        Measurement { line, ..Measurement::at(q.to_vec(), lie::Vector3::zeros()) }
     }
 
     #[test]

@@ -182,15 +182,11 @@ impl CalibratedModel {
         }
         let n = self.kinematics.joint_count();
         let row = |q: Vec<f64>, payload_kg: f64| Measurement {
-            line: 0,
-            q,
-            position: lie::Vector3::zeros(),
-            orientation: None,
             payload_kg,
-            tool: 0,
             temp_c: Some(0.0),
             t_s: Some(0.0),
             torques_nm: Some(vec![0.0; n]),
+            ..Measurement::at(q, lie::Vector3::zeros())
         };
         match &self.residual_gp {
             Some(residual_gp) => {

@@ -78,18 +78,14 @@ impl TrainingRange {
     /// corners where every input is at its smallest and at its largest (tool 0, no measured pose).
     pub(crate) fn probe_rows(&self) -> Vec<Measurement> {
         let at = |pick: fn(&[f64; 2]) -> f64| Measurement {
-            line: 0,
-            q: self.q.iter().map(pick).collect(),
-            position: lie::Vector3::zeros(),
-            orientation: None,
             payload_kg: pick(&self.payload_kg),
-            tool: 0,
             temp_c: Some(self.temp_c.as_ref().map_or(0.0, pick)),
             t_s: Some(self.t_s.as_ref().map_or(0.0, pick)),
             torques_nm: Some(match &self.torques_nm {
                 Some(t) => t.iter().map(pick).collect(),
                 None => vec![0.0; self.q.len()],
             }),
+            ..Measurement::at(self.q.iter().map(pick).collect(), lie::Vector3::zeros())
         };
         vec![at(|r| 0.5 * (r[0] + r[1])), at(|r| r[0]), at(|r| r[1])]
     }

@@ -10,18 +10,13 @@ use pipeline::{
 };
 use std::path::{Path, PathBuf};
 
-fn robot(name: &str) -> RobotDescription {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name);
-    RobotDescription::read(&path).unwrap_or_else(|e| panic!("{e}"))
-}
-
 fn fitted(
     method: Method,
     effects: Effects,
     full_pose: bool,
     payloads: Vec<f64>,
 ) -> (RobotDescription, CalibratedModel, MeasurementSet) {
-    let irb = robot("irb4400.ron");
+    let irb = testkit::robot("irb4400.ron");
     let cell = simulated::simulated_cell(&irb, &Perturbation::default(), 21).unwrap();
     let config = GeneratorConfig { sample_count: 160, seed: 21, payloads_kg: payloads, ..GeneratorConfig::default() };
     let set = simulated::simulate(&cell, &effects, &simulated::joint_ranges(&irb), &config, full_pose).unwrap();
@@ -40,17 +35,7 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 fn predicted(model: &CalibratedModel, q: &[f64], payload_kg: f64) -> SE3 {
-    let row = pipeline::Measurement {
-        line: 0,
-        q: q.to_vec(),
-        position: Vector3::zeros(),
-        orientation: None,
-        payload_kg,
-        tool: 0,
-        temp_c: None,
-        t_s: None,
-        torques_nm: None,
-    };
+    let row = pipeline::Measurement { payload_kg, ..pipeline::Measurement::at(q.to_vec(), Vector3::zeros()) };
     model.predict(&[row], &[0]).unwrap()[0].pose
 }
 
@@ -224,7 +209,7 @@ fn targets_files_that_cannot_be_compensated_are_refused_at_their_place() {
     let message = refusal(pipeline::compensate(
         &model,
         &joints,
-        Some((&robot("ur10.ron"), "ur10.ron")),
+        Some((&testkit::robot("ur10.ron"), "ur10.ron")),
         TargetFrame::Tracker,
         &options,
     ));

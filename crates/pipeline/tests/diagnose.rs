@@ -2,17 +2,12 @@
 
 use loadsim::{CouplingFactor, CouplingTerm, Harmonic, JointCoupling, PeriodicError};
 use pipeline::diagnose::{DiagnoseOptions, Effect, NoiseSource, StructureOptions, diagnose};
+use pipeline::effects::CandidateOptions;
 use pipeline::simulated::{
     Effects, GeneratorConfig, Perturbation, Remount, TrackerNoise, joint_ranges, payload_run_campaign, simulate,
     simulate_campaign, simulated_cell,
 };
 use pipeline::{MeasurementSet, RobotDescription};
-use std::path::PathBuf;
-
-fn irb4400() -> RobotDescription {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron");
-    RobotDescription::read(&path).unwrap()
-}
 
 fn simulated(robot: &RobotDescription, effects: &Effects, full_pose: bool, seed: u64) -> MeasurementSet {
     let cell = simulated_cell(robot, &Perturbation::default(), seed).unwrap();
@@ -28,7 +23,7 @@ fn blind(robot: &RobotDescription) -> RobotDescription {
 
 #[test]
 fn a_second_harmonic_on_joint_three_is_named_and_removed_position_only_and_full_pose() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
         periodic: Some(PeriodicError {
             harmonics: vec![Harmonic { joint_index: 2, order: 2.0, amplitude_rad: 2e-4, phase_rad: 0.4 }],
@@ -62,7 +57,7 @@ fn a_second_harmonic_on_joint_three_is_named_and_removed_position_only_and_full_
 
 #[test]
 fn compliance_is_found_without_the_masses() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let effects = Effects { compliance: Some(loadsim::JointCompliance::default()), ..Effects::default() };
     let data = simulated(&robot, &effects, false, 23);
     let d = diagnose(&blind(&robot), &data, &DiagnoseOptions::default()).unwrap();
@@ -72,7 +67,7 @@ fn compliance_is_found_without_the_masses() {
 
 #[test]
 fn noise_alone_gives_none() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     for (seed, full_pose) in [(24, false), (25, true)] {
         let data = simulated(&robot, &Effects::default(), full_pose, seed);
         let d = diagnose(&blind(&robot), &data, &DiagnoseOptions::default()).unwrap();
@@ -84,7 +79,7 @@ fn noise_alone_gives_none() {
 
 #[test]
 fn a_report_has_a_plot_per_joint_and_the_tables() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let data = simulated(&robot, &Effects::default(), false, 26);
     let options = DiagnoseOptions {
         structure: StructureOptions { enabled: false, ..StructureOptions::default() },
@@ -105,16 +100,11 @@ fn a_report_has_a_plot_per_joint_and_the_tables() {
 
 #[test]
 fn too_few_rows_are_refused() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let data = simulated(&robot, &Effects::default(), false, 27);
     let small = data.subset(&(0..30).collect::<Vec<_>>());
     let error = diagnose(&robot, &small, &DiagnoseOptions::default()).unwrap_err();
     assert!(matches!(error, pipeline::Error::TooFewRows { rows: 30, needed: 50, .. }), "{error}");
-}
-
-fn iiwa7() -> RobotDescription {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/iiwa7.ron");
-    RobotDescription::read(&path).unwrap()
 }
 
 /// The 7-axis campaign of issue 11: joints 1 and 2 move, the others sit at 0 within 2 mrad;
@@ -122,7 +112,7 @@ fn iiwa7() -> RobotDescription {
 /// torques. Only joint 2 is compliant.
 #[test]
 fn the_seven_axis_two_moving_joint_campaign_names_compliance_on_joint_two() {
-    let robot = iiwa7();
+    let robot = testkit::robot("iiwa7.ron");
     let mut soft = robot.clone();
     if let Some(d) = soft.dynamics.as_mut() {
         for (j, k) in d.stiffness_nm_per_rad.iter_mut().enumerate() {
@@ -158,7 +148,7 @@ fn the_seven_axis_two_moving_joint_campaign_names_compliance_on_joint_two() {
 /// verdict is `unknown`, and it points at joints 2 and 4.
 #[test]
 fn a_coupling_between_joints_is_unknown_with_the_joints_it_depends_on() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
         coupling: Some(JointCoupling {
             terms: vec![CouplingTerm {
@@ -187,8 +177,7 @@ fn a_coupling_between_joints_is_unknown_with_the_joints_it_depends_on() {
 /// the same arm is still found.
 #[test]
 fn a_lifting_column_is_reported_in_millimetres_and_offered_no_series_of_its_angle() {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/column_ur10.ron");
-    let robot = RobotDescription::read(&path).unwrap();
+    let robot = testkit::robot("column_ur10.ron");
     assert_eq!(robot.joints[0].kind, pipeline::JointType::Prismatic);
     let periodic =
         PeriodicError { harmonics: vec![Harmonic { joint_index: 2, order: 3.0, amplitude_rad: 4e-4, phase_rad: 0.3 }] };
@@ -208,4 +197,34 @@ fn a_lifting_column_is_reported_in_millimetres_and_offered_no_series_of_its_angl
         error.to_string(),
         "gear_periodic on joint 1: joint 1 is prismatic, and a gear_periodic is a function of a revolute joint's angle"
     );
+}
+
+/// The spans below which temperature and time offer no candidate are options: above the data's
+/// spans thermal growth and drift are not tried, at the defaults they are, and a negative or NaN
+/// threshold is refused.
+#[test]
+fn thermal_and_drift_are_candidates_only_where_their_input_varies_more_than_the_option() {
+    let robot = testkit::robot("irb4400.ron");
+    let data = simulated(&robot, &Effects::default(), false, 27);
+    let tried = |candidates: CandidateOptions| {
+        let options = DiagnoseOptions {
+            structure: StructureOptions { enabled: false, ..StructureOptions::default() },
+            candidates,
+            ..DiagnoseOptions::default()
+        };
+        let d = diagnose(&blind(&robot), &data, &options).unwrap();
+        let has = |effect: Effect| d.candidates.iter().any(|c| c.effect == effect);
+        (has(Effect::Thermal), has(Effect::TimeDrift))
+    };
+    assert_eq!(tried(CandidateOptions::default()), (true, true));
+    let never = CandidateOptions { thermal_min_span_k: 1e6, drift_min_offset_s: 1e12 };
+    assert_eq!(tried(never), (false, false));
+    for bad in [-0.1, f64::NAN] {
+        let options = DiagnoseOptions {
+            candidates: CandidateOptions { thermal_min_span_k: bad, ..CandidateOptions::default() },
+            ..DiagnoseOptions::default()
+        };
+        let error = diagnose(&blind(&robot), &data, &options).unwrap_err().to_string();
+        assert!(error.contains("candidates.thermal_min_span_k"), "{error}");
+    }
 }

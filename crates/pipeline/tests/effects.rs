@@ -8,12 +8,6 @@ use pipeline::simulated::{
     Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell,
 };
 use pipeline::{FitOptions, MeasurementSet, Method, RobotDescription};
-use std::path::PathBuf;
-
-fn irb4400() -> RobotDescription {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron");
-    RobotDescription::read(&path).unwrap()
-}
 
 /// 400 poses with `effects` and the tracker's noise: 250 to train on (the even rows... the first
 /// 250) and 150 held out.
@@ -48,7 +42,7 @@ fn joint_2_gear_error() -> PeriodicError {
 
 #[test]
 fn a_gear_error_of_high_order_is_identified_down_to_the_noise() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let effects = Effects { periodic: Some(joint_2_gear_error()), ..Effects::default() };
     let (train, test) = split(&robot, &effects, 31);
     let poe = heldout(&robot, &train, &test, "");
@@ -61,7 +55,7 @@ fn a_gear_error_of_high_order_is_identified_down_to_the_noise() {
 
 #[test]
 fn backlash_thermal_growth_and_drift_are_each_identified_down_to_the_noise() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let floor = noise_floor(&robot, 32);
     let cases = [
         (
@@ -100,7 +94,7 @@ fn backlash_thermal_growth_and_drift_are_each_identified_down_to_the_noise() {
 
 #[test]
 fn an_effect_the_data_cannot_feed_is_refused_with_the_column_it_needs() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let (mut train, _) = split(&robot, &Effects::default(), 33);
     for row in &mut train.rows {
         row.temp_c = None;
@@ -115,7 +109,7 @@ fn an_effect_the_data_cannot_feed_is_refused_with_the_column_it_needs() {
 
 #[test]
 fn a_model_with_every_effect_reads_back_and_predicts_the_same() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let (train, test) = split(&robot, &Effects::default(), 34);
     let selection = "joint_compliance,gear_periodic:1:3,backlash:2,thermal,time_drift".parse().unwrap();
     let (model, _) =
@@ -136,15 +130,10 @@ fn a_model_with_every_effect_reads_back_and_predicts_the_same() {
     }
 }
 
-fn iiwa7() -> RobotDescription {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/iiwa7.ron");
-    RobotDescription::read(&path).unwrap()
-}
-
 /// The 7-axis campaign of issue 11 (joints 1 and 2 moving, the others at 0 within 2 mrad, four
 /// payload runs with a tool each, measured torques), full pose, split even / odd rows.
 fn campaign(effects: &Effects, seed: u64) -> (MeasurementSet, MeasurementSet) {
-    let robot = iiwa7();
+    let robot = testkit::robot("iiwa7.ron");
     let config = pipeline::simulated::payload_run_campaign(400, seed);
     let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..effects.clone() };
     let remount = pipeline::simulated::Remount::default();
@@ -158,7 +147,7 @@ fn campaign(effects: &Effects, seed: u64) -> (MeasurementSet, MeasurementSet) {
 
 #[test]
 fn a_seven_axis_campaign_with_two_moving_joints_reaches_the_noise_with_joint_compliance() {
-    let robot = iiwa7();
+    let robot = testkit::robot("iiwa7.ron");
     let seed = 35;
     let (train, test) = campaign(&pipeline::simulated::paper_effects(), seed);
     let (noise_train, noise_test) = campaign(&Effects::default(), seed);
@@ -192,7 +181,7 @@ proptest::proptest! {
             ITEMS.iter().enumerate().filter(|(k, _)| bits & (1 << k) != 0).map(|(_, s)| *s).collect::<Vec<_>>().join(",")
         };
         let (subset, superset) = (pick(mask), pick(mask | extra));
-        let robot = irb4400();
+        let robot = testkit::robot("irb4400.ron");
         let effects = Effects {
             periodic: Some(PeriodicError { harmonics: vec![Harmonic { joint_index: 1, order: 3.0, amplitude_rad: 2e-4, phase_rad: 0.5 }] }),
             ..Effects::default()
@@ -222,7 +211,7 @@ proptest::proptest! {
 
 #[test]
 fn a_model_is_its_parts_applied_in_order_and_export_reports_each_one() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
         periodic: Some(PeriodicError {
             harmonics: vec![Harmonic { joint_index: 2, order: 2.0, amplitude_rad: 3e-4, phase_rad: 0.1 }],
@@ -278,7 +267,7 @@ fn rows_where(all: &MeasurementSet, keep: impl Fn(f64) -> bool) -> MeasurementSe
 
 #[test]
 fn a_gear_series_warns_where_it_is_used_outside_the_angles_it_was_fitted_on() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let cell = simulated_cell(&robot, &Perturbation::default(), 47).unwrap();
     let config = GeneratorConfig { sample_count: 900, seed: 47, ..GeneratorConfig::default() };
     let all = simulate(&cell, &Effects::default(), &joint_ranges(&robot), &config, false).unwrap();
@@ -307,7 +296,7 @@ fn a_gear_series_warns_where_it_is_used_outside_the_angles_it_was_fitted_on() {
 /// 1,500 poses of the IRB 4400 with the gear error of joint 2 and the tracker's noise (seed 53),
 /// over the whole range of every joint: the tests of issue 23 cut gaps into it.
 fn joint_2_gear_campaign() -> (RobotDescription, MeasurementSet) {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
         periodic: Some(joint_2_gear_error()),
         tracker_noise: Some(TrackerNoise::default()),
@@ -426,7 +415,7 @@ fn the_diagnosis_predicts_the_error_in_a_gap_and_past_the_end_from_arcs_of_the_j
 /// there, so `--effects time_drift` is no worse than without it, where the line was far worse.
 #[test]
 fn a_drift_fitted_in_one_session_is_not_carried_into_another_days_later() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
         drift: Some(BaseDrift { twist_per_s: [4e-8, -3e-8, 2e-8, 0.0, 1e-8, 0.0] }),
         tracker_noise: Some(TrackerNoise::default()),

@@ -6,12 +6,6 @@ use pipeline::{
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::path::PathBuf;
-
-fn irb4400() -> RobotDescription {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron");
-    RobotDescription::read(&path).unwrap()
-}
 
 fn twist(rng: &mut ChaCha8Rng, translation: f64, rotation: f64) -> Twist {
     let mut v = || Vector3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
@@ -38,15 +32,9 @@ fn synthetic(robot: &RobotDescription, rows: usize, tools: &[&str], full_pose: b
             let tool = i % tools.len();
             let pose = truth.forward(&q, tool).unwrap();
             Measurement {
-                line: 0,
-                q,
-                position: pose.translation(),
                 orientation: full_pose.then(|| pose.rotation()),
-                payload_kg: 0.0,
                 tool,
-                temp_c: None,
-                t_s: None,
-                torques_nm: None,
+                ..Measurement::at(q, pose.translation())
             }
         })
         .collect();
@@ -62,7 +50,7 @@ fn through_csv(set: &MeasurementSet) -> MeasurementSet {
 
 #[test]
 fn poe_fit_through_csv_and_model_file_reproduces_held_out_poses() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     for full_pose in [true, false] {
         let all = through_csv(&synthetic(&robot, 160, &["A", "B"], full_pose, 5));
         let train = all.subset(&(0..100).collect::<Vec<_>>());
@@ -82,7 +70,7 @@ fn poe_fit_through_csv_and_model_file_reproduces_held_out_poses() {
 
 #[test]
 fn base_tool_fit_cannot_absorb_joint_errors_but_poe_can() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let all = synthetic(&robot, 150, &["T"], true, 6);
     let train = all.subset(&(0..100).collect::<Vec<_>>());
     let test = all.subset(&(100..150).collect::<Vec<_>>());
@@ -96,7 +84,7 @@ fn base_tool_fit_cannot_absorb_joint_errors_but_poe_can() {
 
 #[test]
 fn evaluation_refuses_a_tool_the_model_does_not_know() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let train = through_csv(&synthetic(&robot, 60, &["A"], true, 7));
     let (model, _) = pipeline::fit(&robot, &train, Method::BaseTool, &FitOptions::default()).unwrap();
     let other = through_csv(&synthetic(&robot, 10, &["Z"], true, 8));
@@ -107,7 +95,7 @@ fn evaluation_refuses_a_tool_the_model_does_not_know() {
 
 #[test]
 fn model_files_of_another_schema_or_broken_are_refused_with_a_position() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let train = synthetic(&robot, 60, &["A"], true, 9);
     let (model, _) = pipeline::fit(&robot, &train, Method::BaseTool, &FitOptions::default()).unwrap();
     let dir = tempfile::tempdir().unwrap();
@@ -125,7 +113,7 @@ fn model_files_of_another_schema_or_broken_are_refused_with_a_position() {
 
 #[test]
 fn a_data_file_for_another_robot_is_refused() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let text = "q1_rad,q2_rad,x_mm,y_mm,z_mm\n0,0,1,2,3\n";
     let set = parse_measurements(text.as_bytes(), "two.csv", &ReadOptions::default()).unwrap();
     let error = pipeline::fit(&robot, &set, Method::Poe, &FitOptions::default()).unwrap_err();
@@ -134,7 +122,7 @@ fn a_data_file_for_another_robot_is_refused() {
 
 #[test]
 fn a_blank_tool_is_the_default_tool_in_the_fit_its_report_and_the_evaluation() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     // Rows alternate between tool "A" and a blank cell, 0.3 m and 1 rad apart.
     let all = through_csv(&synthetic(&robot, 160, &["A", ""], true, 10));
     assert_eq!(all.tools, vec!["A".to_owned(), String::new()]);
@@ -160,7 +148,7 @@ fn a_blank_tool_is_the_default_tool_in_the_fit_its_report_and_the_evaluation() {
 
 #[test]
 fn the_default_tool_is_refused_by_a_model_fitted_only_with_named_tools() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let train = through_csv(&synthetic(&robot, 60, &["A", "B"], true, 11));
     let (model, _) = pipeline::fit(&robot, &train, Method::BaseTool, &FitOptions::default()).unwrap();
     let unnamed = through_csv(&synthetic(&robot, 10, &[""], true, 12));

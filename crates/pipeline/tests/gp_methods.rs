@@ -2,12 +2,6 @@
 
 use pipeline::simulated::{GeneratorConfig, Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
 use pipeline::{FitOptions, MeasurementSet, Method, RobotDescription};
-use std::path::PathBuf;
-
-fn irb4400() -> RobotDescription {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron");
-    RobotDescription::read(&path).unwrap()
-}
 
 /// Simulated tracker data of a perturbed IRB 4400 whose joints give under gravity and payload.
 /// The payloads span the robot's rating (0 to 60 kg), where the load effect is of the same order
@@ -25,7 +19,7 @@ fn loaded_data(robot: &RobotDescription, rows: usize, full_pose: bool, seed: u64
 
 #[test]
 fn with_a_load_effect_poe_gp_load_beats_poe_gp_which_beats_poe() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     for (seed, full_pose) in [(11, true), (12, false)] {
         let all = loaded_data(&robot, 400, full_pose, seed);
         let train = all.subset(&(0..250).collect::<Vec<_>>());
@@ -43,7 +37,7 @@ fn with_a_load_effect_poe_gp_load_beats_poe_gp_which_beats_poe() {
 
 #[test]
 fn identified_joint_compliance_leaves_little_more_than_the_noise() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     for (seed, full_pose) in [(13, true), (14, false)] {
         let all = loaded_data(&robot, 400, full_pose, seed);
         let train = all.subset(&(0..250).collect::<Vec<_>>());
@@ -67,7 +61,7 @@ fn identified_joint_compliance_leaves_little_more_than_the_noise() {
 
 #[test]
 fn a_gp_search_stopped_by_its_iteration_limit_is_reported_not_passed_off_as_converged() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let data = loaded_data(&robot, 120, false, 21);
     let warned = |max_iterations: usize, method: pipeline::GpChoice| {
         let mut options = FitOptions::default();
@@ -93,7 +87,7 @@ fn a_gp_search_stopped_by_its_iteration_limit_is_reported_not_passed_off_as_conv
 /// one kernel (`rotation_follows_position`).
 #[test]
 fn fit_report_gives_the_gp_leave_one_out_error_near_the_held_out_error() {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     for (seed, full_pose) in [(15, true), (16, false)] {
         let all = loaded_data(&robot, 400, full_pose, seed);
         let train = all.subset(&(0..250).collect::<Vec<_>>());

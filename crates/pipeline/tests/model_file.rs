@@ -4,17 +4,11 @@
 
 use pipeline::effects::IdentifiedEffect;
 use pipeline::simulated::{GeneratorConfig, Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
-use pipeline::{CalibratedModel, Error, FitOptions, Method, RobotDescription};
-use std::path::PathBuf;
-
-fn irb4400() -> RobotDescription {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron");
-    RobotDescription::read(&path).unwrap()
-}
+use pipeline::{CalibratedModel, Error, FitOptions, Method};
 
 /// A `poe-gp-load` model with joint compliance (every part a model can have), and its file text.
 fn fitted(full_pose: bool) -> (CalibratedModel, String) {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let cell = simulated_cell(&robot, &Perturbation::default(), 3).unwrap();
     let config = GeneratorConfig { sample_count: 60, seed: 3, ..GeneratorConfig::default() };
     let data = simulate(&cell, &paper_effects(), &joint_ranges(&robot), &config, full_pose).unwrap();
@@ -178,9 +172,9 @@ fn a_version_1_file_with_joint_compliance_reads_and_predicts_as_before() {
     };
     assert_eq!((&again.terms, &again.theta), (&compliance.terms, &compliance.theta));
     let data = simulate(
-        &simulated_cell(&irb4400(), &Perturbation::default(), 3).unwrap(),
+        &simulated_cell(&testkit::robot("irb4400.ron"), &Perturbation::default(), 3).unwrap(),
         &paper_effects(),
-        &joint_ranges(&irb4400()),
+        &joint_ranges(&testkit::robot("irb4400.ron")),
         &GeneratorConfig { sample_count: 20, seed: 4, ..GeneratorConfig::default() },
         true,
     )
@@ -198,7 +192,7 @@ fn a_version_1_file_with_joint_compliance_reads_and_predicts_as_before() {
 
 /// A `poe` model with a gear error and time drift, and its file text.
 fn with_effects() -> (CalibratedModel, String) {
-    let robot = irb4400();
+    let robot = testkit::robot("irb4400.ron");
     let cell = simulated_cell(&robot, &Perturbation::default(), 5).unwrap();
     let config = GeneratorConfig { sample_count: 60, seed: 5, ..GeneratorConfig::default() };
     let data = simulate(&cell, &paper_effects(), &joint_ranges(&robot), &config, false).unwrap();
@@ -289,7 +283,7 @@ fn in_robot(text: &str, from: &str, to: &str) -> String {
 #[test]
 fn the_robot_a_model_keeps_is_checked_as_a_robot_file_and_against_the_kinematics() {
     let (model, text) = fitted(false);
-    assert_eq!(model.robot_description, Some(irb4400()), "the robot the fit started from");
+    assert_eq!(model.robot_description, Some(testkit::robot("irb4400.ron")), "the robot the fit started from");
     let (_, message) = refused(&in_robot(&text, "axis: (0.0,", "axis: (5.0,"));
     assert!(message.contains("robot_description is not a valid robot") && message.contains("norm"), "{message}");
     let prismatic = in_robot(&text, "kind: Revolute", "kind: Prismatic");

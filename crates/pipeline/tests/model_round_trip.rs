@@ -9,12 +9,6 @@ use pipeline::simulated::{
     simulate, simulate_campaign, simulated_cell,
 };
 use pipeline::{FitOptions, MeasurementSet, Method, RobotDescription};
-use std::path::PathBuf;
-
-fn robot(name: &str) -> RobotDescription {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name);
-    RobotDescription::read(&path).unwrap()
-}
 
 /// A data shape: its robot, its rows, and an explicit effects list that fits it.
 struct Shape {
@@ -28,7 +22,7 @@ const ROWS: usize = 100;
 
 fn shapes() -> Vec<Shape> {
     let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..paper_effects() };
-    let iiwa = robot("iiwa7.ron");
+    let iiwa = testkit::robot("iiwa7.ron");
     // The campaign of the issue: joints 1–2 moving, the others within 2 mrad of 0, four payload
     // runs with a tool each, measured torques; full pose and position only.
     let campaign = |full_pose: bool| {
@@ -36,7 +30,7 @@ fn shapes() -> Vec<Shape> {
         simulate_campaign(&iiwa, &effects, &Perturbation::default(), &Remount::default(), &config, full_pose).unwrap().1
     };
     // Every joint moving, one tool, no torques: the paper's shape.
-    let irb = robot("irb4400.ron");
+    let irb = testkit::robot("irb4400.ron");
     let cell = simulated_cell(&irb, &Perturbation::default(), 23).unwrap();
     let config = GeneratorConfig { sample_count: ROWS, seed: 23, ..GeneratorConfig::default() };
     let paper = simulate(&cell, &effects, &joint_ranges(&irb), &config, false).unwrap();

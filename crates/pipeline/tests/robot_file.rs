@@ -3,17 +3,11 @@
 use pipeline::{Error, RobotDescription};
 use poe::{DhConvention, DhRow, JointKind, LocalPoe};
 use std::f64::consts::FRAC_PI_2;
-use std::path::PathBuf;
-
-fn fixture(name: &str) -> RobotDescription {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name);
-    RobotDescription::read(&path).unwrap_or_else(|e| panic!("{e}"))
-}
 
 #[test]
 fn every_fixture_robot_reads_and_builds_its_model() {
     for (name, joints) in [("irb4400.ron", 6), ("ur10.ron", 6), ("iiwa7.ron", 7)] {
-        let robot = fixture(name);
+        let robot = testkit::robot(name);
         assert_eq!(robot.joint_count(), joints, "{name}");
         let model = robot.nominal_model().unwrap();
         let zero = model.forward(&vec![0.0; joints], 0).unwrap();
@@ -29,7 +23,7 @@ fn ur10_fixture_matches_the_published_dh_table() {
     let rows: Vec<DhRow> =
         (0..6).map(|i| DhRow { kind: JointKind::Revolute, a: a[i], alpha: alpha[i], d: d[i], theta: 0.0 }).collect();
     let dh = LocalPoe::from_dh(&rows, DhConvention::Standard);
-    let fixture = fixture("ur10.ron").nominal_model().unwrap();
+    let fixture = testkit::robot("ur10.ron").nominal_model().unwrap();
     let qs = [[0.0; 6], [0.3, -1.2, 0.8, 2.0, -0.5, 1.1], [-2.5, 0.4, -2.9, -1.0, 3.0, -0.2]];
     for q in qs {
         let a = dh.forward(&q, 0).unwrap();
@@ -40,7 +34,7 @@ fn ur10_fixture_matches_the_published_dh_table() {
 
 #[test]
 fn irb4400_positive_joint_two_tilts_the_arm_forward() {
-    let model = fixture("irb4400.ron").nominal_model().unwrap();
+    let model = testkit::robot("irb4400.ron").nominal_model().unwrap();
     let up = model.forward(&[0.0; 6], 0).unwrap().translation();
     let tilted = model.forward(&[0.0, 0.3, 0.0, 0.0, 0.0, 0.0], 0).unwrap().translation();
     assert!(tilted.x > up.x && tilted.z < up.z);

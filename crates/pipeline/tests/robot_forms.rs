@@ -4,15 +4,10 @@
 use lie::{SE3, SO3, Vector3};
 use pipeline::{ChainEnds, RobotDescription, UrdfDocument};
 use poe::{DhConvention, DhRow, JointKind, LocalPoe};
-use std::path::PathBuf;
-
-fn path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name)
-}
 
 fn read(name: &str, base_link: Option<&str>) -> RobotDescription {
     let ends = ChainEnds { base_link: base_link.map(str::to_owned), tip_link: None };
-    RobotDescription::read_with(&path(name), &ends).unwrap_or_else(|e| panic!("{e}"))
+    RobotDescription::read_with(&testkit::robot_path(name), &ends).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Configurations spread over ±2.7 rad, the same for every form of a robot.
@@ -74,7 +69,7 @@ fn the_ur10_urdf_base_link_is_ros_aligned_half_a_turn_from_the_dh_base() {
 
 #[test]
 fn urdf_limits_and_the_default_chain_are_read() {
-    let document = UrdfDocument::read(&path("ur10.urdf")).unwrap();
+    let document = UrdfDocument::read(&testkit::robot_path("ur10.urdf")).unwrap();
     let chain = document.chain(&ChainEnds::default()).unwrap();
     assert_eq!((chain.base_link.as_str(), chain.tip_link.as_str(), chain.joint_count()), ("base_link", "tool0", 6));
     let robot = chain.description();

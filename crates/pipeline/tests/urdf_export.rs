@@ -9,15 +9,6 @@ use pipeline::{
     UrdfDocument, UrdfTemplate, export_urdf, in_base_frame,
 };
 use poe::LocalPoe;
-use std::path::PathBuf;
-
-fn path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name)
-}
-
-fn robot(name: &str) -> RobotDescription {
-    RobotDescription::read(&path(name)).unwrap_or_else(|e| panic!("{e}"))
-}
 
 /// Tracker data of a perturbed `robot` (noise only, so every method fits).
 fn data(robot: &RobotDescription, rows: usize, full_pose: bool, seed: u64) -> MeasurementSet {
@@ -57,7 +48,7 @@ fn largest_difference_m(a: &LocalPoe, a_tool: usize, b: &LocalPoe, b_tool: usize
 
 #[test]
 fn a_plain_export_reads_back_to_the_model_in_the_tracker_and_the_base_frame() {
-    let irb = robot("irb4400.ron");
+    let irb = testkit::robot("irb4400.ron");
     let (model, _) = fitted(&irb, Method::Poe, true);
     let nominal = irb.nominal_model().unwrap();
     for description in [None, Some((&irb, "irb4400.ron"))] {
@@ -106,9 +97,9 @@ fn write(text: &str) -> tempfile::TempPath {
 
 #[test]
 fn an_export_like_the_ur10_urdf_keeps_its_links_and_their_meaning() {
-    let urdf = robot("ur10.urdf");
+    let urdf = testkit::robot("ur10.urdf");
     let (model, _) = fitted(&urdf, Method::Poe, true);
-    let original = std::fs::read_to_string(path("ur10.urdf")).unwrap();
+    let original = std::fs::read_to_string(testkit::robot_path("ur10.urdf")).unwrap();
     let document = UrdfDocument::parse(&original, "ur10.urdf").unwrap();
     let chain = document.chain(&ChainEnds::default()).unwrap();
     let export = export_urdf(
@@ -139,8 +130,8 @@ fn an_export_like_the_ur10_urdf_keeps_its_links_and_their_meaning() {
 
 #[test]
 fn a_description_the_model_was_not_fitted_with_is_refused() {
-    let (model, _) = fitted(&robot("ur10.ron"), Method::Poe, false);
-    let original = std::fs::read_to_string(path("ur10.urdf")).unwrap();
+    let (model, _) = fitted(&testkit::robot("ur10.ron"), Method::Poe, false);
+    let original = std::fs::read_to_string(testkit::robot_path("ur10.urdf")).unwrap();
     let document = UrdfDocument::parse(&original, "ur10.urdf").unwrap();
     let chain = document.chain(&ChainEnds::default()).unwrap();
     let template = UrdfTemplate::Like { document: &document, chain: &chain };
@@ -154,7 +145,7 @@ fn a_description_the_model_was_not_fitted_with_is_refused() {
 
 #[test]
 fn what_a_urdf_cannot_hold_is_measured_on_the_training_data_or_refused() {
-    let irb = robot("irb4400.ron");
+    let irb = testkit::robot("irb4400.ron");
     let (model, training) = fitted(&irb, Method::PoeGp, false);
     let template = UrdfTemplate::Plain { nominal: Some((&irb, "irb4400.ron")) };
     match export_urdf(&model, template, None, &NominalTolerance::default()) {

@@ -6,11 +6,6 @@ use lie::{SE3, SO3, Vector3};
 use pipeline::{ChainEnds, Error, JointType, RobotDescription, StepMotion, UrdfChain, UrdfDocument};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::path::PathBuf;
-
-fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name)
-}
 
 fn chain(text: &str, ends: &ChainEnds) -> UrdfChain {
     UrdfDocument::parse(text, "arm.urdf").and_then(|d| d.chain(ends)).unwrap_or_else(|e| panic!("{e}"))
@@ -72,7 +67,7 @@ fn largest_difference(chain: &UrdfChain, seed: u64) -> f64 {
 
 #[test]
 fn the_column_arm_folds_its_three_column_stages_into_one_joint_of_scale_three() {
-    let robot = RobotDescription::read(&fixture("column_arm.urdf")).unwrap_or_else(|e| panic!("{e}"));
+    let robot = testkit::robot("column_arm.urdf");
     assert_eq!(robot.joint_count(), 7);
     let column = &robot.joints[0];
     assert_eq!(column.kind, JointType::Prismatic);
@@ -91,17 +86,17 @@ fn the_column_arm_folds_its_three_column_stages_into_one_joint_of_scale_three() 
 
 #[test]
 fn the_folded_column_arm_moves_as_its_urdf_joint_by_joint() {
-    let text = std::fs::read_to_string(fixture("column_arm.urdf")).unwrap();
+    let text = std::fs::read_to_string(testkit::robot_path("column_arm.urdf")).unwrap();
     let difference = largest_difference(&chain(&text, &ChainEnds::default()), 1);
     assert!(difference < 1e-12, "{difference:e}");
 }
 
 #[test]
 fn from_the_column_foot_the_column_arm_is_column_ur10_with_the_lift_tripled() {
-    let text = std::fs::read_to_string(fixture("column_arm.urdf")).unwrap();
+    let text = std::fs::read_to_string(testkit::robot_path("column_arm.urdf")).unwrap();
     let ends = ChainEnds { base_link: Some("column_foot".into()), tip_link: Some("tool0".into()) };
     let folded = chain(&text, &ends).description().nominal_model().unwrap();
-    let ron = RobotDescription::read(&fixture("column_ur10.ron")).unwrap();
+    let ron = testkit::robot("column_ur10.ron");
     let reference = ron.nominal_model().unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(2);
     for _ in 0..50 {
@@ -319,7 +314,7 @@ mod export {
 
     /// A poe fit of the column arm on simulated data (noise only) and the URDF text.
     pub(super) fn fitted() -> (pipeline::CalibratedModel, pipeline::FitReport, String, RobotDescription) {
-        let text = std::fs::read_to_string(fixture("column_arm.urdf")).unwrap();
+        let text = std::fs::read_to_string(testkit::robot_path("column_arm.urdf")).unwrap();
         let robot = chain(&text, &ChainEnds::default()).description();
         let cell = simulated::simulated_cell(&robot, &Perturbation::default(), 7).unwrap();
         let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };

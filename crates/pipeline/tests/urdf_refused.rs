@@ -213,7 +213,7 @@ fn chain_ends_that_do_not_make_a_chain_are_refused() {
 
 #[test]
 fn a_ron_file_refuses_chain_ends() {
-    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/ur10.ron");
+    let path = testkit::robot_path("ur10.ron");
     let error = RobotDescription::read_with(&path, &ends(Some("base"), None)).unwrap_err().to_string();
     assert!(
         error.ends_with(

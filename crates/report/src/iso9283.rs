@@ -120,17 +120,7 @@ mod tests {
     use super::*;
 
     fn row(q: f64, x: f64) -> Measurement {
-        Measurement {
-            line: 0,
-            q: vec![q, 0.5],
-            position: nalgebra::Vector3::new(x, 0.0, 0.0),
-            orientation: None,
-            payload_kg: 0.0,
-            tool: 0,
-            temp_c: None,
-            t_s: None,
-            torques_nm: None,
-        }
+        Measurement::at(vec![q, 0.5], nalgebra::Vector3::new(x, 0.0, 0.0))
     }
 
     #[test]

@@ -5,7 +5,7 @@ use loadsim::{Effects, Harmonic, PeriodicError};
 use pipeline::diagnose::{DiagnoseOptions, diagnose};
 use pipeline::effects::{EffectSelection, EffectSpec};
 use pipeline::simulated::{Perturbation, Remount, campaign_cell, joint_ranges, payload_run_campaign, simulate};
-use pipeline::{EvalReport, FitOptions, MeasurementSet, Method, RobotDescription};
+use pipeline::{EvalReport, FitOptions, MeasurementSet, Method};
 use std::collections::HashMap;
 use std::sync::OnceLock;
 
@@ -16,17 +16,12 @@ struct Rendered {
     diagnosis_plot_names: Vec<String>,
 }
 
-fn robot() -> RobotDescription {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/robots/irb4400.ron");
-    RobotDescription::read(std::path::Path::new(path)).expect("the UR10 fixture reads")
-}
-
 /// A payload campaign (joints 1 and 2 moving, four payload runs, a remounted tool each) with a
 /// gear error on joint 2, fitted `poe-gp` with that gear series, rendered once for every test.
 fn rendered() -> &'static Rendered {
     static RENDERED: OnceLock<Rendered> = OnceLock::new();
     RENDERED.get_or_init(|| {
-        let robot = robot();
+        let robot = testkit::robot("irb4400.ron");
         let effects = Effects {
             periodic: Some(PeriodicError {
                 harmonics: vec![
@@ -169,7 +164,7 @@ fn the_charts_are_there_histogram_workspace_effect_curve_and_the_diagnosis_plots
 #[test]
 fn the_diagnosis_folder_keeps_its_file_names() {
     let r = rendered();
-    let robot = robot();
+    let robot = testkit::robot("irb4400.ron");
     let config = payload_run_campaign(160, 11);
     let cell = campaign_cell(&robot, &Perturbation::default(), &Remount::default(), &config).unwrap();
     let train = simulate(&cell, &pipeline::simulated::paper_effects(), &joint_ranges(&robot), &config, false).unwrap();
