@@ -107,3 +107,21 @@ fn fitted_on_one_wrist_configuration_every_method_is_within_5_percent_of_the_nom
         }
     }
 }
+
+#[test]
+fn above_max_rows_the_strength_is_not_chosen_and_the_report_says_so() {
+    let robot = ur10();
+    // Both wrists, so that there are clusters to hold out at the default.
+    let mut train = wrist(3, 150, false);
+    train.rows.extend(wrist(3, 150, true).rows);
+    let (_, report) = pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default()).unwrap();
+    assert!(!report.nominal_prior.as_ref().unwrap().reason.contains("max_rows"), "{:?}", report.nominal_prior);
+    let mut capped = FitOptions::default();
+    capped.nominal_prior.max_rows = 299;
+    let (_, report) = pipeline::fit(&robot, &train, Method::Poe, &capped).unwrap();
+    let choice = report.nominal_prior.unwrap();
+    assert!(
+        choice.chosen().is_none() && choice.reason.contains("300 rows, more than nominal_prior.max_rows = 299"),
+        "{choice}"
+    );
+}
