@@ -45,6 +45,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         for warning in &report.beyond_joint_limits {
             eprintln!("warning: {warning}");
         }
+        if let Some(suspects) = &report.suspect_rows {
+            eprintln!("warning: {}", suspect_text(suspects));
+        }
         return Ok(());
     }
     let s = &evaluation.summary;
@@ -70,6 +73,19 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     }
+    if let Some(split) = &report.range_split {
+        for (what, part) in [("inside", &split.inside), ("outside", &split.outside)] {
+            if part.n > 0 {
+                println!(
+                    "  {what} the range the model was fitted on: {} rows, mean {:.4} mm, max {:.4} mm",
+                    part.n, part.mean_position_error_mm, part.max_position_error_mm
+                );
+            }
+        }
+    }
+    if let Some(suspects) = &report.suspect_rows {
+        println!("  warning: {}", suspect_text(suspects));
+    }
     for warning in &report.warnings {
         println!("  warning: {warning}");
     }
@@ -80,4 +96,19 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         println!("  warning: {warning}");
     }
     Ok(())
+}
+
+/// The warning about rows far beyond the others, with what the others give.
+fn suspect_text(suspects: &pipeline::SuspectRows) -> String {
+    let w = &suspects.without;
+    format!(
+        "{} row(s) lie beyond {} robust sigmas of the other rows' errors: {}; a measurement error \
+         (a tracker glitch, a row measured twice apart) more likely than the model's; without them: \
+         mean {:.4} mm, max {:.4} mm (the numbers above keep them)",
+        suspects.rows.len(),
+        suspects.threshold_sigmas,
+        pipeline::list_lines(&suspects.rows),
+        w.mean_position_error_mm,
+        w.max_position_error_mm
+    )
 }

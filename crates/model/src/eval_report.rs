@@ -46,6 +46,15 @@ pub struct EvalReport {
     /// Joints beyond the robot's limits, for every model that keeps them.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub beyond_joint_limits: Vec<crate::BeyondLimitsWarning>,
+    /// The errors on the rows whose every input (joints, payload, temperature, time) lies within
+    /// the range the model was fitted on, and on the others, apart: for every model that records
+    /// its range, when some row lies outside it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub range_split: Option<CoverageSplit>,
+    /// Rows whose error lies far beyond the others' (a measurement error more likely than the
+    /// model's), named beside the statistics, which keep them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub suspect_rows: Option<crate::SuspectRows>,
 }
 
 /// The errors inside and outside a model's coverage.
@@ -79,6 +88,36 @@ impl EvalReport {
             warnings: model.extrapolation(&data.rows),
             out_of_range: model.outside_training_range(&data.rows),
             beyond_joint_limits: model.beyond_joint_limits(&data.rows),
+            range_split: model.training_range.as_ref().and_then(|range| {
+                let (inside, outside): (Vec<_>, Vec<_>) =
+                    data.rows.iter().zip(&evaluation.errors).partition(|(row, _)| range.contains(row));
+                (!outside.is_empty()).then(|| {
+                    let summary = |part: Vec<(_, &PoseError)>| {
+                        ErrorSummary::from_errors(&part.into_iter().map(|(_, e)| *e).collect::<Vec<_>>())
+                    };
+                    CoverageSplit { inside: summary(inside), outside: summary(outside) }
+                })
+            }),
+            suspect_rows: suspects(model, data, evaluation),
         }
     }
+}
+
+/// The rows far beyond the others among those on the model's firm ground (inside its fitted
+/// range and its effects' coverage): outside it a large error is the model's, not the data's.
+/// The threshold is the one the fit names gross outliers of its training rows by.
+fn suspects(model: &CalibratedModel, data: &MeasurementSet, evaluation: &Evaluation) -> Option<crate::SuspectRows> {
+    let firm = |row: &measurements::Measurement| {
+        model.covers(row) && model.training_range.as_ref().is_none_or(|range| range.contains(row))
+    };
+    let kept: Vec<usize> = (0..data.rows.len()).filter(|&i| firm(&data.rows[i])).collect();
+    let rows: Vec<_> = kept.iter().map(|&i| data.rows[i].clone()).collect();
+    let errors: Vec<PoseError> = kept.iter().map(|&i| evaluation.errors[i]).collect();
+    let mut found = crate::suspect_rows(&rows, &errors, poe::identify::RobustOptions::default().outlier_threshold)?;
+    // The statistics without them are of every row, not only of those judged.
+    let named: Vec<usize> = crate::suspect_rows::named_rows(&errors, &found).into_iter().map(|k| kept[k]).collect();
+    let others: Vec<PoseError> =
+        evaluation.errors.iter().enumerate().filter(|(i, _)| !named.contains(i)).map(|(_, e)| *e).collect();
+    found.without = ErrorSummary::from_errors(&others);
+    Some(found)
 }

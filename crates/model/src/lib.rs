@@ -45,6 +45,7 @@ mod model_file;
 mod model_parts;
 mod predictions;
 mod residual_gp;
+mod suspect_rows;
 mod training_range;
 pub use evaluate::{Evaluation, evaluate, tool_indices};
 pub use predictions::write_predictions;
@@ -61,4 +62,5 @@ pub use residual_gp::{
     GpChoice, GpFitReport, GpModel, ResidualFrame, ResidualGp, ResidualGpOptions, ResidualGpReport, ResidualSet,
     UnknownGpChoice,
 };
+pub use suspect_rows::{SuspectRows, suspect_rows};
 pub use training_range::{OutOfRangeWarning, TrainingRange};

@@ -123,6 +123,16 @@ impl std::fmt::Display for OutOfRangeWarning {
 }
 
 impl TrainingRange {
+    /// Whether every input of `row` (joints, payload, and temperature and time where the range
+    /// records them) lies within the range.
+    pub fn contains(&self, row: &Measurement) -> bool {
+        let within = |v: f64, [low, high]: [f64; 2]| (low..=high).contains(&v);
+        self.q.iter().zip(&row.q).all(|(&range, &q)| within(q, range))
+            && within(row.payload_kg, self.payload_kg)
+            && self.temp_c.zip(row.temp_c).is_none_or(|(range, v)| within(v, range))
+            && self.t_s.zip(row.t_s).is_none_or(|(range, v)| within(v, range))
+    }
+
     /// One warning per input that some of `rows` put outside its fitted range (`prismatic[j]`:
     /// whether joint `j` is prismatic, for its unit).
     pub fn outside(&self, rows: &[Measurement], prismatic: &[bool]) -> Vec<OutOfRangeWarning> {

@@ -5,8 +5,14 @@
 //! UR or an IRB: joint 3 at the stretched elbow, joint 5 where axes 4 and 6 align; the shoulder's
 //! singular surface depends on several joints and is not a joint's sign). A row's branch of such a
 //! joint is the parity of the singular angles below its angle; a cluster is one pattern of
-//! branches. Arms that are not six-jointed (the determinant is of a non-square matrix) and
-//! prismatic joints have no such sign: their data is one cluster.
+//! branches. The determinant is of the six revolute joints' columns, so an arm on a lifting
+//! column or a linear track (six revolute joints and prismatic ones) has branches too; an arm with
+//! another number of revolute joints (a 7-axis arm: the matrix is not square) has none.
+//!
+//! A prismatic joint whose values in the data span at least `min_height_span_m` (a lifting
+//! column, a track) splits the rows at its median: the lower and the upper half are clusters of
+//! their own, so that the prior's strength is also chosen by how a fit on one half carries to the
+//! other (issue 30: "a column height").
 
 use errors::Error;
 use measurements::Measurement;
@@ -17,6 +23,8 @@ use std::f64::consts::PI;
 /// How the branches are found. Tuning constants of [`crate::NominalPriorOptions`].
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct ScanOptions {
+    /// A prismatic joint splits the rows at its median when its values span at least this, m.
+    pub min_height_span_m: f64,
     /// Angles of a joint at which the determinant is evaluated over a turn.
     pub steps: usize,
     /// Rows (spread over the data) at which a joint's singular angles must agree.
@@ -32,6 +40,35 @@ pub struct BranchJoint {
     pub joint: usize,
     /// Its singular angles in `[-180°, 180°)`, degrees, ascending.
     pub singular_deg: Vec<f64>,
+}
+
+/// A prismatic joint whose median splits the rows into a lower and an upper cluster.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HeightSplit {
+    /// The joint, 1-based.
+    pub joint: usize,
+    /// The median of its values, m: rows below it are the lower half.
+    pub split_m: f64,
+}
+
+/// The prismatic joints of `model` whose values in `rows` span at least `options.min_height_span_m`.
+pub(crate) fn height_splits(model: &LocalPoe, rows: &[Measurement], options: ScanOptions) -> Vec<HeightSplit> {
+    if rows.is_empty() {
+        return Vec::new();
+    }
+    (0..model.joint_count())
+        .filter(|&j| model.joints()[j].kind == JointKind::Prismatic)
+        .filter_map(|j| {
+            let mut values: Vec<f64> = rows.iter().map(|r| r.q[j]).collect();
+            values.sort_by(f64::total_cmp);
+            let span = values[values.len() - 1] - values[0];
+            (span >= options.min_height_span_m).then(|| {
+                // The split lies strictly above the lowest value, so that neither half is empty.
+                let median = values[values.len() / 2];
+                HeightSplit { joint: j + 1, split_m: if median > values[0] { median } else { values[0] + 0.5 * span } }
+            })
+        })
+        .collect()
 }
 
 /// The rows of one configuration cluster.
@@ -51,10 +88,21 @@ fn wrap(angle: f64) -> f64 {
     (angle + PI).rem_euclid(2.0 * PI) - PI
 }
 
-/// The determinant of the 6 × 6 spatial Jacobian at `q`.
+/// The indices of the revolute joints, when there are six of them.
+fn six_revolute(model: &LocalPoe) -> Option<Vec<usize>> {
+    let revolute: Vec<usize> =
+        (0..model.joint_count()).filter(|&j| model.joints()[j].kind == JointKind::Revolute).collect();
+    (revolute.len() == 6).then_some(revolute)
+}
+
+/// The determinant of the 6 × 6 spatial Jacobian of the six revolute joints at `q`.
 fn determinant(model: &LocalPoe, q: &[f64]) -> Result<f64, Error> {
     let twists = model.spatial_twists(q)?;
-    let columns: Vec<nalgebra::Vector6<f64>> = twists.iter().map(|t| t.to_vector()).collect();
+    let columns: Vec<nalgebra::Vector6<f64>> =
+        six_revolute(model).unwrap_or_default().into_iter().map(|j| twists[j].to_vector()).collect();
+    if columns.len() != 6 {
+        return Ok(0.0);
+    }
     Ok(nalgebra::Matrix6::from_columns(&columns).determinant())
 }
 
@@ -87,7 +135,7 @@ pub(crate) fn branch_joints(
     options: ScanOptions,
 ) -> Result<Vec<BranchJoint>, Error> {
     let n = model.joint_count();
-    if n != 6 || rows.is_empty() {
+    if six_revolute(model).is_none() || rows.is_empty() {
         return Ok(Vec::new());
     }
     // One probe from each of `probes` consecutive stretches of the rows: the one farthest from
@@ -146,21 +194,33 @@ fn side(joint: &BranchJoint, even: bool) -> String {
     }
 }
 
-/// The rows grouped by their pattern of branches, largest cluster first (ties by label).
-pub(crate) fn clusters(joints: &[BranchJoint], rows: &[Measurement]) -> Vec<Cluster> {
+/// The rows grouped by their pattern of branches and column halves, largest cluster first (ties
+/// by label).
+pub(crate) fn clusters(joints: &[BranchJoint], heights: &[HeightSplit], rows: &[Measurement]) -> Vec<Cluster> {
     let mut groups: std::collections::BTreeMap<Vec<bool>, Vec<usize>> = std::collections::BTreeMap::new();
     for (i, row) in rows.iter().enumerate() {
-        let key: Vec<bool> = joints.iter().map(|j| branch(j, row.q[j.joint - 1])).collect();
+        let key: Vec<bool> = joints
+            .iter()
+            .map(|j| branch(j, row.q[j.joint - 1]))
+            .chain(heights.iter().map(|h| row.q[h.joint - 1] >= h.split_m))
+            .collect();
         groups.entry(key).or_default().push(i);
     }
     let mut clusters: Vec<Cluster> = groups
         .into_iter()
         .map(|(key, rows)| {
-            let label = if joints.is_empty() {
+            let label = if joints.is_empty() && heights.is_empty() {
                 "all rows".to_owned()
             } else {
-                let parts: Vec<String> =
-                    joints.iter().zip(&key).map(|(j, &even)| format!("joint {} {}", j.joint, side(j, even))).collect();
+                let parts: Vec<String> = joints
+                    .iter()
+                    .zip(&key)
+                    .map(|(j, &even)| format!("joint {} {}", j.joint, side(j, even)))
+                    .chain(heights.iter().zip(&key[joints.len()..]).map(|(h, &upper)| {
+                        let relation = if upper { "at or above" } else { "below" };
+                        format!("joint {} {relation} {:.1} mm", h.joint, h.split_m * 1e3)
+                    }))
+                    .collect();
                 parts.join(", ")
             };
             Cluster { label, n: rows.len(), rows }
@@ -204,7 +264,7 @@ mod tests {
                 row([0.3 * t - 1.0, -0.2 * t - 0.5, 0.25 * t - 1.1, 0.4 * t - 2.0, 0.3 * t - 1.3, 0.1 * t])
             }))
             .collect();
-        let options = ScanOptions { steps: 720, probes: 8, tolerance_rad: 1e-2 };
+        let options = ScanOptions { steps: 720, probes: 8, tolerance_rad: 1e-2, min_height_span_m: 0.1 };
         let joints = branch_joints(&ur10(), &rows, options).unwrap();
         let named: Vec<usize> = joints.iter().map(|j| j.joint).collect();
         assert_eq!(named, [3, 5], "{joints:?}");
@@ -213,7 +273,8 @@ mod tests {
             assert!(joint.singular_deg.iter().any(|s| s.abs() < 0.5), "{joint:?}");
             assert!(joint.singular_deg.iter().any(|s| (s.abs() - 180.0).abs() < 0.5), "{joint:?}");
         }
-        let found = clusters(&joints, &[row([0.0, -1.0, 1.0, 0.0, 1.0, 0.0]), row([0.0, -1.0, -1.0, 0.0, 1.0, 0.0])]);
+        let found =
+            clusters(&joints, &[], &[row([0.0, -1.0, 1.0, 0.0, 1.0, 0.0]), row([0.0, -1.0, -1.0, 0.0, 1.0, 0.0])]);
         assert_eq!(found.len(), 2, "{found:?}");
         assert_ne!(found[0].label, found[1].label);
     }

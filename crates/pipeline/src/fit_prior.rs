@@ -4,7 +4,7 @@
 //! lies on one branch of the arm, a fit on it cannot say how it does on another, and nothing is
 //! changed: the fit is the plain least-squares one, and the report says why.
 
-use crate::clusters::{self, BranchJoint, Cluster, ScanOptions};
+use crate::clusters::{self, BranchJoint, Cluster, HeightSplit, ScanOptions};
 use errors::Error;
 use measurements::MeasurementSet;
 use model::geometric::observations;
@@ -45,6 +45,11 @@ pub struct NominalPriorOptions {
     /// How closely they must agree, rad: 0.01 (0.6°; the interpolation error on a 0.5° grid is
     /// below 0.01°).
     pub scan_tolerance_rad: f64,
+    /// A prismatic joint (a lifting column, a linear track) splits the rows at its median into two
+    /// clusters when its values span at least this, m: 0.1 (a column's stroke is metres and moves
+    /// the arm's gravity and lever arms by as much; a track held at one position varies by
+    /// micrometres).
+    pub min_height_span_m: f64,
     /// Above this many rows the strength is not chosen and the fit has no prior (the report says
     /// so): 20,000. The choice costs an extra fit per candidate and held-out cluster (about 30 on
     /// a 6-axis arm with four clusters): on issue 31's 242,000-row, 65.7 MB campaign it took the
@@ -64,6 +69,7 @@ impl Default for NominalPriorOptions {
             scan_steps: 720,
             scan_probes: 8,
             scan_tolerance_rad: 0.01,
+            min_height_span_m: 0.1,
             max_rows: 20_000,
         }
     }
@@ -81,7 +87,13 @@ impl NominalPriorOptions {
                 ),
             ));
         }
-        let checks: [(&'static str, f64, bool, &str); 3] = [
+        let checks: [(&'static str, f64, bool, &str); 4] = [
+            (
+                "min_height_span_m",
+                self.min_height_span_m,
+                self.min_height_span_m.is_finite() && self.min_height_span_m > 0.0,
+                "a finite number above 0",
+            ),
             ("length_m", self.length_m, self.length_m.is_finite() && self.length_m > 0.0, "a finite number above 0"),
             (
                 "min_cluster_share",
@@ -138,6 +150,9 @@ pub struct PriorCandidate {
 pub struct PriorChoice {
     /// The joints whose singular angles separate branches of the arm.
     pub branch_joints: Vec<BranchJoint>,
+    /// The prismatic joints whose median splits the rows into a lower and an upper cluster.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub height_splits: Vec<HeightSplit>,
     /// The data's configuration clusters, largest first.
     pub clusters: Vec<Cluster>,
     /// The clusters held out in turn (labels).
@@ -162,6 +177,7 @@ impl PriorChoice {
     fn without(branch_joints: Vec<BranchJoint>, clusters: Vec<Cluster>, reason: String) -> Self {
         Self {
             branch_joints,
+            height_splits: Vec::new(),
             clusters,
             held_out: Vec::new(),
             candidates: Vec::new(),
@@ -228,17 +244,33 @@ pub fn choose(
         );
         return Ok(PriorChoice::without(Vec::new(), Vec::new(), reason));
     }
-    let scan =
-        ScanOptions { steps: prior.scan_steps, probes: prior.scan_probes, tolerance_rad: prior.scan_tolerance_rad };
+    let scan = ScanOptions {
+        steps: prior.scan_steps,
+        probes: prior.scan_probes,
+        tolerance_rad: prior.scan_tolerance_rad,
+        min_height_span_m: prior.min_height_span_m,
+    };
     let branch_joints = clusters::branch_joints(nominal, &data.rows, scan)?;
-    let found = clusters::clusters(&branch_joints, &data.rows);
-    if branch_joints.is_empty() {
-        let reason = if nominal.joint_count() == 6 {
+    let height_splits = clusters::height_splits(nominal, &data.rows, scan);
+    let found = clusters::clusters(&branch_joints, &height_splits, &data.rows);
+    let without = |reason: String| {
+        let mut choice = PriorChoice::without(branch_joints.clone(), found.clone(), reason);
+        choice.height_splits = height_splits.clone();
+        choice
+    };
+    if branch_joints.is_empty() && height_splits.is_empty() {
+        let revolute = nominal.joints().iter().filter(|j| j.kind == poe::JointKind::Revolute).count();
+        let reason = if revolute == 6 {
             "no joint's singular angles separate branches of the arm: one configuration cluster".to_owned()
-        } else {
+        } else if revolute == nominal.joint_count() {
             format!("{} joints, not 6: the branches are not found, one configuration cluster", nominal.joint_count())
+        } else {
+            format!(
+                "{revolute} revolute joints, not 6, and no prismatic joint spans nominal_prior.min_height_span_m: \
+                 one configuration cluster"
+            )
         };
-        return Ok(PriorChoice::without(branch_joints, found, reason));
+        return Ok(without(reason));
     }
     let least = (prior.min_cluster_share * data.rows.len() as f64).ceil() as usize;
     let folds: Vec<&Cluster> = found.iter().filter(|c| c.n >= least).collect();
@@ -248,7 +280,7 @@ pub fn choose(
             100.0 * prior.min_cluster_share,
             found.first().map_or("no rows".into(), |c| c.label.clone())
         );
-        return Ok(PriorChoice::without(branch_joints, found, reason));
+        return Ok(without(reason));
     }
     // Each fold trains on every other row; a fold whose rows carry a tool no other row carries
     // cannot be predicted and is not held out.
@@ -283,7 +315,7 @@ pub fn choose(
             "no configuration cluster could be held out (a tool only it carries, or too few rows without it): \
                       the fit as without a prior"
                 .to_owned();
-        return Ok(PriorChoice::without(branch_joints, found, reason));
+        return Ok(without(reason));
     }
     // Every held-out row of every usable fold, per candidate, in the same order.
     let rows: Vec<Vec<(f64, f64)>> = (0..sigmas.len())
@@ -320,6 +352,7 @@ pub fn choose(
     );
     Ok(PriorChoice {
         branch_joints,
+        height_splits,
         clusters: found,
         held_out,
         translation_m: candidates[chosen].translation_m,

@@ -13,7 +13,7 @@ mod fit_options;
 mod fit_prior;
 mod plausibility;
 
-pub use clusters::{BranchJoint, Cluster};
+pub use clusters::{BranchJoint, Cluster, HeightSplit};
 pub use fit::{FitReport, FitWarning, fit};
 pub use fit_options::{EffectOptions, FitOptions};
 pub use fit_prior::{NominalPriorOptions, PriorCandidate, PriorChoice, choose as choose_prior};

@@ -125,3 +125,65 @@ fn above_max_rows_the_strength_is_not_chosen_and_the_report_says_so() {
         "{choice}"
     );
 }
+
+/// `eval` gives the error inside and outside the fitted range apart for a plain geometric model,
+/// and names a row far beyond the others among those inside, not the rows outside it, whose
+/// large errors are the model's.
+#[test]
+fn eval_splits_the_error_at_the_fitted_range_and_names_a_glitch_inside_it() {
+    let robot = ur10();
+    let mut train = wrist(5, 260, false);
+    let mut test = train.clone();
+    test.rows = train.rows.split_off(200);
+    let (model, _) = pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default()).unwrap();
+    // The later rows are later and warmer than every training row: not what this test is about.
+    for row in &mut test.rows {
+        (row.t_s, row.temp_c) = (None, None);
+    }
+    let range = model.training_range.clone().unwrap();
+    test.rows.retain(|row| range.contains(row));
+    let inside = test.rows.len();
+    assert!(inside >= 40, "{inside} of 60 rows inside the fitted range");
+    // One row measured 10 mm off (a tracker glitch), then the flipped wrist.
+    let glitch = test.rows[10].line;
+    test.rows[10].position.x += 1e-2;
+    let flipped = wrist(5, 20, true);
+    test.rows.extend(flipped.rows.iter().map(|r| pipeline::Measurement { line: r.line + 1000, ..r.clone() }));
+    let evaluation = pipeline::evaluate(&model, &test).unwrap();
+    let report = EvalReport::new(&model, &test, &evaluation);
+    let split = report.range_split.expect("rows outside the fitted range: a split");
+    assert_eq!((split.inside.n, split.outside.n), (inside, 20));
+    let suspects = report.suspect_rows.expect("the glitch is named");
+    assert_eq!(suspects.rows.iter().map(|r| r.line).collect::<Vec<_>>(), vec![glitch], "{suspects:?}");
+    assert_eq!(suspects.without.n, inside + 20 - 1);
+    assert!(suspects.without.max_position_error_mm < 3.0, "{suspects:?}");
+    assert!(evaluation.summary.max_position_error_mm > 9.0);
+}
+
+/// An arm on a lifting column (seven joints: the column, folded from its URDF mimic stages, and
+/// six revolute ones) has configuration clusters too: the arm's branches from its six revolute
+/// joints, and the column's lower and upper half, so the prior's strength is chosen by holding
+/// them out (issue 30: "a column height").
+#[test]
+fn a_column_arms_clusters_are_its_branches_and_the_halves_of_its_column() {
+    let robot = testkit::robot("column_arm.urdf");
+    let geometry = Perturbation { translation_m: 1e-4, rotation_rad: 1e-4, ..Perturbation::default() };
+    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+    let ranges = pipeline::simulated::joint_ranges(&robot);
+    let config = GeneratorConfig { sample_count: 300, seed: 4, ..Default::default() };
+    let data = simulate(&simulated_cell(&robot, &geometry, 4).unwrap(), &effects, &ranges, &config, false).unwrap();
+    let (_, report) = pipeline::fit(&robot, &data, Method::Poe, &FitOptions::default()).unwrap();
+    let choice = report.nominal_prior.expect("a prior choice is reported");
+    eprintln!("{choice}\n{:?}", choice.clusters.iter().map(|c| (&c.label, c.n)).collect::<Vec<_>>());
+    assert_eq!(choice.height_splits.iter().map(|h| h.joint).collect::<Vec<_>>(), vec![1], "{choice:?}");
+    assert!(!choice.branch_joints.is_empty(), "{choice:?}");
+    assert!(choice.clusters.iter().any(|c| c.label.contains("joint 1 below")), "{:?}", choice.clusters);
+    assert!(choice.clusters.iter().any(|c| c.label.contains("joint 1 at or above")), "{:?}", choice.clusters);
+    assert!(choice.held_out.len() >= 2, "{choice}");
+    // A column that hardly moves (a few centimetres) is no cluster of its own.
+    let mut held = ranges.clone();
+    held[0] = JointRange { lower_rad: 0.3, upper_rad: 0.5 };
+    let fixed = simulate(&simulated_cell(&robot, &geometry, 4).unwrap(), &effects, &held, &config, false).unwrap();
+    let (_, report) = pipeline::fit(&robot, &fixed, Method::Poe, &FitOptions::default()).unwrap();
+    assert!(report.nominal_prior.unwrap().height_splits.is_empty());
+}
