@@ -1,6 +1,6 @@
 //! `calib compensate`: joint targets rewritten so that the calibrated robot reaches what they mean.
 
-use pipeline::{ChainEnds, CompensateOptions, RobotDescription, TargetFrame};
+use pipeline::{CompensateOptions, TargetFrame};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -21,16 +21,10 @@ pub struct Args {
     /// qw, qx, qy, qz or rx_deg, ry_deg, rz_deg.
     #[arg(long)]
     targets: PathBuf,
-    /// The robot description the model was fitted with (RON or URDF): the nominal model of joint
-    /// targets, the base frame of --frame base, and the joint limits.
-    #[arg(long)]
-    robot: Option<PathBuf>,
-    /// URDF only: the chain's base link.
-    #[arg(long)]
-    base_link: Option<String>,
-    /// URDF only: the chain's tip link.
-    #[arg(long)]
-    tip_link: Option<String>,
+    /// The robot description the model was fitted with: the nominal model of joint targets, the
+    /// base frame of --frame base, and the joint limits.
+    #[command(flatten)]
+    robot: crate::robot_args::KeptRobotArgs,
     /// Frame of pose targets: tracker or base.
     #[arg(long, default_value = "tracker")]
     frame: TargetFrame,
@@ -41,12 +35,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let model = pipeline::read_model(&args.model)?;
-    let ends = ChainEnds { base_link: args.base_link.clone(), tip_link: args.tip_link.clone() };
-    let robot = match &args.robot {
-        Some(path) => Some((RobotDescription::read_with(path, &ends)?, path.display().to_string())),
-        None if ends != ChainEnds::default() => return Err("--base-link and --tip-link need --robot".into()),
-        None => None,
-    };
+    let robot = args.robot.read_or_kept(&model, &args.model)?;
     let file = pipeline::read_targets(&args.targets, &model, args.columns.clone().unwrap_or_default())?;
     let robot_ref = robot.as_ref().map(|(r, f)| (r, f.as_str()));
     let (solved, summary) = pipeline::compensate(&model, &file, robot_ref, args.frame, &CompensateOptions::default())?;
@@ -82,7 +71,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         line.push_str("; position-only model: the tool point is compensated, not the orientation");
     }
     if robot.is_none() {
-        line.push_str("; no --robot: joint limits not checked");
+        line.push_str("; no --robot and the model keeps none: joint limits not checked");
     }
     eprintln!("{line}");
     Ok(())

@@ -22,8 +22,9 @@ pub struct Args {
     #[arg(long, conflicts_with = "robot")]
     like: Option<PathBuf>,
     /// The nominal robot description the model was fitted with (RON or URDF): places the base
-    /// frame and gives the limits [default: the --like URDF; without either, the base is the
-    /// calibrated joint 1 frame and revolute joints are written as continuous].
+    /// frame and gives the limits [default: the --like URDF, else the description the model keeps;
+    /// without any, the base is the calibrated joint 1 frame and revolute joints are written as
+    /// continuous].
     #[arg(long)]
     robot: Option<PathBuf>,
     /// URDF only: the chain's base link in --like or --robot.
@@ -79,7 +80,10 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
                     "--base-link and --tip-link choose the chain of --like or --robot, and neither is given".into()
                 );
             }
-            pipeline::export_urdf(&model, UrdfTemplate::Plain { nominal: None }, training.as_ref(), &tolerance)?
+            let kept = model.robot_description.clone();
+            let file = format!("{} (as the model keeps it)", args.model.display());
+            let nominal = kept.as_ref().map(|description| (description, file.as_str()));
+            pipeline::export_urdf(&model, UrdfTemplate::Plain { nominal }, training.as_ref(), &tolerance)?
         }
     };
     pipeline::write_urdf(&args.urdf, &export)?;

@@ -11,16 +11,8 @@ pub struct Args {
     /// Calibrated model (RON, from `calib fit`).
     #[arg(long)]
     model: PathBuf,
-    /// Robot description (RON or URDF) [default: the one the model carries; models written
-    /// before it was kept need this].
-    #[arg(long)]
-    robot: Option<PathBuf>,
-    /// URDF only: the link whose frame is the robot base [default: the root link].
-    #[arg(long)]
-    base_link: Option<String>,
-    /// URDF only: the link whose frame is the flange [default: the leaf with the most movable joints].
-    #[arg(long)]
-    tip_link: Option<String>,
+    #[command(flatten)]
+    robot: crate::robot_args::KeptRobotArgs,
     /// Test measurements (SPEC CSV; `;` and decimal commas are detected).
     #[arg(long)]
     data: PathBuf,
@@ -37,7 +29,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let mut inputs = pipeline::InputFiles::new().with("--model", &args.model).with("--data", &args.data);
-    if let Some(robot) = &args.robot {
+    if let Some(robot) = &args.robot.robot {
         inputs = inputs.with("--robot", robot);
     }
     if let Some(train) = &args.train {
@@ -46,19 +38,12 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     inputs.check_output("--out", &args.out)?;
     let started = std::time::Instant::now();
     let model = pipeline::read_model(&args.model)?;
-    let (robot, robot_file) = match (&args.robot, &model.robot_description) {
-        (Some(path), _) => {
-            let ends = pipeline::ChainEnds { base_link: args.base_link.clone(), tip_link: args.tip_link.clone() };
-            (pipeline::RobotDescription::read_with(path, &ends)?, path.display().to_string())
-        }
-        (None, Some(robot)) => (robot.clone(), format!("{} (as the model keeps it)", args.model.display())),
-        (None, None) => {
-            return Err(format!(
-                "{}: the model does not keep its robot description (written before it was kept): give --robot",
-                args.model.display()
-            )
-            .into());
-        }
+    let Some((robot, robot_file)) = args.robot.read_or_kept(&model, &args.model)? else {
+        return Err(format!(
+            "{}: the model does not keep its robot description (written before it was kept): give --robot",
+            args.model.display()
+        )
+        .into());
     };
     let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
     let data = pipeline::read_measurements(&args.data, &options)?;

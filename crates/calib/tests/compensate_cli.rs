@@ -88,6 +88,9 @@ fn a_program_comes_out_compensated_with_its_columns_and_residuals() {
     }
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("compensated 2 of 2 targets"), "{stderr}");
+    // Without --robot, the description the model keeps: the same targets.
+    let kept = succeeds(&["compensate", "--model", &text(&model), "--targets", &text(&program)]);
+    assert_eq!(kept.stdout, out.stdout);
     let help = String::from_utf8_lossy(&succeeds(&["compensate", "--help"]).stdout).into_owned();
     assert!(help.contains("--frame"), "{help}");
 }
@@ -96,7 +99,12 @@ fn a_program_comes_out_compensated_with_its_columns_and_residuals() {
 fn compensate_refusals_are_one_line() {
     let dir = tempfile::tempdir().unwrap();
     let (model, program) = setup(dir.path());
-    let message = fails(&["compensate", "--model", &text(&model), "--targets", &text(&program)]);
+    // A model written before it kept its robot description: joint targets need --robot.
+    let old = dir.path().join("old.ron");
+    let kept = std::fs::read_to_string(&model).unwrap();
+    let cut = kept.find("    robot_description:").expect("the model keeps its robot");
+    std::fs::write(&old, format!("{})\n", &kept[..cut])).unwrap();
+    let message = fails(&["compensate", "--model", &text(&old), "--targets", &text(&program)]);
     assert!(message.contains("program.csv:1:1: joint targets are a program taught on the nominal model"), "{message}");
     let message = fails(&["compensate", "--model", &text(&model), "--targets", &text(&program), "--frame", "world"]);
     assert!(message.contains("unknown frame 'world'"), "{message}");

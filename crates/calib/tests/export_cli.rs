@@ -58,6 +58,10 @@ fn an_exported_urdf_fits_like_the_model_it_came_from() {
     assert_eq!(report["base_link"], "base_link");
     assert_eq!(report["tool_links"][0], "tool");
     assert_eq!(report["axis_changes"].as_array().map(Vec::len), Some(6));
+    // Without --robot, the description the model keeps: the same URDF.
+    let kept = dir.path().join("kept.urdf");
+    succeeds(&["export", "--model", &text(&model), "--urdf", &text(&kept), "--json"]);
+    assert_eq!(std::fs::read_to_string(&kept).unwrap(), std::fs::read_to_string(&urdf).unwrap());
     // The calibrated URDF is a robot description: a base-tool fit on it needs nothing more.
     let refit = dir.path().join("refit.ron");
     let summary = succeeds(&[
