@@ -35,7 +35,7 @@ pub use column_map::{ColumnMap, ColumnMapFault};
 pub use dialect::{Decimal, DecimalFault, Delimiter, Dialect};
 pub use writer::{CsvColumns, MeasurementWriter};
 
-use errors::Error;
+use errors::{Error, ErrorKind};
 use layout::{Expectation, Layout, OrientationColumns};
 use lie::{SO3, Vector3};
 use poe::JointKind;
@@ -179,7 +179,7 @@ impl ReadOptions {
 /// Reads a measurement file.
 pub fn read_measurements(path: &Path, options: &ReadOptions) -> Result<MeasurementSet, Error> {
     let file = path.display().to_string();
-    let reader = std::fs::File::open(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+    let reader = std::fs::File::open(path).map_err(|source| Error::io(file.clone(), source))?;
     parse(reader, &file, options, true)
 }
 
@@ -193,7 +193,7 @@ pub fn parse_measurements<R: Read>(reader: R, file: &str, options: &ReadOptions)
 /// position is zero). Every other rule of the format holds.
 pub fn read_configurations(path: &Path, options: &ReadOptions) -> Result<MeasurementSet, Error> {
     let file = path.display().to_string();
-    let reader = std::fs::File::open(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+    let reader = std::fs::File::open(path).map_err(|source| Error::io(file.clone(), source))?;
     parse(reader, &file, options, false)
 }
 
@@ -210,7 +210,7 @@ pub struct Cells {
 /// [`read_configurations`], with every cell as written.
 pub fn read_configurations_with_cells(path: &Path, options: &ReadOptions) -> Result<(MeasurementSet, Cells), Error> {
     let file = path.display().to_string();
-    let reader = std::fs::File::open(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+    let reader = std::fs::File::open(path).map_err(|source| Error::io(file.clone(), source))?;
     let mut cells = Cells::default();
     let set = parse_keeping(reader, &file, options, false, Some(&mut cells))?;
     Ok((set, cells))
@@ -233,7 +233,7 @@ fn parse_keeping<R: Read>(
     mut cells: Option<&mut Cells>,
 ) -> Result<MeasurementSet, Error> {
     let mut bytes = Vec::new();
-    reader.read_to_end(&mut bytes).map_err(|source| Error::Io { path: file.to_owned(), source })?;
+    reader.read_to_end(&mut bytes).map_err(|source| Error::io(file.to_owned(), source))?;
     let body = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
     let mut dialect = Dialect::from_header_line(body);
     let mut csv = csv::ReaderBuilder::new()
@@ -244,7 +244,7 @@ fn parse_keeping<R: Read>(
     let delimiter = dialect.delimiter;
     let header = csv.headers().map_err(|e| syntax_error(&e, file, delimiter))?.clone();
     if header.is_empty() || (header.len() == 1 && header[0].is_empty()) {
-        return Err(Error::EmptyFile { file: file.to_owned() });
+        return Err(Error::at_line(file.to_owned(), 1, 1, ErrorKind::EmptyFile));
     }
     let expect = Expectation {
         file,
@@ -292,7 +292,12 @@ fn parse_keeping<R: Read>(
             Some(c) => {
                 let value = row.number(c)?;
                 if value < 0.0 {
-                    return Err(Error::NegativePayload { file: file.to_owned(), line, column: c.index + 1, value });
+                    return Err(Error::at_line(
+                        file.to_owned(),
+                        line,
+                        c.index + 1,
+                        ErrorKind::NegativePayload { value },
+                    ));
                 }
                 value
             }
@@ -312,7 +317,7 @@ fn parse_keeping<R: Read>(
         }
     }
     if rows.is_empty() {
-        return Err(Error::EmptyFile { file: file.to_owned() });
+        return Err(Error::at_line(file.to_owned(), 1, 1, ErrorKind::EmptyFile));
     }
     Ok(MeasurementSet {
         source: file.to_owned(),
@@ -389,13 +394,12 @@ impl MeasurementSet {
         if self.joint_count == joints {
             return Ok(());
         }
-        Err(Error::JointCountMismatch {
-            file: self.source.clone(),
-            line: 1,
-            column: 1,
-            found: self.joint_count,
-            expected: joints,
-        })
+        Err(Error::at_line(
+            self.source.clone(),
+            1,
+            1,
+            ErrorKind::JointCountMismatch { found: self.joint_count, expected: joints },
+        ))
     }
 
     /// Refuses a set whose joint columns do not match a robot's joints: their count, and each
@@ -404,13 +408,12 @@ impl MeasurementSet {
         self.check_joint_count(kinds.len())?;
         for (k, (column, kind)) in self.joint_columns.iter().zip(kinds).enumerate() {
             if column.kind != *kind {
-                return Err(Error::JointUnit {
-                    file: self.source.clone(),
-                    line: 1,
-                    column: column.column,
-                    joint: k + 1,
-                    kind: *kind,
-                });
+                return Err(Error::at_line(
+                    self.source.clone(),
+                    1,
+                    column.column,
+                    ErrorKind::JointUnit { joint: k + 1, kind: layout::error_kind(*kind) },
+                ));
             }
         }
         Ok(())

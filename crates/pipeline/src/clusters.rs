@@ -53,7 +53,7 @@ fn wrap(angle: f64) -> f64 {
 
 /// The determinant of the 6 × 6 spatial Jacobian at `q`.
 fn determinant(model: &LocalPoe, q: &[f64]) -> Result<f64, Error> {
-    let twists = model.spatial_twists(q)?;
+    let twists = model.spatial_twists(q).map_err(Error::kinematics)?;
     let columns: Vec<nalgebra::Vector6<f64>> = twists.iter().map(|t| t.to_vector()).collect();
     Ok(nalgebra::Matrix6::from_columns(&columns).determinant())
 }

@@ -5,7 +5,7 @@ use crate::fit_options::FitOptions;
 use effects::{
     EffectContext, EffectCorrection, EffectReport, EffectSelection, EffectSpec, IdentifiedEffect, effect_reports,
 };
-use errors::Error;
+use errors::{Error, ErrorKind};
 use measurements::MeasurementSet;
 use measurements::{OutlierLine, list_lines, without};
 use model::geometric::{fit_geometry_with_prior, observations};
@@ -229,7 +229,8 @@ pub fn fit(
             Some(&correction),
             prior.as_ref(),
             &id_options,
-        )?;
+        )
+        .map_err(Error::kinematics)?;
         EffectCorrection::distribute(&mut effects, &fitted.correction);
         for effect in &mut effects {
             if let IdentifiedEffect::GearPeriodic(gear) = effect {
@@ -260,7 +261,7 @@ pub fn fit(
     let text = model::model_text(&model, "the fitted model")?;
     model
         .check(&text, "the fitted model")
-        .map_err(|source| Error::FittedModelRefused { method: method.to_string(), source: Box::new(source) })?;
+        .map_err(|source| Error::new(ErrorKind::FittedModelRefused { method: method.to_string(), source }))?;
     let registered = CalibratedModel {
         kinematics: geometry.registered,
         effects: Vec::new(),
