@@ -4,10 +4,6 @@
 use crate::{ErrorKind, Place};
 use std::fmt;
 
-/// The error of a lower crate (`poe`, `loadsim`, `gp`) that this crate does not know by name: its
-/// message and its `source()` chain are kept.
-pub(crate) type Lower = Box<dyn std::error::Error + Send + Sync + 'static>;
-
 /// What went wrong ([`kind`](Error::kind)) and where ([`place`](Error::place)): its message is the
 /// place's `file:line:column: ` (or `file: `) followed by the kind's.
 ///

@@ -1,11 +1,10 @@
 //! What went wrong, apart from where: [`ErrorKind`] holds the numbers that explain a refusal, and
 //! [`Error`](crate::Error) adds the [`Place`](crate::Place) that its message starts with.
 
-use crate::error::Lower;
-use crate::{ColumnMapFault, DecimalFault, EffectListFault, Error, FileKind, JointKind};
+use crate::{ColumnMapFault, DecimalFault, EffectListFault, FileKind, JointKind};
 use std::fmt;
 
-/// What can go wrong reading inputs, fitting or evaluating: the kind of an [`Error`], without its
+/// What can go wrong reading inputs, fitting or evaluating: the kind of an [`Error`](crate::Error), without its
 /// place (the file, line and column a message starts with).
 #[non_exhaustive]
 #[derive(Debug)]
@@ -291,18 +290,21 @@ pub enum ErrorKind {
     },
     /// The kinematic model or its identification failed.
     Kinematics {
-        /// The underlying error.
-        source: Lower,
+        /// The underlying error (a `poe::Error`, `loadsim::Error` or `gp::Error`, boxed: this crate
+        /// knows none of them), its message and `source()` chain kept.
+        source: Box<dyn std::error::Error + Send + Sync + 'static>,
     },
     /// The load and effect models refused their input.
     Load {
-        /// The underlying error.
-        source: Lower,
+        /// The underlying error (a `poe::Error`, `loadsim::Error` or `gp::Error`, boxed: this crate
+        /// knows none of them), its message and `source()` chain kept.
+        source: Box<dyn std::error::Error + Send + Sync + 'static>,
     },
     /// The Gaussian process failed.
     Gp {
-        /// The underlying error.
-        source: Lower,
+        /// The underlying error (a `poe::Error`, `loadsim::Error` or `gp::Error`, boxed: this crate
+        /// knows none of them), its message and `source()` chain kept.
+        source: Box<dyn std::error::Error + Send + Sync + 'static>,
     },
     /// A simulated pose that is not finite: an effect or a robot beyond any real range.
     NonFiniteSimulation {
@@ -369,8 +371,9 @@ pub enum ErrorKind {
     FittedModelRefused {
         /// The method fitted.
         method: String,
-        /// The check's refusal.
-        source: Error,
+        /// The check's refusal (an [`Error`](crate::Error), boxed so that the kinds stay apart
+        /// from the error that carries them).
+        source: Box<dyn std::error::Error + Send + Sync + 'static>,
     },
     /// A model's parts in an order they cannot apply in (an effect before the geometry).
     PartOrder {
@@ -793,11 +796,11 @@ impl ErrorKind {
     pub(crate) fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             ErrorKind::Io { source } => Some(source),
-            ErrorKind::Kinematics { source } | ErrorKind::Load { source } | ErrorKind::Gp { source } => {
-                Some(source.as_ref())
-            }
+            ErrorKind::Kinematics { source }
+            | ErrorKind::Load { source }
+            | ErrorKind::Gp { source }
+            | ErrorKind::FittedModelRefused { source, .. } => Some(source.as_ref()),
             ErrorKind::Json { source, .. } => Some(source),
-            ErrorKind::FittedModelRefused { source, .. } => Some(source),
             _ => None,
         }
     }

@@ -259,9 +259,9 @@ pub fn fit(
     // The check `read_model` runs, on the text `write_model` writes: a fit never hands over a
     // model that its own file would be refused for, and the cause shows here (issue 23).
     let text = model::model_text(&model, "the fitted model")?;
-    model
-        .check(&text, "the fitted model")
-        .map_err(|source| Error::new(ErrorKind::FittedModelRefused { method: method.to_string(), source }))?;
+    model.check(&text, "the fitted model").map_err(|source| {
+        Error::new(ErrorKind::FittedModelRefused { method: method.to_string(), source: Box::new(source) })
+    })?;
     let registered = CalibratedModel {
         kinematics: geometry.registered,
         effects: Vec::new(),
