@@ -113,8 +113,8 @@ fn heldout_of(calib: &Path, model: &Path, test: &Path) -> anyhow::Result<f64> {
         .arg(test)
         .stderr(Stdio::null())
         .output()?;
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).context("calib eval --json")?;
-    json["mean_position_error_mm"].as_f64().context("calib eval --json: no mean_position_error_mm")
+    let report: pipeline::EvalReport = serde_json::from_slice(&out.stdout).context("calib eval --json")?;
+    Ok(report.errors.mean_position_error_mm)
 }
 
 /// The first `n` data rows of `csv` (header kept) written to `out`.

@@ -40,7 +40,7 @@ use layout::{Expectation, Layout, OrientationColumns};
 use lie::{SO3, Vector3};
 use poe::JointKind;
 use row::{JOINT_ANGLE_RANGE, JOINT_TRAVEL_RANGE, POSITION_RANGE, Row, syntax_error};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::fmt;
 use std::io::Read;
@@ -102,7 +102,8 @@ pub struct JointColumn {
 }
 
 /// How a file was written, as the reader found it (reported by the CLI in one line).
-#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(default)]
 pub struct FileFormat {
     /// Field separator and decimal mark.
     pub dialect: Dialect,

@@ -174,7 +174,7 @@ impl CalibratedModel {
 
 /// Rows at which an effect of the model is used outside the joint angles it was fitted on: there
 /// the model extrapolates, and its error on them is not what the fit measured.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ExtrapolationWarning {
     /// The effect, as reports name it (`gear_periodic:1:48`).
     pub effect: String,

@@ -46,6 +46,7 @@ mod model_parts;
 mod predictions;
 mod residual_gp;
 mod training_range;
+mod unit_name;
 pub use evaluate::{Evaluation, evaluate, tool_indices};
 pub use predictions::write_predictions;
 
