@@ -23,14 +23,14 @@ const HEADER2: &str = "q1_rad,q2_rad,x_mm,y_mm,z_mm";
 #[test]
 fn an_empty_file_is_refused() {
     let (error, message) = refuse("", None);
-    assert!(matches!(error.kind(), ErrorKind::EmptyFile { .. }), "{message}");
+    assert!(matches!(error.kind(), ErrorKind::EmptyFile), "{message}");
     assert_eq!(message, "cell.csv:1:1: the file has no header or no data row");
 }
 
 #[test]
 fn a_header_without_rows_is_refused() {
     let (error, message) = refuse(&format!("{HEADER2}\n"), Some(2));
-    assert!(matches!(error.kind(), ErrorKind::EmptyFile { .. }), "{message}");
+    assert!(matches!(error.kind(), ErrorKind::EmptyFile), "{message}");
 }
 
 #[test]
@@ -269,7 +269,7 @@ fn invalid_utf8_is_refused_at_its_line_and_field() {
     bytes.extend([0xff, 0xfe, b'\n']);
     let error = parse_measurements(bytes.as_slice(), "cell.csv", &revolute(Some(2))).unwrap_err();
     assert!(
-        matches!(error.kind(), ErrorKind::InvalidUtf8 { .. }) && matches!(error.position(), Some((3, 6))),
+        matches!(error.kind(), ErrorKind::InvalidUtf8) && matches!(error.position(), Some((3, 6))),
         "{error}"
     );
     assert_eq!(error.to_string(), "cell.csv:3:6: the text is not UTF-8");
