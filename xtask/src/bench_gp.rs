@@ -11,6 +11,7 @@
 //! setting and the UR10 against scikit-learn (`bench_gp_paper`), `--lml-floor N` one
 //! evaluation against the n³ flop floor.
 
+use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -79,7 +80,7 @@ pub struct Args {
 /// the page faults of 144 MB at n = 3,000). Other jobs share the machine, so each of the seven
 /// rounds times the product and both evaluations back to back and the best of each is kept: a
 /// floor measured minutes apart from the evaluation would compare two different machines.
-fn lml_floor(n: usize) -> Result<String, String> {
+fn lml_floor(n: usize) -> anyhow::Result<String> {
     const ROUNDS: usize = 7;
     let d = data(n, 2024);
     let kernel = Kernel::start(KernelChoice::SquaredExponentialArd, DIM);
@@ -97,7 +98,7 @@ fn lml_floor(n: usize) -> Result<String, String> {
         let mut workspace = gp::LmlWorkspace::default();
         let evaluate = |w: &mut gp::LmlWorkspace| {
             w.log_marginal_likelihood(&kernel, d.x.as_ref(), y.as_ref(), true, parallelism)
-                .map_err(|e| format!("LML at n = {n}: {e}"))
+                .with_context(|| format!("LML at n = {n}"))
         };
         evaluate(&mut workspace)?;
         let (mut reused, mut fresh, mut product) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
@@ -208,7 +209,7 @@ fn peak_gflops(n: usize, par: Par) -> f64 {
 
 /// GFLOP/s of the Cholesky factorisation of an n × n kernel matrix (n³/3 flops), best of three,
 /// through the same faer routine the crate uses.
-fn cholesky_gflops(x: &Mat<f64>, n: usize, par: Par) -> Result<f64, String> {
+fn cholesky_gflops(x: &Mat<f64>, n: usize, par: Par) -> anyhow::Result<f64> {
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::linalg::cholesky::llt;
     let kernel = Kernel::start(KernelChoice::SquaredExponentialArd, DIM);
@@ -224,7 +225,7 @@ fn cholesky_gflops(x: &Mat<f64>, n: usize, par: Par) -> Result<f64, String> {
         }
     });
     match failed {
-        Some(e) => Err(format!("benchmark Cholesky failed: {e}")),
+        Some(e) => Err(anyhow::anyhow!("benchmark Cholesky failed: {e}")),
         None => Ok((n as f64).powi(3) / 3.0 / t / 1e9),
     }
 }
@@ -259,19 +260,19 @@ fn sub(m: &Mat<f64>, n: usize) -> Mat<f64> {
     Mat::from_fn(n, m.ncols(), |i, j| m[(i, j)])
 }
 
-fn ours(d: &Data, n: usize, restarts: usize) -> Result<OurRow, String> {
+fn ours(d: &Data, n: usize, restarts: usize) -> anyhow::Result<OurRow> {
     let (x, y) = (sub(&d.x, n), sub(&d.y, n));
     let shared = config(restarts, OutputMode::Shared, Parallelism::Rayon);
     let t = Instant::now();
-    let model = ExactGp::fit(x.as_ref(), y.as_ref(), &shared).map_err(|e| e.to_string())?;
+    let model = ExactGp::fit(x.as_ref(), y.as_ref(), &shared)?;
     let fit = t.elapsed().as_secs_f64();
     let mut prediction = None;
     let predict = best_of(3, || prediction = Some(model.predict_with(d.x_test.as_ref(), &PredictOptions::default())));
-    let prediction = prediction.ok_or("no prediction")?.map_err(|e| e.to_string())?;
+    let prediction = prediction.context("no prediction")??;
     let small = n <= 1000;
-    let timed = |c: GpConfig| -> Result<f64, String> {
+    let timed = |c: GpConfig| -> anyhow::Result<f64> {
         let t = Instant::now();
-        ExactGp::fit(x.as_ref(), y.as_ref(), &c).map_err(|e| e.to_string())?;
+        ExactGp::fit(x.as_ref(), y.as_ref(), &c)?;
         Ok(t.elapsed().as_secs_f64())
     };
     let fit_serial = small.then(|| timed(config(restarts, OutputMode::Shared, Parallelism::Sequential))).transpose()?;
@@ -296,10 +297,10 @@ fn sklearn_available() -> bool {
         .unwrap_or(false)
 }
 
-fn sklearn(d: &Data, sizes: &[usize], restarts: usize) -> Result<Vec<SklearnRow>, String> {
+fn sklearn(d: &Data, sizes: &[usize], restarts: usize) -> anyhow::Result<Vec<SklearnRow>> {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/bench_gp_sklearn.py");
     let dir = std::env::temp_dir().join(format!("calib-bench-gp-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(&dir).with_context(|| dir.display().to_string())?;
     let (request, response) = (dir.join("request.json"), dir.join("response.json"));
     let max_n = sizes.iter().copied().max().unwrap_or(0);
     // Same start and box as gp's defaults, so both searches solve the same problem.
@@ -315,24 +316,24 @@ fn sklearn(d: &Data, sizes: &[usize], restarts: usize) -> Result<Vec<SklearnRow>
         "lower": bounds.lower,
         "upper": bounds.upper,
     });
-    std::fs::write(&request, body.to_string()).map_err(|e| format!("{}: {e}", request.display()))?;
+    std::fs::write(&request, body.to_string()).with_context(|| request.display().to_string())?;
     let status = Command::new(crate::bench_gp_sklearn::python())
         .arg(&script)
         .arg(&request)
         .arg(&response)
         .status()
-        .map_err(|e| format!("{}: {e}", script.display()))?;
+        .with_context(|| script.display().to_string())?;
     if !status.success() {
-        return Err(format!("{} failed: {status}", script.display()));
+        anyhow::bail!("{} failed: {status}", script.display());
     }
-    let text = std::fs::read_to_string(&response).map_err(|e| format!("{}: {e}", response.display()))?;
+    let text = std::fs::read_to_string(&response).with_context(|| response.display().to_string())?;
     let _ = std::fs::remove_dir_all(&dir);
-    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| e.to_string())?;
-    let results = v["results"].as_array().ok_or("sklearn response has no results")?;
+    let v: serde_json::Value = serde_json::from_str(&text)?;
+    let results = v["results"].as_array().context("sklearn response has no results")?;
     results
         .iter()
         .map(|r| {
-            let num = |k: &str| r[k].as_f64().ok_or(format!("sklearn response lacks {k}"));
+            let num = |k: &str| r[k].as_f64().with_context(|| format!("sklearn response lacks {k}"));
             Ok(SklearnRow { fit: num("fit_s")?, predict: num("predict_s")?, lml: num("lml")? })
         })
         .collect()
@@ -354,12 +355,12 @@ fn fmt_opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
 }
 
 /// Runs the benchmark and prints the markdown table.
-pub fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.paper {
         let md = crate::bench_gp_paper::run(&args.paper_args, &args.kernel_args.ur10_data)?;
         println!("{md}");
         if let Some(path) = &args.out {
-            std::fs::write(path, &md).map_err(|e| format!("{}: {e}", path.display()))?;
+            std::fs::write(path, &md).with_context(|| path.display().to_string())?;
         }
         return Ok(());
     }
@@ -389,7 +390,7 @@ pub fn run(args: &Args) -> Result<(), String> {
         let md = crate::bench_gp_sweep::run(&sweep, svg.as_deref())?;
         println!("{md}");
         if let Some(path) = &args.out {
-            std::fs::write(path, &md).map_err(|e| format!("{}: {e}", path.display()))?;
+            std::fs::write(path, &md).with_context(|| path.display().to_string())?;
         }
         return Ok(());
     }
@@ -428,7 +429,7 @@ pub fn run(args: &Args) -> Result<(), String> {
         match sklearn(&d, &skl_sizes, args.restarts) {
             Ok(r) => Some(r),
             Err(e) => {
-                eprintln!("scikit-learn comparison skipped: {e}");
+                eprintln!("scikit-learn comparison skipped: {e:#}");
                 None
             }
         }
@@ -499,20 +500,20 @@ pub fn run(args: &Args) -> Result<(), String> {
             ..SparseConfig::default()
         };
         let t = Instant::now();
-        let sparse = SparseGp::fit(x.as_ref(), y.as_ref(), &sc).map_err(|e| e.to_string())?;
+        let sparse = SparseGp::fit(x.as_ref(), y.as_ref(), &sc)?;
         let sparse_fit = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let ps = sparse.predict(d.x_test.as_ref()).map_err(|e| e.to_string())?;
+        let ps = sparse.predict(d.x_test.as_ref())?;
         let sparse_predict = t.elapsed().as_secs_f64();
         let kernels: Vec<Kernel> = sparse.report().components.iter().map(|c| c.kernel.clone()).collect();
         let t = Instant::now();
-        SparseGp::fit_fixed(x.as_ref(), y.as_ref(), &kernels, &sc).map_err(|e| e.to_string())?;
+        SparseGp::fit_fixed(x.as_ref(), y.as_ref(), &kernels, &sc)?;
         let sparse_fixed = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let exact = ExactGp::fit_fixed(x.as_ref(), y.as_ref(), &kernels, &sc.gp).map_err(|e| e.to_string())?;
+        let exact = ExactGp::fit_fixed(x.as_ref(), y.as_ref(), &kernels, &sc.gp)?;
         let exact_fit = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let pe = exact.predict(d.x_test.as_ref()).map_err(|e| e.to_string())?;
+        let pe = exact.predict(d.x_test.as_ref())?;
         let exact_predict = t.elapsed().as_secs_f64();
         line(format!(
             "| {n} | {m} | {sparse_fit:.3} | {sparse_fixed:.3} | {sparse_predict:.4} | {:.4} | {exact_fit:.3} | {exact_predict:.4} | {:.4} |",
@@ -523,7 +524,7 @@ pub fn run(args: &Args) -> Result<(), String> {
     line(String::new());
 
     if let Some(path) = &args.out {
-        std::fs::write(path, &out).map_err(|e| format!("{}: {e}", path.display()))?;
+        std::fs::write(path, &out).with_context(|| path.display().to_string())?;
     }
     Ok(())
 }

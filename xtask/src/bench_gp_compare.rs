@@ -2,6 +2,7 @@
 //! same run: the real UR10 (series C, even rows → odd rows) and simulated soft joints with
 //! payloads (300 poses, several seeds); held-out error and fit time.
 
+use anyhow::Context;
 use std::fmt::Write;
 use std::time::{Duration, Instant};
 
@@ -13,7 +14,7 @@ use crate::bench_gp_residuals::heldout_mm;
 use crate::bench_gp_sklearn::{SklearnOptions, available, fit_predict};
 
 /// Runs the comparison and returns the markdown table.
-pub fn run(args: &KernelArgs, timeout: Duration) -> Result<String, String> {
+pub fn run(args: &KernelArgs, timeout: Duration) -> anyhow::Result<String> {
     let sets = data_sets(args)?;
     let with_sklearn = available();
     if !with_sklearn {
@@ -31,9 +32,9 @@ pub fn run(args: &KernelArgs, timeout: Duration) -> Result<String, String> {
         let config = ResidualGpOptions::default().gp;
         let t = Instant::now();
         let model = ExactGp::fit(set.train.inputs.as_ref(), set.train.outputs.as_ref(), &config)
-            .map_err(|e| format!("{}: {e}", set.name))?;
+            .with_context(|| set.name.clone())?;
         let ours_s = t.elapsed().as_secs_f64();
-        let mean = model.predict_mean(set.test.inputs.as_ref()).map_err(|e| e.to_string())?;
+        let mean = model.predict_mean(set.test.inputs.as_ref())?;
         let ours = heldout_mm(&mean, &set.test);
         for c in &model.report().components {
             eprintln!("  gp outputs {:?}: LML {:.3}, {:?}", c.outputs, c.log_marginal_likelihood, c.kernel);

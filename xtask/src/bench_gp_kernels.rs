@@ -2,6 +2,7 @@
 //! candidate kernel on the residuals of the real UR10 series (C even → odd, B and D split the same
 //! way) and of simulated soft joints with payloads (several seeds), held-out error in mm.
 
+use anyhow::Context;
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -113,10 +114,10 @@ pub fn candidates() -> Vec<(&'static str, KernelChoice, OutputMode)> {
 }
 
 /// Every data set this machine has.
-pub fn data_sets(args: &KernelArgs) -> Result<Vec<Residuals>, String> {
+pub fn data_sets(args: &KernelArgs) -> anyhow::Result<Vec<Residuals>> {
     let mut sets = Vec::new();
     let robot =
-        |file: &str| RobotDescription::read(&PathBuf::from("fixtures/robots").join(file)).map_err(|e| e.to_string());
+        |file: &str| RobotDescription::read(&PathBuf::from("fixtures/robots").join(file)).map_err(anyhow::Error::from);
     if args.ur10_data.join("ur10_C_even.csv").exists() {
         let ur10 = robot("ur10.ron")?;
         let d = &args.ur10_data;
@@ -149,7 +150,7 @@ pub fn data_sets(args: &KernelArgs) -> Result<Vec<Residuals>, String> {
         }
     }
     if sets.is_empty() && !args.patterns().is_empty() {
-        return Err(format!("--only {:?} matches no data set", args.only));
+        anyhow::bail!("--only {:?} matches no data set", args.only);
     }
     Ok(sets)
 }
@@ -159,7 +160,7 @@ pub fn data_sets(args: &KernelArgs) -> Result<Vec<Residuals>, String> {
 /// the seed's own warm-start subset, it shows how far the held-out error depends on which of
 /// several nearly equal local optima the search happens to reach. Sets no larger than the
 /// warm-start subset have no subset to draw, so without it every seed would give the same fit.
-fn perturbed_start(choice: KernelChoice, dim: usize, seed: u64) -> Result<Kernel, String> {
+fn perturbed_start(choice: KernelChoice, dim: usize, seed: u64) -> anyhow::Result<Kernel> {
     let start = Kernel::start(choice, dim);
     if seed == 0 {
         return Ok(start);
@@ -173,22 +174,22 @@ fn perturbed_start(choice: KernelChoice, dim: usize, seed: u64) -> Result<Kernel
         ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
     };
     let p: Vec<f64> = start.log_parameters().iter().map(|v| v + 1e-3 * (2.0 * next() - 1.0)).collect();
-    start.with_log_parameters(&p).map_err(|e| e.to_string())
+    start.with_log_parameters(&p).map_err(anyhow::Error::from)
 }
 
 /// Runs every candidate on every set and returns the markdown table.
-pub fn run(args: &KernelArgs) -> Result<String, String> {
+pub fn run(args: &KernelArgs) -> anyhow::Result<String> {
     let sets = data_sets(args)?;
     let kernels: Vec<_> = candidates()
         .into_iter()
         .filter(|(name, ..)| args.kernel_names.is_empty() || args.kernel_names.iter().any(|k| k == name))
         .collect();
     if kernels.is_empty() {
-        return Err(format!("no candidate kernel is named {:?}", args.kernel_names));
+        anyhow::bail!("no candidate kernel is named {:?}", args.kernel_names);
     }
     let seeds = &args.search_seeds;
     if seeds.is_empty() {
-        return Err("--search-seeds is empty".into());
+        anyhow::bail!("--search-seeds is empty");
     }
     let bar = ProgressBar::new((sets.len() * kernels.len() * seeds.len()) as u64);
     bar.set_style(
@@ -222,10 +223,10 @@ pub fn run(args: &KernelArgs) -> Result<String, String> {
                 let start = perturbed_start(*choice, set.train.inputs.ncols(), seed)?;
                 let t = Instant::now();
                 let model = ExactGp::fit_from(set.train.inputs.as_ref(), set.train.outputs.as_ref(), &start, &config)
-                    .map_err(|e| format!("{} / {name}: {e}", set.name))?;
+                    .with_context(|| format!("{} / {name}", set.name))?;
                 seconds += t.elapsed().as_secs_f64();
                 lml += model.log_marginal_likelihood();
-                let mean = model.predict_mean(set.test.inputs.as_ref()).map_err(|e| e.to_string())?;
+                let mean = model.predict_mean(set.test.inputs.as_ref())?;
                 errors.push(heldout_mm(&mean, &set.test));
                 bar.inc(1);
             }

@@ -16,6 +16,7 @@
 //! leave-one-out error on its training rows is shown beside it. Times are the GP fit alone, wall
 //! clock, on the same residuals.
 
+use anyhow::Context;
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -55,15 +56,15 @@ fn positions(m: &Mat<f64>) -> Mat<f64> {
 
 /// Mean position error (mm) of the training rows corrected by the closed-form leave-one-out
 /// prediction.
-fn leave_one_out_mm(model: &ExactGp, set: &Residuals) -> Result<f64, String> {
-    let loo = model.leave_one_out().map_err(|e| e.to_string())?;
+fn leave_one_out_mm(model: &ExactGp, set: &Residuals) -> anyhow::Result<f64> {
+    let loo = model.leave_one_out()?;
     Ok(heldout_mm(&loo.mean, &set.train))
 }
 
 /// Runs the comparison and returns the markdown table.
-pub fn run(args: &PaperArgs, ur10_data: &std::path::Path) -> Result<String, String> {
+pub fn run(args: &PaperArgs, ur10_data: &std::path::Path) -> anyhow::Result<String> {
     let robot =
-        |file: &str| RobotDescription::read(&PathBuf::from("fixtures/robots").join(file)).map_err(|e| e.to_string());
+        |file: &str| RobotDescription::read(&PathBuf::from("fixtures/robots").join(file)).map_err(anyhow::Error::from);
     // (residuals, the scikit-learn kernel compared with).
     let mut sets: Vec<(Residuals, bool)> = Vec::new();
     if !args.paper_skip_simulated {
@@ -94,7 +95,7 @@ pub fn run(args: &PaperArgs, ur10_data: &std::path::Path) -> Result<String, Stri
     let patterns: Vec<&str> = args.paper_only.iter().map(|p| p.trim()).filter(|p| !p.is_empty()).collect();
     sets.retain(|(set, _)| patterns.is_empty() || patterns.iter().any(|p| set.name.contains(p)));
     if sets.is_empty() {
-        return Err(format!("--paper-only {:?} matches no data set", args.paper_only));
+        anyhow::bail!("--paper-only {:?} matches no data set", args.paper_only);
     }
     let with_sklearn = available();
     if !with_sklearn {
@@ -116,11 +117,10 @@ pub fn run(args: &PaperArgs, ur10_data: &std::path::Path) -> Result<String, Stri
         let config = ResidualGpOptions::default().gp;
         let t = Instant::now();
         let model = ExactGp::fit(set.train.inputs.as_ref(), set.train.outputs.as_ref(), &config)
-            .map_err(|e| format!("{}: {e}", set.name))?;
+            .with_context(|| set.name.clone())?;
         let ours_s = t.elapsed().as_secs_f64();
-        let ours = heldout_mm(&model.predict_mean(set.test.inputs.as_ref()).map_err(|e| e.to_string())?, &set.test);
-        let training =
-            heldout_mm(&model.predict_mean(set.train.inputs.as_ref()).map_err(|e| e.to_string())?, &set.train);
+        let ours = heldout_mm(&model.predict_mean(set.test.inputs.as_ref())?, &set.test);
+        let training = heldout_mm(&model.predict_mean(set.train.inputs.as_ref())?, &set.train);
         let loo = leave_one_out_mm(&model, set)?;
         let components = &model.report().components;
         let kept = components.iter().filter(|c| matches!(c.kernel, Kernel::Quadratic(_))).count();

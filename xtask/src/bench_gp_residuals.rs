@@ -2,6 +2,7 @@
 //! and simulated measurements, as the GP stage sees it, so that `gp` and scikit-learn are given the
 //! same inputs and outputs; and the held-out error of a GP's prediction on them.
 
+use anyhow::Context;
 use std::path::Path;
 
 use faer::Mat;
@@ -34,20 +35,20 @@ pub fn residuals(
     train: &MeasurementSet,
     test: &MeasurementSet,
     with_payload: bool,
-) -> Result<Residuals, String> {
-    let (model, _) = pipeline::fit(robot, train, Method::Poe, &FitOptions::default()).map_err(|e| e.to_string())?;
-    let set = |data: &MeasurementSet| -> Result<ResidualSet, String> {
-        let tools = pipeline::tool_indices(&model, data).map_err(|e| e.to_string())?;
-        let poses = model.geometric_poses(&data.rows, &tools).map_err(|e| e.to_string())?;
+) -> anyhow::Result<Residuals> {
+    let (model, _) = pipeline::fit(robot, train, Method::Poe, &FitOptions::default())?;
+    let set = |data: &MeasurementSet| -> anyhow::Result<ResidualSet> {
+        let tools = pipeline::tool_indices(&model, data)?;
+        let poses = model.geometric_poses(&data.rows, &tools)?;
         Ok(ResidualSet::new(&poses, data, with_payload, ResidualFrame::ToolPoint))
     };
     Ok(Residuals { name, train: set(train)?, test: set(test)? })
 }
 
 /// A real data set from a SPEC CSV, split into even (train) and odd (test) rows, or from two files.
-pub fn real(name: &str, robot: &RobotDescription, train: &Path, test: Option<&Path>) -> Result<Residuals, String> {
+pub fn real(name: &str, robot: &RobotDescription, train: &Path, test: Option<&Path>) -> anyhow::Result<Residuals> {
     let options = ReadOptions::for_joints(robot.joint_kinds());
-    let read = |p: &Path| pipeline::read_measurements(p, &options).map_err(|e| e.to_string());
+    let read = |p: &Path| pipeline::read_measurements(p, &options).map_err(anyhow::Error::from);
     let (train_set, test_set) = match test {
         Some(t) => (read(train)?, read(t)?),
         None => even_odd(&read(train)?),
@@ -57,7 +58,7 @@ pub fn real(name: &str, robot: &RobotDescription, train: &Path, test: Option<&Pa
 
 /// A simulated campaign with the paper's effects (joint compliance under gravity and payload,
 /// tracker noise) and payloads: the first `train` poses to train on, the next `test` to test.
-pub fn simulated(robot: &RobotDescription, seed: u64, train: usize, test: usize) -> Result<Residuals, String> {
+pub fn simulated(robot: &RobotDescription, seed: u64, train: usize, test: usize) -> anyhow::Result<Residuals> {
     simulated_campaign(robot, &paper_effects(), "", seed, train, test, false)
 }
 
@@ -72,11 +73,10 @@ pub fn simulated_campaign(
     train: usize,
     test: usize,
     full_pose: bool,
-) -> Result<Residuals, String> {
+) -> anyhow::Result<Residuals> {
     let config = GeneratorConfig { sample_count: train + test, seed, ..GeneratorConfig::default() };
     let (_, data) =
-        simulate_campaign(robot, effects, &Perturbation::default(), &Remount::default(), &config, full_pose)
-            .map_err(|e| e.to_string())?;
+        simulate_campaign(robot, effects, &Perturbation::default(), &Remount::default(), &config, full_pose)?;
     let train_set = data.subset(&(0..train).collect::<Vec<_>>());
     let test_set = data.subset(&(train..train + test).collect::<Vec<_>>());
     let kind = if full_pose { ", full pose" } else { "" };
@@ -93,12 +93,11 @@ pub fn simulated_payload_runs(
     seed: u64,
     train: usize,
     test: usize,
-) -> Result<Residuals, String> {
+) -> anyhow::Result<Residuals> {
     let total = train + test;
     let config = payload_run_campaign(total, seed);
     let (_, data) =
-        simulate_campaign(robot, &paper_effects(), &Perturbation::default(), &Remount::default(), &config, false)
-            .map_err(|e| e.to_string())?;
+        simulate_campaign(robot, &paper_effects(), &Perturbation::default(), &Remount::default(), &config, false)?;
     // Row i is a training row when ⌊(i + 1)·train/total⌋ > ⌊i·train/total⌋: `train` rows spread
     // evenly over the campaign.
     let is_train = |i: usize| (i + 1) * train / total > i * train / total;
@@ -124,8 +123,8 @@ pub fn heldout_mm(mean: &Mat<f64>, test: &ResidualSet) -> f64 {
 
 /// Writes every set as `DIR/NAME.train.csv` and `DIR/NAME.test.csv` (name made file-safe): columns
 /// `x0 … x{d−1}`, then `y0 … y{m−1}`, full precision.
-pub fn dump(sets: &[Residuals], dir: &Path) -> Result<(), String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+pub fn dump(sets: &[Residuals], dir: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
     for set in sets {
         let stem: String = set.name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
         for (part, r) in [("train", &set.train), ("test", &set.test)] {
@@ -142,7 +141,7 @@ pub fn dump(sets: &[Residuals], dir: &Path) -> Result<(), String> {
                 text.push('\n');
             }
             let path = dir.join(format!("{stem}.{part}.csv"));
-            std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+            std::fs::write(&path, text).with_context(|| path.display().to_string())?;
             eprintln!("{}", path.display());
         }
     }

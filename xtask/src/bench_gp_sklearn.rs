@@ -5,6 +5,7 @@
 //! `target/pyenv` (made by `python3 -m venv target/pyenv && target/pyenv/bin/pip install -r
 //! xtask/scripts/requirements.txt`), else `python3` on the path.
 
+use anyhow::Context;
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -68,10 +69,10 @@ pub fn fit_predict(
     y: &Mat<f64>,
     x_test: &Mat<f64>,
     options: &SklearnOptions,
-) -> Result<Option<SklearnResult>, String> {
+) -> anyhow::Result<Option<SklearnResult>> {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/bench_gp_sklearn.py");
     let dir = std::env::temp_dir().join(format!("calib-bench-gp-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(&dir).with_context(|| dir.display().to_string())?;
     let (request, response) = (dir.join("request.json"), dir.join("response.json"));
     let body = serde_json::json!({
         "x": rows(x),
@@ -83,7 +84,7 @@ pub fn fit_predict(
         "independent": options.independent,
         "processes": options.processes,
     });
-    std::fs::write(&request, body.to_string()).map_err(|e| format!("{}: {e}", request.display()))?;
+    std::fs::write(&request, body.to_string()).with_context(|| request.display().to_string())?;
     let _ = std::fs::remove_file(&response);
     let start = Instant::now();
     // Its own process group, so that a timeout ends the pool's workers with it.
@@ -93,9 +94,9 @@ pub fn fit_predict(
         .arg(&request)
         .arg(&response)
         .spawn()
-        .map_err(|e| format!("{}: {e}", script.display()))?;
+        .with_context(|| script.display().to_string())?;
     let status = loop {
-        if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+        if let Some(status) = child.try_wait()? {
             break status;
         }
         if start.elapsed() > options.timeout {
@@ -109,18 +110,18 @@ pub fn fit_predict(
         std::thread::sleep(Duration::from_millis(100));
     };
     if !status.success() {
-        return Err(format!("{} failed: {status}", script.display()));
+        anyhow::bail!("{} failed: {status}", script.display());
     }
-    let text = std::fs::read_to_string(&response).map_err(|e| format!("{}: {e}", response.display()))?;
+    let text = std::fs::read_to_string(&response).with_context(|| response.display().to_string())?;
     let _ = std::fs::remove_dir_all(&dir);
-    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| e.to_string())?;
-    let num = |k: &str| v[k].as_f64().ok_or(format!("scikit-learn response lacks {k}"));
-    let mean_rows = v["mean"].as_array().ok_or("scikit-learn response lacks mean")?;
+    let v: serde_json::Value = serde_json::from_str(&text)?;
+    let num = |k: &str| v[k].as_f64().with_context(|| format!("scikit-learn response lacks {k}"));
+    let mean_rows = v["mean"].as_array().context("scikit-learn response lacks mean")?;
     let cols = y.ncols();
     let mut mean = Mat::zeros(mean_rows.len(), cols);
     for (i, r) in mean_rows.iter().enumerate() {
         for j in 0..cols {
-            mean[(i, j)] = r[j].as_f64().ok_or("scikit-learn mean is not a number")?;
+            mean[(i, j)] = r[j].as_f64().context("scikit-learn mean is not a number")?;
         }
     }
     let fitted = v["fitted"]

@@ -10,6 +10,7 @@
 //! again at larger sizes. An exact fit whose time predicted from the last measured size (n³)
 //! exceeds `--exact-budget-s` is skipped and the prediction printed instead.
 
+use anyhow::Context;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -62,23 +63,23 @@ impl Cell {
     }
 }
 
-fn calib_binary(root: &Path) -> Result<PathBuf, String> {
+fn calib_binary(root: &Path) -> anyhow::Result<PathBuf> {
     let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
         .args(["build", "--release", "--quiet", "-p", "calib"])
         .current_dir(root)
         .status()
-        .map_err(|e| format!("cargo build: {e}"))?;
+        .context("cargo build")?;
     if !status.success() {
-        return Err("cargo build --release -p calib failed".into());
+        anyhow::bail!("cargo build --release -p calib failed");
     }
     let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| root.join("target"));
     Ok(target.join("release").join("calib"))
 }
 
 /// Runs `command` to completion; its wall clock and its peak resident memory in MB.
-fn run_measured(command: &mut Command) -> Result<(f64, f64), String> {
+fn run_measured(command: &mut Command) -> anyhow::Result<(f64, f64)> {
     let start = Instant::now();
-    let mut child = command.stdout(Stdio::null()).stderr(Stdio::piped()).spawn().map_err(|e| format!("spawn: {e}"))?;
+    let mut child = command.stdout(Stdio::null()).stderr(Stdio::piped()).spawn().context("spawn")?;
     let status_path = format!("/proc/{}/status", child.id());
     let mut peak_kb = 0.0f64;
     let status = loop {
@@ -88,7 +89,7 @@ fn run_measured(command: &mut Command) -> Result<(f64, f64), String> {
             let kb: f64 = line.split_whitespace().nth(1).and_then(|v| v.parse().ok()).unwrap_or(0.0);
             peak_kb = peak_kb.max(kb);
         }
-        match child.try_wait().map_err(|e| e.to_string())? {
+        match child.try_wait()? {
             Some(status) => break status,
             None => std::thread::sleep(Duration::from_millis(20)),
         }
@@ -99,26 +100,25 @@ fn run_measured(command: &mut Command) -> Result<(f64, f64), String> {
         if let Some(mut e) = child.stderr.take() {
             let _ = std::io::Read::read_to_string(&mut e, &mut err);
         }
-        return Err(format!("{command:?} failed: {}", err.lines().last().unwrap_or("")));
+        anyhow::bail!("{command:?} failed: {}", err.lines().last().unwrap_or(""));
     }
     Ok((seconds, peak_kb / 1024.0))
 }
 
-fn heldout_of(calib: &Path, model: &Path, test: &Path) -> Result<f64, String> {
+fn heldout_of(calib: &Path, model: &Path, test: &Path) -> anyhow::Result<f64> {
     let out = Command::new(calib)
         .args(["eval", "--json", "--model"])
         .arg(model)
         .arg("--data")
         .arg(test)
         .stderr(Stdio::null())
-        .output()
-        .map_err(|e| e.to_string())?;
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).map_err(|e| format!("calib eval --json: {e}"))?;
-    json["mean_position_error_mm"].as_f64().ok_or_else(|| "calib eval --json: no mean_position_error_mm".into())
+        .output()?;
+    let report: pipeline::EvalReport = serde_json::from_slice(&out.stdout).context("calib eval --json")?;
+    Ok(report.errors.mean_position_error_mm)
 }
 
 /// The first `n` data rows of `csv` (header kept) written to `out`.
-fn head_rows(csv: &str, n: usize, out: &Path) -> Result<(), String> {
+fn head_rows(csv: &str, n: usize, out: &Path) -> anyhow::Result<()> {
     let mut lines = csv.lines();
     let header = lines.next().unwrap_or_default();
     let mut text = String::with_capacity(csv.len());
@@ -128,11 +128,11 @@ fn head_rows(csv: &str, n: usize, out: &Path) -> Result<(), String> {
         text.push_str(line);
         text.push('\n');
     }
-    std::fs::write(out, text).map_err(|e| format!("{}: {e}", out.display()))
+    std::fs::write(out, text).with_context(|| out.display().to_string())
 }
 
 /// The last `n` data rows of `csv` (header kept) written to `out`.
-fn tail_rows(csv: &str, n: usize, out: &Path) -> Result<(), String> {
+fn tail_rows(csv: &str, n: usize, out: &Path) -> anyhow::Result<()> {
     let mut lines: Vec<&str> = csv.lines().collect();
     let header = lines.remove(0);
     let start = lines.len().saturating_sub(n);
@@ -141,7 +141,7 @@ fn tail_rows(csv: &str, n: usize, out: &Path) -> Result<(), String> {
         text.push_str(line);
         text.push('\n');
     }
-    std::fs::write(out, text).map_err(|e| format!("{}: {e}", out.display()))
+    std::fs::write(out, text).with_context(|| out.display().to_string())
 }
 
 /// Least-squares slope of `ln t` against `ln n` over the measured cells.
@@ -164,13 +164,13 @@ fn predicted(sizes: &[usize], cells: &[Cell], n: usize, power: i32) -> Option<f6
 }
 
 /// Runs the sweep; returns the markdown (with the SVG written beside `svg_path`).
-pub fn run(args: &SweepArgs, svg_path: Option<&Path>) -> Result<String, String> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().ok_or("no workspace root")?.to_path_buf();
+pub fn run(args: &SweepArgs, svg_path: Option<&Path>) -> anyhow::Result<String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().context("no workspace root")?.to_path_buf();
     let calib = calib_binary(&root)?;
     let robot = root.join("fixtures/robots/irb4400.ron");
     let work = if args.work.is_absolute() { args.work.clone() } else { root.join(&args.work) };
-    std::fs::create_dir_all(&work).map_err(|e| format!("{}: {e}", work.display()))?;
-    let largest = *args.sizes.iter().max().ok_or("no sizes")?;
+    std::fs::create_dir_all(&work).with_context(|| work.display().to_string())?;
+    let largest = *args.sizes.iter().max().context("no sizes")?;
     let test_rows = 3000;
     let campaign = work.join(format!("campaign-{}.csv", largest + test_rows));
     if !campaign.exists() {
@@ -181,18 +181,17 @@ pub fn run(args: &SweepArgs, svg_path: Option<&Path>) -> Result<String, String> 
             .arg("--out")
             .arg(&campaign)
             .stdout(Stdio::null())
-            .status()
-            .map_err(|e| e.to_string())?;
+            .status()?;
         if !status.success() {
-            return Err("calib simulate failed".into());
+            anyhow::bail!("calib simulate failed");
         }
     }
-    let csv = std::fs::read_to_string(&campaign).map_err(|e| format!("{}: {e}", campaign.display()))?;
+    let csv = std::fs::read_to_string(&campaign).with_context(|| campaign.display().to_string())?;
     let test = work.join("test.csv");
     tail_rows(&csv, test_rows, &test)?;
-    let description = pipeline::RobotDescription::read(&robot).map_err(|e| e.to_string())?;
+    let description = pipeline::RobotDescription::read(&robot)?;
     let read_options = pipeline::ReadOptions::for_joints(description.joint_kinds());
-    let test_set = pipeline::read_measurements(&test, &read_options).map_err(|e| e.to_string())?;
+    let test_set = pipeline::read_measurements(&test, &read_options)?;
     let with_sklearn = available();
 
     let bar = ProgressBar::new((args.sizes.len() * 3) as u64);
@@ -238,7 +237,7 @@ pub fn run(args: &SweepArgs, svg_path: Option<&Path>) -> Result<String, String> 
             // A smaller size was already stopped: this one would be too.
             Cell::Skipped(format!("skipped: predicted {:.0} s", guess.unwrap_or(f64::INFINITY)))
         } else {
-            let train_set = pipeline::read_measurements(&train, &read_options).map_err(|e| e.to_string())?;
+            let train_set = pipeline::read_measurements(&train, &read_options)?;
             let r = residuals(format!("n = {n}"), &description, &train_set, &test_set, true)?;
             let options = SklearnOptions {
                 linear: false,
@@ -286,7 +285,7 @@ pub fn run(args: &SweepArgs, svg_path: Option<&Path>) -> Result<String, String> 
         let series =
             [("exact GP", &exact, "#1f77b4"), ("sparse GP", &sparse, "#2ca02c"), ("scikit-learn", &sklearn, "#d62728")];
         let svg = plot(&args.sizes, &series);
-        std::fs::write(path, svg).map_err(|e| format!("{}: {e}", path.display()))?;
+        std::fs::write(path, svg).with_context(|| path.display().to_string())?;
     }
     Ok(md)
 }

@@ -327,7 +327,7 @@ pub fn run_case(robots: &Robots, index: usize, seed: u64, rows: usize, dump: Opt
         (cell, config)
     } else {
         let tool_m = rng.random_range(0.1..0.3);
-        let geometry = perturbed_robot(robot, &mut rng, 0.002, 0.002, tool_m).map_err(anyhow::Error::msg)?;
+        let geometry = perturbed_robot(robot, &mut rng, 0.002, 0.002, tool_m)?;
         let mut cell = SimulatedCell::new(geometry, robot.dynamics.clone());
         cell.tracker_from_base = tracker_placement(&mut rng);
         (cell, GeneratorConfig { sample_count: rows, seed: rng.random(), ..GeneratorConfig::default() })
@@ -338,7 +338,7 @@ pub fn run_case(robots: &Robots, index: usize, seed: u64, rows: usize, dump: Opt
     let base_dynamics = cell.dynamics.clone();
     let ranges = ranges(robot);
     let sim = |cell: &SimulatedCell, effects: &Effects, full_pose: bool| -> Result<MeasurementSet> {
-        simulate(cell, effects, &ranges, &config, full_pose).map_err(anyhow::Error::msg)
+        simulate(cell, effects, &ranges, &config, full_pose)
     };
     let with_noise = |effects: &Effects| Effects { tracker_noise: Some(TrackerNoise::default()), ..effects.clone() };
     let clean_none = sim(&cell, &Effects::default(), full_pose)?;

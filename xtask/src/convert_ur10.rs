@@ -51,16 +51,16 @@ const SERIES: [(&str, &str); 4] = [
 const JOINTS: [&str; 6] =
     ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"];
 
-fn number(text: &str, file: &Path, line: usize, column: usize) -> Result<f64, String> {
+fn number(text: &str, file: &Path, line: usize, column: usize) -> anyhow::Result<f64> {
     let value: f64 = text
         .trim()
         .replace(',', ".")
         .parse()
-        .map_err(|_| format!("{}:{line}:{column}: '{text}' is not a number", file.display()))?;
+        .map_err(|_| anyhow::anyhow!("{}:{line}:{column}: '{text}' is not a number", file.display()))?;
     if value.is_finite() {
         Ok(value)
     } else {
-        Err(format!("{}:{line}:{column}: '{text}' is not finite", file.display()))
+        Err(anyhow::anyhow!("{}:{line}:{column}: '{text}' is not finite", file.display()))
     }
 }
 
@@ -86,20 +86,23 @@ fn seconds(stamp: &str) -> Option<f64> {
 }
 
 /// Reads one series as measurements.
-pub fn read_series(input: &Path, series: &str, full_pose: bool) -> Result<MeasurementSet, String> {
+pub fn read_series(input: &Path, series: &str, full_pose: bool) -> anyhow::Result<MeasurementSet> {
     let relative = SERIES
         .iter()
         .find(|(name, _)| name.eq_ignore_ascii_case(series))
         .map(|(_, path)| *path)
-        .ok_or_else(|| format!("unknown series '{series}': expected A, B, C or D"))?;
+        .ok_or_else(|| anyhow::anyhow!("unknown series '{series}': expected A, B, C or D"))?;
     let file = input.join(relative);
     let text = std::fs::read_to_string(&file).map_err(|e| {
-        format!("{}: {e} (get the dataset of Landgraf et al., CASE 2021, and pass --input)", file.display())
+        anyhow::anyhow!("{}: {e} (get the dataset of Landgraf et al., CASE 2021, and pass --input)", file.display())
     })?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or("").split(';').map(str::trim).collect();
     let column = |name: &str| {
-        header.iter().position(|h| *h == name).ok_or_else(|| format!("{}:1: no column '{name}'", file.display()))
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| anyhow::anyhow!("{}:1: no column '{name}'", file.display()))
     };
     let joints: Vec<usize> = JOINTS.iter().map(|j| column(j)).collect::<Result<_, _>>()?;
     let position = [column("measurement_x")?, column("measurement_y")?, column("measurement_z")?];
@@ -114,7 +117,7 @@ pub fn read_series(input: &Path, series: &str, full_pose: bool) -> Result<Measur
         }
         let cells: Vec<&str> = raw.split(';').collect();
         let cell =
-            |c: usize| -> Result<f64, String> { number(cells.get(c).copied().unwrap_or(""), &file, line, c + 1) };
+            |c: usize| -> anyhow::Result<f64> { number(cells.get(c).copied().unwrap_or(""), &file, line, c + 1) };
         let q = joints.iter().map(|&c| cell(c)).collect::<Result<Vec<_>, _>>()?;
         let p = Vector3::new(cell(position[0])?, cell(position[1])?, cell(position[2])?) * 1e-3;
         let orientation =
@@ -148,7 +151,7 @@ fn write(set: &MeasurementSet, path: &Path) -> anyhow::Result<()> {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let set = read_series(&args.dataset.input, &args.dataset.series, args.full_pose).map_err(anyhow::Error::msg)?;
+    let set = read_series(&args.dataset.input, &args.dataset.series, args.full_pose)?;
     match (&args.out, &args.train, &args.test) {
         (Some(out), _, _) => write(&set, out),
         (None, Some(train), Some(test)) => {

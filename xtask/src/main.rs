@@ -86,8 +86,8 @@ fn main() -> ExitCode {
     faer::set_global_parallelism(faer::Par::Seq);
     let cli = Cli::parse();
     let result = match &cli.command {
-        Command::ReproduceSim(args) => reproduce_sim::run(args),
-        Command::BenchGp(args) => bench_gp::run(args),
+        Command::ReproduceSim(args) => reproduce_sim::run(args).map_err(|e| format!("{e:#}")),
+        Command::BenchGp(args) => bench_gp::run(args).map_err(|e| format!("{e:#}")),
         Command::BenchIdentify(args) => bench_identify::run(args).map_err(|e| format!("{e:#}")),
         Command::BenchMemory(args) => bench_memory::run(args).map_err(|e| format!("{e:#}")),
         Command::Hostile(args) => hostile::run(args).map_err(|e| format!("{e:#}")),

@@ -12,6 +12,7 @@ use crate::box_plot::{BoxGroup, box_plot};
 use crate::reproduce_sim_params::{Params, Preset, Seeds, Setup, Sizes, Variant};
 use crate::reproduce_sim_report::{Magnitudes, Outcome, VariantResult, json, markdown};
 use crate::simulation::mean_distance_mm;
+use anyhow::Context;
 use gp::{KernelChoice, OutputMode, Parallelism};
 use indicatif::{ProgressBar, ProgressStyle};
 use loadsim::{Effects, GeneratorConfig, JointCompliance, RobotDynamics, SimulatedCell};
@@ -111,9 +112,9 @@ pub(crate) fn workspace_root() -> PathBuf {
 }
 
 /// The robot with the preset's stiffness.
-pub(crate) fn robot_for(robot: &RobotDescription, preset: Preset, file: &Path) -> Result<RobotDescription, String> {
+pub(crate) fn robot_for(robot: &RobotDescription, preset: Preset, file: &Path) -> anyhow::Result<RobotDescription> {
     let mut dynamics: RobotDynamics = robot.dynamics.clone().ok_or_else(|| {
-        format!("{}: the load model needs the robot's masses and stiffness (a dynamics block)", file.display())
+        anyhow::anyhow!("{}: the load model needs the robot's masses and stiffness (a dynamics block)", file.display())
     })?;
     for k in &mut dynamics.stiffness_nm_per_rad {
         *k /= preset.softening();
@@ -141,8 +142,8 @@ fn magnitudes(
     ranges: &[loadsim::JointRange],
     config: &GeneratorConfig,
     full_pose: bool,
-) -> Result<Magnitudes, String> {
-    let run = |effects: &Effects| simulate(cell, effects, ranges, config, full_pose).map_err(|e| e.to_string());
+) -> anyhow::Result<Magnitudes> {
+    let run = |effects: &Effects| simulate(cell, effects, ranges, config, full_pose).map_err(anyhow::Error::from);
     let rigid = run(&Effects::default())?;
     let bent = run(&Effects { compliance: effects.compliance, ..Effects::default() })?;
     let payload_only = JointCompliance { payload_only: true, ..JointCompliance::default() };
@@ -166,25 +167,25 @@ fn fit_and_test(
     variant: &Variant,
     train: &MeasurementSet,
     tests: &[&MeasurementSet],
-) -> Result<FitResult, String> {
+) -> anyhow::Result<FitResult> {
     let (model, report) = pipeline::fit(robot, train, variant.method, &variant.options)
-        .map_err(|e| format!("{} on {} rows: {e}", variant.label, train.rows.len()))?;
+        .with_context(|| format!("{} on {} rows", variant.label, train.rows.len()))?;
     let errors = tests
         .iter()
         .map(|test| {
-            pipeline::evaluate(&model, test).map(|e| e.summary.mean_position_error_mm).map_err(|e| e.to_string())
+            pipeline::evaluate(&model, test).map(|e| e.summary.mean_position_error_mm).map_err(anyhow::Error::from)
         })
-        .collect::<Result<Vec<f64>, String>>()?;
+        .collect::<anyhow::Result<Vec<f64>>>()?;
     let loo = report.residual_gp.as_ref().and_then(|c| c.leave_one_out.as_ref()).map(|l| l.mean_position_error_mm);
     Ok((report.after.mean_position_error_mm, loo, errors))
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> anyhow::Result<()> {
     let started = Instant::now();
     let root = workspace_root();
     let robot_file = args.robot.clone().unwrap_or_else(|| root.join("fixtures/robots/irb4400.ron"));
     let out_dir = args.out.clone().unwrap_or_else(|| root.join("docs/results"));
-    let nominal = RobotDescription::read(&robot_file).map_err(|e| e.to_string())?;
+    let nominal = RobotDescription::read(&robot_file)?;
     let robot = robot_for(&nominal, args.preset, &robot_file)?;
     let sizes = if args.quick { Sizes::QUICK } else { Sizes::PAPER };
     let seeds = seeds(args.seed);
@@ -193,13 +194,14 @@ pub fn run(args: &Args) -> Result<(), String> {
     let effects = args.preset.effects();
 
     // The truth: a perturbed arm with the preset's stiffness; the tracker placed at random.
-    let cell = simulated_cell(&robot, &perturbation, seeds.cell).map_err(|e| e.to_string())?;
+    let cell = simulated_cell(&robot, &perturbation, seeds.cell)?;
     let ranges = joint_ranges(&robot);
     let generator = |sample_count, seed| GeneratorConfig { sample_count, seed, ..GeneratorConfig::default() };
-    let dataset =
-        |count, seed| simulate(&cell, &effects, &ranges, &generator(count, seed), full_pose).map_err(|e| e.to_string());
+    let dataset = |count, seed| {
+        simulate(&cell, &effects, &ranges, &generator(count, seed), full_pose).map_err(anyhow::Error::from)
+    };
     let train = dataset(sizes.training, seeds.training)?;
-    let tests = seeds.tests.iter().map(|&s| dataset(sizes.test, s)).collect::<Result<Vec<_>, String>>()?;
+    let tests = seeds.tests.iter().map(|&s| dataset(sizes.test, s)).collect::<anyhow::Result<Vec<_>>>()?;
     let magnitudes = magnitudes(&cell, &effects, &ranges, &generator(sizes.training, seeds.training), full_pose)?;
 
     // Fold k holds the k-th of `folds` nearly equal slices of a seeded shuffle of the rows.
@@ -236,7 +238,7 @@ pub fn run(args: &Args) -> Result<(), String> {
             bar.inc(1);
             result
         })
-        .collect::<Result<_, String>>()?;
+        .collect::<anyhow::Result<_>>()?;
     bar.finish_and_clear();
 
     let per_variant = sizes.folds + 1;
@@ -276,7 +278,7 @@ pub fn run(args: &Args) -> Result<(), String> {
         variants: &variants,
     })?;
 
-    std::fs::create_dir_all(&out_dir).map_err(|e| format!("{}: {e}", out_dir.display()))?;
+    std::fs::create_dir_all(&out_dir).with_context(|| out_dir.display().to_string())?;
     let stem = match args.preset {
         Preset::Physical => "reproduce-sim".to_owned(),
         preset => format!("reproduce-sim-{}", preset.name()),
@@ -286,7 +288,7 @@ pub fn run(args: &Args) -> Result<(), String> {
         outcome.variants.iter().map(|v| BoxGroup { label: v.short_label(), values: v.cv.clone() }).collect();
     let title = format!("{}-fold cross-validation, simulated IRB 4400 ({} preset)", sizes.folds, args.preset.name());
     let svg = box_plot(&title, "mean position error per fold (mm, log scale)", &groups, true);
-    let write = |path: PathBuf, text: &str| std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()));
+    let write = |path: PathBuf, text: &str| std::fs::write(&path, text).with_context(|| path.display().to_string());
     write(out_dir.join(&svg_name), &svg)?;
     write(out_dir.join(format!("{stem}.md")), &markdown(&params, &outcome, &svg_name))?;
     if let Some(path) = &args.json {

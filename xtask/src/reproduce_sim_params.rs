@@ -1,6 +1,7 @@
 //! Every parameter of the simulation study (the JSON's `params`), and the report's account of
 //! each with its source and of what differs from the paper.
 
+use anyhow::Context;
 use loadsim::{Effects, GeneratorConfig, JointCompliance, RobotDynamics, SimulatedCell};
 use pipeline::simulated::{Perturbation, paper_effects};
 use pipeline::{FitOptions, Method, RobotDescription};
@@ -117,7 +118,7 @@ pub struct Setup<'a> {
 
 impl Params {
     /// The parameters of a study.
-    pub fn new(s: &Setup<'_>) -> Result<Self, String> {
+    pub fn new(s: &Setup<'_>) -> anyhow::Result<Self> {
         let base_in_tracker = s.cell.tracker_from_base;
         Ok(Params {
             preset: s.preset,
@@ -134,7 +135,7 @@ impl Params {
                 translation_m: base_in_tracker.translation().into(),
                 rotation_vector_rad: base_in_tracker.rotation().log().into(),
             },
-            dynamics: s.robot.dynamics.clone().ok_or("the robot has no dynamics block")?,
+            dynamics: s.robot.dynamics.clone().context("the robot has no dynamics block")?,
             effects: s.effects.clone(),
             generator: s.generator.clone(),
             fit_options: s

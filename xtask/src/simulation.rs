@@ -18,9 +18,9 @@ pub fn perturbed_robot<R: Rng>(
     translation_m: f64,
     rotation_rad: f64,
     tool_m: f64,
-) -> Result<LocalPoe, String> {
+) -> anyhow::Result<LocalPoe> {
     let perturbation = Perturbation { translation_m, rotation_rad, tool_m };
-    pipeline::simulated::perturbed_robot(robot, &perturbation, rng).map_err(|e| e.to_string())
+    pipeline::simulated::perturbed_robot(robot, &perturbation, rng).map_err(anyhow::Error::from)
 }
 
 /// A tracker 3–5 m from the base, turned about the vertical, levelled.
@@ -40,8 +40,8 @@ pub fn simulate(
     ranges: &[JointRange],
     config: &GeneratorConfig,
     full_pose: bool,
-) -> Result<MeasurementSet, String> {
-    pipeline::simulated::simulate(cell, effects, ranges, config, full_pose).map_err(|e| e.to_string())
+) -> anyhow::Result<MeasurementSet> {
+    pipeline::simulated::simulate(cell, effects, ranges, config, full_pose).map_err(anyhow::Error::from)
 }
 
 /// Mean distance between the measured points of two sets of the same poses, mm.

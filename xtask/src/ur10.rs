@@ -127,7 +127,7 @@ fn methods(args: &Args, robot: &RobotDescription) -> Result<String> {
     let mut rows = Vec::new();
     let mut sizes = (0, 0);
     for (label, full_pose) in [("position", false), ("full pose", true)] {
-        let set = read_series(&args.dataset.input, &args.dataset.series, full_pose).map_err(anyhow::Error::msg)?;
+        let set = read_series(&args.dataset.input, &args.dataset.series, full_pose)?;
         let (train, test) = split(&set, args.split);
         sizes = (train.rows.len(), test.rows.len());
         for (name, method, options) in &variants {
@@ -221,7 +221,7 @@ fn by_training_range(train: &MeasurementSet, test: &MeasurementSet) -> (Vec<usiz
 }
 
 fn check_series(args: &Args, robot: &RobotDescription, series: &str) -> Result<Checked> {
-    let set = read_series(&args.dataset.input, series, false).map_err(anyhow::Error::msg)?;
+    let set = read_series(&args.dataset.input, series, false)?;
     let (train, test) = split(&set, args.split);
     let mut seconds = Vec::new();
     let mut cpu_seconds = Vec::new();

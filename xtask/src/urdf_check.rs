@@ -57,7 +57,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let _ = writeln!(md, "| --- | --- | ---: | ---: | ---: | ---: |");
     let mut round_trips = Vec::new();
     for (label, full_pose) in [("position", false), ("full pose", true)] {
-        let set = read_series(&args.dataset.input, &args.dataset.series, full_pose).map_err(anyhow::Error::msg)?;
+        let set = read_series(&args.dataset.input, &args.dataset.series, full_pose)?;
         let (train, test) = halves(&set);
         let mut means = Vec::new();
         for form in FORMS {

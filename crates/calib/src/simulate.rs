@@ -1,8 +1,8 @@
 //! `calib simulate`: a simulated tracker campaign written as SPEC measurement CSV, to try the other
 //! subcommands without a robot, or to test a calibration on data whose truth is known.
 
-use pipeline::Error;
 use pipeline::simulated::{self, GeneratorConfig, Perturbation, Remount, TorqueSensorNoise};
+use pipeline::{Error, ErrorKind};
 use std::path::PathBuf;
 
 /// Simulate tracker measurements of a robot whose kinematics are off its nominal.
@@ -68,9 +68,11 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         .with_optional("--effects", args.effects.as_deref())
         .check_output("--out", &args.out)?;
     if args.rows > simulated::MAX_ROWS {
-        return Err(
-            format!("--rows: {}", Error::TooManySimulatedRows { rows: args.rows, max: simulated::MAX_ROWS }).into()
-        );
+        return Err(format!(
+            "--rows: {}",
+            Error::new(ErrorKind::TooManySimulatedRows { rows: args.rows, max: simulated::MAX_ROWS })
+        )
+        .into());
     }
     let robot = args.robot.read()?;
     let effects = match &args.effects {
@@ -87,7 +89,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         && let Some(direction) = robot.planar_direction()
     {
         let file = args.robot.robot.display().to_string();
-        return Err(Error::PlanarChain { file, direction, joints: robot.joint_count() }.into());
+        return Err(Error::in_file(file, ErrorKind::PlanarChain { direction, joints: robot.joint_count() }).into());
     }
     let cell = simulated::campaign_cell(&robot, &Perturbation::default(), &Remount::default(), &config)?;
     // Each row is written as it is drawn (memory of one row, whatever --rows), into the atomic

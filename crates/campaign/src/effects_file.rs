@@ -2,8 +2,8 @@
 //! against the robot at the field at fault. loadsim checks the same values when it simulates, but
 //! without a file to point at; a hostile count (`fixed_point_iterations: 1e18`) it would run for ever.
 
-use errors::Error;
 use errors::ron_position::{field_position, field_position_in, ron_options};
+use errors::{Error, ErrorKind};
 use loadsim::{Backlash, Effects, JointCoupling, PeriodicError};
 use robot::RobotDescription;
 use ron::Value;
@@ -52,8 +52,9 @@ pub fn read_effects(path: &Path, robot: &RobotDescription) -> Result<Effects, Er
 /// Parses an [`Effects`] RON text; `file` names it in errors. A field name that no effect has is
 /// refused at its line: serde would skip it, and a misspelt effect would silently stay off.
 pub fn parse_effects(text: &str, file: &str) -> Result<Effects, Error> {
-    let at =
-        |line: usize, column: usize, message: String| Error::RonFormat { file: file.to_owned(), line, column, message };
+    let at = |line: usize, column: usize, message: String| {
+        Error::at_line(file.to_owned(), line as u64, column, ErrorKind::RonFormat { message })
+    };
     let syntax = |e: ron::error::SpannedError| at(e.span.start.line, e.span.start.col, e.code.to_string());
     let effects: Effects = ron_options().from_str(text).map_err(syntax)?;
     let given: Value = ron_options().from_str(text).map_err(syntax)?;
@@ -106,7 +107,12 @@ pub fn check_effects(effects: &Effects, robot: &RobotDescription, text: &str, fi
     let n = robot.joint_count();
     let at = |section: &str, field: &str, index: usize, message: String| {
         let (line, column) = field_position_in(text, section, field, index);
-        Error::RonFormat { file: file.to_owned(), line, column, message: format!("{section}: {message}") }
+        Error::at_line(
+            file.to_owned(),
+            line as u64,
+            column,
+            ErrorKind::RonFormat { message: format!("{section}: {message}") },
+        )
     };
     // The field a loadsim error names, as the file writes it (`thermal.reference_temp_c` → `reference_temp_c`).
     let named = |error: &loadsim::Error| match error {
@@ -231,12 +237,10 @@ mod tests {
                 3,
             ),
         ] {
-            match parse_effects(text, "e.ron") {
-                Err(Error::RonFormat { file, line: at, .. }) => {
-                    assert_eq!((file.as_str(), at), ("e.ron", line), "{text}")
-                }
-                other => panic!("{text}: {other:?}"),
-            }
+            let e = parse_effects(text, "e.ron").expect_err(text);
+            assert!(matches!(e.kind(), ErrorKind::RonFormat { .. }), "{text}: {e:?}");
+            let place = e.place().expect("a RON error has a place");
+            assert_eq!((place.file(), place.line()), ("e.ron", Some(line)), "{text}");
         }
     }
 
@@ -278,13 +282,11 @@ mod tests {
                 "coupling: term 1: ",
             ),
         ] {
-            match check(text) {
-                Err(Error::RonFormat { file, line, column, message }) => {
-                    assert_eq!((file.as_str(), (line, column)), ("e.ron", position), "{text}: {message}");
-                    assert!(message.contains(words), "{message}");
-                }
-                other => panic!("{text}: {other:?}"),
-            }
+            let e = check(text).expect_err(text);
+            let ErrorKind::RonFormat { message } = e.kind() else { panic!("{text}: {e:?}") };
+            let place = e.place().expect("a RON error has a place");
+            assert_eq!((place.file(), place.position()), ("e.ron", Some(position)), "{text}: {message}");
+            assert!(message.contains(words), "{message}");
         }
     }
 

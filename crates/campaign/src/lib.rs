@@ -31,7 +31,7 @@
 
 mod effects_file;
 
-use errors::Error;
+use errors::{Error, ErrorKind};
 use lie::{SE3, SO3, Twist, Vector3};
 use measurements::{Measurement, MeasurementSet};
 use poe::LocalPoe;
@@ -277,11 +277,11 @@ pub fn simulate(
     full_pose: bool,
 ) -> Result<MeasurementSet, Error> {
     if config.sample_count > MAX_ROWS {
-        return Err(Error::TooManySimulatedRows { rows: config.sample_count, max: MAX_ROWS });
+        return Err(Error::new(ErrorKind::TooManySimulatedRows { rows: config.sample_count, max: MAX_ROWS }));
     }
-    let samples = loadsim::generate(cell, effects, ranges, config)?;
+    let samples = loadsim::generate(cell, effects, ranges, config).map_err(Error::load)?;
     if let Some(row) = samples.iter().position(|s| !finite(s)) {
-        return Err(Error::NonFiniteSimulation { row: row + 1 });
+        return Err(Error::new(ErrorKind::NonFiniteSimulation { row: row + 1 }));
     }
     Ok(measurement_set("simulated", samples, full_pose))
 }
@@ -307,7 +307,7 @@ pub fn simulate_to_csv<W: std::io::Write>(
     path: &str,
 ) -> Result<usize, Error> {
     if config.sample_count > MAX_ROWS {
-        return Err(Error::TooManySimulatedRows { rows: config.sample_count, max: MAX_ROWS });
+        return Err(Error::new(ErrorKind::TooManySimulatedRows { rows: config.sample_count, max: MAX_ROWS }));
     }
     // The tools the rows will use, known before the first row: with `tool_per_run` the runs
     // that have a row (`run_of(i) = i·runs/n`: all of them once n ≥ runs), else the cell's.
@@ -325,19 +325,30 @@ pub fn simulate_to_csv<W: std::io::Write>(
         t_s: true,
         torques: if config.torque_sensor.is_some() { cell.robot.joint_count() } else { 0 },
     };
-    let io = |source: std::io::Error| Error::Io { path: path.to_owned(), source };
+    let io = |source: std::io::Error| Error::io(path.to_owned(), source);
     let mut out = measurements::MeasurementWriter::new(writer, columns).map_err(io)?;
     let mut written = 0;
     loadsim::generate_each(cell, effects, ranges, config, |sample| {
         if !finite(&sample) {
-            return Err(Error::NonFiniteSimulation { row: written + 1 });
+            return Err(Written(Error::new(ErrorKind::NonFiniteSimulation { row: written + 1 })));
         }
-        out.write_row(&measurement(written, sample, &used, full_pose)).map_err(io)?;
+        out.write_row(&measurement(written, sample, &used, full_pose)).map_err(|e| Written(io(e)))?;
         written += 1;
         Ok(())
-    })?;
+    })
+    .map_err(|Written(e)| e)?;
     out.finish().map_err(io)?;
     Ok(written)
+}
+
+/// The error of a simulated set being written, as `loadsim::generate_each` wants it (one its
+/// own errors convert into; `errors` knows no `loadsim`).
+struct Written(Error);
+
+impl From<loadsim::Error> for Written {
+    fn from(e: loadsim::Error) -> Self {
+        Written(Error::load(e))
+    }
 }
 
 #[cfg(test)]
@@ -382,7 +393,10 @@ mod tests {
         let noise = TrackerNoise { transverse_sigma_per_m: 1e308, ..TrackerNoise::default() };
         let effects = Effects { tracker_noise: Some(noise), ..Effects::default() };
         let result = simulate(&cell, &effects, &joint_ranges(&robot), &config, true);
-        assert!(matches!(result, Err(Error::NonFiniteSimulation { row: 1 })), "{result:?}");
+        assert!(
+            matches!(result.as_ref().map_err(Error::kind), Err(ErrorKind::NonFiniteSimulation { row: 1 })),
+            "{result:?}"
+        );
     }
 
     #[test]
@@ -460,9 +474,15 @@ mod tests {
         let noise = TrackerNoise { transverse_sigma_per_m: 1e308, ..TrackerNoise::default() };
         let effects = Effects { tracker_noise: Some(noise), ..Effects::default() };
         let result = simulate_to_csv(&cell, &effects, &joint_ranges(&robot), &config, true, Vec::new(), "mem");
-        assert!(matches!(result, Err(Error::NonFiniteSimulation { row: 1 })), "{result:?}");
+        assert!(
+            matches!(result.as_ref().map_err(Error::kind), Err(ErrorKind::NonFiniteSimulation { row: 1 })),
+            "{result:?}"
+        );
         let many = GeneratorConfig { sample_count: MAX_ROWS + 1, ..GeneratorConfig::default() };
         let result = simulate_to_csv(&cell, &effects, &joint_ranges(&robot), &many, true, Vec::new(), "mem");
-        assert!(matches!(result, Err(Error::TooManySimulatedRows { .. })), "{result:?}");
+        assert!(
+            matches!(result.as_ref().map_err(Error::kind), Err(ErrorKind::TooManySimulatedRows { .. })),
+            "{result:?}"
+        );
     }
 }

@@ -172,7 +172,7 @@ fn errors(target: &PoseTarget, pose: &SE3) -> (Vector3, Vector3) {
 
 /// The tool-point Jacobian (point rows, then rotation rows if the orientation counts).
 fn jacobian(model: &CalibratedModel, q: &[f64], tool: usize, orientation: bool) -> Result<DMatrix<f64>, Error> {
-    let full = loadsim::tool_point_jacobian(&model.kinematics, q, tool)?;
+    let full = loadsim::tool_point_jacobian(&model.kinematics, q, tool).map_err(Error::load)?;
     Ok(if orientation { full } else { full.rows(0, 3).into_owned() })
 }
 

@@ -14,7 +14,7 @@
 //! compensation is the error a user with a registered cell would see.
 
 use crate::inverse::{InverseOptions, PoseTarget, Solved, TargetStatus, solve_targets};
-use errors::Error;
+use errors::{Error, ErrorKind};
 use lie::{SE3, SO3};
 use measurements::{Cells, ColumnMap, MeasurementSet, ReadOptions};
 use model::CalibratedModel;
@@ -104,11 +104,12 @@ pub fn read_targets(path: &Path, model: &CalibratedModel, columns: ColumnMap) ->
             set.format.mapped_columns.iter().find(|(spec, _)| spec == name).map_or(name.to_owned(), |(_, h)| h.clone())
         };
         let column = names.iter().find_map(|n| cells.header.iter().position(|h| *h == mapped(n))).map_or(1, |i| i + 1);
-        return Err(Error::TargetOrientation {
-            file: set.source.clone(),
+        return Err(Error::at_line(
+            set.source.clone(),
+            1,
             column,
-            without_position: !set.positions_measured,
-        });
+            ErrorKind::TargetOrientation { without_position: !set.positions_measured },
+        ));
     }
     Ok(TargetFile { set, cells })
 }
@@ -132,27 +133,28 @@ pub fn registered_nominal(
 ) -> Result<RegisteredNominal, Error> {
     let nominal = robot.nominal_model()?;
     if nominal.joint_count() != model.joint_count() {
-        return Err(Error::RobotJointCount {
-            file: file.to_owned(),
-            robot: nominal.joint_count(),
-            model: model.joint_count(),
-        });
+        return Err(Error::in_file(
+            file.to_owned(),
+            ErrorKind::RobotJointCount { robot: nominal.joint_count(), model: model.joint_count() },
+        ));
     }
     let config = loadsim::GeneratorConfig {
         sample_count: options.registration_configurations,
         seed: options.registration_seed,
         ..loadsim::GeneratorConfig::default()
     };
-    let configurations = loadsim::sample_configurations(&nominal, 0, &campaign::joint_ranges(robot), &config)?;
+    let configurations =
+        loadsim::sample_configurations(&nominal, 0, &campaign::joint_ranges(robot), &config).map_err(Error::load)?;
     let mut observations = Vec::new();
     for q in &configurations {
         for tool in 0..model.kinematics.tool_count() {
-            let pose = model.kinematics.forward(q, tool)?;
+            let pose = model.kinematics.forward(q, tool).map_err(Error::kinematics)?;
             let target = if model.full_pose { Target::Pose(pose) } else { Target::Point(pose.translation()) };
             observations.push(Observation { q: q.clone(), tool, target });
         }
     }
-    let fitted = poe::identify::calibrate(&nominal, &observations, Scope::BaseTool, &IdentificationOptions::default())?;
+    let fitted = poe::identify::calibrate(&nominal, &observations, Scope::BaseTool, &IdentificationOptions::default())
+        .map_err(Error::kinematics)?;
     let squares: f64 = observations
         .iter()
         .map(|o| {
@@ -166,11 +168,10 @@ pub fn registered_nominal(
         .sum();
     let rms_m = (squares / observations.len().max(1) as f64).sqrt();
     if rms_m > options.nominal.offset_m {
-        return Err(Error::RegistrationMismatch {
-            file: file.to_owned(),
-            rms_mm: rms_m * 1e3,
-            limit_mm: options.nominal.offset_m * 1e3,
-        });
+        return Err(Error::in_file(
+            file.to_owned(),
+            ErrorKind::RegistrationMismatch { rms_mm: rms_m * 1e3, limit_mm: options.nominal.offset_m * 1e3 },
+        ));
     }
     Ok(RegisteredNominal { model: fitted.model, rms_m })
 }
@@ -206,7 +207,8 @@ pub fn pose_targets(
     options: &CompensateOptions,
 ) -> Result<(Vec<PoseTarget>, Option<RegisteredNominal>), Error> {
     let tools = model::tool_indices(model, &file.set)?;
-    let need_robot = || Error::TargetsNeedRobot { file: file.set.source.clone(), poses: file.poses() };
+    let need_robot =
+        || Error::at_line(file.set.source.clone(), 1, 1, ErrorKind::TargetsNeedRobot { poses: file.poses() });
     if !file.poses() {
         let (robot, robot_file) = robot.ok_or_else(need_robot)?;
         let registered = registered_nominal(model, robot, robot_file, options)?;
@@ -218,7 +220,7 @@ pub fn pose_targets(
             .map(|(row, &tool)| {
                 Ok(PoseTarget {
                     seed: row.q.clone(),
-                    pose: registered.model.forward(&row.q, tool)?,
+                    pose: registered.model.forward(&row.q, tool).map_err(Error::kinematics)?,
                     orientation: model.full_pose,
                     payload_kg: row.payload_kg,
                     tool,

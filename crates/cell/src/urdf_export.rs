@@ -11,7 +11,7 @@
 
 use crate::urdf_like::{check_joint_kinds, write_like};
 use crate::urdf_text::{Written, escape, fixed_joint, origin_element};
-use errors::Error;
+use errors::{Error, ErrorKind};
 use lie::SE3;
 use measurements::MeasurementSet;
 use model::{CalibratedModel, ErrorSummary};
@@ -132,7 +132,7 @@ pub fn export_urdf(
                 without_each,
             })
         }
-        None if !not_in_urdf.is_empty() => return Err(Error::ExportNeedsData { parts: not_in_urdf }),
+        None if !not_in_urdf.is_empty() => return Err(Error::new(ErrorKind::ExportNeedsData { parts: not_in_urdf })),
         None => None,
     };
     let (nominal, nominal_file) = match template {
@@ -252,7 +252,7 @@ fn write_plain(
             (JointKind::Revolute, Some(_)) => "revolute",
             (JointKind::Revolute, None) => "continuous",
             (JointKind::Prismatic, Some(_)) => "prismatic",
-            (JointKind::Prismatic, None) => return Err(Error::PrismaticWithoutLimits { joint: i + 1 }),
+            (JointKind::Prismatic, None) => return Err(Error::new(ErrorKind::PrismaticWithoutLimits { joint: i + 1 })),
         };
         let staged = joint.scale != 1.0;
         let _ = writeln!(

@@ -15,7 +15,7 @@
 //! carries them exactly, and the multipliers stay as written.
 
 use crate::urdf_text::{Written, escape, fixed_joint, origin_element};
-use errors::Error;
+use errors::{Error, ErrorKind};
 use lie::SE3;
 use poe::{JointKind, LocalPoe};
 use robot::{StepMotion, UrdfChain, UrdfDocument};
@@ -41,18 +41,28 @@ pub(crate) fn check_joint_kinds(document: &UrdfDocument, chain: &UrdfChain, mode
         };
         if urdf_kind != model_kind {
             let (line, column) = document.element("joint", &step.joint).map_or((1, 1), |e| e.position);
-            return Err(Error::UrdfJointKind {
-                file: document.file().to_owned(),
-                line,
+            return Err(Error::at_line(
+                document.file().to_owned(),
+                line as u64,
                 column,
-                joint: step.joint.clone(),
-                index: k + 1,
-                urdf: urdf_kind,
-                model: model_kind,
-            });
+                ErrorKind::UrdfJointKind {
+                    joint: step.joint.clone(),
+                    index: k + 1,
+                    urdf: error_kind(urdf_kind),
+                    model: error_kind(model_kind),
+                },
+            ));
         }
     }
     Ok(())
+}
+
+/// A joint's kind as an error names it (the errors know no kinematics crate).
+fn error_kind(kind: JointKind) -> errors::JointKind {
+    match kind {
+        JointKind::Revolute => errors::JointKind::Revolute,
+        JointKind::Prismatic => errors::JointKind::Prismatic,
+    }
 }
 
 pub(crate) fn write_like(
@@ -64,7 +74,8 @@ pub(crate) fn write_like(
 ) -> Result<Written, Error> {
     let nominal = chain.description().nominal_model()?;
     let zero = vec![0.0; nominal.joint_count()];
-    let (nominal_frames, calibrated_frames) = (nominal.frames(&zero)?, in_base.frames(&zero)?);
+    let (nominal_frames, calibrated_frames) =
+        (nominal.frames(&zero).map_err(Error::kinematics)?, in_base.frames(&zero).map_err(Error::kinematics)?);
     let link_frames = chain.link_frames();
     let text = document.text();
     // (byte offset, bytes replaced, new text), applied from the end.

@@ -46,7 +46,7 @@ impl Design {
         let mut points = Vec::with_capacity(data.rows.len());
         let mut buffer = vec![0.0; rows_per_pose * columns];
         for (i, row) in data.rows.iter().enumerate() {
-            let pose = model.identification_jacobian(&row.q, row.tool, kind, &mut buffer)?;
+            let pose = model.identification_jacobian(&row.q, row.tool, kind, &mut buffer).map_err(Error::kinematics)?;
             let base = i * rows_per_pose;
             let d = row.position - pose.translation();
             for r in 0..3 {

@@ -59,7 +59,7 @@ pub use verdict::{GpCheck, InputScale, Verdict, VerdictOptions};
 
 use design::{Design, Weights};
 use effects::IdentifiedEffect;
-use errors::Error;
+use errors::{Error, ErrorKind};
 use lie::Vector3;
 use measurements::MeasurementSet;
 use model::geometric::{fit_geometry, observations};
@@ -143,7 +143,7 @@ impl DiagnoseOptions {
         ];
         for (field, value) in positive {
             if !(value.is_finite() && value > 0.0) {
-                return Err(Error::DiagnoseOption { field, value });
+                return Err(Error::new(ErrorKind::DiagnoseOption { field, value }));
             }
         }
         let fractions: [(&'static str, f64); 5] = [
@@ -155,7 +155,7 @@ impl DiagnoseOptions {
         ];
         for (field, value) in fractions {
             if !(0.0..1.0).contains(&value) {
-                return Err(Error::DiagnoseOption { field, value });
+                return Err(Error::new(ErrorKind::DiagnoseOption { field, value }));
             }
         }
         let at_least_zero: [(&'static str, f64); 2] = [
@@ -164,18 +164,18 @@ impl DiagnoseOptions {
         ];
         for (field, value) in at_least_zero {
             if !(value.is_finite() && value >= 0.0) {
-                return Err(Error::DiagnoseOption { field, value });
+                return Err(Error::new(ErrorKind::DiagnoseOption { field, value }));
             }
         }
         if self.arc_folds < 2 {
-            return Err(Error::DiagnoseOption { field: "arc_folds", value: self.arc_folds as f64 });
+            return Err(Error::new(ErrorKind::DiagnoseOption { field: "arc_folds", value: self.arc_folds as f64 }));
         }
         if self.folds < 3 {
             // Inner cross-validation inside a fold needs two folds left.
-            return Err(Error::DiagnoseOption { field: "folds", value: self.folds as f64 });
+            return Err(Error::new(ErrorKind::DiagnoseOption { field: "folds", value: self.folds as f64 }));
         }
         if self.selection.series_orders.is_empty() || self.selection.series_orders.contains(&0) {
-            return Err(Error::DiagnoseOption { field: "selection.series_orders", value: 0.0 });
+            return Err(Error::new(ErrorKind::DiagnoseOption { field: "selection.series_orders", value: 0.0 }));
         }
         Ok(())
     }
@@ -390,14 +390,14 @@ pub fn diagnose(
     let folds = options.folds;
     let needed = folds * 10;
     if data.rows.len() < needed {
-        return Err(Error::TooFewRows { file: data.source.clone(), rows: data.rows.len(), needed });
+        return Err(Error::in_file(data.source.clone(), ErrorKind::TooFewRows { rows: data.rows.len(), needed }));
     }
     let nominal = robot.nominal_model()?;
     let screened = outliers::screen(&nominal, data, &options.outliers)?;
     let data = screened.data.as_ref();
     let geometry = fit_geometry(&nominal, data, Scope::Full, &IdentificationOptions::default())?;
     let model = geometry.model;
-    let stats = poe::identify::evaluate(&model, &observations(data))?;
+    let stats = poe::identify::evaluate(&model, &observations(data)).map_err(Error::kinematics)?;
     // Weight each kind of row by its own residual scale, so that neither swamps the other.
     let weights = Weights {
         position_m: (stats.rms_position_m / 3f64.sqrt()).max(1e-9),
@@ -452,8 +452,11 @@ pub fn diagnose(
 
     // What any smooth function of the joint angles explains, before and after the effects.
     let single_critical = statistics::normal_quantile(1.0 - options.selection.significance);
-    let link1: Vec<lie::SO3> =
-        data.rows.iter().map(|row| Ok(model.frames(&row.q)?[0].rotation())).collect::<Result<_, Error>>()?;
+    let link1: Vec<lie::SO3> = data
+        .rows
+        .iter()
+        .map(|row| Ok(model.frames(&row.q).map_err(Error::kinematics)?[0].rotation()))
+        .collect::<Result<_, Error>>()?;
     let structure = |residuals: &[lie::Vector6]| {
         structure::residual_structure(residuals, &link1, data, &moving, &fold, folds, &options.structure)
     };
@@ -539,7 +542,8 @@ pub fn diagnose(
 
     // Base-frame axes for the breakdown: tracker_from_base = calibrated · nominal⁻¹ at q = 0.
     let zero = vec![0.0; robot.joint_count()];
-    let tracker_from_base = model.frames(&zero)?[0] * nominal.frames(&zero)?[0].inverse();
+    let tracker_from_base = model.frames(&zero).map_err(Error::kinematics)?[0]
+        * nominal.frames(&zero).map_err(Error::kinematics)?[0].inverse();
     let base_from_tracker = tracker_from_base.inverse();
     let to_base = |v: &lie::Vector6| -> [f64; 3] {
         let r = base_from_tracker.rotation().act(&Vector3::new(v[0], v[1], v[2])) * 1e3;

@@ -14,7 +14,7 @@
 use super::design::{Design, Weights};
 #[cfg(test)]
 use super::statistics::mean;
-use errors::Error;
+use errors::{Error, ErrorKind};
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
 use faer::{Accum, Mat, Par, Side};
@@ -393,7 +393,9 @@ impl Pool {
             [] => self.gram.len() - 1,
             [f] if f < folds => f,
             [f, g] if f < folds && g < folds && f != g => pair_index(folds, f.min(g), f.max(g)),
-            _ => return Err(Error::DiagnoseSolve { left_out: left_out.to_vec(), columns: m, pivot: 0 }),
+            _ => {
+                return Err(Error::new(ErrorKind::DiagnoseSolve { left_out: left_out.to_vec(), columns: m, pivot: 0 }));
+            }
         };
         let (gram, xty) = (&self.gram[index], &self.xty[index]);
         let mut a = Mat::<f64>::zeros(m, m);
@@ -420,7 +422,7 @@ impl Pool {
             let pivot = match e {
                 faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => index,
             };
-            Error::DiagnoseSolve { left_out: left_out.to_vec(), columns: m, pivot }
+            Error::new(ErrorKind::DiagnoseSolve { left_out: left_out.to_vec(), columns: m, pivot })
         })?;
         Ok((Factor { l: llt.L().to_owned(), d }, rhs))
     }
@@ -634,7 +636,7 @@ mod tests {
         let blocks = [(std::slice::from_ref(&effect), None)];
         let pool = Pool::new(&design, &prior(1.0), &blocks, &fold, 5, &PriorOptions::default());
         let error = pool.solve(&[0], &(0..13).collect::<Vec<_>>()).unwrap_err();
-        assert!(matches!(error, Error::DiagnoseSolve { columns: 13, .. }), "{error}");
+        assert!(matches!(error.kind(), ErrorKind::DiagnoseSolve { columns: 13, .. }), "{error}");
         assert!(pool.solve(&[0], &(0..12).collect::<Vec<_>>()).is_ok(), "the kinematic columns alone are fine");
     }
 }

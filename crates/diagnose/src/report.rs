@@ -5,7 +5,7 @@ use super::candidates::Effect;
 use super::noise::NoiseSource;
 use super::regions::{PoseDiagnosis, Region};
 use super::{Diagnosis, svg};
-use errors::Error;
+use errors::{Error, ErrorKind};
 use serde::{Deserialize, Serialize};
 
 /// One candidate tried alone on top of the geometric model.
@@ -115,7 +115,7 @@ fn list(joints: &[usize]) -> String {
 impl Diagnosis {
     /// The SPEC JSON text: the diagnosis as it is, without the per-pose table.
     pub fn to_json(&self) -> Result<String, Error> {
-        serde_json::to_string(self).map_err(|source| Error::Json { what: "diagnosis", source })
+        serde_json::to_string(self).map_err(|source| Error::new(ErrorKind::Json { what: "diagnosis", source }))
     }
 
     /// The region whose geometric-model error is largest, with at least 15 poses.

@@ -141,9 +141,9 @@ pub(crate) fn residual_structure(
         }
         let xt = Mat::from_fn(train.len(), x.ncols(), |i, c| x[(train[i], c)]);
         let yt = Mat::from_fn(train.len(), 3, |i, c| local[train[i]][c]);
-        let model = gp::ExactGp::fit(xt.as_ref(), yt.as_ref(), &config)?;
+        let model = gp::ExactGp::fit(xt.as_ref(), yt.as_ref(), &config).map_err(Error::gp)?;
         let xs = Mat::from_fn(test.len(), x.ncols(), |i, c| x[(test[i], c)]);
-        let predicted = model.predict_mean(xs.as_ref())?;
+        let predicted = model.predict_mean(xs.as_ref()).map_err(Error::gp)?;
         let left = test
             .iter()
             .enumerate()

@@ -9,7 +9,7 @@ use crate::{
     Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect, has_torques,
     stand_in_dynamics,
 };
-use errors::Error;
+use errors::{Error, ErrorKind};
 use loadsim::{Payload, RobotDynamics};
 use measurements::Measurement;
 use serde::{Deserialize, Serialize};
@@ -70,15 +70,20 @@ impl Backlash {
     /// The torque of the joint at one row, whose sign is the feature.
     pub fn torque(&self, row: &Measurement, tool: usize) -> Result<f64, Error> {
         let j = self.joint;
-        let missing = Error::EffectJoint { joint: j + 1, joint_count: row.q.len() };
+        let missing = Error::new(ErrorKind::EffectJoint { joint: j + 1, joint_count: row.q.len() });
         match &self.sign {
             TorqueSign::Measured => match &row.torques_nm {
                 Some(tau) => tau.get(j).copied().ok_or(missing),
-                None => Err(Error::EffectNeedsColumn { line: row.line, effect: "backlash", column: "tau1_nm" }),
+                None => Err(Error::new(ErrorKind::EffectNeedsColumn {
+                    line: row.line,
+                    effect: "backlash",
+                    column: "tau1_nm",
+                })),
             },
             TorqueSign::Stated { load, dynamics } => {
                 let payload = Payload::at_tool(row.payload_kg);
-                let torque = loadsim::static_torque(&load.base_model, dynamics, &row.q, tool, &payload)?;
+                let torque =
+                    loadsim::static_torque(&load.base_model, dynamics, &row.q, tool, &payload).map_err(Error::load)?;
                 torque.get(j).copied().ok_or(missing)
             }
             TorqueSign::Learnt { load, columns, coefficients } => {

@@ -4,7 +4,7 @@
 //! (`EffectTerm::check`, in its file) through a [`Cursor`]; this module places the faults.
 
 use super::{IdentifiedEffect, LoadFrame};
-use errors::Error;
+use errors::{Error, ErrorKind};
 
 /// What is wrong, where.
 #[derive(Debug)]
@@ -41,17 +41,25 @@ impl EffectFault {
         let field = self.path;
         match self.kind {
             FaultKind::Count { what, found, expected } => {
-                Error::ModelCount { file, line, column, field, what, found, expected }
+                Error::at_line(file, line as u64, column, ErrorKind::ModelCount { field, what, found, expected })
             }
-            FaultKind::Index { index, limit } => Error::ModelIndex { file, line, column, field, index, limit },
-            FaultKind::NotFinite { value } => Error::NotFinite { file, line, column, field, value },
-            FaultKind::Value { value, limit } => Error::ModelValue { file, line, column, field, value, limit },
-            FaultKind::Order { low, high } => Error::RonFormat {
+            FaultKind::Index { index, limit } => {
+                Error::at_line(file, line as u64, column, ErrorKind::ModelIndex { field, index, limit })
+            }
+            FaultKind::NotFinite { value } => {
+                Error::at_line(file, line as u64, column, ErrorKind::NotFinite { field, value })
+            }
+            FaultKind::Value { value, limit } => {
+                Error::at_line(file, line as u64, column, ErrorKind::ModelValue { field, value, limit })
+            }
+            FaultKind::Order { low, high } => Error::at_line(
                 file,
-                line,
+                line as u64,
                 column,
-                message: format!("{field} is [{low}, {high}]: its first value must not exceed its second"),
-            },
+                ErrorKind::RonFormat {
+                    message: format!("{field} is [{low}, {high}]: its first value must not exceed its second"),
+                },
+            ),
         }
     }
 }

@@ -11,7 +11,7 @@ use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect, has_torques};
 
 use crate::Direction;
-use errors::Error;
+use errors::{Error, ErrorKind};
 use measurements::Measurement;
 use serde::{Deserialize, Serialize};
 
@@ -55,11 +55,9 @@ impl TorqueFit {
         for (row, &tool) in rows.iter().zip(tools) {
             let all = load.regressors(row, tool)?;
             regressors.push(all.get(joint).cloned().unwrap_or_default());
-            let tau = row.torques_nm.as_ref().and_then(|t| t.get(joint)).copied().ok_or(Error::EffectNeedsColumn {
-                line: row.line,
-                effect: "joint_compliance",
-                column: "tau1_nm",
-            })?;
+            let tau = row.torques_nm.as_ref().and_then(|t| t.get(joint)).copied().ok_or(Error::new(
+                ErrorKind::EffectNeedsColumn { line: row.line, effect: "joint_compliance", column: "tau1_nm" },
+            ))?;
             measured.push(tau);
         }
         let width = regressors.first().map_or(0, Vec::len);
@@ -162,7 +160,11 @@ impl JointCompliance {
             }
             ComplianceTorque::Measured => match &row.torques_nm {
                 Some(tau) => Ok(tau.iter().map(|t| vec![*t]).collect()),
-                None => Err(Error::EffectNeedsColumn { line: row.line, effect: "joint_compliance", column: "tau1_nm" }),
+                None => Err(Error::new(ErrorKind::EffectNeedsColumn {
+                    line: row.line,
+                    effect: "joint_compliance",
+                    column: "tau1_nm",
+                })),
             },
             ComplianceTorque::GravityRegressor(load) => load.regressors(row, tool),
         }
@@ -190,7 +192,7 @@ impl Regressor for JointCompliance {
                     .get(t.joint)
                     .and_then(|r| r.get(t.column))
                     .copied()
-                    .ok_or(Error::EffectJoint { joint: t.joint + 1, joint_count: torques.len() })?;
+                    .ok_or(Error::new(ErrorKind::EffectJoint { joint: t.joint + 1, joint_count: torques.len() }))?;
                 Ok(value / t.scale)
             })
             .collect()

@@ -1,7 +1,7 @@
 //! Where one effect parameter moves the pose: the left twist that a unit of its scaled feature
 //! adds, in the model's reference frame (the tracker for a calibrated model).
 
-use errors::Error;
+use errors::{Error, ErrorKind};
 use lie::{Twist, Vector6};
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
@@ -41,11 +41,14 @@ impl<'a> RowTwists<'a> {
         match direction {
             Direction::Joint(j) => {
                 if self.spatial.is_none() {
-                    self.spatial = Some(self.model.spatial_twists(self.q)?);
+                    self.spatial = Some(self.model.spatial_twists(self.q).map_err(Error::kinematics)?);
                 }
                 let spatial = self.spatial.as_deref().unwrap_or(&[]);
                 let joint_count = spatial.len();
-                spatial.get(j).map(Twist::to_vector).ok_or(Error::EffectJoint { joint: j + 1, joint_count })
+                spatial
+                    .get(j)
+                    .map(Twist::to_vector)
+                    .ok_or(Error::new(ErrorKind::EffectJoint { joint: j + 1, joint_count }))
             }
             Direction::Component(k) => {
                 let mut twist = Vector6::zeros();
@@ -56,7 +59,8 @@ impl<'a> RowTwists<'a> {
             }
             Direction::LinkGrowth => {
                 if self.growth.is_none() {
-                    let columns = loadsim::thermal_regressor(self.model, self.q, self.tool, 1.0)?;
+                    let columns =
+                        loadsim::thermal_regressor(self.model, self.q, self.tool, 1.0).map_err(Error::load)?;
                     // Column 0 grows the tracker-to-base distance, which is not a robot link.
                     self.growth = Some(columns.iter().skip(1).map(|c| c.twist).sum());
                 }

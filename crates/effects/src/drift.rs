@@ -6,7 +6,7 @@ use crate::Direction;
 use crate::check::{Cursor, EffectFault};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect};
-use errors::Error;
+use errors::{Error, ErrorKind};
 use measurements::Measurement;
 use serde::{Deserialize, Serialize};
 
@@ -33,7 +33,13 @@ impl TimeDrift {
     pub fn new(rows: &[Measurement], hold_beyond_span: f64) -> Result<Self, Error> {
         let times: Vec<f64> = rows
             .iter()
-            .map(|r| r.t_s.ok_or(Error::EffectNeedsColumn { line: r.line, effect: "time_drift", column: "t_s" }))
+            .map(|r| {
+                r.t_s.ok_or(Error::new(ErrorKind::EffectNeedsColumn {
+                    line: r.line,
+                    effect: "time_drift",
+                    column: "t_s",
+                }))
+            })
             .collect::<Result<_, _>>()?;
         check_column_varies(&times, rows, "time_drift", "t_s")?;
         let reference_s = times.iter().sum::<f64>() / times.len().max(1) as f64;
@@ -53,7 +59,11 @@ impl Regressor for TimeDrift {
     }
 
     fn features(&self, row: &Measurement, _tool: usize) -> Result<Vec<f64>, Error> {
-        let t = row.t_s.ok_or(Error::EffectNeedsColumn { line: row.line, effect: "time_drift", column: "t_s" })?;
+        let t = row.t_s.ok_or(Error::new(ErrorKind::EffectNeedsColumn {
+            line: row.line,
+            effect: "time_drift",
+            column: "t_s",
+        }))?;
         // Past the span (and its margin) the drift falls back to the placement the geometry holds:
         // a later session starts from a placement of its own, which no line from this one knows.
         if self.fitted_span.is_some_and(|[low, high]| !(low..=high).contains(&t)) {

@@ -17,7 +17,7 @@ use crate::Direction;
 use crate::check::{Cursor, EffectFault, FaultKind};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect, MAX_HARMONICS};
-use errors::Error;
+use errors::{Error, ErrorKind};
 use measurements::Measurement;
 use serde::{Deserialize, Serialize};
 
@@ -260,7 +260,10 @@ impl Regressor for GearPeriodic {
     }
 
     fn features(&self, row: &Measurement, _tool: usize) -> Result<Vec<f64>, Error> {
-        let q = *row.q.get(self.joint).ok_or(Error::EffectJoint { joint: self.joint + 1, joint_count: row.q.len() })?;
+        let q = *row
+            .q
+            .get(self.joint)
+            .ok_or(Error::new(ErrorKind::EffectJoint { joint: self.joint + 1, joint_count: row.q.len() }))?;
         Ok(self.features_at(q))
     }
 
@@ -390,7 +393,7 @@ impl NewEffect for GearPeriodic {
     ) -> Result<Self, Error> {
         let joint = spec.joint_index()?;
         if context.robot.joints[joint].kind == robot::JointType::Prismatic {
-            return Err(Error::EffectJointKind { effect: "gear_periodic", joint: joint + 1 });
+            return Err(Error::new(ErrorKind::EffectJointKind { effect: "gear_periodic", joint: joint + 1 }));
         }
         let harmonics = spec.required_harmonics()?;
         GearPeriodic::with_options(joint, (1..=harmonics).collect(), rows, &context.gear)

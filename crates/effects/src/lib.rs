@@ -59,7 +59,7 @@ pub use check::{EffectFault, FaultKind, check_effects};
 pub use correction::EffectCorrection;
 pub use direction::RowTwists;
 
-use errors::Error;
+use errors::{Error, ErrorKind};
 use lie::Vector6;
 use measurements::Measurement;
 use poe::LocalPoe;
@@ -102,13 +102,13 @@ pub fn check_column_varies(
     column: &'static str,
 ) -> Result<(), Error> {
     match values.first() {
-        Some(&value) if values.iter().all(|&v| v == value) => Err(Error::EffectColumnConstant {
+        Some(&value) if values.iter().all(|&v| v == value) => Err(Error::new(ErrorKind::EffectColumnConstant {
             effect,
             column,
             value,
             rows: values.len(),
             lines: [rows.first().map_or(0, |r| r.line), rows.last().map_or(0, |r| r.line)],
-        }),
+        })),
         _ => Ok(()),
     }
 }
@@ -172,11 +172,7 @@ macro_rules! identified_effect {
                     $( EffectKind::$kind => {
                         <$kind as NewEffect>::build(spec, context, rows, tools).map(IdentifiedEffect::$kind)
                     } )*
-                    _ => Err(Error::EffectList {
-                        column: 1,
-                        text: spec.to_string(),
-                        fault: EffectListFault::UnknownEffect,
-                    }),
+                    _ => Err(Error::at_line("--effects", 1, 1, ErrorKind::EffectList { text: spec.to_string(), fault: EffectListFault::UnknownEffect })),
                 }
             }
 
@@ -239,7 +235,7 @@ impl IdentifiedEffect {
     ) -> Result<Self, Error> {
         let joint_count = context.robot.joint_count();
         if let Some(joint) = spec.joint.filter(|&j| j == 0 || j > joint_count) {
-            return Err(Error::EffectJoint { joint, joint_count });
+            return Err(Error::new(ErrorKind::EffectJoint { joint, joint_count }));
         }
         Self::build(spec, context, rows, tools)
     }

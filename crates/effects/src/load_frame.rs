@@ -52,8 +52,9 @@ impl LoadFrame {
             let mut sum = Vector3::zeros();
             let mut rotation = None;
             for q in &carried {
-                let flange = base_model.frames(q)?.last().copied().unwrap_or_else(SE3::identity);
-                let local = flange.inverse() * in_base.forward(q, tool)?;
+                let flange =
+                    base_model.frames(q).map_err(Error::kinematics)?.last().copied().unwrap_or_else(SE3::identity);
+                let local = flange.inverse() * in_base.forward(q, tool).map_err(Error::kinematics)?;
                 sum += local.translation();
                 rotation.get_or_insert(local.rotation());
             }
@@ -74,9 +75,10 @@ impl LoadFrame {
     /// is `Y_j(q) π + τ_payload,j` with `π` the links' unknown mass moments.
     pub fn regressors(&self, row: &Measurement, tool: usize) -> Result<Vec<Vec<f64>>, Error> {
         let g = self.gravity();
-        let y = loadsim::gravity_regressor(&self.base_model, &row.q, &g)?;
+        let y = loadsim::gravity_regressor(&self.base_model, &row.q, &g).map_err(Error::load)?;
         let payload =
-            loadsim::payload_gravity_torque(&self.base_model, &row.q, tool, &Payload::at_tool(row.payload_kg), &g)?;
+            loadsim::payload_gravity_torque(&self.base_model, &row.q, tool, &Payload::at_tool(row.payload_kg), &g)
+                .map_err(Error::load)?;
         Ok((0..y.nrows())
             .map(|j| (0..y.ncols()).map(|c| y[(j, c)]).chain(std::iter::once(payload[j])).collect())
             .collect())

@@ -6,7 +6,7 @@
 //! so a new effect is parsed and printed without a change here.
 
 use crate::IdentifiedEffect;
-use errors::Error;
+use errors::{Error, ErrorKind};
 use loadsim::EffectKind;
 use std::fmt;
 use std::str::FromStr;
@@ -94,7 +94,12 @@ impl EffectSpec {
     fn missing(&self) -> Error {
         let expected = self.arguments().len();
         let found = usize::from(self.joint.is_some()) + usize::from(self.harmonics.is_some());
-        Error::EffectList { column: 1, text: self.to_string(), fault: EffectListFault::Arguments { expected, found } }
+        Error::at_line(
+            "--effects",
+            1,
+            1,
+            ErrorKind::EffectList { text: self.to_string(), fault: EffectListFault::Arguments { expected, found } },
+        )
     }
 }
 
@@ -166,10 +171,13 @@ impl FromStr for EffectSelection {
     type Err = Error;
 
     fn from_str(text: &str) -> Result<Self, Error> {
-        let fault = |offset: usize, item: &str, fault| Error::EffectList {
-            column: text[..offset].chars().count() + 1,
-            text: item.to_owned(),
-            fault,
+        let fault = |offset: usize, item: &str, fault| {
+            Error::at_line(
+                "--effects",
+                1,
+                text[..offset].chars().count() + 1,
+                ErrorKind::EffectList { text: item.to_owned(), fault },
+            )
         };
         if text.trim().is_empty() {
             return Err(fault(0, text, EffectListFault::Empty));
@@ -207,9 +215,12 @@ mod tests {
     use super::*;
 
     fn fault_of(text: &str) -> (usize, String, EffectListFault) {
-        match text.parse::<EffectSelection>() {
-            Err(Error::EffectList { column, text, fault }) => (column, text, fault),
-            other => panic!("{text}: {other:?}"),
+        let e = text.parse::<EffectSelection>().expect_err(text);
+        match (e.place(), e.kind()) {
+            (Some(place), ErrorKind::EffectList { text, fault }) if place.file() == "--effects" => {
+                (place.column().expect("a column"), text.clone(), *fault)
+            }
+            _ => panic!("{text}: {e:?}"),
         }
     }
 

@@ -6,7 +6,7 @@ use crate::Direction;
 use crate::check::{Cursor, EffectFault};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect};
-use errors::Error;
+use errors::{Error, ErrorKind};
 use measurements::Measurement;
 use serde::{Deserialize, Serialize};
 
@@ -32,7 +32,13 @@ impl Thermal {
     pub fn new(rows: &[Measurement], hold_beyond_span: f64) -> Result<Self, Error> {
         let temps: Vec<f64> = rows
             .iter()
-            .map(|r| r.temp_c.ok_or(Error::EffectNeedsColumn { line: r.line, effect: "thermal", column: "temp_c" }))
+            .map(|r| {
+                r.temp_c.ok_or(Error::new(ErrorKind::EffectNeedsColumn {
+                    line: r.line,
+                    effect: "thermal",
+                    column: "temp_c",
+                }))
+            })
             .collect::<Result<_, _>>()?;
         check_column_varies(&temps, rows, "thermal", "temp_c")?;
         let reference_c = temps.iter().sum::<f64>() / temps.len().max(1) as f64;
@@ -52,7 +58,11 @@ impl Regressor for Thermal {
     }
 
     fn features(&self, row: &Measurement, _tool: usize) -> Result<Vec<f64>, Error> {
-        let t = row.temp_c.ok_or(Error::EffectNeedsColumn { line: row.line, effect: "thermal", column: "temp_c" })?;
+        let t = row.temp_c.ok_or(Error::new(ErrorKind::EffectNeedsColumn {
+            line: row.line,
+            effect: "thermal",
+            column: "temp_c",
+        }))?;
         let t = super::held_in(t, self.fitted_span);
         Ok(vec![(t - self.reference_c) / self.scale[0]])
     }

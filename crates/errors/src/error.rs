@@ -1,1001 +1,137 @@
-//! The errors of the `pipeline` crate. Every error about a user's file names the file, and where
-//! it can, the line and the column.
+//! The error of the calibration crates: a [`Place`] (where, if anywhere) and an [`ErrorKind`]
+//! (what), kept apart as ripgrep's globset keeps a glob apart from its error's kind.
 
-use crate::{ColumnMapFault, DecimalFault, EffectListFault, FileKind};
+use crate::{ErrorKind, Place};
 use std::fmt;
 
-/// What can go wrong reading inputs, fitting or evaluating.
-#[non_exhaustive]
+/// What went wrong ([`kind`](Error::kind)) and where ([`place`](Error::place)): its message is the
+/// place's `file:line:column: ` (or `file: `) followed by the kind's.
+///
+/// Boxed, so that a `Result` carrying it stays one pointer wide.
 #[derive(Debug)]
-pub enum Error {
-    /// A file could not be read or written.
-    Io {
-        /// The path.
-        path: String,
-        /// The operating system's error.
-        source: std::io::Error,
-    },
-    /// A measurement file has no header or no data row.
-    EmptyFile {
-        /// The file.
-        file: String,
-    },
-    /// The CSV layer refused a line (e.g. a row with a different number of fields).
-    CsvSyntax {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: u64,
-        /// 1-based column (field index) where known, else 1.
-        column: usize,
-        /// What the CSV reader said.
-        message: String,
-    },
-    /// A row with another number of fields than the header.
-    FieldCount {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: u64,
-        /// 1-based column: the first field one of the two lacks.
-        column: usize,
-        /// Fields in the row.
-        found: u64,
-        /// Fields in the header.
-        expected: u64,
-        /// The file's field separator.
-        delimiter: char,
-    },
-    /// Bytes that are not UTF-8 text.
-    InvalidUtf8 {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: u64,
-        /// 1-based column (the field, in a CSV file; the character, in a RON file).
-        column: usize,
-    },
-    /// A number whose decimal mark does not fit the file.
-    DecimalMark {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: u64,
-        /// 1-based column.
-        column: usize,
-        /// The column's name.
-        name: String,
-        /// The cell's text.
-        text: String,
-        /// What is wrong with it.
-        fault: DecimalFault,
-    },
-    /// A negative `payload_kg`.
-    NegativePayload {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: u64,
-        /// 1-based column.
-        column: usize,
-        /// The value, kg.
-        value: f64,
-    },
-    /// A joint column whose unit does not fit its joint: an angle on a prismatic joint, a
-    /// length on a revolute one.
-    JointUnit {
-        /// The file.
-        file: String,
-        /// The header line (1).
-        line: u64,
-        /// 1-based column.
-        column: usize,
-        /// 1-based joint.
-        joint: usize,
-        /// The robot's kind of that joint.
-        kind: poe::JointKind,
-    },
-    /// A per-joint column (`tau<k>_nm`) for a joint the data does not have.
-    ColumnBeyondJoints {
-        /// The file.
-        file: String,
-        /// The header line (1).
-        line: u64,
-        /// 1-based column.
-        column: usize,
-        /// The column's name.
-        name: String,
-        /// The joint it names (1-based).
-        index: usize,
-        /// The data's joint count.
-        joints: usize,
-    },
-    /// The orientation given both as a quaternion and as Euler angles.
-    OrientationTwice {
-        /// The file.
-        file: String,
-        /// The header line (1).
-        line: u64,
-        /// 1-based column of the later of the two.
-        column: usize,
-        /// Its name.
-        name: String,
-        /// The name of the earlier one.
-        other: String,
-    },
-    /// A column map names a header the file does not have.
-    MappedHeaderMissing {
-        /// The file.
-        file: String,
-        /// The header line (1).
-        line: u64,
-        /// Where the header ends (its field count + 1).
-        column: usize,
-        /// The SPEC name it was to give.
-        target: String,
-        /// The header named.
-        header: String,
-    },
-    /// A `--columns` argument that does not parse.
-    ColumnMap {
-        /// 1-based character of the argument where the faulty item starts.
-        column: usize,
-        /// The faulty item.
-        text: String,
-        /// What is wrong with it.
-        fault: ColumnMapFault,
-    },
-    /// A value in a RON file (robot or model) that must be a finite number and is not.
-    NotFinite {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column.
-        column: usize,
-        /// The field, e.g. `flange.position` or `links[2].com_m`.
-        field: String,
-        /// The value found.
-        value: f64,
-    },
-    /// A model file whose parts do not fit together: a count that differs from what another
-    /// part needs (an edited or corrupt file).
-    ModelCount {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column.
-        column: usize,
-        /// The field, e.g. `compensation.gp`.
-        field: String,
-        /// What is counted, e.g. `inputs`.
-        what: &'static str,
-        /// The count found.
-        found: usize,
-        /// The count the rest of the model needs.
-        expected: usize,
-    },
-    /// A model file with an index out of its range.
-    ModelIndex {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column.
-        column: usize,
-        /// The field, e.g. `joint_compliance.terms[3].joint`.
-        field: String,
-        /// The index found.
-        index: usize,
-        /// The index must be below this.
-        limit: usize,
-    },
-    /// A robot or model file with a finite value far outside any robot cell (an edited or corrupt
-    /// file): left in, its products overflow and the model predicts NaN poses.
-    ModelValue {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column.
-        column: usize,
-        /// The field, e.g. `kinematics.joints[1]`.
-        field: String,
-        /// The value found.
-        value: f64,
-        /// Its magnitude must not exceed this.
-        limit: f64,
-    },
-    /// A required column is absent.
-    MissingColumn {
-        /// The file.
-        file: String,
-        /// The header line (1).
-        line: u64,
-        /// Where the header ends (its field count + 1): the column that should have been there.
-        column: usize,
-        /// The missing column's name.
-        name: String,
-    },
-    /// A column name appears twice (or a quantity twice in two units).
-    DuplicateColumn {
-        /// The file.
-        file: String,
-        /// The header line (1).
-        line: u64,
-        /// 1-based column of the second occurrence.
-        column: usize,
-        /// The column's name.
-        name: String,
-    },
-    /// A cell that must be a number is not one, or is NaN or infinite.
-    NotANumber {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: u64,
-        /// 1-based column.
-        column: usize,
-        /// The column's name.
-        name: String,
-        /// The cell's text.
-        text: String,
-    },
-    /// A number beyond any physical range for its column (e.g. a position beyond 1 km): a unit
-    /// or export error, refused before it wrecks a fit.
-    BeyondPhysicalRange {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: u64,
-        /// 1-based column.
-        column: usize,
-        /// The column's name.
-        name: String,
-        /// The value, in SI units (`unit`).
-        value: f64,
-        /// The largest magnitude accepted, in `unit`.
-        limit: f64,
-        /// The SI unit of `value` and `limit`.
-        unit: &'static str,
-        /// What the column holds (e.g. "position", "joint angle").
-        quantity: &'static str,
-    },
-    /// The joint columns do not match the robot's joint count.
-    JointCountMismatch {
-        /// The file.
-        file: String,
-        /// The header line (1).
-        line: u64,
-        /// The column at fault: the first extra joint column, or where the missing one should be.
-        column: usize,
-        /// Joint columns found.
-        found: usize,
-        /// The robot's joint count.
-        expected: usize,
-    },
-    /// A quaternion whose norm is off by more than 1e-3.
-    QuaternionNorm {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: u64,
-        /// 1-based column of `qw`.
-        column: usize,
-        /// The norm found.
-        norm: f64,
-    },
-    /// A tool identifier the model was not fitted with.
-    UnknownTool {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: u64,
-        /// 1-based column of `tool`.
-        column: usize,
-        /// The identifier.
-        tool: String,
-        /// The identifiers the model knows.
-        known: Vec<String>,
-    },
-    /// A RON file (robot or model) that does not parse, or holds an invalid value.
-    RonFormat {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column.
-        column: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// A URDF file that does not parse, or whose kinematic chain cannot be calibrated.
-    UrdfFormat {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column.
-        column: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// A joint of the URDF written into (`export --like`) that turns where the model's slides, or
-    /// the other way round: the URDF keeps its joint types, so it would be calibrated wrongly.
-    UrdfJointKind {
-        /// The URDF file.
-        file: String,
-        /// 1-based line of the `<joint>` element.
-        line: usize,
-        /// 1-based column of the `<joint>` element.
-        column: usize,
-        /// The joint's name in the URDF.
-        joint: String,
-        /// The joint's 1-based place among the chain's movable joints.
-        index: usize,
-        /// Its kind in the URDF.
-        urdf: poe::JointKind,
-        /// The model's kind of that joint.
-        model: poe::JointKind,
-    },
-    /// A nominal robot description whose joints are not where a calibrated model has them, once
-    /// its base is placed by joint 1: not the description the model was fitted with.
-    NominalMismatch {
-        /// The description.
-        file: String,
-        /// 1-based joint that is furthest off.
-        joint: usize,
-        /// Distance of the model's joint frame origin from the description's axis, mm.
-        offset_mm: f64,
-        /// Angle between the two axes, mrad.
-        angle_mrad: f64,
-        /// The largest offset accepted, mm.
-        limit_mm: f64,
-        /// The largest angle accepted, mrad.
-        limit_mrad: f64,
-    },
-    /// A robot description with another number of joints than a calibrated model.
-    RobotJointCount {
-        /// The description.
-        file: String,
-        /// Its joints.
-        robot: usize,
-        /// The model's joints.
-        model: usize,
-    },
-    /// A targets file with an orientation that cannot be used: without a position, or for a model
-    /// fitted on positions only.
-    TargetOrientation {
-        /// The file.
-        file: String,
-        /// 1-based column of the orientation.
-        column: usize,
-        /// Whether the position columns are missing (otherwise the model has no orientation).
-        without_position: bool,
-    },
-    /// Targets whose meaning needs the robot description: joint targets (the nominal model) or
-    /// poses in the base frame.
-    TargetsNeedRobot {
-        /// The targets file.
-        file: String,
-        /// Whether the targets are poses (in the base frame) rather than joint targets.
-        poses: bool,
-    },
-    /// A robot description that a base-and-tool fit cannot lay onto the calibrated model.
-    RegistrationMismatch {
-        /// The description.
-        file: String,
-        /// RMS distance left, mm.
-        rms_mm: f64,
-        /// The largest accepted, mm.
-        limit_mm: f64,
-    },
-    /// A model with parts a URDF cannot hold, exported without the training data that measure
-    /// the error left without them.
-    ExportNeedsData {
-        /// The parts.
-        parts: Vec<String>,
-    },
-    /// A prismatic joint exported without the limits a URDF requires (no nominal description).
-    PrismaticWithoutLimits {
-        /// 1-based joint.
-        joint: usize,
-    },
-    /// A model file written by another schema version.
-    SchemaVersion {
-        /// The file.
-        file: String,
-        /// The version found.
-        found: u32,
-        /// The version this build reads.
-        supported: u32,
-    },
-    /// The kinematic model or its identification failed.
-    Kinematics {
-        /// The underlying error.
-        source: poe::Error,
-    },
-    /// The load and effect models refused their input.
-    Load {
-        /// The underlying error.
-        source: loadsim::Error,
-    },
-    /// The Gaussian process failed.
-    Gp {
-        /// The underlying error.
-        source: gp::Error,
-    },
-    /// A simulated pose that is not finite: an effect or a robot beyond any real range.
-    NonFiniteSimulation {
-        /// 1-based row of the simulated set.
-        row: usize,
-    },
-    /// A diagnosis option out of its range.
-    DiagnoseOption {
-        /// The option.
-        field: &'static str,
-        /// Its value.
-        value: f64,
-    },
-    /// A report could not be written as JSON.
-    Json {
-        /// What was being written.
-        what: &'static str,
-        /// The underlying error.
-        source: serde_json::Error,
-    },
-    /// The diagnosis's regularised normal equations were not positive definite: the data hold a
-    /// non-finite number or are degenerate beyond what the prior can hold.
-    DiagnoseSolve {
-        /// Folds whose rows were left out of the fit (empty: every row).
-        left_out: Vec<usize>,
-        /// Number of columns of the system.
-        columns: usize,
-        /// The pivot at which the factorisation failed.
-        pivot: usize,
-    },
-    /// Too few rows for what was asked.
-    TooFewRows {
-        /// The file.
-        file: String,
-        /// Rows available.
-        rows: usize,
-        /// Rows needed.
-        needed: usize,
-    },
-    /// An `--effects` argument that does not parse.
-    EffectList {
-        /// 1-based character of the argument where the faulty item starts.
-        column: usize,
-        /// The faulty item.
-        text: String,
-        /// What is wrong with it.
-        fault: EffectListFault,
-    },
-    /// An effect names a joint the robot does not have.
-    EffectJoint {
-        /// The 1-based joint named.
-        joint: usize,
-        /// The robot's joint count.
-        joint_count: usize,
-    },
-    /// An effect that means nothing on the kind of joint it names (a series in a prismatic
-    /// joint's "angle").
-    EffectJointKind {
-        /// The effect's name.
-        effect: &'static str,
-        /// The 1-based joint named.
-        joint: usize,
-    },
-    /// A fit produced a model that the model file's check refuses: `fit` says so rather than
-    /// write a file that `eval` would refuse.
-    FittedModelRefused {
-        /// The method fitted.
-        method: String,
-        /// The check's refusal.
-        source: Box<Error>,
-    },
-    /// A model's parts in an order they cannot apply in (an effect before the geometry).
-    PartOrder {
-        /// The part out of place.
-        part: &'static str,
-    },
-    /// An effect needs a column that a row lacks (e.g. `thermal` without `temp_c`).
-    EffectNeedsColumn {
-        /// 1-based line of the row (0 for rows made in memory).
-        line: u64,
-        /// The effect.
-        effect: &'static str,
-        /// The column it needs.
-        column: &'static str,
-    },
-    /// An effect whose column has the same value on every training row: the effect's
-    /// parameters multiply the column's deviation from its mean, zero everywhere, so they are
-    /// unobservable (fitted, they would read zero and look identified).
-    EffectColumnConstant {
-        /// The effect.
-        effect: &'static str,
-        /// Its column.
-        column: &'static str,
-        /// The one value every row has.
-        value: f64,
-        /// The training rows.
-        rows: usize,
-        /// 1-based lines of the first and the last row (0 for rows made in memory).
-        lines: [u64; 2],
-    },
-    /// An output that is one of the command's own inputs (the same path, a symbolic link to it,
-    /// or a hard link): refused before anything is written.
-    OutputIsInput {
-        /// The option that names the output (e.g. `--out`).
-        output_option: &'static str,
-        /// The output path as given.
-        output: String,
-        /// The option that names the input (e.g. `--data`).
-        input_option: &'static str,
-        /// The input path as given.
-        input: String,
-    },
-    /// An output path where something other than a regular file (or a symbolic link to one)
-    /// exists: a directory, a FIFO, a device node. Writing would replace it with a regular file.
-    OutputNotRegularFile {
-        /// The path as given (and where a symbolic link led).
-        path: String,
-        /// What is there.
-        kind: FileKind,
-    },
-    /// A simulation asked for more rows than are made (`campaign::MAX_ROWS`).
-    TooManySimulatedRows {
-        /// The rows asked for.
-        rows: usize,
-        /// The most rows made.
-        max: usize,
-    },
-    /// Two consecutive joints of a robot description whose motions are one (revolute about the
-    /// same line, or prismatic along the same direction): their Jacobian columns are equal.
-    RepeatedJointAxis {
-        /// The robot file.
-        file: String,
-        /// Line of the second joint's axis (0 where the file is not RON).
-        line: usize,
-        /// Its column.
-        column: usize,
-        /// The first joint, 1-based.
-        first: usize,
-        /// The second joint, 1-based.
-        second: usize,
-        /// Whether they are revolute (otherwise prismatic).
-        revolute: bool,
-        /// The second joint's axis direction.
-        axis: [f64; 3],
-        /// A point on it.
-        point: [f64; 3],
-    },
-    /// A planar chain asked for what needs three dimensions (a simulated 3-D campaign).
-    PlanarChain {
-        /// The robot file.
-        file: String,
-        /// The direction every revolute axis is parallel to.
-        direction: [f64; 3],
-        /// The joint count.
-        joints: usize,
-    },
-    /// Measured positions that leave a plane, for a planar chain (whose tool moves in one): the
-    /// data of another robot, or a joint axis wrong in the robot file.
-    PlanarChainData {
-        /// The measurement file.
-        file: String,
-        /// The robot's name.
-        robot: String,
-        /// The direction every revolute axis is parallel to.
-        direction: [f64; 3],
-        /// The joint count.
-        joints: usize,
-        /// RMS distance of the measured positions from their best plane, mm.
-        out_of_plane_mm: f64,
-        /// RMS distance of the measured positions from their centroid, mm.
-        spread_mm: f64,
-        /// Refused above this ratio of the two (`PlausibilityOptions::planar_ratio`).
-        ratio: f64,
-    },
-    /// An output path that starts a chain of more symbolic links than are followed (a loop).
-    OutputSymlinkChain {
-        /// The path as given.
-        path: String,
-        /// How many links were followed.
-        links: usize,
-    },
-    /// A joint value beyond the robot's limits by more than the margin
-    /// (`PlausibilityOptions::limit_margin_rad`): the first in file order.
-    JointBeyondLimits {
-        /// The file.
-        file: String,
-        /// 1-based line (0 for rows made in memory).
-        line: u64,
-        /// 1-based column (the joint's number for rows made in memory).
-        column: usize,
-        /// 1-based joint.
-        joint: usize,
-        /// Revolute (value and limits in radians) or prismatic (metres).
-        kind: poe::JointKind,
-        /// The value, SI.
-        value: f64,
-        /// The robot's limits, SI.
-        limits: (f64, f64),
-        /// The margin allowed beyond them, SI.
-        margin: f64,
-        /// Whether every value of the column, read as degrees, is within the limits (and the
-        /// column says `_rad`).
-        degrees_under_rad: bool,
-    },
-    /// Measured positions whose spread is not the robot's at the same joints: a unit mistake, a
-    /// scale, or another robot (`PlausibilityOptions::scale_band`).
-    PositionScale {
-        /// The file.
-        file: String,
-        /// RMS distance of the measured positions from their centroid, mm (read as the columns say).
-        measured_spread_mm: f64,
-        /// The same of the nominal model's tool points at the same joints, the tool fitted, mm.
-        robot_spread_mm: f64,
-        /// Measured over robot.
-        ratio: f64,
-        /// The unit the position columns name (`mm` or `m`).
-        column_unit: &'static str,
-        /// The unit the ratio says the positions are in, where it is near a unit mistake's factor.
-        likely_unit: Option<&'static str>,
-        /// The accepted ratios.
-        band: (f64, f64),
-    },
-    /// Measured positions that a mirror image of the robot fits much better than the robot: a
-    /// left-handed frame (`PlausibilityOptions::reflection_ratio`).
-    LeftHandedFrame {
-        /// The file.
-        file: String,
-        /// RMS residual of the best rotation of the nominal tool points onto the measured, mm.
-        rotation_rms_mm: f64,
-        /// RMS residual of the best reflection, mm.
-        reflection_rms_mm: f64,
-        /// Refused where the reflection's residual is below this fraction of the rotation's.
-        reflection_ratio: f64,
-    },
+pub struct Error(Box<Inner>);
+
+#[derive(Debug)]
+struct Inner {
+    place: Option<Place>,
+    kind: ErrorKind,
+}
+
+impl Error {
+    /// An error without a place (about an argument, a fit, a simulation).
+    pub fn new(kind: ErrorKind) -> Error {
+        Error(Box::new(Inner { place: None, kind }))
+    }
+
+    /// An error at a place.
+    pub fn at(place: Place, kind: ErrorKind) -> Error {
+        Error(Box::new(Inner { place: Some(place), kind }))
+    }
+
+    /// An error about a whole file (or a path): its message starts with `file: `.
+    pub fn in_file(file: impl Into<String>, kind: ErrorKind) -> Error {
+        Error::at(Place::in_file(file), kind)
+    }
+
+    /// An error at a line and column of a file: its message starts with `file:line:column: `.
+    pub fn at_line(file: impl Into<String>, line: u64, column: usize, kind: ErrorKind) -> Error {
+        Error::at(Place::new(file, line, column), kind)
+    }
+
+    /// A file that could not be read or written.
+    pub fn io(path: impl Into<String>, source: std::io::Error) -> Error {
+        Error::in_file(path, ErrorKind::Io { source })
+    }
+
+    /// The kinematic model or its identification failed (a `poe::Error`, say).
+    pub fn kinematics(source: impl std::error::Error + Send + Sync + 'static) -> Error {
+        Error::new(ErrorKind::Kinematics { source: Box::new(source) })
+    }
+
+    /// The load and effect models refused their input (a `loadsim::Error`, say).
+    pub fn load(source: impl std::error::Error + Send + Sync + 'static) -> Error {
+        Error::new(ErrorKind::Load { source: Box::new(source) })
+    }
+
+    /// The Gaussian process failed (a `gp::Error`, say).
+    pub fn gp(source: impl std::error::Error + Send + Sync + 'static) -> Error {
+        Error::new(ErrorKind::Gp { source: Box::new(source) })
+    }
+
+    /// Where the error is: a file (or a command-line option's argument), and a line and column
+    /// where known; `None` for an error about no file.
+    pub fn place(&self) -> Option<&Place> {
+        self.0.place.as_ref()
+    }
+
+    /// What went wrong.
+    pub fn kind(&self) -> &ErrorKind {
+        &self.0.kind
+    }
+
+    /// The kind, the place dropped.
+    pub fn into_kind(self) -> ErrorKind {
+        self.0.kind
+    }
+
+    /// The 1-based line and column of the place, where it has them.
+    pub fn position(&self) -> Option<(u64, usize)> {
+        self.place().and_then(Place::position)
+    }
+}
+
+impl From<ErrorKind> for Error {
+    fn from(kind: ErrorKind) -> Self {
+        Error::new(kind)
+    }
 }
 
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Error::Io { path, source } => write!(f, "{path}: {source}"),
-            Error::EmptyFile { file } => write!(f, "{file}:1:1: the file has no header or no data row"),
-            Error::CsvSyntax { file, line, column, message } => write!(f, "{file}:{line}:{column}: {message}"),
-            Error::FieldCount { file, line, column, found, expected, delimiter } => {
-                write!(f, "{file}:{line}:{column}: row has {found} fields, the header has {expected}")?;
-                if *delimiter == ',' && found > expected {
-                    write!(
-                        f,
-                        " (decimal commas in a ','-separated file? tracker exports with decimal commas separate fields with ';')"
-                    )?;
-                }
-                Ok(())
-            }
-            Error::InvalidUtf8 { file, line, column } => write!(f, "{file}:{line}:{column}: the text is not UTF-8"),
-            Error::DecimalMark { file, line, column, name, text, fault } => {
-                write!(f, "{file}:{line}:{column}: column '{name}': '{text}' {fault}")
-            }
-            Error::NegativePayload { file, line, column, value } => {
-                write!(f, "{file}:{line}:{column}: column 'payload_kg': {value} kg, a payload cannot be negative")
-            }
-            Error::JointUnit { file, line, column, joint, kind } => match kind {
-                poe::JointKind::Prismatic => write!(
-                    f,
-                    "{file}:{line}:{column}: joint {joint} is prismatic: its column is q{joint}_m or q{joint}_mm, not an angle"
-                ),
-                poe::JointKind::Revolute => write!(
-                    f,
-                    "{file}:{line}:{column}: joint {joint} is revolute: its column is q{joint}_rad or q{joint}_deg, not a length"
-                ),
-            },
-            Error::ColumnBeyondJoints { file, line, column, name, index, joints } => {
-                write!(f, "{file}:{line}:{column}: column '{name}' is for joint {index}, the data has {joints} joints")
-            }
-            Error::OrientationTwice { file, line, column, name, other } => write!(
-                f,
-                "{file}:{line}:{column}: column '{name}': the orientation is already given by '{other}'; give a quaternion (qw, qx, qy, qz) or Euler angles (rx, ry, rz), not both"
-            ),
-            Error::MappedHeaderMissing { file, line, column, target, header } => write!(
-                f,
-                "{file}:{line}:{column}: --columns maps {target} to the header '{header}', which the file does not have"
-            ),
-            Error::ColumnMap { column, text, fault } => write!(f, "--columns:1:{column}: '{text}' {fault}"),
-            Error::NotFinite { file, line, column, field, value } => {
-                write!(f, "{file}:{line}:{column}: {field} is {value}, a finite number is needed")
-            }
-            Error::ModelCount { file, line, column, field, what, found, expected } => {
-                write!(f, "{file}:{line}:{column}: {field} has {found} {what}, the rest of the model needs {expected}")
-            }
-            Error::ModelIndex { file, line, column, field, index, limit } => {
-                write!(f, "{file}:{line}:{column}: {field} is {index}, it must be below {limit}")
-            }
-            Error::ModelValue { file, line, column, field, value, limit } => write!(
-                f,
-                "{file}:{line}:{column}: {field} is {value:e}, beyond ±{limit:e}: larger than any robot cell (an edited or corrupt file)"
-            ),
-            Error::MissingColumn { file, line, column, name } => {
-                write!(f, "{file}:{line}:{column}: missing required column '{name}'")
-            }
-            Error::DuplicateColumn { file, line, column, name } => {
-                write!(f, "{file}:{line}:{column}: column '{name}' appears more than once")
-            }
-            Error::NotANumber { file, line, column, name, text } => {
-                write!(f, "{file}:{line}:{column}: column '{name}': '{text}' is not a finite number")
-            }
-            Error::BeyondPhysicalRange { file, line, column, name, value, limit, unit, quantity } => write!(
-                f,
-                "{file}:{line}:{column}: column '{name}': {value:e} {unit} is beyond any physical {quantity} \
-                 (at most {limit:e} {unit} in magnitude): check the column's unit"
-            ),
-            Error::UrdfJointKind { file, line, column, joint, index, urdf, model } => write!(
-                f,
-                "{file}:{line}:{column}: joint '{joint}' (movable joint {index}) is {} in the URDF but {} in the \
-                 model: refusing to write the calibration into a joint of another kind",
-                kind_name(*urdf),
-                kind_name(*model)
-            ),
-            Error::JointCountMismatch { file, line, column, found, expected } => {
-                write!(f, "{file}:{line}:{column}: {found} joint columns, the robot has {expected} joints")
-            }
-            Error::QuaternionNorm { file, line, column, norm } => write!(
-                f,
-                "{file}:{line}:{column}: quaternion (qw, qx, qy, qz) has norm {norm:.6}, expected 1 within 1e-3"
-            ),
-            Error::UnknownTool { file, line, column, tool, known } => {
-                let known: Vec<String> = known
-                    .iter()
-                    .map(|t| if t.is_empty() { "the default tool".to_owned() } else { format!("'{t}'") })
-                    .collect();
-                let known = if known.is_empty() { "none".to_owned() } else { known.join(", ") };
-                if tool.is_empty() {
-                    write!(
-                        f,
-                        "{file}:{line}:{column}: a row without a tool name is the default tool, which the model was not fitted with (it knows {known}); name the tool in a 'tool' column"
-                    )
-                } else {
-                    write!(f, "{file}:{line}:{column}: tool '{tool}' is not in the model (it knows {known})")
-                }
-            }
-            Error::RonFormat { file, line, column, message } | Error::UrdfFormat { file, line, column, message } => {
-                write!(f, "{file}:{line}:{column}: {message}")
-            }
-            Error::NominalMismatch { file, joint, offset_mm, angle_mrad, limit_mm, limit_mrad } => write!(
-                f,
-                "{file}: joint {joint} of this robot is {offset_mm:.1} mm and {angle_mrad:.1} mrad from the model's (at most {limit_mm} mm and {limit_mrad} mrad expected): give the robot description the model was fitted with"
-            ),
-            Error::TargetOrientation { file, column, without_position: true } => write!(
-                f,
-                "{file}:1:{column}: an orientation without x_mm, y_mm, z_mm: give the whole pose, or joint targets alone"
-            ),
-            Error::TargetOrientation { file, column, without_position: false } => write!(
-                f,
-                "{file}:1:{column}: the model was fitted on positions only, its orientation is not calibrated: give position targets"
-            ),
-            Error::TargetsNeedRobot { file, poses: false } => write!(
-                f,
-                "{file}:1:1: joint targets are a program taught on the nominal model: give its robot description (--robot)"
-            ),
-            Error::TargetsNeedRobot { file, poses: true } => {
-                write!(f, "{file}:1:1: poses in the base frame need the robot description (--robot) to place the base")
-            }
-            Error::RegistrationMismatch { file, rms_mm, limit_mm } => write!(
-                f,
-                "{file}: this robot, placed on the model by base and tool, stays {rms_mm:.1} mm from it (at most {limit_mm} mm expected): give the robot description the model was fitted with"
-            ),
-            Error::RobotJointCount { file, robot, model } => {
-                write!(
-                    f,
-                    "{file}: the robot has {robot} joints, the model {model}: not the robot the model was fitted for"
-                )
-            }
-            Error::ExportNeedsData { parts } => write!(
-                f,
-                "the model has {} that a URDF cannot hold: give its training data (--data) to measure the error left without them",
-                parts.join(" and ")
-            ),
-            Error::PrismaticWithoutLimits { joint } => write!(
-                f,
-                "joint {joint} is prismatic and a URDF needs its limits: give the robot description (--robot or --like)"
-            ),
-            Error::SchemaVersion { file, found, supported } => {
-                write!(
-                    f,
-                    "{file}:1:1: model file has schema version {found}, this calib reads versions 1 to {supported}"
-                )
-            }
-            Error::Kinematics { source } => write!(f, "{source}"),
-            Error::Load { source } => write!(f, "load model: {source}"),
-            Error::Gp { source } => write!(f, "Gaussian process: {source}"),
-            Error::NonFiniteSimulation { row } => write!(
-                f,
-                "simulated row {row} is not finite: an effect or the robot is beyond any real range (nothing written)"
-            ),
-            Error::DiagnoseOption { field, value } => write!(f, "diagnose option {field} = {value} is out of range"),
-            Error::Json { what, source } => write!(f, "{what} as JSON: {source}"),
-            Error::DiagnoseSolve { left_out, columns, pivot } => write!(
-                f,
-                "diagnose: the regularised fit without folds {left_out:?} ({columns} columns) is not positive definite at pivot {pivot}"
-            ),
-            Error::TooFewRows { file, rows, needed } => {
-                write!(f, "{file}: {rows} measurement rows, at least {needed} needed")
-            }
-            Error::EffectList { column, text, fault } => write!(f, "--effects:1:{column}: '{text}' {fault}"),
-            Error::EffectJoint { joint, joint_count } => {
-                write!(f, "effect on joint {joint}: the robot has joints 1 to {joint_count}")
-            }
-            Error::EffectJointKind { effect, joint } => write!(
-                f,
-                "{effect} on joint {joint}: joint {joint} is prismatic, and a {effect} is a function of a revolute joint's angle"
-            ),
-            Error::FittedModelRefused { method, source } => write!(
-                f,
-                "the fitted {method} model fails the check every model file passes on reading, so it is not written: {source}"
-            ),
-            Error::PartOrder { part } => write!(f, "a model's {part} comes before its geometry"),
-            Error::EffectNeedsColumn { line, effect, column } => {
-                write!(f, "line {line}: {effect} needs the column '{column}', which this row lacks")
-            }
-            Error::EffectColumnConstant { effect, column, value, rows, lines: [first, last] } => write!(
-                f,
-                "lines {first}-{last}: {effect} needs the column '{column}' to vary, but its values do not vary \
-                 ({column} = {value} on all {rows} rows): its parameters are unobservable; leave {effect} out"
-            ),
-            Error::OutputIsInput { output_option, output, input_option, input } => write!(
-                f,
-                "{output_option} {output} is the same file as {input_option} {input}: refusing to overwrite an input"
-            ),
-            Error::OutputNotRegularFile { path, kind } => {
-                write!(f, "{path}: is {kind}, not a regular file: refusing to replace it with an output")
-            }
-            Error::TooManySimulatedRows { rows, max } => write!(
-                f,
-                "{rows} rows asked for: at most {max} are simulated (up to 280 MB of CSV and 25 s; is the count mistyped?)"
-            ),
-            Error::RepeatedJointAxis { file, line, column, first, second, revolute, axis, point } => {
-                let place = if *line > 0 { format!("{file}:{line}:{column}") } else { file.clone() };
-                let [a, b, c] = axis;
-                let [x, y, z] = point;
-                if *revolute {
-                    write!(
-                        f,
-                        "{place}: joints {first} and {second} turn about the same line (direction ({a}, {b}, {c}) through \
-                         ({x}, {y}, {z}) m): no joint between them moves one off the other, so their columns in the \
-                         identification Jacobian are equal at every pose and their angles cannot be told apart; \
-                         correct the axis or merge the two joints"
-                    )
-                } else {
-                    write!(
-                        f,
-                        "{place}: joints {first} and {second} slide along the same direction ({a}, {b}, {c}): their columns \
-                         in the identification Jacobian are equal at every pose and their values cannot be told apart; \
-                         correct the axis or merge the two joints"
-                    )
-                }
-            }
-            Error::PlanarChain { file, direction: [a, b, c], joints } => write!(
-                f,
-                "{file}: the chain is planar: all {joints} joints turn about axes parallel to ({a}, {b}, {c}) (prismatic \
-                 ones slide across it), so the tool moves in a plane and 3-D positions cannot be drawn for it; \
-                 check the joint axes"
-            ),
-            Error::PlanarChainData { file, robot, direction: [a, b, c], joints, out_of_plane_mm, spread_mm, ratio } => {
-                write!(
-                    f,
-                    "{file}: the positions leave a plane, but {robot}'s chain is planar: all {joints} joints turn about \
-                     axes parallel to ({a}, {b}, {c}), so its tool moves in a plane; the positions lie {out_of_plane_mm:.1} mm \
-                     RMS off their best plane, {:.1} % of their {spread_mm:.1} mm spread (accepted: {:.1} %): the data of \
-                     another robot, or a joint axis wrong in the robot file?",
-                    100.0 * out_of_plane_mm / spread_mm,
-                    100.0 * ratio
-                )
-            }
-            Error::OutputSymlinkChain { path, links } => {
-                write!(f, "{path}: more than {links} symbolic links in a row (a loop?): refusing to write there")
-            }
-            Error::JointBeyondLimits {
-                file,
-                line,
-                column,
-                joint,
-                kind,
-                value,
-                limits: (lo, hi),
-                margin,
-                degrees_under_rad,
-            } => {
-                match kind {
-                    poe::JointKind::Revolute => write!(
-                        f,
-                        "{file}:{line}:{column}: joint {joint} is at {value} rad ({:.1}°), beyond its limits {:.1}° to {:.1}° by more than {:.1}°",
-                        value.to_degrees(),
-                        lo.to_degrees(),
-                        hi.to_degrees(),
-                        margin.to_degrees()
-                    )?,
-                    poe::JointKind::Prismatic => write!(
-                        f,
-                        "{file}:{line}:{column}: joint {joint} is at {value} m, beyond its limits {lo} m to {hi} m by more than {margin} m"
-                    )?,
-                }
-                if *degrees_under_rad {
-                    write!(f, ": degrees under `_rad`? (every value of the column fits the limits read as degrees)")?;
-                }
-                write!(f, " (--force fits anyway)")
-            }
-            Error::PositionScale {
-                file,
-                measured_spread_mm,
-                robot_spread_mm,
-                ratio,
-                column_unit,
-                likely_unit,
-                band,
-            } => {
-                let spreads = format!(
-                    "measured spread {measured_spread_mm:.4} mm, the robot's {robot_spread_mm:.1} mm at these joints: ratio {ratio:.4}"
-                );
-                match likely_unit {
-                    Some(unit) => write!(
-                        f,
-                        "{file}: positions look like {unit} under _{column_unit} columns ({spreads}); give the columns the positions' unit (--force fits anyway)"
-                    ),
-                    None => write!(
-                        f,
-                        "{file}: the positions do not have the robot's size ({spreads}, outside {} to {}): a unit, a scale or another robot's description? (--force fits anyway)",
-                        band.0, band.1
-                    ),
-                }
-            }
-            Error::LeftHandedFrame { file, rotation_rms_mm, reflection_rms_mm, .. } => write!(
-                f,
-                "{file}: the measured frame looks left-handed: two position columns swapped? (the robot turned onto the measurements leaves {rotation_rms_mm:.1} mm RMS, its mirror image {reflection_rms_mm:.1} mm) (--force fits anyway)"
-            ),
+        if let Some(place) = &self.0.place {
+            write!(f, "{place}: ")?;
         }
+        write!(f, "{}", self.0.kind)
     }
 }
 
 impl std::error::Error for Error {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            Error::Io { source, .. } => Some(source),
-            Error::Kinematics { source } => Some(source),
-            Error::Load { source } => Some(source),
-            Error::Gp { source } => Some(source),
-            Error::Json { source, .. } => Some(source),
-            Error::FittedModelRefused { source, .. } => Some(source.as_ref()),
-            _ => None,
-        }
+        self.0.kind.source()
     }
 }
 
-impl From<poe::Error> for Error {
-    fn from(source: poe::Error) -> Self {
-        Error::Kinematics { source }
-    }
-}
+#[cfg(test)]
+mod tests {
+    use super::Error;
+    use crate::{ErrorKind, Place};
 
-impl From<loadsim::Error> for Error {
-    fn from(source: loadsim::Error) -> Self {
-        Error::Load { source }
+    #[test]
+    fn a_message_is_the_place_then_the_kind() {
+        let kind = || ErrorKind::MissingColumn { name: "y_mm".into() };
+        let error = Error::at_line("poses.csv", 1, 5, kind());
+        assert_eq!(error.to_string(), "poses.csv:1:5: missing required column 'y_mm'");
+        assert_eq!(error.position(), Some((1, 5)));
+        assert_eq!(error.place().map(Place::file), Some("poses.csv"));
+        let error = Error::in_file("poses.csv", ErrorKind::TooFewRows { rows: 3, needed: 50 });
+        assert_eq!(error.to_string(), "poses.csv: 3 measurement rows, at least 50 needed");
+        assert_eq!(error.position(), None);
+        let error = Error::new(ErrorKind::PartOrder { part: "effect" });
+        assert_eq!(error.to_string(), "a model's effect comes before its geometry");
+        assert!(error.place().is_none());
     }
-}
 
-impl From<gp::Error> for Error {
-    fn from(source: gp::Error) -> Self {
-        Error::Gp { source }
+    #[test]
+    fn a_lower_crates_error_keeps_its_message_and_chain() {
+        let error = Error::gp(std::io::Error::other("not positive definite"));
+        assert_eq!(error.to_string(), "Gaussian process: not positive definite");
+        let source = std::error::Error::source(&error).map(ToString::to_string);
+        assert_eq!(source.as_deref(), Some("not positive definite"));
+        assert!(matches!(error.kind(), ErrorKind::Gp { .. }));
     }
-}
 
-/// A joint kind as a URDF names it.
-fn kind_name(kind: poe::JointKind) -> &'static str {
-    match kind {
-        poe::JointKind::Revolute => "revolute",
-        poe::JointKind::Prismatic => "prismatic",
+    #[test]
+    fn the_error_is_one_pointer_wide() {
+        assert_eq!(std::mem::size_of::<Error>(), std::mem::size_of::<usize>());
     }
 }

@@ -5,7 +5,7 @@
 /// standard library's message names neither).
 pub fn read_text(path: &std::path::Path) -> Result<String, crate::Error> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| crate::Error::Io { path: file.clone(), source })?;
+    let bytes = std::fs::read(path).map_err(|source| crate::Error::io(file.clone(), source))?;
     text_of(bytes, &file)
 }
 
@@ -16,7 +16,7 @@ pub fn text_of(bytes: Vec<u8>, file: &str) -> Result<String, crate::Error> {
         let valid = std::str::from_utf8(valid).unwrap_or_default();
         let line = valid.matches('\n').count() as u64 + 1;
         let column = valid.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-        crate::Error::InvalidUtf8 { file: file.to_owned(), line, column }
+        crate::Error::at_line(file, line, column, crate::ErrorKind::InvalidUtf8)
     })
 }
 

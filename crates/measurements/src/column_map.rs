@@ -3,7 +3,7 @@
 
 use super::quantity::quantity;
 pub use errors::ColumnMapFault;
-use errors::Error;
+use errors::{Error, ErrorKind};
 use std::fmt;
 use std::str::FromStr;
 
@@ -60,7 +60,12 @@ fn items(text: &str) -> Result<Vec<(usize, &str)>, Error> {
 fn fault(argument: &str, offset: usize, fault: ColumnMapFault) -> Error {
     let column = argument[..offset.min(argument.len())].chars().count() + 1;
     let end = argument[offset.min(argument.len())..].find(',').map_or(argument.len(), |e| offset + e);
-    Error::ColumnMap { column, text: argument[offset.min(argument.len())..end].to_owned(), fault }
+    Error::at_line(
+        "--columns",
+        1,
+        column,
+        ErrorKind::ColumnMap { text: argument[offset.min(argument.len())..end].to_owned(), fault },
+    )
 }
 
 impl FromStr for ColumnMap {

@@ -4,11 +4,11 @@
 //! that have one; every later number must agree.
 
 pub use errors::DecimalFault;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// The character between fields.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Delimiter {
     /// `,` (SPEC v1).
@@ -28,7 +28,7 @@ impl Delimiter {
 }
 
 /// The decimal mark of the file's numbers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Decimal {
     /// `1.5`.
@@ -47,7 +47,7 @@ impl Decimal {
 }
 
 /// What the reader detected about how the file is written.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Dialect {
     /// Between fields.
     pub delimiter: Delimiter,

@@ -5,7 +5,7 @@
 //! a symbolic link) or, on Unix, when they have the same device and inode (a hard link).
 
 use crate::output_file::output_target;
-use errors::Error;
+use errors::{Error, ErrorKind};
 use std::path::{Path, PathBuf};
 
 /// One input: the option that named it, the path as given, and what identifies the file.
@@ -79,7 +79,7 @@ impl InputFiles {
     }
 
     /// Checks that writing `output` (named by `option`) would neither overwrite one of the inputs
-    /// ([`Error::OutputIsInput`]) nor replace something that is not a regular file
+    /// ([`ErrorKind::OutputIsInput`]) nor replace something that is not a regular file
     /// ([`crate::output_target`]'s refusals). Symbolic links at `output` are followed, as the
     /// writer follows them.
     pub fn check_output(&self, option: &'static str, output: &Path) -> Result<(), Error> {
@@ -91,12 +91,12 @@ impl InputFiles {
                 || input.path == output
         };
         match self.files.iter().find(|input| same(input)) {
-            Some(input) => Err(Error::OutputIsInput {
+            Some(input) => Err(Error::new(ErrorKind::OutputIsInput {
                 output_option: option,
                 output: output.display().to_string(),
                 input_option: input.option,
                 input: input.path.display().to_string(),
-            }),
+            })),
             None => Ok(()),
         }
     }
@@ -108,7 +108,7 @@ mod tests {
 
     fn refused(inputs: &InputFiles, output: &Path) -> String {
         match inputs.check_output("--out", output) {
-            Err(e @ Error::OutputIsInput { .. }) => e.to_string(),
+            Err(e) if matches!(e.kind(), ErrorKind::OutputIsInput { .. }) => e.to_string(),
             other => panic!("{} should be refused as an input, got {other:?}", output.display()),
         }
     }

@@ -3,7 +3,7 @@
 
 use super::ColumnMap;
 use super::quantity::{Quantity, quantity};
-use errors::Error;
+use errors::{Error, ErrorKind};
 use poe::JointKind;
 use std::collections::HashSet;
 
@@ -53,6 +53,14 @@ pub(crate) struct Expectation<'a> {
 }
 
 /// The SPEC name of joint `k`'s column for a joint of `kind`.
+/// A joint's kind as an error names it (the errors know no kinematics crate).
+pub(crate) fn error_kind(kind: JointKind) -> errors::JointKind {
+    match kind {
+        JointKind::Revolute => errors::JointKind::Revolute,
+        JointKind::Prismatic => errors::JointKind::Prismatic,
+    }
+}
+
 fn joint_name(k: usize, kind: JointKind) -> String {
     match kind {
         JointKind::Revolute => format!("q{k}_rad"),
@@ -66,7 +74,7 @@ impl Layout {
     pub fn from_header(header: &csv::StringRecord, expect: &Expectation<'_>) -> Result<Self, Error> {
         let file = expect.file;
         let width = header.len();
-        let at_end = |name: String| Error::MissingColumn { file: file.to_owned(), line: 1, column: width + 1, name };
+        let at_end = |name: String| Error::at_line(file.to_owned(), 1, width + 1, ErrorKind::MissingColumn { name });
         let mut names: Vec<String> = Vec::with_capacity(width);
         // Sets, not scans of the lists: a header of 400,000 columns took minutes when each name was
         // compared with every earlier one (found by `cargo xtask fuzz`).
@@ -83,7 +91,7 @@ impl Layout {
             let raw = raw.trim();
             let name = expect.columns.target_of(raw).unwrap_or(raw).to_owned();
             let duplicate =
-                || Error::DuplicateColumn { file: file.to_owned(), line: 1, column: index + 1, name: name.clone() };
+                || Error::at_line(file.to_owned(), 1, index + 1, ErrorKind::DuplicateColumn { name: name.clone() });
             if !seen.insert(name.clone()) {
                 return Err(duplicate());
             }
@@ -116,13 +124,12 @@ impl Layout {
         }
         for (target, mapped) in expect.columns.entries() {
             if !header.iter().any(|h| h.trim() == mapped) {
-                return Err(Error::MappedHeaderMissing {
-                    file: file.to_owned(),
-                    line: 1,
-                    column: width + 1,
-                    target: target.clone(),
-                    header: mapped.clone(),
-                });
+                return Err(Error::at_line(
+                    file.to_owned(),
+                    1,
+                    width + 1,
+                    ErrorKind::MappedHeaderMissing { target: target.clone(), header: mapped.clone() },
+                ));
             }
         }
 
@@ -130,14 +137,12 @@ impl Layout {
         let n = joints.len();
         torques.sort_by_key(|(k, _)| *k);
         if let Some((k, c)) = torques.iter().find(|(k, _)| *k > n) {
-            return Err(Error::ColumnBeyondJoints {
-                file: file.to_owned(),
-                line: 1,
-                column: c.index + 1,
-                name: names[c.index].clone(),
-                index: *k,
-                joints: n,
-            });
+            return Err(Error::at_line(
+                file.to_owned(),
+                1,
+                c.index + 1,
+                ErrorKind::ColumnBeyondJoints { name: names[c.index].clone(), index: *k, joints: n },
+            ));
         }
         if !torques.is_empty()
             && let Some(k) = (1..=n).find(|k| torques.get(k - 1).is_none_or(|(j, _)| j != k))
@@ -185,36 +190,40 @@ fn check_joints(
         let beyond = found.iter().find(|(k, _, _)| *k > expected);
         if count != expected || beyond.is_some() {
             let column = beyond.map_or(width + 1, |(_, c, _)| c.index + 1);
-            return Err(Error::JointCountMismatch { file: file.to_owned(), line: 1, column, found: count, expected });
+            return Err(Error::at_line(
+                file.to_owned(),
+                1,
+                column,
+                ErrorKind::JointCountMismatch { found: count, expected },
+            ));
         }
     }
     let kind_of = |k: usize| expect.joints.and_then(|kinds| kinds.get(k - 1)).copied().unwrap_or(JointKind::Revolute);
     if count == 0 {
-        return Err(Error::MissingColumn {
-            file: file.to_owned(),
-            line: 1,
-            column: width + 1,
-            name: joint_name(1, kind_of(1)),
-        });
+        return Err(Error::at_line(
+            file.to_owned(),
+            1,
+            width + 1,
+            ErrorKind::MissingColumn { name: joint_name(1, kind_of(1)) },
+        ));
     }
     if let Some(k) = (1..=count).find(|&k| found[k - 1].0 != k) {
-        return Err(Error::MissingColumn {
-            file: file.to_owned(),
-            line: 1,
-            column: width + 1,
-            name: joint_name(k, kind_of(k)),
-        });
+        return Err(Error::at_line(
+            file.to_owned(),
+            1,
+            width + 1,
+            ErrorKind::MissingColumn { name: joint_name(k, kind_of(k)) },
+        ));
     }
     if let Some(kinds) = expect.joints {
         for ((k, column, kind), robot) in found.iter().zip(kinds) {
             if kind != robot {
-                return Err(Error::JointUnit {
-                    file: file.to_owned(),
-                    line: 1,
-                    column: column.index + 1,
-                    joint: *k,
-                    kind: *robot,
-                });
+                return Err(Error::at_line(
+                    file.to_owned(),
+                    1,
+                    column.index + 1,
+                    ErrorKind::JointUnit { joint: *k, kind: error_kind(*robot) },
+                ));
             }
         }
     }
@@ -230,19 +239,18 @@ fn orientation(
     width: usize,
 ) -> Result<Option<OrientationColumns>, Error> {
     let missing =
-        |name: &str| Error::MissingColumn { file: file.to_owned(), line: 1, column: width + 1, name: name.into() };
+        |name: &str| Error::at_line(file.to_owned(), 1, width + 1, ErrorKind::MissingColumn { name: name.into() });
     let any_quaternion = quaternion.iter().flatten().next();
     let any_euler = euler.iter().flatten().next();
     if let (Some(q), Some(e)) = (any_quaternion, any_euler) {
         let later = if e.index > q.index { e } else { q };
         let earlier = if e.index > q.index { q } else { e };
-        return Err(Error::OrientationTwice {
-            file: file.to_owned(),
-            line: 1,
-            column: later.index + 1,
-            name: names[later.index].clone(),
-            other: names[earlier.index].clone(),
-        });
+        return Err(Error::at_line(
+            file.to_owned(),
+            1,
+            later.index + 1,
+            ErrorKind::OrientationTwice { name: names[later.index].clone(), other: names[earlier.index].clone() },
+        ));
     }
     match (quaternion, euler) {
         ([Some(w), Some(x), Some(y), Some(z)], _) => Ok(Some(OrientationColumns::Quaternion([w, x, y, z]))),

@@ -35,12 +35,12 @@ pub use column_map::{ColumnMap, ColumnMapFault};
 pub use dialect::{Decimal, DecimalFault, Delimiter, Dialect};
 pub use writer::{CsvColumns, MeasurementWriter};
 
-use errors::Error;
+use errors::{Error, ErrorKind};
 use layout::{Expectation, Layout, OrientationColumns};
 use lie::{SO3, Vector3};
 use poe::JointKind;
 use row::{JOINT_ANGLE_RANGE, JOINT_TRAVEL_RANGE, POSITION_RANGE, Row, syntax_error};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::fmt;
 use std::io::Read;
@@ -102,7 +102,8 @@ pub struct JointColumn {
 }
 
 /// How a file was written, as the reader found it (reported by the CLI in one line).
-#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(default)]
 pub struct FileFormat {
     /// Field separator and decimal mark.
     pub dialect: Dialect,
@@ -179,7 +180,7 @@ impl ReadOptions {
 /// Reads a measurement file.
 pub fn read_measurements(path: &Path, options: &ReadOptions) -> Result<MeasurementSet, Error> {
     let file = path.display().to_string();
-    let reader = std::fs::File::open(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+    let reader = std::fs::File::open(path).map_err(|source| Error::io(file.clone(), source))?;
     parse(reader, &file, options, true)
 }
 
@@ -193,7 +194,7 @@ pub fn parse_measurements<R: Read>(reader: R, file: &str, options: &ReadOptions)
 /// position is zero). Every other rule of the format holds.
 pub fn read_configurations(path: &Path, options: &ReadOptions) -> Result<MeasurementSet, Error> {
     let file = path.display().to_string();
-    let reader = std::fs::File::open(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+    let reader = std::fs::File::open(path).map_err(|source| Error::io(file.clone(), source))?;
     parse(reader, &file, options, false)
 }
 
@@ -210,7 +211,7 @@ pub struct Cells {
 /// [`read_configurations`], with every cell as written.
 pub fn read_configurations_with_cells(path: &Path, options: &ReadOptions) -> Result<(MeasurementSet, Cells), Error> {
     let file = path.display().to_string();
-    let reader = std::fs::File::open(path).map_err(|source| Error::Io { path: file.clone(), source })?;
+    let reader = std::fs::File::open(path).map_err(|source| Error::io(file.clone(), source))?;
     let mut cells = Cells::default();
     let set = parse_keeping(reader, &file, options, false, Some(&mut cells))?;
     Ok((set, cells))
@@ -233,7 +234,7 @@ fn parse_keeping<R: Read>(
     mut cells: Option<&mut Cells>,
 ) -> Result<MeasurementSet, Error> {
     let mut bytes = Vec::new();
-    reader.read_to_end(&mut bytes).map_err(|source| Error::Io { path: file.to_owned(), source })?;
+    reader.read_to_end(&mut bytes).map_err(|source| Error::io(file.to_owned(), source))?;
     let body = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
     let mut dialect = Dialect::from_header_line(body);
     let mut csv = csv::ReaderBuilder::new()
@@ -244,7 +245,7 @@ fn parse_keeping<R: Read>(
     let delimiter = dialect.delimiter;
     let header = csv.headers().map_err(|e| syntax_error(&e, file, delimiter))?.clone();
     if header.is_empty() || (header.len() == 1 && header[0].is_empty()) {
-        return Err(Error::EmptyFile { file: file.to_owned() });
+        return Err(Error::at_line(file.to_owned(), 1, 1, ErrorKind::EmptyFile));
     }
     let expect = Expectation {
         file,
@@ -292,7 +293,12 @@ fn parse_keeping<R: Read>(
             Some(c) => {
                 let value = row.number(c)?;
                 if value < 0.0 {
-                    return Err(Error::NegativePayload { file: file.to_owned(), line, column: c.index + 1, value });
+                    return Err(Error::at_line(
+                        file.to_owned(),
+                        line,
+                        c.index + 1,
+                        ErrorKind::NegativePayload { value },
+                    ));
                 }
                 value
             }
@@ -312,7 +318,7 @@ fn parse_keeping<R: Read>(
         }
     }
     if rows.is_empty() {
-        return Err(Error::EmptyFile { file: file.to_owned() });
+        return Err(Error::at_line(file.to_owned(), 1, 1, ErrorKind::EmptyFile));
     }
     Ok(MeasurementSet {
         source: file.to_owned(),
@@ -389,13 +395,12 @@ impl MeasurementSet {
         if self.joint_count == joints {
             return Ok(());
         }
-        Err(Error::JointCountMismatch {
-            file: self.source.clone(),
-            line: 1,
-            column: 1,
-            found: self.joint_count,
-            expected: joints,
-        })
+        Err(Error::at_line(
+            self.source.clone(),
+            1,
+            1,
+            ErrorKind::JointCountMismatch { found: self.joint_count, expected: joints },
+        ))
     }
 
     /// Refuses a set whose joint columns do not match a robot's joints: their count, and each
@@ -404,13 +409,12 @@ impl MeasurementSet {
         self.check_joint_count(kinds.len())?;
         for (k, (column, kind)) in self.joint_columns.iter().zip(kinds).enumerate() {
             if column.kind != *kind {
-                return Err(Error::JointUnit {
-                    file: self.source.clone(),
-                    line: 1,
-                    column: column.column,
-                    joint: k + 1,
-                    kind: *kind,
-                });
+                return Err(Error::at_line(
+                    self.source.clone(),
+                    1,
+                    column.column,
+                    ErrorKind::JointUnit { joint: k + 1, kind: layout::error_kind(*kind) },
+                ));
             }
         }
         Ok(())

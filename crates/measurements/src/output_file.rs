@@ -7,8 +7,8 @@
 //! FIFO, a socket, a device node such as `/dev/null`) is refused rather than replaced by a
 //! regular file.
 
-use errors::Error;
 pub use errors::FileKind;
+use errors::{Error, ErrorKind};
 use std::fs::{File, OpenOptions};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -40,7 +40,7 @@ fn kind_of(file_type: std::fs::FileType) -> FileKind {
 
 /// The file an output to `path` replaces: `path` itself, or where the chain of symbolic links
 /// starting at it ends. The file need not exist; if something exists there that is not a regular
-/// file, it is refused ([`Error::OutputNotRegularFile`], [`Error::OutputSymlinkChain`]).
+/// file, it is refused ([`ErrorKind::OutputNotRegularFile`], [`ErrorKind::OutputSymlinkChain`]).
 pub fn output_target(path: &Path) -> Result<PathBuf, Error> {
     let shown = || path.display().to_string();
     let mut current = path.to_path_buf();
@@ -48,7 +48,7 @@ pub fn output_target(path: &Path) -> Result<PathBuf, Error> {
         let metadata = match std::fs::symlink_metadata(&current) {
             Ok(metadata) => metadata,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(current),
-            Err(source) => return Err(Error::Io { path: current.display().to_string(), source }),
+            Err(source) => return Err(Error::io(current.display().to_string(), source)),
         };
         let file_type = metadata.file_type();
         if file_type.is_file() {
@@ -60,23 +60,22 @@ pub fn output_target(path: &Path) -> Result<PathBuf, Error> {
             } else {
                 format!("{} (the link's target {})", shown(), current.display())
             };
-            return Err(Error::OutputNotRegularFile { path, kind: kind_of(file_type) });
+            return Err(Error::in_file(path, ErrorKind::OutputNotRegularFile { kind: kind_of(file_type) }));
         }
-        let link =
-            std::fs::read_link(&current).map_err(|source| Error::Io { path: current.display().to_string(), source })?;
+        let link = std::fs::read_link(&current).map_err(|source| Error::io(current.display().to_string(), source))?;
         // A relative link is relative to the folder that holds the link.
         current = match current.parent() {
             Some(folder) if link.is_relative() => folder.join(link),
             _ => link,
         };
     }
-    Err(Error::OutputSymlinkChain { path: shown(), links: MAX_SYMLINKS })
+    Err(Error::in_file(shown(), ErrorKind::OutputSymlinkChain { links: MAX_SYMLINKS }))
 }
 
 /// Writes `bytes` to `path` atomically (see the module doc).
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     let mut file = OutputFile::create(path)?;
-    file.write_all(bytes).map_err(|source| Error::Io { path: path.display().to_string(), source })?;
+    file.write_all(bytes).map_err(|source| Error::io(path.display().to_string(), source))?;
     file.finish()
 }
 
@@ -101,7 +100,7 @@ impl OutputFile {
     /// file in the target's folder, with the target's permissions where it exists.
     pub fn create(path: &Path) -> Result<OutputFile, Error> {
         let shown = path.display().to_string();
-        let io = |source| Error::Io { path: shown.clone(), source };
+        let io = |source| Error::io(shown.clone(), source);
         let target = output_target(path)?;
         let folder = match target.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
@@ -133,7 +132,7 @@ impl OutputFile {
 
     /// Flushes and syncs the temporary file, then renames it over the target.
     pub fn finish(mut self) -> Result<(), Error> {
-        let io = |source| Error::Io { path: self.shown.clone(), source };
+        let io = |source| Error::io(self.shown.clone(), source);
         let writer = self.writer.take().expect("an OutputFile is finished once (finish takes it by value)");
         let result = (|| {
             let file = writer.into_inner().map_err(|e| e.into_error())?;
@@ -253,7 +252,10 @@ mod tests {
         let (a, b) = (dir.path().join("a"), dir.path().join("b"));
         std::os::unix::fs::symlink(&b, &a).unwrap();
         std::os::unix::fs::symlink(&a, &b).unwrap();
-        assert!(matches!(write_file(&a, b"x"), Err(Error::OutputSymlinkChain { links: MAX_SYMLINKS, .. })));
+        assert!(matches!(
+            write_file(&a, b"x").unwrap_err().kind(),
+            ErrorKind::OutputSymlinkChain { links: MAX_SYMLINKS }
+        ));
     }
 
     #[test]
@@ -262,7 +264,7 @@ mod tests {
         let folder = dir.path().join("folder");
         std::fs::create_dir(&folder).unwrap();
         let error = write_file(&folder, b"x").unwrap_err();
-        assert!(matches!(error, Error::OutputNotRegularFile { kind: FileKind::Directory, .. }), "{error:?}");
+        assert!(matches!(error.kind(), ErrorKind::OutputNotRegularFile { kind: FileKind::Directory, .. }), "{error:?}");
         assert!(error.to_string().contains("is a directory"), "{error}");
         assert!(folder.is_dir());
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary file made");
@@ -274,14 +276,20 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let link = dir.path().join("link");
         std::os::unix::fs::symlink(dir.path(), &link).unwrap();
-        assert!(matches!(write_file(&link, b"x"), Err(Error::OutputNotRegularFile { kind: FileKind::Directory, .. })));
+        assert!(matches!(
+            write_file(&link, b"x").unwrap_err().kind(),
+            ErrorKind::OutputNotRegularFile { kind: FileKind::Directory }
+        ));
     }
 
     #[cfg(unix)]
     #[test]
     fn a_character_device_is_refused() {
         let error = output_target(Path::new("/dev/null")).unwrap_err();
-        assert!(matches!(error, Error::OutputNotRegularFile { kind: FileKind::CharacterDevice, .. }), "{error:?}");
+        assert!(
+            matches!(error.kind(), ErrorKind::OutputNotRegularFile { kind: FileKind::CharacterDevice, .. }),
+            "{error:?}"
+        );
     }
 
     #[cfg(unix)]

@@ -3,7 +3,7 @@
 
 use super::dialect::{Delimiter, Dialect};
 use super::layout::{Column, OrientationColumns};
-use errors::Error;
+use errors::{Error, ErrorKind};
 use lie::{SO3, Vector3};
 
 /// The largest magnitude a column's value can have, in SI units: beyond it the cell is a unit or
@@ -39,16 +39,16 @@ pub(super) const JOINT_ANGLE_RANGE: PhysicalRange =
 pub(super) fn syntax_error(e: &csv::Error, file: &str, delimiter: Delimiter) -> Error {
     let line = e.position().map_or(1, |p| p.line());
     match e.kind() {
-        csv::ErrorKind::UnequalLengths { expected_len, len, .. } => Error::FieldCount {
-            file: file.to_owned(),
+        csv::ErrorKind::UnequalLengths { expected_len, len, .. } => Error::at_line(
+            file.to_owned(),
             line,
-            column: (*expected_len).min(*len) as usize + 1,
-            found: *len,
-            expected: *expected_len,
-            delimiter: delimiter.byte() as char,
-        },
-        csv::ErrorKind::Utf8 { err, .. } => Error::InvalidUtf8 { file: file.to_owned(), line, column: err.field() + 1 },
-        _ => Error::CsvSyntax { file: file.to_owned(), line, column: 1, message: e.to_string() },
+            (*expected_len).min(*len) as usize + 1,
+            ErrorKind::FieldCount { found: *len, expected: *expected_len, delimiter: delimiter.byte() as char },
+        ),
+        csv::ErrorKind::Utf8 { err, .. } => {
+            Error::at_line(file.to_owned(), line, err.field() + 1, ErrorKind::InvalidUtf8)
+        }
+        _ => Error::at_line(file.to_owned(), line, 1, ErrorKind::CsvSyntax { message: e.to_string() }),
     }
 }
 
@@ -72,11 +72,11 @@ impl Row<'_> {
             Ok(Some(value)) => Ok(value * column.scale),
             Ok(None) => {
                 let (file, line, column, name, text) = at(text);
-                Err(Error::NotANumber { file, line, column, name, text })
+                Err(Error::at_line(file, line, column, ErrorKind::NotANumber { name, text }))
             }
             Err(fault) => {
                 let (file, line, column, name, text) = at(text);
-                Err(Error::DecimalMark { file, line, column, name, text, fault })
+                Err(Error::at_line(file, line, column, ErrorKind::DecimalMark { name, text, fault }))
             }
         }
     }
@@ -95,16 +95,18 @@ impl Row<'_> {
                 if value.abs() <= range.limit {
                     return Ok(value);
                 }
-                Err(Error::BeyondPhysicalRange {
-                    file: self.file.to_owned(),
-                    line: self.line,
-                    column: c.index + 1,
-                    name: self.names[c.index].clone(),
-                    value,
-                    limit: range.limit,
-                    unit: range.unit,
-                    quantity: range.quantity,
-                })
+                Err(Error::at_line(
+                    self.file.to_owned(),
+                    self.line,
+                    c.index + 1,
+                    ErrorKind::BeyondPhysicalRange {
+                        name: self.names[c.index].clone(),
+                        value,
+                        limit: range.limit,
+                        unit: range.unit,
+                        quantity: range.quantity,
+                    },
+                ))
             })
             .collect()
     }
@@ -114,11 +116,13 @@ impl Row<'_> {
         match columns {
             OrientationColumns::Quaternion(c) => {
                 let q = self.numbers(c)?;
-                SO3::from_quaternion(q[0], q[1], q[2], q[3]).map_err(|_| Error::QuaternionNorm {
-                    file: self.file.to_owned(),
-                    line: self.line,
-                    column: c[0].index + 1,
-                    norm: q.iter().map(|v| v * v).sum::<f64>().sqrt(),
+                SO3::from_quaternion(q[0], q[1], q[2], q[3]).map_err(|_| {
+                    Error::at_line(
+                        self.file.to_owned(),
+                        self.line,
+                        c[0].index + 1,
+                        ErrorKind::QuaternionNorm { norm: q.iter().map(|v| v * v).sum::<f64>().sqrt() },
+                    )
                 })
             }
             OrientationColumns::Euler(c) => {

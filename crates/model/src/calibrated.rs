@@ -4,7 +4,7 @@
 use crate::Method;
 use crate::model_parts::{Part, Walk};
 use effects::IdentifiedEffect;
-use errors::Error;
+use errors::{Error, ErrorKind};
 use lie::SE3;
 use measurements::Measurement;
 use poe::LocalPoe;
@@ -89,12 +89,13 @@ impl CalibratedModel {
     /// file without the column), matched like any other name, as in the fit (SPEC v2); an
     /// identifier the model was not fitted with is refused.
     pub fn tool_index(&self, name: &str, file: &str, line: u64, column: usize) -> Result<usize, Error> {
-        self.tools.iter().position(|t| t == name).ok_or_else(|| Error::UnknownTool {
-            file: file.to_owned(),
-            line,
-            column,
-            tool: name.to_owned(),
-            known: self.tools.clone(),
+        self.tools.iter().position(|t| t == name).ok_or_else(|| {
+            Error::at_line(
+                file.to_owned(),
+                line,
+                column,
+                ErrorKind::UnknownTool { tool: name.to_owned(), known: self.tools.clone() },
+            )
         })
     }
 
@@ -173,7 +174,7 @@ impl CalibratedModel {
 
 /// Rows at which an effect of the model is used outside the joint angles it was fitted on: there
 /// the model extrapolates, and its error on them is not what the fit measured.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ExtrapolationWarning {
     /// The effect, as reports name it (`gear_periodic:1:48`).
     pub effect: String,

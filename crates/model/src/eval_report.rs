@@ -5,60 +5,67 @@
 use crate::Evaluation;
 use crate::{CalibratedModel, ErrorSummary, ExtrapolationWarning, Method, PoseError};
 use measurements::{FileFormat, MeasurementSet};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What `eval` says when the data has orientations that a position-only model cannot be judged on.
 pub const ORIENTATIONS_NOT_EVALUATED: &str =
     "the model was fitted on positions only: orientations in the data are not evaluated";
 
-/// The evaluation of a model on one measurement file.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// The evaluation of a model on one measurement file: `calib eval --json`. It reads back from that
+/// JSON, and from the SPEC's older one (the error statistics with `method` and `full_pose`): a field
+/// an older report lacks reads as empty (`robot`, `data`, the warnings, no coverage split) or, for
+/// `format`, as SPEC v1's only dialect (`,` and a decimal point).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EvalReport {
     /// The model's method.
     pub method: Method,
     /// The robot the model was fitted for.
+    #[serde(default)]
     pub robot: String,
     /// The measurement file.
+    #[serde(default)]
     pub data: String,
     /// Whether the rotation errors are given: the data has orientations and the model was
     /// fitted on them.
     pub full_pose: bool,
     /// The data has orientations but the model was fitted on positions only: they are not
     /// evaluated (see [`ORIENTATIONS_NOT_EVALUATED`]).
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub orientations_not_evaluated: bool,
     /// The error statistics, at the top level of the object.
     #[serde(flatten)]
     pub errors: ErrorSummary,
     /// How the measurement file was written.
+    #[serde(default)]
     pub format: FileFormat,
     /// The errors on the rows inside the model's coverage (every effect's joint within the
     /// angles it was fitted on) and on the others, apart: the model is on firm ground only on
     /// the first. `None` for a model without effects that record their angles.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coverage: Option<CoverageSplit>,
     /// Effects used outside the joint angles they were fitted on.
+    #[serde(default)]
     pub warnings: Vec<ExtrapolationWarning>,
     /// Inputs (joints, payload, temperature, time) outside the range the model was fitted on,
     /// for every model that records it.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub out_of_range: Vec<crate::OutOfRangeWarning>,
     /// Joints beyond the robot's limits, for every model that keeps them.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub beyond_joint_limits: Vec<crate::BeyondLimitsWarning>,
     /// The errors on the rows whose every input (joints, payload, temperature, time) lies within
     /// the range the model was fitted on, and on the others, apart: for every model that records
     /// its range, when some row lies outside it.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub range_split: Option<CoverageSplit>,
     /// Rows whose error lies far beyond the others' (a measurement error more likely than the
     /// model's), named beside the statistics, which keep them.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub suspect_rows: Option<crate::SuspectRows>,
 }
 
 /// The errors inside and outside a model's coverage.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CoverageSplit {
     /// Rows whose every effect is within the angles it was fitted on.
     pub inside: ErrorSummary,
@@ -120,4 +127,51 @@ fn suspects(model: &CalibratedModel, data: &MeasurementSet, evaluation: &Evaluat
         evaluation.errors.iter().enumerate().filter(|(i, _)| !named.contains(i)).map(|(_, e)| *e).collect();
     found.without = ErrorSummary::from_errors(&others);
     Some(found)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::EvalReport;
+    use crate::Method;
+
+    /// `calib eval --json` as the first typed report and the SPEC's first binary wrote it: the error
+    /// statistics, `method` and `full_pose`, nothing else.
+    const OLDEST: &str = r#"{"n":3,"mean_position_error_mm":0.5,"rms_position_error_mm":0.6,
+        "max_position_error_mm":0.9,"median_position_error_mm":0.4,"method":"poe-gp","full_pose":false}"#;
+
+    #[test]
+    fn the_oldest_eval_json_reads_with_empty_extras() {
+        let report: EvalReport = serde_json::from_str(OLDEST).unwrap();
+        assert_eq!((report.method, report.errors.n, report.errors.max_position_error_mm), (Method::PoeGp, 3, 0.9));
+        assert!(report.robot.is_empty() && report.warnings.is_empty() && report.coverage.is_none());
+        assert_eq!(report.format, measurements::FileFormat::default());
+        assert_eq!(report.errors.mean_rotation_error_mrad, None);
+    }
+
+    #[test]
+    fn a_report_reads_back_as_it_was_written() {
+        let mut report: EvalReport = serde_json::from_str(OLDEST).unwrap();
+        report.robot = "irb4400".into();
+        report.errors.mean_rotation_error_mrad = Some(0.2);
+        report.out_of_range.push(crate::OutOfRangeWarning {
+            input: "temp_c".into(),
+            unit: "°C",
+            fitted: [20.0, 25.0],
+            rows_outside: 1,
+            rows: 3,
+            first_line: 4,
+        });
+        let text = serde_json::to_string(&report).unwrap();
+        assert_eq!(serde_json::from_str::<EvalReport>(&text).unwrap(), report, "{text}");
+    }
+
+    #[test]
+    fn a_unit_no_report_writes_is_refused() {
+        let text = OLDEST.replace(
+            "\"full_pose\":false",
+            "\"full_pose\":false,\"out_of_range\":[{\"input\":\"t_s\",\"unit\":\"h\",\"fitted\":[0,1],\"rows_outside\":1,\"rows\":3,\"first_line\":2}]",
+        );
+        let error = serde_json::from_str::<EvalReport>(&text).unwrap_err();
+        assert!(error.to_string().contains("a unit"), "{error}");
+    }
 }

@@ -44,7 +44,8 @@ pub fn fit_geometry(
     let observations = observations(data);
     // The "before" is the nominal model at its base-tool fit, not the closed-form registration
     // that starts it (UR10 series B: 24 m off against 0.87 mm).
-    let (registered, identification) = poe::identify::calibrate_placed(nominal, &observations, scope, options)?;
+    let (registered, identification) =
+        poe::identify::calibrate_placed(nominal, &observations, scope, options).map_err(Error::kinematics)?;
     Ok(GeometricFit { model: identification.model, registered, report: identification.report })
 }
 
@@ -60,6 +61,7 @@ pub fn fit_geometry_with_prior(
 ) -> Result<GeometricFit, Error> {
     let observations = observations(data);
     let (registered, identification) =
-        poe::identify::calibrate_placed_with_prior(nominal, &observations, scope, prior, options)?;
+        poe::identify::calibrate_placed_with_prior(nominal, &observations, scope, prior, options)
+            .map_err(Error::kinematics)?;
     Ok(GeometricFit { model: identification.model, registered, report: identification.report })
 }

@@ -5,7 +5,7 @@
 //! fitted; this says where the robot can be at all, and holds for models fitted on part of it.
 
 use measurements::Measurement;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The limits as a model file keeps them: per joint `[lower, upper]` in SI units (rad, m), `None`
 /// for a joint without limits (a URDF's continuous joint).
@@ -26,12 +26,13 @@ pub(crate) fn limits_fault(limits: &[Option<[f64; 2]>], joints: usize) -> Option
 }
 
 /// Rows that put a joint beyond the robot's limits: one warning per such joint.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BeyondLimitsWarning {
     /// The 1-based joint.
     pub joint: usize,
     /// Its unit: `rad`, or `m` for a prismatic joint.
-    pub unit: &'static str,
+    #[serde(deserialize_with = "crate::unit_name::deserialize")]
+    pub unit: crate::unit_name::Unit,
     /// The robot description's limits, `[lower, upper]`.
     pub limits: [f64; 2],
     /// How many rows put the joint beyond them.

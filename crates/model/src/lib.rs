@@ -47,6 +47,7 @@ mod predictions;
 mod residual_gp;
 mod suspect_rows;
 mod training_range;
+mod unit_name;
 pub use evaluate::{Evaluation, evaluate, tool_indices};
 pub use predictions::write_predictions;
 

@@ -5,8 +5,8 @@
 
 use crate::model_parts::{Part, Walk};
 use crate::{CalibratedModel, Method};
-use errors::Error;
 use errors::ron_position::field_position;
+use errors::{Error, ErrorKind};
 use measurements::Measurement;
 use robot::{MAX_TRANSLATION_M, bad_translation};
 
@@ -23,12 +23,17 @@ impl Located<'_> {
 
     fn count(&self, at: (&str, usize), field: String, what: &'static str, found: usize, expected: usize) -> Error {
         let (line, column) = self.at(at.0, at.1);
-        Error::ModelCount { file: self.file.to_owned(), line, column, field, what, found, expected }
+        Error::at_line(
+            self.file.to_owned(),
+            line as u64,
+            column,
+            ErrorKind::ModelCount { field, what, found, expected },
+        )
     }
 
     fn not_finite(&self, at: (&str, usize), field: String, value: f64) -> Error {
         let (line, column) = self.at(at.0, at.1);
-        Error::NotFinite { file: self.file.to_owned(), line, column, field, value }
+        Error::at_line(self.file.to_owned(), line as u64, column, ErrorKind::NotFinite { field, value })
     }
 
     /// A value that is not finite, or finite and beyond [`robot::MAX_TRANSLATION_M`].
@@ -37,12 +42,17 @@ impl Located<'_> {
             return self.not_finite(at, field, value);
         }
         let (line, column) = self.at(at.0, at.1);
-        Error::ModelValue { file: self.file.to_owned(), line, column, field, value, limit: MAX_TRANSLATION_M }
+        Error::at_line(
+            self.file.to_owned(),
+            line as u64,
+            column,
+            ErrorKind::ModelValue { field, value, limit: MAX_TRANSLATION_M },
+        )
     }
 
     fn part(&self, field: &str, message: String) -> Error {
         let (line, column) = self.at(field, 0);
-        Error::RonFormat { file: self.file.to_owned(), line, column, message }
+        Error::at_line(self.file.to_owned(), line as u64, column, ErrorKind::RonFormat { message })
     }
 }
 
@@ -74,11 +84,16 @@ fn check_robot(robot: &robot::RobotDescription, model: &CalibratedModel, at: &Lo
     let start: usize = at.text.split_inclusive('\n').take(line - 1).map(str::len).sum();
     match robot.check_kept(&at.text[start.min(at.text.len())..], at.file) {
         Ok(()) => {}
-        Err(Error::RonFormat { file, line: relative, column, message }) => {
-            let message = format!("robot_description is not a valid robot: {message}");
-            return Err(Error::RonFormat { file, line: line + relative - 1, column, message });
+        Err(e) => {
+            if let (ErrorKind::RonFormat { message }, Some(place)) = (e.kind(), e.place())
+                && let Some((relative, column)) = place.position()
+            {
+                let message = format!("robot_description is not a valid robot: {message}");
+                let line = line as u64 + relative - 1;
+                return Err(Error::at_line(place.file(), line, column, ErrorKind::RonFormat { message }));
+            }
+            return Err(at.part(field, format!("robot_description is not a valid robot: {e}")));
         }
-        Err(e) => return Err(at.part(field, format!("robot_description is not a valid robot: {e}"))),
     }
     let kinds = robot.joint_kinds();
     if kinds != model.joint_kinds() {
@@ -116,7 +131,7 @@ impl CalibratedModel {
             let (lo, hi) = robot::SCALE_BOUNDS;
             let (line, column) = at.at("scale", k);
             let message = format!("a joint's scale is {scale:e}, expected a finite number from {lo:e} to {hi:e}");
-            return Err(Error::RonFormat { file: file.to_owned(), line, column, message });
+            return Err(Error::at_line(file.to_owned(), line as u64, column, ErrorKind::RonFormat { message }));
         }
         if self.tools.len() != tool_count {
             return Err(at.count(("tools", 0), "tools".into(), "tool names", self.tools.len(), tool_count));

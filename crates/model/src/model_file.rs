@@ -1,7 +1,7 @@
 //! The calibrated model as a file: RON with a schema version, written atomically.
 
 use crate::CalibratedModel;
-use errors::Error;
+use errors::{Error, ErrorKind};
 use std::path::Path;
 
 /// The schema version this build writes. Version 2 holds the non-geometric effects as a list
@@ -18,12 +18,8 @@ pub fn write_model(path: &Path, model: &CalibratedModel) -> Result<(), Error> {
 
 /// The text [`write_model`] writes; `file` names it in errors.
 pub fn model_text(model: &CalibratedModel, file: &str) -> Result<String, Error> {
-    ron::ser::to_string_pretty(model, ron::ser::PrettyConfig::default().depth_limit(6)).map_err(|e| Error::RonFormat {
-        file: file.to_owned(),
-        line: 1,
-        column: 1,
-        message: e.to_string(),
-    })
+    ron::ser::to_string_pretty(model, ron::ser::PrettyConfig::default().depth_limit(6))
+        .map_err(|e| Error::at_line(file.to_owned(), 1, 1, ErrorKind::RonFormat { message: e.to_string() }))
 }
 
 /// Reads a calibrated model, refusing a file of another schema version.
@@ -39,28 +35,34 @@ pub fn parse_model(text: &str, file: &str) -> Result<CalibratedModel, Error> {
     struct Version {
         schema_version: u32,
     }
-    let position_error = |e: ron::error::SpannedError| Error::RonFormat {
-        file: file.to_owned(),
-        line: e.span.start.line,
-        column: e.span.start.col,
-        message: e.code.to_string(),
+    let position_error = |e: ron::error::SpannedError| {
+        Error::at_line(
+            file.to_owned(),
+            e.span.start.line as u64,
+            e.span.start.col,
+            ErrorKind::RonFormat { message: e.code.to_string() },
+        )
     };
     // Read the version alone first so that a model from another version is refused with that
     // reason rather than with whichever field changed.
     let options = errors::ron_position::ron_options();
     let version: Version = match options.from_str::<ron::Value>(text) {
-        Ok(value) => value.into_rust().map_err(|e| Error::RonFormat {
-            file: file.to_owned(),
-            line: 1,
-            column: 1,
-            message: format!("no schema_version: {e}"),
+        Ok(value) => value.into_rust().map_err(|e| {
+            Error::at_line(file.to_owned(), 1, 1, ErrorKind::RonFormat { message: format!("no schema_version: {e}") })
         })?,
         Err(e) => return Err(position_error(e)),
     };
     let model: CalibratedModel = match version.schema_version {
         1 => options.from_str::<version_1::Model>(text).map_err(position_error)?.into(),
         SCHEMA_VERSION => options.from_str(text).map_err(position_error)?,
-        found => return Err(Error::SchemaVersion { file: file.to_owned(), found, supported: SCHEMA_VERSION }),
+        found => {
+            return Err(Error::at_line(
+                file.to_owned(),
+                1,
+                1,
+                ErrorKind::SchemaVersion { found, supported: SCHEMA_VERSION },
+            ));
+        }
     };
     model.check(text, file)?;
     Ok(model)

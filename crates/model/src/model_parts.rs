@@ -10,7 +10,7 @@
 
 use crate::ResidualGp;
 use effects::IdentifiedEffect;
-use errors::Error;
+use errors::{Error, ErrorKind};
 use lie::{SE3, Twist, Vector6};
 use measurements::Measurement;
 use poe::LocalPoe;
@@ -58,12 +58,13 @@ impl<'a> Part<'a> {
                     .iter()
                     .zip(walk.tools)
                     .map(|(row, &tool)| kinematics.forward(&row.q, tool))
-                    .collect::<Result<_, _>>()?;
+                    .collect::<Result<_, _>>()
+                    .map_err(Error::kinematics)?;
                 walk.pending = vec![Vector6::zeros(); walk.rows.len()];
                 walk.coverage = vec![1.0; walk.rows.len()];
             }
             Part::Effect(effect) => {
-                let kinematics = walk.kinematics.ok_or(Error::PartOrder { part: "effect" })?;
+                let kinematics = walk.kinematics.ok_or(Error::new(ErrorKind::PartOrder { part: "effect" }))?;
                 for (((pending, coverage), row), &tool) in
                     walk.pending.iter_mut().zip(&mut walk.coverage).zip(walk.rows).zip(walk.tools)
                 {
@@ -89,7 +90,7 @@ impl<'a> Part<'a> {
                 {
                     if *coverage < 1.0 {
                         // T = exp(w · log(T_e T_g⁻¹)) T_g: the geometry alone at w = 0.
-                        let alone = fallback.forward(&row.q, tool)?;
+                        let alone = fallback.forward(&row.q, tool).map_err(Error::kinematics)?;
                         let towards = (*pose * alone.inverse()).log().to_vector() * *coverage;
                         *pose = Twist::from_vector(&towards).exp() * alone;
                     }

@@ -18,7 +18,7 @@ pub fn write_predictions<W: Write>(
     data: &MeasurementSet,
     predictions: &[PredictedPose],
 ) -> Result<(), Error> {
-    let failed = |e: csv::Error| Error::Io { path: sink.to_owned(), source: std::io::Error::other(e) };
+    let failed = |e: csv::Error| Error::io(sink.to_owned(), std::io::Error::other(e));
     let mut out = csv::Writer::from_writer(out);
     // The GP's standard deviation, and that of what the effects leave where they fade out.
     let gp = model.predicts_std();
@@ -54,5 +54,5 @@ pub fn write_predictions<W: Write>(
         }
         out.write_record(&record).map_err(failed)?;
     }
-    out.flush().map_err(|source| Error::Io { path: sink.to_owned(), source })
+    out.flush().map_err(|source| Error::io(sink.to_owned(), source))
 }

@@ -513,7 +513,7 @@ impl ResidualGp {
                     ..options.gp.clone()
                 };
                 let config = gp::SparseConfig { gp, inducing_points, ..options.sparse.clone() };
-                let model = gp::SparseGp::fit(x.as_ref(), y.as_ref(), &config)?;
+                let model = gp::SparseGp::fit(x.as_ref(), y.as_ref(), &config).map_err(Error::gp)?;
                 let report = GpFitReport::Sparse(model.report().clone());
                 (GpModel::Sparse(model), report, None)
             }
@@ -522,9 +522,9 @@ impl ResidualGp {
                 if data.full_pose && options.rotation_follows_position && config.follower_groups.is_empty() {
                     config.follower_groups = vec![vec![3, 4, 5]];
                 }
-                let model = gp::ExactGp::fit(x.as_ref(), y.as_ref(), &config)?;
+                let model = gp::ExactGp::fit(x.as_ref(), y.as_ref(), &config).map_err(Error::gp)?;
                 let report = GpFitReport::Exact(model.report().clone());
-                let loo = model.leave_one_out()?;
+                let loo = model.leave_one_out().map_err(Error::gp)?;
                 (GpModel::Exact(model), report, Some(loo.mean))
             }
         };
@@ -597,7 +597,7 @@ impl ResidualGp {
         model_poses: &[SE3],
         tools: &[usize],
     ) -> Result<Vec<(SE3, [f64; 6])>, Error> {
-        let prediction = self.gp.predict(inputs(rows, self.with_payload).as_ref())?;
+        let prediction = self.gp.predict(inputs(rows, self.with_payload).as_ref()).map_err(Error::gp)?;
         let outputs = prediction.mean.ncols();
         Ok(model_poses
             .iter()

@@ -94,12 +94,13 @@ impl TrainingRange {
 /// Rows that put an input outside the range the model was fitted on: there every part of the
 /// model (geometry, effects, GP) answers for poses it never saw, and its error is not what the
 /// fit measured. One per input that some row leaves.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct OutOfRangeWarning {
     /// The input: `joint 3`, `payload_kg`, `temp_c` or `t_s`.
     pub input: String,
     /// Its unit: `rad`, `m` (a prismatic joint), `kg`, `°C`, `s`.
-    pub unit: &'static str,
+    #[serde(deserialize_with = "crate::unit_name::deserialize")]
+    pub unit: crate::unit_name::Unit,
     /// Its smallest and largest value on the training rows.
     pub fitted: [f64; 2],
     /// How many rows lie outside.

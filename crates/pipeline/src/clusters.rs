@@ -97,7 +97,7 @@ fn six_revolute(model: &LocalPoe) -> Option<Vec<usize>> {
 
 /// The determinant of the 6 × 6 spatial Jacobian of the six revolute joints at `q`.
 fn determinant(model: &LocalPoe, q: &[f64]) -> Result<f64, Error> {
-    let twists = model.spatial_twists(q)?;
+    let twists = model.spatial_twists(q).map_err(Error::kinematics)?;
     let columns: Vec<nalgebra::Vector6<f64>> =
         six_revolute(model).unwrap_or_default().into_iter().map(|j| twists[j].to_vector()).collect();
     if columns.len() != 6 {

@@ -5,7 +5,7 @@ use crate::fit_options::FitOptions;
 use effects::{
     EffectContext, EffectCorrection, EffectReport, EffectSelection, EffectSpec, IdentifiedEffect, effect_reports,
 };
-use errors::Error;
+use errors::{Error, ErrorKind};
 use measurements::MeasurementSet;
 use measurements::{OutlierLine, list_lines, without};
 use model::geometric::{fit_geometry_with_prior, observations};
@@ -229,7 +229,8 @@ pub fn fit(
             Some(&correction),
             prior.as_ref(),
             &id_options,
-        )?;
+        )
+        .map_err(Error::kinematics)?;
         EffectCorrection::distribute(&mut effects, &fitted.correction);
         for effect in &mut effects {
             if let IdentifiedEffect::GearPeriodic(gear) = effect {
@@ -258,9 +259,9 @@ pub fn fit(
     // The check `read_model` runs, on the text `write_model` writes: a fit never hands over a
     // model that its own file would be refused for, and the cause shows here (issue 23).
     let text = model::model_text(&model, "the fitted model")?;
-    model
-        .check(&text, "the fitted model")
-        .map_err(|source| Error::FittedModelRefused { method: method.to_string(), source: Box::new(source) })?;
+    model.check(&text, "the fitted model").map_err(|source| {
+        Error::new(ErrorKind::FittedModelRefused { method: method.to_string(), source: Box::new(source) })
+    })?;
     let registered = CalibratedModel {
         kinematics: geometry.registered,
         effects: Vec::new(),

@@ -3,7 +3,7 @@
 
 use diagnose::DiagnoseOptions;
 use effects::EffectSelection;
-use errors::Error;
+use errors::{Error, ErrorKind};
 use model::ResidualGpOptions;
 use poe::identify::{IdentificationOptions, Solver};
 use serde::{Deserialize, Serialize};
@@ -137,15 +137,17 @@ impl FitOptions {
 
     /// Parses options from RON text and checks them; `file` names it in errors.
     pub fn parse(text: &str, file: &str) -> Result<Self, Error> {
-        let options: FitOptions = errors::ron_position::ron_options().from_str(text).map_err(|e| Error::RonFormat {
-            file: file.to_owned(),
-            line: e.span.start.line,
-            column: e.span.start.col,
-            message: e.code.to_string(),
+        let options: FitOptions = errors::ron_position::ron_options().from_str(text).map_err(|e| {
+            Error::at_line(
+                file.to_owned(),
+                e.span.start.line as u64,
+                e.span.start.col,
+                ErrorKind::RonFormat { message: e.code.to_string() },
+            )
         })?;
         options.validate().map_err(|(field, message)| {
             let (line, column) = errors::ron_position::field_position(text, field, 0);
-            Error::RonFormat { file: file.to_owned(), line, column, message }
+            Error::at_line(file.to_owned(), line as u64, column, ErrorKind::RonFormat { message })
         })?;
         Ok(options)
     }

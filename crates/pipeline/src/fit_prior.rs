@@ -210,7 +210,7 @@ fn heldout(model: &LocalPoe, data: &MeasurementSet, options: &IdentificationOpti
     observations(data)
         .chunks(1)
         .map(|row| {
-            let stats = evaluate(model, row)?;
+            let stats = evaluate(model, row).map_err(Error::kinematics)?;
             let rotation = stats.rms_rotation_rad.map_or(0.0, |r| r / options.rotation_sigma_rad);
             let loss = (stats.rms_position_m / options.position_sigma_m).powi(2) + rotation.powi(2);
             Ok((loss, (stats.rms_position_m * 1e3).powi(2)))

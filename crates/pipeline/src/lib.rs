@@ -20,7 +20,7 @@ pub use fit_prior::{NominalPriorOptions, PriorCandidate, PriorChoice, choose as 
 pub use plausibility::{PlausibilityOptions, PlausibilityReport};
 
 pub use cell::*;
-pub use errors::{ColumnMapFault, DecimalFault, EffectListFault, Error, FileKind};
+pub use errors::{ColumnMapFault, DecimalFault, EffectListFault, Error, ErrorKind, FileKind, Place};
 pub use measurements::*;
 pub use model::*;
 pub use robot::*;

@@ -11,7 +11,7 @@
 //! matrix of `R_i t` is `n I`, so the bounded solution is the unbounded one brought into the
 //! ball). The two steps alternate; each lowers the sum of squares.
 
-use errors::Error;
+use errors::{Error, ErrorKind};
 use lie::{Matrix3, Vector3};
 use measurements::MeasurementSet;
 use poe::JointKind;
@@ -171,7 +171,7 @@ pub(crate) fn check(
     nominal.set_tools(vec![nominal.tools()[0] * lie::SE3::from_translation(-start)]);
     let mut flanges = Vec::with_capacity(data.rows.len());
     for row in &data.rows {
-        let pose = nominal.forward(&row.q, 0)?;
+        let pose = nominal.forward(&row.q, 0).map_err(Error::kinematics)?;
         flanges.push((pose.rotation().matrix(), pose.translation()));
     }
     let measured: Vec<Vector3> = data.rows.iter().map(|r| r.position).collect();
@@ -181,15 +181,17 @@ pub(crate) fn check(
     if let Some((direction, out_of_plane)) = planar {
         let spread = spread(&measured);
         if out_of_plane > options.planar_ratio * spread {
-            refusals.push(Error::PlanarChainData {
-                file: data.source.clone(),
-                robot: robot.name.clone(),
-                direction,
-                joints: robot.joint_count(),
-                out_of_plane_mm: out_of_plane * 1e3,
-                spread_mm: spread * 1e3,
-                ratio: options.planar_ratio,
-            });
+            refusals.push(Error::in_file(
+                data.source.clone(),
+                ErrorKind::PlanarChainData {
+                    robot: robot.name.clone(),
+                    direction,
+                    joints: robot.joint_count(),
+                    out_of_plane_mm: out_of_plane * 1e3,
+                    spread_mm: spread * 1e3,
+                    ratio: options.planar_ratio,
+                },
+            ));
         }
     }
     let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
@@ -213,23 +215,27 @@ pub(crate) fn check(
         && !(lo..=hi).contains(&ratio)
     {
         let column_unit = data.position_unit.unwrap_or("mm");
-        refusals.push(Error::PositionScale {
-            file: data.source.clone(),
-            measured_spread_mm: report.measured_spread_mm,
-            robot_spread_mm: report.robot_spread_mm,
-            ratio,
-            column_unit,
-            likely_unit: likely_unit(ratio, column_unit, options.unit_factor_tolerance),
-            band: options.scale_band,
-        });
+        refusals.push(Error::in_file(
+            data.source.clone(),
+            ErrorKind::PositionScale {
+                measured_spread_mm: report.measured_spread_mm,
+                robot_spread_mm: report.robot_spread_mm,
+                ratio,
+                column_unit,
+                likely_unit: likely_unit(ratio, column_unit, options.unit_factor_tolerance),
+                band: options.scale_band,
+            },
+        ));
     } else if rotation.rms > 0.0 && reflection.rms < options.reflection_ratio * rotation.rms {
         // Only where the scale is right: a scaled point cloud fits neither, and says nothing.
-        refusals.push(Error::LeftHandedFrame {
-            file: data.source.clone(),
-            rotation_rms_mm: report.rotation_rms_mm,
-            reflection_rms_mm: report.reflection_rms_mm,
-            reflection_ratio: options.reflection_ratio,
-        });
+        refusals.push(Error::in_file(
+            data.source.clone(),
+            ErrorKind::LeftHandedFrame {
+                rotation_rms_mm: report.rotation_rms_mm,
+                reflection_rms_mm: report.reflection_rms_mm,
+                reflection_ratio: options.reflection_ratio,
+            },
+        ));
     }
     Ok(Findings { report: Some(report), refusals })
 }
@@ -255,17 +261,23 @@ fn joint_limits(robot: &RobotDescription, data: &MeasurementSet, options: &Plaus
             // Degrees written under `_rad`: every value of the column, read as degrees, fits.
             let degrees_under_rad = column.is_some_and(|c| c.unit == "rad")
                 && data.rows.iter().all(|r| r.q.get(k).is_none_or(|&v| within(k, v.to_radians())));
-            return Some(Error::JointBeyondLimits {
-                file: data.source.clone(),
-                line: row.line,
-                column: column.map_or(k + 1, |c| c.column),
-                joint: k + 1,
-                kind: kinds[k],
-                value,
-                limits: limits[k],
-                margin: margin(k),
-                degrees_under_rad,
-            });
+            let kind = match kinds[k] {
+                JointKind::Revolute => errors::JointKind::Revolute,
+                JointKind::Prismatic => errors::JointKind::Prismatic,
+            };
+            return Some(Error::at_line(
+                data.source.clone(),
+                row.line,
+                column.map_or(k + 1, |c| c.column),
+                ErrorKind::JointBeyondLimits {
+                    joint: k + 1,
+                    kind,
+                    value,
+                    limits: limits[k],
+                    margin: margin(k),
+                    degrees_under_rad,
+                },
+            ));
         }
     }
     None

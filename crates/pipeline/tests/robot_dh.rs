@@ -1,7 +1,7 @@
 //! DH tables in the robot RON: a flange given with a table, and every refusal at its line and
 //! column (the forward kinematics of every form are in `robot_forms.rs`).
 
-use pipeline::{Error, RobotDescription};
+use pipeline::{ErrorKind, RobotDescription};
 
 const TABLE: &str = r#"Robot(
     name: "three",
@@ -28,17 +28,13 @@ fn a_flange_given_with_a_table_replaces_the_last_dh_frame() {
 }
 
 fn refuse(text: &str) -> (usize, usize, String) {
-    match RobotDescription::parse(text, "three.ron") {
-        Err(e @ Error::RonFormat { .. }) => {
-            let message = e.to_string();
-            assert!(message.starts_with("three.ron:"), "{message}");
-            match e {
-                Error::RonFormat { line, column, message, .. } => (line, column, message),
-                _ => unreachable!(),
-            }
-        }
-        other => panic!("expected a RON error, got {other:?}"),
-    }
+    let e = RobotDescription::parse(text, "three.ron").expect_err("a RON error");
+    let shown = e.to_string();
+    assert!(shown.starts_with("three.ron:"), "{shown}");
+    let (Some((line, column)), ErrorKind::RonFormat { message }) = (e.position(), e.kind()) else {
+        panic!("expected a RON error, got {e:?}")
+    };
+    (line as usize, column, message.clone())
 }
 
 #[test]

@@ -1,6 +1,6 @@
 //! The robot description files: the committed fixtures, and the bad inputs refused.
 
-use pipeline::{Error, RobotDescription};
+use pipeline::{ErrorKind, RobotDescription};
 use poe::{DhConvention, DhRow, JointKind, LocalPoe};
 use std::f64::consts::FRAC_PI_2;
 
@@ -53,10 +53,11 @@ Robot(
 "#;
 
 fn refuse(text: &str) -> (usize, usize, String) {
-    match RobotDescription::parse(text, "robot.ron") {
-        Err(Error::RonFormat { line, column, message, .. }) => (line, column, message),
-        other => panic!("expected a RON error, got {other:?}"),
-    }
+    let e = RobotDescription::parse(text, "robot.ron").expect_err("a RON error");
+    let (Some((line, column)), ErrorKind::RonFormat { message }) = (e.position(), e.kind()) else {
+        panic!("expected a RON error, got {e:?}")
+    };
+    (line as usize, column, message.clone())
 }
 
 #[test]
@@ -128,14 +129,11 @@ fn dynamics_of_the_wrong_length_are_refused() {
 
 /// The refusal of a value that must be finite: its field and where it is.
 fn refuse_not_finite(text: &str) -> (usize, usize, String, String) {
-    match RobotDescription::parse(text, "robot.ron") {
-        Err(e @ Error::NotFinite { .. }) => {
-            let message = e.to_string();
-            let Error::NotFinite { line, column, field, .. } = e else { unreachable!() };
-            (line, column, field, message)
-        }
-        other => panic!("expected a NotFinite error, got {other:?}"),
-    }
+    let e = RobotDescription::parse(text, "robot.ron").expect_err("a NotFinite error");
+    let (Some((line, column)), ErrorKind::NotFinite { field, .. }) = (e.position(), e.kind()) else {
+        panic!("expected a NotFinite error, got {e:?}")
+    };
+    (line as usize, column, field.clone(), e.to_string())
 }
 
 #[test]
@@ -207,5 +205,9 @@ fn finite_but_absurd_geometry_is_refused_at_its_field() {
     assert!(column > 1 && message.contains("joint 2: point coordinate 1e308 m is beyond ±1e3 m"), "{message}");
     let text = GOOD.replace("position: (1.0, 0.0, 1.0)", "position: (1.0, 0.0, 2e3)");
     let error = RobotDescription::parse(&text, "robot.ron").unwrap_err();
-    assert!(matches!(error, Error::ModelValue { ref field, line: 8, .. } if field == "flange.position"), "{error}");
+    assert!(
+        matches!(error.kind(), ErrorKind::ModelValue { field, .. } if field == "flange.position")
+            && matches!(error.position(), Some((8, _))),
+        "{error}"
+    );
 }

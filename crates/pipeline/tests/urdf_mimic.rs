@@ -3,7 +3,7 @@
 //! offset`; chains whose mimic joints do not fold are refused at the `<mimic>` element.
 
 use lie::{SE3, SO3, Vector3};
-use pipeline::{ChainEnds, Error, JointType, RobotDescription, StepMotion, UrdfChain, UrdfDocument};
+use pipeline::{ChainEnds, ErrorKind, JointType, RobotDescription, StepMotion, UrdfChain, UrdfDocument};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -213,11 +213,13 @@ fn the_scaled_joints_twists_are_the_derivatives_of_the_urdf_chain() {
 /// The refusal of `text`: line, column and message, checked to name the file first.
 fn refusal(text: &str) -> (usize, usize, String) {
     match UrdfDocument::parse(text, "arm.urdf").and_then(|d| d.chain(&ChainEnds::default())) {
-        Err(e @ Error::UrdfFormat { .. }) => {
+        Err(e) if matches!(e.kind(), ErrorKind::UrdfFormat { .. }) => {
             let shown = e.to_string();
-            let Error::UrdfFormat { line, column, message, .. } = e else { unreachable!() };
+            let (Some((line, column)), ErrorKind::UrdfFormat { message }) = (e.position(), e.kind()) else {
+                unreachable!()
+            };
             assert_eq!(shown, format!("arm.urdf:{line}:{column}: {message}"));
-            (line, column, message)
+            (line as usize, column, message.clone())
         }
         other => panic!("expected a URDF error, got {other:?}"),
     }
@@ -262,8 +264,10 @@ fn a_mimic_of_a_joint_off_the_chain_or_undefined_is_refused() {
     );
     let ends = ChainEnds { base_link: None, tip_link: Some("tip".into()) };
     let error = UrdfDocument::parse(&off_chain, "arm.urdf").and_then(|d| d.chain(&ends)).unwrap_err();
-    let Error::UrdfFormat { line, column, message, .. } = error else { panic!("{error:?}") };
-    assert_eq!((line, column), mimic_position(&off_chain, "turn_stage"), "{message}");
+    let (Some((line, column)), ErrorKind::UrdfFormat { message }) = (error.position(), error.kind()) else {
+        panic!("{error:?}")
+    };
+    assert_eq!((line as usize, column), mimic_position(&off_chain, "turn_stage"), "{message}");
     assert!(message.contains("follows joint 'gripper', which is not on the calibrated chain"), "{message}");
     let undefined = staged(SKEW_STAGE, &COAXIAL_WRIST.replace("joint=\"turn\"", "joint=\"nowhere\""));
     assert_refused(&undefined, "turn_stage", &["'nowhere', which the URDF does not define"]);
@@ -405,13 +409,12 @@ fn a_robot_file_may_give_a_joint_scale_and_a_scale_out_of_bounds_is_refused_at_i
     assert!((flange.translation() - Vector3::new(0.5, 0.0, 3.0)).norm() < 1e-12, "{}", flange.translation());
     for bad in ["0.0", "-3.0", "1e9", "inf"] {
         let text = SCALED_RON.replace("scale: 3.0", &format!("scale: {bad}"));
-        match RobotDescription::parse(&text, "column.ron") {
-            Err(Error::RonFormat { line, column, message, .. }) => {
-                assert_eq!((line, column), position_of(&text, &format!("scale: {bad}")), "{bad}: {message}");
-                assert!(message.contains("joint 1: scale"), "{message}");
-            }
-            other => panic!("{bad}: {other:?}"),
-        }
+        let e = RobotDescription::parse(&text, "column.ron").expect_err(bad);
+        let (Some((line, column)), ErrorKind::RonFormat { message }) = (e.position(), e.kind()) else {
+            panic!("{bad}: {e:?}")
+        };
+        assert_eq!((line as usize, column), position_of(&text, &format!("scale: {bad}")), "{bad}: {message}");
+        assert!(message.contains("joint 1: scale"), "{message}");
     }
 }
 
@@ -429,13 +432,10 @@ fn a_model_file_with_a_scale_out_of_bounds_is_refused_at_it() {
     assert_eq!(pipeline::parse_model(&text, "model.ron").unwrap().kinematics.joints()[0].scale, 3.0);
     let broken = text.replacen("scale: 3.0", "scale: 0.0", 1);
     let (line, column) = position_of(&broken, "scale: 0.0");
-    match pipeline::parse_model(&broken, "model.ron") {
-        Err(Error::RonFormat { line: l, column: c, message, .. }) => {
-            assert_eq!((l, c), (line, column), "{message}");
-            assert!(message.contains("scale is 0e0"), "{message}");
-        }
-        other => panic!("{other:?}"),
-    }
+    let e = pipeline::parse_model(&broken, "model.ron").expect_err("a refusal");
+    let (Some((l, c)), ErrorKind::RonFormat { message }) = (e.position(), e.kind()) else { panic!("{e:?}") };
+    assert_eq!((l as usize, c), (line, column), "{message}");
+    assert!(message.contains("scale is 0e0"), "{message}");
 }
 
 /// The 1-based line and column of the first `needle` in `text`.

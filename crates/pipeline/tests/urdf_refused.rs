@@ -1,6 +1,6 @@
 //! Every URDF the robot reader refuses, each at the file, line and column at fault.
 
-use pipeline::{ChainEnds, Error, RobotDescription, UrdfDocument};
+use pipeline::{ChainEnds, ErrorKind, RobotDescription, UrdfDocument};
 
 /// A two-joint arm; each test breaks one thing.
 const ARM: &str = r#"<?xml version="1.0"?>
@@ -33,15 +33,13 @@ fn ends(base: Option<&str>, tip: Option<&str>) -> ChainEnds {
 fn refuse_with(text: &str, ends: &ChainEnds) -> (usize, usize, String) {
     let result = UrdfDocument::parse(text, "arm.urdf").and_then(|d| d.chain(ends));
     match result {
-        Err(e @ Error::UrdfFormat { .. }) => {
+        Err(e) if matches!(e.kind(), ErrorKind::UrdfFormat { .. }) => {
             let shown = e.to_string();
-            match e {
-                Error::UrdfFormat { line, column, message, .. } => {
-                    assert_eq!(shown, format!("arm.urdf:{line}:{column}: {message}"));
-                    (line, column, message)
-                }
-                _ => unreachable!(),
-            }
+            let (Some((line, column)), ErrorKind::UrdfFormat { message }) = (e.position(), e.kind()) else {
+                unreachable!()
+            };
+            assert_eq!(shown, format!("arm.urdf:{line}:{column}: {message}"));
+            (line as usize, column, message.clone())
         }
         other => panic!("expected a URDF error, got {other:?}"),
     }

@@ -66,7 +66,7 @@ pub fn fit(
 /// test campaign), and the CLI only ever uses the file: so the package's numbers are the CLI's
 /// to the last bit.
 fn as_its_file_holds(model: &CalibratedModel) -> Result<CalibratedModel, pipeline::Error> {
-    let io = |source| pipeline::Error::Io { path: "a temporary model file".into(), source };
+    let io = |source| pipeline::Error::io("a temporary model file", source);
     let folder = tempfile::tempdir().map_err(io)?;
     let path = folder.path().join("model.ron");
     pipeline::write_model(&path, model)?;
@@ -289,7 +289,7 @@ impl Model {
                     pipeline::compensate(model, &file, robot_ref, frame, &CompensateOptions::default())?;
                 let mut csv = Vec::new();
                 pipeline::write_compensated(&mut csv, &file, &solved)
-                    .map_err(|source| pipeline::Error::Io { path: "the compensated targets".into(), source })?;
+                    .map_err(|source| pipeline::Error::io("the compensated targets", source))?;
                 Ok::<_, pipeline::Error>((file, solved, summary, csv))
             })
             .map_err(to_py)?;

@@ -5,7 +5,7 @@ use crate::robot::Robot;
 use crate::types::Measurements;
 use pipeline::diagnose::DiagnoseOptions;
 use pipeline::simulated::{self, GeneratorConfig, Perturbation, Remount, TorqueSensorNoise};
-use pipeline::{Error, ReadOptions};
+use pipeline::{Error, ErrorKind, ReadOptions};
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
@@ -42,10 +42,9 @@ pub fn diagnose(
             .map(|folder| {
                 report::write_diagnosis_report(&diagnosis, folder, "report", &inputs).map_err(|e| match e {
                     report::Error::Pipeline(e) => e,
-                    other => pipeline::Error::Io {
-                        path: folder.display().to_string(),
-                        source: std::io::Error::other(other.to_string()),
-                    },
+                    other => {
+                        pipeline::Error::io(folder.display().to_string(), std::io::Error::other(other.to_string()))
+                    }
                 })
             })
             .transpose()?;
@@ -79,7 +78,7 @@ pub fn simulate(
     out: Option<PathBuf>,
 ) -> PyResult<Measurements> {
     if rows > simulated::MAX_ROWS {
-        return Err(argument("rows", Error::TooManySimulatedRows { rows, max: simulated::MAX_ROWS }));
+        return Err(argument("rows", Error::new(ErrorKind::TooManySimulatedRows { rows, max: simulated::MAX_ROWS })));
     }
     if rows == 0 {
         return Err(argument("rows", "at least one pose is needed"));
@@ -95,7 +94,10 @@ pub fn simulate(
         && let Some(direction) = description.planar_direction()
     {
         let file = robot.path.clone();
-        return Err(to_py(Error::PlanarChain { file, direction, joints: description.joint_count() }));
+        return Err(to_py(Error::in_file(
+            file,
+            ErrorKind::PlanarChain { direction, joints: description.joint_count() },
+        )));
     }
     let source = out.as_ref().map_or_else(|| "simulated".to_owned(), |p| p.display().to_string());
     py.detach(|| {

@@ -12,7 +12,7 @@
 //! is the calibrated joint 1 frame at zero (`T_{0,1}(0) = I`), which is the nominal base frame for
 //! descriptions whose joint 1 turns about the base z axis through the origin (all RON fixtures).
 
-use errors::Error;
+use errors::{Error, ErrorKind};
 use lie::SE3;
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
@@ -60,7 +60,8 @@ pub fn in_base_frame(calibrated: &LocalPoe, nominal: Option<&LocalPoe>) -> Local
 /// same number of joints.
 pub fn axis_changes(in_base: &LocalPoe, nominal: &LocalPoe) -> Result<Vec<(f64, f64)>, Error> {
     let zero = vec![0.0; nominal.joint_count()];
-    let (calibrated, described) = (in_base.frames(&zero)?, nominal.frames(&zero)?);
+    let (calibrated, described) =
+        (in_base.frames(&zero).map_err(Error::kinematics)?, nominal.frames(&zero).map_err(Error::kinematics)?);
     Ok(calibrated
         .iter()
         .zip(&described)
@@ -89,11 +90,10 @@ pub fn check_nominal(
     file: &str,
 ) -> Result<(), Error> {
     if in_base.joint_count() != nominal.joint_count() {
-        return Err(Error::RobotJointCount {
-            file: file.to_owned(),
-            robot: nominal.joint_count(),
-            model: in_base.joint_count(),
-        });
+        return Err(Error::in_file(
+            file.to_owned(),
+            ErrorKind::RobotJointCount { robot: nominal.joint_count(), model: in_base.joint_count() },
+        ));
     }
     let excess = |(offset, angle): (f64, f64)| (offset / tolerance.offset_m).max(angle / tolerance.angle_rad);
     let mut changes = axis_changes(in_base, nominal)?;
@@ -102,14 +102,16 @@ pub fn check_nominal(
     }
     let worst = (0..changes.len()).max_by(|&a, &b| excess(changes[a]).total_cmp(&excess(changes[b])));
     match worst {
-        Some(joint) if excess(changes[joint]) > 1.0 => Err(Error::NominalMismatch {
-            file: file.to_owned(),
-            joint: joint + 1,
-            offset_mm: changes[joint].0 * 1e3,
-            angle_mrad: changes[joint].1 * 1e3,
-            limit_mm: tolerance.offset_m * 1e3,
-            limit_mrad: tolerance.angle_rad * 1e3,
-        }),
+        Some(joint) if excess(changes[joint]) > 1.0 => Err(Error::in_file(
+            file.to_owned(),
+            ErrorKind::NominalMismatch {
+                joint: joint + 1,
+                offset_mm: changes[joint].0 * 1e3,
+                angle_mrad: changes[joint].1 * 1e3,
+                limit_mm: tolerance.offset_m * 1e3,
+                limit_mrad: tolerance.angle_rad * 1e3,
+            },
+        )),
         _ => Ok(()),
     }
 }

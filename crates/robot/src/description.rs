@@ -199,7 +199,8 @@ impl RobotDescription {
     /// The nominal local POE model in the base frame, with one tool: the flange, or the nominal
     /// tool point if the description has one.
     pub fn nominal_model(&self) -> Result<LocalPoe, Error> {
-        let mut model = LocalPoe::from_zero_configuration(&self.joint_axes(), self.base_from_flange_zero())?;
+        let mut model = LocalPoe::from_zero_configuration(&self.joint_axes(), self.base_from_flange_zero())
+            .map_err(Error::kinematics)?;
         for (joint, description) in model.joints_mut().iter_mut().zip(&self.joints) {
             joint.scale = description.scale;
         }

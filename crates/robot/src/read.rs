@@ -5,8 +5,8 @@ use crate::description::limit_bound;
 use crate::robot_dh::DhTable;
 use crate::urdf_chain::{ChainEnds, UrdfDocument};
 use crate::{FlangeDescription, JointDescription, JointType, RobotDescription, SCALE_BOUNDS, scale_in_bounds};
-use errors::Error;
 use errors::ron_position::{field_position, ron_options};
+use errors::{Error, ErrorKind};
 use lie::Vector3;
 use serde::Deserialize;
 use std::path::Path;
@@ -36,7 +36,7 @@ impl RobotFile {
     fn into_description(self, text: &str, file: &str) -> Result<RobotDescription, Error> {
         let at = |field: &str, message: &str| {
             let (line, column) = field_position(text, field, 0);
-            Error::RonFormat { file: file.to_owned(), line, column, message: message.to_owned() }
+            Error::at_line(file.to_owned(), line as u64, column, ErrorKind::RonFormat { message: message.to_owned() })
         };
         let (joints, flange) = match (self.joints, self.dh) {
             (Some(_), Some(_)) => return Err(at("dh", "give the kinematics as `joints` or as a `dh` table, not both")),
@@ -80,13 +80,15 @@ impl RobotDescription {
             return Ok(robot);
         }
         if *ends != ChainEnds::default() {
-            return Err(Error::RonFormat {
+            return Err(Error::at_line(
                 file,
-                line: 1,
-                column: 1,
-                message: "--base-link and --tip-link choose the chain of a URDF (.urdf), not of a RON robot file"
-                    .into(),
-            });
+                1,
+                1,
+                ErrorKind::RonFormat {
+                    message: "--base-link and --tip-link choose the chain of a URDF (.urdf), not of a RON robot file"
+                        .into(),
+                },
+            ));
         }
         let text = errors::ron_position::read_text(path)?;
         Self::parse(&text, &file)
@@ -95,11 +97,13 @@ impl RobotDescription {
     /// Parses and validates a robot description; `file` names it in errors. The kinematics may be
     /// zero-configuration axes or a DH table (turned into axes, see [`DhTable`]).
     pub fn parse(text: &str, file: &str) -> Result<Self, Error> {
-        let form: RobotFile = ron_options().from_str(text).map_err(|e| Error::RonFormat {
-            file: file.to_owned(),
-            line: e.span.start.line,
-            column: e.span.start.col,
-            message: e.code.to_string(),
+        let form: RobotFile = ron_options().from_str(text).map_err(|e| {
+            Error::at_line(
+                file.to_owned(),
+                e.span.start.line as u64,
+                e.span.start.col,
+                ErrorKind::RonFormat { message: e.code.to_string() },
+            )
         })?;
         let robot = form.into_description(text, file)?;
         robot.validate(text, file)?;
@@ -116,7 +120,7 @@ impl RobotDescription {
     fn validate(&self, text: &str, file: &str) -> Result<(), Error> {
         let at = |field: &str, index: usize, message: String| {
             let (line, column) = field_position(text, field, index);
-            Error::RonFormat { file: file.to_owned(), line, column, message }
+            Error::at_line(file.to_owned(), line as u64, column, ErrorKind::RonFormat { message })
         };
         if self.joints.is_empty() {
             return Err(at("joints", 0, "a robot needs at least one joint".into()));

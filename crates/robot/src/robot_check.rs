@@ -4,8 +4,8 @@
 //! are too alike to register the tracker: rank 0 of 13").
 
 use crate::RobotDescription;
-use errors::Error;
 use errors::ron_position::field_position;
+use errors::{Error, ErrorKind, Place};
 
 /// Checks the flange, the tool and the dynamics of `robot`, read from `text`.
 pub(crate) fn check_values(robot: &RobotDescription, text: &str, file: &str) -> Result<(), Error> {
@@ -13,9 +13,14 @@ pub(crate) fn check_values(robot: &RobotDescription, text: &str, file: &str) -> 
         let (line, column) = field_position(text, field, index);
         let file = file.to_owned();
         if value.is_finite() {
-            Error::ModelValue { file, line, column, field: name, value, limit: crate::MAX_TRANSLATION_M }
+            Error::at_line(
+                file,
+                line as u64,
+                column,
+                ErrorKind::ModelValue { field: name, value, limit: crate::MAX_TRANSLATION_M },
+            )
         } else {
-            Error::NotFinite { file, line, column, field: name, value }
+            Error::at_line(file, line as u64, column, ErrorKind::NotFinite { field: name, value })
         }
     };
     // Not finite, or beyond a kilometre (in m, m/s² or rad): larger than any robot, and its
@@ -58,7 +63,7 @@ pub(crate) fn check_values(robot: &RobotDescription, text: &str, file: &str) -> 
         // The radii-difference check names no single field: point at the first radius.
         let field = if field.contains(' ') { "anchor_radius_m" } else { field };
         let (line, column) = field_position(text, field, 0);
-        return Err(Error::RonFormat { file: file.to_owned(), line, column, message });
+        return Err(Error::at_line(file.to_owned(), line as u64, column, ErrorKind::RonFormat { message }));
     }
     Ok(())
 }
@@ -116,18 +121,22 @@ pub(crate) fn planar_direction(robot: &RobotDescription) -> Option<[f64; 3]> {
 /// [`repeated_axis`] as the refusal of the file `file` (`text` for a RON file's position).
 pub(crate) fn check_chain(robot: &RobotDescription, text: Option<&str>, file: &str) -> Result<(), Error> {
     let Some((first, second)) = repeated_axis(robot) else { return Ok(()) };
-    let (line, column) = text.map_or((0, 0), |text| field_position(text, "axis", second - 1));
+    // A RON file's refusal is placed at the second joint's axis; another file's names the file.
+    let place = match text.map(|text| field_position(text, "axis", second - 1)) {
+        Some((line, column)) => Place::new(file, line as u64, column),
+        None => Place::in_file(file),
+    };
     let joint = &robot.joints[second - 1];
-    Err(Error::RepeatedJointAxis {
-        file: file.to_owned(),
-        line,
-        column,
-        first,
-        second,
-        revolute: joint.kind == crate::description::JointType::Revolute,
-        axis: joint.axis,
-        point: joint.point,
-    })
+    Err(Error::at(
+        place,
+        ErrorKind::RepeatedJointAxis {
+            first,
+            second,
+            revolute: joint.kind == crate::description::JointType::Revolute,
+            axis: joint.axis,
+            point: joint.point,
+        },
+    ))
 }
 
 impl RobotDescription {
@@ -156,7 +165,11 @@ mod tests {
     fn two_consecutive_joints_about_one_line_are_refused_at_the_second() {
         let error = RobotDescription::parse(TWO_COAXIAL, "coaxial.ron").unwrap_err();
         let message = error.to_string();
-        assert!(matches!(error, Error::RepeatedJointAxis { first: 1, second: 2, line: 5, .. }), "{message}");
+        assert!(
+            matches!(error.kind(), ErrorKind::RepeatedJointAxis { first: 1, second: 2, .. })
+                && matches!(error.position(), Some((5, _))),
+            "{message}"
+        );
         assert!(message.starts_with("coaxial.ron:5:"), "{message}");
         assert!(message.contains("joints 1 and 2 turn about the same line"), "{message}");
     }

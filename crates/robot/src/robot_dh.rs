@@ -5,8 +5,8 @@
 //! the file gives one, is the last DH frame.
 
 use crate::description::{FlangeDescription, JointDescription, JointType};
-use errors::Error;
 use errors::ron_position::field_position;
+use errors::{Error, ErrorKind};
 use poe::{DhConvention, DhRow, JointKind, LocalPoe};
 use serde::{Deserialize, Serialize};
 
@@ -68,16 +68,21 @@ impl DhTable {
     fn poe_rows(&self, text: &str, file: &str) -> Result<Vec<DhRow>, Error> {
         let at = |row: usize, message: String| {
             let (line, column) = field_position(text, "a_m", row);
-            Error::RonFormat { file: file.to_owned(), line, column, message: format!("DH row {}: {message}", row + 1) }
+            Error::at_line(
+                file.to_owned(),
+                line as u64,
+                column,
+                ErrorKind::RonFormat { message: format!("DH row {}: {message}", row + 1) },
+            )
         };
         if self.rows.is_empty() {
             let (line, column) = field_position(text, "rows", 0);
-            return Err(Error::RonFormat {
-                file: file.to_owned(),
-                line,
+            return Err(Error::at_line(
+                file.to_owned(),
+                line as u64,
                 column,
-                message: "a DH table needs at least one row".into(),
-            });
+                ErrorKind::RonFormat { message: "a DH table needs at least one row".into() },
+            ));
         }
         self.rows
             .iter()
@@ -108,7 +113,7 @@ impl DhTable {
         let zero = vec![0.0; rows.len()];
         // `from_dh` puts each joint's frame on the DH frame it turns about, so the frame at q = 0
         // holds that joint's axis (its z column) and a point on it (its origin).
-        let frames = model.frames(&zero)?;
+        let frames = model.frames(&zero).map_err(Error::kinematics)?;
         let joints = frames
             .iter()
             .zip(&self.rows)
@@ -124,7 +129,7 @@ impl DhTable {
                 }
             })
             .collect();
-        let flange = model.forward(&zero, 0)?;
+        let flange = model.forward(&zero, 0).map_err(Error::kinematics)?;
         let rotation = flange.rotation().matrix();
         let flange = FlangeDescription {
             position: flange.translation().into(),

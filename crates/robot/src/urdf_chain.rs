@@ -13,7 +13,7 @@ use crate::urdf_mimic::{ChainJoint, fold, folded_joint};
 use crate::urdf_steps::{ChainStep, StepMimic, StepMotion};
 use crate::xml_outline::{Element, Position, outline};
 use crate::{FlangeDescription, JointDescription, JointType, RobotDescription};
-use errors::Error;
+use errors::{Error, ErrorKind};
 use lie::{SE3, SO3, Vector3};
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
@@ -80,11 +80,8 @@ impl UrdfDocument {
 
     /// Parses and checks a URDF; `file` names it in errors.
     pub fn parse(text: &str, file: &str) -> Result<Self, Error> {
-        let at = |(line, column): Position, message: String| Error::UrdfFormat {
-            file: file.to_owned(),
-            line,
-            column,
-            message,
+        let at = |(line, column): Position, message: String| {
+            Error::at_line(file.to_owned(), line as u64, column, ErrorKind::UrdfFormat { message })
         };
         let root = outline(text).map_err(|e| at(e.position, e.message))?;
         if root.name != "robot" {
@@ -142,7 +139,7 @@ impl UrdfDocument {
     /// An error at the element `<kind name="name">` (or at `<robot>` if there is none).
     pub fn error_at(&self, kind: &str, name: &str, message: String) -> Error {
         let (line, column) = self.element(kind, name).map_or(self.outline.position, |e| e.position);
-        Error::UrdfFormat { file: self.file.clone(), line, column, message }
+        Error::at_line(self.file.clone(), line as u64, column, ErrorKind::UrdfFormat { message })
     }
 
     /// Checks names (present, unique, joints naming defined links, one parent per link) and
@@ -190,7 +187,7 @@ impl UrdfDocument {
     }
 
     fn at(&self, (line, column): Position, message: String) -> Error {
-        Error::UrdfFormat { file: self.file.clone(), line, column, message }
+        Error::at_line(self.file.clone(), line as u64, column, ErrorKind::UrdfFormat { message })
     }
 
     /// The joint of which `link` is the child.
