@@ -154,8 +154,8 @@ impl LinkDeflection {
         for link in &self.links {
             let bend = link_bend(model, q, tool, link.joint_index)?;
             let features = link_deflection_features(model, dynamics, q, tool, payload, link.joint_index)?;
-            for a in 0..2 {
-                total += bend.unit_twist(a) * (link.flexibility_per_nm2[a] * features[a]);
+            for (a, (flexibility, feature)) in link.flexibility_per_nm2.iter().zip(features).enumerate() {
+                total += bend.unit_twist(a) * (flexibility * feature);
             }
         }
         Ok(total)
