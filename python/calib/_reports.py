@@ -123,7 +123,8 @@ class Diagnosis:
     """What ``calib diagnose --json`` prints: the verdict, the held-out errors, the candidates."""
 
     effect: str
-    """The verdict's effect: joint_compliance, backlash, gear_periodic, thermal, time_drift, none or unknown."""
+    """The verdict's effect: joint_compliance, backlash, gear_periodic, thermal, time_drift,
+    link_deflection, none or unknown."""
     joints: List[int]
     """The 1-based joints the verdict involves."""
     heldout_before_mm: float

@@ -1,8 +1,11 @@
 //! The cases of `cargo xtask blind-check`: one class per kind of hidden truth, each drawn with
 //! what the diagnosis's candidates do not parameterise exactly.
 //!
-//! Classes, in the order case `i` takes them (`i mod 10`, so any ten consecutive cases hold one of
-//! each and the CI's first six hold the hardest):
+//! Classes, in the order case `i` takes them (position `i mod 11` of a round of eleven: the ten
+//! below in their order, then `deflection`; so any eleven consecutive cases hold one of each and
+//! the CI's first six hold the hardest). A case of the ten is drawn exactly as case
+//! `10 · (i / 11) + i mod 11` was before the deflection class existed (its seed and data the
+//! same), so the ten classes' cases are those of earlier reports:
 //! `none`; `gear` (1–4 harmonics of orders 1–40, random phases and weights, any joint, joint 1
 //! included); `compliance` (one or two of joints 2–6); `coupling` (joint 2–5's error a product of
 //! harmonics of two *other* joints' angles: no candidate models it, the truth is `unknown`);
@@ -10,7 +13,11 @@
 //! remounted probe each, measured torques, every joint compliant, full pose); `two_effects` (two
 //! of compliance, backlash, gear at once); `backlash` (one or two of joints 2–6); `joint_one`
 //! (compliance or backlash on joint 1 of a base tilted 30–90°, so that gravity loads joint 1; the
-//! diagnosis is told the mounting, not the masses); `thermal`; `drift`.
+//! diagnosis is told the mounting, not the masses); `thermal`; `drift`; `deflection` (issue 30:
+//! `column_ur10.ron`, a UR10 on a 2.5 m lifting column, whose column bends under the arm's
+//! gravity moment by `1/EI` of 1e-7 1/(N·m²) times weights 0.3–1 about its two horizontal axes,
+//! the masses 50 kg per metre of link times 0.5–1.5 link by link; the diagnosis gets the robot
+//! without masses, so its stand-in masses are not the truth).
 //!
 //! Each effect's size is what a geometric calibration leaves of it on noise-free positions (what
 //! any diagnosis could possibly see), drawn log-uniformly from 1.2× the noise floor to 4 mm, the
@@ -19,8 +26,9 @@
 use crate::simulation::{mean_distance_mm, perturbed_robot, ranges, simulate, tracker_placement};
 use anyhow::{Context, Result, bail};
 use loadsim::{
-    Backlash, BaseDrift, CouplingFactor, CouplingTerm, Effects, GeneratorConfig, Harmonic, JointBacklash,
-    JointCompliance, JointCoupling, PeriodicError, RobotDynamics, SimulatedCell, ThermalGrowth, TrackerNoise,
+    Backlash, BaseDrift, BentLink, CouplingFactor, CouplingTerm, Effects, GeneratorConfig, Harmonic, JointBacklash,
+    JointCompliance, JointCoupling, LinkDeflection, PeriodicError, RobotDynamics, SimulatedCell, ThermalGrowth,
+    TrackerNoise,
 };
 use pipeline::diagnose::{DiagnoseOptions, Effect, StructureOptions, diagnose};
 use pipeline::simulated::{Perturbation, Remount, campaign_cell, payload_run_campaign};
@@ -41,11 +49,12 @@ pub enum Class {
     JointOne,
     Thermal,
     Drift,
+    Deflection,
 }
 
 impl Class {
     /// Every class, in the order the cases cycle through them.
-    pub const ALL: [Class; 10] = [
+    pub const ALL: [Class; 11] = [
         Class::None,
         Class::Gear,
         Class::Compliance,
@@ -56,7 +65,19 @@ impl Class {
         Class::JointOne,
         Class::Thermal,
         Class::Drift,
+        Class::Deflection,
     ];
+
+    /// The class of case `index` and the index its seed and data are drawn from: the ten classes
+    /// as before the deflection class (case `10 · round + position`), the deflection class on
+    /// seeds of its own.
+    fn of_case(index: usize) -> (Class, u64) {
+        let (round, position) = (index / Self::ALL.len(), index % Self::ALL.len());
+        match Self::ALL[position] {
+            Class::Deflection => (Class::Deflection, (1 << 32) + round as u64),
+            class => (class, (10 * round + position) as u64),
+        }
+    }
 
     pub fn name(self) -> &'static str {
         match self {
@@ -70,6 +91,7 @@ impl Class {
             Class::JointOne => "joint 1, tilted base",
             Class::Thermal => "thermal",
             Class::Drift => "drift",
+            Class::Deflection => "deflection (lifting column)",
         }
     }
 }
@@ -89,6 +111,9 @@ enum Hidden {
     Drift,
     /// Joint `j`'s error 0.1 mrad × scale × Π cos(h q_s + φ) over the factors `(s, h, φ)`.
     Coupling(usize, Vec<(usize, f64, f64)>),
+    /// Joint `j`'s link bends with `1/EI` of 1e-7 1/(N·m²) × scale × the weights about the x and
+    /// y axes of its frame.
+    Deflection(usize, [f64; 2]),
 }
 
 impl Hidden {
@@ -103,6 +128,7 @@ impl Hidden {
             Hidden::Thermal => (Effect::Thermal, vec![]),
             Hidden::Drift => (Effect::TimeDrift, vec![]),
             Hidden::Coupling(..) => (Effect::Unknown, vec![]),
+            Hidden::Deflection(joint, _) => (Effect::LinkDeflection, vec![joint + 1]),
         }
     }
 
@@ -112,6 +138,9 @@ impl Hidden {
         match self {
             Hidden::Backlash(_) | Hidden::Coupling(..) => 50.0,
             Hidden::Gear(_, harmonics) => 50.0 / harmonics.iter().map(|h| h.1).sum::<f64>().max(1e-9),
+            // The column's moment times its length reaches about 1.2e3 N·m² (the UR10 stretched
+            // out at full lift, 50 kg per metre): 4e-6 1/(N·m²) turns its top by 5 mrad.
+            Hidden::Deflection(_, weights) => 40.0 / weights[0].max(weights[1]).max(1e-9),
             _ => f64::INFINITY,
         }
     }
@@ -179,6 +208,14 @@ impl Hidden {
                     }],
                 });
             }
+            Hidden::Deflection(joint, weights) => {
+                effects.deflection = Some(LinkDeflection {
+                    links: vec![BentLink {
+                        joint_index: *joint,
+                        flexibility_per_nm2: weights.map(|w| 1e-7 * w * scale),
+                    }],
+                });
+            }
         }
     }
 }
@@ -223,6 +260,8 @@ impl Case {
 pub struct Robots {
     pub irb4400: RobotDescription,
     pub iiwa7: RobotDescription,
+    /// A UR10 on a lifting column, without masses (`column_ur10.ron`).
+    pub column: RobotDescription,
 }
 
 fn draw_joints(rng: &mut ChaCha8Rng, from: &[usize], at_most: usize) -> Vec<usize> {
@@ -277,11 +316,17 @@ fn blind(robot: &RobotDescription, gravity: Option<[f64; 3]>) -> RobotDescriptio
 
 /// Draws and diagnoses case `index` of the check seeded `seed`.
 pub fn run_case(robots: &Robots, index: usize, seed: u64, rows: usize, dump: Option<&std::path::Path>) -> Result<Case> {
-    let class = Class::ALL[index % Class::ALL.len()];
-    let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ index as u64);
-    // Position only and full pose alternate within each round of ten and between rounds.
-    let mut full_pose = (index + index / Class::ALL.len()) % 2 == 1;
-    let robot = if class == Class::SevenAxis { &robots.iiwa7 } else { &robots.irb4400 };
+    let (class, drawn) = Class::of_case(index);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ drawn);
+    // Position only and full pose alternate within each round of ten and between rounds; the
+    // deflection cases alternate from round to round.
+    let mut full_pose =
+        if class == Class::Deflection { index / Class::ALL.len() % 2 == 1 } else { (drawn + drawn / 10) % 2 == 1 };
+    let robot = match class {
+        Class::SevenAxis => &robots.iiwa7,
+        Class::Deflection => &robots.column,
+        _ => &robots.irb4400,
+    };
     let n = robot.joint_count();
     let loaded: Vec<usize> = (1..n).collect();
     let hidden: Vec<Hidden> = match class {
@@ -317,6 +362,7 @@ pub fn run_case(robots: &Robots, index: usize, seed: u64, rows: usize, dump: Opt
             full_pose = true;
             vec![Hidden::ComplianceAll]
         }
+        Class::Deflection => vec![Hidden::Deflection(0, [rng.random_range(0.3..1.0), rng.random_range(0.3..1.0)])],
     };
     let gravity = (class == Class::JointOne).then(|| {
         loadsim::tilted_base_gravity(rng.random_range(0.5..1.6), rng.random_range(0.0..std::f64::consts::TAU))
@@ -328,7 +374,16 @@ pub fn run_case(robots: &Robots, index: usize, seed: u64, rows: usize, dump: Opt
     } else {
         let tool_m = rng.random_range(0.1..0.3);
         let geometry = perturbed_robot(robot, &mut rng, 0.002, 0.002, tool_m)?;
-        let mut cell = SimulatedCell::new(geometry, robot.dynamics.clone());
+        let dynamics = match class {
+            // The truth's masses: the stand-in's bars, each 0.5–1.5 times as heavy.
+            Class::Deflection => {
+                let mut truth = pipeline::effects::stand_in_dynamics(robot);
+                truth.links.iter_mut().for_each(|l| l.mass_kg *= rng.random_range(0.5..1.5));
+                Some(truth)
+            }
+            _ => robot.dynamics.clone(),
+        };
+        let mut cell = SimulatedCell::new(geometry, dynamics);
         cell.tracker_from_base = tracker_placement(&mut rng);
         (cell, GeneratorConfig { sample_count: rows, seed: rng.random(), ..GeneratorConfig::default() })
     };

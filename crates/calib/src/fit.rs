@@ -24,7 +24,8 @@ pub struct Args {
     out: PathBuf,
     /// Non-geometric effects identified with the geometry, applied before any GP (beyond the
     /// paper): a comma-separated list of joint_compliance, gear_periodic:JOINT:HARMONICS,
-    /// backlash:JOINT, thermal, time_drift; or auto, what `calib diagnose` selects on the data.
+    /// backlash:JOINT, thermal, time_drift, link_deflection:JOINT; or auto, what `calib diagnose`
+    /// selects on the data.
     #[arg(long, value_name = "LIST|auto")]
     effects: Option<EffectSelection>,
     /// The same as --effects joint_compliance: joint compliance through measured torques

@@ -4,7 +4,7 @@
 
 use errors::ron_position::{field_position, field_position_in, ron_options};
 use errors::{Error, ErrorKind};
-use loadsim::{Backlash, Effects, JointCoupling, PeriodicError};
+use loadsim::{Backlash, Effects, JointCoupling, LinkDeflection, PeriodicError};
 use robot::RobotDescription;
 use ron::Value;
 use std::path::Path;
@@ -33,6 +33,11 @@ pub const MAX_TEMPERATURE_C: f64 = 1e4;
 /// Largest drift rate per component, m/s or rad/s: a settling cell drifts by micrometres per hour;
 /// a base moving a metre per second is not drifting.
 pub const MAX_DRIFT_PER_S: f64 = 1.0;
+
+/// Largest link flexibility `1/EI`, 1/(N·m²) (link deflection): an aluminium tube of 20 mm
+/// diameter and 1 mm wall, too thin to carry any arm, has `EI ≈ 220 N·m²` (4.5e-3); an industrial
+/// column or boom has `EI` of 1e5 to 1e7 N·m². Beyond the bound the bend is no longer small.
+pub const MAX_FLEXIBILITY_PER_NM2: f64 = 1e-2;
 
 /// Most fixed-point steps of the compliance equilibrium an effects file may ask for. Each step
 /// shrinks the error by the factor `C·∂τ/∂q`, below 1e-2 for industrial arms (loadsim's
@@ -121,7 +126,11 @@ pub fn check_effects(effects: &Effects, robot: &RobotDescription, text: &str, fi
         }
         _ => String::new(),
     };
-    let needs_dynamics = [("compliance", effects.compliance.is_some()), ("backlash", effects.backlash.is_some())];
+    let needs_dynamics = [
+        ("compliance", effects.compliance.is_some()),
+        ("backlash", effects.backlash.is_some()),
+        ("deflection", effects.deflection.is_some()),
+    ];
     for (section, on) in needs_dynamics {
         if on && robot.dynamics.is_none() {
             let message = format!("needs the robot's masses and stiffness (a `dynamics` block in {})", robot.name);
@@ -165,6 +174,17 @@ pub fn check_effects(effects: &Effects, robot: &RobotDescription, text: &str, fi
                 .or_else(|| beyond(&[("half_band_rad", joint.half_band_rad, MAX_JOINT_ERROR_RAD)]));
             if let Some(fault) = fault {
                 return Err(at("backlash", "joint_index", k, format!("entry {}: {fault}", k + 1)));
+            }
+        }
+    }
+    if let Some(deflection) = &effects.deflection {
+        for (k, link) in deflection.links.iter().enumerate() {
+            let alone = LinkDeflection { links: vec![*link] };
+            let bounds: Vec<_> =
+                link.flexibility_per_nm2.iter().map(|&f| ("flexibility_per_nm2", f, MAX_FLEXIBILITY_PER_NM2)).collect();
+            let fault = alone.validate(n).err().map(|e| e.to_string()).or_else(|| beyond(&bounds));
+            if let Some(fault) = fault {
+                return Err(at("deflection", "joint_index", k, format!("link {}: {fault}", k + 1)));
             }
         }
     }
@@ -276,6 +296,16 @@ mod tests {
             ),
             ("(thermal: (\n expansion_per_k: 5.0))", (2, 2), "thermal: expansion_per_k is 5"),
             ("(drift: (\n twist_per_s: (0.0, 0.0, 0.0, 0.0, 0.0, 1e300)))", (2, 2), "drift: twist_per_s is 1e300"),
+            (
+                "(deflection: (links: [\n  (joint_index: 0, flexibility_per_nm2: (1e-7, 2e-7)),\n  (joint_index: 7, flexibility_per_nm2: (0.0, 0.0))]))",
+                (3, 4),
+                "deflection: link 2: ",
+            ),
+            (
+                "(deflection: (links: [\n  (joint_index: 1, flexibility_per_nm2: (1e-7, 5.0))]))",
+                (2, 4),
+                "link 1: flexibility_per_nm2 is 5, at most 0.01",
+            ),
             (
                 "(coupling: (terms: [(joint_index: 2, amplitude_rad: 1e-3,\n factors: [(source_joint_index: 2, order: 1.0, phase_rad: 0.0)])]))",
                 (1, 22),

@@ -83,7 +83,10 @@ impl PoseCorrection for EffectCorrection {
             Direction::Joint(j) => Some(j),
             // A fixed twist does not follow the kinematics; the arm's growth does, but its
             // derivative (strain 1e-5 to 1e-4 times a link change) is far below the noise.
-            Direction::Component(_) | Direction::LinkGrowth => None,
+            // A link's bend follows the kinematics too, but it is not a joint's twist: its
+            // derivative in the geometry (a bend of mrad times a link change of mm) is far below
+            // the noise, as the growth's.
+            Direction::Component(_) | Direction::LinkGrowth | Direction::LinkBend { .. } => None,
         }
     }
 }

@@ -18,6 +18,14 @@ pub enum Direction {
     /// Every link but the base placement grows by a unit strain: `Σ_{i ≥ 1} (R_{i-1}(q) t_i, 0)`
     /// (`loadsim::thermal_regressor`, one expansion coefficient for the whole arm).
     LinkGrowth,
+    /// Joint `joint`'s link (0-based) turns about the `axis` (0: x, 1: y) of the joint's frame
+    /// through the link's midpoint: `(m × e, e)` (`loadsim::link_bend`, link deflection).
+    LinkBend {
+        /// 0-based joint whose link bends.
+        joint: usize,
+        /// 0: the x axis of the joint's frame, 1: its y axis.
+        axis: usize,
+    },
 }
 
 /// The twists of one row under one model, computed once for all the parameters that use them.
@@ -66,6 +74,13 @@ impl<'a> RowTwists<'a> {
                 }
                 Ok(self.growth.unwrap_or_else(Vector6::zeros))
             }
+            Direction::LinkBend { joint, axis } => {
+                let joint_count = self.model.joint_count();
+                if joint >= joint_count || axis > 1 {
+                    return Err(Error::new(ErrorKind::EffectJoint { joint: joint + 1, joint_count }));
+                }
+                Ok(loadsim::link_bend(self.model, self.q, self.tool, joint).map_err(Error::load)?.unit_twist(axis))
+            }
         }
     }
 }
@@ -113,6 +128,31 @@ mod tests {
             assert!((numeric - analytic).norm() < 1e-6 * (1.0 + analytic.norm()), "joint {j}: {numeric} {analytic}");
         }
         assert!(RowTwists::new(&model, &q, 0).twist(Direction::Joint(3)).is_err());
+    }
+
+    #[test]
+    fn a_link_bend_is_the_derivative_of_the_pose_in_a_turn_of_the_far_end_about_the_midpoint() {
+        let model = arm();
+        let q = [0.3, -0.8, 1.1];
+        let h = 1e-7;
+        let frames = model.frames(&q).unwrap();
+        // Link 2 runs from joint 2's axis point to joint 3's; turning everything beyond it (joint 3
+        // on) by h about the joint frame's axis through its midpoint.
+        let start = frames[0] * model.joints()[1].previous_from_joint_zero;
+        let end = frames[1] * model.joints()[2].previous_from_joint_zero;
+        let midpoint = (start.translation() + end.translation()) * 0.5;
+        for axis in 0..2 {
+            let e = frames[1].rotation().matrix().column(axis).into_owned();
+            let turn = SE3::from_translation(midpoint)
+                * SE3::new(lie::SO3::exp(&(e * h)), Vector3::zeros())
+                * SE3::from_translation(-midpoint);
+            let before = model.forward(&q, 0).unwrap();
+            let numeric = slope(&(turn * before), &before, h);
+            let analytic = RowTwists::new(&model, &q, 0).twist(Direction::LinkBend { joint: 1, axis }).unwrap();
+            assert!((numeric - analytic).norm() < 1e-6 * (1.0 + analytic.norm()), "axis {axis}: {numeric} {analytic}");
+        }
+        assert!(RowTwists::new(&model, &q, 0).twist(Direction::LinkBend { joint: 3, axis: 0 }).is_err());
+        assert!(RowTwists::new(&model, &q, 0).twist(Direction::LinkBend { joint: 0, axis: 2 }).is_err());
     }
 
     #[test]

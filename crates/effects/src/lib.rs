@@ -36,6 +36,7 @@ mod correction;
 mod direction;
 mod drift;
 mod gear;
+mod link_deflection;
 mod load_frame;
 mod report;
 mod spec;
@@ -47,6 +48,7 @@ pub use compliance::{ComplianceTerm, ComplianceTorque, JointCompliance, TorqueFi
 pub use direction::Direction;
 pub use drift::TimeDrift;
 pub use gear::{GearOptions, GearPeriodic};
+pub use link_deflection::LinkDeflection;
 pub use load_frame::LoadFrame;
 pub use loadsim::EffectKind;
 pub use report::effect_reports;

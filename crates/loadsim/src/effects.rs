@@ -3,8 +3,8 @@
 //! [`crate::EffectKind`] from the one list of kinds (module `kinds`).
 
 use crate::{
-    Backlash, BaseDrift, Error, JointBacklash, JointCompliance, JointCoupling, PeriodicError, PoseContext,
-    SimulatedCell, ThermalGrowth, TrackerNoise, compliance::compliance_deflection, gravity::static_torque,
+    Backlash, BaseDrift, Error, JointBacklash, JointCompliance, JointCoupling, LinkDeflection, PeriodicError,
+    PoseContext, SimulatedCell, ThermalGrowth, TrackerNoise, compliance::compliance_deflection, gravity::static_torque,
     periodic::Harmonic,
 };
 use lie::SE3;
@@ -30,6 +30,9 @@ pub struct Effects {
     pub tracker_noise: Option<TrackerNoise>,
     /// A joint error driven by other joints' angles (module [`JointCoupling`]).
     pub coupling: Option<JointCoupling>,
+    /// Links bending under the gravity moment of everything beyond them (masses from the robot's
+    /// dynamics; module [`LinkDeflection`]).
+    pub deflection: Option<LinkDeflection>,
 }
 
 /// The joint-space part of the forward model at one pose, each effect apart.
@@ -86,6 +89,7 @@ impl Effects {
             drift: Some(BaseDrift::default()),
             tracker_noise: Some(TrackerNoise::default()),
             coupling: None,
+            deflection: None,
         }
     }
 
@@ -117,6 +121,10 @@ impl Effects {
         }
         if let Some(coupling) = &self.coupling {
             coupling.validate(n)?;
+        }
+        if let Some(deflection) = &self.deflection {
+            deflection.validate(n)?;
+            cell.dynamics_for("link deflection")?.validate(n)?;
         }
         Ok(())
     }
@@ -171,13 +179,19 @@ impl Effects {
     }
 
     /// The true `tracker_from_tool` at commanded joints `q`, every active effect applied except the
-    /// tracker noise: `exp(t ξ̂) · tracker_from_base · T_grown(q + δq)`.
+    /// tracker noise: `exp(t ξ̂) · tracker_from_base · exp(δ̂) · T_grown(q + δq)`, with `δ` the links'
+    /// bending at the commanded joints (first order, as the joint compliance).
     pub fn true_pose(&self, cell: &SimulatedCell, q: &[f64], context: &PoseContext) -> Result<SE3, Error> {
         self.validate(cell)?;
         let model = self.model_at(cell, context)?;
         let offsets = self.joint_offsets_on(&model, cell, q, context)?;
         let moved: Vec<f64> = q.iter().zip(offsets.total()).map(|(a, b)| a + b).collect();
-        let tracker_from_tool = cell.tracker_from_base * model.forward(&moved, cell.tool)?;
+        let mut base_from_tool = model.forward(&moved, cell.tool)?;
+        if let (Some(deflection), Some(dynamics)) = (&self.deflection, &cell.dynamics) {
+            let bend = deflection.twist(&model, dynamics, q, cell.tool, &context.payload)?;
+            base_from_tool = lie::Twist::from_vector(&bend).exp() * base_from_tool;
+        }
+        let tracker_from_tool = cell.tracker_from_base * base_from_tool;
         Ok(match &self.drift {
             Some(drift) => drift.motion_at(context.t_s) * tracker_from_tool,
             None => tracker_from_tool,

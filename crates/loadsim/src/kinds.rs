@@ -42,6 +42,8 @@ macro_rules! effect_kinds {
                 Thermal "thermal" thermal,
                 /// Drift of the robot's placement with `t_s`.
                 TimeDrift "time_drift" drift,
+                /// A link bending under the gravity moment of everything beyond it.
+                LinkDeflection "link_deflection" deflection,
             }
             simulated {
                 /// Tracker measurement noise.

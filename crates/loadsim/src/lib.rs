@@ -1,6 +1,6 @@
 //! Non-geometric error models of a serial robot: payload and gravity deflection through joint
 //! compliance (the paper's ref. \[15\], Tao, Yang & Tomizuka 2013), a joint-2 spring balancer,
-//! backlash, gear periodic error, thermal growth, base drift, tracker noise, and a coupled joint
+//! backlash, gear periodic error, thermal growth, base drift, link deflection, tracker noise, and a coupled joint
 //! error that no diagnosis candidate models; measured joint torques; and a seeded dataset
 //! generator that also draws the shapes of real campaigns (some joints fixed, payload runs with a
 //! tool each).
@@ -43,6 +43,7 @@ mod cell;
 mod compliance;
 mod counterbalance;
 mod coupling;
+mod deflection;
 mod drift;
 mod dynamics;
 mod effects;
@@ -63,6 +64,7 @@ pub use cell::{PoseContext, SimulatedCell};
 pub use compliance::{JointCompliance, compliance_deflection, spring_torque};
 pub use counterbalance::Counterbalance;
 pub use coupling::{CouplingFactor, CouplingTerm, JointCoupling};
+pub use deflection::{BentLink, LinkBend, LinkDeflection, link_bend, link_deflection_features, moment_beyond};
 pub use drift::BaseDrift;
 pub use dynamics::{FLOOR_GRAVITY_M_PER_S2, LinkInertia, RobotDynamics, tilted_base_gravity};
 pub use effects::{Effects, JointOffsets};
