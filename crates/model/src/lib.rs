@@ -44,6 +44,7 @@ mod model_check;
 mod model_file;
 mod model_parts;
 mod predictions;
+mod repeats;
 mod residual_gp;
 mod training_range;
 pub use evaluate::{Evaluation, evaluate, tool_indices};
@@ -57,6 +58,7 @@ pub use method::{Method, UnknownMethod};
 pub use metrics::{ErrorSummary, PoseError, pose_error};
 pub use model_file::{SCHEMA_VERSION, model_text, parse_model, read_model, write_model};
 pub use model_parts::Part;
+pub use repeats::{HeldoutOptions, RepeatGroups};
 pub use residual_gp::{
     GpChoice, GpFitReport, GpModel, ResidualFrame, ResidualGp, ResidualGpOptions, ResidualGpReport, ResidualSet,
     UnknownGpChoice,
