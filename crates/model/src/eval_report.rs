@@ -46,6 +46,11 @@ pub struct EvalReport {
     /// Joints beyond the robot's limits, for every model that keeps them.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub beyond_joint_limits: Vec<crate::BeyondLimitsWarning>,
+    /// Revolute joints whose angles some rows had wrapped by whole turns into the range the model
+    /// was fitted on before it was applied ([`crate::wrapped`], as `calib register` does); empty
+    /// where none was (and left out of the JSON).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub wrapped: Vec<crate::WrappedJoint>,
 }
 
 /// The errors inside and outside a model's coverage.
@@ -79,6 +84,7 @@ impl EvalReport {
             warnings: model.extrapolation(&data.rows),
             out_of_range: model.outside_training_range(&data.rows),
             beyond_joint_limits: model.beyond_joint_limits(&data.rows),
+            wrapped: Vec::new(),
         }
     }
 }

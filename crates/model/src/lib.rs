@@ -47,6 +47,7 @@ mod predictions;
 mod repeats;
 mod residual_gp;
 mod training_range;
+mod wrap;
 pub use evaluate::{Evaluation, evaluate, tool_indices};
 pub use predictions::write_predictions;
 
@@ -64,3 +65,4 @@ pub use residual_gp::{
     UnknownGpChoice,
 };
 pub use training_range::{OutOfRangeWarning, TrainingRange};
+pub use wrap::{WrappedJoint, wrapped};
