@@ -24,15 +24,21 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let model = pipeline::read_model(&args.model)?;
     let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
     let data = pipeline::read_measurements(&args.data, &options)?;
+    // Angles a turn away from the fitted range are taken into it, as `calib register` does.
+    let (rows, wrapped) = pipeline::wrapped(&model, &data.rows);
+    let data = pipeline::MeasurementSet { rows, ..data };
     let evaluation = pipeline::evaluate(&model, &data)?;
     let finite = |e: &pipeline::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
     if let Some((row, _)) = data.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
         return Err(crate::predict::non_finite(&args.model, &data.source, row.line).into());
     }
-    let report = EvalReport::new(&model, &data, &evaluation);
+    let report = EvalReport { wrapped, ..EvalReport::new(&model, &data, &evaluation) };
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
         eprintln!("{}", data.read_summary());
+        for joint in &report.wrapped {
+            eprintln!("note: {joint}");
+        }
         if report.orientations_not_evaluated {
             eprintln!("note: {}", pipeline::ORIENTATIONS_NOT_EVALUATED);
         }
@@ -62,6 +68,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     if report.orientations_not_evaluated {
         println!("  note: {}", pipeline::ORIENTATIONS_NOT_EVALUATED);
+    }
+    for joint in &report.wrapped {
+        println!("  note: {joint}");
     }
     if let Some(split) = &report.coverage {
         for (what, part) in [("inside", &split.inside), ("outside", &split.outside)] {

@@ -114,8 +114,21 @@ fn summarise(
     errors(out, "training error after", &report.after);
     // Beside the training error, which a GP that interpolates its poses drives to nothing: the
     // same rows, each corrected by the GP fitted without it (closed form, issue 25).
-    if let Some(loo) = report.residual_gp.as_ref().and_then(|c| c.leave_one_out.as_ref()) {
-        errors(out, "GP leave-one-out error (each row predicted without it)", loo);
+    if let Some(gp) = &report.residual_gp {
+        // Where rows repeat a configuration, a row left out alone keeps its twin, whose value the
+        // GP returns: the grouped error is the one to read, and is what the model keeps (issue 26).
+        match (&gp.leave_one_out, &gp.leave_group_out) {
+            (Some(loo), Some(grouped)) => {
+                errors(out, "GP leave-one-out error (each row predicted without it, its repeats kept)", loo);
+                let label = format!(
+                    "GP leave-group-out error ({} rows repeat {} configurations, each left out whole)",
+                    gp.repeated_rows, gp.repeated_configurations
+                );
+                errors(out, &label, grouped);
+            }
+            (Some(loo), None) => errors(out, "GP leave-one-out error (each row predicted without it)", loo),
+            _ => {}
+        }
     }
     let id = &report.identification;
     let _ = writeln!(

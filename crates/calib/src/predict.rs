@@ -22,7 +22,11 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let model = pipeline::read_model(&args.model)?;
     let options =
         pipeline::ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
-    let data = pipeline::read_configurations(&args.data, &options)?;
+    let read = pipeline::read_configurations(&args.data, &options)?;
+    // Angles a turn away from the fitted range are taken into it, as `calib register` does; the
+    // CSV's columns are the same, the note on stderr says which rows.
+    let (rows, wrapped) = pipeline::wrapped(&model, &read.rows);
+    let data = pipeline::MeasurementSet { rows, ..read };
     let tools = pipeline::tool_indices(&model, &data)?;
     let predictions = model.predict(&data.rows, &tools)?;
     let finite = |p: &pipeline::PredictedPose| {
@@ -31,6 +35,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     };
     if let Some(row) = data.rows.iter().zip(&predictions).find_map(|(row, p)| (!finite(p)).then_some(row)) {
         return Err(non_finite(&args.model, &data.source, row.line).into());
+    }
+    for joint in &wrapped {
+        eprintln!("note: {joint}");
     }
     for warning in model.extrapolation(&data.rows) {
         eprintln!("warning: {warning}");

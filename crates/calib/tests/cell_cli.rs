@@ -261,3 +261,78 @@ fn plan_without_candidates_draws_them_within_the_limits() {
     assert!(output.starts_with("q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad\n"));
     assert_eq!(output.lines().count(), 13);
 }
+
+/// `eval` and `predict` take a revolute angle a turn away from the fitted range back into it, as
+/// `register` does, and say so: the IRB 4400's joint 6 spans ±400°; a `poe-gp` model fitted on
+/// rows with |q6| < 3 rad, evaluated on rows inside its range whose negative q6 is shifted by +2π, gives the errors
+/// and the poses of the unshifted rows (the GP, fitted on q6 as an input, would otherwise be
+/// asked 2π away from its data), and the JSON names the joint.
+#[test]
+fn eval_and_predict_wrap_angles_a_turn_away_into_the_fitted_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("sim.csv");
+    let robot = fixture("irb4400.ron");
+    succeeds_with_stderr(&["simulate", "--robot", &robot, "--out", &text(&data), "--rows", "600", "--seed", "6"]);
+    let content = std::fs::read_to_string(&data).unwrap();
+    let mut lines = content.lines();
+    let header = lines.next().unwrap();
+    let q6 = header.split(',').position(|h| h == "q6_rad").unwrap();
+    let value = |line: &str| line.split(',').nth(q6).unwrap().parse::<f64>().unwrap();
+    let inside: Vec<&str> = lines.filter(|l| value(l).abs() < 3.0).collect();
+    let (train, rest) = inside.split_at(120);
+    // Test rows within the angles the model was fitted on, so that each shifted row wraps back.
+    let (low, high) = train.iter().map(|l| value(l)).fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
+    let test: Vec<&str> = rest.iter().copied().filter(|l| (low..=high).contains(&value(l))).collect();
+    let shifted: Vec<String> = test
+        .iter()
+        .map(|l| {
+            let mut cells: Vec<String> = l.split(',').map(str::to_owned).collect();
+            let q = value(l);
+            if q < 0.0 {
+                cells[q6] = (q + std::f64::consts::TAU).to_string();
+            }
+            cells.join(",")
+        })
+        .collect();
+    let write = |name: &str, rows: &[String]| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, format!("{header}\n{}\n", rows.join("\n"))).unwrap();
+        path
+    };
+    let own = |rows: &[&str]| rows.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let (train, test, shifted) =
+        (write("train.csv", &own(train)), write("test.csv", &own(&test)), write("shifted.csv", &shifted));
+    let moved = shifted_rows(&std::fs::read_to_string(&shifted).unwrap(), q6);
+    assert!(moved > 20, "{moved} rows shifted");
+    let model = dir.path().join("gp.ron");
+    let args = ["fit", "--robot", &robot, "--data", &text(&train), "--method", "poe-gp", "--gp", "exact"];
+    succeeds_with_stderr(&[&args[..], &["--out", &text(&model)]].concat());
+    let eval = |data: &Path| succeeds_with_stderr(&["eval", "--model", &text(&model), "--data", &text(data), "--json"]);
+    let ((plain, _), (wrapped, note)) = (eval(&test), eval(&shifted));
+    let (a, b) = (json_number(&plain, "mean_position_error_mm"), json_number(&wrapped, "mean_position_error_mm"));
+    assert!((a - b).abs() < 1e-9, "unshifted {a} mm, shifted {b} mm");
+    // Joint 4 (±200°) may wrap a row in both; joint 6 only the shifted rows, every one of them.
+    let joint6 = "{\"joint\":6,\"rows_wrapped\":";
+    assert!(!plain.contains(joint6), "{plain}");
+    let at = wrapped.find(joint6).unwrap_or_else(|| panic!("{wrapped}")) + joint6.len();
+    let count: usize = wrapped[at..].split(',').next().unwrap().parse().unwrap();
+    assert_eq!(count, moved);
+    assert!(note.contains("joint 6:") && note.contains("modulo 2π"), "{note}");
+    let predict = |data: &Path| succeeds_with_stderr(&["predict", "--model", &text(&model), "--data", &text(data)]);
+    let ((plain, _), (wrapped, note)) = (predict(&test), predict(&shifted));
+    assert!(note.contains("joint 6:"), "{note}");
+    let numbers = |csv: &str| -> Vec<f64> {
+        csv.lines()
+            .skip(1)
+            .flat_map(|l| l.split(',').skip(1).map(|c| c.parse::<f64>().unwrap_or(0.0)).collect::<Vec<_>>())
+            .collect()
+    };
+    let (p, w) = (numbers(&plain), numbers(&wrapped));
+    assert_eq!(p.len(), w.len());
+    assert!(p.iter().zip(&w).all(|(x, y)| (x - y).abs() < 2e-6), "the poses of shifted rows differ");
+}
+
+/// Rows of a CSV whose joint column `q6` lies above π (those shifted by a turn).
+fn shifted_rows(csv: &str, q6: usize) -> usize {
+    csv.lines().skip(1).filter(|l| l.split(',').nth(q6).unwrap().parse::<f64>().unwrap() > std::f64::consts::PI).count()
+}

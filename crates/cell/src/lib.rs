@@ -95,7 +95,6 @@ mod report;
 mod urdf_export;
 mod urdf_like;
 mod urdf_text;
-mod wrap;
 
 pub use candidates::{CandidateSet, file_candidates, generated_candidates, write_chosen_rows, write_generated_rows};
 pub use coverage::AxisCoverage;
@@ -107,6 +106,8 @@ pub use joint_targets::{
     CompensateOptions, CompensationSummary, RegisteredNominal, TargetFile, TargetFrame, compensate, pose_targets,
     read_targets, registered_nominal, write_compensated,
 };
+/// Moved to `model` (shared with `calib eval` and `predict`); re-exported where it was.
+pub use model::{WrappedJoint, wrapped};
 pub use model_text::checked_model_text;
 pub use plan::{Checkpoint, Plan, PlanOptions, PlanReport, measuring_order, plan};
 pub use register::{Registered, register};
@@ -115,4 +116,3 @@ pub use report::{FrameChange, HeldoutFrom, RegisterReport, RegisterWarning, Regi
 pub use urdf_export::{
     AxisChange, PartError, TrainingErrors, UrdfExport, UrdfExportReport, UrdfTemplate, export_urdf, write_urdf,
 };
-pub use wrap::{WrappedJoint, wrapped};

@@ -29,7 +29,7 @@ pub struct Registered {
 /// (e.g. `calib eval` on rows it was not fitted on), against which the residual is judged; without
 /// it the fit's own estimate in the model file ([`model::HeldoutEstimate`]) is used, and without
 /// that the verdict is [`Verdict::Unknown`]. Revolute angles a turn away from the fitted range are
-/// wrapped into it where the joint's limits allow ([`crate::WrappedJoint`]).
+/// wrapped into it where the joint's limits allow ([`model::WrappedJoint`]).
 pub fn register(
     model: &CalibratedModel,
     data: &MeasurementSet,
@@ -71,7 +71,7 @@ pub fn register(
     check_counts(data, &slots, unknowns, use_rotation, options)?;
 
     // Angles one turn away from the training poses are taken back into the fitted range.
-    let (rows, wrapped) = crate::wrap::wrapped(model, &data.rows);
+    let (rows, wrapped) = model::wrapped(model, &data.rows);
     let data = &MeasurementSet { rows, ..data.clone() };
     let reference: Vec<usize> = data.rows.iter().map(|r| known[r.tool].unwrap_or(0)).collect();
     let predicted = model.predict(&data.rows, &reference)?;

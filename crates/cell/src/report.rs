@@ -3,8 +3,8 @@
 use crate::Error;
 use crate::register_options::{Refit, RegisterOptions};
 use crate::registration::Registration;
-use crate::wrap::WrappedJoint;
 use measurements::MeasurementSet;
+use model::WrappedJoint;
 use model::{
     BeyondLimitsWarning, CalibratedModel, ErrorSummary, ExtrapolationWarning, HeldoutSource, OutOfRangeWarning,
 };

@@ -104,6 +104,14 @@ pub enum Error {
         /// The value found.
         value: f64,
     },
+    /// The groups of a leave-group-out prediction are not a partition of the training rows: a
+    /// row is beyond them, in two groups, or in none.
+    InvalidGroups {
+        /// Training rows.
+        rows: usize,
+        /// The first row out of range, repeated or missing.
+        row: usize,
+    },
 }
 
 impl fmt::Display for Error {
@@ -149,6 +157,11 @@ impl fmt::Display for Error {
                 f,
                 "leave-one-out prediction failed: the inverse of the {size}x{size} training covariance has \
                  {value:e} on its diagonal at row {row}"
+            ),
+            Self::InvalidGroups { rows, row } => write!(
+                f,
+                "leave-group-out groups must hold each of the {rows} training rows once: row {row} is out of range, \
+                 repeated or missing"
             ),
         }
     }

@@ -424,12 +424,18 @@ pub(crate) fn validate_training_data(x: MatRef<'_, f64>, y: MatRef<'_, f64>) -> 
 impl Component {
     /// `[K⁻¹]ᵢᵢ` for every row: the squared column norms of `L⁻¹`.
     pub(crate) fn inverse_diagonal(&self, par: faer::Par) -> Vec<f64> {
-        let component = self;
-        let n = component.alpha.nrows();
-        let mut inverse = Mat::<f64>::identity(n, n);
-        component.factor.solve_lower_in_place(inverse.as_mut(), par);
+        let inverse = self.inverse_factor(par);
+        let n = inverse.nrows();
         // L⁻¹ is lower triangular: column i has entries from row i down.
         (0..n).map(|i| (i..n).map(|k| inverse[(k, i)] * inverse[(k, i)]).sum()).collect()
+    }
+
+    /// `L⁻¹`, lower triangular: `[K⁻¹]ᵢⱼ = Σ_{k ≥ max(i, j)} L⁻¹ₖᵢ L⁻¹ₖⱼ`.
+    pub(crate) fn inverse_factor(&self, par: faer::Par) -> Mat<f64> {
+        let n = self.alpha.nrows();
+        let mut inverse = Mat::<f64>::identity(n, n);
+        self.factor.solve_lower_in_place(inverse.as_mut(), par);
+        inverse
     }
 
     /// Per served output, the log predictive probability of Eq. 5.11 summed over rows, for the

@@ -61,6 +61,81 @@ fn closed_form_leave_one_out_equals_refitting_without_the_row() {
     }
 }
 
+/// Rows 0..40 and, for rows 0..12, a second measurement of the same input (a repeated pose,
+/// other noise): the groups are `{i, 40 + i}` for `i < 12` and singletons otherwise.
+fn twinned(seed: u64) -> (Mat<f64>, Mat<f64>, Vec<Vec<usize>>) {
+    let (x0, y0) = data(seed, 40, 3, 2);
+    let mut r = rng(seed + 100);
+    let noise = uniform_points(&mut r, 12, 2, -0.05, 0.05);
+    let x = Mat::from_fn(52, 3, |i, j| x0[(if i < 40 { i } else { i - 40 }, j)]);
+    let y = Mat::from_fn(52, 2, |i, c| if i < 40 { y0[(i, c)] } else { y0[(i - 40, c)] + noise[(i - 40, c)] });
+    let groups = (0..40).map(|i| if i < 12 { vec![i, 40 + i] } else { vec![i] }).collect();
+    (x, y, groups)
+}
+
+/// Each row of a group predicted in closed form equals the prediction of a GP refitted without
+/// the whole group, same hyperparameters; and a twin's leave-one-out prediction is its twin's
+/// value (what made the per-row error flatter), the grouped one is not.
+#[test]
+fn closed_form_leave_group_out_equals_refitting_without_the_group() {
+    let (x, y, groups) = twinned(8);
+    let config = GpConfig {
+        kernel: KernelChoice::SquaredExponentialArd,
+        standardise_inputs: false,
+        normalise_outputs: false,
+        optimiser: OptimiserConfig { restarts: 0, ..OptimiserConfig::default() },
+        ..GpConfig::default()
+    };
+    let model = ExactGp::fit(x.as_ref(), y.as_ref(), &config).expect("fit");
+    let kernels: Vec<Kernel> = model.report().components.iter().map(|c| c.kernel.clone()).collect();
+    let grouped = model.leave_groups_out(&groups).expect("leave-group-out");
+    let single = model.leave_one_out().expect("leave-one-out");
+    for group in [&groups[0], &groups[5], &groups[20]] {
+        let keep: Vec<usize> = (0..x.nrows()).filter(|i| !group.contains(i)).collect();
+        let pick = |m: &Mat<f64>, rows: &[usize]| Mat::from_fn(rows.len(), m.ncols(), |a, j| m[(rows[a], j)]);
+        let refit =
+            ExactGp::fit_fixed(pick(&x, &keep).as_ref(), pick(&y, &keep).as_ref(), &kernels, &config).expect("refit");
+        let options = PredictOptions { include_noise: true, ..PredictOptions::default() };
+        let p = refit.predict_with(pick(&x, group).as_ref(), &options).expect("predict");
+        for (a, &i) in group.iter().enumerate() {
+            for c in 0..y.ncols() {
+                let (mean, var) = (p.mean[(a, c)], p.variance[(a, c)]);
+                assert!(
+                    (grouped.mean[(i, c)] - mean).abs() < 1e-8,
+                    "row {i} output {c}: {} vs {mean}",
+                    grouped.mean[(i, c)]
+                );
+                assert!((grouped.variance[(i, c)] - var).abs() < 1e-8 * var.max(1.0), "row {i} output {c}");
+            }
+        }
+    }
+    // Summed over the twinned rows, the per-row error is far below the grouped one.
+    let error = |m: &Mat<f64>| groups[..12].iter().flatten().map(|&i| (m[(i, 0)] - y[(i, 0)]).abs()).sum::<f64>();
+    assert!(error(&single.mean) < 0.8 * error(&grouped.mean), "{} vs {}", error(&single.mean), error(&grouped.mean));
+}
+
+/// With every group one row, the grouped prediction is the leave-one-out prediction to the bit;
+/// groups that are not a partition of the rows are refused with the row.
+#[test]
+fn singleton_groups_give_leave_one_out_and_bad_groups_are_refused() {
+    let (x, y) = data(9, 30, 3, 2);
+    let config = GpConfig { kernel: KernelChoice::SquaredExponentialArd, ..GpConfig::default() };
+    let model = ExactGp::fit(x.as_ref(), y.as_ref(), &config).expect("fit");
+    let singles: Vec<Vec<usize>> = (0..30).map(|i| vec![i]).collect();
+    let grouped = model.leave_groups_out(&singles).expect("groups");
+    let single = model.leave_one_out().expect("leave-one-out");
+    assert_eq!(grouped.mean, single.mean);
+    assert_eq!(grouped.variance, single.variance);
+    assert_eq!(grouped.log_predictive, single.log_predictive);
+    let missing: Vec<Vec<usize>> = (0..29).map(|i| vec![i]).collect();
+    let twice: Vec<Vec<usize>> = (0..30).map(|i| vec![i, (i + 1) % 30]).collect();
+    let beyond: Vec<Vec<usize>> = (0..30).map(|i| vec![if i == 3 { 30 } else { i }]).collect();
+    for (groups, row) in [(missing, 29), (twice, 1), (beyond, 30)] {
+        let result = model.leave_groups_out(&groups);
+        assert!(matches!(result, Err(gp::Error::InvalidGroups { rows: 30, row: r }) if r == row), "{result:?}");
+    }
+}
+
 /// With the isotropic candidate on, each kernel's report says which kernel was kept and why, the
 /// model's kernel is that one, and the criterion recorded for the kept kernel is the leave-one-out
 /// log predictive probability of the model as fitted.

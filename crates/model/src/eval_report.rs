@@ -62,6 +62,11 @@ pub struct EvalReport {
     /// model's), named beside the statistics, which keep them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub suspect_rows: Option<crate::SuspectRows>,
+    /// Revolute joints whose angles some rows had wrapped by whole turns into the range the model
+    /// was fitted on before it was applied ([`crate::wrapped`], as `calib register` does); empty
+    /// where none was (and left out of the JSON).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub wrapped: Vec<crate::WrappedJoint>,
 }
 
 /// The errors inside and outside a model's coverage.
@@ -106,6 +111,7 @@ impl EvalReport {
                 })
             }),
             suspect_rows: suspects(model, data, evaluation),
+            wrapped: Vec::new(),
         }
     }
 }

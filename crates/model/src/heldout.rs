@@ -11,10 +11,15 @@ pub enum HeldoutSource {
     /// The exact GP's closed-form leave-one-out prediction on every training row (the
     /// hyperparameters and the geometry as fitted on all rows).
     GpLeaveOneOut,
+    /// The same with each repeated configuration left out whole ([`crate::RepeatGroups`]), where
+    /// rows repeat one: a row left out alone keeps its twin.
+    GpLeaveGroupOut,
     /// The training error corrected for the identifiable parameters `p` (the effects' among them)
     /// among the residual rows
     /// `r`: `× √((r + p) / (r − p))`, the ratio of the expected held-out and training mean squares
-    /// of linear least squares (`σ²(1 + p/r)` against `σ²(1 − p/r)`).
+    /// of linear least squares (`σ²(1 + p/r)` against `σ²(1 − p/r)`). A configuration measured
+    /// more than once counts once in `r`: the error a model leaves is a function of the
+    /// configuration, so a repeat adds no independent residual.
     DegreesOfFreedom,
 }
 
@@ -22,6 +27,7 @@ impl std::fmt::Display for HeldoutSource {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
             Self::GpLeaveOneOut => "the GP's leave-one-out error",
+            Self::GpLeaveGroupOut => "the GP's leave-one-out error, repeated configurations left out whole",
             Self::DegreesOfFreedom => "the training error corrected for the fitted parameters",
         })
     }
@@ -45,9 +51,17 @@ impl HeldoutEstimate {
     }
 
     /// The degrees-of-freedom corrected training error ([`HeldoutSource::DegreesOfFreedom`]);
-    /// `None` where the parameters leave no residual rows.
-    pub fn degrees_of_freedom(training_mean_mm: f64, residual_rows: usize, parameters: usize) -> Option<Self> {
-        let (r, p) = (residual_rows as f64, parameters as f64);
+    /// `None` where the parameters leave no residual rows. `distinct` of the `rows` measurements
+    /// behind the `residual_rows` are distinct configurations: the residual rows count in that
+    /// proportion.
+    pub fn degrees_of_freedom(
+        training_mean_mm: f64,
+        residual_rows: usize,
+        parameters: usize,
+        (distinct, rows): (usize, usize),
+    ) -> Option<Self> {
+        let share = if rows == 0 { 1.0 } else { distinct.min(rows) as f64 / rows as f64 };
+        let (r, p) = (residual_rows as f64 * share, parameters as f64);
         if r <= p {
             return None;
         }
@@ -61,11 +75,15 @@ mod tests {
 
     #[test]
     fn the_correction_grows_with_the_parameters_and_refuses_none_left() {
-        let few = HeldoutEstimate::degrees_of_freedom(1.0, 100, 10).unwrap();
-        let many = HeldoutEstimate::degrees_of_freedom(1.0, 100, 50).unwrap();
+        let few = HeldoutEstimate::degrees_of_freedom(1.0, 100, 10, (50, 50)).unwrap();
+        let many = HeldoutEstimate::degrees_of_freedom(1.0, 100, 50, (50, 50)).unwrap();
         assert!((few.mean_position_error_mm - (110.0f64 / 90.0).sqrt()).abs() < 1e-12);
         assert!(many.mean_position_error_mm > few.mean_position_error_mm);
-        assert!(HeldoutEstimate::degrees_of_freedom(1.0, 30, 30).is_none());
+        assert!(HeldoutEstimate::degrees_of_freedom(1.0, 30, 30, (15, 15)).is_none());
+        // Half the rows repeats of the other half: 50 independent residual rows, not 100.
+        let twins = HeldoutEstimate::degrees_of_freedom(1.0, 100, 10, (25, 50)).unwrap();
+        assert!((twins.mean_position_error_mm - (60.0f64 / 40.0).sqrt()).abs() < 1e-12);
+        assert!(HeldoutEstimate::degrees_of_freedom(1.0, 100, 50, (25, 50)).is_none());
         assert!(HeldoutEstimate::new(f64::NAN, HeldoutSource::GpLeaveOneOut).is_none());
         assert!(HeldoutEstimate::new(0.0, HeldoutSource::GpLeaveOneOut).is_none());
     }

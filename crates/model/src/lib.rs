@@ -44,10 +44,12 @@ mod model_check;
 mod model_file;
 mod model_parts;
 mod predictions;
+mod repeats;
 mod residual_gp;
 mod suspect_rows;
 mod training_range;
 mod unit_name;
+mod wrap;
 pub use evaluate::{Evaluation, evaluate, tool_indices};
 pub use predictions::write_predictions;
 
@@ -59,9 +61,11 @@ pub use method::{Method, UnknownMethod};
 pub use metrics::{ErrorSummary, PoseError, pose_error};
 pub use model_file::{SCHEMA_VERSION, model_text, parse_model, read_model, write_model};
 pub use model_parts::Part;
+pub use repeats::{HeldoutOptions, RepeatGroups};
 pub use residual_gp::{
     GpChoice, GpFitReport, GpModel, ResidualFrame, ResidualGp, ResidualGpOptions, ResidualGpReport, ResidualSet,
     UnknownGpChoice,
 };
 pub use suspect_rows::{SuspectRows, suspect_rows};
 pub use training_range::{OutOfRangeWarning, TrainingRange};
+pub use wrap::{WrappedJoint, wrapped};

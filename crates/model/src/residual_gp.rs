@@ -441,6 +441,23 @@ pub struct ResidualGpReport {
     /// error after it says little; this says what it does on a pose it has not seen. `None` for
     /// the sparse GP, which has no closed form.
     pub leave_one_out: Option<crate::ErrorSummary>,
+    /// Where rows repeat a configuration ([`crate::RepeatGroups`]), the same with each repeated
+    /// configuration left out whole (closed form by blocks, [`gp::ExactGp::leave_groups_out`]):
+    /// leaving one row out keeps its twin, whose value the GP then returns, so
+    /// [`ResidualGpReport::leave_one_out`] flatters the model there. Absent without repeats and for
+    /// the sparse GP.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub leave_group_out: Option<crate::ErrorSummary>,
+    /// Rows that repeat another row's configuration (0: none), and in how many configurations.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub repeated_rows: usize,
+    /// The configurations measured more than once.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub repeated_configurations: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 fn inputs(rows: &[Measurement], with_payload: bool) -> Mat<f64> {
@@ -496,15 +513,18 @@ impl ResidualSet {
 }
 
 impl ResidualGp {
-    /// Fits the GP to the error that the model poses `poses` (one per row) leave on `data`.
+    /// Fits the GP to the error that the model poses `poses` (one per row) leave on `data`;
+    /// `repeats` groups the rows of `data` that repeat a configuration, for the leave-group-out
+    /// error.
     pub fn fit(
         poses: &[SE3],
         data: &MeasurementSet,
         with_payload: bool,
         options: &ResidualGpOptions,
+        repeats: &crate::RepeatGroups,
     ) -> Result<(Self, ResidualGpReport), Error> {
         let ResidualSet { inputs: x, outputs: y } = ResidualSet::new(poses, data, with_payload, options.residual_frame);
-        let (gp, report, leave_one_out) = match options.choice_for(x.nrows()) {
+        let (gp, report, leave_one_out, leave_group_out) = match options.choice_for(x.nrows()) {
             GpChoice::Sparse => {
                 let inducing_points = options.sparse.inducing_points.min(x.nrows());
                 let gp = gp::GpConfig {
@@ -515,7 +535,7 @@ impl ResidualGp {
                 let config = gp::SparseConfig { gp, inducing_points, ..options.sparse.clone() };
                 let model = gp::SparseGp::fit(x.as_ref(), y.as_ref(), &config).map_err(Error::gp)?;
                 let report = GpFitReport::Sparse(model.report().clone());
-                (GpModel::Sparse(model), report, None)
+                (GpModel::Sparse(model), report, None, None)
             }
             GpChoice::Exact | GpChoice::Auto => {
                 let mut config = options.gp.clone();
@@ -525,7 +545,12 @@ impl ResidualGp {
                 let model = gp::ExactGp::fit(x.as_ref(), y.as_ref(), &config).map_err(Error::gp)?;
                 let report = GpFitReport::Exact(model.report().clone());
                 let loo = model.leave_one_out().map_err(Error::gp)?;
-                (GpModel::Exact(model), report, Some(loo.mean))
+                let grouped = if repeats.any() {
+                    Some(model.leave_groups_out(&repeats.groups).map_err(Error::gp)?.mean)
+                } else {
+                    None
+                };
+                (GpModel::Exact(model), report, Some(loo.mean), grouped)
             }
         };
         let residual_gp = Self {
@@ -536,7 +561,7 @@ impl ResidualGp {
             moved_by: None,
             tool_points: Vec::new(),
         };
-        let leave_one_out = leave_one_out.map(|mean| {
+        let summary = |mean: Mat<f64>| {
             let errors: Vec<crate::PoseError> = poses
                 .iter()
                 .zip(&data.rows)
@@ -548,8 +573,15 @@ impl ResidualGp {
                 })
                 .collect();
             crate::ErrorSummary::from_errors(&errors)
-        });
-        Ok((residual_gp, ResidualGpReport { gp: report, leave_one_out }))
+        };
+        let report = ResidualGpReport {
+            gp: report,
+            leave_one_out: leave_one_out.map(&summary),
+            leave_group_out: leave_group_out.map(&summary),
+            repeated_rows: repeats.repeated_rows(),
+            repeated_configurations: repeats.groups.iter().filter(|g| g.len() > 1).count(),
+        };
+        Ok((residual_gp, report))
     }
 
     /// `G` for the GP's output `g` at a model pose: a translation for position-only data, else the

@@ -252,7 +252,8 @@ pub fn fit(
         let kept = if left_out { Cow::Owned(without(data, &identification.robust)) } else { Cow::Borrowed(data) };
         let tools: Vec<usize> = kept.rows.iter().map(|r| r.tool).collect();
         let poses = model.geometric_poses(&kept.rows, &tools)?;
-        let (fitted, report) = ResidualGp::fit(&poses, &kept, with_payload, &options.residual_gp)?;
+        let repeats = model::RepeatGroups::of(&kept.rows, options.heldout.repeat_tolerance);
+        let (fitted, report) = ResidualGp::fit(&poses, &kept, with_payload, &options.residual_gp, &repeats)?;
         model.residual_gp = Some(fitted);
         residual_gp = Some(report);
     }
@@ -271,7 +272,8 @@ pub fn fit(
     };
     let before = evaluate(&registered, data)?.summary;
     let after = evaluate(&model, data)?.summary;
-    model.heldout = heldout_estimate(&after, &identification, residual_gp.as_ref());
+    let distinct = model::RepeatGroups::of(&data.rows, options.heldout.repeat_tolerance).groups.len();
+    model.heldout = heldout_estimate(&after, &identification, residual_gp.as_ref(), (distinct, data.rows.len()));
     if identification.redundancy() < options.min_redundancy {
         warnings.push(FitWarning::LowRedundancy {
             residual_rows: identification.residual_rows,
@@ -319,17 +321,29 @@ pub fn fit(
 /// The fit's estimate of its held-out error, kept in the model (`calib register` judges against
 /// it): the exact GP's leave-one-out error where there is a GP (`None` for the sparse GP, whose
 /// training error says nothing of new poses), else the training error corrected for the
-/// identifiable parameters, the effects' among them. (For `--effects auto` the diagnosis's
-/// cross-validated error was the other candidate: on the UR10's even rows it said 0.122 mm where
-/// the odd rows measure 0.143 (C), the correction 0.137.)
+/// identifiable parameters, the effects' among them. Both count a configuration measured more
+/// than once as one (`distinct` configurations of the rows): the GP's error leaves the repeats of
+/// a configuration out together, the correction counts the residual rows of distinct
+/// configurations. (For `--effects auto` the diagnosis's cross-validated error was the other
+/// candidate: on the UR10's even rows it said 0.122 mm where the odd rows measure 0.143 (C), the
+/// correction 0.137.)
 fn heldout_estimate(
     after: &ErrorSummary,
     identification: &IdentificationReport,
     residual_gp: Option<&ResidualGpReport>,
+    distinct: (usize, usize),
 ) -> Option<HeldoutEstimate> {
     if let Some(gp) = residual_gp {
+        if let Some(grouped) = &gp.leave_group_out {
+            return HeldoutEstimate::new(grouped.mean_position_error_mm, HeldoutSource::GpLeaveGroupOut);
+        }
         let loo = gp.leave_one_out.as_ref()?;
         return HeldoutEstimate::new(loo.mean_position_error_mm, HeldoutSource::GpLeaveOneOut);
     }
-    HeldoutEstimate::degrees_of_freedom(after.mean_position_error_mm, identification.residual_rows, identification.rank)
+    HeldoutEstimate::degrees_of_freedom(
+        after.mean_position_error_mm,
+        identification.residual_rows,
+        identification.rank,
+        distinct,
+    )
 }

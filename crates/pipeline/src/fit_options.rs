@@ -105,6 +105,8 @@ pub struct FitOptions {
     pub plausibility: crate::PlausibilityOptions,
     /// The prior toward the nominal geometry and how its strength is chosen (issue 30).
     pub nominal_prior: crate::NominalPriorOptions,
+    /// How the held-out estimate kept in the model treats repeated configurations (issue 26).
+    pub heldout: model::HeldoutOptions,
 }
 
 impl Default for FitOptions {
@@ -116,6 +118,7 @@ impl Default for FitOptions {
             min_redundancy: 3.0,
             plausibility: crate::PlausibilityOptions::default(),
             nominal_prior: crate::NominalPriorOptions::default(),
+            heldout: model::HeldoutOptions::default(),
         }
     }
 }
@@ -189,6 +192,7 @@ impl FitOptions {
         }
         self.plausibility.validate()?;
         self.nominal_prior.validate()?;
+        self.heldout.validate()?;
         let prior = self.effects.prior_sigma;
         if prior.is_nan() || prior <= 0.0 {
             return Err((

@@ -128,3 +128,44 @@ fn fit_report_gives_the_gp_leave_one_out_error_near_the_held_out_error() {
         }
     }
 }
+
+/// Every training configuration measured twice (issue 26: a third of UR10 series B's rows): a
+/// row left out alone keeps its twin, whose value the GP returns, so the per-row leave-one-out
+/// error flatters the model; the model keeps the error with each configuration left out whole,
+/// near what fresh poses measure, and the report gives both.
+#[test]
+fn repeated_configurations_are_left_out_together_in_the_stored_heldout_estimate() {
+    use rand::{Rng, SeedableRng};
+    let robot = testkit::robot("irb4400.ron");
+    for seed in [17, 18] {
+        let all = loaded_data(&robot, 400, false, seed);
+        let once = all.subset(&(0..120).collect::<Vec<_>>());
+        let test = all.subset(&(250..400).collect::<Vec<_>>());
+        // The twin: the same joints and payload, the tracker's noise drawn again (±0.05 mm).
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut train = once.clone();
+        for row in &once.rows {
+            let mut twin = row.clone();
+            for c in 0..3 {
+                twin.position[c] += rng.random_range(-5e-5..5e-5);
+            }
+            train.rows.push(twin);
+        }
+        let (model, report) = pipeline::fit(&robot, &train, Method::PoeGpLoad, &FitOptions::default()).unwrap();
+        let held_out = pipeline::evaluate(&model, &test).unwrap().summary.mean_position_error_mm;
+        let gp = report.residual_gp.as_ref().expect("a GP method reports its GP");
+        let per_row = gp.leave_one_out.as_ref().expect("exact GP").mean_position_error_mm;
+        let grouped = gp.leave_group_out.as_ref().expect("repeats give a grouped error").mean_position_error_mm;
+        let stored = model.heldout.expect("the fit keeps an estimate");
+        eprintln!("seed {seed}: leave-one-out {per_row:.4}, leave-group-out {grouped:.4}, held out {held_out:.4} mm");
+        assert_eq!((gp.repeated_rows, gp.repeated_configurations), (240, 120));
+        assert_eq!(stored.source, pipeline::HeldoutSource::GpLeaveGroupOut);
+        assert_eq!(stored.mean_position_error_mm, grouped);
+        let ratio = grouped / held_out;
+        assert!((0.7..1.3).contains(&ratio), "leave-group-out {grouped} mm against held out {held_out} mm");
+        assert!(
+            per_row < 0.7 * held_out,
+            "the twins no longer flatter the per-row error: {per_row} against {held_out}"
+        );
+    }
+}

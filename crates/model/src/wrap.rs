@@ -3,15 +3,16 @@
 //! turn away from the training poses (UR10 series D's joint 1 against C's) are where the model
 //! was fitted once the turn is taken off. Only where the limits allow the other turn, only for a
 //! joint that turns its frame by its angle (scale 1), and only where the wrapped angle lies inside
-//! the fitted range and the given one does not.
+//! the fitted range and the given one does not. `calib register`, `eval` and `predict` all wrap
+//! through [`wrapped`] and say which joints they wrapped.
 
+use crate::CalibratedModel;
 use measurements::Measurement;
-use model::CalibratedModel;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 
 /// A joint whose angles some rows had wrapped into the fitted range.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WrappedJoint {
     /// The joint, from 1.
     pub joint: usize,
@@ -32,7 +33,7 @@ impl std::fmt::Display for WrappedJoint {
             f,
             "joint {}: {} of {} rows (the first at line {}) lie in the range the model was fitted on only modulo 2π \
              (shifted by {}; the joint's limits span more than a turn): the model was applied at the wrapped angles, \
-             the same link positions; give it the wrapped angles in eval and predict too",
+             the same link positions",
             self.joint,
             self.rows_wrapped,
             self.rows,
