@@ -76,8 +76,8 @@ impl LinkDeflection {
     /// `L (e_a · M)` of every bending axis at one row, unscaled, N·m².
     fn raw_features(&self, row: &Measurement, tool: usize) -> Result<[f64; 2], Error> {
         let payload = Payload::at_tool(row.payload_kg);
-        Ok(loadsim::link_deflection_features(&self.load.base_model, &self.dynamics, &row.q, tool, &payload, self.joint)
-            .map_err(Error::load)?)
+        loadsim::link_deflection_features(&self.load.base_model, &self.dynamics, &row.q, tool, &payload, self.joint)
+            .map_err(Error::load)
     }
 }
 

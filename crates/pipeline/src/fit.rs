@@ -107,6 +107,15 @@ pub enum FitWarning {
         /// Whether the fit left them out (the Huber loss) or kept them (plain least squares).
         left_out: bool,
     },
+    /// The fitted model misses the training positions by more than the nominal robot placed by a
+    /// rigid transform ([`crate::PlausibilityOptions::wrong_minimum_ratio`]): the identification
+    /// stopped in a wrong minimum, and the model is not to be used.
+    WrongMinimum {
+        /// The fitted model's RMS position error on the training rows, mm.
+        rms_mm: f64,
+        /// The rigidly placed nominal robot's, mm (`plausibility.rotation_rms_mm`).
+        rigid_rms_mm: f64,
+    },
 }
 
 impl std::fmt::Display for FitWarning {
@@ -132,6 +141,12 @@ impl std::fmt::Display for FitWarning {
                 rows.len(),
                 list_lines(rows),
                 if *left_out { "left out of the fit" } else { "KEPT in the fit (least-squares loss)" }
+            ),
+            FitWarning::WrongMinimum { rms_mm, rigid_rms_mm } => write!(
+                f,
+                "the fitted model misses the training positions by {rms_mm:.3} mm RMS, more than the nominal robot \
+                 placed by a rigid transform does ({rigid_rms_mm:.3} mm): the identification stopped in a wrong \
+                 minimum; do NOT use this model (report the data: the fit should never do worse than that placement)"
             ),
         }
     }
@@ -282,6 +297,10 @@ pub fn fit(
             min_redundancy: options.min_redundancy,
         });
     }
+    if outliers.is_empty() {
+        let ratio = options.plausibility.wrong_minimum_ratio;
+        warnings.extend(wrong_minimum(after.rms_position_error_mm, findings.report.as_ref(), ratio));
+    }
     if !outliers.is_empty() {
         warnings.push(FitWarning::GrossOutliers {
             rows: outliers.clone(),
@@ -318,6 +337,13 @@ pub fn fit(
     Ok((model, report))
 }
 
+/// The warning for a fit whose training RMS (`rms_mm`) is above `ratio` times that of the rigidly
+/// placed nominal robot (`None` without a plausibility report: too few rows, no positions).
+fn wrong_minimum(rms_mm: f64, plausible: Option<&crate::PlausibilityReport>, ratio: f64) -> Option<FitWarning> {
+    let rigid_rms_mm = plausible?.rotation_rms_mm;
+    (rms_mm > ratio * rigid_rms_mm).then_some(FitWarning::WrongMinimum { rms_mm, rigid_rms_mm })
+}
+
 /// The fit's estimate of its held-out error, kept in the model (`calib register` judges against
 /// it): the exact GP's leave-one-out error where there is a GP (`None` for the sparse GP, whose
 /// training error says nothing of new poses), else the training error corrected for the
@@ -346,4 +372,31 @@ fn heldout_estimate(
         identification.rank,
         distinct,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plausible(rigid_rms_mm: f64) -> crate::PlausibilityReport {
+        crate::PlausibilityReport {
+            measured_spread_mm: 1000.0,
+            robot_spread_mm: 1000.0,
+            scale_ratio: Some(1.0),
+            rotation_rms_mm: rigid_rms_mm,
+            reflection_rms_mm: 800.0,
+            out_of_plane_mm: None,
+        }
+    }
+
+    #[test]
+    fn a_fit_worse_than_the_rigid_placement_is_named_a_wrong_minimum() {
+        // Issue 23's 7-axis shape before the second registration start: 894.5 mm RMS against 4.0.
+        let warning = wrong_minimum(894.5, Some(&plausible(4.01)), 2.0).expect("a wrong minimum");
+        assert!(warning.to_string().contains("894.500 mm RMS") && warning.to_string().contains("do NOT use"));
+        // A fit at or below the placement, or within the ratio of it, is not.
+        assert_eq!(wrong_minimum(3.79, Some(&plausible(4.01)), 2.0), None);
+        assert_eq!(wrong_minimum(7.9, Some(&plausible(4.01)), 2.0), None);
+        assert_eq!(wrong_minimum(894.5, None, 2.0), None);
+    }
 }

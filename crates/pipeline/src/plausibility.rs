@@ -66,6 +66,15 @@ pub struct PlausibilityOptions {
     /// 3-D data, which leaves any plane by a third of its spread or more (the fixtures' simulated
     /// campaigns, the UR10's real series).
     pub planar_ratio: f64,
+    /// After the fit: warn when the fitted model misses the training positions by more than this
+    /// times the RMS of the nominal robot placed by a rigid transform (`rotation_rms_mm`). The
+    /// identification holds that placement as a special case (its base and tool parameters), so
+    /// at its optimum it cannot do worse; a fit that does stopped in a wrong minimum (issue 23's
+    /// 7-axis shape: 855 mm against 4.0 mm before 7eb349d's second registration start). 2: a
+    /// robust fit that leaves a few gross outliers out may exceed the least-squares placement's
+    /// RMS over every row somewhat, never by half again (the check is skipped when rows were left
+    /// out).
+    pub wrong_minimum_ratio: f64,
 }
 
 impl Default for PlausibilityOptions {
@@ -80,6 +89,7 @@ impl Default for PlausibilityOptions {
             limit_margin_m: 0.002,
             max_iterations: 500,
             planar_ratio: 0.05,
+            wrong_minimum_ratio: 2.0,
         }
     }
 }
@@ -102,6 +112,7 @@ impl PlausibilityOptions {
             ("limit_margin_rad", self.limit_margin_rad, 0.0, true),
             ("limit_margin_m", self.limit_margin_m, 0.0, true),
             ("planar_ratio", self.planar_ratio, 0.0, false),
+            ("wrong_minimum_ratio", self.wrong_minimum_ratio, 1.0, true),
         ];
         for (field, value, lowest, inclusive) in bounded {
             if !(value.is_finite() && (value > lowest || (inclusive && value == lowest))) {
