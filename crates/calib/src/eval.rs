@@ -72,26 +72,8 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     for joint in &report.wrapped {
         println!("  note: {joint}");
     }
-    if let Some(split) = &report.coverage {
-        for (what, part) in [("inside", &split.inside), ("outside", &split.outside)] {
-            if part.n > 0 {
-                println!(
-                    "  {what} the angles the effects were fitted on: {} rows, mean {:.4} mm, max {:.4} mm",
-                    part.n, part.mean_position_error_mm, part.max_position_error_mm
-                );
-            }
-        }
-    }
-    if let Some(split) = &report.range_split {
-        for (what, part) in [("inside", &split.inside), ("outside", &split.outside)] {
-            if part.n > 0 {
-                println!(
-                    "  {what} the range the model was fitted on: {} rows, mean {:.4} mm, max {:.4} mm",
-                    part.n, part.mean_position_error_mm, part.max_position_error_mm
-                );
-            }
-        }
-    }
+    print_split(report.coverage.as_ref(), "the angles the effects were fitted on");
+    print_split(report.range_split.as_ref(), "the range the model was fitted on");
     if let Some(suspects) = &report.suspect_rows {
         println!("  warning: {}", suspect_text(suspects));
     }
@@ -120,4 +102,17 @@ fn suspect_text(suspects: &pipeline::SuspectRows) -> String {
         w.mean_position_error_mm,
         w.max_position_error_mm
     )
+}
+
+/// The two lines of a split: `inside WHAT: …` and `outside WHAT: …`, each where it has rows.
+fn print_split(split: Option<&pipeline::CoverageSplit>, what: &str) {
+    let Some(split) = split else { return };
+    for (side, part) in [("inside", &split.inside), ("outside", &split.outside)] {
+        if part.n > 0 {
+            println!(
+                "  {side} {what}: {} rows, mean {:.4} mm, max {:.4} mm",
+                part.n, part.mean_position_error_mm, part.max_position_error_mm
+            );
+        }
+    }
 }

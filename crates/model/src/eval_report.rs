@@ -78,6 +78,17 @@ pub struct CoverageSplit {
     pub outside: ErrorSummary,
 }
 
+impl CoverageSplit {
+    /// The errors of the rows `inside` holds for and of the others.
+    fn of(data: &MeasurementSet, evaluation: &Evaluation, inside: impl Fn(&measurements::Measurement) -> bool) -> Self {
+        let (ins, outs): (Vec<_>, Vec<_>) = data.rows.iter().zip(&evaluation.errors).partition(|(row, _)| inside(row));
+        let summary = |part: Vec<(_, &PoseError)>| {
+            ErrorSummary::from_errors(&part.into_iter().map(|(_, e)| *e).collect::<Vec<_>>())
+        };
+        Self { inside: summary(ins), outside: summary(outs) }
+    }
+}
+
 impl EvalReport {
     /// The report of `evaluation`, the result of `model` on `data`.
     pub fn new(model: &CalibratedModel, data: &MeasurementSet, evaluation: &Evaluation) -> Self {
@@ -89,27 +100,15 @@ impl EvalReport {
             orientations_not_evaluated: data.full_pose && !model.full_pose,
             errors: evaluation.summary,
             format: data.format.clone(),
-            coverage: model.records_coverage().then(|| {
-                let (inside, outside): (Vec<_>, Vec<_>) =
-                    data.rows.iter().zip(&evaluation.errors).partition(|(row, _)| model.covers(row));
-                let summary = |part: Vec<(_, &PoseError)>| {
-                    ErrorSummary::from_errors(&part.into_iter().map(|(_, e)| *e).collect::<Vec<_>>())
-                };
-                CoverageSplit { inside: summary(inside), outside: summary(outside) }
-            }),
+            coverage: model.records_coverage().then(|| CoverageSplit::of(data, evaluation, |row| model.covers(row))),
             warnings: model.extrapolation(&data.rows),
             out_of_range: model.outside_training_range(&data.rows),
             beyond_joint_limits: model.beyond_joint_limits(&data.rows),
-            range_split: model.training_range.as_ref().and_then(|range| {
-                let (inside, outside): (Vec<_>, Vec<_>) =
-                    data.rows.iter().zip(&evaluation.errors).partition(|(row, _)| range.contains(row));
-                (!outside.is_empty()).then(|| {
-                    let summary = |part: Vec<(_, &PoseError)>| {
-                        ErrorSummary::from_errors(&part.into_iter().map(|(_, e)| *e).collect::<Vec<_>>())
-                    };
-                    CoverageSplit { inside: summary(inside), outside: summary(outside) }
-                })
-            }),
+            range_split: model
+                .training_range
+                .as_ref()
+                .map(|range| CoverageSplit::of(data, evaluation, |row| range.contains(row)))
+                .filter(|split| split.outside.n > 0),
             suspect_rows: suspects(model, data, evaluation),
             wrapped: Vec::new(),
         }
