@@ -298,4 +298,16 @@ mod tests {
             assert_eq!(fault_of(kind.name()).2, EffectListFault::UnknownEffect, "{kind:?}");
         }
     }
+
+    #[test]
+    fn the_refusals_list_every_identified_kind() {
+        // The list in the messages is written out in `errors` (a leaf that knows no kinds): a
+        // kind added to `effect_kinds!` must be added there too.
+        for fault in [EffectListFault::Empty, EffectListFault::UnknownEffect] {
+            let message = fault.to_string();
+            for &kind in EffectKind::IDENTIFIED {
+                assert!(message.contains(kind.name()), "{message} lacks {}", kind.name());
+            }
+        }
+    }
 }

@@ -132,10 +132,10 @@ impl fmt::Display for EffectListFault {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
             EffectListFault::Empty => f.write_str(
-                "is empty (expected auto, or a list of joint_compliance, gear_periodic:JOINT:HARMONICS, backlash:JOINT, thermal, time_drift)",
+                "is empty (expected auto, or a list of joint_compliance, gear_periodic:JOINT:HARMONICS, backlash:JOINT, thermal, time_drift, link_deflection:JOINT)",
             ),
             EffectListFault::UnknownEffect => f.write_str(
-                "is not an effect (joint_compliance, gear_periodic:JOINT:HARMONICS, backlash:JOINT, thermal, time_drift)",
+                "is not an effect (joint_compliance, gear_periodic:JOINT:HARMONICS, backlash:JOINT, thermal, time_drift, link_deflection:JOINT)",
             ),
             EffectListFault::Arguments { expected, found } => {
                 write!(f, "takes {expected} ':' argument(s), {found} given")
