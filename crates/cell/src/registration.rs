@@ -9,6 +9,7 @@
 use crate::Error;
 use lie::{Matrix3, SE3, SO3, Twist, Vector3};
 use nalgebra::{DMatrix, DVector};
+use poe::identify::{kabsch, nearest_rotation};
 use serde::{Deserialize, Serialize};
 
 /// The numbers the registration is tuned by.
@@ -134,29 +135,6 @@ impl Registration {
         let tool = row.slot.map_or_else(SE3::identity, |s| self.tools[s]);
         self.frame * row.predicted * tool
     }
-}
-
-/// The rotation nearest to `m` (polar decomposition), right-handed.
-fn nearest_rotation(m: &Matrix3) -> SO3 {
-    let svd = m.svd(true, true);
-    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
-        return SO3::identity();
-    };
-    let mut d = Matrix3::identity();
-    if (u * v_t).determinant() < 0.0 {
-        d[(2, 2)] = -1.0;
-    }
-    SO3::from_matrix_unchecked(u * d * v_t)
-}
-
-/// Kabsch (1976): the rigid motion taking `from` onto `to` in least squares.
-fn kabsch(from: &[Vector3], to: &[Vector3]) -> SE3 {
-    let n = from.len().max(1) as f64;
-    let cf = from.iter().sum::<Vector3>() / n;
-    let ct = to.iter().sum::<Vector3>() / n;
-    let h: Matrix3 = from.iter().zip(to).map(|(a, b)| (b - ct) * (a - cf).transpose()).sum();
-    let r = nearest_rotation(&h);
-    SE3::new(r, ct - r.act(&cf))
 }
 
 /// Fits the unknowns to the rows: the closed-form start, Levenberg–Marquardt, and with rotation

@@ -122,16 +122,9 @@ fn suspects(model: &CalibratedModel, data: &MeasurementSet, evaluation: &Evaluat
     let firm = |row: &measurements::Measurement| {
         model.covers(row) && model.training_range.as_ref().is_none_or(|range| range.contains(row))
     };
-    let kept: Vec<usize> = (0..data.rows.len()).filter(|&i| firm(&data.rows[i])).collect();
-    let rows: Vec<_> = kept.iter().map(|&i| data.rows[i].clone()).collect();
-    let errors: Vec<PoseError> = kept.iter().map(|&i| evaluation.errors[i]).collect();
-    let mut found = crate::suspect_rows(&rows, &errors, poe::identify::RobustOptions::default().outlier_threshold)?;
-    // The statistics without them are of every row, not only of those judged.
-    let named: Vec<usize> = crate::suspect_rows::named_rows(&errors, &found).into_iter().map(|k| kept[k]).collect();
-    let others: Vec<PoseError> =
-        evaluation.errors.iter().enumerate().filter(|(i, _)| !named.contains(i)).map(|(_, e)| *e).collect();
-    found.without = ErrorSummary::from_errors(&others);
-    Some(found)
+    let judged: Vec<usize> = (0..data.rows.len()).filter(|&i| firm(&data.rows[i])).collect();
+    let threshold = poe::identify::RobustOptions::default().outlier_threshold;
+    crate::suspect_rows::suspects_among(&data.rows, &evaluation.errors, &judged, threshold)
 }
 
 #[cfg(test)]

@@ -25,7 +25,7 @@ pub struct SuspectRows {
     pub rows: Vec<OutlierLine>,
     /// The threshold they are beyond, robust sigmas above the median position error.
     pub threshold_sigmas: f64,
-    /// The statistics of the other rows (`EvalReport`: of every other row of the file).
+    /// The statistics of every other row (judged or not).
     pub without: ErrorSummary,
 }
 
@@ -48,44 +48,50 @@ fn robust_scale(values: impl Iterator<Item = f64>) -> (f64, f64) {
 /// than `threshold_sigmas` robust sigmas above the median; `None` when there are none, fewer
 /// than [`MIN_ROWS`] rows, or no spread to measure against.
 pub fn suspect_rows(rows: &[Measurement], errors: &[PoseError], threshold_sigmas: f64) -> Option<SuspectRows> {
-    if errors.len() < MIN_ROWS || rows.len() != errors.len() {
+    let judged: Vec<usize> = (0..rows.len()).collect();
+    suspects_among(rows, errors, &judged, threshold_sigmas)
+}
+
+/// [`suspect_rows`] judged among the rows `judged` (indices into `rows` and `errors`); the
+/// statistics without them are of every other row of `errors`.
+pub(crate) fn suspects_among(
+    rows: &[Measurement],
+    errors: &[PoseError],
+    judged: &[usize],
+    threshold_sigmas: f64,
+) -> Option<SuspectRows> {
+    if judged.len() < MIN_ROWS || rows.len() != errors.len() {
         return None;
     }
-    let (median, sigma) = robust_scale(errors.iter().map(|e| e.position_mm));
+    let (median, sigma) = robust_scale(judged.iter().map(|&i| errors[i].position_mm));
     if !(sigma.is_finite() && sigma > 0.0) {
         return None;
     }
-    let rotation = errors
+    let rotation = judged
         .iter()
-        .map(|e| e.rotation_mrad)
+        .map(|&i| errors[i].rotation_mrad)
         .collect::<Option<Vec<f64>>>()
         .map(|angles| robust_scale(angles.into_iter()))
         .filter(|(_, s)| *s > 0.0);
     let sigmas = |e: &PoseError| (e.position_mm - median) / sigma;
-    let mut named: Vec<OutlierLine> = rows
-        .iter()
-        .zip(errors)
-        .filter(|(_, e)| sigmas(e) > threshold_sigmas)
-        .map(|(row, e)| OutlierLine {
-            line: row.line,
-            position_mm: e.position_mm,
-            position_sigmas: sigmas(e),
-            rotation_mrad: e.rotation_mrad,
-            rotation_sigmas: e.rotation_mrad.zip(rotation).map(|(a, (m, s))| (a - m) / s),
-        })
-        .collect();
+    let named: Vec<usize> = judged.iter().copied().filter(|&i| sigmas(&errors[i]) > threshold_sigmas).collect();
     if named.is_empty() {
         return None;
     }
-    named.sort_by(|a, b| b.position_sigmas.total_cmp(&a.position_sigmas));
-    let others: Vec<PoseError> = errors.iter().copied().filter(|e| sigmas(e) <= threshold_sigmas).collect();
-    Some(SuspectRows { rows: named, threshold_sigmas, without: ErrorSummary::from_errors(&others) })
-}
-
-/// The indices into `errors` of the rows `found` names (those beyond its threshold).
-pub(crate) fn named_rows(errors: &[PoseError], found: &SuspectRows) -> Vec<usize> {
-    let least = found.rows.iter().map(|r| r.position_mm).fold(f64::INFINITY, f64::min);
-    (0..errors.len()).filter(|&i| errors[i].position_mm >= least).collect()
+    let mut lines: Vec<OutlierLine> = named
+        .iter()
+        .map(|&i| OutlierLine {
+            line: rows[i].line,
+            position_mm: errors[i].position_mm,
+            position_sigmas: sigmas(&errors[i]),
+            rotation_mrad: errors[i].rotation_mrad,
+            rotation_sigmas: errors[i].rotation_mrad.zip(rotation).map(|(a, (m, s))| (a - m) / s),
+        })
+        .collect();
+    lines.sort_by(|a, b| b.position_sigmas.total_cmp(&a.position_sigmas));
+    let others: Vec<PoseError> =
+        errors.iter().enumerate().filter(|(i, _)| !named.contains(i)).map(|(_, e)| *e).collect();
+    Some(SuspectRows { rows: lines, threshold_sigmas, without: ErrorSummary::from_errors(&others) })
 }
 
 #[cfg(test)]

@@ -240,17 +240,7 @@ mod tests {
     }
 
     fn row(q: [f64; 6]) -> Measurement {
-        Measurement {
-            line: 0,
-            q: q.to_vec(),
-            position: lie::Vector3::zeros(),
-            orientation: None,
-            payload_kg: 0.0,
-            tool: 0,
-            temp_c: None,
-            t_s: None,
-            torques_nm: None,
-        }
+        Measurement::at(q.to_vec(), lie::Vector3::zeros())
     }
 
     #[test]

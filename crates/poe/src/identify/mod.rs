@@ -19,7 +19,7 @@ pub use correction::PoseCorrection;
 pub use options::{IdentificationOptions, Observation, ParameterMask, Solver, Target};
 pub use prior::KinematicPrior;
 pub use redundancy::Redundancy;
-pub use registration::register;
+pub use registration::{kabsch, nearest_rotation, register};
 pub use report::{DampingFallback, IdentificationReport, IterationRecord};
 pub use residual::ResidualStats;
 pub use robust::{KindScale, Loss, OutlierRow, RobustOptions, RobustReport, huber_loss, huber_weight, median};

@@ -6,7 +6,7 @@ use crate::{Error, LocalPoe};
 use lie::{Matrix3, SE3, SO3, Vector3};
 
 /// Nearest rotation to a 3×3 matrix (polar decomposition), keeping a right-handed result.
-fn nearest_rotation(m: &Matrix3) -> SO3 {
+pub fn nearest_rotation(m: &Matrix3) -> SO3 {
     let svd = m.svd(true, true);
     let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
         return SO3::identity();
@@ -143,9 +143,9 @@ pub fn register(nominal: &LocalPoe, observations: &[Observation]) -> Result<Loca
     Ok(model)
 }
 
-/// The rigid transform `(R, t)` minimising `Σ |R a_i + t − b_i|²` (Kabsch's SVD solution, a
-/// proper rotation).
-fn kabsch(from: &[Vector3], to: &[Vector3]) -> SE3 {
+/// The rigid transform `(R, t)` minimising `Σ |R a_i + t − b_i|²` (Kabsch 1976, the SVD solution,
+/// a proper rotation).
+pub fn kabsch(from: &[Vector3], to: &[Vector3]) -> SE3 {
     let count = from.len().max(1) as f64;
     let (mean_from, mean_to) = (from.iter().sum::<Vector3>() / count, to.iter().sum::<Vector3>() / count);
     let covariance: Matrix3 = from.iter().zip(to).map(|(a, b)| (b - mean_to) * (a - mean_from).transpose()).sum();
