@@ -35,6 +35,11 @@ pub struct CalibratedModel {
     /// written before it was kept (the fitted geometry is then used everywhere).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fallback_kinematics: Option<LocalPoe>,
+    /// The effects' posterior uncertainty: a σ for their correction at every row, and where the
+    /// model falls back to [`CalibratedModel::fallback_kinematics`] because that σ is far above
+    /// the training rows'. Files written before it was kept have none (no σ, no fallback by it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub effect_uncertainty: Option<crate::EffectUncertainty>,
     /// The GP on the residual, step 2 (methods `poe-gp`, `poe-gp-load`); `compensation` in the file.
     #[serde(default, skip_serializing_if = "Option::is_none", rename = "compensation")]
     pub residual_gp: Option<crate::ResidualGp>,
@@ -99,6 +104,11 @@ impl CalibratedModel {
         })
     }
 
+    /// The posterior uncertainty and the effects it is of, where the model keeps it.
+    pub(crate) fn uncertainty(&self) -> Option<(&crate::EffectUncertainty, &[IdentifiedEffect])> {
+        self.effect_uncertainty.as_ref().map(|u| (u, self.effects.as_slice()))
+    }
+
     /// The parts of the model in the order they apply: the geometry, each effect, the GP.
     pub fn parts(&self) -> Vec<Part<'_>> {
         let mut parts = vec![Part::Geometry(&self.kinematics)];
@@ -118,6 +128,8 @@ impl CalibratedModel {
         let fallback = usize::from(self.fallback_kinematics.is_some() && effects > 0);
         if (1..=effects).contains(&index) {
             model.effects.remove(index - 1);
+            // The uncertainty was of every effect together.
+            model.effect_uncertainty = None;
         } else if fallback == 1 && index == effects + 1 {
             model.fallback_kinematics = None;
         } else if index == effects + fallback + 1 {
@@ -134,6 +146,7 @@ impl CalibratedModel {
         CalibratedModel {
             effects: Vec::new(),
             fallback_kinematics: None,
+            effect_uncertainty: None,
             residual_gp: None,
             heldout: None,
             ..self.clone()
@@ -147,7 +160,7 @@ impl CalibratedModel {
 
     /// The poses of the geometry and the effects, before any GP.
     pub fn geometric_poses(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<SE3>, Error> {
-        let mut walk = Walk::new(rows, tools);
+        let mut walk = Walk::new(rows, tools, self.uncertainty());
         for part in self.parts().iter().filter(|p| !matches!(p, Part::GaussianProcess(_))) {
             part.apply(&mut walk)?;
         }
@@ -158,7 +171,7 @@ impl CalibratedModel {
     /// Predicts the tool pose of rows of a measurement set by applying every part in turn; the
     /// GP is placed before the POE model as in the paper's Eq. 9: `T = exp(ĝ(q, m)) · T_POE(q)`.
     pub fn predict(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<PredictedPose>, Error> {
-        let mut walk = Walk::new(rows, tools);
+        let mut walk = Walk::new(rows, tools, self.uncertainty());
         for part in self.parts() {
             part.apply(&mut walk)?;
         }
@@ -169,6 +182,46 @@ impl CalibratedModel {
             }
             None => walk.poses.into_iter().map(|pose| PredictedPose { pose, std: None }).collect(),
         })
+    }
+}
+
+/// Rows at which the model's own σ (of the geometry and effects together) is so far above what the
+/// training rows had that the model falls back to the geometry fitted alone: the rows excite a
+/// combination of the effects' parameters that no training row did.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SigmaFallback {
+    /// How many rows fall back, in part or fully.
+    pub rows: usize,
+    /// How many of them fully (the geometry alone).
+    pub fully: usize,
+    /// How many rows there are.
+    pub of_rows: usize,
+    /// The file line of the first.
+    pub first_line: u64,
+    /// The σ of the tool point's position above which the model falls back, mm.
+    pub limit_mm: f64,
+    /// The largest σ over the training rows, mm.
+    pub training_max_mm: f64,
+    /// The largest σ among these rows, mm.
+    pub largest_sigma_mm: f64,
+}
+
+impl std::fmt::Display for SigmaFallback {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} of {} rows (the first at line {}) excite combinations of the effects' parameters that no training \
+             row did: the model's σ there reaches {:.3} mm, above the {:.3} mm it falls back from ({:.3} mm at \
+             most on the training rows), so there it uses the geometry fitted alone ({} fully, {} blended)",
+            self.rows,
+            self.of_rows,
+            self.first_line,
+            self.largest_sigma_mm,
+            self.limit_mm,
+            self.training_max_mm,
+            self.fully,
+            self.rows - self.fully
+        )
     }
 }
 
@@ -220,7 +273,9 @@ impl CalibratedModel {
     /// Whether predictions carry a standard deviation: a GP, or an effect that reports what it
     /// leaves uncorrected where it fades out.
     pub fn predicts_std(&self) -> bool {
-        self.residual_gp.is_some() || self.effects.iter().any(IdentifiedEffect::has_sigma)
+        self.residual_gp.is_some()
+            || self.effect_uncertainty.is_some()
+            || self.effects.iter().any(IdentifiedEffect::has_sigma)
     }
 
     /// One warning per input (joint, payload, temperature, time) that some of `rows` put outside
@@ -235,6 +290,34 @@ impl CalibratedModel {
     pub fn beyond_joint_limits(&self, rows: &[Measurement]) -> Vec<crate::BeyondLimitsWarning> {
         let prismatic: Vec<bool> = self.joint_kinds().iter().map(|k| *k == poe::JointKind::Prismatic).collect();
         crate::beyond_limits(&self.joint_limits, &prismatic, rows)
+    }
+
+    /// The rows of `rows` (model tools `tools`) at which the model's σ is above its fallback limit,
+    /// where it falls back to the geometry fitted alone ([`crate::EffectUncertainty`]); `None`
+    /// when there are none or the model keeps no uncertainty.
+    pub fn sigma_fallback(&self, rows: &[Measurement], tools: &[usize]) -> Result<Option<SigmaFallback>, Error> {
+        let Some(uncertainty) = &self.effect_uncertainty else { return Ok(None) };
+        let mut fallen: Option<SigmaFallback> = None;
+        for (row, &tool) in rows.iter().zip(tools) {
+            let sigma = uncertainty.sigma(&self.kinematics, &self.effects, row, tool)?;
+            let position = (sigma[0] * sigma[0] + sigma[1] * sigma[1] + sigma[2] * sigma[2]).sqrt();
+            let weight = uncertainty.weight(position);
+            if weight < 1.0 {
+                let entry = fallen.get_or_insert(SigmaFallback {
+                    rows: 0,
+                    fully: 0,
+                    of_rows: rows.len(),
+                    first_line: row.line,
+                    limit_mm: uncertainty.fallback_sigma_m * 1e3,
+                    training_max_mm: uncertainty.training_sigma_m[1] * 1e3,
+                    largest_sigma_mm: 0.0,
+                });
+                entry.rows += 1;
+                entry.fully += usize::from(weight == 0.0);
+                entry.largest_sigma_mm = entry.largest_sigma_mm.max(position * 1e3);
+            }
+        }
+        Ok(fallen)
     }
 
     /// Whether any effect records the joint angles it was fitted on.

@@ -33,6 +33,7 @@
 #![deny(missing_docs)]
 
 mod calibrated;
+mod effect_sigma;
 mod eval_report;
 mod evaluate;
 pub mod geometric;
@@ -53,7 +54,8 @@ mod wrap;
 pub use evaluate::{Evaluation, evaluate, tool_indices};
 pub use predictions::write_predictions;
 
-pub use calibrated::{CalibratedModel, ExtrapolationWarning, PredictedPose};
+pub use effect_sigma::EffectUncertainty;
+pub use calibrated::{CalibratedModel, ExtrapolationWarning, PredictedPose, SigmaFallback};
 pub use eval_report::{CoverageSplit, EvalReport, ORIENTATIONS_NOT_EVALUATED};
 pub use heldout::{HeldoutEstimate, HeldoutSource};
 pub use joint_limits::{BeyondLimitsWarning, beyond_limits, stored_limits};

@@ -239,9 +239,14 @@ impl CalibratedModel {
             );
             return Err(at.part("joint_limits", message));
         }
+        if let Some(uncertainty) = &self.effect_uncertainty
+            && let Some(message) = uncertainty_fault(uncertainty, &self.effects, self.kinematics.layout().len())
+        {
+            return Err(at.part("effect_uncertainty", message));
+        }
         let (rows, where_) = self.probe_rows();
         let tools = vec![0; rows.len()];
-        let mut walk = Walk::new(&rows, &tools);
+        let mut walk = Walk::new(&rows, &tools, self.uncertainty());
         for (k, part) in self.parts().iter().enumerate() {
             let applied = part.apply(&mut walk);
             if applied.is_ok() && walk.is_bounded(MAX_TRANSLATION_M) {
@@ -265,4 +270,41 @@ impl CalibratedModel {
         }
         Ok(())
     }
+}
+
+/// What is wrong with an effect uncertainty read from a file, if anything: a free index inside
+/// the layout, a factor of the size the free and effect parameters make, finite numbers, a
+/// positive fallback σ.
+fn uncertainty_fault(
+    uncertainty: &crate::EffectUncertainty,
+    effects: &[effects::IdentifiedEffect],
+    layout: usize,
+) -> Option<String> {
+    if let Some(index) = uncertainty.free.iter().find(|&&i| i >= layout) {
+        return Some(format!(
+            "effect_uncertainty.free: {index} is not a parameter of the kinematics ({layout} parameters; an edited or corrupt file)"
+        ));
+    }
+    let p = uncertainty.free.len() + effects.iter().map(effects::IdentifiedEffect::parameter_count).sum::<usize>();
+    if uncertainty.factor.len() != p * (p + 1) / 2 {
+        return Some(format!(
+            "effect_uncertainty.factor: {} numbers, {} expected for {p} parameters (an edited or corrupt file)",
+            uncertainty.factor.len(),
+            p * (p + 1) / 2,
+        ));
+    }
+    if let Some(value) = uncertainty.factor.iter().find(|v| !v.is_finite()) {
+        return Some(format!("effect_uncertainty.factor: {value} is not finite (an edited or corrupt file)"));
+    }
+    let [median, largest] = uncertainty.training_sigma_m;
+    let limit = uncertainty.fallback_sigma_m;
+    if !(median.is_finite() && largest.is_finite() && 0.0 <= median && median <= largest)
+        || !(limit.is_finite() && limit > 0.0)
+    {
+        return Some(format!(
+            "effect_uncertainty: training_sigma_m ({median:e}, {largest:e}) and fallback_sigma_m {limit:e} must be \
+             finite, the first two ordered and at least 0, the last above 0 (an edited or corrupt file)"
+        ));
+    }
+    None
 }

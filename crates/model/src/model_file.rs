@@ -121,6 +121,7 @@ mod version_1 {
                 kinematics: v1.kinematics,
                 effects,
                 fallback_kinematics: None,
+                effect_uncertainty: None,
                 residual_gp: v1.residual_gp,
                 training_range: None,
                 joint_limits: Vec::new(),

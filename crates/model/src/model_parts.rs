@@ -9,6 +9,7 @@
 //! end.
 
 use crate::ResidualGp;
+use crate::effect_sigma::EffectUncertainty;
 use effects::IdentifiedEffect;
 use errors::{Error, ErrorKind};
 use lie::{SE3, Twist, Vector6};
@@ -62,6 +63,7 @@ impl<'a> Part<'a> {
                     .map_err(Error::kinematics)?;
                 walk.pending = vec![Vector6::zeros(); walk.rows.len()];
                 walk.coverage = vec![1.0; walk.rows.len()];
+                walk.posterior_variance = None;
             }
             Part::Effect(effect) => {
                 let kinematics = walk.kinematics.ok_or(Error::new(ErrorKind::PartOrder { part: "effect" }))?;
@@ -85,6 +87,19 @@ impl<'a> Part<'a> {
             }
             Part::Fallback(fallback) => {
                 walk.flush();
+                // Where the effects' own σ says they were fitted on nothing like the row, the
+                // model falls back to the geometry fitted alone, as outside a gear series' angles;
+                // the σ of what is still applied shrinks with it.
+                if let Some((uncertainty, effects)) = walk.uncertainty {
+                    let kinematics = walk.kinematics.ok_or(Error::new(ErrorKind::PartOrder { part: "fallback" }))?;
+                    let mut variances = Vec::with_capacity(walk.rows.len());
+                    for ((coverage, row), &tool) in walk.coverage.iter_mut().zip(walk.rows).zip(walk.tools) {
+                        let sigma = uncertainty.sigma(kinematics, effects, row, tool)?;
+                        *coverage *= uncertainty.weight((sigma[0] * sigma[0] + sigma[1] * sigma[1] + sigma[2] * sigma[2]).sqrt());
+                        variances.push(sigma.map(|s| s * s * *coverage * *coverage));
+                    }
+                    walk.posterior_variance = Some(variances);
+                }
                 for (((pose, coverage), row), &tool) in
                     walk.poses.iter_mut().zip(&walk.coverage).zip(walk.rows).zip(walk.tools)
                 {
@@ -126,11 +141,21 @@ pub(crate) struct Walk<'a> {
     /// The variance each row's effects leave uncorrected where they fade out, per component
     /// (`None` when no effect reports one).
     pub(crate) effect_variance: Option<Vec<[f64; 6]>>,
+    /// The posterior uncertainty of the geometry and effects, where the model keeps it, and the
+    /// effects it is of.
+    uncertainty: Option<(&'a EffectUncertainty, &'a [IdentifiedEffect])>,
+    /// The variance of the effects' correction at each row from their parameters' posterior,
+    /// per component (`None` without [`Walk::uncertainty`]).
+    pub(crate) posterior_variance: Option<Vec<[f64; 6]>>,
     pub(crate) std: Option<Vec<[f64; 6]>>,
 }
 
 impl<'a> Walk<'a> {
-    pub(crate) fn new(rows: &'a [Measurement], tools: &'a [usize]) -> Self {
+    pub(crate) fn new(
+        rows: &'a [Measurement],
+        tools: &'a [usize],
+        uncertainty: Option<(&'a EffectUncertainty, &'a [IdentifiedEffect])>,
+    ) -> Self {
         Self {
             rows,
             tools,
@@ -139,6 +164,8 @@ impl<'a> Walk<'a> {
             pending: Vec::new(),
             coverage: Vec::new(),
             effect_variance: None,
+            uncertainty,
+            posterior_variance: None,
             std: None,
         }
     }
@@ -157,20 +184,18 @@ impl<'a> Walk<'a> {
     /// The standard deviation of each row's pose: the GP's and the faded effects', in
     /// quadrature (independent sources); `None` when neither is part of the model.
     pub(crate) fn standard_deviations(&self) -> Option<Vec<[f64; 6]>> {
-        match (&self.std, &self.effect_variance) {
-            (None, None) => None,
-            (Some(std), None) => Some(std.clone()),
-            (std, Some(variance)) => Some(
-                variance
-                    .iter()
-                    .enumerate()
-                    .map(|(i, v)| {
-                        let gp = std.as_ref().map_or([0.0; 6], |s| s[i]);
-                        std::array::from_fn(|k| (gp[k] * gp[k] + v[k]).sqrt())
-                    })
-                    .collect(),
-            ),
+        if self.std.is_none() && self.effect_variance.is_none() && self.posterior_variance.is_none() {
+            return None;
         }
+        let at = |v: &Option<Vec<[f64; 6]>>, i: usize| v.as_ref().map_or([0.0; 6], |v| v[i]);
+        Some(
+            (0..self.rows.len())
+                .map(|i| {
+                    let (gp, faded, posterior) = (at(&self.std, i), at(&self.effect_variance, i), at(&self.posterior_variance, i));
+                    std::array::from_fn(|k| (gp[k] * gp[k] + faded[k] + posterior[k]).sqrt())
+                })
+                .collect(),
+        )
     }
 
     /// Applies the effects' pending twists: `exp(Σ twists) · pose`.

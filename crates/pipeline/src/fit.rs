@@ -152,6 +152,37 @@ impl std::fmt::Display for FitWarning {
     }
 }
 
+/// The posterior uncertainty of the geometry and effects ([`model::EffectUncertainty`]) from the
+/// identification's covariance, its σ at the training rows, and the σ beyond which the model falls
+/// back to the geometry (`None` where the covariance is not definite).
+fn effect_uncertainty(
+    kinematics: &poe::LocalPoe,
+    effects: &[IdentifiedEffect],
+    free: Vec<usize>,
+    covariance: &[f64],
+    data: &MeasurementSet,
+    options: &crate::EffectOptions,
+) -> Result<Option<model::EffectUncertainty>, Error> {
+    let p = free.len() + effects.iter().map(IdentifiedEffect::parameter_count).sum::<usize>();
+    let Some(factor) = model::EffectUncertainty::factor_of(covariance, p) else { return Ok(None) };
+    let mut uncertainty = model::EffectUncertainty { free, factor, training_sigma_m: [0.0; 2], fallback_sigma_m: 1e3 };
+    let mut sigmas = Vec::with_capacity(data.rows.len());
+    for row in &data.rows {
+        let sigma = uncertainty.sigma(kinematics, effects, row, row.tool)?;
+        sigmas.push((sigma[0] * sigma[0] + sigma[1] * sigma[1] + sigma[2] * sigma[2]).sqrt());
+    }
+    sigmas.sort_by(f64::total_cmp);
+    let median = sigmas.get(sigmas.len() / 2).copied().unwrap_or(0.0);
+    let largest = sigmas.last().copied().unwrap_or(0.0);
+    if std::env::var_os("CALIB_DEBUG_SIGMA").is_some() {
+        eprintln!("sigma on training rows: median {median:e} max {largest:e} p90 {:e}", sigmas[sigmas.len() * 9 / 10]);
+    }
+    uncertainty.training_sigma_m = [median, largest];
+    // inf (never) is kept as the largest finite σ, which no row reaches.
+    uncertainty.fallback_sigma_m = (options.fallback_sigma_ratio * largest).min(f64::MAX / 2.0).max(f64::MIN_POSITIVE);
+    Ok(Some(uncertainty))
+}
+
 /// The effects a list names, built on the training rows.
 fn build_effects(
     specs: &[EffectSpec],
@@ -203,6 +234,7 @@ pub fn fit(
         kinematics: geometry.model,
         effects: Vec::new(),
         fallback_kinematics: None,
+        effect_uncertainty: None,
         residual_gp: None,
         training_range: model::TrainingRange::of(&data.rows),
         joint_limits: model::stored_limits(&robot.limits()),
@@ -254,6 +286,8 @@ pub fn fit(
         }
         effect_report = effect_reports(&effects, &fitted.report.held_at_prior);
         model.fallback_kinematics = Some(std::mem::replace(&mut model.kinematics, fitted.model));
+        model.effect_uncertainty =
+            effect_uncertainty(&model.kinematics, &effects, mask.free_indices(), &fitted.covariance, data, &options.effects)?;
         model.effects = effects;
         identification = fitted.report;
     }

@@ -13,7 +13,7 @@ use crate::Error;
 /// The prior weight `1/σ` of every parameter: kinematic blocks are `(v, ω)` sextuples, held by
 /// the problem's [`super::KinematicPrior`] where it has one, else by the options' prior about the
 /// start.
-fn prior_weights(problem: &Problem<'_>) -> Vec<f64> {
+pub(super) fn prior_weights(problem: &Problem<'_>) -> Vec<f64> {
     let options = problem.options;
     let mut weights: Vec<f64> = match problem.prior {
         Some(prior) => prior.weights(&problem.free),

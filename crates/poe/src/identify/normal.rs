@@ -91,10 +91,48 @@ impl Normal {
 
     /// The posterior variance of each parameter, `diag(H⁻¹)`, where `H` is definite.
     pub(super) fn posterior_variances(&self) -> Option<Vec<f64>> {
+        let inverse = self.inverse()?;
+        Some((0..inverse.nrows()).map(|i| inverse[(i, i)]).collect())
+    }
+
+    /// `H⁻¹`, where `H` is definite.
+    pub(super) fn inverse(&self) -> Option<Mat<f64>> {
         let p = self.h.nrows();
         let llt = self.h.llt(Side::Lower).ok()?;
-        let inverse = llt.solve(Mat::<f64>::identity(p, p));
-        Some((0..p).map(|i| inverse[(i, i)]).collect())
+        Some(llt.solve(Mat::<f64>::identity(p, p)))
+    }
+
+    /// `H⁺`: the inverse on the directions whose eigenvalue is above the larger of `rcond²` (the
+    /// rank's `rcond` is of the singular values of `A`, whose squares `H` has) and `p·ε` (the
+    /// rounding floor of a symmetric `p × p` eigenvalue problem: numerical rank as MATLAB's
+    /// `pinv` and LAPACK take it) times the largest, zero on the others. A local POE model has
+    /// directions no pose sees (a joint frame moved along its own axis): their eigenvalues are
+    /// rounding (1e-16 of the largest, against 1e-8 for the weakest direction a pose sees on the
+    /// simulated IRB 4400), and they have no variance to carry to a prediction.
+    pub(super) fn pseudo_inverse(&self, rcond: f64) -> Option<Mat<f64>> {
+        let p = self.h.nrows();
+        let svd = self.h.thin_svd().ok()?;
+        let s = svd.S().column_vector();
+        let largest = (0..p).map(|k| s[k]).fold(0.0_f64, f64::max);
+        let threshold = (rcond * rcond).max(p as f64 * f64::EPSILON) * largest;
+        let v = svd.V();
+        let mut inverse = Mat::<f64>::zeros(p, p);
+        for k in 0..p {
+            if !(s[k] > threshold && s[k] > 0.0) {
+                continue;
+            }
+            let scale = 1.0 / s[k];
+            for i in 0..p {
+                let vi = v[(i, k)] * scale;
+                if vi == 0.0 {
+                    continue;
+                }
+                for j in 0..p {
+                    inverse[(i, j)] += vi * v[(j, k)];
+                }
+            }
+        }
+        (0..p).all(|i| inverse[(i, i)].is_finite()).then_some(inverse)
     }
 }
 

@@ -20,6 +20,15 @@ pub struct Identification {
     pub model: LocalPoe,
     /// The identified correction parameters (empty without a [`PoseCorrection`]).
     pub correction: Vec<f64>,
+    /// The posterior covariance of the free parameters, the free kinematic ones in the mask's
+    /// order (their left perturbations, as [`LocalPoe::identification_jacobian`] orders them),
+    /// then [`Identification::correction`]'s, row-major `p × p`: `s² (AᵀA + W²)⁻¹` at the solution
+    /// (`A` the weighted Jacobian, `W` the prior weights the solver used, `s²` the reduced χ² of
+    /// the weighted residual, so that a model that misses by more than the stated noise is the
+    /// less certain for it). Directions the data and the prior leave undetermined (below
+    /// `rcond`, [`IdentificationReport::rank`]) get no variance: on a local POE model they are
+    /// the ones no pose sees. Empty where the decomposition fails.
+    pub covariance: Vec<f64>,
     /// Iterations, identifiability and the unidentifiable directions.
     pub report: IdentificationReport,
 }
@@ -95,9 +104,11 @@ pub fn identify_with_prior(
     };
     let unidentifiable =
         find_redundancies(&solved.state.model, observations, mask, solved.a.r.ncols().saturating_sub(rank));
+    let covariance = covariance(&problem, &solved, rows.saturating_sub(rank));
     Ok(Identification {
         model: solved.state.model,
         correction: solved.state.theta,
+        covariance,
         report: IdentificationReport {
             iterations: solved.iterations,
             converged: solved.termination.converged(),
@@ -115,6 +126,21 @@ pub fn identify_with_prior(
             robust,
         },
     })
+}
+
+/// [`Identification::covariance`]: the pseudo-inverse of the normal matrix under the prior the
+/// solver used (none for the pseudo-inverse iteration), the directions below `rcond` dropped as
+/// the rank drops them, times the reduced χ² (`dof`: residual rows less the rank).
+fn covariance(problem: &Problem<'_>, solved: &Solved, dof: usize) -> Vec<f64> {
+    let weights = match problem.options.solver {
+        Solver::PseudoInverse if problem.prior.is_none() => vec![0.0; problem.parameter_count()],
+        _ => super::levenberg::prior_weights(problem),
+    };
+    let normal = normal::Normal::new(&solved.a, &weights, &solved.state.deviation);
+    let Some(inverse) = normal.pseudo_inverse(problem.options.rcond) else { return Vec::new() };
+    let scale = solved.a.residual_sq / dof.max(1) as f64;
+    let p = inverse.nrows();
+    (0..p).flat_map(|i| (0..p).map(move |j| (i, j))).map(|(i, j)| inverse[(i, j)] * scale).collect()
 }
 
 fn solve(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
