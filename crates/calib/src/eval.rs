@@ -54,6 +54,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         if let Some(suspects) = &report.suspect_rows {
             eprintln!("warning: {}", suspect_text(suspects));
         }
+        if let Some(fallen) = &report.sigma_fallback {
+            eprintln!("warning: {fallen}");
+        }
         return Ok(());
     }
     let s = &evaluation.summary;
@@ -72,7 +75,12 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     for joint in &report.wrapped {
         println!("  note: {joint}");
     }
-    print_split(report.coverage.as_ref(), "the angles the effects were fitted on");
+    let covered = if report.sigma_fallback.is_some() {
+        "the effects' coverage (the angles they were fitted on, their σ within the fallback limit)"
+    } else {
+        "the angles the effects were fitted on"
+    };
+    print_split(report.coverage.as_ref(), covered);
     print_split(report.range_split.as_ref(), "the range the model was fitted on");
     if let Some(suspects) = &report.suspect_rows {
         println!("  warning: {}", suspect_text(suspects));
@@ -85,6 +93,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     for warning in &report.beyond_joint_limits {
         println!("  warning: {warning}");
+    }
+    if let Some(fallen) = &report.sigma_fallback {
+        println!("  warning: {fallen}");
     }
     Ok(())
 }

@@ -48,6 +48,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     for warning in model.beyond_joint_limits(&data.rows) {
         eprintln!("warning: {warning}");
     }
+    if let Some(fallen) = model.sigma_fallback(&data.rows, &tools)? {
+        eprintln!("warning: {fallen}");
+    }
     pipeline::write_predictions(std::io::stdout().lock(), "stdout", &model, &data, &predictions)?;
     std::io::stdout().flush()?;
     eprintln!("{}", data.read_summary());

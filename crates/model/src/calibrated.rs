@@ -206,6 +206,30 @@ pub struct SigmaFallback {
     pub largest_sigma_mm: f64,
 }
 
+impl SigmaFallback {
+    /// The rows whose weight (of [`CalibratedModel::sigma_weights`]) is below 1; `None` if none.
+    pub fn of(rows: &[Measurement], weights: &[(f64, f64)], uncertainty: &crate::EffectUncertainty) -> Option<Self> {
+        let mut fallen: Option<SigmaFallback> = None;
+        for (row, &(weight, sigma)) in rows.iter().zip(weights) {
+            if weight < 1.0 {
+                let entry = fallen.get_or_insert(SigmaFallback {
+                    rows: 0,
+                    fully: 0,
+                    of_rows: rows.len(),
+                    first_line: row.line,
+                    limit_mm: uncertainty.fallback_sigma_m * 1e3,
+                    training_max_mm: uncertainty.training_sigma_m[1] * 1e3,
+                    largest_sigma_mm: 0.0,
+                });
+                entry.rows += 1;
+                entry.fully += usize::from(weight == 0.0);
+                entry.largest_sigma_mm = entry.largest_sigma_mm.max(sigma * 1e3);
+            }
+        }
+        fallen
+    }
+}
+
 impl std::fmt::Display for SigmaFallback {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
@@ -292,32 +316,28 @@ impl CalibratedModel {
         crate::beyond_limits(&self.joint_limits, &prismatic, rows)
     }
 
+    /// How fully the effects apply at each of `rows` (model tools `tools`) by the model's σ there
+    /// ([`crate::EffectUncertainty::weight`]) and that σ of the tool point's position (m); `None`
+    /// for a model that keeps no uncertainty.
+    pub fn sigma_weights(&self, rows: &[Measurement], tools: &[usize]) -> Result<Option<Vec<(f64, f64)>>, Error> {
+        let Some(uncertainty) = &self.effect_uncertainty else { return Ok(None) };
+        let mut weights = Vec::with_capacity(rows.len());
+        for (row, &tool) in rows.iter().zip(tools) {
+            let sigma = uncertainty.sigma(&self.kinematics, &self.effects, row, tool)?;
+            let position = (sigma[0] * sigma[0] + sigma[1] * sigma[1] + sigma[2] * sigma[2]).sqrt();
+            weights.push((uncertainty.weight(position), position));
+        }
+        Ok(Some(weights))
+    }
+
     /// The rows of `rows` (model tools `tools`) at which the model's σ is above its fallback limit,
     /// where it falls back to the geometry fitted alone ([`crate::EffectUncertainty`]); `None`
     /// when there are none or the model keeps no uncertainty.
     pub fn sigma_fallback(&self, rows: &[Measurement], tools: &[usize]) -> Result<Option<SigmaFallback>, Error> {
-        let Some(uncertainty) = &self.effect_uncertainty else { return Ok(None) };
-        let mut fallen: Option<SigmaFallback> = None;
-        for (row, &tool) in rows.iter().zip(tools) {
-            let sigma = uncertainty.sigma(&self.kinematics, &self.effects, row, tool)?;
-            let position = (sigma[0] * sigma[0] + sigma[1] * sigma[1] + sigma[2] * sigma[2]).sqrt();
-            let weight = uncertainty.weight(position);
-            if weight < 1.0 {
-                let entry = fallen.get_or_insert(SigmaFallback {
-                    rows: 0,
-                    fully: 0,
-                    of_rows: rows.len(),
-                    first_line: row.line,
-                    limit_mm: uncertainty.fallback_sigma_m * 1e3,
-                    training_max_mm: uncertainty.training_sigma_m[1] * 1e3,
-                    largest_sigma_mm: 0.0,
-                });
-                entry.rows += 1;
-                entry.fully += usize::from(weight == 0.0);
-                entry.largest_sigma_mm = entry.largest_sigma_mm.max(position * 1e3);
-            }
-        }
-        Ok(fallen)
+        let (Some(uncertainty), Some(weights)) = (&self.effect_uncertainty, self.sigma_weights(rows, tools)?) else {
+            return Ok(None);
+        };
+        Ok(SigmaFallback::of(rows, &weights, uncertainty))
     }
 
     /// Whether any effect records the joint angles it was fitted on.

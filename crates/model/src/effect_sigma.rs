@@ -7,12 +7,12 @@
 //! falls back to the geometry fitted alone there (`model_parts`, [`EffectUncertainty::weight`]).
 
 use effects::{IdentifiedEffect, RowTwists};
-use poe::RowKind;
 use errors::Error;
 use faer::{Mat, Side};
 use lie::Vector3;
 use measurements::Measurement;
 use poe::LocalPoe;
+use poe::RowKind;
 use serde::{Deserialize, Serialize};
 
 /// The posterior uncertainty of a model's geometry and effects, as a model file keeps it.
@@ -74,32 +74,29 @@ impl EffectUncertainty {
     /// [`EffectUncertainty::fallback_sigma_m`], 0 from twice it, linear between.
     pub fn weight(&self, sigma_m: f64) -> f64 {
         let limit = self.fallback_sigma_m;
-        if !(limit > 0.0) || sigma_m <= limit {
-            1.0
-        } else {
-            (2.0 - sigma_m / limit).clamp(0.0, 1.0)
-        }
+        if !(limit > 0.0) || sigma_m <= limit { 1.0 } else { (2.0 - sigma_m / limit).clamp(0.0, 1.0) }
     }
 
-    /// The standard deviation of the pose the geometry and `effects` predict at `row` (model
-    /// tool `tool`), per component of the pose error `(v, ω)` at the tool point: `σ_k = ‖Lᵀ g_k‖`,
-    /// `g_k` the k-th component of each parameter's pose change at the point (the identification
-    /// Jacobian's columns, then each effect parameter's twist times its feature).
-    pub fn sigma(
+    /// How the pose at `row` (model tool `tool`) moves per unit of each parameter of the factor,
+    /// at the tool point, as `(v, ω)`: the tool point's displacement and the rotation (the
+    /// identification Jacobian's columns of the free kinematic parameters, then each effect
+    /// parameter's twist times its feature, moved to the point). First order in the effects:
+    /// how their own twist turns the kinematic columns (`poe::identify::PoseCorrection`, of the
+    /// effects' size, 1e-4 on an industrial arm) is left out of a σ.
+    pub fn parameter_changes(
         &self,
         kinematics: &LocalPoe,
         effects: &[IdentifiedEffect],
         row: &Measurement,
         tool: usize,
-    ) -> Result<[f64; 6], Error> {
-        let p = self.parameter_count();
+    ) -> Result<Vec<[f64; 6]>, Error> {
         let columns = kinematics.layout().len();
         let mut jacobian = vec![0.0; 6 * columns];
         let pose = kinematics
             .identification_jacobian(&row.q, tool, RowKind::PointAndRotation, &mut jacobian)
             .map_err(Error::kinematics)?;
         let point = pose.translation();
-        let mut changes: Vec<[f64; 6]> = Vec::with_capacity(p);
+        let mut changes: Vec<[f64; 6]> = Vec::with_capacity(self.free.len());
         for &c in &self.free {
             changes.push(std::array::from_fn(|k| jacobian.get(k * columns + c).copied().unwrap_or(0.0)));
         }
@@ -117,6 +114,22 @@ impl EffectUncertainty {
                 changes.push([v.x, v.y, v.z, w.x, w.y, w.z]);
             }
         }
+        Ok(changes)
+    }
+
+    /// The standard deviation of the pose the geometry and `effects` predict at `row` (model
+    /// tool `tool`), per component of the pose error `(v, ω)` at the tool point: `σ_k = ‖Lᵀ g_k‖`,
+    /// `g_k` the k-th component of [`EffectUncertainty::parameter_changes`]. Zero when the factor
+    /// is not of those parameters (a model edited by hand; the file check refuses it).
+    pub fn sigma(
+        &self,
+        kinematics: &LocalPoe,
+        effects: &[IdentifiedEffect],
+        row: &Measurement,
+        tool: usize,
+    ) -> Result<[f64; 6], Error> {
+        let p = self.parameter_count();
+        let changes = self.parameter_changes(kinematics, effects, row, tool)?;
         if changes.len() != p {
             return Ok([0.0; 6]);
         }
@@ -154,7 +167,9 @@ mod packed_numbers {
         text.split_ascii_whitespace()
             .enumerate()
             .map(|(k, token)| {
-                token.parse::<f64>().map_err(|_| D::Error::custom(format!("number {} of the list, '{token}', is not a number", k + 1)))
+                token
+                    .parse::<f64>()
+                    .map_err(|_| D::Error::custom(format!("number {} of the list, '{token}', is not a number", k + 1)))
             })
             .collect()
     }
@@ -166,7 +181,12 @@ mod tests {
 
     #[test]
     fn the_weight_is_one_inside_the_limit_and_zero_from_twice_it() {
-        let u = EffectUncertainty { free: Vec::new(), factor: Vec::new(), training_sigma_m: [1e-5, 2e-5], fallback_sigma_m: 1e-4 };
+        let u = EffectUncertainty {
+            free: Vec::new(),
+            factor: Vec::new(),
+            training_sigma_m: [1e-5, 2e-5],
+            fallback_sigma_m: 1e-4,
+        };
         assert_eq!(u.weight(5e-5), 1.0);
         assert_eq!(u.weight(1e-4), 1.0);
         assert!((u.weight(1.5e-4) - 0.5).abs() < 1e-12);

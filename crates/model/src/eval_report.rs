@@ -62,6 +62,10 @@ pub struct EvalReport {
     /// model's), named beside the statistics, which keep them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub suspect_rows: Option<crate::SuspectRows>,
+    /// Rows at which the model's σ is so far above the training rows' that it falls back to the
+    /// geometry fitted alone ([`crate::SigmaFallback`]); `None` where there are none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sigma_fallback: Option<crate::SigmaFallback>,
     /// Revolute joints whose angles some rows had wrapped by whole turns into the range the model
     /// was fitted on before it was applied ([`crate::wrapped`], as `calib register` does); empty
     /// where none was (and left out of the JSON).
@@ -80,8 +84,13 @@ pub struct CoverageSplit {
 
 impl CoverageSplit {
     /// The errors of the rows `inside` holds for and of the others.
-    fn of(data: &MeasurementSet, evaluation: &Evaluation, inside: impl Fn(&measurements::Measurement) -> bool) -> Self {
-        let (ins, outs): (Vec<_>, Vec<_>) = data.rows.iter().zip(&evaluation.errors).partition(|(row, _)| inside(row));
+    fn of(
+        data: &MeasurementSet,
+        evaluation: &Evaluation,
+        inside: impl Fn(usize, &measurements::Measurement) -> bool,
+    ) -> Self {
+        let (ins, outs): (Vec<_>, Vec<_>) =
+            data.rows.iter().enumerate().zip(&evaluation.errors).partition(|((i, row), _)| inside(*i, row));
         let summary = |part: Vec<(_, &PoseError)>| {
             ErrorSummary::from_errors(&part.into_iter().map(|(_, e)| *e).collect::<Vec<_>>())
         };
@@ -92,6 +101,16 @@ impl CoverageSplit {
 impl EvalReport {
     /// The report of `evaluation`, the result of `model` on `data`.
     pub fn new(model: &CalibratedModel, data: &MeasurementSet, evaluation: &Evaluation) -> Self {
+        // The evaluation has walked the same rows: the σ cannot fail where it did not.
+        let weights = crate::tool_indices(model, data)
+            .ok()
+            .and_then(|tools| model.sigma_weights(&data.rows, &tools).ok().flatten());
+        let held = |i: usize| weights.as_ref().is_none_or(|w| w[i].0 == 1.0);
+        let sigma_fallback = match (&model.effect_uncertainty, &weights) {
+            (Some(uncertainty), Some(weights)) => crate::SigmaFallback::of(&data.rows, weights, uncertainty),
+            _ => None,
+        };
+        let covered = |i: usize, row: &measurements::Measurement| model.covers(row) && held(i);
         Self {
             method: model.method,
             robot: model.robot.clone(),
@@ -100,29 +119,36 @@ impl EvalReport {
             orientations_not_evaluated: data.full_pose && !model.full_pose,
             errors: evaluation.summary,
             format: data.format.clone(),
-            coverage: model.records_coverage().then(|| CoverageSplit::of(data, evaluation, |row| model.covers(row))),
+            coverage: (model.records_coverage() || sigma_fallback.is_some())
+                .then(|| CoverageSplit::of(data, evaluation, covered)),
             warnings: model.extrapolation(&data.rows),
             out_of_range: model.outside_training_range(&data.rows),
             beyond_joint_limits: model.beyond_joint_limits(&data.rows),
             range_split: model
                 .training_range
                 .as_ref()
-                .map(|range| CoverageSplit::of(data, evaluation, |row| range.contains(row)))
+                .map(|range| CoverageSplit::of(data, evaluation, |_, row| range.contains(row)))
                 .filter(|split| split.outside.n > 0),
-            suspect_rows: suspects(model, data, evaluation),
+            suspect_rows: suspects(model, data, evaluation, &held),
+            sigma_fallback,
             wrapped: Vec::new(),
         }
     }
 }
 
 /// The rows far beyond the others among those on the model's firm ground (inside its fitted
-/// range and its effects' coverage): outside it a large error is the model's, not the data's.
+/// range and its effects' coverage, and not fallen back by σ): outside it a large error is the model's, not the data's.
 /// The threshold is the one the fit names gross outliers of its training rows by.
-fn suspects(model: &CalibratedModel, data: &MeasurementSet, evaluation: &Evaluation) -> Option<crate::SuspectRows> {
+fn suspects(
+    model: &CalibratedModel,
+    data: &MeasurementSet,
+    evaluation: &Evaluation,
+    held: &dyn Fn(usize) -> bool,
+) -> Option<crate::SuspectRows> {
     let firm = |row: &measurements::Measurement| {
         model.covers(row) && model.training_range.as_ref().is_none_or(|range| range.contains(row))
     };
-    let judged: Vec<usize> = (0..data.rows.len()).filter(|&i| firm(&data.rows[i])).collect();
+    let judged: Vec<usize> = (0..data.rows.len()).filter(|&i| firm(&data.rows[i]) && held(i)).collect();
     let threshold = poe::identify::RobustOptions::default().outlier_threshold;
     crate::suspect_rows::suspects_among(&data.rows, &evaluation.errors, &judged, threshold)
 }

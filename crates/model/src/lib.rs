@@ -54,8 +54,8 @@ mod wrap;
 pub use evaluate::{Evaluation, evaluate, tool_indices};
 pub use predictions::write_predictions;
 
-pub use effect_sigma::EffectUncertainty;
 pub use calibrated::{CalibratedModel, ExtrapolationWarning, PredictedPose, SigmaFallback};
+pub use effect_sigma::EffectUncertainty;
 pub use eval_report::{CoverageSplit, EvalReport, ORIENTATIONS_NOT_EVALUATED};
 pub use heldout::{HeldoutEstimate, HeldoutSource};
 pub use joint_limits::{BeyondLimitsWarning, beyond_limits, stored_limits};

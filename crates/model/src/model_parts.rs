@@ -95,7 +95,8 @@ impl<'a> Part<'a> {
                     let mut variances = Vec::with_capacity(walk.rows.len());
                     for ((coverage, row), &tool) in walk.coverage.iter_mut().zip(walk.rows).zip(walk.tools) {
                         let sigma = uncertainty.sigma(kinematics, effects, row, tool)?;
-                        *coverage *= uncertainty.weight((sigma[0] * sigma[0] + sigma[1] * sigma[1] + sigma[2] * sigma[2]).sqrt());
+                        *coverage *= uncertainty
+                            .weight((sigma[0] * sigma[0] + sigma[1] * sigma[1] + sigma[2] * sigma[2]).sqrt());
                         variances.push(sigma.map(|s| s * s * *coverage * *coverage));
                     }
                     walk.posterior_variance = Some(variances);
@@ -191,7 +192,8 @@ impl<'a> Walk<'a> {
         Some(
             (0..self.rows.len())
                 .map(|i| {
-                    let (gp, faded, posterior) = (at(&self.std, i), at(&self.effect_variance, i), at(&self.posterior_variance, i));
+                    let (gp, faded, posterior) =
+                        (at(&self.std, i), at(&self.effect_variance, i), at(&self.posterior_variance, i));
                     std::array::from_fn(|k| (gp[k] * gp[k] + faded[k] + posterior[k]).sqrt())
                 })
                 .collect(),

@@ -286,8 +286,14 @@ pub fn fit(
         }
         effect_report = effect_reports(&effects, &fitted.report.held_at_prior);
         model.fallback_kinematics = Some(std::mem::replace(&mut model.kinematics, fitted.model));
-        model.effect_uncertainty =
-            effect_uncertainty(&model.kinematics, &effects, mask.free_indices(), &fitted.covariance, data, &options.effects)?;
+        model.effect_uncertainty = effect_uncertainty(
+            &model.kinematics,
+            &effects,
+            mask.free_indices(),
+            &fitted.covariance,
+            data,
+            &options.effects,
+        )?;
         model.effects = effects;
         identification = fitted.report;
     }

@@ -492,7 +492,8 @@ fn rows_that_excite_what_no_training_row_did_have_a_large_sigma_and_fall_back_to
         // training rows is the tracker's noise.
         let (alone, floor) = (error(&geometry, &off), error(&geometry, &train));
         for effects in ["joint_compliance", "joint_compliance,gear_periodic:2:8,gear_periodic:3:8"] {
-            let (model, never) = (fit(effects, FitOptions::default().effects.fallback_sigma_ratio), fit(effects, f64::INFINITY));
+            let (model, never) =
+                (fit(effects, FitOptions::default().effects.fallback_sigma_ratio), fit(effects, f64::INFINITY));
             let (corrected, unguarded) = (error(&model, &off), error(&never, &off));
             eprintln!(
                 "seed {seed}, {effects}: off the band: geometry {alone:.4} mm, with effects {corrected:.4} mm \
@@ -511,6 +512,72 @@ fn rows_that_excite_what_no_training_row_did_have_a_large_sigma_and_fall_back_to
             let fallen = model.sigma_fallback(&off.rows, &pipeline::tool_indices(&model, &off).unwrap()).unwrap();
             let fallen = fallen.expect("rows off the band fall back");
             assert!(fallen.rows > off.rows.len() / 4, "seed {seed}, {effects}: {fallen:?}");
+        }
+    }
+}
+
+/// The columns the effects' σ is carried through (`EffectUncertainty::parameter_changes`) against
+/// finite differences of the model's own prediction: each free kinematic parameter (a left
+/// perturbation of its local transform) and each effect parameter moves the tool point and the
+/// orientation as the column says.
+#[test]
+fn the_sigmas_columns_are_the_derivatives_of_the_prediction() {
+    let robot = testkit::robot("irb4400.ron");
+    let effects = Effects {
+        periodic: Some(joint_2_gear_error()),
+        tracker_noise: Some(TrackerNoise::default()),
+        ..Effects::default()
+    };
+    let (train, test) = split(&robot, &effects, 5);
+    let options = FitOptions::default().with_effects("joint_compliance,gear_periodic:2:4".parse().unwrap());
+    let (model, _) = pipeline::fit(&robot, &train, Method::Poe, &options).unwrap();
+    let uncertainty = model.effect_uncertainty.clone().expect("a fit with effects keeps its uncertainty");
+    // The plain sum of the parts: no fallback, so the prediction is the geometry and the effects.
+    let plain = pipeline::CalibratedModel { effect_uncertainty: None, fallback_kinematics: None, ..model.clone() };
+    let rows = &test.rows[..3];
+    let tools = vec![0; rows.len()];
+    let poses = |m: &pipeline::CalibratedModel| m.geometric_poses(rows, &tools).unwrap();
+    let base = poses(&plain);
+    let layout = plain.kinematics.layout().len();
+    let h = 1e-7;
+    let mut perturbed = Vec::new();
+    for &c in &uncertainty.free {
+        let mut m = plain.clone();
+        let mut delta = vec![0.0; layout];
+        delta[c] = h;
+        m.kinematics.apply_update(&delta);
+        perturbed.push(poses(&m));
+    }
+    let mut offset = 0;
+    for k in 0..plain.effects.len() {
+        for l in 0..plain.effects[k].parameter_count() {
+            let mut m = plain.clone();
+            let mut theta = m.effects[k].theta().to_vec();
+            theta[l] += h;
+            m.effects[k].set_theta(&theta);
+            perturbed.push(poses(&m));
+        }
+        offset += plain.effects[k].parameter_count();
+    }
+    assert_eq!(perturbed.len(), uncertainty.free.len() + offset);
+    for (i, row) in rows.iter().enumerate() {
+        let changes = uncertainty.parameter_changes(&model.kinematics, &model.effects, row, 0).unwrap();
+        assert_eq!(changes.len(), perturbed.len());
+        for (j, (change, moved)) in changes.iter().zip(&perturbed).enumerate() {
+            let dp = (moved[i].translation() - base[i].translation()) / h;
+            let dr = (moved[i].rotation() * base[i].rotation().inverse()).log() / h;
+            let fd = [dp.x, dp.y, dp.z, dr[0], dr[1], dr[2]];
+            let norm = change.iter().map(|v| v * v).sum::<f64>().sqrt().max(1e-3);
+            for k in 0..6 {
+                // The columns leave out how the effects' own twist turns the kinematic columns
+                // (first order in the effects' size, 1e-4 here): 1e-3 of the column.
+                assert!(
+                    (fd[k] - change[k]).abs() <= 1e-3 * norm,
+                    "row {i}, parameter {j}, component {k}: analytic {} against {}",
+                    change[k],
+                    fd[k]
+                );
+            }
         }
     }
 }

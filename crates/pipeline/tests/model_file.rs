@@ -297,3 +297,35 @@ fn the_robot_a_model_keeps_is_checked_as_a_robot_file_and_against_the_kinematics
     let field_line = 1 + text[..text.find("robot_description:").unwrap()].matches('\n').count();
     assert_eq!(line, field_line, "{message}");
 }
+
+/// The effects' uncertainty (issue 23) is checked on reading: a factor of the wrong size, a number
+/// that is not one, a free parameter the kinematics lacks and a fallback limit that is not above
+/// zero are refused at the field, with its line and column.
+#[test]
+fn an_effect_uncertainty_that_does_not_fit_the_model_is_refused_at_its_field() {
+    let (model, text) = fitted(false);
+    let uncertainty = model.effect_uncertainty.clone().expect("a fit with effects keeps its uncertainty");
+    let at_field = |message: &str, field: &str| {
+        let line = text.lines().position(|l| l.contains("effect_uncertainty:")).unwrap() + 1;
+        assert!(message.starts_with(&format!("m.ron:{line}:")), "{message}");
+        assert!(message.contains(field), "{message}");
+    };
+    let mut short = model.clone();
+    short.effect_uncertainty.as_mut().unwrap().factor.pop();
+    let (_, message) = refused(&text_of(&short));
+    at_field(&message, "effect_uncertainty.factor:");
+    let mut free = model.clone();
+    free.effect_uncertainty.as_mut().unwrap().free[0] = 999;
+    let (_, message) = refused(&text_of(&free));
+    at_field(&message, "999 is not a parameter of the kinematics");
+    let mut limit = model.clone();
+    limit.effect_uncertainty.as_mut().unwrap().fallback_sigma_m = 0.0;
+    let (_, message) = refused(&text_of(&limit));
+    at_field(&message, "fallback_sigma_m");
+    let first = format!("{:.6e}", uncertainty.factor[0]);
+    let (_, message) = refused(&text.replacen(&first, "x1", 1));
+    assert!(message.contains("'x1', is not a number"), "{message}");
+    // The packed numbers read back exactly as the fit used them.
+    let again = pipeline::parse_model(&text, "m.ron").unwrap();
+    assert_eq!(again.effect_uncertainty, Some(uncertainty));
+}
