@@ -19,6 +19,7 @@
 //!     kinematics: fit.model,
 //!     effects: Vec::new(),
 //!     fallback_kinematics: None,
+//!     effect_uncertainty: None,
 //!     residual_gp: None,
 //!     training_range: None,
 //!     joint_limits: Vec::new(),
