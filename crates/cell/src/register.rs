@@ -8,10 +8,10 @@
 //! are carried by [`model::ResidualGp::moved_by`]. A tool becomes `T_{n,n+1} · D_t` of the
 //! model tool it was measured against (a new tool: the model's first tool).
 
-use crate::Error;
 use crate::register_options::{Refit, RegisterOptions};
 use crate::registration::{Registration, RegistrationRow, Unknowns, register_rows};
 use crate::report::{Fitted, Heldout, HeldoutFrom, RegisterReport, RegisterWarning, RegisteredTool, Verdict};
+use errors::{Error, ErrorKind};
 use lie::{SE3, Vector3};
 use measurements::MeasurementSet;
 use model::CalibratedModel;
@@ -47,7 +47,12 @@ pub fn register(
         let found = model.tools.iter().position(|t| t == name);
         if found.is_none() && !refit.tools {
             let line = data.rows.iter().find(|r| r.tool == index).map_or(0, |r| r.line);
-            return Err(Error::NewToolWithoutRefit { file: data.source.clone(), line, column, tool: name.clone() });
+            return Err(Error::at_line(
+                data.source.clone(),
+                line,
+                column,
+                ErrorKind::NewToolWithoutRefit { tool: name.clone() },
+            ));
         }
         known.push(found);
     }
@@ -132,13 +137,13 @@ fn check_counts(
     // A frame needs three points off one line whatever the redundancy.
     let needed = needed_rows.div_ceil(per_pose).max(if unknowns.frame { 3 } else { 1 });
     if poses < needed {
-        return Err(Error::TooFewPoses {
+        return Err(Error::new(ErrorKind::TooFewPoses {
             what: "the registration".into(),
             poses,
             needed_poses: needed,
             rows: poses * per_pose,
             parameters,
-        });
+        }));
     }
     for (tool, slot) in slots.iter().enumerate() {
         if slot.is_none() {
@@ -146,13 +151,13 @@ fn check_counts(
         }
         let mine = data.rows.iter().filter(|r| r.tool == tool).count();
         if mine < options.min_poses_per_tool {
-            return Err(Error::TooFewPoses {
+            return Err(Error::new(ErrorKind::TooFewPoses {
                 what: format!("tool '{}'", data.tools[tool]),
                 poses: mine,
                 needed_poses: options.min_poses_per_tool,
                 rows: mine * per_pose,
                 parameters: unknowns.per_tool(),
-            });
+            }));
         }
     }
     Ok(())
@@ -395,6 +400,9 @@ mod tests {
         let refit = Refit { base: true, tools: true };
         let err = register(&model, &few.subset(&[0, 1, 2, 3, 4, 5, 6, 7]), refit, None, &RegisterOptions::default())
             .unwrap_err();
-        assert!(matches!(err, Error::TooFewPoses { poses: 8, needed_poses: 9, rows: 24, parameters: 9, .. }), "{err}");
+        assert!(
+            matches!(err.kind(), ErrorKind::TooFewPoses { poses: 8, needed_poses: 9, rows: 24, parameters: 9, .. }),
+            "{err}"
+        );
     }
 }

@@ -40,11 +40,13 @@ pub fn diagnose(
         let written = report
             .as_deref()
             .map(|folder| {
-                report::write_diagnosis_report(&diagnosis, folder, "report", &inputs).map_err(|e| match e {
-                    report::Error::Pipeline(e) => e,
-                    other => {
-                        pipeline::Error::io(folder.display().to_string(), std::io::Error::other(other.to_string()))
+                report::write_diagnosis_report(&diagnosis, folder, "report", &inputs).map_err(|e| match e.kind() {
+                    // A chart or the embedded JSON: named by the folder they were for, as before the
+                    // report's errors were `pipeline::Error`s.
+                    pipeline::ErrorKind::Plot { .. } | pipeline::ErrorKind::EvaluationJson { .. } => {
+                        pipeline::Error::io(folder.display().to_string(), std::io::Error::other(e.to_string()))
                     }
+                    _ => e,
                 })
             })
             .transpose()?;

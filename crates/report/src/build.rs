@@ -69,7 +69,7 @@ impl Report {
         inputs: &ReportInputs<'_>,
         diagnosis: Option<Diagnosis>,
         options: &ReportOptions,
-    ) -> Result<Self, crate::Error> {
+    ) -> Result<Self, errors::Error> {
         let ReportInputs { model, data, .. } = *inputs;
         let evaluation = pipeline::evaluate(model, data)?;
         let eval = EvalReport::new(model, data, &evaluation);
@@ -127,7 +127,7 @@ impl Report {
 fn before_calibration(
     inputs: &ReportInputs<'_>,
     options: &ReportOptions,
-) -> Result<Option<(String, Evaluation)>, crate::Error> {
+) -> Result<Option<(String, Evaluation)>, errors::Error> {
     let model = inputs.model;
     if let Some(train) = inputs.training {
         let (placed, _) = pipeline::fit(inputs.robot, train, pipeline::Method::BaseTool, &options.base_tool)?;

@@ -1,8 +1,8 @@
 //! The diagnosis's figures, drawn by the same writer as the calibration report, so the diagnosis
 //! folder (`folder.rs`) and the report cannot drift apart.
 
-use crate::Error;
 use crate::figures::{self, Series};
+use errors::Error;
 use pipeline::diagnose::{Diagnosis, PoseDiagnosis};
 
 /// The diagnosis's plots as `(file name, SVG text)`: the held-out error against each moving joint

@@ -2,7 +2,8 @@
 //! page, written through the same writer as the calibration report.
 
 use crate::diagnosis::diagnosis_figures;
-use crate::{Error, html};
+use crate::html;
+use errors::Error;
 use pipeline::InputFiles;
 use pipeline::diagnose::Diagnosis;
 use std::path::{Path, PathBuf};
@@ -26,7 +27,7 @@ pub fn write_diagnosis_report(
         inputs.check_output(option, &path)?;
     }
     let html = html::diagnosis_page(diagnosis, &plots);
-    std::fs::create_dir_all(folder).map_err(|source| Error::Io { path: folder.display().to_string(), source })?;
+    std::fs::create_dir_all(folder).map_err(|source| Error::io(folder.display().to_string(), source))?;
     for (name, svg) in &plots {
         pipeline::write_file(&folder.join(name), svg.as_bytes())?;
     }

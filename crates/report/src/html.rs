@@ -2,9 +2,9 @@
 //! printable). Every number a test compares carries its full value in a `data-value` attribute
 //! next to the rounded text, under a `data-key` naming it.
 
-use crate::Error;
 use crate::content::{ErrorStats, GroupedErrors, Report};
 use crate::figures;
+use errors::{Error, ErrorKind};
 use pipeline::diagnose::Diagnosis;
 use std::fmt::Write;
 
@@ -82,7 +82,8 @@ pub fn render_html(report: &Report) -> Result<String, Error> {
         diagnosis_section(&mut out, d, &plots);
     }
     // `calib eval --json` as it prints it: data for a reader or a test, not a script to run.
-    let eval = serde_json::to_string(&report.eval).map_err(|e| Error::Json { message: e.to_string() })?;
+    let eval =
+        serde_json::to_string(&report.eval).map_err(|source| Error::new(ErrorKind::EvaluationJson { source }))?;
     let _ = writeln!(
         out,
         "<script type=\"application/json\" id=\"eval-json\">{}</script>\n</body></html>",

@@ -6,7 +6,8 @@
 //!
 //! The after-calibration numbers are `calib eval --json`'s own: [`pipeline::evaluate`] and
 //! [`pipeline::EvalReport`], embedded in the page as they serialise. Charts are drawn with
-//! `plotters`' SVG backend.
+//! `plotters`' SVG backend. Errors are `errors::Error`, as in every calibration crate: a chart that
+//! cannot be drawn is `errors::ErrorKind::Plot`.
 //!
 //! ```
 //! use pipeline::simulated::{Perturbation, paper_effects, simulated_cell, simulate, joint_ranges};
@@ -41,7 +42,6 @@
 mod build;
 mod content;
 mod diagnosis;
-mod error;
 mod figures;
 mod folder;
 mod html;
@@ -53,7 +53,6 @@ pub use content::{
     KernelScales, ModelSummary, Report, RobotSummary, RowError,
 };
 pub use diagnosis::diagnosis_figures;
-pub use error::Error;
 pub use folder::write_diagnosis_report;
 pub use html::{SECTIONS, render_html};
 pub use iso9283::{Iso9283, RepeatOptions};
