@@ -2,8 +2,8 @@
 //! folder (`folder.rs`) and the report cannot drift apart.
 
 use crate::figures::{self, Series};
+use diagnose::{Diagnosis, PoseDiagnosis};
 use errors::Error;
-use pipeline::diagnose::{Diagnosis, PoseDiagnosis};
 
 /// The diagnosis's plots as `(file name, SVG text)`: the held-out error against each moving joint
 /// (`joint<k>.svg`), the payload (`payload.svg`), the temperature (`temperature.svg`) and the time

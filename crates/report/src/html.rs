@@ -4,8 +4,8 @@
 
 use crate::content::{ErrorStats, GroupedErrors, Report};
 use crate::figures;
+use diagnose::Diagnosis;
 use errors::{Error, ErrorKind};
-use pipeline::diagnose::Diagnosis;
 use std::fmt::Write;
 
 /// The sections of a calibration report, in order: `(id, heading)`. The diagnosis section is
@@ -342,11 +342,11 @@ fn errors(out: &mut String, r: &Report) -> Result<(), Error> {
         out.push_str("<h3>Inside and outside the model's coverage</h3><p class=\"how\">Inside: every effect's joint within the angles it was fitted on; outside, the effects fade out and the model falls back to the geometry.</p><table>");
         out.push_str(STATS_HEAD);
         for (key, label, part) in [("inside", "inside", &split.inside), ("outside", "outside", &split.outside)] {
-            let rows: Vec<pipeline::PoseError> = r
+            let rows: Vec<model::PoseError> = r
                 .rows
                 .iter()
                 .filter(|row| row.inside_coverage == (key == "inside"))
-                .map(|row| pipeline::PoseError { position_mm: row.after_mm, rotation_mrad: row.after_mrad })
+                .map(|row| model::PoseError { position_mm: row.after_mm, rotation_mrad: row.after_mrad })
                 .collect();
             let stats = ErrorStats { summary: *part, ..crate::build::stats(&rows) };
             stats_row(out, &format!("coverage.{key}"), label, &stats);
