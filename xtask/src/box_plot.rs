@@ -4,7 +4,7 @@
 //! Drawn on the frame `diagnose::chart` shares with the diagnosis's plots (hand-written SVG; see
 //! there for why not `plotters`).
 
-use diagnose::{chart::Canvas, chart::escape, chart::linear_ticks};
+use diagnose::chart::{Canvas, escape, linear_ticks};
 use std::fmt::Write;
 
 /// One box: its label under the axis and the values it summarises.

@@ -43,7 +43,7 @@ pub struct PlanOptions {
     pub exchange_tolerance: f64,
     /// Bins over each moving joint's range (and the payloads) that the poses must cover where
     /// candidates are: 8, so that no gap wider than 1/8 of a range is left for the angle-dependent
-    /// effects, which `pipeline` fades outside the angles they were fitted on. Fewer when fewer
+    /// effects, which a calibrated model fades outside the angles they were fitted on. Fewer when fewer
     /// poses are asked for.
     pub coverage_bins: usize,
     /// A joint whose candidates span less than this (rad or m) does not move and needs no

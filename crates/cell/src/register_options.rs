@@ -49,7 +49,7 @@ pub struct RegisterOptions {
     /// a change beyond half the model's error is one a re-calibration removes.
     pub changed_ratio: f64,
     /// A re-fitted tool point this far (mm) from the one a position-only model was fitted with
-    /// is warned about ([`RegisterWarning::PositionModelToolPoint`]): 1 mm, where the orientation
+    /// is warned about ([`crate::RegisterWarning::PositionModelToolPoint`]): 1 mm, where the orientation
     /// a position-only fit leaves free (tens of mrad on the simulated IRB 4400) starts to cost
     /// more than a tracker's noise.
     pub moved_point_mm: f64,
