@@ -7,7 +7,7 @@ use std::fmt::Write;
 use std::time::{Duration, Instant};
 
 use gp::ExactGp;
-use pipeline::ResidualGpOptions;
+use model::ResidualGpOptions;
 
 use crate::bench_gp_kernels::{KernelArgs, data_sets};
 use crate::bench_gp_residuals::heldout_mm;

@@ -9,7 +9,8 @@ use std::time::Instant;
 
 use gp::{ExactGp, Kernel, KernelChoice, OutputMode, StationaryShape};
 use indicatif::{ProgressBar, ProgressStyle};
-use pipeline::{ResidualGpOptions, RobotDescription};
+use model::ResidualGpOptions;
+use robot::RobotDescription;
 
 use crate::bench_gp_residuals::{Residuals, heldout_mm, real, simulated, simulated_payload_runs};
 

@@ -23,9 +23,10 @@ use std::time::{Duration, Instant};
 
 use faer::Mat;
 use gp::{ExactGp, Kernel};
-use pipeline::{ResidualGpOptions, RobotDescription};
+use model::ResidualGpOptions;
+use robot::RobotDescription;
 
-use pipeline::simulated::paper_effects;
+use campaign::paper_effects;
 
 use crate::bench_gp_residuals::{Residuals, heldout_mm, real, simulated_campaign};
 use crate::bench_gp_sklearn::{SklearnOptions, available, fit_predict};

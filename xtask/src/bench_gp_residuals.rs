@@ -5,11 +5,12 @@
 use anyhow::Context;
 use std::path::Path;
 
+use campaign::{GeneratorConfig, Perturbation, Remount, paper_effects, payload_run_campaign, simulate_campaign};
 use faer::Mat;
-use pipeline::simulated::{
-    GeneratorConfig, Perturbation, Remount, paper_effects, payload_run_campaign, simulate_campaign,
-};
-use pipeline::{FitOptions, MeasurementSet, Method, ReadOptions, ResidualFrame, ResidualSet, RobotDescription};
+use measurements::{MeasurementSet, ReadOptions};
+use model::{Method, ResidualFrame, ResidualSet};
+use pipeline::FitOptions;
+use robot::RobotDescription;
 
 /// Training and test residuals of one data set.
 pub struct Residuals {
@@ -38,7 +39,7 @@ pub fn residuals(
 ) -> anyhow::Result<Residuals> {
     let (model, _) = pipeline::fit(robot, train, Method::Poe, &FitOptions::default())?;
     let set = |data: &MeasurementSet| -> anyhow::Result<ResidualSet> {
-        let tools = pipeline::tool_indices(&model, data)?;
+        let tools = model::tool_indices(&model, data)?;
         let poses = model.geometric_poses(&data.rows, &tools)?;
         Ok(ResidualSet::new(&poses, data, with_payload, ResidualFrame::ToolPoint))
     };
@@ -48,7 +49,7 @@ pub fn residuals(
 /// A real data set from a SPEC CSV, split into even (train) and odd (test) rows, or from two files.
 pub fn real(name: &str, robot: &RobotDescription, train: &Path, test: Option<&Path>) -> anyhow::Result<Residuals> {
     let options = ReadOptions::for_joints(robot.joint_kinds());
-    let read = |p: &Path| pipeline::read_measurements(p, &options).map_err(anyhow::Error::from);
+    let read = |p: &Path| measurements::read_measurements(p, &options).map_err(anyhow::Error::from);
     let (train_set, test_set) = match test {
         Some(t) => (read(train)?, read(t)?),
         None => even_odd(&read(train)?),

@@ -16,8 +16,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+use diagnose::chart::{Canvas, escape};
 use indicatif::{ProgressBar, ProgressStyle};
-use pipeline::chart::{Canvas, escape};
 
 use crate::bench_gp_residuals::{heldout_mm, residuals};
 use crate::bench_gp_sklearn::{SklearnOptions, available, fit_predict};
@@ -113,7 +113,7 @@ fn heldout_of(calib: &Path, model: &Path, test: &Path) -> anyhow::Result<f64> {
         .arg(test)
         .stderr(Stdio::null())
         .output()?;
-    let report: pipeline::EvalReport = serde_json::from_slice(&out.stdout).context("calib eval --json")?;
+    let report: model::EvalReport = serde_json::from_slice(&out.stdout).context("calib eval --json")?;
     Ok(report.errors.mean_position_error_mm)
 }
 
@@ -189,9 +189,9 @@ pub fn run(args: &SweepArgs, svg_path: Option<&Path>) -> anyhow::Result<String> 
     let csv = std::fs::read_to_string(&campaign).with_context(|| campaign.display().to_string())?;
     let test = work.join("test.csv");
     tail_rows(&csv, test_rows, &test)?;
-    let description = pipeline::RobotDescription::read(&robot)?;
-    let read_options = pipeline::ReadOptions::for_joints(description.joint_kinds());
-    let test_set = pipeline::read_measurements(&test, &read_options)?;
+    let description = robot::RobotDescription::read(&robot)?;
+    let read_options = measurements::ReadOptions::for_joints(description.joint_kinds());
+    let test_set = measurements::read_measurements(&test, &read_options)?;
     let with_sklearn = available();
 
     let bar = ProgressBar::new((args.sizes.len() * 3) as u64);
@@ -237,7 +237,7 @@ pub fn run(args: &SweepArgs, svg_path: Option<&Path>) -> anyhow::Result<String> 
             // A smaller size was already stopped: this one would be too.
             Cell::Skipped(format!("skipped: predicted {:.0} s", guess.unwrap_or(f64::INFINITY)))
         } else {
-            let train_set = pipeline::read_measurements(&train, &read_options)?;
+            let train_set = measurements::read_measurements(&train, &read_options)?;
             let r = residuals(format!("n = {n}"), &description, &train_set, &test_set, true)?;
             let options = SklearnOptions {
                 linear: false,

@@ -7,12 +7,12 @@
 //! same closed-form registration.
 
 use anyhow::Context;
+use campaign::{Perturbation, simulated_cell};
 use lie::{Matrix4, SE3, Vector3};
-use pipeline::RobotDescription;
-use pipeline::simulated::{Perturbation, simulated_cell};
 use poe::identify::{IdentificationOptions, Observation, ParameterMask, Target, identify, register};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use robot::RobotDescription;
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::process::Command;
@@ -86,7 +86,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let configurations = loadsim::sample_configurations(
             &cell.robot,
             0,
-            &pipeline::simulated::joint_ranges(&robot),
+            &campaign::joint_ranges(&robot),
             &loadsim::GeneratorConfig { sample_count: rows, seed: rows as u64, ..Default::default() },
         )?;
         let observations: Vec<Observation> = configurations

@@ -6,10 +6,10 @@
 
 use crate::blind_check_cases::{Case, Class, Robots, run_case};
 use anyhow::{Context, Result, bail};
+use diagnose::Effect;
 use indicatif::{ProgressBar, ProgressStyle};
-use pipeline::RobotDescription;
-use pipeline::diagnose::Effect;
 use rayon::prelude::*;
+use robot::RobotDescription;
 use std::fmt::Write;
 use std::path::PathBuf;
 

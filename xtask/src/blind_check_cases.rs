@@ -25,16 +25,19 @@
 
 use crate::simulation::{mean_distance_mm, perturbed_robot, ranges, simulate, tracker_placement};
 use anyhow::{Context, Result, bail};
+use campaign::{Perturbation, Remount, campaign_cell, payload_run_campaign};
+use diagnose::{DiagnoseOptions, Effect, StructureOptions, diagnose};
 use loadsim::{
     Backlash, BaseDrift, BentLink, CouplingFactor, CouplingTerm, Effects, GeneratorConfig, Harmonic, JointBacklash,
     JointCompliance, JointCoupling, LinkDeflection, PeriodicError, RobotDynamics, SimulatedCell, ThermalGrowth,
     TrackerNoise,
 };
-use pipeline::diagnose::{DiagnoseOptions, Effect, StructureOptions, diagnose};
-use pipeline::simulated::{Perturbation, Remount, campaign_cell, payload_run_campaign};
-use pipeline::{FitOptions, MeasurementSet, Method, RobotDescription};
+use measurements::MeasurementSet;
+use model::Method;
+use pipeline::FitOptions;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use robot::RobotDescription;
 
 /// The kind of hidden truth.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -377,7 +380,7 @@ pub fn run_case(robots: &Robots, index: usize, seed: u64, rows: usize, dump: Opt
         let dynamics = match class {
             // The truth's masses: the stand-in's bars, each 0.5–1.5 times as heavy.
             Class::Deflection => {
-                let mut truth = pipeline::effects::stand_in_dynamics(robot);
+                let mut truth = effects::stand_in_dynamics(robot);
                 truth.links.iter_mut().for_each(|l| l.mass_kg *= rng.random_range(0.5..1.5));
                 Some(truth)
             }

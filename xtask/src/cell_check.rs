@@ -14,14 +14,17 @@
 //!   `--effects`, 300 planned against 300 random even rows for `poe-gp --effects auto`.
 
 use anyhow::{Context, Result};
+use campaign::{Effects, GeneratorConfig, Perturbation};
 use cell::{Refit, RegisterOptions};
+use effects::EffectSelection;
 use lie::{SE3, SO3, Vector3};
-use pipeline::effects::EffectSelection;
-use pipeline::simulated::{self, Effects, GeneratorConfig, Perturbation};
-use pipeline::{CalibratedModel, FitOptions, MeasurementSet, Method, ReadOptions, RobotDescription};
+use measurements::{MeasurementSet, ReadOptions};
+use model::{CalibratedModel, Method};
+use pipeline::FitOptions;
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 use rand_chacha::ChaCha8Rng;
+use robot::RobotDescription;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -75,11 +78,11 @@ fn draw(n: usize, count: usize, seed: u64) -> Vec<usize> {
 
 fn read(robot: &RobotDescription, path: &Path) -> Result<MeasurementSet> {
     let kinds = robot.nominal_model()?.joints().iter().map(|j| j.kind).collect();
-    pipeline::read_measurements(path, &ReadOptions::for_joints(kinds)).with_context(|| path.display().to_string())
+    measurements::read_measurements(path, &ReadOptions::for_joints(kinds)).with_context(|| path.display().to_string())
 }
 
 fn mean_error(model: &CalibratedModel, data: &MeasurementSet) -> Result<f64> {
-    Ok(pipeline::evaluate(model, data)?.summary.mean_position_error_mm)
+    Ok(model::evaluate(model, data)?.summary.mean_position_error_mm)
 }
 
 fn fit_and_test(
@@ -125,7 +128,7 @@ fn scipy_reference(
     picked: &[usize],
     rotation_weight: f64,
 ) -> Result<Option<f64>> {
-    let tools = pipeline::tool_indices(model, data)?;
+    let tools = model::tool_indices(model, data)?;
     let predicted = model.predict(&data.rows, &tools)?;
     let dir = std::env::temp_dir().join(format!("cell-check-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
@@ -207,8 +210,8 @@ fn register_ur10(args: &Args, md: &mut String) -> Result<()> {
 
 fn register_simulated(args: &Args, md: &mut String) -> Result<()> {
     let robot = RobotDescription::read(&args.irb4400)?;
-    let ranges = simulated::joint_ranges(&robot);
-    let effects = simulated::paper_effects();
+    let ranges = campaign::joint_ranges(&robot);
+    let effects = campaign::paper_effects();
     let _ = writeln!(
         md,
         "\n## Simulated truth: the tracker moved and a new tool, 20 poses registered\n\nIRB 4400 of the paper's \
@@ -225,9 +228,9 @@ fn register_simulated(args: &Args, md: &mut String) -> Result<()> {
     );
     let _ = writeln!(md, "| ---: | --- | --- | ---: | ---: | ---: | ---: | --- | --- |");
     for seed in 1..=args.seeds {
-        let original = simulated::simulated_cell(&robot, &Perturbation::default(), seed)?;
+        let original = campaign::simulated_cell(&robot, &Perturbation::default(), seed)?;
         let mut same_tool = original.clone();
-        same_tool.tracker_from_base = simulated::tracker_placement(&mut ChaCha8Rng::seed_from_u64(seed + 100));
+        same_tool.tracker_from_base = campaign::tracker_placement(&mut ChaCha8Rng::seed_from_u64(seed + 100));
         let mut new_tool = same_tool.clone();
         let tool = original.robot.tools()[original.tool]
             * SE3::new(SO3::exp(&Vector3::new(0.0, 0.3, 0.1)), Vector3::new(0.06, -0.05, 0.06));
@@ -239,8 +242,8 @@ fn register_simulated(args: &Args, md: &mut String) -> Result<()> {
             ..GeneratorConfig::default()
         };
         for (full_pose, new) in [(true, true), (true, false), (false, false), (false, true)] {
-            let train = simulated::simulate(&original, &effects, &ranges, &config(300, 0), full_pose)?;
-            let test = simulated::simulate(&original, &effects, &ranges, &config(1000, 1), full_pose)?;
+            let train = campaign::simulate(&original, &effects, &ranges, &config(300, 0), full_pose)?;
+            let test = campaign::simulate(&original, &effects, &ranges, &config(1000, 1), full_pose)?;
             let (model, _) = pipeline::fit(&robot, &train, Method::PoeGpLoad, &FitOptions::default())?;
             let before = mean_error(&model, &test)?;
             let moved = if new { &new_tool } else { &same_tool };
@@ -250,8 +253,8 @@ fn register_simulated(args: &Args, md: &mut String) -> Result<()> {
                 }
                 set
             };
-            let few = renamed(simulated::simulate(moved, &effects, &ranges, &config(20, 2), full_pose)?);
-            let moved_test = renamed(simulated::simulate(moved, &effects, &ranges, &config(1000, 3), full_pose)?);
+            let few = renamed(campaign::simulate(moved, &effects, &ranges, &config(20, 2), full_pose)?);
+            let moved_test = renamed(campaign::simulate(moved, &effects, &ranges, &config(1000, 3), full_pose)?);
             let refit = Refit { base: true, tools: new };
             let registered = cell::register(&model, &few, refit, Some(before), &RegisterOptions::default())?;
             let after = mean_error(&registered.model, &moved_test)?;
@@ -328,17 +331,17 @@ fn plan_ur10(args: &Args, md: &mut String) -> Result<()> {
 
 fn plan_irb4400(args: &Args, md: &mut String) -> Result<()> {
     let robot = RobotDescription::read(&args.irb4400)?;
-    let ranges = simulated::joint_ranges(&robot);
+    let ranges = campaign::joint_ranges(&robot);
     let effects = Effects { tracker_noise: Some(Default::default()), ..Effects::default() };
-    let cell = simulated::simulated_cell(&robot, &Perturbation::default(), 7)?;
+    let cell = campaign::simulated_cell(&robot, &Perturbation::default(), 7)?;
     let config = |rows: usize, seed: u64| GeneratorConfig {
         sample_count: rows,
         seed,
         payloads_kg: vec![0.0],
         ..GeneratorConfig::default()
     };
-    let candidates = simulated::simulate(&cell, &effects, &ranges, &config(5000, 70), false)?;
-    let test = simulated::simulate(&cell, &effects, &ranges, &config(5000, 71), false)?;
+    let candidates = campaign::simulate(&cell, &effects, &ranges, &config(5000, 70), false)?;
+    let test = campaign::simulate(&cell, &effects, &ranges, &config(5000, 71), false)?;
     let options = FitOptions::default();
     let random = |n: usize| -> Result<Vec<f64>> {
         (1..=args.seeds)

@@ -10,11 +10,14 @@
 //! `compensate.md` into `--out`.
 
 use anyhow::Context;
+use campaign::{Effects, GeneratorConfig, Perturbation, SimulatedCell, TrackerNoise};
+use cell::{CompensateOptions, InverseOptions, PoseTarget};
 use indicatif::{ProgressBar, ProgressStyle};
 use lie::{Matrix4, SE3};
 use loadsim::{Payload, PoseContext};
-use pipeline::simulated::{self, Effects, GeneratorConfig, Perturbation, SimulatedCell, TrackerNoise};
-use pipeline::{CalibratedModel, CompensateOptions, FitOptions, InverseOptions, Method, PoseTarget, RobotDescription};
+use model::{CalibratedModel, Method};
+use pipeline::FitOptions;
+use robot::RobotDescription;
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::process::Command;
@@ -72,7 +75,7 @@ struct Outcome {
 
 fn cases() -> Vec<Case> {
     let noise = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
-    let paper = simulated::paper_effects();
+    let paper = campaign::paper_effects();
     let payloads = GeneratorConfig::default().payloads_kg;
     vec![
         Case {
@@ -116,7 +119,7 @@ fn program(
 ) -> anyhow::Result<Vec<(Vec<f64>, f64)>> {
     let config =
         GeneratorConfig { sample_count: count, seed, payloads_kg: payloads.to_vec(), ..GeneratorConfig::default() };
-    let set = simulated::simulate(cell, &Effects::default(), &simulated::joint_ranges(robot), &config, false)?;
+    let set = campaign::simulate(cell, &Effects::default(), &campaign::joint_ranges(robot), &config, false)?;
     Ok(set.rows.into_iter().map(|r| (r.q, r.payload_kg)).collect())
 }
 
@@ -126,7 +129,7 @@ fn targets(
     robot: &RobotDescription,
     rows: &[(Vec<f64>, f64)],
 ) -> anyhow::Result<Vec<PoseTarget>> {
-    let registered = pipeline::registered_nominal(model, robot, "robot", &CompensateOptions::default())?;
+    let registered = cell::registered_nominal(model, robot, "robot", &CompensateOptions::default())?;
     rows.iter()
         .map(|(q, payload_kg)| {
             Ok(PoseTarget {
@@ -146,7 +149,7 @@ fn run_case(
     cell: &SimulatedCell,
     args: &Args,
 ) -> anyhow::Result<(Outcome, CalibratedModel)> {
-    let ranges = simulated::joint_ranges(robot);
+    let ranges = campaign::joint_ranges(robot);
     let data = |count: usize, seed: u64| {
         let config = GeneratorConfig {
             sample_count: count,
@@ -154,14 +157,14 @@ fn run_case(
             payloads_kg: case.payloads_kg.clone(),
             ..GeneratorConfig::default()
         };
-        simulated::simulate(cell, &case.effects, &ranges, &config, true)
+        campaign::simulate(cell, &case.effects, &ranges, &config, true)
     };
     let (train, test) = (data(args.train, args.seed)?, data(args.test, args.seed + 1000)?);
     let (model, _) = pipeline::fit(robot, &train, case.method, &FitOptions::default())?;
-    let heldout = pipeline::evaluate(&model, &test)?.summary;
+    let heldout = model::evaluate(&model, &test)?.summary;
     let rows = program(cell, robot, args.program, args.seed + 2000, &case.payloads_kg)?;
     let targets = targets(&model, robot, &rows)?;
-    let solved = pipeline::solve_targets(&model, &targets, Some(&robot.limits()), &InverseOptions::default())?;
+    let solved = cell::solve_targets(&model, &targets, Some(&robot.limits()), &InverseOptions::default())?;
     let truth = Effects { tracker_noise: None, ..case.effects.clone() };
     let (mut before, mut after, mut wanted) = (Vec::new(), Vec::new(), Vec::new());
     for ((target, solved), (q, payload_kg)) in targets.iter().zip(&solved).zip(&rows) {
@@ -199,7 +202,7 @@ fn time_targets(
 ) -> anyhow::Result<(f64, usize)> {
     let begin = Instant::now();
     let targets = targets(model, robot, rows)?;
-    let solved = pipeline::solve_targets(model, &targets, Some(&robot.limits()), &InverseOptions::default())?;
+    let solved = cell::solve_targets(model, &targets, Some(&robot.limits()), &InverseOptions::default())?;
     Ok((begin.elapsed().as_secs_f64(), solved.iter().filter(|s| s.status.is_ok()).count()))
 }
 
@@ -249,7 +252,7 @@ struct ScipyResult {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let robot = RobotDescription::read(&args.robot)?;
-    let cell = simulated::simulated_cell(&robot, &Perturbation::default(), args.seed)?;
+    let cell = campaign::simulated_cell(&robot, &Perturbation::default(), args.seed)?;
     let cases = cases();
     let bar = ProgressBar::new(cases.len() as u64 + 2);
     bar.set_style(

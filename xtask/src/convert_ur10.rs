@@ -8,7 +8,7 @@
 
 use anyhow::Context;
 use lie::{SO3, Vector3};
-use pipeline::{Measurement, MeasurementSet};
+use measurements::{Measurement, MeasurementSet};
 use std::path::{Path, PathBuf};
 
 /// Where the IPA UR10 dataset is and which series to read.
@@ -165,7 +165,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use pipeline::{ColumnMap, ReadOptions, parse_measurements};
+    use measurements::{ColumnMap, ReadOptions, parse_measurements};
 
     /// The T-Mac angles of the first rows of series C, as the export writes them.
     const ANGLES: [&str; 3] =

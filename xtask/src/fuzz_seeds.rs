@@ -4,10 +4,13 @@
 //! model files written by `calib fit`'s writer for every kind of part, and effects files.
 
 use anyhow::{Context, Result};
-use pipeline::effects::{EffectKind, EffectSelection, EffectSpec};
-use pipeline::simulated::{self, Effects, GeneratorConfig, JointCoupling, Perturbation, Remount};
-use pipeline::{FitOptions, MeasurementSet, Method, RobotDescription};
+use campaign::{Effects, GeneratorConfig, JointCoupling, Perturbation, Remount};
+use effects::{EffectKind, EffectSelection, EffectSpec};
+use measurements::MeasurementSet;
+use model::Method;
+use pipeline::FitOptions;
 use poe::JointKind;
+use robot::RobotDescription;
 use std::path::{Path, PathBuf};
 
 /// Which reader a seed feeds.
@@ -85,9 +88,9 @@ fn csv_bytes(set: &MeasurementSet) -> Result<Vec<u8>> {
 
 /// A simulated set of `rows` rows of `robot` from `config`'s seed.
 fn simulated_set(robot: &RobotDescription, config: &GeneratorConfig, full_pose: bool) -> Result<MeasurementSet> {
-    let effects = simulated::paper_effects();
+    let effects = campaign::paper_effects();
     let (_, set) =
-        simulated::simulate_campaign(robot, &effects, &Perturbation::default(), &Remount::default(), config, full_pose)
+        campaign::simulate_campaign(robot, &effects, &Perturbation::default(), &Remount::default(), config, full_pose)
             .context("simulating a seed data set")?;
     Ok(set)
 }
@@ -136,7 +139,7 @@ fn csv_seeds() -> Result<Vec<Seed>> {
     let six = irb.joint_kinds();
     let position = simulated_set(&irb, &rows(8, 1), false)?;
     let full = simulated_set(&irb, &rows(8, 2), true)?;
-    let campaign = simulated_set(&iiwa, &simulated::payload_run_campaign(8, 3), true)?;
+    let campaign = simulated_set(&iiwa, &campaign::payload_run_campaign(8, 3), true)?;
     let with = |name: &str, bytes: Vec<u8>, joints: Option<Vec<JointKind>>, columns: Option<String>| Seed {
         name: name.to_owned(),
         extension: "csv",
@@ -186,9 +189,9 @@ fn robot_seeds() -> Result<Vec<Seed>> {
         .collect()
 }
 
-fn model_text(model: &pipeline::CalibratedModel, folder: &Path) -> Result<Vec<u8>> {
+fn model_text(model: &model::CalibratedModel, folder: &Path) -> Result<Vec<u8>> {
     let path = folder.join("seed-model.ron");
-    pipeline::write_model(&path, model).context("writing a seed model")?;
+    model::write_model(&path, model).context("writing a seed model")?;
     std::fs::read(&path).with_context(|| format!("reading {}", path.display()))
 }
 
@@ -219,15 +222,15 @@ fn model_seeds(folder: &Path) -> Result<Vec<Seed>> {
 fn effects_seeds() -> Result<Vec<Seed>> {
     let mut typical = Effects::typical(6);
     typical.coupling = Some(JointCoupling {
-        terms: vec![simulated::CouplingTerm {
+        terms: vec![campaign::CouplingTerm {
             joint_index: 2,
             amplitude_rad: 1e-3,
-            factors: vec![simulated::CouplingFactor { source_joint_index: 1, order: 2.0, phase_rad: 0.3 }],
+            factors: vec![campaign::CouplingFactor { source_joint_index: 1, order: 2.0, phase_rad: 0.3 }],
         }],
     });
     let pretty = ron::ser::PrettyConfig::default();
     let mut seeds = Vec::new();
-    for (name, effects) in [("every effect", typical.clone()), ("the paper's", simulated::paper_effects())] {
+    for (name, effects) in [("every effect", typical.clone()), ("the paper's", campaign::paper_effects())] {
         let text = ron::ser::to_string_pretty(&effects, pretty.clone()).context("writing a seed effects file")?;
         seeds.push(Seed::file(name, "ron", text.into_bytes()));
     }

@@ -10,9 +10,11 @@
 use crate::fuzz_inputs::{Case, generate, regressions};
 use crate::fuzz_seeds::{Reader, Seed, fixture_robot, seeds};
 use anyhow::{Context, Result};
-use pipeline::effects::EffectSelection;
-use pipeline::simulated::{self, GeneratorConfig, SimulatedCell};
-use pipeline::{ColumnMap, FitOptions, Measurement, ReadOptions, RobotDescription};
+use campaign::{GeneratorConfig, SimulatedCell};
+use effects::EffectSelection;
+use measurements::{ColumnMap, Measurement, ReadOptions};
+use pipeline::FitOptions;
+use robot::RobotDescription;
 use std::io::Write;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
@@ -123,7 +125,7 @@ impl Bench {
                     Err(e) => return Ok(refused(e.to_string())),
                 };
                 let options = ReadOptions { joints: seed.joints.clone(), columns };
-                match pipeline::read_measurements(&path, &options) {
+                match measurements::read_measurements(&path, &options) {
                     Err(e) => refused(e.to_string()),
                     Ok(set) => check_rows(&set.rows),
                 }
@@ -132,11 +134,11 @@ impl Bench {
                 Err(e) => refused(e.to_string()),
                 Ok(robot) => use_robot(&robot),
             },
-            Reader::Model => match pipeline::read_model(&path) {
+            Reader::Model => match model::read_model(&path) {
                 Err(e) => refused(e.to_string()),
                 Ok(model) => use_model(&model),
             },
-            Reader::Effects => match simulated::read_effects(&path, &self.robot) {
+            Reader::Effects => match campaign::read_effects(&path, &self.robot) {
                 Err(e) => refused(e.to_string()),
                 Ok(effects) => self.use_effects(&effects),
             },
@@ -155,9 +157,9 @@ impl Bench {
         })
     }
 
-    fn use_effects(&self, effects: &simulated::Effects) -> Outcome {
+    fn use_effects(&self, effects: &campaign::Effects) -> Outcome {
         let config = GeneratorConfig { sample_count: 3, ..GeneratorConfig::default() };
-        match pipeline::simulated::simulate(&self.cell, effects, &simulated::joint_ranges(&self.robot), &config, true) {
+        match campaign::simulate(&self.cell, effects, &campaign::joint_ranges(&self.robot), &config, true) {
             Err(e) => Outcome::Late(e.to_string()),
             Ok(set) => check_rows(&set.rows),
         }
@@ -183,7 +185,7 @@ fn use_robot(robot: &RobotDescription) -> Outcome {
         Ok(model) => model,
         Err(e) => return Outcome::Late(e.to_string()),
     };
-    let ranges = simulated::joint_ranges(robot);
+    let ranges = campaign::joint_ranges(robot);
     for k in 0..3 {
         let q: Vec<f64> =
             ranges.iter().map(|r| r.lower_rad + (r.upper_rad - r.lower_rad) * (k as f64 + 0.5) / 3.0).collect();
@@ -197,7 +199,7 @@ fn use_robot(robot: &RobotDescription) -> Outcome {
 }
 
 /// The model's predictions at a few configurations, every tool, with a payload.
-fn use_model(model: &pipeline::CalibratedModel) -> Outcome {
+fn use_model(model: &model::CalibratedModel) -> Outcome {
     let n = model.joint_count();
     let tools = model.kinematics.tool_count();
     let rows: Vec<Measurement> = (0..4)

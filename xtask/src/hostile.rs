@@ -347,7 +347,7 @@ fn position_only(b: &Bench) -> Result<Outcome> {
     std::fs::write(&positions, body)?;
     ensure!(b.fit(&positions, &model, &[])?.status.success(), "fit failed");
     let (json, stderr) = b.ok(&["eval", "--model", &model, "--data", &full, "--json"])?;
-    let report: pipeline::EvalReport = serde_json::from_str(&json)?;
+    let report: model::EvalReport = serde_json::from_str(&json)?;
     ensure!(report.errors.mean_rotation_error_mrad.is_none(), "a rotation error is reported: {json}");
     ensure!(stderr.contains("orientations in the data are not evaluated"), "{stderr}");
     Ok(Outcome::Passed("no rotation error; says orientations are not evaluated".into()))

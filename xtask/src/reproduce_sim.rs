@@ -13,16 +13,19 @@ use crate::reproduce_sim_params::{Params, Preset, Seeds, Setup, Sizes, Variant};
 use crate::reproduce_sim_report::{Magnitudes, Outcome, VariantResult, json, markdown};
 use crate::simulation::mean_distance_mm;
 use anyhow::Context;
+use campaign::{Perturbation, joint_ranges, simulate, simulated_cell};
+use effects::EffectSelection;
 use gp::{KernelChoice, OutputMode, Parallelism};
 use indicatif::{ProgressBar, ProgressStyle};
 use loadsim::{Effects, GeneratorConfig, JointCompliance, RobotDynamics, SimulatedCell};
-use pipeline::effects::EffectSelection;
-use pipeline::simulated::{Perturbation, joint_ranges, simulate, simulated_cell};
-use pipeline::{FitOptions, MeasurementSet, Method, ResidualFrame, ResidualGpOptions, RobotDescription};
+use measurements::MeasurementSet;
+use model::{Method, ResidualFrame, ResidualGpOptions};
+use pipeline::FitOptions;
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use robot::RobotDescription;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -173,7 +176,7 @@ fn fit_and_test(
     let errors = tests
         .iter()
         .map(|test| {
-            pipeline::evaluate(&model, test).map(|e| e.summary.mean_position_error_mm).map_err(anyhow::Error::from)
+            model::evaluate(&model, test).map(|e| e.summary.mean_position_error_mm).map_err(anyhow::Error::from)
         })
         .collect::<anyhow::Result<Vec<f64>>>()?;
     let loo = report.residual_gp.as_ref().and_then(|c| c.leave_one_out.as_ref()).map(|l| l.mean_position_error_mm);

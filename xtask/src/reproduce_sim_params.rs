@@ -2,9 +2,11 @@
 //! each with its source and of what differs from the paper.
 
 use anyhow::Context;
+use campaign::{Perturbation, paper_effects};
 use loadsim::{Effects, GeneratorConfig, JointCompliance, RobotDynamics, SimulatedCell};
-use pipeline::simulated::{Perturbation, paper_effects};
-use pipeline::{FitOptions, Method, RobotDescription};
+use model::Method;
+use pipeline::FitOptions;
+use robot::RobotDescription;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt::Write;

@@ -1,14 +1,15 @@
 //! Shared by the experiments: a perturbed "true" robot in a cell, simulated datasets as
-//! measurement sets. The building blocks live in `pipeline::simulated` (the `calib simulate`
+//! measurement sets. The building blocks live in `campaign` (the `calib simulate`
 //! command needs them too; `random_twist` moved there); these wrappers keep the experiments'
 //! signatures.
 
+use campaign::Perturbation;
 use lie::SE3;
 use loadsim::{Effects, GeneratorConfig, JointRange, SimulatedCell};
-use pipeline::simulated::Perturbation;
-use pipeline::{MeasurementSet, RobotDescription};
+use measurements::MeasurementSet;
 use poe::LocalPoe;
 use rand::Rng;
+use robot::RobotDescription;
 
 /// The nominal arm with every constant transform (joints and tool) off by up to `translation_m`
 /// and `rotation_rad` per axis, and a tool `tool_m` out along the flange's z axis.
@@ -20,17 +21,17 @@ pub fn perturbed_robot<R: Rng>(
     tool_m: f64,
 ) -> anyhow::Result<LocalPoe> {
     let perturbation = Perturbation { translation_m, rotation_rad, tool_m };
-    pipeline::simulated::perturbed_robot(robot, &perturbation, rng).map_err(anyhow::Error::from)
+    campaign::perturbed_robot(robot, &perturbation, rng).map_err(anyhow::Error::from)
 }
 
 /// A tracker 3–5 m from the base, turned about the vertical, levelled.
 pub fn tracker_placement<R: Rng>(rng: &mut R) -> SE3 {
-    pipeline::simulated::tracker_placement(rng)
+    campaign::tracker_placement(rng)
 }
 
 /// The robot's joint ranges as the generator takes them.
 pub fn ranges(robot: &RobotDescription) -> Vec<JointRange> {
-    pipeline::simulated::joint_ranges(robot)
+    campaign::joint_ranges(robot)
 }
 
 /// A simulated dataset as a measurement set (position only unless `full_pose`).
@@ -41,7 +42,7 @@ pub fn simulate(
     config: &GeneratorConfig,
     full_pose: bool,
 ) -> anyhow::Result<MeasurementSet> {
-    pipeline::simulated::simulate(cell, effects, ranges, config, full_pose).map_err(anyhow::Error::from)
+    campaign::simulate(cell, effects, ranges, config, full_pose).map_err(anyhow::Error::from)
 }
 
 /// Mean distance between the measured points of two sets of the same poses, mm.

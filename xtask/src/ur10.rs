@@ -4,17 +4,21 @@
 //!
 //! The diagnosis part, for each series of `--diagnose-series`: `calib diagnose` on the training
 //! rows, timed; then the verdict's effect fitted with the geometry on the same rows (`calib fit
-//! --effects …`, the list `pipeline::effects::effects_of` makes of the verdict's selected effects)
+//! --effects …`, the list `pipeline::effects_of` makes of the verdict's selected effects)
 //! and evaluated on the test rows, against the diagnosis's cross-validated prediction. Writes
 //! `ur10.md` into `--out` (with `--diagnosis-only`, only its section from `## Diagnosis` on is
 //! replaced, the methods table kept) and the report folder `ur10-diagnosis/` (the first series).
 
 use crate::convert_ur10::{Dataset, read_series};
 use anyhow::{Context, Result};
+use diagnose::{DiagnoseOptions, Diagnosis, diagnose};
+use effects::EffectSelection;
 use indicatif::{ProgressBar, ProgressStyle};
-use pipeline::diagnose::{DiagnoseOptions, Diagnosis, diagnose};
-use pipeline::effects::{EffectSelection, effects_of};
-use pipeline::{FitOptions, MeasurementSet, Method, ResidualFrame, ResidualGpOptions, RobotDescription};
+use measurements::MeasurementSet;
+use model::{Method, ResidualFrame, ResidualGpOptions};
+use pipeline::FitOptions;
+use pipeline::effects_of;
+use robot::RobotDescription;
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -135,7 +139,7 @@ fn methods(args: &Args, robot: &RobotDescription) -> Result<String> {
             let start = Instant::now();
             let (model, _) = pipeline::fit(robot, &train, *method, options)?;
             let fit_s = start.elapsed().as_secs_f64();
-            let s = pipeline::evaluate(&model, &test)?.summary;
+            let s = model::evaluate(&model, &test)?.summary;
             rows.push(Row {
                 data: label,
                 method: name.clone(),
@@ -237,7 +241,7 @@ fn check_series(args: &Args, robot: &RobotDescription, series: &str) -> Result<C
     seconds.sort_by(f64::total_cmp);
     cpu_seconds.sort_by(f64::total_cmp);
     let (poe, _) = pipeline::fit(robot, &train, Method::Poe, &FitOptions::default())?;
-    let poe_test_mm = pipeline::evaluate(&poe, &test)?.summary.mean_position_error_mm;
+    let poe_test_mm = model::evaluate(&poe, &test)?.summary.mean_position_error_mm;
     let verdict: Vec<_> = diagnosis.selected.iter().filter(|s| s.effect == diagnosis.verdict.effect).cloned().collect();
     let specs = effects_of(&verdict);
     let effects = specs.iter().map(ToString::to_string).collect::<Vec<_>>().join(",");
@@ -252,10 +256,10 @@ fn check_series(args: &Args, robot: &RobotDescription, series: &str) -> Result<C
             if rows.is_empty() {
                 return Ok(None);
             }
-            Ok(Some(pipeline::evaluate(&model, &test.subset(rows))?.summary.mean_position_error_mm))
+            Ok(Some(model::evaluate(&model, &test.subset(rows))?.summary.mean_position_error_mm))
         };
         Some(Fitted {
-            all_mm: pipeline::evaluate(&model, &test)?.summary.mean_position_error_mm,
+            all_mm: model::evaluate(&model, &test)?.summary.mean_position_error_mm,
             inside: (inside.len(), mean(&inside)?),
             outside: (outside.len(), mean(&outside)?),
         })
@@ -283,7 +287,7 @@ fn diagnosis_section(args: &Args, checked: &[Checked]) -> String {
          --diagnosis-only` (release build, {} threads; load average when it ran: {}). \"predicted\" is the diagnosis's \
          cross-validated held-out error with the verdict's effect, on the training rows alone; \"fitted, test rows\" is \
          that effect identified with the geometry on the training rows and evaluated on the test rows. Diagnose time: \
-         median of {} runs (wall clock, `pipeline::diagnose` alone, data already read); CPU: the CPU time it used on \
+         median of {} runs (wall clock, `diagnose::diagnose` alone, data already read); CPU: the CPU time it used on \
          all threads (about the wall clock on one idle core; rayon's idle threads spin briefly, which adds a little). The same by hand, for series C \
          (`/work/data` holds the converted CSVs, see `cargo xtask convert-ur10`):\n\n```sh\n\
          calib diagnose --robot fixtures/robots/ur10.ron --data ur10_C_even.csv\n\
@@ -372,7 +376,7 @@ pub fn run(args: &Args) -> Result<()> {
     progress.finish_and_clear();
     if let Some(first) = checked.first() {
         let folder = args.out.join("ur10-diagnosis");
-        report::write_diagnosis_report(&first.diagnosis, &folder, "--out", &pipeline::InputFiles::new())?;
+        report::write_diagnosis_report(&first.diagnosis, &folder, "--out", &measurements::InputFiles::new())?;
     }
     let section = diagnosis_section(args, &checked);
     let path = args.out.join("ur10.md");

@@ -5,10 +5,12 @@
 
 use crate::convert_ur10::{Dataset, read_series};
 use anyhow::Context;
+use cell::UrdfTemplate;
 use lie::{SE3, Vector3};
-use pipeline::{
-    ChainEnds, FitOptions, MeasurementSet, Method, NominalTolerance, RobotDescription, UrdfDocument, UrdfTemplate,
-};
+use measurements::MeasurementSet;
+use model::Method;
+use pipeline::FitOptions;
+use robot::{ChainEnds, NominalTolerance, RobotDescription, UrdfDocument};
 use std::fmt::Write;
 use std::path::PathBuf;
 
@@ -63,7 +65,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         for form in FORMS {
             let robot = RobotDescription::read(&PathBuf::from(form))?;
             let (model, _) = pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default())?;
-            let s = pipeline::evaluate(&model, &test)?.summary;
+            let s = model::evaluate(&model, &test)?.summary;
             let _ = writeln!(
                 md,
                 "| {label} | `{form}` | {:.6} | {:.6} | {:.6} | {} |",
@@ -102,11 +104,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 }
 
 /// Exports `model` like `urdf` and reads the result back from the tracker link to the tool.
-fn round_trip(urdf: &str, model: &pipeline::CalibratedModel, test: &MeasurementSet) -> anyhow::Result<f64> {
+fn round_trip(urdf: &str, model: &model::CalibratedModel, test: &MeasurementSet) -> anyhow::Result<f64> {
     let document = UrdfDocument::read(&PathBuf::from(urdf))?;
     let chain = document.chain(&ChainEnds::default())?;
     let template = UrdfTemplate::Like { document: &document, chain: &chain };
-    let export = pipeline::export_urdf(model, template, None, &NominalTolerance::default())?;
+    let export = cell::export_urdf(model, template, None, &NominalTolerance::default())?;
     let ends = ChainEnds {
         base_link: Some(export.report.tracker_link.clone()),
         tip_link: export.report.tool_links.first().cloned(),

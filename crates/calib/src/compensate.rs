@@ -1,6 +1,6 @@
 //! `calib compensate`: joint targets rewritten so that the calibrated robot reaches what they mean.
 
-use pipeline::{CompensateOptions, TargetFrame};
+use cell::{CompensateOptions, TargetFrame};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -30,18 +30,18 @@ pub struct Args {
     frame: TargetFrame,
     /// Map other headers onto the SPEC's names, e.g. `x_mm="X [mm]",qw=Q0`.
     #[arg(long)]
-    columns: Option<pipeline::ColumnMap>,
+    columns: Option<measurements::ColumnMap>,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let model = pipeline::read_model(&args.model)?;
+    let model = model::read_model(&args.model)?;
     let robot = args.robot.read_or_kept(&model, &args.model)?;
-    let file = pipeline::read_targets(&args.targets, &model, args.columns.clone().unwrap_or_default())?;
+    let file = cell::read_targets(&args.targets, &model, args.columns.clone().unwrap_or_default())?;
     let robot_ref = robot.as_ref().map(|(r, f)| (r, f.as_str()));
-    let (solved, summary) = pipeline::compensate(&model, &file, robot_ref, args.frame, &CompensateOptions::default())?;
+    let (solved, summary) = cell::compensate(&model, &file, robot_ref, args.frame, &CompensateOptions::default())?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
-    pipeline::write_compensated(&mut out, &file, &solved)?;
+    cell::write_compensated(&mut out, &file, &solved)?;
     out.flush()?;
     eprintln!("{}", file.set.read_summary());
     for warning in model.extrapolation(&file.set.rows) {

@@ -1,7 +1,7 @@
 //! `calib diagnose`: where the geometric model misses, which effect explains it, how far it shrinks.
 
-use pipeline::ReadOptions;
-use pipeline::diagnose::{DiagnoseOptions, diagnose};
+use diagnose::{DiagnoseOptions, diagnose};
+use measurements::ReadOptions;
 use std::path::PathBuf;
 
 /// Diagnose what a geometric calibration leaves: where, which effect, how far it shrinks.
@@ -14,7 +14,7 @@ pub struct Args {
     data: PathBuf,
     /// Other headers mapped onto the SPEC's column names: NAME=HEADER,… (e.g. x_mm="X [mm]",qw=Q0).
     #[arg(long)]
-    columns: Option<pipeline::ColumnMap>,
+    columns: Option<measurements::ColumnMap>,
     /// Print one JSON object on stdout instead of the summary.
     #[arg(long)]
     json: bool,
@@ -39,10 +39,10 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     {
         return Err(format!("--noise-mm must be a positive number of millimetres, got {noise}").into());
     }
-    let inputs = pipeline::InputFiles::new().with("--robot", &args.robot.robot).with("--data", &args.data);
+    let inputs = measurements::InputFiles::new().with("--robot", &args.robot.robot).with("--data", &args.data);
     let robot = args.robot.read()?;
     let read = ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
-    let data = pipeline::read_measurements(&args.data, &read)?;
+    let data = measurements::read_measurements(&args.data, &read)?;
     let options =
         DiagnoseOptions { folds: args.folds, seed: args.seed, noise_mm: args.noise_mm, ..DiagnoseOptions::default() };
     let diagnosis = diagnose(&robot, &data, &options)?;

@@ -1,6 +1,7 @@
 //! `calib eval`: the errors of a calibrated model on measurements.
 
-use pipeline::{ColumnMap, EvalReport, ReadOptions};
+use measurements::{ColumnMap, ReadOptions};
+use model::EvalReport;
 use std::path::PathBuf;
 
 /// Evaluate a calibrated model on measurements.
@@ -21,14 +22,14 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let model = pipeline::read_model(&args.model)?;
+    let model = model::read_model(&args.model)?;
     let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
-    let data = pipeline::read_measurements(&args.data, &options)?;
+    let data = measurements::read_measurements(&args.data, &options)?;
     // Angles a turn away from the fitted range are taken into it, as `calib register` does.
-    let (rows, wrapped) = pipeline::wrapped(&model, &data.rows);
-    let data = pipeline::MeasurementSet { rows, ..data };
-    let evaluation = pipeline::evaluate(&model, &data)?;
-    let finite = |e: &pipeline::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
+    let (rows, wrapped) = model::wrapped(&model, &data.rows);
+    let data = measurements::MeasurementSet { rows, ..data };
+    let evaluation = model::evaluate(&model, &data)?;
+    let finite = |e: &model::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
     if let Some((row, _)) = data.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
         return Err(crate::predict::non_finite(&args.model, &data.source, row.line).into());
     }
@@ -40,7 +41,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             eprintln!("note: {joint}");
         }
         if report.orientations_not_evaluated {
-            eprintln!("note: {}", pipeline::ORIENTATIONS_NOT_EVALUATED);
+            eprintln!("note: {}", model::ORIENTATIONS_NOT_EVALUATED);
         }
         for warning in &report.warnings {
             eprintln!("warning: {warning}");
@@ -70,7 +71,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         println!("  rotation error: mean {mean:.4} mrad, max {max:.4} mrad");
     }
     if report.orientations_not_evaluated {
-        println!("  note: {}", pipeline::ORIENTATIONS_NOT_EVALUATED);
+        println!("  note: {}", model::ORIENTATIONS_NOT_EVALUATED);
     }
     for joint in &report.wrapped {
         println!("  note: {joint}");
@@ -101,7 +102,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
 }
 
 /// The warning about rows far beyond the others, with what the others give.
-fn suspect_text(suspects: &pipeline::SuspectRows) -> String {
+fn suspect_text(suspects: &model::SuspectRows) -> String {
     let w = &suspects.without;
     format!(
         "{} row(s) lie beyond {} robust sigmas of the other rows' errors: {}; a measurement error \
@@ -109,14 +110,14 @@ fn suspect_text(suspects: &pipeline::SuspectRows) -> String {
          mean {:.4} mm, max {:.4} mm (the numbers above keep them)",
         suspects.rows.len(),
         suspects.threshold_sigmas,
-        pipeline::list_lines(&suspects.rows),
+        measurements::list_lines(&suspects.rows),
         w.mean_position_error_mm,
         w.max_position_error_mm
     )
 }
 
 /// The two lines of a split: `inside WHAT: …` and `outside WHAT: …`, each where it has rows.
-fn print_split(split: Option<&pipeline::CoverageSplit>, what: &str) {
+fn print_split(split: Option<&model::CoverageSplit>, what: &str) {
     let Some(split) = split else { return };
     for (side, part) in [("inside", &split.inside), ("outside", &split.outside)] {
         if part.n > 0 {

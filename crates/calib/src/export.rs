@@ -1,6 +1,8 @@
 //! `calib export`: the calibrated geometry as a URDF for controllers, planners and simulators.
 
-use pipeline::{ChainEnds, NominalTolerance, ReadOptions, RobotDescription, UrdfDocument, UrdfTemplate};
+use cell::UrdfTemplate;
+use measurements::ReadOptions;
+use robot::{ChainEnds, NominalTolerance, RobotDescription, UrdfDocument};
 use std::path::PathBuf;
 
 /// Write a calibrated model's geometry as a URDF.
@@ -44,16 +46,16 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     // Refused before any work: the URDF must not replace a file this export reads.
-    pipeline::InputFiles::new()
+    measurements::InputFiles::new()
         .with("--model", &args.model)
         .with_optional("--like", args.like.as_deref())
         .with_optional("--robot", args.robot.as_deref())
         .with_optional("--data", args.data.as_deref())
         .check_output("--urdf", &args.urdf)?;
-    let model = pipeline::read_model(&args.model)?;
+    let model = model::read_model(&args.model)?;
     let ends = ChainEnds { base_link: args.base_link.clone(), tip_link: args.tip_link.clone() };
     let training = match &args.data {
-        Some(path) => Some(pipeline::read_measurements(path, &ReadOptions::for_joints(model.joint_kinds()))?),
+        Some(path) => Some(measurements::read_measurements(path, &ReadOptions::for_joints(model.joint_kinds()))?),
         None => None,
     };
     let tolerance = NominalTolerance::default();
@@ -61,7 +63,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         (Some(like), _) => {
             let document = UrdfDocument::read(like)?;
             let chain = document.chain(&ends)?;
-            pipeline::export_urdf(
+            cell::export_urdf(
                 &model,
                 UrdfTemplate::Like { document: &document, chain: &chain },
                 training.as_ref(),
@@ -72,7 +74,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             let description = RobotDescription::read_with(robot, &ends)?;
             let file = robot.display().to_string();
             let template = UrdfTemplate::Plain { nominal: Some((&description, &file)) };
-            pipeline::export_urdf(&model, template, training.as_ref(), &tolerance)?
+            cell::export_urdf(&model, template, training.as_ref(), &tolerance)?
         }
         (None, None) => {
             if ends != ChainEnds::default() {
@@ -83,10 +85,10 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             let kept = model.robot_description.clone();
             let file = format!("{} (as the model keeps it)", args.model.display());
             let nominal = kept.as_ref().map(|description| (description, file.as_str()));
-            pipeline::export_urdf(&model, UrdfTemplate::Plain { nominal }, training.as_ref(), &tolerance)?
+            cell::export_urdf(&model, UrdfTemplate::Plain { nominal }, training.as_ref(), &tolerance)?
         }
     };
-    pipeline::write_urdf(&args.urdf, &export)?;
+    cell::write_urdf(&args.urdf, &export)?;
     let report = &export.report;
     if args.json {
         println!("{}", serde_json::to_string(report)?);

@@ -1,7 +1,9 @@
 //! `calib fit`: fit a calibration method to measurements and write the model.
 
-use pipeline::effects::{EffectKind, EffectSelection, EffectSpec};
-use pipeline::{ErrorSummary, FitOptions, FitReport, Method, ReadOptions};
+use effects::{EffectKind, EffectSelection, EffectSpec};
+use measurements::ReadOptions;
+use model::{ErrorSummary, Method};
+use pipeline::{FitOptions, FitReport};
 use std::fmt::Write;
 use std::path::PathBuf;
 
@@ -15,7 +17,7 @@ pub struct Args {
     data: PathBuf,
     /// Other headers mapped onto the SPEC's column names: NAME=HEADER,… (e.g. x_mm="X [mm]",qw=Q0).
     #[arg(long)]
-    columns: Option<pipeline::ColumnMap>,
+    columns: Option<measurements::ColumnMap>,
     /// Calibration method: base-tool, poe, poe-gp or poe-gp-load.
     #[arg(long)]
     method: Method,
@@ -39,7 +41,7 @@ pub struct Args {
     /// The GP of the -gp methods: exact, sparse (variational, inducing inputs: for large data
     /// sets) or auto (sparse above 4000 training rows) [default: auto, or what --options says].
     #[arg(long)]
-    gp: Option<pipeline::GpChoice>,
+    gp: Option<model::GpChoice>,
     /// Print the fit report as one JSON object on stdout (the summary goes to stderr).
     #[arg(long)]
     json: bool,
@@ -51,14 +53,14 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     // Refused before any work: the model must not replace a file this fit reads.
-    pipeline::InputFiles::new()
+    measurements::InputFiles::new()
         .with("--robot", &args.robot.robot)
         .with("--data", &args.data)
         .with_optional("--options", args.options.as_deref())
         .check_output("--out", &args.out)?;
     let robot = args.robot.read()?;
     let options = ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
-    let data = pipeline::read_measurements(&args.data, &options)?;
+    let data = measurements::read_measurements(&args.data, &options)?;
     let mut options = match &args.options {
         Some(path) => FitOptions::read(path)?,
         None => FitOptions::default(),
@@ -77,7 +79,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         options.residual_gp.method = choice;
     }
     let (model, report) = pipeline::fit(&robot, &data, args.method, &options)?;
-    pipeline::write_model(&args.out, &model)?;
+    model::write_model(&args.out, &model)?;
     // With --json the report is the one object on stdout and the summary goes to stderr.
     let mut summary = String::new();
     summary.push_str(&data.read_summary());
@@ -96,8 +98,8 @@ fn summarise(
     out: &mut String,
     args: &Args,
     robot: &str,
-    data: &pipeline::MeasurementSet,
-    model: &pipeline::CalibratedModel,
+    data: &measurements::MeasurementSet,
+    model: &model::CalibratedModel,
     report: &FitReport,
 ) {
     let kind = if data.full_pose { "full pose" } else { "position only" };
@@ -181,13 +183,13 @@ fn summarise(
     }
     if let (Some(residual_gp), Some(gp)) = (&model.residual_gp, &report.residual_gp) {
         let kernels = match &gp.gp {
-            pipeline::GpFitReport::Exact(r) => r.components.len(),
-            pipeline::GpFitReport::Sparse(r) => r.components.len(),
+            model::GpFitReport::Exact(r) => r.components.len(),
+            model::GpFitReport::Sparse(r) => r.components.len(),
         };
         let converged = kernels - gp.gp.unconverged().len();
         // Where the additive term was weighed (BIC), how often it paid for itself.
         let additive = match &gp.gp {
-            pipeline::GpFitReport::Exact(r) => {
+            model::GpFitReport::Exact(r) => {
                 let choices: Vec<bool> =
                     r.components.iter().filter_map(|c| c.additive_choice.as_ref().map(|a| a.kept)).collect();
                 let kept = choices.iter().filter(|k| **k).count();
@@ -197,11 +199,11 @@ fn summarise(
                     format!("; additive term kept (BIC) for {kept} of {}", choices.len())
                 }
             }
-            pipeline::GpFitReport::Sparse(_) => String::new(),
+            model::GpFitReport::Sparse(_) => String::new(),
         };
         // Where the paper's isotropic kernel was weighed (leave-one-out), how often it won.
         let isotropic = match &gp.gp {
-            pipeline::GpFitReport::Exact(r) => {
+            model::GpFitReport::Exact(r) => {
                 let choices: Vec<bool> =
                     r.components.iter().filter_map(|c| c.isotropic_choice.as_ref().map(|a| a.kept_isotropic)).collect();
                 let kept = choices.iter().filter(|k| **k).count();
@@ -211,7 +213,7 @@ fn summarise(
                     format!("; the paper's isotropic Eq. 5 kernel kept (leave-one-out) for {kept} of {}", choices.len())
                 }
             }
-            pipeline::GpFitReport::Sparse(_) => String::new(),
+            model::GpFitReport::Sparse(_) => String::new(),
         };
         let _ = writeln!(
             out,

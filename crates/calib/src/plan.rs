@@ -1,7 +1,7 @@
 //! `calib plan`: the poses worth measuring, chosen from candidates (crate `cell`).
 
 use crate::robot_args::RobotArgs;
-use pipeline::{ColumnMap, ReadOptions};
+use measurements::{ColumnMap, ReadOptions};
 use std::path::PathBuf;
 
 /// Choose the poses that determine the identification best, covering every moving joint's range.
@@ -50,14 +50,14 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    pipeline::InputFiles::new()
+    measurements::InputFiles::new()
         .with("--robot", &args.robot.robot)
         .with_optional("--model", args.model.as_deref())
         .with_optional("--candidates", args.candidates.as_deref())
         .with_optional("--options", args.options.as_deref())
         .check_output("--out", &args.out)?;
     let robot = args.robot.read()?;
-    let model = args.model.as_deref().map(pipeline::read_model).transpose()?;
+    let model = args.model.as_deref().map(model::read_model).transpose()?;
     let full_pose = args.full_pose || model.as_ref().is_some_and(|m| m.full_pose);
     let mut options = match &args.options {
         Some(path) => {
@@ -75,7 +75,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         Some(path) => {
             let kinds = robot.nominal_model()?.joints().iter().map(|j| j.kind).collect();
             let read = ReadOptions::for_joints(kinds).with_columns(args.columns.clone().unwrap_or_default());
-            let (data, cells) = pipeline::read_configurations_with_cells(path, &read)?;
+            let (data, cells) = measurements::read_configurations_with_cells(path, &read)?;
             notes.push(data.read_summary());
             (cell::file_candidates(&data, &robot, model.as_ref())?, Some((cells, data.format.dialect.delimiter.byte())))
         }
@@ -89,7 +89,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     let plan = cell::plan(&set.model, &set.candidates, args.poses, full_pose, &options)?;
     let seconds = started.elapsed().as_secs_f64();
-    let mut out = pipeline::OutputFile::create(&args.out)?;
+    let mut out = measurements::OutputFile::create(&args.out)?;
     match &file {
         Some((cells, delimiter)) => cell::write_chosen_rows(&mut out, cells, *delimiter, &plan.order)?,
         None => {

@@ -15,21 +15,21 @@ pub struct Args {
     data: PathBuf,
     /// Other headers mapped onto the SPEC's column names: NAME=HEADER,… (e.g. x_mm="X [mm]",qw=Q0).
     #[arg(long)]
-    columns: Option<pipeline::ColumnMap>,
+    columns: Option<measurements::ColumnMap>,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let model = pipeline::read_model(&args.model)?;
-    let options =
-        pipeline::ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
-    let read = pipeline::read_configurations(&args.data, &options)?;
+    let model = model::read_model(&args.model)?;
+    let options = measurements::ReadOptions::for_joints(model.joint_kinds())
+        .with_columns(args.columns.clone().unwrap_or_default());
+    let read = measurements::read_configurations(&args.data, &options)?;
     // Angles a turn away from the fitted range are taken into it, as `calib register` does; the
     // CSV's columns are the same, the note on stderr says which rows.
-    let (rows, wrapped) = pipeline::wrapped(&model, &read.rows);
-    let data = pipeline::MeasurementSet { rows, ..read };
-    let tools = pipeline::tool_indices(&model, &data)?;
+    let (rows, wrapped) = model::wrapped(&model, &read.rows);
+    let data = measurements::MeasurementSet { rows, ..read };
+    let tools = model::tool_indices(&model, &data)?;
     let predictions = model.predict(&data.rows, &tools)?;
-    let finite = |p: &pipeline::PredictedPose| {
+    let finite = |p: &model::PredictedPose| {
         let pose = p.pose;
         pose.translation().iter().chain(pose.rotation().matrix().iter()).all(|v| v.is_finite())
     };
@@ -51,7 +51,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(fallen) = model.sigma_fallback(&data.rows, &tools)? {
         eprintln!("warning: {fallen}");
     }
-    pipeline::write_predictions(std::io::stdout().lock(), "stdout", &model, &data, &predictions)?;
+    model::write_predictions(std::io::stdout().lock(), "stdout", &model, &data, &predictions)?;
     std::io::stdout().flush()?;
     eprintln!("{}", data.read_summary());
     Ok(())

@@ -1,7 +1,7 @@
 //! `calib register`: a calibrated model carried to a moved tracker or new tools from a few poses
 //! (crate `cell`).
 
-use pipeline::{ColumnMap, ReadOptions};
+use measurements::{ColumnMap, ReadOptions};
 use std::path::PathBuf;
 
 /// Re-fit the tracker-to-base transform and/or the tools from a few poses, everything else held.
@@ -36,17 +36,17 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    pipeline::InputFiles::new()
+    measurements::InputFiles::new()
         .with("--model", &args.model)
         .with("--data", &args.data)
         .check_output("--out", &args.out)?;
-    let model = pipeline::read_model(&args.model)?;
+    let model = model::read_model(&args.model)?;
     let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
-    let data = pipeline::read_measurements(&args.data, &options)?;
+    let data = measurements::read_measurements(&args.data, &options)?;
     let register = cell::RegisterOptions { changed_ratio: args.changed_ratio, ..cell::RegisterOptions::default() };
     let registered = cell::register(&model, &data, args.refit, args.heldout_mm, &register)?;
     let text = cell::checked_model_text(&registered.model, &args.out.display().to_string())?;
-    pipeline::write_file(&args.out, text.as_bytes())?;
+    measurements::write_file(&args.out, text.as_bytes())?;
     let report = &registered.report;
     if args.json {
         println!("{}", serde_json::to_string(report)?);

@@ -1,7 +1,7 @@
 //! `calib report`: one self-contained HTML page on a calibrated model and test data.
 
-use pipeline::diagnose::{DiagnoseOptions, diagnose};
-use pipeline::{ColumnMap, ReadOptions};
+use diagnose::{DiagnoseOptions, diagnose};
+use measurements::{ColumnMap, ReadOptions};
 use std::path::PathBuf;
 
 /// Write a calibration report: one HTML file with the errors before and after, ISO 9283 AP/RP,
@@ -28,7 +28,7 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let mut inputs = pipeline::InputFiles::new().with("--model", &args.model).with("--data", &args.data);
+    let mut inputs = measurements::InputFiles::new().with("--model", &args.model).with("--data", &args.data);
     if let Some(robot) = &args.robot.robot {
         inputs = inputs.with("--robot", robot);
     }
@@ -37,7 +37,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     inputs.check_output("--out", &args.out)?;
     let started = std::time::Instant::now();
-    let model = pipeline::read_model(&args.model)?;
+    let model = model::read_model(&args.model)?;
     let Some((robot, robot_file)) = args.robot.read_or_kept(&model, &args.model)? else {
         return Err(format!(
             "{}: the model does not keep its robot description (written before it was kept): give --robot",
@@ -46,13 +46,13 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         .into());
     };
     let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
-    let data = pipeline::read_measurements(&args.data, &options)?;
-    let evaluation = pipeline::evaluate(&model, &data)?;
-    let finite = |e: &pipeline::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
+    let data = measurements::read_measurements(&args.data, &options)?;
+    let evaluation = model::evaluate(&model, &data)?;
+    let finite = |e: &model::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
     if let Some((row, _)) = data.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
         return Err(crate::predict::non_finite(&args.model, &data.source, row.line).into());
     }
-    let train = args.train.as_ref().map(|path| pipeline::read_measurements(path, &options)).transpose()?;
+    let train = args.train.as_ref().map(|path| measurements::read_measurements(path, &options)).transpose()?;
     let diagnosis = train.as_ref().map(|t| diagnose(&robot, t, &DiagnoseOptions::default())).transpose()?;
     let model_file = args.model.display().to_string();
     let report_inputs = ::report::ReportInputs {
@@ -66,7 +66,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let built = ::report::Report::build(&report_inputs, diagnosis, &::report::ReportOptions::default())?;
     let written = std::time::Instant::now();
     let html = ::report::render_html(&built)?;
-    pipeline::write_file(&args.out, html.as_bytes())?;
+    measurements::write_file(&args.out, html.as_bytes())?;
     eprintln!("{}", data.read_summary());
     println!(
         "report: {} ({} bytes; {:.2} s in all, {:.3} s to draw and write the page)",

@@ -1,6 +1,7 @@
 //! `--robot` with `--base-link` and `--tip-link`, shared by every subcommand that reads a robot.
 
-use pipeline::{ChainEnds, Error, RobotDescription};
+use errors::Error;
+use robot::{ChainEnds, RobotDescription};
 use std::path::PathBuf;
 
 /// The robot description and, for a URDF, the chain's ends.
@@ -56,7 +57,7 @@ impl KeptRobotArgs {
     /// without `--robot` are refused (the kept description is already one chain).
     pub fn read_or_kept(
         &self,
-        model: &pipeline::CalibratedModel,
+        model: &model::CalibratedModel,
         model_path: &std::path::Path,
     ) -> Result<Option<(RobotDescription, String)>, Box<dyn std::error::Error>> {
         match &self.robot {

@@ -1,8 +1,8 @@
 //! `calib simulate`: a simulated tracker campaign written as SPEC measurement CSV, to try the other
 //! subcommands without a robot, or to test a calibration on data whose truth is known.
 
-use pipeline::simulated::{self, GeneratorConfig, Perturbation, Remount, TorqueSensorNoise};
-use pipeline::{Error, ErrorKind};
+use campaign::{GeneratorConfig, Perturbation, Remount, TorqueSensorNoise};
+use errors::{Error, ErrorKind};
 use std::path::PathBuf;
 
 /// Simulate tracker measurements of a robot whose kinematics are off its nominal.
@@ -63,21 +63,21 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     // Refused before any work: the measurements must not replace the robot or the effects file.
-    pipeline::InputFiles::new()
+    measurements::InputFiles::new()
         .with("--robot", &args.robot.robot)
         .with_optional("--effects", args.effects.as_deref())
         .check_output("--out", &args.out)?;
-    if args.rows > simulated::MAX_ROWS {
+    if args.rows > campaign::MAX_ROWS {
         return Err(format!(
             "--rows: {}",
-            Error::new(ErrorKind::TooManySimulatedRows { rows: args.rows, max: simulated::MAX_ROWS })
+            Error::new(ErrorKind::TooManySimulatedRows { rows: args.rows, max: campaign::MAX_ROWS })
         )
         .into());
     }
     let robot = args.robot.read()?;
     let effects = match &args.effects {
-        Some(path) => simulated::read_effects(path, &robot)?,
-        None => simulated::paper_effects(),
+        Some(path) => campaign::read_effects(path, &robot)?,
+        None => campaign::paper_effects(),
     };
     if args.rows == 0 {
         return Err("--rows: at least one pose is needed".into());
@@ -91,14 +91,14 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         let file = args.robot.robot.display().to_string();
         return Err(Error::in_file(file, ErrorKind::PlanarChain { direction, joints: robot.joint_count() }).into());
     }
-    let cell = simulated::campaign_cell(&robot, &Perturbation::default(), &Remount::default(), &config)?;
+    let cell = campaign::campaign_cell(&robot, &Perturbation::default(), &Remount::default(), &config)?;
     // Each row is written as it is drawn (memory of one row, whatever --rows), into the atomic
     // output: a failure or a kill leaves the old file, never a part.
-    let mut out = pipeline::OutputFile::create(&args.out)?;
-    let rows = simulated::simulate_to_csv(
+    let mut out = measurements::OutputFile::create(&args.out)?;
+    let rows = campaign::simulate_to_csv(
         &cell,
         &effects,
-        &simulated::joint_ranges(&robot),
+        &campaign::joint_ranges(&robot),
         &config,
         args.full_pose,
         &mut out,
@@ -188,6 +188,6 @@ fn shape_lines(config: &GeneratorConfig) -> Vec<String> {
 }
 
 /// The names of the effects that are on, as the RON file spells them.
-fn effect_names(effects: &simulated::Effects) -> Vec<&'static str> {
-    simulated::EffectKind::ALL.iter().filter(|&&kind| effects.is_on(kind)).map(|kind| kind.simulated_field()).collect()
+fn effect_names(effects: &campaign::Effects) -> Vec<&'static str> {
+    campaign::EffectKind::ALL.iter().filter(|&&kind| effects.is_on(kind)).map(|kind| kind.simulated_field()).collect()
 }

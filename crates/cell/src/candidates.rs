@@ -1,8 +1,8 @@
 //! The candidates of `calib plan`: read from a measurement-like CSV (every cell kept, so that the
 //! chosen rows are written unchanged), or generated within the robot's joint limits.
 
-use crate::Error;
 use crate::information::Candidate;
+use errors::Error;
 use measurements::{Cells, MeasurementSet};
 use model::CalibratedModel;
 use poe::{JointKind, LocalPoe};
@@ -77,7 +77,7 @@ pub fn generated_candidates(
     let nominal = robot.nominal_model()?;
     let config = loadsim::GeneratorConfig { sample_count: count, seed, ..loadsim::GeneratorConfig::default() };
     let ranges = campaign::joint_ranges(robot);
-    let configurations = loadsim::sample_configurations(&nominal, 0, &ranges, &config)?;
+    let configurations = loadsim::sample_configurations(&nominal, 0, &ranges, &config).map_err(Error::generator)?;
     let candidates = configurations.into_iter().map(|q| Candidate { q, tool: 0, payload_kg: 0.0 }).collect();
     let kinematics = model.map_or(nominal, |m| m.kinematics.clone());
     Ok(CandidateSet { model: kinematics, candidates, unknown_tools: Vec::new() })

@@ -1,6 +1,6 @@
 //! Coverage of each moving joint's range (and of the payloads): the angle-dependent effects
 //! (gear periodic error, backlash, compliance) are identified, and held, only on the angles the
-//! poses visit (`pipeline`'s effects fade outside them), which a D-optimal design for the
+//! poses visit (a calibrated model's effects fade outside them), which a D-optimal design for the
 //! geometry alone does not care about: it favours the ends of each range.
 
 use crate::design::Design;

@@ -6,7 +6,7 @@
 //! POE model has 6(n + tools) parameters, of which only some are identifiable: Chen, Yang et al.).
 //! The information of a set of poses is then `M = Σ A_iᵀ A_i`, in units of the noise.
 
-use crate::Error;
+use errors::{Error, ErrorKind};
 use nalgebra::{DMatrix, SymmetricEigen};
 use poe::{LocalPoe, RowKind};
 use rayon::prelude::*;
@@ -85,7 +85,8 @@ pub fn candidate_rows(
             }
             Ok(out)
         })
-        .collect::<Result<_, poe::Error>>()?;
+        .collect::<Result<_, poe::Error>>()
+        .map_err(Error::kinematics)?;
     let mut gram = DMatrix::<f64>::zeros(p, p);
     for j in &jacobians {
         let m = DMatrix::from_row_slice(k, p, j);
@@ -100,7 +101,7 @@ pub fn candidate_rows(
     let kept: Vec<usize> =
         (0..p).filter(|&i| largest > 0.0 && eigen.eigenvalues[i] > weights.rank_tolerance * largest).collect();
     if kept.is_empty() {
-        return Err(Error::NoIdentifiableDirection { candidates: candidates.len() });
+        return Err(Error::new(ErrorKind::NoIdentifiableDirection { candidates: candidates.len() }));
     }
     let r = kept.len();
     // S⁻¹ V_r: p × r.

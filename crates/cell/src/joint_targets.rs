@@ -34,7 +34,7 @@ pub enum TargetFrame {
     /// The tracker frame, as measurements are.
     #[default]
     Tracker,
-    /// The robot's base frame (the calibrated model's, [`robot::base_frame`]).
+    /// The robot's base frame (the calibrated model's, `robot`'s `base_frame.rs`).
     Base,
 }
 

@@ -2,6 +2,10 @@
 //! program's targets rewritten so the calibrated robot reaches them (`compensate`), and the model's
 //! geometry exported as a URDF.
 //!
+//! Every function returns `errors::Error`, the one error of the calibration crates (its message
+//! names the file, line and column where there is one); the refusals only registration and
+//! planning raise are kinds of it (`errors::ErrorKind::TooFewPoses`, `PosesUndetermined`, …).
+//!
 //! ```
 //! # let fixture = |name: &str| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name);
 //! let robot = robot::RobotDescription::read(&fixture("irb4400.ron"))?;
@@ -83,7 +87,6 @@
 mod candidates;
 mod coverage;
 mod design;
-mod error;
 mod information;
 mod inverse;
 mod joint_targets;
@@ -100,7 +103,6 @@ mod urdf_text;
 pub use candidates::{CandidateSet, file_candidates, generated_candidates, write_chosen_rows, write_generated_rows};
 pub use coverage::AxisCoverage;
 pub use design::Criterion;
-pub use error::Error;
 pub use information::Candidate;
 pub use inverse::{InverseOptions, PoseTarget, Solved, TargetStatus, solve_targets};
 pub use joint_targets::{

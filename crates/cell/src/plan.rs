@@ -6,10 +6,10 @@
 //! the shortest joint move next); reported with the predicted error at the chosen count and at a
 //! few others, so that the user sees where more poses stop paying.
 
-use crate::Error;
 use crate::coverage::{Axis, AxisCoverage, cover, coverage};
 use crate::design::{Criterion, Design};
 use crate::information::{Candidate, RowWeights, candidate_rows};
+use errors::{Error, ErrorKind};
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
 
@@ -43,7 +43,7 @@ pub struct PlanOptions {
     pub exchange_tolerance: f64,
     /// Bins over each moving joint's range (and the payloads) that the poses must cover where
     /// candidates are: 8, so that no gap wider than 1/8 of a range is left for the angle-dependent
-    /// effects, which `pipeline` fades outside the angles they were fitted on. Fewer when fewer
+    /// effects, which a calibrated model fades outside the angles they were fitted on. Fewer when fewer
     /// poses are asked for.
     pub coverage_bins: usize,
     /// A joint whose candidates span less than this (rad or m) does not move and needs no
@@ -72,11 +72,11 @@ impl PlanOptions {
     /// unknown ones refused, each value validated; errors name the file, line and column.
     pub fn parse(text: &str, file: &str) -> Result<Self, Error> {
         let options: PlanOptions = ron::from_str(text).map_err(|e| {
-            errors::Error::at_line(
+            Error::at_line(
                 file.to_owned(),
                 e.span.start.line as u64,
                 e.span.start.col,
-                errors::ErrorKind::RonFormat { message: e.code.to_string() },
+                ErrorKind::RonFormat { message: e.code.to_string() },
             )
         })?;
         options.validate()?;
@@ -94,22 +94,26 @@ impl PlanOptions {
         ];
         for (field, value) in positive {
             if !(value.is_finite() && value > 0.0) {
-                return Err(Error::BadOption { field, value, expected: "a positive finite number" });
+                return Err(Error::new(ErrorKind::OptionOutOfRange {
+                    field,
+                    value,
+                    expected: "a positive finite number",
+                }));
             }
         }
         if self.coverage_bins > 1000 {
-            return Err(Error::BadOption {
+            return Err(Error::new(ErrorKind::OptionOutOfRange {
                 field: "coverage_bins",
                 value: self.coverage_bins as f64,
                 expected: "at most 1000",
-            });
+            }));
         }
         if !(self.exchange_tolerance.is_finite() && self.exchange_tolerance >= 0.0) {
-            return Err(Error::BadOption {
+            return Err(Error::new(ErrorKind::OptionOutOfRange {
                 field: "exchange_tolerance",
                 value: self.exchange_tolerance,
                 expected: "a finite number ≥ 0",
-            });
+            }));
         }
         Ok(())
     }
@@ -240,7 +244,7 @@ pub fn plan(
 ) -> Result<Plan, Error> {
     options.validate()?;
     if poses == 0 || candidates.len() < poses {
-        return Err(Error::TooFewCandidates { candidates: candidates.len(), poses });
+        return Err(Error::new(ErrorKind::TooFewCandidates { candidates: candidates.len(), poses }));
     }
     let weights = RowWeights {
         position_m: options.position_noise_mm * 1e-3,
@@ -249,7 +253,7 @@ pub fn plan(
     };
     let rows = candidate_rows(model, candidates, &weights)?;
     if rows.is_empty() {
-        return Err(Error::NoIdentifiableDirection { candidates: candidates.len() });
+        return Err(Error::new(ErrorKind::NoIdentifiableDirection { candidates: candidates.len() }));
     }
     let mean_trace = rows.a.iter().map(|v| v * v).sum::<f64>() / candidates.len() as f64;
     let prior = options.prior_fraction * mean_trace / rows.r as f64;
@@ -435,7 +439,7 @@ mod tests {
     #[test]
     fn more_poses_than_candidates_are_refused_with_the_counts() {
         let err = plan(&arm(), &candidates(5, 4), 6, false, &PlanOptions::default()).unwrap_err();
-        assert!(matches!(err, Error::TooFewCandidates { candidates: 5, poses: 6 }), "{err}");
+        assert!(matches!(err.kind(), ErrorKind::TooFewCandidates { candidates: 5, poses: 6 }), "{err}");
     }
 
     #[test]

@@ -8,10 +8,10 @@
 //! are carried by [`model::ResidualGp::moved_by`]. A tool becomes `T_{n,n+1} · D_t` of the
 //! model tool it was measured against (a new tool: the model's first tool).
 
-use crate::Error;
 use crate::register_options::{Refit, RegisterOptions};
 use crate::registration::{Registration, RegistrationRow, Unknowns, register_rows};
 use crate::report::{Fitted, Heldout, HeldoutFrom, RegisterReport, RegisterWarning, RegisteredTool, Verdict};
+use errors::{Error, ErrorKind};
 use lie::{SE3, Vector3};
 use measurements::MeasurementSet;
 use model::CalibratedModel;
@@ -47,7 +47,12 @@ pub fn register(
         let found = model.tools.iter().position(|t| t == name);
         if found.is_none() && !refit.tools {
             let line = data.rows.iter().find(|r| r.tool == index).map_or(0, |r| r.line);
-            return Err(Error::NewToolWithoutRefit { file: data.source.clone(), line, column, tool: name.clone() });
+            return Err(Error::at_line(
+                data.source.clone(),
+                line,
+                column,
+                ErrorKind::NewToolWithoutRefit { tool: name.clone() },
+            ));
         }
         known.push(found);
     }
@@ -132,13 +137,13 @@ fn check_counts(
     // A frame needs three points off one line whatever the redundancy.
     let needed = needed_rows.div_ceil(per_pose).max(if unknowns.frame { 3 } else { 1 });
     if poses < needed {
-        return Err(Error::TooFewPoses {
+        return Err(Error::new(ErrorKind::TooFewPoses {
             what: "the registration".into(),
             poses,
             needed_poses: needed,
             rows: poses * per_pose,
             parameters,
-        });
+        }));
     }
     for (tool, slot) in slots.iter().enumerate() {
         if slot.is_none() {
@@ -146,13 +151,13 @@ fn check_counts(
         }
         let mine = data.rows.iter().filter(|r| r.tool == tool).count();
         if mine < options.min_poses_per_tool {
-            return Err(Error::TooFewPoses {
+            return Err(Error::new(ErrorKind::TooFewPoses {
                 what: format!("tool '{}'", data.tools[tool]),
                 poses: mine,
                 needed_poses: options.min_poses_per_tool,
                 rows: mine * per_pose,
                 parameters: unknowns.per_tool(),
-            });
+            }));
         }
     }
     Ok(())
@@ -238,10 +243,12 @@ impl Verdict {
 mod tests {
     use super::*;
     use crate::HeldoutFrom;
+    use campaign::{GeneratorConfig, Perturbation};
     use lie::SO3;
-    use pipeline::simulated::{self, GeneratorConfig, Perturbation};
-    use pipeline::{FitOptions, Method, RobotDescription};
+    use model::Method;
+    use pipeline::FitOptions;
     use rand::SeedableRng;
+    use robot::RobotDescription;
 
     fn irb4400() -> RobotDescription {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots/irb4400.ron");
@@ -251,21 +258,21 @@ mod tests {
     /// A simulated cell's model, and data of the same robot seen from a moved tracker with a new tool.
     fn scenario(full_pose: bool, method: Method) -> (CalibratedModel, MeasurementSet, MeasurementSet, f64) {
         let robot = irb4400();
-        let ranges = simulated::joint_ranges(&robot);
-        let effects = simulated::paper_effects();
-        let original = simulated::simulated_cell(&robot, &Perturbation::default(), 3).unwrap();
+        let ranges = campaign::joint_ranges(&robot);
+        let effects = campaign::paper_effects();
+        let original = campaign::simulated_cell(&robot, &Perturbation::default(), 3).unwrap();
         let mut moved = original.clone();
-        moved.tracker_from_base = simulated::tracker_placement(&mut rand_chacha::ChaCha8Rng::seed_from_u64(9));
+        moved.tracker_from_base = campaign::tracker_placement(&mut rand_chacha::ChaCha8Rng::seed_from_u64(9));
         let tool = original.robot.tools()[original.tool]
             * SE3::new(SO3::exp(&Vector3::new(0.0, 0.3, 0.1)), Vector3::new(0.06, -0.05, 0.06));
         moved.robot.set_tools(vec![tool]);
         moved.tool = 0;
         let config = |rows, seed| GeneratorConfig { sample_count: rows, seed, ..GeneratorConfig::default() };
         let simulate =
-            |cell, rows, seed| simulated::simulate(cell, &effects, &ranges, &config(rows, seed), full_pose).unwrap();
+            |cell, rows, seed| campaign::simulate(cell, &effects, &ranges, &config(rows, seed), full_pose).unwrap();
         let train = simulate(&original, 200, 1);
         let (model, _) = pipeline::fit(&robot, &train, method, &FitOptions::default()).unwrap();
-        let heldout = pipeline::evaluate(&model, &simulate(&original, 300, 2)).unwrap().summary.mean_position_error_mm;
+        let heldout = model::evaluate(&model, &simulate(&original, 300, 2)).unwrap().summary.mean_position_error_mm;
         let rename = |mut set: MeasurementSet| {
             set.tools = vec!["probe2".into()];
             set
@@ -278,7 +285,7 @@ mod tests {
         let (model, few, test, heldout) = scenario(true, Method::Poe);
         let refit = Refit { base: true, tools: true };
         let registered = register(&model, &few, refit, Some(heldout), &RegisterOptions::default()).unwrap();
-        let after = pipeline::evaluate(&registered.model, &test).unwrap().summary.mean_position_error_mm;
+        let after = model::evaluate(&registered.model, &test).unwrap().summary.mean_position_error_mm;
         assert!(after < 1.3 * heldout, "{after} mm against {heldout} mm: {:#?}", registered.report);
         assert_eq!(registered.report.verdict, Verdict::Consistent);
         assert!(registered.report.warnings.is_empty(), "{:?}", registered.report.warnings);
@@ -379,7 +386,7 @@ mod tests {
         let (model, few, test, heldout) = scenario(false, Method::Poe);
         let refit = Refit { base: true, tools: true };
         let registered = register(&model, &few, refit, Some(heldout), &RegisterOptions::default()).unwrap();
-        let after = pipeline::evaluate(&registered.model, &test).unwrap().summary.mean_position_error_mm;
+        let after = model::evaluate(&registered.model, &test).unwrap().summary.mean_position_error_mm;
         assert!(registered.report.warnings.contains(&RegisterWarning::PositionModelToolPoint));
         let expected = if after > RegisterOptions::default().changed_ratio * heldout {
             Verdict::RobotChanged
@@ -395,6 +402,9 @@ mod tests {
         let refit = Refit { base: true, tools: true };
         let err = register(&model, &few.subset(&[0, 1, 2, 3, 4, 5, 6, 7]), refit, None, &RegisterOptions::default())
             .unwrap_err();
-        assert!(matches!(err, Error::TooFewPoses { poses: 8, needed_poses: 9, rows: 24, parameters: 9, .. }), "{err}");
+        assert!(
+            matches!(err.kind(), ErrorKind::TooFewPoses { poses: 8, needed_poses: 9, rows: 24, parameters: 9, .. }),
+            "{err}"
+        );
     }
 }

@@ -1,7 +1,7 @@
 //! What `calib register` re-fits and how it is tuned.
 
-use crate::Error;
 use crate::registration::RegistrationOptions;
+use errors::{Error, ErrorKind};
 use serde::{Deserialize, Serialize};
 
 /// What `register` re-fits.
@@ -49,7 +49,7 @@ pub struct RegisterOptions {
     /// a change beyond half the model's error is one a re-calibration removes.
     pub changed_ratio: f64,
     /// A re-fitted tool point this far (mm) from the one a position-only model was fitted with
-    /// is warned about ([`RegisterWarning::PositionModelToolPoint`]): 1 mm, where the orientation
+    /// is warned about ([`crate::RegisterWarning::PositionModelToolPoint`]): 1 mm, where the orientation
     /// a position-only fit leaves free (tens of mrad on the simulated IRB 4400) starts to cost
     /// more than a tracker's noise.
     pub moved_point_mm: f64,
@@ -73,7 +73,11 @@ impl RegisterOptions {
         self.registration.validate()?;
         for (field, value) in [("min_redundancy", self.min_redundancy), ("changed_ratio", self.changed_ratio)] {
             if !(value.is_finite() && value >= 1.0) {
-                return Err(Error::BadOption { field, value, expected: "a finite number of at least 1" });
+                return Err(Error::new(ErrorKind::OptionOutOfRange {
+                    field,
+                    value,
+                    expected: "a finite number of at least 1",
+                }));
             }
         }
         Ok(())

@@ -6,7 +6,7 @@
 //! least squares), then Levenberg–Marquardt on the left perturbation of `X` and the right
 //! perturbation of each `D_t`, with the exact Jacobian (the rotation rows through `J_l⁻¹`).
 
-use crate::Error;
+use errors::{Error, ErrorKind};
 use lie::{Matrix3, SE3, SO3, Twist, Vector3};
 use nalgebra::{DMatrix, DVector};
 use poe::identify::{kabsch, nearest_rotation};
@@ -68,11 +68,19 @@ impl RegistrationOptions {
         ];
         for (field, value) in positive {
             if !(value.is_finite() && value > 0.0) {
-                return Err(Error::BadOption { field, value, expected: "a positive finite number" });
+                return Err(Error::new(ErrorKind::OptionOutOfRange {
+                    field,
+                    value,
+                    expected: "a positive finite number",
+                }));
             }
         }
         if self.max_iterations == 0 {
-            return Err(Error::BadOption { field: "max_iterations", value: 0.0, expected: "at least 1" });
+            return Err(Error::new(ErrorKind::OptionOutOfRange {
+                field: "max_iterations",
+                value: 0.0,
+                expected: "at least 1",
+            }));
         }
         Ok(())
     }
@@ -226,7 +234,10 @@ fn solve(
             break;
         }
         if iteration == options.max_iterations {
-            return Err(Error::NotConverged { iterations: iteration, rms_m: rms(rows, &fit, options) });
+            return Err(Error::new(ErrorKind::RegistrationNotConverged {
+                iterations: iteration,
+                rms_m: rms(rows, &fit, options),
+            }));
         }
     }
     fit.rms_m = rms(rows, &fit, options);
@@ -393,7 +404,7 @@ fn check_determined(jacobian: &DMatrix<f64>, options: &RegistrationOptions) -> R
     let condition = if smallest > 0.0 { largest / smallest } else { f64::INFINITY };
     if jacobian.nrows() < jacobian.ncols() || condition > options.max_condition {
         let rank = s.iter().filter(|&&v| v * options.max_condition > largest).count();
-        return Err(Error::Undetermined { rank, parameters: jacobian.ncols(), condition });
+        return Err(Error::new(ErrorKind::PosesUndetermined { rank, parameters: jacobian.ncols(), condition }));
     }
     Ok(())
 }
@@ -513,7 +524,7 @@ mod tests {
             .collect();
         let unknowns = Unknowns { frame: true, tools: 0, tool_rotations: false };
         let err = register_rows(&data, unknowns, &RegistrationOptions::default()).unwrap_err();
-        assert!(matches!(err, Error::Undetermined { parameters: 6, .. }), "{err}");
+        assert!(matches!(err.kind(), ErrorKind::PosesUndetermined { parameters: 6, .. }), "{err}");
     }
 
     #[test]

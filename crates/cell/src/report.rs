@@ -1,8 +1,8 @@
 //! What `calib register` reports (`--json`: [`RegisterReport`], additive to the SPEC's JSON).
 
-use crate::Error;
 use crate::register_options::{Refit, RegisterOptions};
 use crate::registration::Registration;
+use errors::Error;
 use measurements::MeasurementSet;
 use model::WrappedJoint;
 use model::{

@@ -53,6 +53,12 @@ impl Error {
         Error::new(ErrorKind::Load { source: Box::new(source) })
     }
 
+    /// The pose generator refused its input while drawing candidates (a `loadsim::Error`, say);
+    /// the message is the generator's own.
+    pub fn generator(source: impl std::error::Error + Send + Sync + 'static) -> Error {
+        Error::new(ErrorKind::Generator { source: Box::new(source) })
+    }
+
     /// The Gaussian process failed (a `gp::Error`, say).
     pub fn gp(source: impl std::error::Error + Send + Sync + 'static) -> Error {
         Error::new(ErrorKind::Gp { source: Box::new(source) })
@@ -128,6 +134,51 @@ mod tests {
         let source = std::error::Error::source(&error).map(ToString::to_string);
         assert_eq!(source.as_deref(), Some("not positive definite"));
         assert!(matches!(error.kind(), ErrorKind::Gp { .. }));
+    }
+
+    #[test]
+    fn the_registration_and_report_kinds_keep_the_messages_of_their_former_enums() {
+        // The texts `cell::Error` and `report::Error` wrote before they were folded in here.
+        let error = Error::at_line("d.csv", 7, 3, ErrorKind::NewToolWithoutRefit { tool: "probe".into() });
+        assert_eq!(
+            error.to_string(),
+            "d.csv:7:3: tool 'probe' is not in the model; re-fit tools to add it (--refit tools or --refit base,tools)"
+        );
+        let kind = ErrorKind::TooFewPoses {
+            what: "the registration".into(),
+            poses: 8,
+            needed_poses: 9,
+            rows: 24,
+            parameters: 9,
+        };
+        assert_eq!(
+            kind.to_string(),
+            "too few poses for the registration: 8 poses (24 residual rows) for 9 re-fitted parameters; at least 9 poses are needed"
+        );
+        let kind = ErrorKind::PosesUndetermined { rank: 5, parameters: 6, condition: 1234.5 };
+        assert_eq!(
+            kind.to_string(),
+            "the poses determine only 5 of the 6 re-fitted parameters (condition number 1.234e3): measure poses with more varied joint angles and flange orientations"
+        );
+        let kind = ErrorKind::RegistrationNotConverged { iterations: 50, rms_m: 0.000_123_4 };
+        assert_eq!(kind.to_string(), "the registration did not converge in 50 iterations (RMS residual 0.1234 mm)");
+        let kind = ErrorKind::OptionOutOfRange { field: "ridge", value: -1.0, expected: "a positive finite number" };
+        assert_eq!(kind.to_string(), "option ridge = -1: expected a positive finite number");
+        assert_eq!(
+            ErrorKind::TooFewCandidates { candidates: 5, poses: 6 }.to_string(),
+            "6 poses asked for but only 5 candidates given"
+        );
+        assert_eq!(
+            ErrorKind::NoIdentifiableDirection { candidates: 4 }.to_string(),
+            "the 4 candidates determine no direction of the identification"
+        );
+        let error = Error::generator(std::io::Error::other("joint 2 has no range"));
+        assert_eq!(error.to_string(), "joint 2 has no range");
+        let kind = ErrorKind::Plot { figure: "histogram".into(), message: "no room".into() };
+        assert_eq!(kind.to_string(), "the chart \"histogram\" could not be drawn: no room");
+        let source = serde_json::from_str::<f64>("x").unwrap_err();
+        let expected = format!("the evaluation could not be written as JSON: {source}");
+        assert_eq!(ErrorKind::EvaluationJson { source }.to_string(), expected);
     }
 
     #[test]

@@ -518,6 +518,84 @@ pub enum ErrorKind {
         /// Refused where the reflection's residual is below this fraction of the rotation's.
         reflection_ratio: f64,
     },
+    /// Too few poses for what a registration re-fits: `rows` residual rows for `parameters`
+    /// parameters, `needed_poses` poses wanted (or too few poses of one tool).
+    TooFewPoses {
+        /// What is short: `the registration` or `tool 'x'`.
+        what: String,
+        /// Poses given.
+        poses: usize,
+        /// Poses needed.
+        needed_poses: usize,
+        /// Residual rows given.
+        rows: usize,
+        /// Parameters re-fitted.
+        parameters: usize,
+    },
+    /// Registration data that name a tool the model does not know, and tools are not re-fitted.
+    ///
+    /// At the first row with it, its `tool` column.
+    NewToolWithoutRefit {
+        /// The tool's identifier.
+        tool: String,
+    },
+    /// Poses that do not determine what a registration re-fits (e.g. all points on a line, or
+    /// one flange orientation for a tool offset and a base rotation).
+    PosesUndetermined {
+        /// Directions the poses determine.
+        rank: usize,
+        /// Parameters re-fitted.
+        parameters: usize,
+        /// Largest over smallest singular value of the scaled Jacobian.
+        condition: f64,
+    },
+    /// The registration's least squares did not converge.
+    RegistrationNotConverged {
+        /// Iterations run.
+        iterations: usize,
+        /// RMS residual at the end, m.
+        rms_m: f64,
+    },
+    /// A registration or planning option out of its range.
+    OptionOutOfRange {
+        /// The option's field name.
+        field: &'static str,
+        /// Its value.
+        value: f64,
+        /// What it must be.
+        expected: &'static str,
+    },
+    /// Fewer planning candidates than poses asked for.
+    TooFewCandidates {
+        /// Candidates available.
+        candidates: usize,
+        /// Poses asked for.
+        poses: usize,
+    },
+    /// Planning candidates that determine no direction of the identification.
+    NoIdentifiableDirection {
+        /// Candidates.
+        candidates: usize,
+    },
+    /// The pose generator refused its input while drawing planning candidates (`calib plan
+    /// --generate`); the message is the generator's own.
+    Generator {
+        /// The underlying error (a `loadsim::Error`, boxed: this crate knows none of them), its
+        /// message and `source()` chain kept.
+        source: Box<dyn std::error::Error + Send + Sync + 'static>,
+    },
+    /// A chart of the calibration report could not be drawn.
+    Plot {
+        /// The chart.
+        figure: String,
+        /// What `plotters` said.
+        message: String,
+    },
+    /// The evaluation embedded in the calibration report could not be written as JSON.
+    EvaluationJson {
+        /// The underlying error.
+        source: serde_json::Error,
+    },
 }
 
 impl fmt::Display for ErrorKind {
@@ -787,6 +865,39 @@ impl fmt::Display for ErrorKind {
                 f,
                 "the measured frame looks left-handed: two position columns swapped? (the robot turned onto the measurements leaves {rotation_rms_mm:.1} mm RMS, its mirror image {reflection_rms_mm:.1} mm) (--force fits anyway)"
             ),
+            ErrorKind::TooFewPoses { what, poses, needed_poses, rows, parameters } => write!(
+                f,
+                "too few poses for {what}: {poses} poses ({rows} residual rows) for {parameters} re-fitted \
+                 parameters; at least {needed_poses} poses are needed"
+            ),
+            ErrorKind::NewToolWithoutRefit { tool } => write!(
+                f,
+                "tool '{tool}' is not in the model; re-fit tools to add it (--refit tools or --refit base,tools)"
+            ),
+            ErrorKind::PosesUndetermined { rank, parameters, condition } => write!(
+                f,
+                "the poses determine only {rank} of the {parameters} re-fitted parameters (condition number \
+                 {condition:.3e}): measure poses with more varied joint angles and flange orientations"
+            ),
+            ErrorKind::RegistrationNotConverged { iterations, rms_m } => write!(
+                f,
+                "the registration did not converge in {iterations} iterations (RMS residual {:.4} mm)",
+                rms_m * 1e3
+            ),
+            ErrorKind::OptionOutOfRange { field, value, expected } => {
+                write!(f, "option {field} = {value}: expected {expected}")
+            }
+            ErrorKind::TooFewCandidates { candidates, poses } => {
+                write!(f, "{poses} poses asked for but only {candidates} candidates given")
+            }
+            ErrorKind::NoIdentifiableDirection { candidates } => {
+                write!(f, "the {candidates} candidates determine no direction of the identification")
+            }
+            ErrorKind::Generator { source } => write!(f, "{source}"),
+            ErrorKind::Plot { figure, message } => write!(f, "the chart {figure:?} could not be drawn: {message}"),
+            ErrorKind::EvaluationJson { source } => {
+                write!(f, "the evaluation could not be written as JSON: {source}")
+            }
         }
     }
 }
@@ -799,8 +910,9 @@ impl ErrorKind {
             ErrorKind::Kinematics { source }
             | ErrorKind::Load { source }
             | ErrorKind::Gp { source }
+            | ErrorKind::Generator { source }
             | ErrorKind::FittedModelRefused { source, .. } => Some(source.as_ref()),
-            ErrorKind::Json { source, .. } => Some(source),
+            ErrorKind::Json { source, .. } | ErrorKind::EvaluationJson { source } => Some(source),
             _ => None,
         }
     }

@@ -3,9 +3,10 @@
 //!
 //! An [`Error`] is a [`Place`] (a file, and a line and column where known) and an [`ErrorKind`]
 //! (what is wrong, with the numbers that explain it); its message is the place, then the kind's.
-//! The crate is a leaf: it knows no other crate of the workspace. The errors of `poe`, `loadsim`
-//! and `gp` are carried boxed ([`Error::kinematics`], [`Error::load`], [`Error::gp`]), their
-//! message and `source()` chain kept.
+//! The crate is a leaf: it knows no other crate of the workspace. Every calibration crate returns
+//! this error, from the readers up to `cell` (registration, planning) and `report`. The errors of
+//! `poe`, `loadsim` and `gp` are carried boxed ([`Error::kinematics`], [`Error::load`],
+//! [`Error::generator`], [`Error::gp`]), their message and `source()` chain kept.
 //!
 //! ```
 //! use errors::{Error, ErrorKind, Place};

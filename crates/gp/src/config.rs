@@ -133,7 +133,7 @@ pub struct GpConfig {
     /// kernel (output or shared group), the smaller model unless the additive term raises the log
     /// marginal likelihood by more than the Schwarz (BIC) penalty `½ k ln N` for its `k = 2d`
     /// extra hyperparameters and `N` observed values. Off by default in the library; the
-    /// calibration's GP stage turns it on (see `pipeline::ResidualGpOptions`).
+    /// calibration's GP stage turns it on (see `model::ResidualGpOptions`).
     pub additive_by_bic: bool,
     /// Also fit the paper's isotropic Eq. 5 kernel ([`crate::QuadraticKernel`]: one length scale,
     /// a constant and a linear term) for each kernel (output or shared group) and keep it where its

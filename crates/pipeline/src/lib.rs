@@ -2,8 +2,33 @@
 //! local POE model with the selected non-geometric effects, then a Gaussian process on the
 //! remaining pose error; `--effects auto` chooses the effects through the diagnosis.
 //!
-//! `pipeline` is also the one crate a downstream user (the `calib` binary, xtask) needs: it
-//! re-exports the public API of the crates it joins, so `pipeline::X` names every type of the SPEC.
+//! The crate holds the fit ([`fit()`], [`FitOptions`], [`FitReport`]), the plausibility checks
+//! that run before it ([`PlausibilityOptions`]), the prior toward the nominal geometry
+//! ([`choose_prior`], [`NominalPriorOptions`]) and `--effects auto` ([`choose_effects`],
+//! [`effects_of`]). Every other item is named by the crate that owns it, not re-exported here:
+//! `errors` (the one `Error`), `robot` (`RobotDescription`), `measurements` (the CSV,
+//! `MeasurementSet`, `OutputFile`), `model` (`CalibratedModel`, `Method`, `evaluate`, the model
+//! file), `effects`, `diagnose`, `campaign` (simulated data) and `cell` (inverse, `compensate`,
+//! URDF export, `register`, `plan`). There is no prelude: a type has one path, and a dependent's
+//! `Cargo.toml` lists the crates it uses.
+//!
+//! ```
+//! use campaign::{Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
+//! use model::Method;
+//! use pipeline::FitOptions;
+//!
+//! # fn main() -> Result<(), errors::Error> {
+//! let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots");
+//! let robot = robot::RobotDescription::read(&fixtures.join("irb4400.ron"))?;
+//! let cell = simulated_cell(&robot, &Perturbation::default(), 1)?;
+//! let config = loadsim::GeneratorConfig { sample_count: 60, seed: 1, ..Default::default() };
+//! let data = simulate(&cell, &paper_effects(), &joint_ranges(&robot), &config, false)?;
+//! let (model, report) = pipeline::fit(&robot, &data, Method::Poe, &FitOptions::default())?;
+//! assert_eq!(model.method, Method::Poe);
+//! assert!(model::evaluate(&model, &data)?.summary.mean_position_error_mm < 1.0, "{report:?}");
+//! # Ok(())
+//! # }
+//! ```
 #![deny(missing_docs)]
 
 mod auto;
@@ -13,24 +38,9 @@ mod fit_options;
 mod fit_prior;
 mod plausibility;
 
+pub use auto::{AutoChoice, choose as choose_effects, effects_of};
 pub use clusters::{BranchJoint, Cluster, HeightSplit};
 pub use fit::{FitReport, FitWarning, fit};
 pub use fit_options::{EffectOptions, FitOptions};
 pub use fit_prior::{NominalPriorOptions, PriorCandidate, PriorChoice, choose as choose_prior};
 pub use plausibility::{PlausibilityOptions, PlausibilityReport};
-
-pub use cell::*;
-pub use errors::{ColumnMapFault, DecimalFault, EffectListFault, Error, ErrorKind, FileKind, Place};
-pub use measurements::*;
-pub use model::*;
-pub use robot::*;
-
-pub use ::diagnose;
-/// The non-geometric effects (the `effects` crate), and the choice `--effects auto` makes of them.
-pub mod effects {
-    pub use crate::auto::{AutoChoice, choose, effects_of};
-    pub use ::effects::*;
-}
-pub use campaign as simulated;
-pub use diagnose::chart;
-pub use model::geometric;

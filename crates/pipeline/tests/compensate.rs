@@ -2,12 +2,14 @@
 //! reaches what each row means; every refusal says why, and the targets file's refusals name the
 //! file, line and column.
 
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise};
+use cell::{CompensateOptions, InverseOptions, PoseTarget, TargetFrame, TargetStatus};
+use errors::Error;
 use lie::{SE3, Vector3};
-use pipeline::simulated::{self, Effects, GeneratorConfig, Perturbation, TrackerNoise};
-use pipeline::{
-    CalibratedModel, ColumnMap, CompensateOptions, Error, FitOptions, InverseOptions, MeasurementSet, Method,
-    PoseTarget, RobotDescription, TargetFrame, TargetStatus,
-};
+use measurements::{ColumnMap, MeasurementSet};
+use model::{CalibratedModel, Method};
+use pipeline::FitOptions;
+use robot::RobotDescription;
 use std::path::{Path, PathBuf};
 
 fn fitted(
@@ -17,9 +19,9 @@ fn fitted(
     payloads: Vec<f64>,
 ) -> (RobotDescription, CalibratedModel, MeasurementSet) {
     let irb = testkit::robot("irb4400.ron");
-    let cell = simulated::simulated_cell(&irb, &Perturbation::default(), 21).unwrap();
+    let cell = campaign::simulated_cell(&irb, &Perturbation::default(), 21).unwrap();
     let config = GeneratorConfig { sample_count: 160, seed: 21, payloads_kg: payloads, ..GeneratorConfig::default() };
-    let set = simulated::simulate(&cell, &effects, &simulated::joint_ranges(&irb), &config, full_pose).unwrap();
+    let set = campaign::simulate(&cell, &effects, &campaign::joint_ranges(&irb), &config, full_pose).unwrap();
     let (model, _) = pipeline::fit(&irb, &set, method, &FitOptions::default()).unwrap();
     (irb, model, set)
 }
@@ -35,7 +37,7 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 fn predicted(model: &CalibratedModel, q: &[f64], payload_kg: f64) -> SE3 {
-    let row = pipeline::Measurement { payload_kg, ..pipeline::Measurement::at(q.to_vec(), Vector3::zeros()) };
+    let row = measurements::Measurement { payload_kg, ..measurements::Measurement::at(q.to_vec(), Vector3::zeros()) };
     model.predict(&[row], &[0]).unwrap()[0].pose
 }
 
@@ -48,15 +50,14 @@ const PROGRAM: &str = "q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,payload_kg,spee
 fn a_program_taught_on_the_nominal_model_is_rewritten_to_reach_its_poses() {
     let (irb, model, _) = fitted(Method::Poe, noise_only(), true, vec![0.0]);
     let dir = tempfile::tempdir().unwrap();
-    let file =
-        pipeline::read_targets(&write(dir.path(), "program.csv", PROGRAM), &model, ColumnMap::default()).unwrap();
+    let file = cell::read_targets(&write(dir.path(), "program.csv", PROGRAM), &model, ColumnMap::default()).unwrap();
     let options = CompensateOptions::default();
     let (targets, registered) =
-        pipeline::pose_targets(&model, &file, Some((&irb, "irb4400.ron")), TargetFrame::Tracker, &options).unwrap();
+        cell::pose_targets(&model, &file, Some((&irb, "irb4400.ron")), TargetFrame::Tracker, &options).unwrap();
     let registered = registered.unwrap();
     assert!(registered.rms_m > 1e-4 && registered.rms_m < 5e-3, "{}", registered.rms_m);
     let (solved, summary) =
-        pipeline::compensate(&model, &file, Some((&irb, "irb4400.ron")), TargetFrame::Tracker, &options).unwrap();
+        cell::compensate(&model, &file, Some((&irb, "irb4400.ron")), TargetFrame::Tracker, &options).unwrap();
     assert_eq!((summary.rows, summary.ok), (3, 3), "{summary:?}");
     assert!(summary.before_mean_mm > 0.1, "{summary:?}");
     for ((solved, target), row) in solved.iter().zip(&targets).zip(&file.set.rows) {
@@ -72,7 +73,7 @@ fn a_program_taught_on_the_nominal_model_is_rewritten_to_reach_its_poses() {
     }
     // The CSV: compensated joints first, the input columns as written, then the residuals.
     let mut csv = Vec::new();
-    pipeline::write_compensated(&mut csv, &file, &solved).unwrap();
+    cell::write_compensated(&mut csv, &file, &solved).unwrap();
     let csv = String::from_utf8(csv).unwrap();
     let mut lines = csv.lines();
     assert_eq!(
@@ -96,7 +97,7 @@ fn pose_targets_from_a_seed_are_reached_on_the_seeds_branch() {
         PoseTarget { seed: seed.clone(), pose, orientation: true, payload_kg: 0.0, tool: 0 },
         PoseTarget { seed, pose, orientation: false, payload_kg: 0.0, tool: 0 },
     ];
-    let solved = pipeline::solve_targets(&model, &targets, None, &InverseOptions::default()).unwrap();
+    let solved = cell::solve_targets(&model, &targets, None, &InverseOptions::default()).unwrap();
     assert!(solved[0].status.is_ok(), "{}", solved[0].status);
     let off = solved[0].q.iter().zip(&q).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
     assert!(off < 1e-8, "{off}");
@@ -106,7 +107,7 @@ fn pose_targets_from_a_seed_are_reached_on_the_seeds_branch() {
 
 #[test]
 fn a_gp_model_with_payload_is_compensated_through_its_whole_prediction() {
-    let (_, model, _) = fitted(Method::PoeGpLoad, simulated::paper_effects(), false, vec![0.0, 5.0, 10.0]);
+    let (_, model, _) = fitted(Method::PoeGpLoad, campaign::paper_effects(), false, vec![0.0, 5.0, 10.0]);
     assert!(model.residual_gp.is_some());
     let q = vec![0.2, 0.4, -0.2, 0.5, 0.7, 0.1];
     let pose = predicted(&model, &q, 0.0);
@@ -114,7 +115,7 @@ fn a_gp_model_with_payload_is_compensated_through_its_whole_prediction() {
         .iter()
         .map(|&payload_kg| PoseTarget { seed: q.clone(), pose, orientation: false, payload_kg, tool: 0 })
         .collect();
-    let solved = pipeline::solve_targets(&model, &targets, None, &InverseOptions::default()).unwrap();
+    let solved = cell::solve_targets(&model, &targets, None, &InverseOptions::default()).unwrap();
     for (s, t) in solved.iter().zip(&targets) {
         assert!(s.status.is_ok(), "{}", s.status);
         assert!((predicted(&model, &s.q, t.payload_kg).translation() - pose.translation()).norm() < 1e-9);
@@ -143,7 +144,7 @@ fn rows_that_cannot_be_compensated_say_why() {
     ];
     let mut limits = irb.limits();
     limits[3].1 = 0.5;
-    let solved = pipeline::solve_targets(&model, &targets, Some(&limits), &InverseOptions::default()).unwrap();
+    let solved = cell::solve_targets(&model, &targets, Some(&limits), &InverseOptions::default()).unwrap();
     assert!(matches!(solved[0].status, TargetStatus::NoConvergence { iterations: 30, .. }), "{}", solved[0].status);
     assert!(solved[0].status.to_string().starts_with("no convergence: "), "{}", solved[0].status);
     assert!(matches!(solved[1].status, TargetStatus::Singular { .. }), "{}", solved[1].status);
@@ -190,7 +191,7 @@ fn targets_files_that_cannot_be_compensated_are_refused_at_their_place() {
     let (irb, model, _) = fitted(Method::Poe, noise_only(), false, vec![0.0]);
     let dir = tempfile::tempdir().unwrap();
     let read =
-        |name: &str, text: &str| pipeline::read_targets(&write(dir.path(), name, text), &model, ColumnMap::default());
+        |name: &str, text: &str| cell::read_targets(&write(dir.path(), name, text), &model, ColumnMap::default());
     let message = refusal(read("nojoints.csv", "x_mm,y_mm,z_mm\n1,2,3\n"));
     assert!(message.contains("nojoints.csv:1:4: 0 joint columns, the robot has 6 joints"), "{message}");
     let header = "q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad";
@@ -204,9 +205,9 @@ fn targets_files_that_cannot_be_compensated_are_refused_at_their_place() {
 
     let joints = read("joints.csv", &format!("{header}\n0.1,0.2,0.1,0.3,0.5,0.2\n")).unwrap();
     let options = CompensateOptions::default();
-    let message = refusal(pipeline::compensate(&model, &joints, None, TargetFrame::Tracker, &options));
+    let message = refusal(cell::compensate(&model, &joints, None, TargetFrame::Tracker, &options));
     assert!(message.contains("joints.csv:1:1: joint targets are a program taught on the nominal model"), "{message}");
-    let message = refusal(pipeline::compensate(
+    let message = refusal(cell::compensate(
         &model,
         &joints,
         Some((&testkit::robot("ur10.ron"), "ur10.ron")),
@@ -215,9 +216,9 @@ fn targets_files_that_cannot_be_compensated_are_refused_at_their_place() {
     ));
     assert!(message.starts_with("ur10.ron: this robot, placed on the model by base and tool, stays"), "{message}");
     let poses = read("poses.csv", &format!("{header},x_mm,y_mm,z_mm\n0.1,0.2,0.1,0.3,0.5,0.2,1000,0,1500\n")).unwrap();
-    let message = refusal(pipeline::compensate(&model, &poses, None, TargetFrame::Base, &options));
+    let message = refusal(cell::compensate(&model, &poses, None, TargetFrame::Base, &options));
     assert!(message.contains("poses.csv:1:1: poses in the base frame need the robot description"), "{message}");
     let (solved, _) =
-        pipeline::compensate(&model, &poses, Some((&irb, "irb4400.ron")), TargetFrame::Base, &options).unwrap();
+        cell::compensate(&model, &poses, Some((&irb, "irb4400.ron")), TargetFrame::Base, &options).unwrap();
     assert_eq!(solved.len(), 1);
 }

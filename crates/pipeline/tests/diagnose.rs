@@ -1,13 +1,14 @@
 //! `diagnose` on simulated data whose hidden effect it is not told.
 
-use loadsim::{CouplingFactor, CouplingTerm, Harmonic, JointCoupling, PeriodicError};
-use pipeline::diagnose::{DiagnoseOptions, Effect, NoiseSource, StructureOptions, diagnose};
-use pipeline::effects::CandidateOptions;
-use pipeline::simulated::{
+use campaign::{
     Effects, GeneratorConfig, Perturbation, Remount, TrackerNoise, joint_ranges, payload_run_campaign, simulate,
     simulate_campaign, simulated_cell,
 };
-use pipeline::{MeasurementSet, RobotDescription};
+use diagnose::{DiagnoseOptions, Effect, NoiseSource, StructureOptions, diagnose};
+use effects::CandidateOptions;
+use loadsim::{CouplingFactor, CouplingTerm, Harmonic, JointCoupling, PeriodicError};
+use measurements::MeasurementSet;
+use robot::RobotDescription;
 
 fn simulated(robot: &RobotDescription, effects: &Effects, full_pose: bool, seed: u64) -> MeasurementSet {
     let cell = simulated_cell(robot, &Perturbation::default(), seed).unwrap();
@@ -104,7 +105,7 @@ fn too_few_rows_are_refused() {
     let data = simulated(&robot, &Effects::default(), false, 27);
     let small = data.subset(&(0..30).collect::<Vec<_>>());
     let error = diagnose(&robot, &small, &DiagnoseOptions::default()).unwrap_err();
-    assert!(matches!(error.kind(), pipeline::ErrorKind::TooFewRows { rows: 30, needed: 50, .. }), "{error}");
+    assert!(matches!(error.kind(), errors::ErrorKind::TooFewRows { rows: 30, needed: 50, .. }), "{error}");
 }
 
 /// The 7-axis campaign of issue 11: joints 1 and 2 move, the others sit at 0 within 2 mrad;
@@ -178,7 +179,7 @@ fn a_coupling_between_joints_is_unknown_with_the_joints_it_depends_on() {
 #[test]
 fn a_lifting_column_is_reported_in_millimetres_and_offered_no_series_of_its_angle() {
     let robot = testkit::robot("column_ur10.ron");
-    assert_eq!(robot.joints[0].kind, pipeline::JointType::Prismatic);
+    assert_eq!(robot.joints[0].kind, robot::JointType::Prismatic);
     let periodic =
         PeriodicError { harmonics: vec![Harmonic { joint_index: 2, order: 3.0, amplitude_rad: 4e-4, phase_rad: 0.3 }] };
     let data = simulated(&robot, &Effects { periodic: Some(periodic), ..Effects::default() }, false, 5);
@@ -192,7 +193,7 @@ fn a_lifting_column_is_reported_in_millimetres_and_offered_no_series_of_its_angl
     );
     assert!(diagnosis.selected.iter().any(|s| s.effect == Effect::GearPeriodic && s.joints == [3]), "{diagnosis:?}");
     let options = pipeline::FitOptions::default().with_effects("gear_periodic:1:3".parse().unwrap());
-    let error = pipeline::fit(&robot, &data, pipeline::Method::Poe, &options).unwrap_err();
+    let error = pipeline::fit(&robot, &data, model::Method::Poe, &options).unwrap_err();
     assert_eq!(
         error.to_string(),
         "gear_periodic on joint 1: joint 1 is prismatic, and a gear_periodic is a function of a revolute joint's angle"

@@ -2,12 +2,13 @@
 //! that effect hidden, takes the held-out error down to the tracker noise; the model file keeps
 //! them and an older file (schema 1) still reads.
 
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell};
+use effects::{EffectSelection, IdentifiedEffect};
 use loadsim::{BaseDrift, Harmonic, JointBacklash, PeriodicError, ThermalGrowth};
-use pipeline::effects::{EffectSelection, IdentifiedEffect};
-use pipeline::simulated::{
-    Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell,
-};
-use pipeline::{FitOptions, MeasurementSet, Method, RobotDescription};
+use measurements::MeasurementSet;
+use model::Method;
+use pipeline::FitOptions;
+use robot::RobotDescription;
 
 /// 400 poses with `effects` and the tracker's noise: 250 to train on (the even rows... the first
 /// 250) and 150 held out.
@@ -24,7 +25,7 @@ fn heldout(robot: &RobotDescription, train: &MeasurementSet, test: &MeasurementS
     let (model, report) =
         pipeline::fit(robot, train, Method::Poe, &FitOptions::default().with_effects(selection)).unwrap();
     assert!(report.identification.converged, "{effects}: {}", report.identification.termination);
-    pipeline::evaluate(&model, test).unwrap().summary.mean_position_error_mm
+    model::evaluate(&model, test).unwrap().summary.mean_position_error_mm
 }
 
 /// The held-out error the tracker noise alone leaves on the same poses.
@@ -118,13 +119,13 @@ fn a_model_with_every_effect_reads_back_and_predicts_the_same() {
     assert_eq!(kinds, ["joint_compliance", "gear_periodic", "backlash", "thermal", "time_drift"]);
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("m.ron");
-    pipeline::write_model(&path, &model).unwrap();
-    let again = pipeline::read_model(&path).unwrap();
+    model::write_model(&path, &model).unwrap();
+    let again = model::read_model(&path).unwrap();
     for (a, b) in again.effects.iter().zip(&model.effects) {
         assert_eq!(a.theta(), b.theta());
     }
-    let before = pipeline::evaluate(&model, &test).unwrap().errors;
-    let after = pipeline::evaluate(&again, &test).unwrap().errors;
+    let before = model::evaluate(&model, &test).unwrap().errors;
+    let after = model::evaluate(&again, &test).unwrap().errors;
     for (a, b) in before.iter().zip(&after) {
         assert!((a.position_mm - b.position_mm).abs() < 1e-9, "{a:?} {b:?}");
     }
@@ -134,12 +135,11 @@ fn a_model_with_every_effect_reads_back_and_predicts_the_same() {
 /// payload runs with a tool each, measured torques), full pose, split even / odd rows.
 fn campaign(effects: &Effects, seed: u64) -> (MeasurementSet, MeasurementSet) {
     let robot = testkit::robot("iiwa7.ron");
-    let config = pipeline::simulated::payload_run_campaign(400, seed);
+    let config = campaign::payload_run_campaign(400, seed);
     let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..effects.clone() };
-    let remount = pipeline::simulated::Remount::default();
+    let remount = campaign::Remount::default();
     let (_, all) =
-        pipeline::simulated::simulate_campaign(&robot, &effects, &Perturbation::default(), &remount, &config, true)
-            .unwrap();
+        campaign::simulate_campaign(&robot, &effects, &Perturbation::default(), &remount, &config, true).unwrap();
     let even: Vec<usize> = (0..all.rows.len()).step_by(2).collect();
     let odd: Vec<usize> = (1..all.rows.len()).step_by(2).collect();
     (all.subset(&even), all.subset(&odd))
@@ -149,7 +149,7 @@ fn campaign(effects: &Effects, seed: u64) -> (MeasurementSet, MeasurementSet) {
 fn a_seven_axis_campaign_with_two_moving_joints_reaches_the_noise_with_joint_compliance() {
     let robot = testkit::robot("iiwa7.ron");
     let seed = 35;
-    let (train, test) = campaign(&pipeline::simulated::paper_effects(), seed);
+    let (train, test) = campaign(&campaign::paper_effects(), seed);
     let (noise_train, noise_test) = campaign(&Effects::default(), seed);
     let floor = heldout(&robot, &noise_train, &noise_test, "");
     let poe = heldout(&robot, &train, &test, "");
@@ -223,7 +223,7 @@ fn a_model_is_its_parts_applied_in_order_and_export_reports_each_one() {
     let selection = "gear_periodic:3:2,backlash:2".parse().unwrap();
     let (model, _) =
         pipeline::fit(&robot, &train, Method::PoeGp, &FitOptions::default().with_effects(selection)).unwrap();
-    let names: Vec<String> = model.parts().iter().map(pipeline::Part::name).collect();
+    let names: Vec<String> = model.parts().iter().map(model::Part::name).collect();
     assert_eq!(
         names,
         [
@@ -238,17 +238,17 @@ fn a_model_is_its_parts_applied_in_order_and_export_reports_each_one() {
     let not_in_urdf: Vec<String> = names.iter().filter(|n| !n.starts_with("geometry")).cloned().collect();
     assert_eq!(model.non_geometric_parts(), not_in_urdf);
     // Every part matters on held-out rows, and leaving one out costs what it explained.
-    let error = |m: &pipeline::CalibratedModel| pipeline::evaluate(m, &test).unwrap().summary.mean_position_error_mm;
+    let error = |m: &model::CalibratedModel| model::evaluate(m, &test).unwrap().summary.mean_position_error_mm;
     let whole = error(&model);
     for (k, name) in names.iter().enumerate().take(3).skip(1) {
         let without = error(&model.without_part(k));
         assert!(without > 1.5 * whole, "without {name}: {without} mm against {whole} mm");
     }
-    let export = pipeline::export_urdf(
+    let export = cell::export_urdf(
         &model,
-        pipeline::UrdfTemplate::Plain { nominal: Some((&robot, "irb4400.ron")) },
+        cell::UrdfTemplate::Plain { nominal: Some((&robot, "irb4400.ron")) },
         Some(&train),
-        &pipeline::NominalTolerance::default(),
+        &robot::NominalTolerance::default(),
     )
     .unwrap();
     let training = export.report.training_error.unwrap();
@@ -288,7 +288,7 @@ fn a_gear_series_warns_where_it_is_used_outside_the_angles_it_was_fitted_on() {
         // The gaps of the joint's turn (angles modulo 2π): around 0 and the rest of the circle
         // beyond ±0.6 rad.
         assert_eq!(warnings[0].gaps_rad.len(), 2, "{what}: {:?}", warnings[0].gaps_rad);
-        let report = pipeline::EvalReport::new(&model, set, &pipeline::evaluate(&model, set).unwrap());
+        let report = model::EvalReport::new(&model, set, &model::evaluate(&model, set).unwrap());
         assert_eq!(report.warnings, warnings, "{what}: eval --json carries them");
     }
 }
@@ -327,8 +327,8 @@ fn a_gear_series_falls_back_to_the_geometry_in_a_gap_and_past_the_end_of_its_ang
         pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default().with_effects(selection)).unwrap().0
     };
     let (poe, gear) = (fit(""), fit("gear_periodic:2:24"));
-    let error = |model: &pipeline::CalibratedModel, set: &MeasurementSet| {
-        pipeline::evaluate(model, set).unwrap().summary.mean_position_error_mm
+    let error = |model: &model::CalibratedModel, set: &MeasurementSet| {
+        model::evaluate(model, set).unwrap().summary.mean_position_error_mm
     };
     for (set, what) in [(&gap, "in the gap"), (&beyond, "past the end")] {
         assert!(set.rows.len() >= 20, "{what}: {} rows", set.rows.len());
@@ -343,7 +343,7 @@ fn a_gear_series_falls_back_to_the_geometry_in_a_gap_and_past_the_end_of_its_ang
     // standard deviation of the size of the fitted error's RMS times the joint's lever; where it
     // was fitted, none.
     let position_sigma = |set: &MeasurementSet| -> Vec<f64> {
-        let tools = pipeline::tool_indices(&gear, set).unwrap();
+        let tools = model::tool_indices(&gear, set).unwrap();
         gear.predict(&set.rows, &tools)
             .unwrap()
             .iter()
@@ -367,7 +367,7 @@ fn a_gear_series_falls_back_to_the_geometry_in_a_gap_and_past_the_end_of_its_ang
         assert_eq!((joint_2[0].rows_outside, joint_2[0].unit), (beyond.rows.len(), "rad"));
         assert!(joint_2[0].to_string().contains("outside the range the model was fitted on"));
         assert!(model.outside_training_range(&inside.rows).is_empty());
-        let report = pipeline::EvalReport::new(model, &beyond, &pipeline::evaluate(model, &beyond).unwrap());
+        let report = model::EvalReport::new(model, &beyond, &model::evaluate(model, &beyond).unwrap());
         assert_eq!(report.out_of_range, warnings, "eval --json carries them");
     }
     let IdentifiedEffect::GearPeriodic(series) = &gear.effects[0] else { panic!("{:?}", gear.effects) };
@@ -387,11 +387,11 @@ fn the_diagnosis_predicts_the_error_in_a_gap_and_past_the_end_from_arcs_of_the_j
     let (robot, all) = joint_2_gear_campaign();
     let train = rows_where(&all, |q| (0.35..=0.9).contains(&q.abs()));
     let off = rows_where(&all, |q| q.abs() < 0.3 || q.abs() > 0.95);
-    let diagnosis = pipeline::diagnose::diagnose(&robot, &train, &Default::default()).unwrap();
-    let chosen = pipeline::effects::effects_of(&diagnosis.selected);
+    let diagnosis = diagnose::diagnose(&robot, &train, &Default::default()).unwrap();
+    let chosen = pipeline::effects_of(&diagnosis.selected);
     let selection = EffectSelection::List(chosen.clone());
     let model = pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default().with_effects(selection)).unwrap().0;
-    let fitted = pipeline::evaluate(&model, &off).unwrap().summary.mean_position_error_mm;
+    let fitted = model::evaluate(&model, &off).unwrap().summary.mean_position_error_mm;
     let joint_2 = diagnosis.arcs.iter().find(|a| a.joint == 2).expect("joint 2 moves");
     eprintln!(
         "chosen {chosen:?}; random folds {:.4} -> {:.4} mm; joint 2's arcs {:.4} -> {:.4} mm; fitted, off the poses: {fitted:.4} mm ({} rows)",
@@ -447,7 +447,7 @@ fn a_drift_fitted_in_one_session_is_not_carried_into_another_days_later() {
             options.effects.fallback_sigma_ratio = f64::INFINITY;
         }
         let model = pipeline::fit(&robot, &first, Method::Poe, &options).unwrap().0;
-        pipeline::evaluate(&model, &later).unwrap().summary.mean_position_error_mm
+        model::evaluate(&model, &later).unwrap().summary.mean_position_error_mm
     };
     let (alone, with, line) = (fit("", 1.0), fit("time_drift", 1.0), fit("time_drift", 1e9));
     eprintln!("eight days later: poe {alone:.4} mm, with the drift {with:.4} mm, the drift as a line {line:.4} mm");
@@ -484,8 +484,8 @@ fn rows_that_excite_what_no_training_row_did_have_a_large_sigma_and_fall_back_to
             options.effects.fallback_sigma_ratio = ratio;
             pipeline::fit(&robot, &train, Method::Poe, &options).unwrap().0
         };
-        let error = |model: &pipeline::CalibratedModel, set: &MeasurementSet| {
-            pipeline::evaluate(model, set).unwrap().summary.mean_position_error_mm
+        let error = |model: &model::CalibratedModel, set: &MeasurementSet| {
+            model::evaluate(model, set).unwrap().summary.mean_position_error_mm
         };
         let geometry = fit("", f64::INFINITY);
         // The simulated arm has only geometric errors: what the geometry leaves on its own
@@ -509,7 +509,7 @@ fn rows_that_excite_what_no_training_row_did_have_a_large_sigma_and_fall_back_to
             let uncertainty = model.effect_uncertainty.as_ref().unwrap();
             assert!(uncertainty.training_sigma_m[1] < uncertainty.fallback_sigma_m);
             assert_eq!(error(&model, &train), error(&never, &train), "seed {seed}, {effects}");
-            let fallen = model.sigma_fallback(&off.rows, &pipeline::tool_indices(&model, &off).unwrap()).unwrap();
+            let fallen = model.sigma_fallback(&off.rows, &model::tool_indices(&model, &off).unwrap()).unwrap();
             let fallen = fallen.expect("rows off the band fall back");
             assert!(fallen.rows > off.rows.len() / 4, "seed {seed}, {effects}: {fallen:?}");
         }
@@ -533,10 +533,10 @@ fn the_sigmas_columns_are_the_derivatives_of_the_prediction() {
     let (model, _) = pipeline::fit(&robot, &train, Method::Poe, &options).unwrap();
     let uncertainty = model.effect_uncertainty.clone().expect("a fit with effects keeps its uncertainty");
     // The plain sum of the parts: no fallback, so the prediction is the geometry and the effects.
-    let plain = pipeline::CalibratedModel { effect_uncertainty: None, fallback_kinematics: None, ..model.clone() };
+    let plain = model::CalibratedModel { effect_uncertainty: None, fallback_kinematics: None, ..model.clone() };
     let rows = &test.rows[..3];
     let tools = vec![0; rows.len()];
-    let poses = |m: &pipeline::CalibratedModel| m.geometric_poses(rows, &tools).unwrap();
+    let poses = |m: &model::CalibratedModel| m.geometric_poses(rows, &tools).unwrap();
     let base = poses(&plain);
     let layout = plain.kinematics.layout().len();
     let h = 1e-7;

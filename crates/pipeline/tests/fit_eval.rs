@@ -1,11 +1,13 @@
 //! `fit` then `evaluate` on synthetic tracker data made here, through the files users write.
 
+use errors::ErrorKind;
 use lie::{SE3, SO3, Twist, Vector3};
-use pipeline::{
-    ErrorKind, FitOptions, Measurement, MeasurementSet, Method, ReadOptions, RobotDescription, parse_measurements,
-};
+use measurements::{Measurement, MeasurementSet, ReadOptions, parse_measurements};
+use model::Method;
+use pipeline::FitOptions;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use robot::RobotDescription;
 
 fn twist(rng: &mut ChaCha8Rng, translation: f64, rotation: f64) -> Twist {
     let mut v = || Vector3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
@@ -60,9 +62,9 @@ fn poe_fit_through_csv_and_model_file_reproduces_held_out_poses() {
         assert_eq!(report.identification.rank, if full_pose { 36 } else { 30 });
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("model.ron");
-        pipeline::write_model(&path, &model).unwrap();
-        let model = pipeline::read_model(&path).unwrap();
-        let evaluation = pipeline::evaluate(&model, &test).unwrap();
+        model::write_model(&path, &model).unwrap();
+        let model = model::read_model(&path).unwrap();
+        let evaluation = model::evaluate(&model, &test).unwrap();
         assert!(evaluation.summary.mean_position_error_mm < 1e-6, "{:?}", evaluation.summary);
         assert_eq!(evaluation.summary.mean_rotation_error_mrad.is_some(), full_pose);
     }
@@ -77,8 +79,8 @@ fn base_tool_fit_cannot_absorb_joint_errors_but_poe_can() {
     let (base_tool, report) = pipeline::fit(&robot, &train, Method::BaseTool, &FitOptions::default()).unwrap();
     assert_eq!(report.identification.rank, 12);
     let (poe, _) = pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default()).unwrap();
-    let bt = pipeline::evaluate(&base_tool, &test).unwrap().summary.mean_position_error_mm;
-    let full = pipeline::evaluate(&poe, &test).unwrap().summary.mean_position_error_mm;
+    let bt = model::evaluate(&base_tool, &test).unwrap().summary.mean_position_error_mm;
+    let full = model::evaluate(&poe, &test).unwrap().summary.mean_position_error_mm;
     assert!(bt > 0.1 && full < 1e-6, "base-tool {bt} mm, poe {full} mm");
 }
 
@@ -88,7 +90,7 @@ fn evaluation_refuses_a_tool_the_model_does_not_know() {
     let train = through_csv(&synthetic(&robot, 60, &["A"], true, 7));
     let (model, _) = pipeline::fit(&robot, &train, Method::BaseTool, &FitOptions::default()).unwrap();
     let other = through_csv(&synthetic(&robot, 10, &["Z"], true, 8));
-    let error = pipeline::evaluate(&model, &other).unwrap_err();
+    let error = model::evaluate(&model, &other).unwrap_err();
     assert!(
         matches!(error.kind(), ErrorKind::UnknownTool { .. }) && matches!(error.position(), Some((2, _))),
         "{error}"
@@ -103,17 +105,16 @@ fn model_files_of_another_schema_or_broken_are_refused_with_a_position() {
     let (model, _) = pipeline::fit(&robot, &train, Method::BaseTool, &FitOptions::default()).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("model.ron");
-    pipeline::write_model(&path, &model).unwrap();
+    model::write_model(&path, &model).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
-    let error =
-        pipeline::parse_model(&text.replacen("schema_version: 2", "schema_version: 99", 1), "m.ron").unwrap_err();
+    let error = model::parse_model(&text.replacen("schema_version: 2", "schema_version: 99", 1), "m.ron").unwrap_err();
     assert!(matches!(error.kind(), ErrorKind::SchemaVersion { found: 99, supported: 2, .. }), "{error}");
-    let error = pipeline::parse_model(&text.replacen("kinematics", "kinematic", 1), "m.ron").unwrap_err();
+    let error = model::parse_model(&text.replacen("kinematics", "kinematic", 1), "m.ron").unwrap_err();
     assert!(
         matches!(error.kind(), ErrorKind::RonFormat { .. }) && matches!(error.position(), Some((line, _)) if line > 1),
         "{error}"
     );
-    let error = pipeline::parse_model("(schema_version: 1,", "m.ron").unwrap_err();
+    let error = model::parse_model("(schema_version: 1,", "m.ron").unwrap_err();
     assert!(error.to_string().starts_with("m.ron:"), "{error}");
 }
 
@@ -137,7 +138,7 @@ fn a_blank_tool_is_the_default_tool_in_the_fit_its_report_and_the_evaluation() {
     // The fit's own "after" report once sent the blank rows to tool "A": hundreds of mm.
     assert!(report.after.max_position_error_mm < 1e-6, "{:?}", report.after);
     let test = all.subset(&(100..160).collect::<Vec<_>>());
-    let evaluation = pipeline::evaluate(&model, &test).unwrap();
+    let evaluation = model::evaluate(&model, &test).unwrap();
     assert!(evaluation.summary.max_position_error_mm < 1e-6, "{:?}", evaluation.summary);
 
     // A file without a tool column is the default tool too: the blank rows alone, written
@@ -148,7 +149,7 @@ fn a_blank_tool_is_the_default_tool_in_the_fit_its_report_and_the_evaluation() {
     blank.rows.iter_mut().for_each(|r| r.tool = 0);
     let blank = through_csv(&blank);
     assert_eq!(blank.tool_column, None);
-    let evaluation = pipeline::evaluate(&model, &blank).unwrap();
+    let evaluation = model::evaluate(&model, &blank).unwrap();
     assert!(evaluation.summary.max_position_error_mm < 1e-6, "{:?}", evaluation.summary);
 }
 
@@ -158,7 +159,7 @@ fn the_default_tool_is_refused_by_a_model_fitted_only_with_named_tools() {
     let train = through_csv(&synthetic(&robot, 60, &["A", "B"], true, 11));
     let (model, _) = pipeline::fit(&robot, &train, Method::BaseTool, &FitOptions::default()).unwrap();
     let unnamed = through_csv(&synthetic(&robot, 10, &[""], true, 12));
-    let error = pipeline::evaluate(&model, &unnamed).unwrap_err();
+    let error = model::evaluate(&model, &unnamed).unwrap_err();
     assert!(
         matches!(error.kind(), ErrorKind::UnknownTool { tool, .. } if tool.is_empty())
             && matches!(error.position(), Some((2, _))),

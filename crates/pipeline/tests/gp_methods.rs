@@ -1,7 +1,10 @@
 //! The GP methods on simulated data with a load effect: the paper's ordering on held-out rows.
 
-use pipeline::simulated::{GeneratorConfig, Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
-use pipeline::{FitOptions, MeasurementSet, Method, RobotDescription};
+use campaign::{GeneratorConfig, Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
+use measurements::MeasurementSet;
+use model::Method;
+use pipeline::FitOptions;
+use robot::RobotDescription;
 
 /// Simulated tracker data of a perturbed IRB 4400 whose joints give under gravity and payload.
 /// The payloads span the robot's rating (0 to 60 kg), where the load effect is of the same order
@@ -26,7 +29,7 @@ fn with_a_load_effect_poe_gp_load_beats_poe_gp_which_beats_poe() {
         let test = all.subset(&(250..400).collect::<Vec<_>>());
         let error = |method| {
             let (model, _) = pipeline::fit(&robot, &train, method, &FitOptions::default()).unwrap();
-            pipeline::evaluate(&model, &test).unwrap().summary.mean_position_error_mm
+            model::evaluate(&model, &test).unwrap().summary.mean_position_error_mm
         };
         let (poe, gp, load) = (error(Method::Poe), error(Method::PoeGp), error(Method::PoeGpLoad));
         eprintln!("seed {seed} full pose {full_pose}: poe {poe:.4} poe-gp {gp:.4} poe-gp-load {load:.4} mm");
@@ -46,7 +49,7 @@ fn identified_joint_compliance_leaves_little_more_than_the_noise() {
             let effects = if joint_compliance { "joint_compliance".parse().unwrap() } else { Default::default() };
             let options = FitOptions::default().with_effects(effects);
             let (model, _) = pipeline::fit(&robot, &train, method, &options).unwrap();
-            pipeline::evaluate(&model, &test).unwrap().summary.mean_position_error_mm
+            model::evaluate(&model, &test).unwrap().summary.mean_position_error_mm
         };
         let load = error(Method::PoeGpLoad, false);
         let compliance = error(Method::Poe, true);
@@ -63,7 +66,7 @@ fn identified_joint_compliance_leaves_little_more_than_the_noise() {
 fn a_gp_search_stopped_by_its_iteration_limit_is_reported_not_passed_off_as_converged() {
     let robot = testkit::robot("irb4400.ron");
     let data = loaded_data(&robot, 120, false, 21);
-    let warned = |max_iterations: usize, method: pipeline::GpChoice| {
+    let warned = |max_iterations: usize, method: model::GpChoice| {
         let mut options = FitOptions::default();
         options.residual_gp.gp.optimiser.max_iterations = max_iterations;
         options.residual_gp.method = method;
@@ -73,7 +76,7 @@ fn a_gp_search_stopped_by_its_iteration_limit_is_reported_not_passed_off_as_conv
             _ => None,
         })
     };
-    for method in [pipeline::GpChoice::Exact, pipeline::GpChoice::Sparse] {
+    for method in [model::GpChoice::Exact, model::GpChoice::Sparse] {
         let (outputs, iterations) = warned(1, method).expect("one iteration cannot meet the tolerance");
         assert!(!outputs.is_empty() && outputs.iter().all(|o| *o < 3), "{method:?}: outputs {outputs:?}");
         assert_eq!(iterations, 1, "{method:?}");
@@ -97,7 +100,7 @@ fn fit_report_gives_the_gp_leave_one_out_error_near_the_held_out_error() {
         let mut options = FitOptions::default();
         options.residual_gp.rotation_follows_position = true;
         let (model, report) = pipeline::fit(&robot, &train, Method::PoeGpLoad, &options).unwrap();
-        let held_out = pipeline::evaluate(&model, &test).unwrap().summary.mean_position_error_mm;
+        let held_out = model::evaluate(&model, &test).unwrap().summary.mean_position_error_mm;
         let residual_gp = report.residual_gp.as_ref().expect("a GP method reports its GP");
         let loo = residual_gp.leave_one_out.as_ref().expect("the exact GP has a leave-one-out error");
         let training = report.after.mean_position_error_mm;
@@ -114,7 +117,7 @@ fn fit_report_gives_the_gp_leave_one_out_error_near_the_held_out_error() {
             loo.mean_position_error_mm
         );
         assert_eq!(loo.mean_rotation_error_mrad.is_some(), full_pose);
-        if let pipeline::GpFitReport::Exact(gp) = &residual_gp.gp {
+        if let model::GpFitReport::Exact(gp) = &residual_gp.gp {
             let groups: Vec<&Vec<usize>> = gp.components.iter().map(|c| &c.outputs).collect();
             let expected: Vec<Vec<usize>> = if full_pose {
                 vec![vec![0], vec![1], vec![2], vec![3, 4, 5]]
@@ -152,14 +155,14 @@ fn repeated_configurations_are_left_out_together_in_the_stored_heldout_estimate(
             train.rows.push(twin);
         }
         let (model, report) = pipeline::fit(&robot, &train, Method::PoeGpLoad, &FitOptions::default()).unwrap();
-        let held_out = pipeline::evaluate(&model, &test).unwrap().summary.mean_position_error_mm;
+        let held_out = model::evaluate(&model, &test).unwrap().summary.mean_position_error_mm;
         let gp = report.residual_gp.as_ref().expect("a GP method reports its GP");
         let per_row = gp.leave_one_out.as_ref().expect("exact GP").mean_position_error_mm;
         let grouped = gp.leave_group_out.as_ref().expect("repeats give a grouped error").mean_position_error_mm;
         let stored = model.heldout.expect("the fit keeps an estimate");
         eprintln!("seed {seed}: leave-one-out {per_row:.4}, leave-group-out {grouped:.4}, held out {held_out:.4} mm");
         assert_eq!((gp.repeated_rows, gp.repeated_configurations), (240, 120));
-        assert_eq!(stored.source, pipeline::HeldoutSource::GpLeaveGroupOut);
+        assert_eq!(stored.source, model::HeldoutSource::GpLeaveGroupOut);
         assert_eq!(stored.mean_position_error_mm, grouped);
         let ratio = grouped / held_out;
         assert!((0.7..1.3).contains(&ratio), "leave-group-out {grouped} mm against held out {held_out} mm");

@@ -5,13 +5,14 @@
 //! file reads back, and the diagnosis names it beside a backlash, so that `--effects auto` reaches
 //! the noise too.
 
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell};
+use diagnose::{DiagnoseOptions, Effect, diagnose};
+use effects::{EffectSelection, IdentifiedEffect, stand_in_dynamics};
 use loadsim::{Backlash, BentLink, JointBacklash, LinkDeflection};
-use pipeline::diagnose::{DiagnoseOptions, Effect, diagnose};
-use pipeline::effects::{EffectSelection, IdentifiedEffect, stand_in_dynamics};
-use pipeline::simulated::{
-    Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell,
-};
-use pipeline::{FitOptions, MeasurementSet, Method, RobotDescription};
+use measurements::MeasurementSet;
+use model::Method;
+use pipeline::FitOptions;
+use robot::RobotDescription;
 
 /// The column arm with a mass model: the stand-in bars' masses (50 kg per metre of link) scaled
 /// link by link, so that the masses are not the ones a robot without them would be given.
@@ -41,13 +42,13 @@ fn split(robot: &RobotDescription, effects: &Effects, seed: u64) -> (Measurement
     (all.subset(&(0..250).collect::<Vec<_>>()), all.subset(&(250..400).collect::<Vec<_>>()))
 }
 
-fn fitted(robot: &RobotDescription, train: &MeasurementSet, selection: EffectSelection) -> pipeline::CalibratedModel {
+fn fitted(robot: &RobotDescription, train: &MeasurementSet, selection: EffectSelection) -> model::CalibratedModel {
     let options = FitOptions::default().with_effects(selection);
     pipeline::fit(robot, train, Method::Poe, &options).unwrap_or_else(|e| panic!("{e}")).0
 }
 
-fn heldout(model: &pipeline::CalibratedModel, test: &MeasurementSet) -> f64 {
-    pipeline::evaluate(model, test).unwrap().summary.mean_position_error_mm
+fn heldout(model: &model::CalibratedModel, test: &MeasurementSet) -> f64 {
+    model::evaluate(model, test).unwrap().summary.mean_position_error_mm
 }
 
 /// What the tracker's noise alone leaves held out on the same poses.
@@ -74,9 +75,9 @@ fn a_column_deflection_is_identified_down_to_the_noise_and_its_model_file_reads_
     assert_eq!(deflection.parameter_count(), 2, "{:?}", deflection.parameter_names());
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("m.ron");
-    pipeline::write_model(&path, &model).unwrap();
+    model::write_model(&path, &model).unwrap();
     assert!(std::fs::read_to_string(&path).unwrap().contains("link_deflection("));
-    let again = pipeline::read_model(&path).unwrap();
+    let again = model::read_model(&path).unwrap();
     let tools: Vec<usize> = test.rows.iter().map(|r| r.tool).collect();
     let before = model.predict(&test.rows, &tools).unwrap();
     let after = again.predict(&test.rows, &tools).unwrap();
@@ -94,7 +95,7 @@ fn a_column_deflection_is_identified_down_to_the_noise_and_its_model_file_reads_
     let joint = joint + text[joint..].find("joint: ").unwrap() + "joint: ".len();
     let bad_joint = format!("{}9{}", &text[..joint], &text[joint + 1..]);
     for (case, edited, field) in [("axis 5", bad_axis, "axes"), ("joint 9", bad_joint, "joint")] {
-        let message = match pipeline::parse_model(&edited, "m.ron") {
+        let message = match model::parse_model(&edited, "m.ron") {
             Ok(_) => panic!("{case}: read, not refused"),
             Err(e) => e.to_string(),
         };

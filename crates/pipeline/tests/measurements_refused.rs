@@ -1,6 +1,7 @@
 //! Every bad measurement file the SPEC lists is refused with its file, line and column.
 
-use pipeline::{Error, ErrorKind, ReadOptions, parse_measurements};
+use errors::{Error, ErrorKind};
+use measurements::{ReadOptions, parse_measurements};
 use poe::JointKind;
 
 /// Reading for a robot of `joints` revolute joints, or for any robot.

@@ -2,9 +2,11 @@
 //! at the field at fault; before, `eval` and `predict` panicked on an index or silently dropped
 //! compliance terms.
 
-use pipeline::effects::IdentifiedEffect;
-use pipeline::simulated::{GeneratorConfig, Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
-use pipeline::{CalibratedModel, Error, ErrorKind, FitOptions, Method};
+use campaign::{GeneratorConfig, Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
+use effects::IdentifiedEffect;
+use errors::{Error, ErrorKind};
+use model::{CalibratedModel, Method};
+use pipeline::FitOptions;
 
 /// A `poe-gp-load` model with joint compliance (every part a model can have), and its file text.
 fn fitted(full_pose: bool) -> (CalibratedModel, String) {
@@ -20,13 +22,13 @@ fn fitted(full_pose: bool) -> (CalibratedModel, String) {
 fn text_of(model: &CalibratedModel) -> String {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("m.ron");
-    pipeline::write_model(&path, model).unwrap();
+    model::write_model(&path, model).unwrap();
     std::fs::read_to_string(&path).unwrap()
 }
 
 /// The refusal of `text`, checked to name the file and a line past the first.
 fn refused(text: &str) -> (Error, String) {
-    let error = pipeline::parse_model(text, "m.ron").expect_err("the model must be refused");
+    let error = model::parse_model(text, "m.ron").expect_err("the model must be refused");
     let message = error.to_string();
     let line: usize = message.split(':').nth(1).and_then(|l| l.parse().ok()).unwrap_or(0);
     assert!(message.starts_with("m.ron:") && line > 1, "{message}");
@@ -36,7 +38,7 @@ fn refused(text: &str) -> (Error, String) {
 #[test]
 fn a_written_model_reads_back_and_passes_its_check() {
     let (model, text) = fitted(false);
-    let again = pipeline::parse_model(&text, "m.ron").unwrap();
+    let again = model::parse_model(&text, "m.ron").unwrap();
     assert_eq!(again.tools, model.tools);
     model.check(&text, "m.ron").unwrap();
 }
@@ -130,14 +132,14 @@ struct Version1 {
     kinematics: poe::LocalPoe,
     joint_compliance: Option<Version1Compliance>,
     #[serde(rename = "compensation")]
-    residual_gp: Option<pipeline::ResidualGp>,
+    residual_gp: Option<model::ResidualGp>,
 }
 
 #[derive(serde::Serialize)]
 struct Version1Compliance {
     base_model: poe::LocalPoe,
     gravity_m_per_s2: [f64; 3],
-    terms: Vec<pipeline::effects::ComplianceTerm>,
+    terms: Vec<effects::ComplianceTerm>,
     theta: Vec<f64>,
 }
 
@@ -145,7 +147,7 @@ struct Version1Compliance {
 fn a_version_1_file_with_joint_compliance_reads_and_predicts_as_before() {
     let (model, _) = fitted(true);
     let Some(IdentifiedEffect::JointCompliance(compliance)) = model.effects.first() else { panic!("no compliance") };
-    let pipeline::effects::ComplianceTorque::GravityRegressor(load) = &compliance.torque else {
+    let effects::ComplianceTorque::GravityRegressor(load) = &compliance.torque else {
         panic!("simulated data without torques")
     };
     let old = Version1 {
@@ -165,8 +167,8 @@ fn a_version_1_file_with_joint_compliance_reads_and_predicts_as_before() {
     };
     let text = ron::ser::to_string_pretty(&old, ron::ser::PrettyConfig::default()).unwrap();
     assert!(text.contains("joint_compliance:") && !text.contains("effects:"), "{text}");
-    let read = pipeline::parse_model(&text, "old.ron").unwrap();
-    assert_eq!(read.schema_version, pipeline::SCHEMA_VERSION);
+    let read = model::parse_model(&text, "old.ron").unwrap();
+    assert_eq!(read.schema_version, model::SCHEMA_VERSION);
     let (Some(IdentifiedEffect::JointCompliance(again)), 1) = (read.effects.first(), read.effects.len()) else {
         panic!("{:?}", read.effects)
     };
@@ -179,14 +181,14 @@ fn a_version_1_file_with_joint_compliance_reads_and_predicts_as_before() {
         true,
     )
     .unwrap();
-    let now = pipeline::evaluate(&model, &data).unwrap().errors;
-    let then = pipeline::evaluate(&read, &data).unwrap().errors;
+    let now = model::evaluate(&model, &data).unwrap().errors;
+    let then = model::evaluate(&read, &data).unwrap().errors;
     for (a, b) in now.iter().zip(&then) {
         assert!((a.position_mm - b.position_mm).abs() < 1e-9, "{a:?} {b:?}");
     }
     // A version this build does not know is refused with both versions.
     let future = text.replacen("schema_version: 1", "schema_version: 9", 1);
-    let message = pipeline::parse_model(&future, "new.ron").unwrap_err().to_string();
+    let message = model::parse_model(&future, "new.ron").unwrap_err().to_string();
     assert!(message.contains("schema version 9") && message.contains("versions 1 to 2"), "{message}");
 }
 
@@ -326,6 +328,6 @@ fn an_effect_uncertainty_that_does_not_fit_the_model_is_refused_at_its_field() {
     let (_, message) = refused(&text.replacen(&first, "x1", 1));
     assert!(message.contains("'x1', is not a number"), "{message}");
     // The packed numbers read back exactly as the fit used them.
-    let again = pipeline::parse_model(&text, "m.ron").unwrap();
+    let again = model::parse_model(&text, "m.ron").unwrap();
     assert_eq!(again.effect_uncertainty, Some(uncertainty));
 }

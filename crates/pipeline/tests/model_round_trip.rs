@@ -3,12 +3,15 @@
 //! every joint at 1 rad, far from the wrist's 2 mrad). Over methods × effects × data shapes, the
 //! model written by `write_model` reads back with `read_model` and predicts the same poses.
 
-use pipeline::effects::EffectSelection;
-use pipeline::simulated::{
+use campaign::{
     Effects, GeneratorConfig, Perturbation, Remount, TrackerNoise, joint_ranges, paper_effects, payload_run_campaign,
     simulate, simulate_campaign, simulated_cell,
 };
-use pipeline::{FitOptions, MeasurementSet, Method, RobotDescription};
+use effects::EffectSelection;
+use measurements::MeasurementSet;
+use model::Method;
+use pipeline::FitOptions;
+use robot::RobotDescription;
 
 /// A data shape: its robot, its rows, and an explicit effects list that fits it.
 struct Shape {
@@ -66,8 +69,8 @@ fn every_model_fit_writes_reads_back_and_predicts_the_same() {
                 let (model, _) = pipeline::fit(&shape.robot, &shape.data, method, &options)
                     .unwrap_or_else(|e| panic!("{case}: fit refused: {e}"));
                 let path = dir.path().join("m.ron");
-                pipeline::write_model(&path, &model).unwrap();
-                let again = pipeline::read_model(&path).unwrap_or_else(|e| panic!("{case}: eval would refuse: {e}"));
+                model::write_model(&path, &model).unwrap();
+                let again = model::read_model(&path).unwrap_or_else(|e| panic!("{case}: eval would refuse: {e}"));
                 let before = model.predict(&shape.data.rows, &tools).unwrap();
                 let after = again.predict(&shape.data.rows, &tools).unwrap();
                 for (a, b) in before.iter().zip(&after) {
@@ -83,23 +86,23 @@ fn every_model_fit_writes_reads_back_and_predicts_the_same() {
 fn a_model_file_without_a_training_range_still_reads() {
     let shape = shapes().remove(0);
     let (model, _) = pipeline::fit(&shape.robot, &shape.data, Method::PoeGpLoad, &FitOptions::default()).unwrap();
-    let older = pipeline::CalibratedModel { training_range: None, ..model };
+    let older = model::CalibratedModel { training_range: None, ..model };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("m.ron");
-    pipeline::write_model(&path, &older).unwrap();
+    model::write_model(&path, &older).unwrap();
     assert!(!std::fs::read_to_string(&path).unwrap().contains("training_range"));
-    let again = pipeline::read_model(&path).unwrap();
+    let again = model::read_model(&path).unwrap();
     assert_eq!(again.training_range, None);
 }
 
 /// A `poe-gp-load` model of the campaign with joint compliance, and its file text.
-fn campaign_model() -> (pipeline::CalibratedModel, String) {
+fn campaign_model() -> (model::CalibratedModel, String) {
     let shape = shapes().remove(0);
     let options = FitOptions::default().with_effects("joint_compliance".parse().unwrap());
     let (model, _) = pipeline::fit(&shape.robot, &shape.data, Method::PoeGpLoad, &options).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("m.ron");
-    pipeline::write_model(&path, &model).unwrap();
+    model::write_model(&path, &model).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
     (model, text)
 }
@@ -114,7 +117,7 @@ fn with_first(text: &str, field: &str, value: &str) -> String {
 
 /// The refusal of `text`, checked to name the file and a line past the first.
 fn refused_at_a_line(text: &str, case: &str) -> String {
-    let message = match pipeline::parse_model(text, "m.ron") {
+    let message = match model::parse_model(text, "m.ron") {
         Ok(_) => panic!("{case}: read, not refused"),
         Err(e) => e.to_string(),
     };
@@ -126,7 +129,7 @@ fn refused_at_a_line(text: &str, case: &str) -> String {
 #[test]
 fn absurd_finite_values_are_still_refused_at_a_line_and_column() {
     let (_, text) = campaign_model();
-    pipeline::parse_model(&text, "m.ron").unwrap();
+    model::parse_model(&text, "m.ron").unwrap();
     for (field, value) in [
         ("signal_variance", "1e200"),
         ("noise_variance", "1e200"),

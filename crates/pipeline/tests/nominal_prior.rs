@@ -2,10 +2,13 @@
 //! evaluated on the flipped one, a calibrated model is no further off than the nominal geometry
 //! (at its fitted base and tool placement), and `eval` says the rows lie outside the fitted range.
 
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, simulate, simulated_cell};
+use effects::EffectSelection;
 use loadsim::{Harmonic, JointRange, PeriodicError};
-use pipeline::effects::EffectSelection;
-use pipeline::simulated::{Effects, GeneratorConfig, Perturbation, TrackerNoise, simulate, simulated_cell};
-use pipeline::{EvalReport, FitOptions, MeasurementSet, Method, RobotDescription};
+use measurements::MeasurementSet;
+use model::{EvalReport, Method};
+use pipeline::FitOptions;
+use robot::RobotDescription;
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
@@ -71,7 +74,7 @@ fn heldout_with(
 ) -> (f64, EvalReport) {
     let selection: EffectSelection = if effects.is_empty() { EffectSelection::None } else { effects.parse().unwrap() };
     let (model, _) = pipeline::fit(robot, train, method, &options.with_effects(selection)).unwrap();
-    let evaluation = pipeline::evaluate(&model, test).unwrap();
+    let evaluation = model::evaluate(&model, test).unwrap();
     let report = EvalReport::new(&model, test, &evaluation);
     (evaluation.summary.rms_position_error_mm, report)
 }
@@ -148,8 +151,8 @@ fn eval_splits_the_error_at_the_fitted_range_and_names_a_glitch_inside_it() {
     let glitch = test.rows[10].line;
     test.rows[10].position.x += 1e-2;
     let flipped = wrist(5, 20, true);
-    test.rows.extend(flipped.rows.iter().map(|r| pipeline::Measurement { line: r.line + 1000, ..r.clone() }));
-    let evaluation = pipeline::evaluate(&model, &test).unwrap();
+    test.rows.extend(flipped.rows.iter().map(|r| measurements::Measurement { line: r.line + 1000, ..r.clone() }));
+    let evaluation = model::evaluate(&model, &test).unwrap();
     let report = EvalReport::new(&model, &test, &evaluation);
     let split = report.range_split.expect("rows outside the fitted range: a split");
     assert_eq!((split.inside.n, split.outside.n), (inside, 20));
@@ -169,7 +172,7 @@ fn a_column_arms_clusters_are_its_branches_and_the_halves_of_its_column() {
     let robot = testkit::robot("column_arm.urdf");
     let geometry = Perturbation { translation_m: 1e-4, rotation_rad: 1e-4, ..Perturbation::default() };
     let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
-    let ranges = pipeline::simulated::joint_ranges(&robot);
+    let ranges = campaign::joint_ranges(&robot);
     let config = GeneratorConfig { sample_count: 300, seed: 4, ..Default::default() };
     let data = simulate(&simulated_cell(&robot, &geometry, 4).unwrap(), &effects, &ranges, &config, false).unwrap();
     let (_, report) = pipeline::fit(&robot, &data, Method::Poe, &FitOptions::default()).unwrap();

@@ -1,7 +1,8 @@
 //! DH tables in the robot RON: a flange given with a table, and every refusal at its line and
 //! column (the forward kinematics of every form are in `robot_forms.rs`).
 
-use pipeline::{ErrorKind, RobotDescription};
+use errors::ErrorKind;
+use robot::RobotDescription;
 
 const TABLE: &str = r#"Robot(
     name: "three",

@@ -1,7 +1,8 @@
 //! The robot description files: the committed fixtures, and the bad inputs refused.
 
-use pipeline::{ErrorKind, RobotDescription};
+use errors::ErrorKind;
 use poe::{DhConvention, DhRow, JointKind, LocalPoe};
+use robot::RobotDescription;
 use std::f64::consts::FRAC_PI_2;
 
 #[test]

@@ -2,8 +2,8 @@
 //! kinematics: per fixture robot to 1e-9 m, and a DH table to poe's own DH model.
 
 use lie::{SE3, SO3, Vector3};
-use pipeline::{ChainEnds, RobotDescription, UrdfDocument};
 use poe::{DhConvention, DhRow, JointKind, LocalPoe};
+use robot::{ChainEnds, RobotDescription, UrdfDocument};
 
 fn read(name: &str, base_link: Option<&str>) -> RobotDescription {
     let ends = ChainEnds { base_link: base_link.map(str::to_owned), tip_link: None };

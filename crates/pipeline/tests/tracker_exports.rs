@@ -2,17 +2,16 @@
 //! Euler angle columns, and a column map for any other header; every refusal at its file, line
 //! and column.
 
+use errors::{ColumnMapFault, DecimalFault, Error, ErrorKind};
 use lie::{Matrix3, SO3};
-use pipeline::{
-    ColumnMap, ColumnMapFault, Decimal, DecimalFault, Delimiter, Error, ErrorKind, ReadOptions, parse_measurements,
-};
+use measurements::{ColumnMap, Decimal, Delimiter, ReadOptions, parse_measurements};
 use poe::JointKind;
 
 fn two_joints() -> ReadOptions {
     ReadOptions::for_joints(vec![JointKind::Revolute; 2])
 }
 
-fn read(text: &str, options: &ReadOptions) -> pipeline::MeasurementSet {
+fn read(text: &str, options: &ReadOptions) -> measurements::MeasurementSet {
     parse_measurements(text.as_bytes(), "export.csv", options).unwrap_or_else(|e| panic!("{e}"))
 }
 

@@ -2,20 +2,22 @@
 //! 1e-9 m in the tracker and in the base frame; written like an existing URDF it keeps that file's
 //! links and their meaning; what it cannot hold is measured or refused.
 
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise};
+use cell::{UrdfTemplate, export_urdf};
+use errors::ErrorKind;
 use lie::{SE3, Vector3};
-use pipeline::simulated::{self, Effects, GeneratorConfig, Perturbation, TrackerNoise};
-use pipeline::{
-    CalibratedModel, ChainEnds, ErrorKind, FitOptions, MeasurementSet, Method, NominalTolerance, RobotDescription,
-    UrdfDocument, UrdfTemplate, export_urdf, in_base_frame,
-};
+use measurements::MeasurementSet;
+use model::{CalibratedModel, Method};
+use pipeline::FitOptions;
 use poe::LocalPoe;
+use robot::{ChainEnds, NominalTolerance, RobotDescription, UrdfDocument, in_base_frame};
 
 /// Tracker data of a perturbed `robot` (noise only, so every method fits).
 fn data(robot: &RobotDescription, rows: usize, full_pose: bool, seed: u64) -> MeasurementSet {
-    let cell = simulated::simulated_cell(robot, &Perturbation::default(), seed).unwrap();
+    let cell = campaign::simulated_cell(robot, &Perturbation::default(), seed).unwrap();
     let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
     let config = GeneratorConfig { sample_count: rows, seed, payloads_kg: vec![0.0], ..GeneratorConfig::default() };
-    simulated::simulate(&cell, &effects, &simulated::joint_ranges(robot), &config, full_pose).unwrap()
+    campaign::simulate(&cell, &effects, &campaign::joint_ranges(robot), &config, full_pose).unwrap()
 }
 
 fn fitted(robot: &RobotDescription, method: Method, full_pose: bool) -> (CalibratedModel, MeasurementSet) {
@@ -158,7 +160,7 @@ fn what_a_urdf_cannot_hold_is_measured_on_the_training_data_or_refused() {
     assert_eq!(export.report.not_in_urdf, ["gaussian_process"]);
     assert!(!export.report.tool_orientation_calibrated);
     let errors = export.report.training_error.unwrap();
-    let geometric = pipeline::evaluate(&model.geometry_only(), &training).unwrap().summary;
+    let geometric = model::evaluate(&model.geometry_only(), &training).unwrap().summary;
     assert_eq!(errors.urdf, geometric);
     assert_eq!(errors.model.n, 150);
 }

@@ -2,10 +2,11 @@
 //! kinematics equal the URDF chain evaluated joint by joint, every mimic at `multiplier · q +
 //! offset`; chains whose mimic joints do not fold are refused at the `<mimic>` element.
 
+use errors::ErrorKind;
 use lie::{SE3, SO3, Vector3};
-use pipeline::{ChainEnds, ErrorKind, JointType, RobotDescription, StepMotion, UrdfChain, UrdfDocument};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use robot::{ChainEnds, JointType, RobotDescription, StepMotion, UrdfChain, UrdfDocument};
 
 fn chain(text: &str, ends: &ChainEnds) -> UrdfChain {
     UrdfDocument::parse(text, "arm.urdf").and_then(|d| d.chain(ends)).unwrap_or_else(|e| panic!("{e}"))
@@ -312,19 +313,22 @@ fn a_mimic_before_the_joint_it_follows_is_refused() {
 
 mod export {
     use super::*;
-    use pipeline::simulated::{self, Effects, GeneratorConfig, Perturbation, TrackerNoise};
-    use pipeline::{FitOptions, Method, NominalTolerance, UrdfTemplate, export_urdf};
+    use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise};
+    use cell::{UrdfTemplate, export_urdf};
+    use model::Method;
+    use pipeline::FitOptions;
     use poe::LocalPoe;
+    use robot::NominalTolerance;
 
     /// A poe fit of the column arm on simulated data (noise only) and the URDF text.
-    pub(super) fn fitted() -> (pipeline::CalibratedModel, pipeline::FitReport, String, RobotDescription) {
+    pub(super) fn fitted() -> (model::CalibratedModel, pipeline::FitReport, String, RobotDescription) {
         let text = std::fs::read_to_string(testkit::robot_path("column_arm.urdf")).unwrap();
         let robot = chain(&text, &ChainEnds::default()).description();
-        let cell = simulated::simulated_cell(&robot, &Perturbation::default(), 7).unwrap();
+        let cell = campaign::simulated_cell(&robot, &Perturbation::default(), 7).unwrap();
         let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
         let config =
             GeneratorConfig { sample_count: 150, seed: 7, payloads_kg: vec![0.0], ..GeneratorConfig::default() };
-        let set = simulated::simulate(&cell, &effects, &simulated::joint_ranges(&robot), &config, true).unwrap();
+        let set = campaign::simulate(&cell, &effects, &campaign::joint_ranges(&robot), &config, true).unwrap();
         let (model, report) = pipeline::fit(&robot, &set, Method::Poe, &FitOptions::default()).unwrap();
         (model, report, text, robot)
     }
@@ -423,16 +427,16 @@ fn a_model_file_with_a_scale_out_of_bounds_is_refused_at_it() {
     let (model, _, _, _) = export::fitted();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("model.ron");
-    pipeline::write_model(&path, &model).unwrap();
+    model::write_model(&path, &model).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
     // Once in the kinematics, for joint 1 alone (and once more in the robot description the model
     // keeps, last in the file).
     let kinematics = &text[..text.find("robot_description:").unwrap()];
     assert_eq!(kinematics.matches("scale: 3.0").count(), 1, "written once, for joint 1 alone");
-    assert_eq!(pipeline::parse_model(&text, "model.ron").unwrap().kinematics.joints()[0].scale, 3.0);
+    assert_eq!(model::parse_model(&text, "model.ron").unwrap().kinematics.joints()[0].scale, 3.0);
     let broken = text.replacen("scale: 3.0", "scale: 0.0", 1);
     let (line, column) = position_of(&broken, "scale: 0.0");
-    let e = pipeline::parse_model(&broken, "model.ron").expect_err("a refusal");
+    let e = model::parse_model(&broken, "model.ron").expect_err("a refusal");
     let (Some((l, c)), ErrorKind::RonFormat { message }) = (e.position(), e.kind()) else { panic!("{e:?}") };
     assert_eq!((l as usize, c), (line, column), "{message}");
     assert!(message.contains("scale is 0e0"), "{message}");

@@ -1,6 +1,7 @@
 //! Every URDF the robot reader refuses, each at the file, line and column at fault.
 
-use pipeline::{ChainEnds, ErrorKind, RobotDescription, UrdfDocument};
+use errors::ErrorKind;
+use robot::{ChainEnds, RobotDescription, UrdfDocument};
 
 /// A two-joint arm; each test breaks one thing.
 const ARM: &str = r#"<?xml version="1.0"?>

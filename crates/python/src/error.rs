@@ -12,10 +12,10 @@ pyo3::create_exception!(
 );
 
 /// The exception of a pipeline error.
-pub fn to_py(error: pipeline::Error) -> PyErr {
+pub fn to_py(error: errors::Error) -> PyErr {
     let message = error.to_string();
     match error.kind() {
-        pipeline::ErrorKind::Io { source } if source.kind() == std::io::ErrorKind::NotFound => {
+        errors::ErrorKind::Io { source } if source.kind() == std::io::ErrorKind::NotFound => {
             PyFileNotFoundError::new_err(message)
         }
         _ => CalibError::new_err(message),

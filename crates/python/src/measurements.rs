@@ -9,8 +9,8 @@
 use crate::error::{argument, to_py};
 use crate::robot::Robot;
 use crate::types::{Measurements, Model, matrix};
+use measurements::{ColumnMap, ReadOptions};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
-use pipeline::{ColumnMap, ReadOptions};
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
@@ -46,8 +46,8 @@ fn column_map(columns: Option<Vec<(String, String)>>) -> PyResult<ColumnMap> {
 
 impl Measurements {
     /// The set parsed from CSV text, as `calib` parses a file.
-    pub(crate) fn parse(text: &[u8], source: &str, options: &ReadOptions) -> Result<Self, pipeline::Error> {
-        Ok(Self { set: pipeline::parse_measurements(text, source, options)? })
+    pub(crate) fn parse(text: &[u8], source: &str, options: &ReadOptions) -> Result<Self, errors::Error> {
+        Ok(Self { set: measurements::parse_measurements(text, source, options)? })
     }
 }
 
@@ -71,9 +71,9 @@ impl Measurements {
         let set = py
             .detach(|| {
                 if positions {
-                    pipeline::read_measurements(&path, &options)
+                    measurements::read_measurements(&path, &options)
                 } else {
-                    pipeline::read_configurations(&path, &options)
+                    measurements::read_configurations(&path, &options)
                 }
             })
             .map_err(to_py)?;

@@ -4,11 +4,12 @@
 use crate::error::{argument, to_py};
 use crate::robot::Robot;
 use crate::types::{Measurements, Model, matrix};
+use cell::CompensateOptions;
+use effects::EffectSelection;
+use measurements::Measurement;
+use model::{CalibratedModel, EvalReport, GpChoice, Method, PredictedPose};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
-use pipeline::effects::EffectSelection;
-use pipeline::{
-    CalibratedModel, CompensateOptions, EvalReport, FitOptions, GpChoice, Measurement, Method, PredictedPose,
-};
+use pipeline::FitOptions;
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -52,7 +53,7 @@ pub fn fit(
     let ((model, fitted), report) = py
         .detach(|| {
             let (fitted, report) = pipeline::fit(robot, data, method, &options)?;
-            Ok::<_, pipeline::Error>(((as_its_file_holds(&fitted)?, fitted), report))
+            Ok::<_, errors::Error>(((as_its_file_holds(&fitted)?, fitted), report))
         })
         .map_err(to_py)?;
     let json = serde_json::to_string(&report).map_err(|e| argument("report", e))?;
@@ -65,12 +66,12 @@ pub fn fit(
 /// The file does not keep every bit of the fitted model (predictions moved by ~1e-12 mm on the
 /// test campaign), and the CLI only ever uses the file: so the package's numbers are the CLI's
 /// to the last bit.
-fn as_its_file_holds(model: &CalibratedModel) -> Result<CalibratedModel, pipeline::Error> {
-    let io = |source| pipeline::Error::io("a temporary model file", source);
+fn as_its_file_holds(model: &CalibratedModel) -> Result<CalibratedModel, errors::Error> {
+    let io = |source| errors::Error::io("a temporary model file", source);
     let folder = tempfile::tempdir().map_err(io)?;
     let path = folder.path().join("model.ron");
-    pipeline::write_model(&path, model)?;
-    pipeline::read_model(&path)
+    model::write_model(&path, model)?;
+    model::read_model(&path)
 }
 
 /// What `predict` returns: poses, their standard deviations where the model has them, warnings.
@@ -82,7 +83,7 @@ impl Model {
     /// runs on it.
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
-        let model = py.detach(|| pipeline::read_model(&path)).map_err(to_py)?;
+        let model = py.detach(|| model::read_model(&path)).map_err(to_py)?;
         Ok(Self { model, fitted: None, name: path.display().to_string() })
     }
 
@@ -90,7 +91,7 @@ impl Model {
     /// link's target without following it).
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let model = self.fitted.as_ref().unwrap_or(&self.model);
-        py.detach(|| pipeline::write_model(&path, model)).map_err(to_py)
+        py.detach(|| model::write_model(&path, model)).map_err(to_py)
     }
 
     /// The method that produced the model.
@@ -147,18 +148,18 @@ impl Model {
         let (model, set) = (&self.model, &data.set);
         let (evaluation, report) = py
             .detach(|| {
-                let evaluation = pipeline::evaluate(model, set)?;
+                let evaluation = model::evaluate(model, set)?;
                 let report = EvalReport::new(model, set, &evaluation);
-                Ok::<_, pipeline::Error>((evaluation, report))
+                Ok::<_, errors::Error>((evaluation, report))
             })
             .map_err(to_py)?;
-        let finite = |e: &pipeline::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
+        let finite = |e: &model::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
         if let Some((row, _)) = set.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
             return Err(crate::error::CalibError::new_err(non_finite(&self.name, &set.source, row.line)));
         }
         let mut warnings = Vec::new();
         if report.orientations_not_evaluated {
-            warnings.push(pipeline::ORIENTATIONS_NOT_EVALUATED.to_owned());
+            warnings.push(model::ORIENTATIONS_NOT_EVALUATED.to_owned());
         }
         warnings.extend(report.warnings.iter().map(ToString::to_string));
         warnings.extend(report.out_of_range.iter().map(ToString::to_string));
@@ -172,7 +173,7 @@ impl Model {
     /// `calib predict` on a measurement set (tools matched by name, as the CLI matches them).
     fn predict_set<'py>(&self, py: Python<'py>, data: &Measurements) -> PyResult<Predicted<'py>> {
         let (model, set) = (&self.model, &data.set);
-        let tools = pipeline::tool_indices(model, set).map_err(to_py)?;
+        let tools = model::tool_indices(model, set).map_err(to_py)?;
         self.predict_rows(py, &set.rows, &tools, &set.source)
     }
 
@@ -271,26 +272,26 @@ impl Model {
         String,
         Vec<String>,
     )> {
-        let frame: pipeline::TargetFrame = frame.parse().map_err(|e| argument("frame", e))?;
+        let frame: cell::TargetFrame = frame.parse().map_err(|e| argument("frame", e))?;
         let columns = match columns {
             Some(pairs) if !pairs.is_empty() => {
                 let text: Vec<String> =
                     pairs.iter().map(|(n, h)| format!("{n}=\"{}\"", h.replace('"', "\"\""))).collect();
-                text.join(",").parse::<pipeline::ColumnMap>().map_err(|e| argument("columns", e))?
+                text.join(",").parse::<measurements::ColumnMap>().map_err(|e| argument("columns", e))?
             }
-            _ => pipeline::ColumnMap::default(),
+            _ => measurements::ColumnMap::default(),
         };
         let model = &self.model;
         let robot_ref = robot.map(|r| (&r.description, r.path.as_str()));
         let (file, solved, summary, csv) = py
             .detach(|| {
-                let file = pipeline::read_targets(&targets, model, columns)?;
+                let file = cell::read_targets(&targets, model, columns)?;
                 let (solved, summary) =
-                    pipeline::compensate(model, &file, robot_ref, frame, &CompensateOptions::default())?;
+                    cell::compensate(model, &file, robot_ref, frame, &CompensateOptions::default())?;
                 let mut csv = Vec::new();
-                pipeline::write_compensated(&mut csv, &file, &solved)
-                    .map_err(|source| pipeline::Error::io("the compensated targets", source))?;
-                Ok::<_, pipeline::Error>((file, solved, summary, csv))
+                cell::write_compensated(&mut csv, &file, &solved)
+                    .map_err(|source| errors::Error::io("the compensated targets", source))?;
+                Ok::<_, errors::Error>((file, solved, summary, csv))
             })
             .map_err(to_py)?;
         let n = model.joint_count();
@@ -337,7 +338,7 @@ impl Model {
                 let mut warnings: Vec<String> = model.extrapolation(rows).iter().map(ToString::to_string).collect();
                 warnings.extend(model.outside_training_range(rows).iter().map(ToString::to_string));
                 warnings.extend(model.beyond_joint_limits(rows).iter().map(ToString::to_string));
-                Ok::<_, pipeline::Error>((predictions, warnings))
+                Ok::<_, errors::Error>((predictions, warnings))
             })
             .map_err(to_py)?;
         let finite = |p: &PredictedPose| {

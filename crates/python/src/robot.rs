@@ -1,8 +1,8 @@
 //! `Robot`: a robot description read as `calib --robot … [--base-link …] [--tip-link …]` reads it.
 
 use crate::error::to_py;
-use pipeline::{ChainEnds, RobotDescription};
 use pyo3::prelude::*;
+use robot::{ChainEnds, RobotDescription};
 use std::path::PathBuf;
 
 /// A robot description (RON with axes or a DH table, or URDF with its chain's ends).

@@ -3,9 +3,10 @@
 use crate::error::{argument, to_py};
 use crate::robot::Robot;
 use crate::types::Measurements;
-use pipeline::diagnose::DiagnoseOptions;
-use pipeline::simulated::{self, GeneratorConfig, Perturbation, Remount, TorqueSensorNoise};
-use pipeline::{Error, ErrorKind, ReadOptions};
+use ::diagnose::DiagnoseOptions;
+use campaign::{GeneratorConfig, Perturbation, Remount, TorqueSensorNoise};
+use errors::{Error, ErrorKind};
+use measurements::ReadOptions;
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
@@ -34,17 +35,19 @@ pub fn diagnose(
     let robot_path = PathBuf::from(&robot.path);
     let data_path = PathBuf::from(&set.source);
     py.detach(|| {
-        let diagnosis = pipeline::diagnose::diagnose(description, set, &options)?;
-        let inputs = pipeline::InputFiles::new().with("robot", &robot_path).with("data", &data_path);
+        let diagnosis = ::diagnose::diagnose(description, set, &options)?;
+        let inputs = measurements::InputFiles::new().with("robot", &robot_path).with("data", &data_path);
         // The folder `calib diagnose --report` writes, through the report crate's one writer.
         let written = report
             .as_deref()
             .map(|folder| {
-                report::write_diagnosis_report(&diagnosis, folder, "report", &inputs).map_err(|e| match e {
-                    report::Error::Pipeline(e) => e,
-                    other => {
-                        pipeline::Error::io(folder.display().to_string(), std::io::Error::other(other.to_string()))
+                report::write_diagnosis_report(&diagnosis, folder, "report", &inputs).map_err(|e| match e.kind() {
+                    // A chart or the embedded JSON: named by the folder they were for, as before the
+                    // report crate had an error type of its own.
+                    errors::ErrorKind::Plot { .. } | errors::ErrorKind::EvaluationJson { .. } => {
+                        errors::Error::io(folder.display().to_string(), std::io::Error::other(e.to_string()))
                     }
+                    _ => e,
                 })
             })
             .transpose()?;
@@ -77,16 +80,16 @@ pub fn simulate(
     torque_sigma_nm: Option<f64>,
     out: Option<PathBuf>,
 ) -> PyResult<Measurements> {
-    if rows > simulated::MAX_ROWS {
-        return Err(argument("rows", Error::new(ErrorKind::TooManySimulatedRows { rows, max: simulated::MAX_ROWS })));
+    if rows > campaign::MAX_ROWS {
+        return Err(argument("rows", Error::new(ErrorKind::TooManySimulatedRows { rows, max: campaign::MAX_ROWS })));
     }
     if rows == 0 {
         return Err(argument("rows", "at least one pose is needed"));
     }
     let description = &robot.description;
     let effects = match &effects {
-        Some(path) => simulated::read_effects(path, description).map_err(to_py)?,
-        None => simulated::paper_effects(),
+        Some(path) => campaign::read_effects(path, description).map_err(to_py)?,
+        None => campaign::paper_effects(),
     };
     let shape = Shape { payloads, moving_joints, fixed_jitter_mrad, runs, tool_per_payload, torques, torque_sigma_nm };
     let config = shape.config(rows, seed)?;
@@ -101,19 +104,19 @@ pub fn simulate(
     }
     let source = out.as_ref().map_or_else(|| "simulated".to_owned(), |p| p.display().to_string());
     py.detach(|| {
-        let cell = simulated::campaign_cell(description, &Perturbation::default(), &Remount::default(), &config)?;
+        let cell = campaign::campaign_cell(description, &Perturbation::default(), &Remount::default(), &config)?;
         let mut csv = Vec::new();
-        simulated::simulate_to_csv(
+        campaign::simulate_to_csv(
             &cell,
             &effects,
-            &simulated::joint_ranges(description),
+            &campaign::joint_ranges(description),
             &config,
             full_pose,
             &mut csv,
             &source,
         )?;
         if let Some(path) = &out {
-            pipeline::write_file(path, &csv)?;
+            measurements::write_file(path, &csv)?;
         }
         let options = ReadOptions::for_joints(description.joint_kinds());
         Measurements::parse(&csv, &source, &options)

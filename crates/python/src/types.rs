@@ -2,8 +2,9 @@
 //! joints, a `Model` evaluates `Measurements`), defined here so that their methods' modules import
 //! this one and not each other, and the numpy helper both use.
 
+use measurements::MeasurementSet;
+use model::CalibratedModel;
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
-use pipeline::{CalibratedModel, MeasurementSet};
 use pyo3::prelude::*;
 
 /// A calibrated model (what `calib fit` writes).

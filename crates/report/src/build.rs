@@ -1,5 +1,5 @@
 //! Gathering a [`Report`] from a model, its robot and measurements. The after-calibration numbers
-//! are `calib eval`'s own ([`pipeline::evaluate`] and [`EvalReport`]); nothing is recomputed
+//! are `calib eval`'s own ([`model::evaluate`] and [`EvalReport`]); nothing is recomputed
 //! another way.
 
 use crate::content::{
@@ -7,12 +7,12 @@ use crate::content::{
     KernelScales, ModelSummary, Report, RobotSummary, RowError,
 };
 use crate::{Iso9283, RepeatOptions};
-use pipeline::diagnose::Diagnosis;
-use pipeline::effects::{GearPeriodic, IdentifiedEffect};
-use pipeline::{
-    CalibratedModel, CompensateOptions, ErrorSummary, EvalReport, Evaluation, GpModel, JointType, MeasurementSet,
-    PoseError, RobotDescription,
-};
+use cell::CompensateOptions;
+use diagnose::Diagnosis;
+use effects::{GearPeriodic, IdentifiedEffect};
+use measurements::MeasurementSet;
+use model::{CalibratedModel, ErrorSummary, EvalReport, Evaluation, GpModel, PoseError};
+use robot::{JointType, RobotDescription};
 use serde::Serialize;
 
 /// What the report is made of.
@@ -69,11 +69,11 @@ impl Report {
         inputs: &ReportInputs<'_>,
         diagnosis: Option<Diagnosis>,
         options: &ReportOptions,
-    ) -> Result<Self, crate::Error> {
+    ) -> Result<Self, errors::Error> {
         let ReportInputs { model, data, .. } = *inputs;
-        let evaluation = pipeline::evaluate(model, data)?;
+        let evaluation = model::evaluate(model, data)?;
         let eval = EvalReport::new(model, data, &evaluation);
-        let tools = pipeline::tool_indices(model, data)?;
+        let tools = model::tool_indices(model, data)?;
         let predicted: Vec<[f64; 3]> =
             model.predict(&data.rows, &tools)?.iter().map(|p| p.pose.translation().into()).collect();
         let before = before_calibration(inputs, options)?;
@@ -101,7 +101,7 @@ impl Report {
             model: ModelSummary {
                 method: model.method.to_string(),
                 file: inputs.model_file.to_owned(),
-                parts: model.parts().iter().map(pipeline::Part::name).collect(),
+                parts: model.parts().iter().map(model::Part::name).collect(),
                 full_pose: model.full_pose,
                 tools: model.tools.clone(),
             },
@@ -121,24 +121,24 @@ impl Report {
 
 /// The nominal model evaluated on the data, its base and tools placed by the `base-tool` method on
 /// the training data where it is given (what `calib fit` reports as "before" on its own rows),
-/// otherwise on the calibrated model at random configurations ([`pipeline::registered_nominal`]),
+/// otherwise on the calibrated model at random configurations ([`cell::registered_nominal`]),
 /// which the report flags: far from the training poses the calibrated geometry is not
 /// determined, so that placement can overstate the error before calibration.
 fn before_calibration(
     inputs: &ReportInputs<'_>,
     options: &ReportOptions,
-) -> Result<Option<(String, Evaluation)>, crate::Error> {
+) -> Result<Option<(String, Evaluation)>, errors::Error> {
     let model = inputs.model;
     if let Some(train) = inputs.training {
-        let (placed, _) = pipeline::fit(inputs.robot, train, pipeline::Method::BaseTool, &options.base_tool)?;
+        let (placed, _) = pipeline::fit(inputs.robot, train, model::Method::BaseTool, &options.base_tool)?;
         let how = format!(
             "the nominal kinematics of {} with its base and tools fitted on the training data (method base-tool), \
              as `calib fit` reports its \"before\"",
             inputs.robot.name
         );
-        return Ok(Some((how, pipeline::evaluate(&placed, inputs.data)?)));
+        return Ok(Some((how, model::evaluate(&placed, inputs.data)?)));
     }
-    let placed = match pipeline::registered_nominal(model, inputs.robot, inputs.robot_file, &options.nominal) {
+    let placed = match cell::registered_nominal(model, inputs.robot, inputs.robot_file, &options.nominal) {
         Ok(placed) => placed,
         // A robot file that is not this robot: "before" is unknown, and the report says so.
         Err(_) => return Ok(None),
@@ -159,7 +159,7 @@ fn before_calibration(
         options.nominal.registration_configurations,
         placed.rms_m * 1e3
     );
-    Ok(Some((how, pipeline::evaluate(&nominal, inputs.data)?)))
+    Ok(Some((how, model::evaluate(&nominal, inputs.data)?)))
 }
 
 fn tool_name(data: &MeasurementSet, tool: usize) -> String {
@@ -178,7 +178,7 @@ pub(crate) fn stats(errors: &[PoseError]) -> ErrorStats {
 }
 
 fn grouped(data: &MeasurementSet, evaluation: &Evaluation) -> GroupedErrors {
-    let pick = |keep: &dyn Fn(&pipeline::Measurement) -> bool| -> ErrorStats {
+    let pick = |keep: &dyn Fn(&measurements::Measurement) -> bool| -> ErrorStats {
         let part: Vec<PoseError> =
             data.rows.iter().zip(&evaluation.errors).filter(|(r, _)| keep(r)).map(|(_, e)| *e).collect();
         stats(&part)
@@ -352,7 +352,7 @@ fn warnings(model: &CalibratedModel, eval: &EvalReport) -> Vec<String> {
     out.extend(eval.out_of_range.iter().map(ToString::to_string));
     out.extend(eval.beyond_joint_limits.iter().map(ToString::to_string));
     if eval.orientations_not_evaluated {
-        out.push(pipeline::ORIENTATIONS_NOT_EVALUATED.to_owned());
+        out.push(model::ORIENTATIONS_NOT_EVALUATED.to_owned());
     }
     // A model that keeps the fit's warnings says this itself, among them.
     if let Some(residual_gp) = model.residual_gp.as_ref().filter(|_| model.fit_warnings.is_none()) {

@@ -2,8 +2,8 @@
 //! [`crate::render_html`]. Every number here is one that the writer prints; none is recomputed
 //! by the writer.
 
-use pipeline::diagnose::Diagnosis;
-use pipeline::{ErrorSummary, EvalReport};
+use diagnose::Diagnosis;
+use model::{ErrorSummary, EvalReport};
 use serde::Serialize;
 
 /// The whole report.

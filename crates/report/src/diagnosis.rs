@@ -1,9 +1,9 @@
 //! The diagnosis's figures, drawn by the same writer as the calibration report, so the diagnosis
 //! folder (`folder.rs`) and the report cannot drift apart.
 
-use crate::Error;
 use crate::figures::{self, Series};
-use pipeline::diagnose::{Diagnosis, PoseDiagnosis};
+use diagnose::{Diagnosis, PoseDiagnosis};
+use errors::Error;
 
 /// The diagnosis's plots as `(file name, SVG text)`: the held-out error against each moving joint
 /// (`joint<k>.svg`), the payload (`payload.svg`), the temperature (`temperature.svg`) and the time

@@ -2,8 +2,8 @@
 //! projections coloured by error, an effect's curve with its σ band, and the scatter plots of the
 //! diagnosis.
 
-use crate::Error;
 use crate::content::{EffectCurve, RowError};
+use errors::{Error, ErrorKind};
 use plotters::prelude::*;
 
 /// Grey for the model before calibration (or the geometric model of the diagnosis).
@@ -59,7 +59,7 @@ pub struct Series {
 }
 
 fn plot_error(figure: &str) -> impl Fn(String) -> Error + '_ {
-    move |message| Error::Plot { figure: figure.to_owned(), message }
+    move |message| Error::new(ErrorKind::Plot { figure: figure.to_owned(), message })
 }
 
 /// `[low, high]` of finite values, widened where they coincide; `fallback` where there are none.

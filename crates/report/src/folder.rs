@@ -2,16 +2,17 @@
 //! page, written through the same writer as the calibration report.
 
 use crate::diagnosis::diagnosis_figures;
-use crate::{Error, html};
-use pipeline::InputFiles;
-use pipeline::diagnose::Diagnosis;
+use crate::html;
+use diagnose::Diagnosis;
+use errors::Error;
+use measurements::InputFiles;
 use std::path::{Path, PathBuf};
 
 /// Writes the diagnosis's report folder: `diagnosis.md` (the diagnosis's own markdown), its SVG
 /// plots ([`diagnosis_figures`]) and `diagnosis.html` (the diagnosis section of the calibration
 /// report, plots inline). The folder is made if need be; every file is checked against `inputs`
 /// (as the output of `option`) before the first is written, and each is written atomically
-/// ([`pipeline::write_file`]). Returns the path of `diagnosis.md`.
+/// ([`measurements::write_file`]). Returns the path of `diagnosis.md`.
 pub fn write_diagnosis_report(
     diagnosis: &Diagnosis,
     folder: &Path,
@@ -26,11 +27,11 @@ pub fn write_diagnosis_report(
         inputs.check_output(option, &path)?;
     }
     let html = html::diagnosis_page(diagnosis, &plots);
-    std::fs::create_dir_all(folder).map_err(|source| Error::Io { path: folder.display().to_string(), source })?;
+    std::fs::create_dir_all(folder).map_err(|source| Error::io(folder.display().to_string(), source))?;
     for (name, svg) in &plots {
-        pipeline::write_file(&folder.join(name), svg.as_bytes())?;
+        measurements::write_file(&folder.join(name), svg.as_bytes())?;
     }
-    pipeline::write_file(&markdown, diagnosis.markdown(&names).as_bytes())?;
-    pipeline::write_file(&page, html.as_bytes())?;
+    measurements::write_file(&markdown, diagnosis.markdown(&names).as_bytes())?;
+    measurements::write_file(&page, html.as_bytes())?;
     Ok(markdown)
 }

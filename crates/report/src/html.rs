@@ -2,10 +2,10 @@
 //! printable). Every number a test compares carries its full value in a `data-value` attribute
 //! next to the rounded text, under a `data-key` naming it.
 
-use crate::Error;
 use crate::content::{ErrorStats, GroupedErrors, Report};
 use crate::figures;
-use pipeline::diagnose::Diagnosis;
+use diagnose::Diagnosis;
+use errors::{Error, ErrorKind};
 use std::fmt::Write;
 
 /// The sections of a calibration report, in order: `(id, heading)`. The diagnosis section is
@@ -82,7 +82,8 @@ pub fn render_html(report: &Report) -> Result<String, Error> {
         diagnosis_section(&mut out, d, &plots);
     }
     // `calib eval --json` as it prints it: data for a reader or a test, not a script to run.
-    let eval = serde_json::to_string(&report.eval).map_err(|e| Error::Json { message: e.to_string() })?;
+    let eval =
+        serde_json::to_string(&report.eval).map_err(|source| Error::new(ErrorKind::EvaluationJson { source }))?;
     let _ = writeln!(
         out,
         "<script type=\"application/json\" id=\"eval-json\">{}</script>\n</body></html>",
@@ -341,11 +342,11 @@ fn errors(out: &mut String, r: &Report) -> Result<(), Error> {
         out.push_str("<h3>Inside and outside the model's coverage</h3><p class=\"how\">Inside: every effect's joint within the angles it was fitted on; outside, the effects fade out and the model falls back to the geometry.</p><table>");
         out.push_str(STATS_HEAD);
         for (key, label, part) in [("inside", "inside", &split.inside), ("outside", "outside", &split.outside)] {
-            let rows: Vec<pipeline::PoseError> = r
+            let rows: Vec<model::PoseError> = r
                 .rows
                 .iter()
                 .filter(|row| row.inside_coverage == (key == "inside"))
-                .map(|row| pipeline::PoseError { position_mm: row.after_mm, rotation_mrad: row.after_mrad })
+                .map(|row| model::PoseError { position_mm: row.after_mm, rotation_mrad: row.after_mrad })
                 .collect();
             let stats = ErrorStats { summary: *part, ..crate::build::stats(&rows) };
             stats_row(out, &format!("coverage.{key}"), label, &stats);

@@ -9,7 +9,7 @@
 //! there are at least two rows, `RP_j = l̄ + 3 S_l` with `l_i = |x_i − x̄|` and
 //! `S_l = √(Σ (l_i − l̄)² / (n − 1))`. A pose measured once has an AP (its error) and no RP.
 
-use pipeline::Measurement;
+use measurements::Measurement;
 use serde::Serialize;
 
 /// Which rows are one pose measured again.

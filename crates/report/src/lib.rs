@@ -4,13 +4,16 @@
 //! diagnosis's figures and report folder ([`diagnosis_figures`], [`write_diagnosis_report`]) are
 //! drawn by the same writer, so `calib report` and `calib diagnose --report` cannot drift apart.
 //!
-//! The after-calibration numbers are `calib eval --json`'s own: [`pipeline::evaluate`] and
-//! [`pipeline::EvalReport`], embedded in the page as they serialise. Charts are drawn with
-//! `plotters`' SVG backend.
+//! The after-calibration numbers are `calib eval --json`'s own: [`model::evaluate`] and
+//! [`model::EvalReport`], embedded in the page as they serialise. Charts are drawn with
+//! `plotters`' SVG backend. Errors are `errors::Error`, as in every calibration crate: a chart that
+//! cannot be drawn is `errors::ErrorKind::Plot`.
 //!
 //! ```
-//! use pipeline::simulated::{Perturbation, paper_effects, simulated_cell, simulate, joint_ranges};
-//! use pipeline::{FitOptions, Method, RobotDescription};
+//! use campaign::{Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
+//! use model::Method;
+//! use pipeline::FitOptions;
+//! use robot::RobotDescription;
 //!
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! let robot = RobotDescription::read(std::path::Path::new(concat!(
@@ -41,7 +44,6 @@
 mod build;
 mod content;
 mod diagnosis;
-mod error;
 mod figures;
 mod folder;
 mod html;
@@ -53,7 +55,6 @@ pub use content::{
     KernelScales, ModelSummary, Report, RobotSummary, RowError,
 };
 pub use diagnosis::diagnosis_figures;
-pub use error::Error;
 pub use folder::write_diagnosis_report;
 pub use html::{SECTIONS, render_html};
 pub use iso9283::{Iso9283, RepeatOptions};

@@ -1,11 +1,13 @@
 //! The report rendered for a simulated payload campaign: every section there, every number the
 //! page states for the calibrated model equal to `calib eval --json`'s, nothing loaded from outside.
 
+use campaign::{Perturbation, Remount, campaign_cell, joint_ranges, payload_run_campaign, simulate};
+use diagnose::{DiagnoseOptions, diagnose};
+use effects::{EffectSelection, EffectSpec};
 use loadsim::{Effects, Harmonic, PeriodicError};
-use pipeline::diagnose::{DiagnoseOptions, diagnose};
-use pipeline::effects::{EffectSelection, EffectSpec};
-use pipeline::simulated::{Perturbation, Remount, campaign_cell, joint_ranges, payload_run_campaign, simulate};
-use pipeline::{EvalReport, FitOptions, MeasurementSet, Method};
+use measurements::MeasurementSet;
+use model::{EvalReport, Method};
+use pipeline::FitOptions;
 use std::collections::HashMap;
 use std::sync::OnceLock;
 
@@ -29,7 +31,7 @@ fn rendered() -> &'static Rendered {
                     Harmonic { joint_index: 1, order: 2.0, amplitude_rad: 1e-4, phase_rad: -1.0 },
                 ],
             }),
-            ..pipeline::simulated::paper_effects()
+            ..campaign::paper_effects()
         };
         let train_config = payload_run_campaign(160, 11);
         let cell = campaign_cell(&robot, &Perturbation::default(), &Remount::default(), &train_config).unwrap();
@@ -51,7 +53,7 @@ fn rendered() -> &'static Rendered {
         };
         let built = report::Report::build(&inputs, Some(diagnosis), &report::ReportOptions::default()).unwrap();
         let html = report::render_html(&built).unwrap();
-        let evaluation = pipeline::evaluate(&model, &test).unwrap();
+        let evaluation = model::evaluate(&model, &test).unwrap();
         let eval = EvalReport::new(&model, &test, &evaluation);
         let errors = test.rows.iter().zip(&evaluation.errors).map(|(r, e)| (r.line, e.position_mm)).collect();
         Rendered { html, eval, errors, diagnosis_plot_names }
@@ -167,7 +169,7 @@ fn the_diagnosis_folder_keeps_its_file_names() {
     let robot = testkit::robot("irb4400.ron");
     let config = payload_run_campaign(160, 11);
     let cell = campaign_cell(&robot, &Perturbation::default(), &Remount::default(), &config).unwrap();
-    let train = simulate(&cell, &pipeline::simulated::paper_effects(), &joint_ranges(&robot), &config, false).unwrap();
+    let train = simulate(&cell, &campaign::paper_effects(), &joint_ranges(&robot), &config, false).unwrap();
     let diagnosis = diagnose(&robot, &train, &DiagnoseOptions::default()).unwrap();
     let ours: Vec<String> = report::diagnosis_figures(&diagnosis).unwrap().into_iter().map(|(n, _)| n).collect();
     let theirs: Vec<String> = diagnosis.plots().into_iter().map(|(n, _)| n).collect();
