@@ -33,7 +33,7 @@ fn the_column_arm_round_trips_through_simulate_fit_eval_and_export() {
     let dir = tempfile::tempdir().unwrap();
     let [effects, all, train, test, model, urdf] =
         ["effects.ron", "all.csv", "train.csv", "test.csv", "poe.ron", "out.urdf"].map(|n| dir.path().join(n));
-    // Tracker noise alone: the URDF carries masses, but the description read from it no load model.
+    // Tracker noise alone (the URDF's masses bend nothing without a deflection).
     std::fs::write(&effects, "(tracker_noise: ())\n").unwrap();
     let robot = fixture("column_arm.urdf");
     let [effects, all, train, test, model, urdf] = [effects, all, train, test, model, urdf].map(|p| text(&p));
@@ -91,4 +91,46 @@ fn the_column_arm_round_trips_through_simulate_fit_eval_and_export() {
     ];
     let refitted = succeeds(&again);
     assert!(refitted.contains("'lift_stage_3' (multiplier 1)"), "{refitted}");
+}
+
+#[test]
+fn simulate_bends_the_column_with_the_urdfs_masses_and_refuses_compliance_without_stiffness() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = fixture("column_arm.urdf");
+    let simulate = |effects: &str, name: &str| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, effects).unwrap();
+        let out = text(&dir.path().join(format!("{name}.csv")));
+        calib(&["simulate", "--robot", &robot, "--out", &out, "--rows", "20", "--seed", "5", "--effects", &text(&path)])
+    };
+    let bent = simulate("(deflection: (links: [(joint_index: 0, flexibility_per_nm2: (1e-6, 1e-6))]))\n", "bent.ron");
+    assert!(bent.status.success(), "{}", String::from_utf8_lossy(&bent.stderr));
+    let still = simulate("()\n", "still.ron");
+    assert!(still.status.success(), "{}", String::from_utf8_lossy(&still.stderr));
+    // The same poses, the column bent under the arm's weight from the URDF's <inertial> masses.
+    let rows = |name: &str| -> Vec<Vec<f64>> {
+        let content = std::fs::read_to_string(dir.path().join(name)).unwrap();
+        let mut lines = content.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let xyz: Vec<usize> =
+            ["x_mm", "y_mm", "z_mm"].iter().map(|c| header.iter().position(|h| h == c).unwrap()).collect();
+        lines
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .map(|f| xyz.iter().map(|&i| f[i].parse().unwrap()).collect())
+            .collect()
+    };
+    let moved: Vec<f64> = rows("bent.ron.csv")
+        .iter()
+        .zip(rows("still.ron.csv"))
+        .map(|(a, b)| a.iter().zip(&b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt())
+        .collect();
+    let largest = moved.iter().copied().fold(0.0, f64::max);
+    assert!(largest > 0.05 && largest < 5.0, "the bending moves the prism by at most {largest} mm");
+    let compliance = simulate("(\n  compliance: ())\n", "compliance.ron");
+    let message = String::from_utf8_lossy(&compliance.stderr);
+    assert!(!compliance.status.success(), "compliance simulated on a robot without stiffness");
+    assert!(
+        message.contains("compliance.ron:2:3: compliance: joint compliance needs the joint stiffness"),
+        "{message}"
+    );
 }

@@ -133,9 +133,20 @@ pub fn check_effects(effects: &Effects, robot: &RobotDescription, text: &str, fi
     ];
     for (section, on) in needs_dynamics {
         if on && robot.dynamics.is_none() {
-            let message = format!("needs the robot's masses and stiffness (a `dynamics` block in {})", robot.name);
+            let what = if section == "compliance" { "masses and joint stiffness" } else { "link masses" };
+            let message = format!(
+                "needs the robot's {what} ({} has none: a `dynamics` block in a RON robot file, or an `<inertial>` \
+                 on every moving link of a URDF)",
+                robot.name
+            );
             return Err(at(section, section, 0, message));
         }
+    }
+    // A URDF's masses come without stiffness: joint compliance has nothing to deflect by.
+    if effects.compliance.is_some()
+        && let Some(Err(error)) = robot.dynamics.as_ref().map(|d| d.stiffness("joint compliance"))
+    {
+        return Err(at("compliance", "compliance", 0, error.to_string()));
     }
     if let Some(compliance) = &effects.compliance
         && compliance.fixed_point_iterations > MAX_FIXED_POINT_ITERATIONS
@@ -328,5 +339,25 @@ mod tests {
         let effects = parse_effects(text, "e.ron").unwrap();
         let message = check_effects(&effects, &robot, text, "e.ron").unwrap_err().to_string();
         assert!(message.starts_with("e.ron:2:3: compliance: needs the robot's masses"), "{message}");
+        let text = "(\n  deflection: (links: [(joint_index: 0, flexibility_per_nm2: (1e-7, 1e-7))]))";
+        let effects = parse_effects(text, "e.ron").unwrap();
+        let message = check_effects(&effects, &robot, text, "e.ron").unwrap_err().to_string();
+        assert!(message.starts_with("e.ron:2:3: deflection: needs the robot's link masses"), "{message}");
+        assert!(message.contains("`<inertial>` on every moving link of a URDF"), "{message}");
+    }
+
+    #[test]
+    fn compliance_is_refused_for_masses_without_stiffness_and_a_deflection_is_taken() {
+        let mut robot = testkit::robot("irb4400.ron");
+        if let Some(dynamics) = &mut robot.dynamics {
+            dynamics.stiffness_nm_per_rad.clear();
+        }
+        let text = "(\n  compliance: ())";
+        let effects = parse_effects(text, "e.ron").unwrap();
+        let message = check_effects(&effects, &robot, text, "e.ron").unwrap_err().to_string();
+        assert!(message.starts_with("e.ron:2:3: compliance: joint compliance needs the joint stiffness"), "{message}");
+        let text = "(\n  deflection: (links: [(joint_index: 0, flexibility_per_nm2: (1e-7, 1e-7))]))";
+        let effects = parse_effects(text, "e.ron").unwrap();
+        check_effects(&effects, &robot, text, "e.ron").unwrap();
     }
 }

@@ -48,9 +48,9 @@ pub fn compliance_deflection(
     payload: &Payload,
     settings: &JointCompliance,
 ) -> Result<Vec<f64>, Error> {
-    let deflect = |torque: Vec<f64>| -> Vec<f64> {
-        torque.iter().zip(&dynamics.stiffness_nm_per_rad).map(|(t, k)| t / k).collect()
-    };
+    dynamics.validate(model.joint_count())?;
+    let stiffness = dynamics.stiffness("joint compliance")?;
+    let deflect = |torque: Vec<f64>| -> Vec<f64> { torque.iter().zip(stiffness).map(|(t, k)| t / k).collect() };
     let mut dq = deflect(spring_torque(model, dynamics, q, tool, payload, settings)?);
     for _ in 0..settings.fixed_point_iterations {
         let moved: Vec<f64> = q.iter().zip(&dq).map(|(a, b)| a + b).collect();

@@ -39,7 +39,11 @@ pub struct LinkInertia {
 pub struct RobotDynamics {
     /// One entry per joint: the body that joint moves.
     pub links: Vec<LinkInertia>,
-    /// Joint stiffness, N·m/rad (N/m for a prismatic joint), one per joint.
+    /// Joint stiffness, N·m/rad (N/m for a prismatic joint), one per joint; empty where it is not
+    /// known (a URDF gives masses but no stiffness): then joint compliance cannot be simulated
+    /// ([`RobotDynamics::stiffness`] refuses), while what needs the masses alone (gravity torque,
+    /// backlash's sign, link deflection) still can.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub stiffness_nm_per_rad: Vec<f64>,
     /// A spring or gas-spring balancer acting on one joint (joint 2 of most large arms), if fitted.
     #[serde(default)]
@@ -51,13 +55,14 @@ pub struct RobotDynamics {
 }
 
 impl RobotDynamics {
-    /// Checks the data against a robot with `joint_count` joints: one link and one stiffness per
-    /// joint, masses finite and non-negative, stiffness finite and positive, a valid balancer.
+    /// Checks the data against a robot with `joint_count` joints: one link per joint, one
+    /// stiffness per joint or none at all, masses finite and non-negative, stiffness finite and
+    /// positive, a valid balancer.
     pub fn validate(&self, joint_count: usize) -> Result<(), Error> {
         if self.links.len() != joint_count {
             return Err(Error::LengthMismatch { field: "links", given: self.links.len(), expected: joint_count });
         }
-        if self.stiffness_nm_per_rad.len() != joint_count {
+        if !self.stiffness_nm_per_rad.is_empty() && self.stiffness_nm_per_rad.len() != joint_count {
             return Err(Error::LengthMismatch {
                 field: "stiffness_nm_per_rad",
                 given: self.stiffness_nm_per_rad.len(),
@@ -82,6 +87,14 @@ impl RobotDynamics {
             balancer.validate(joint_count)?;
         }
         Ok(())
+    }
+
+    /// The joint stiffness, or the error that `effect` needs it where the robot gives none.
+    pub fn stiffness(&self, effect: &'static str) -> Result<&[f64], Error> {
+        if self.stiffness_nm_per_rad.is_empty() {
+            return Err(Error::MissingStiffness { effect });
+        }
+        Ok(&self.stiffness_nm_per_rad)
     }
 
     /// The stacked inertial parameters `π = (m_1, m_1 c_1, …, m_n, m_n c_n)` (4 per link, `c_k` at

@@ -101,7 +101,9 @@ impl Effects {
             return Err(poe::Error::UnknownTool { tool: cell.tool, tool_count: cell.robot.tool_count() }.into());
         }
         if self.compliance.is_some() {
-            cell.dynamics_for("joint compliance")?.validate(n)?;
+            let dynamics = cell.dynamics_for("joint compliance")?;
+            dynamics.validate(n)?;
+            dynamics.stiffness("joint compliance")?;
         }
         if let Some(backlash) = &self.backlash {
             backlash.validate(n)?;

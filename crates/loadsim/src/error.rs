@@ -41,6 +41,11 @@ pub enum Error {
         /// The effect that needs them.
         effect: &'static str,
     },
+    /// An effect needs the joint stiffness, but the robot's dynamics give masses only (a URDF's).
+    MissingStiffness {
+        /// The effect that needs it.
+        effect: &'static str,
+    },
     /// A joint range is empty once the margin is taken off both ends.
     EmptyJointRange {
         /// 0-based joint index.
@@ -102,6 +107,11 @@ impl fmt::Display for Error {
             Error::MissingDynamics { effect } => {
                 write!(f, "{effect} needs link masses and joint stiffness, but the robot has no `dynamics`")
             }
+            Error::MissingStiffness { effect } => write!(
+                f,
+                "{effect} needs the joint stiffness, but the robot's `dynamics` give masses only (a URDF has no \
+                 stiffness): give `stiffness_nm_per_rad` in a RON robot file"
+            ),
             Error::EmptyJointRange { joint_index, lower_rad, upper_rad, margin_rad } => write!(
                 f,
                 "joint {} range [{lower_rad}, {upper_rad}] rad is empty after a margin of {margin_rad} rad",

@@ -284,7 +284,7 @@ pub fn fit(
                 gear.record_rms(&data.rows);
             }
         }
-        effect_report = effect_reports(&effects, &fitted.report.held_at_prior);
+        effect_report = effect_reports(&effects, &fitted.report.held_at_prior, &robot.joint_kinds());
         model.fallback_kinematics = Some(std::mem::replace(&mut model.kinematics, fitted.model));
         model.effect_uncertainty = effect_uncertainty(
             &model.kinematics,

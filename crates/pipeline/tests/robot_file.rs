@@ -128,6 +128,23 @@ fn dynamics_of_the_wrong_length_are_refused() {
     assert!(message.contains("1 links given"), "{message}");
 }
 
+/// A `dynamics` block may leave the stiffness out (masses only, as a URDF gives them): it reads,
+/// and a stiffness list of the wrong length is still refused.
+#[test]
+fn dynamics_without_stiffness_read_and_a_short_stiffness_list_is_refused() {
+    let masses =
+        "    dynamics: (links: [(mass_kg: 1.0, com_m: (0.0, 0.0, 0.5)), (mass_kg: 2.0, com_m: (0.5, 0.0, 1.0))]),\n";
+    let robot = RobotDescription::parse(&GOOD.replace("    tool: (0.0, 0.0, 0.1),\n", masses), "robot.ron").unwrap();
+    let dynamics = robot.dynamics.expect("masses read");
+    assert_eq!(dynamics.links[1].mass_kg, 2.0);
+    assert!(dynamics.stiffness_nm_per_rad.is_empty());
+    assert!(dynamics.stiffness("joint compliance").is_err());
+    let short = masses.replace("]),", "], stiffness_nm_per_rad: [1e5]),");
+    let (line, _, message) = refuse(&GOOD.replace("    tool: (0.0, 0.0, 0.1),\n", &short));
+    assert_eq!(line, 9, "{message}");
+    assert!(message.contains("1 stiffness values given"), "{message}");
+}
+
 /// The refusal of a value that must be finite: its field and where it is.
 fn refuse_not_finite(text: &str) -> (usize, usize, String, String) {
     let e = RobotDescription::parse(text, "robot.ron").expect_err("a NotFinite error");

@@ -109,7 +109,11 @@ impl Report {
             before: before.map(|(how, e)| BeforeCalibration { how, groups: grouped(data, &e) }),
             iso9283: Iso9283::new(&data.rows, &predicted, options.repeat),
             rows,
-            effects: model.effects.iter().map(|e| effect_view(e, data, inputs.training, options)).collect(),
+            effects: model
+                .effects
+                .iter()
+                .map(|e| effect_view(e, inputs.robot, data, inputs.training, options))
+                .collect(),
             gp: model.residual_gp.as_ref().map(|c| gp_view(&c.gp, c.with_payload, model.joint_count())),
             warnings: warnings(model, &eval),
             fit_warnings: model.fit_warnings.clone(),
@@ -264,6 +268,7 @@ fn data_summary(data: &MeasurementSet, robot: &RobotDescription) -> DataSummary 
 
 fn effect_view(
     effect: &IdentifiedEffect,
+    robot: &RobotDescription,
     data: &MeasurementSet,
     training: Option<&MeasurementSet>,
     options: &ReportOptions,
@@ -273,8 +278,8 @@ fn effect_view(
         _ => None,
     };
     EffectView {
-        label: effect.label(),
-        parameters: effect.parameter_names().into_iter().zip(effect.theta().iter().copied()).collect(),
+        label: effects::reported_label(effect, &robot.joint_kinds()),
+        parameters: effects::reported_parameters(effect, &robot.joint_kinds()),
         curve,
     }
 }

@@ -153,8 +153,9 @@ pub struct RowError {
 pub struct EffectView {
     /// Its name in reports (`gear_periodic:2:12`).
     pub label: String,
-    /// Its parameters by name, as identified (scaled: the effect's size at a typical training row).
-    pub parameters: Vec<(String, f64)>,
+    /// Its parameters by name, as identified (scaled: the effect's size at a typical training row),
+    /// each with its unit (`effects::reported_parameters`: a prismatic joint's in mm).
+    pub parameters: Vec<(String, f64, &'static str)>,
     /// The joint error over the joint's angle, for an effect that is a function of one joint's
     /// angle (a gear series); `None` otherwise.
     pub curve: Option<EffectCurve>,

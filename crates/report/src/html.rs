@@ -409,14 +409,18 @@ fn effects(out: &mut String, r: &Report) -> Result<(), Error> {
                 .push_str("<p class=\"how\">Not a function of one joint's angle alone: its parameters are listed.</p>"),
         }
         let shown = e.parameters.iter().take(24);
-        out.push_str("<table><tr><th class=\"l\">parameter</th><th>value</th></tr>");
-        for (name, value) in shown {
-            let _ = write!(out, "<tr><td class=\"l\">{}</td><td>{value:.4e}</td></tr>", escape(name));
+        out.push_str("<table><tr><th class=\"l\">parameter</th><th>value</th><th class=\"l\">unit</th></tr>");
+        for (name, value, unit) in shown {
+            let _ = write!(
+                out,
+                "<tr><td class=\"l\">{}</td><td>{value:.4e}</td><td class=\"l\">{unit}</td></tr>",
+                escape(name)
+            );
         }
         if e.parameters.len() > 24 {
             let _ = write!(
                 out,
-                "<tr><td class=\"l\" colspan=\"2\">… {} more in the model file</td></tr>",
+                "<tr><td class=\"l\" colspan=\"3\">… {} more in the model file</td></tr>",
                 e.parameters.len() - 24
             );
         }

@@ -176,3 +176,16 @@ fn the_diagnosis_folder_keeps_its_file_names() {
     assert_eq!(ours, theirs);
     assert!(!r.diagnosis_plot_names.is_empty());
 }
+
+/// Each effect parameter's row names its unit: the gear series of revolute joint 2 in rad (a
+/// prismatic joint's would read mm, `effects::reported_parameters`).
+#[test]
+fn the_effect_parameters_state_their_unit() {
+    let html = &rendered().html;
+    assert!(html.contains("<th>value</th><th class=\"l\">unit</th>"), "no unit column");
+    for name in ["cos(1 q2)", "sin(1 q2)", "cos(2 q2)", "sin(2 q2)"] {
+        let row = html.split(&format!("<td class=\"l\">{name}</td>")).nth(1).unwrap_or_else(|| panic!("{name}"));
+        let row = row.split("</tr>").next().unwrap();
+        assert!(row.ends_with("<td class=\"l\">rad</td>"), "{name}: {row}");
+    }
+}

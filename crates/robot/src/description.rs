@@ -128,7 +128,8 @@ pub struct RobotDescription {
     /// Nominal tool point in the flange frame, metres (the measured point's design position).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tool: Option<[f64; 3]>,
-    /// Link masses, centres of mass and joint stiffness, for the load model.
+    /// Link masses, centres of mass and joint stiffness, for the load model (a URDF's `<inertial>`
+    /// masses, without stiffness, where every joint carries one).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dynamics: Option<loadsim::RobotDynamics>,
     /// The joints that fold a URDF's mimic joints into their actuated joint (empty for a RON file).

@@ -25,6 +25,7 @@ mod read;
 mod robot_check;
 mod robot_dh;
 mod urdf_chain;
+mod urdf_inertial;
 mod urdf_mimic;
 mod urdf_steps;
 pub mod xml_outline;
@@ -37,5 +38,6 @@ pub use description::{
 };
 pub use robot_dh::{DhTable, DhTableRow};
 pub use urdf_chain::{ChainEnds, UrdfChain, UrdfDocument};
+pub use urdf_inertial::MAX_LINK_MASS_KG;
 pub use urdf_mimic::ChainJoint;
 pub use urdf_steps::{ChainStep, StepMimic, StepMotion};

@@ -201,7 +201,8 @@ impl RobotDescription {
             if dynamics.links.len() != n {
                 return Err(at("links", 0, format!("{} links given, the robot has {n} joints", dynamics.links.len())));
             }
-            if dynamics.stiffness_nm_per_rad.len() != n {
+            // Left out (empty) where not known: compliance then cannot be simulated, nothing else needs it.
+            if !dynamics.stiffness_nm_per_rad.is_empty() && dynamics.stiffness_nm_per_rad.len() != n {
                 return Err(at(
                     "stiffness_nm_per_rad",
                     0,

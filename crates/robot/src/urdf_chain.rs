@@ -7,8 +7,10 @@
 //! fixed joints); several such leaves are ambiguous and need `--tip-link`. The chain may run up
 //! through fixed joints (a base link below the root, such as the ROS-Industrial `base` frame),
 //! never through a movable joint backwards. Mimic joints are folded into the joint that drives
-//! them where their motions add (`urdf_mimic.rs`).
+//! them where their motions add (`urdf_mimic.rs`). The links' `<inertial>` masses become the
+//! load model's data where every joint's body has one (`urdf_inertial.rs`).
 
+use crate::urdf_inertial::{ChainMasses, LinkInertial, LinkTree, chain_masses, read_inertials};
 use crate::urdf_mimic::{ChainJoint, fold, folded_joint};
 use crate::urdf_steps::{ChainStep, StepMimic, StepMotion};
 use crate::xml_outline::{Element, Position, outline};
@@ -40,6 +42,11 @@ pub struct UrdfChain {
     pub steps: Vec<ChainStep>,
     /// The description's joints: each actuated joint with the mimic joints folded into it.
     pub joints: Vec<ChainJoint>,
+    /// The links' masses as the load model's data (no stiffness: a URDF has none), where every
+    /// joint's body has an `<inertial>`.
+    pub dynamics: Option<loadsim::RobotDynamics>,
+    /// The joints (1-based) whose body has no `<inertial>`, for which no mass model is made.
+    pub joints_without_mass: Vec<usize>,
 }
 
 /// A parsed URDF with the positions of its elements.
@@ -49,6 +56,8 @@ pub struct UrdfDocument {
     text: String,
     robot: urdf_rs::Robot,
     outline: Element,
+    /// Each link's `<inertial>`, read from the outline so that a bad value is placed.
+    inertials: HashMap<String, LinkInertial>,
     /// Indices looked up by name, so that every walk of the tree stays linear in its size (a
     /// file of 100,000 links took minutes with scans of the lists; found by `cargo xtask fuzz`).
     index: NameIndex,
@@ -92,6 +101,8 @@ impl UrdfDocument {
         }) {
             return Err(at(xacro.position, "a xacro file: expand it first (`xacro arm.urdf.xacro > arm.urdf`)".into()));
         }
+        // Before urdf-rs, which reads a malformed `xyz` by skipping the words that are no numbers.
+        let inertials = read_inertials(&root, file)?;
         let robot = urdf_rs::read_from_string(text).map_err(|e| {
             let message = e.to_string();
             // The XML parser's own position where it gives one; else urdf-rs quotes the offending
@@ -104,8 +115,14 @@ impl UrdfDocument {
             let position = parser_position(&message, text).or_else(quoted).unwrap_or(root.position);
             at(position, format!("URDF: {message}"))
         })?;
-        let mut document =
-            Self { file: file.to_owned(), text: text.to_owned(), robot, outline: root, index: NameIndex::default() };
+        let mut document = Self {
+            file: file.to_owned(),
+            text: text.to_owned(),
+            robot,
+            outline: root,
+            inertials,
+            index: NameIndex::default(),
+        };
         document.check_structure()?;
         Ok(document)
     }
@@ -259,7 +276,19 @@ impl UrdfDocument {
                 element.and_then(|e| e.child("mimic")).or(element).map_or(self.outline.position, |e| e.position);
             self.at((line, column), format!("mimic joint '{name}': {}", refusal.message))
         })?;
-        Ok(UrdfChain { robot_name: self.robot.name.clone(), base_link: base, tip_link: tip, steps, joints })
+        let (dynamics, joints_without_mass) = match chain_masses(&steps, &joints, &frames, self)? {
+            ChainMasses::Known(dynamics) => (Some(dynamics), Vec::new()),
+            ChainMasses::Missing(joints) => (None, joints),
+        };
+        Ok(UrdfChain {
+            robot_name: self.robot.name.clone(),
+            base_link: base,
+            tip_link: tip,
+            steps,
+            joints,
+            dynamics,
+            joints_without_mass,
+        })
     }
 
     fn root_link(&self) -> Result<String, Error> {
@@ -430,6 +459,30 @@ impl UrdfDocument {
     }
 }
 
+impl LinkTree for UrdfDocument {
+    fn inertial(&self, link: &str) -> Option<LinkInertial> {
+        self.inertials.get(link).copied()
+    }
+
+    fn fixed_children(&self, link: &str) -> Result<Vec<(String, SE3)>, Error> {
+        let below = self.index.child_joints.get(link).map_or(&[][..], Vec::as_slice);
+        let mut children = Vec::new();
+        for joint in below.iter().filter_map(|&j| self.robot.joints.get(j)) {
+            if joint.joint_type != urdf_rs::JointType::Fixed {
+                continue;
+            }
+            if !joint.origin.xyz.iter().chain(joint.origin.rpy.iter()).all(|v| v.is_finite()) {
+                let message = format!("joint '{}': origin must be finite", joint.name);
+                return Err(self.error_at("joint", &joint.name, message));
+            }
+            let [roll, pitch, yaw] = joint.origin.rpy.map(|a| a.rem_euclid(std::f64::consts::TAU));
+            let origin = SE3::new(SO3::from_rpy(roll, pitch, yaw), Vector3::from(*joint.origin.xyz));
+            children.push((joint.child.link.clone(), origin));
+        }
+        Ok(children)
+    }
+}
+
 /// The first element, depth first, that `matches`.
 fn find<'a>(element: &'a Element, matches: &dyn Fn(&Element) -> bool) -> Option<&'a Element> {
     if matches(element) {
@@ -528,7 +581,7 @@ impl UrdfChain {
                 z_axis: rotation.column(2).into_owned().into(),
             },
             tool: None,
-            dynamics: None,
+            dynamics: self.dynamics.clone(),
             folded,
         }
     }

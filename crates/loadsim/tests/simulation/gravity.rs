@@ -160,3 +160,46 @@ fn static_torque_adds_the_balancer_on_its_joint_only() {
     }
     assert!(with[1].abs() < without[1].abs(), "the balancer relieves joint 2 when the arm leans forward");
 }
+
+/// On a prismatic joint the generalised force of gravity is a force along the axis (N, from the
+/// spatial twist `(v, 0)`), what a linear axis's compliance and backlash act under (issue 30): a
+/// tilted track carrying a two-joint arm, against the finite-difference gradient of `V` and the
+/// regressor, with a payload off the tool.
+#[test]
+fn a_prismatic_joints_gravity_force_is_minus_the_gradient_of_the_potential_energy() {
+    use poe::{JointAxis, JointKind, LocalPoe};
+    let axis =
+        |kind, d: [f64; 3], p: [f64; 3]| JointAxis { kind, direction: Vector3::from(d).normalize(), point: p.into() };
+    let model = LocalPoe::from_zero_configuration(
+        &[
+            axis(JointKind::Prismatic, [1.0, 0.0, 0.4], [0.0, 0.0, 0.0]),
+            axis(JointKind::Revolute, [0.0, 0.0, 1.0], [0.2, 0.0, 0.5]),
+            axis(JointKind::Revolute, [0.0, 1.0, 0.0], [0.2, 0.0, 0.9]),
+        ],
+        lie::SE3::from_translation(Vector3::new(0.9, 0.0, 0.9)),
+    )
+    .unwrap();
+    let dynamics = RobotDynamics {
+        links: vec![
+            LinkInertia { mass_kg: 80.0, com_m: [0.1, 0.05, 0.3] },
+            LinkInertia { mass_kg: 20.0, com_m: [0.25, 0.0, 0.7] },
+            LinkInertia { mass_kg: 8.0, com_m: [0.6, 0.02, 0.9] },
+        ],
+        stiffness_nm_per_rad: Vec::new(),
+        counterbalance: None,
+        gravity_m_per_s2: loadsim::FLOOR_GRAVITY_M_PER_S2,
+    };
+    let payload = Payload { mass_kg: 5.0, com_offset_m: [0.02, 0.0, 0.05] };
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    for _ in 0..20 {
+        let q = [rng.random_range(0.0..2.0), rng.random_range(-3.0..3.0), rng.random_range(-1.5..1.5)];
+        let force = gravity_torque(&model, &dynamics, &q, 0, &payload).unwrap();
+        assert_close(&force, &minus_gradient(&dynamics, &model, &q, &payload), 1e-3, "prismatic arm");
+        // The whole moving mass, 113 kg, pulled down the track's 0.4/1.08 slope.
+        let along = 9.81 * 113.0 * 0.4 / (1.0f64 + 0.16).sqrt();
+        assert!((force[0] + along).abs() < 1e-9, "joint 1: {} N against {} N", force[0], -along);
+        let y = gravity_regressor(&model, &q, &Vector3::from(dynamics.gravity_m_per_s2)).unwrap();
+        let links = gravity_torque(&model, &dynamics, &q, 0, &Payload::default()).unwrap();
+        assert_close((&y * dynamics.inertial_parameters()).as_slice(), &links, 1e-8, "Y pi");
+    }
+}

@@ -50,6 +50,22 @@ fn compliance_without_dynamics_is_refused() {
 }
 
 #[test]
+fn compliance_on_masses_without_stiffness_is_refused_and_what_needs_masses_alone_runs() {
+    let robot = irb4400();
+    let dynamics = loadsim::RobotDynamics { stiffness_nm_per_rad: Vec::new(), ..robot.dynamics.clone() };
+    let cell = SimulatedCell::new(robot.model, Some(dynamics));
+    let effects = Effects { compliance: Some(JointCompliance::default()), ..Effects::default() };
+    let q = [0.1, 0.3, -0.2, 0.0, 0.4, 0.0];
+    let refused = effects.true_pose(&cell, &q, &PoseContext::default()).unwrap_err();
+    assert_eq!(refused, Error::MissingStiffness { effect: "joint compliance" });
+    assert!(refused.to_string().contains("stiffness_nm_per_rad"), "{refused}");
+    let backlash = Effects { backlash: Some(Backlash::uniform(6, 1e-4)), ..Effects::default() };
+    let moved = backlash.true_pose(&cell, &q, &PoseContext::default()).unwrap();
+    let still = Effects::default().true_pose(&cell, &q, &PoseContext::default()).unwrap();
+    assert!((moved.translation() - still.translation()).norm() > 1e-5, "the backlash did not act");
+}
+
+#[test]
 fn wrong_joint_count_is_refused() {
     let cell = SimulatedCell::new(irb4400().model, None);
     let refused = Effects::default().true_pose(&cell, &[0.0; 5], &PoseContext::default()).unwrap_err();
