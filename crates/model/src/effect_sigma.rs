@@ -74,7 +74,7 @@ impl EffectUncertainty {
     /// [`EffectUncertainty::fallback_sigma_m`], 0 from twice it, linear between.
     pub fn weight(&self, sigma_m: f64) -> f64 {
         let limit = self.fallback_sigma_m;
-        if !(limit > 0.0) || sigma_m <= limit { 1.0 } else { (2.0 - sigma_m / limit).clamp(0.0, 1.0) }
+        if limit.is_nan() || limit <= 0.0 || sigma_m <= limit { 1.0 } else { (2.0 - sigma_m / limit).clamp(0.0, 1.0) }
     }
 
     /// How the pose at `row` (model tool `tool`) moves per unit of each parameter of the factor,

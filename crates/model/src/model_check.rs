@@ -298,9 +298,8 @@ fn uncertainty_fault(
     }
     let [median, largest] = uncertainty.training_sigma_m;
     let limit = uncertainty.fallback_sigma_m;
-    if !(median.is_finite() && largest.is_finite() && 0.0 <= median && median <= largest)
-        || !(limit.is_finite() && limit > 0.0)
-    {
+    let ordered = median.is_finite() && largest.is_finite() && 0.0 <= median && median <= largest;
+    if !(ordered && limit.is_finite() && limit > 0.0) {
         return Some(format!(
             "effect_uncertainty: training_sigma_m ({median:e}, {largest:e}) and fallback_sigma_m {limit:e} must be \
              finite, the first two ordered and at least 0, the last above 0 (an edited or corrupt file)"

@@ -165,7 +165,8 @@ fn effect_uncertainty(
 ) -> Result<Option<model::EffectUncertainty>, Error> {
     let p = free.len() + effects.iter().map(IdentifiedEffect::parameter_count).sum::<usize>();
     let Some(factor) = model::EffectUncertainty::factor_of(covariance, p) else { return Ok(None) };
-    let mut uncertainty = model::EffectUncertainty { free, factor, training_sigma_m: [0.0; 2], fallback_sigma_m: 1e3 };
+    let mut uncertainty =
+        model::EffectUncertainty { free, factor, training_sigma_m: [0.0; 2], fallback_sigma_m: f64::MAX / 2.0 };
     let mut sigmas = Vec::with_capacity(data.rows.len());
     for row in &data.rows {
         let sigma = uncertainty.sigma(kinematics, effects, row, row.tool)?;
@@ -174,12 +175,10 @@ fn effect_uncertainty(
     sigmas.sort_by(f64::total_cmp);
     let median = sigmas.get(sigmas.len() / 2).copied().unwrap_or(0.0);
     let largest = sigmas.last().copied().unwrap_or(0.0);
-    if std::env::var_os("CALIB_DEBUG_SIGMA").is_some() {
-        eprintln!("sigma on training rows: median {median:e} max {largest:e} p90 {:e}", sigmas[sigmas.len() * 9 / 10]);
-    }
     uncertainty.training_sigma_m = [median, largest];
-    // inf (never) is kept as the largest finite σ, which no row reaches.
-    uncertainty.fallback_sigma_m = (options.fallback_sigma_ratio * largest).min(f64::MAX / 2.0).max(f64::MIN_POSITIVE);
+    // inf (never), and training rows without any σ to compare with, keep a limit no row reaches.
+    let limit = options.fallback_sigma_ratio * largest;
+    uncertainty.fallback_sigma_m = if limit.is_finite() && limit > 0.0 { limit } else { f64::MAX / 2.0 };
     Ok(Some(uncertainty))
 }
 
