@@ -324,7 +324,7 @@ impl CalibratedModel {
         let mut weights = Vec::with_capacity(rows.len());
         for (row, &tool) in rows.iter().zip(tools) {
             let sigma = uncertainty.sigma(&self.kinematics, &self.effects, row, tool)?;
-            let position = (sigma[0] * sigma[0] + sigma[1] * sigma[1] + sigma[2] * sigma[2]).sqrt();
+            let position = crate::EffectUncertainty::position(&sigma);
             weights.push((uncertainty.weight(position), position));
         }
         Ok(Some(weights))

@@ -70,6 +70,12 @@ impl EffectUncertainty {
         (((8 * self.factor.len() + 1) as f64).sqrt() as usize).saturating_sub(1) / 2
     }
 
+    /// The σ of the tool point's position (m) of a row's per-component σ ([`EffectUncertainty::sigma`]):
+    /// the three position components in quadrature.
+    pub fn position(sigma: &[f64; 6]) -> f64 {
+        (sigma[0] * sigma[0] + sigma[1] * sigma[1] + sigma[2] * sigma[2]).sqrt()
+    }
+
     /// How fully the effects apply at a row whose position σ is `sigma_m`: 1 up to
     /// [`EffectUncertainty::fallback_sigma_m`], 0 from twice it, linear between.
     pub fn weight(&self, sigma_m: f64) -> f64 {

@@ -95,8 +95,7 @@ impl<'a> Part<'a> {
                     let mut variances = Vec::with_capacity(walk.rows.len());
                     for ((coverage, row), &tool) in walk.coverage.iter_mut().zip(walk.rows).zip(walk.tools) {
                         let sigma = uncertainty.sigma(kinematics, effects, row, tool)?;
-                        *coverage *= uncertainty
-                            .weight((sigma[0] * sigma[0] + sigma[1] * sigma[1] + sigma[2] * sigma[2]).sqrt());
+                        *coverage *= uncertainty.weight(EffectUncertainty::position(&sigma));
                         variances.push(sigma.map(|s| s * s * *coverage * *coverage));
                     }
                     walk.posterior_variance = Some(variances);

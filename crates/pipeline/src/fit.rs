@@ -170,7 +170,7 @@ fn effect_uncertainty(
     let mut sigmas = Vec::with_capacity(data.rows.len());
     for row in &data.rows {
         let sigma = uncertainty.sigma(kinematics, effects, row, row.tool)?;
-        sigmas.push((sigma[0] * sigma[0] + sigma[1] * sigma[1] + sigma[2] * sigma[2]).sqrt());
+        sigmas.push(model::EffectUncertainty::position(&sigma));
     }
     sigmas.sort_by(f64::total_cmp);
     let median = sigmas.get(sigmas.len() / 2).copied().unwrap_or(0.0);
