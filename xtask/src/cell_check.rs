@@ -48,6 +48,13 @@ pub struct Args {
     /// Also 300 planned against 300 random rows for `poe-gp --effects auto` (10 seeds; minutes).
     #[arg(long)]
     effects: bool,
+    /// Planning options (RON, `cell::PlanOptions`) for every plan of the check; the criterion is
+    /// set per column.
+    #[arg(long)]
+    plan_options: Option<String>,
+    /// The UR10 series the plan-ur10 section plans from (its even rows) and tests on (its odd rows).
+    #[arg(long, default_value = "C")]
+    series: String,
     /// Only these sections (comma separated): register-ur10, register-simulated, plan-ur10,
     /// plan-irb4400, timing, effects [default: all but effects, and effects with --effects].
     #[arg(long, value_delimiter = ',')]
@@ -274,6 +281,14 @@ fn register_simulated(args: &Args, md: &mut String) -> Result<()> {
     Ok(())
 }
 
+/// The planning options of `--plan-options`, or the defaults.
+fn plan_options(args: &Args) -> Result<cell::PlanOptions> {
+    Ok(match &args.plan_options {
+        Some(text) => cell::PlanOptions::parse(text, "--plan-options")?,
+        None => cell::PlanOptions::default(),
+    })
+}
+
 fn plan_rows(
     robot: &RobotDescription,
     set: &MeasurementSet,
@@ -287,17 +302,19 @@ fn plan_rows(
 
 fn plan_ur10(args: &Args, md: &mut String) -> Result<()> {
     let robot = RobotDescription::read(&args.ur10)?;
-    let even = read(&robot, &args.data.join("ur10_C_full_even.csv"))?;
-    let odd = read(&robot, &args.data.join("ur10_C_full_odd.csv"))?;
+    let series = &args.series;
+    let even = read(&robot, &args.data.join(format!("ur10_{series}_full_even.csv")))?;
+    let odd = read(&robot, &args.data.join(format!("ur10_{series}_full_odd.csv")))?;
     let options = FitOptions::default();
     let all = fit_and_test(&robot, &even, &odd, &options, Method::Poe)?;
     let _ = writeln!(
         md,
-        "\n## UR10 C: what a geometric fit needs\n\n`poe` on N rows of the even rows of series C, tested on the {} odd \
-         rows; all {} even rows give {all:.4} mm. Planned: `calib plan --full-pose` from the even rows (criterion i, \
-         the default, and d).\n",
+        "\n## UR10 {series}: what a geometric fit needs\n\n`poe` on N rows of the even rows of series {series}, tested on \
+         the {} odd rows; all {} even rows give {all:.4} mm. Planned: `calib plan --full-pose` from the even rows \
+         (criterion i, the default, and d; options: {}).\n",
         odd.rows.len(),
-        even.rows.len()
+        even.rows.len(),
+        args.plan_options.as_deref().unwrap_or("the defaults")
     );
     let _ = writeln!(
         md,
@@ -313,7 +330,7 @@ fn plan_ur10(args: &Args, md: &mut String) -> Result<()> {
             .collect::<Result<_>>()?;
         let mut planned = Vec::new();
         for criterion in [cell::Criterion::I, cell::Criterion::D] {
-            let plan_options = cell::PlanOptions { criterion, ..cell::PlanOptions::default() };
+            let plan_options = cell::PlanOptions { criterion, ..plan_options(args)? };
             let order = plan_rows(&robot, &even, n, true, &plan_options)?;
             planned.push(fit_and_test(&robot, &even.subset(&order), &odd, &options, Method::Poe)?);
         }
@@ -367,7 +384,7 @@ fn plan_irb4400(args: &Args, md: &mut String) -> Result<()> {
         r25 / reference
     );
     for criterion in [cell::Criterion::I, cell::Criterion::D] {
-        let plan_options = cell::PlanOptions { criterion, ..cell::PlanOptions::default() };
+        let plan_options = cell::PlanOptions { criterion, ..plan_options(args)? };
         let order = plan_rows(&robot, &candidates, 25, false, &plan_options)?;
         let planned = fit_and_test(&robot, &candidates.subset(&order), &test, &options, Method::Poe)?;
         let _ = writeln!(md, "| 25 planned ({criterion:?}) | {planned:.4} | {:.3} |", planned / reference);
@@ -389,7 +406,7 @@ fn plan_timing(args: &Args, md: &mut String) -> Result<()> {
         let set = cell::generated_candidates(&robot, None, 10_000, 0)?;
         for full_pose in [false, true] {
             for criterion in [cell::Criterion::I, cell::Criterion::D] {
-                let options = cell::PlanOptions { criterion, ..cell::PlanOptions::default() };
+                let options = cell::PlanOptions { criterion, ..plan_options(args)? };
                 let (start, cpu) = (Instant::now(), crate::ur10::process_cpu_seconds());
                 cell::plan(&set.model, &set.candidates, 100, full_pose, &options)?;
                 let _ = writeln!(
@@ -416,7 +433,7 @@ fn plan_effects(args: &Args, md: &mut String) -> Result<()> {
             fit_and_test(&robot, &even.subset(&draw(even.rows.len(), 300, seed)), &odd, &options, Method::PoeGp)
         })
         .collect::<Result<_>>()?;
-    let order = plan_rows(&robot, &even, 300, true, &cell::PlanOptions::default())?;
+    let order = plan_rows(&robot, &even, 300, true, &plan_options(args)?)?;
     let planned = fit_and_test(&robot, &even.subset(&order), &odd, &options, Method::PoeGp)?;
     let _ = writeln!(
         md,

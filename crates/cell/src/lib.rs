@@ -84,6 +84,7 @@
 //! ```
 #![deny(missing_docs)]
 
+mod bias;
 mod candidates;
 mod coverage;
 mod design;

@@ -1,11 +1,13 @@
 //! `calib plan`: the poses worth measuring, chosen from candidates.
 //!
 //! D-optimal for the identification ([`crate::information`], [`crate::design`]): greedy, then
-//! Fedorov exchanges, then every moving joint's range (and the payloads) covered
+//! Fedorov exchanges, then exchanges that lower the expected held-out error with the error the
+//! geometry cannot model in it ([`crate::bias`]), then every moving joint's range (and the payloads) covered
 //! ([`crate::coverage`]); put in the order to measure them (tool and payload changes grouped,
 //! the shortest joint move next); reported with the predicted error at the chosen count and at a
 //! few others, so that the user sees where more poses stop paying.
 
+use crate::bias::{BiasModel, Unmodelled};
 use crate::coverage::{Axis, AxisCoverage, cover, coverage};
 use crate::design::{Criterion, Design};
 use crate::information::{Candidate, RowWeights, candidate_rows};
@@ -49,6 +51,32 @@ pub struct PlanOptions {
     /// A joint whose candidates span less than this (rad or m) does not move and needs no
     /// coverage.
     pub min_joint_span: f64,
+    /// RMS per axis of the position error the geometry cannot model (compliance, gear errors),
+    /// mm: 0.2. After `poe` the UR10 of Landgraf et al. keeps 0.44 mm (3-D mean) on series C,
+    /// 0.41 on B and 0.37 on D, about 0.2–0.25 per axis. The design is then exchanged to lower
+    /// the expected held-out error with that error in it ([`crate::bias`]), and the report
+    /// predicts it. 0: tracker noise alone (the plain criterion).
+    pub unmodelled_mm: f64,
+    /// The same for the orientation, mrad: 0.2, the position's at the 1 m lever of an arm's
+    /// reach.
+    pub unmodelled_mrad: f64,
+    /// Correlation length of the unmodelled error over the joints (chordal distance of the
+    /// angles, rad; metres for a prismatic joint): 0.2. Measured: the correlation of `poe`'s
+    /// residuals between two poses of the UR10 (series B, C, D; docs/results/cell-check.md)
+    /// is 0.3–0.5 at 0.1–0.2 rad apart and 0.1–0.3 at 0.3 rad.
+    pub unmodelled_length_rad: f64,
+    /// Candidates (evenly strided) over which the expected error is averaged: 1000.
+    pub unmodelled_test_points: usize,
+    /// Candidates (evenly strided over those not chosen) tried in each position of an exchange
+    /// for the unmodelled error: 500, at most `unmodelled_evaluations / poses`.
+    pub unmodelled_trials: usize,
+    /// Trials in one pass of those exchanges, over all positions: 30,000. Each costs a few `r³`
+    /// (`r` ≈ 40 directions for a 6-axis arm's full pose); this keeps 100 of 10,000 candidates
+    /// within seconds (`cargo xtask cell-check --only timing`), and 30 or 50 poses at 500
+    /// trials each.
+    pub unmodelled_evaluations: usize,
+    /// Passes of those exchanges: 2 (a third changed no pose on the UR10 series).
+    pub unmodelled_passes: usize,
 }
 
 impl Default for PlanOptions {
@@ -63,6 +91,13 @@ impl Default for PlanOptions {
             exchange_tolerance: 1e-6,
             coverage_bins: 8,
             min_joint_span: 1e-3,
+            unmodelled_mm: 0.2,
+            unmodelled_mrad: 0.2,
+            unmodelled_length_rad: 0.2,
+            unmodelled_test_points: 1000,
+            unmodelled_trials: 500,
+            unmodelled_evaluations: 30_000,
+            unmodelled_passes: 2,
         }
     }
 }
@@ -91,6 +126,7 @@ impl PlanOptions {
             ("rank_tolerance", self.rank_tolerance),
             ("prior_fraction", self.prior_fraction),
             ("min_joint_span", self.min_joint_span),
+            ("unmodelled_length_rad", self.unmodelled_length_rad),
         ];
         for (field, value) in positive {
             if !(value.is_finite() && value > 0.0) {
@@ -98,6 +134,26 @@ impl PlanOptions {
                     field,
                     value,
                     expected: "a positive finite number",
+                }));
+            }
+        }
+        for (field, value) in [("unmodelled_mm", self.unmodelled_mm), ("unmodelled_mrad", self.unmodelled_mrad)] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(Error::new(ErrorKind::OptionOutOfRange {
+                    field, value, expected: "a finite number ≥ 0"
+                }));
+            }
+        }
+        for (field, value) in [
+            ("unmodelled_test_points", self.unmodelled_test_points),
+            ("unmodelled_trials", self.unmodelled_trials),
+            ("unmodelled_evaluations", self.unmodelled_evaluations),
+        ] {
+            if value == 0 {
+                return Err(Error::new(ErrorKind::OptionOutOfRange {
+                    field,
+                    value: value as f64,
+                    expected: "at least 1",
                 }));
             }
         }
@@ -135,6 +191,11 @@ pub struct Checkpoint {
     pub max_parameter_error_mm: f64,
     /// Predicted held-out RMS position error: the noise and the parameters' part, mm.
     pub predicted_error_mm: f64,
+    /// The same with the unmodelled error of `PlanOptions::unmodelled_mm` in it: what the fit
+    /// on these poses is expected to leave where the robot is used, mm (absent with
+    /// `unmodelled_mm` 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub predicted_with_unmodelled_mm: Option<f64>,
     /// RMS over the candidates of the orientation error the parameters leave, mrad (full pose).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub parameter_rotation_error_mrad: Option<f64>,
@@ -157,6 +218,8 @@ pub struct PlanReport {
     pub position_noise_mm: f64,
     /// Exchanges made after the greedy choice.
     pub exchanges: usize,
+    /// Exchanges made for the unmodelled error ([`PlanOptions::unmodelled_mm`]).
+    pub unmodelled_exchanges: usize,
     /// Swaps made for coverage.
     pub coverage_swaps: usize,
     /// Coverage of every moving joint (and the payloads) by the chosen poses.
@@ -169,14 +232,15 @@ impl PlanReport {
     /// The report as lines of text.
     pub fn lines(&self) -> Vec<String> {
         let mut lines = vec![format!(
-            "chose {} of {} candidates ({} poses): {} of {} parameter directions determined; {} exchanges, {} \
-             swaps for coverage",
+            "chose {} of {} candidates ({} poses): {} of {} parameter directions determined; {} exchanges, {} for \
+             the unmodelled error, {} swaps for coverage",
             self.poses,
             self.candidates,
             if self.full_pose { "full" } else { "position-only" },
             self.directions,
             self.parameters,
             self.exchanges,
+            self.unmodelled_exchanges,
             self.coverage_swaps
         )];
         for c in &self.coverage {
@@ -188,13 +252,15 @@ impl PlanReport {
         ));
         for c in &self.checkpoints {
             lines.push(format!(
-                "  {:>6} poses{}: from the parameters {:.4} mm (max {:.4}){}, held-out {:.4} mm",
+                "  {:>6} poses{}: from the parameters {:.4} mm (max {:.4}){}, held-out {:.4} mm{}",
                 c.poses,
                 if c.chosen { " (chosen)" } else { "          " },
                 c.parameter_error_mm,
                 c.max_parameter_error_mm,
                 c.parameter_rotation_error_mrad.map_or(String::new(), |r| format!(", {r:.4} mrad")),
-                c.predicted_error_mm
+                c.predicted_error_mm,
+                c.predicted_with_unmodelled_mm
+                    .map_or(String::new(), |u| format!(", {u:.4} mm with the unmodelled error"))
             ));
         }
         lines
@@ -212,6 +278,7 @@ pub struct Plan {
 
 fn checkpoint(
     design: &Design<'_>,
+    unmodelled: Option<&Unmodelled<'_>>,
     directions: usize,
     chosen: bool,
     options: &PlanOptions,
@@ -226,6 +293,7 @@ fn checkpoint(
         parameter_error_mm: sigma * mean.sqrt(),
         max_parameter_error_mm: sigma * max.sqrt(),
         predicted_error_mm: sigma * (3.0 + mean).sqrt(),
+        predicted_with_unmodelled_mm: unmodelled.map(|u| sigma * u.expected(design.chosen()).max(0.0).sqrt()),
         parameter_rotation_error_mrad: if full_pose {
             design.predicted_rotation_variance().map(|(m, _)| options.rotation_noise_mrad * m.sqrt())
         } else {
@@ -257,24 +325,47 @@ pub fn plan(
     }
     let mean_trace = rows.a.iter().map(|v| v * v).sum::<f64>() / candidates.len() as f64;
     let prior = options.prior_fraction * mean_trace / rows.r as f64;
+    let kinds: Vec<poe::JointKind> = model.joints().iter().map(|j| j.kind).collect();
+    let unmodelled = (options.unmodelled_mm > 0.0).then(|| {
+        let bias = BiasModel {
+            position_ratio: (options.unmodelled_mm / options.position_noise_mm).powi(2),
+            rotation_ratio: (options.unmodelled_mrad / options.rotation_noise_mrad).powi(2),
+            length: options.unmodelled_length_rad,
+            test_points: options.unmodelled_test_points,
+            trials: options.unmodelled_trials.min(options.unmodelled_evaluations / poses).max(1),
+            passes: options.unmodelled_passes,
+        };
+        Unmodelled::new(&rows, candidates, &kinds, prior, bias)
+    });
     let mut design = Design::new(&rows, prior, options.criterion);
     let targets: Vec<usize> = [poses / 4, poses / 2].into_iter().filter(|&n| n > 0 && n < poses).collect();
     let mut checkpoints = Vec::new();
     design.greedy(poses, |d| {
         if targets.contains(&d.chosen().len()) {
-            checkpoints.push(checkpoint(d, rows.r, false, options, full_pose));
+            checkpoints.push(checkpoint(d, unmodelled.as_ref(), rows.r, false, options, full_pose));
         }
     });
     let exchanges = design.exchange(options.exchange_passes, options.exchange_tolerance);
+    let mut unmodelled_exchanges = 0;
+    if let Some(unmodelled) = &unmodelled {
+        let mut chosen = design.chosen().to_vec();
+        unmodelled_exchanges = unmodelled.exchange(&mut chosen);
+        if unmodelled_exchanges > 0 {
+            design = Design::new(&rows, prior, options.criterion);
+            for c in chosen {
+                design.add(c);
+            }
+        }
+    }
     let axes = axes(candidates, options.coverage_bins.min(poses), options.min_joint_span);
     let coverage_swaps = cover(&mut design, &axes);
-    checkpoints.push(checkpoint(&design, rows.r, true, options, full_pose));
+    checkpoints.push(checkpoint(&design, unmodelled.as_ref(), rows.r, true, options, full_pose));
     let chosen = design.chosen().to_vec();
     let more = (2 * poses).min(candidates.len());
     if more > poses {
         design.greedy(more, |_| {});
         design.refresh();
-        checkpoints.push(checkpoint(&design, rows.r, false, options, full_pose));
+        checkpoints.push(checkpoint(&design, unmodelled.as_ref(), rows.r, false, options, full_pose));
     }
     let report = PlanReport {
         candidates: candidates.len(),
@@ -284,6 +375,7 @@ pub fn plan(
         directions: rows.r,
         position_noise_mm: options.position_noise_mm,
         exchanges,
+        unmodelled_exchanges,
         coverage_swaps,
         coverage: coverage(&axes, &chosen),
         checkpoints,
