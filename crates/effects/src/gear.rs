@@ -18,7 +18,7 @@ use crate::check::{Cursor, EffectFault, FaultKind};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect, MAX_HARMONICS};
 use errors::{Error, ErrorKind};
-use measurements::Measurement;
+use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};
 
 /// A periodic error of one joint in its own angle.
@@ -388,15 +388,14 @@ impl NewEffect for GearPeriodic {
     fn build(
         spec: &EffectSpec,
         context: &EffectContext<'_>,
-        rows: &[Measurement],
-        _tools: &[usize],
+        data: &BoundSet<'_>,
     ) -> Result<Self, Error> {
         let joint = spec.joint_index()?;
         if context.robot.joints[joint].kind == robot::JointType::Prismatic {
             return Err(Error::new(ErrorKind::EffectJointKind { effect: "gear_periodic", joint: joint + 1 }));
         }
         let harmonics = spec.required_harmonics()?;
-        GearPeriodic::with_options(joint, (1..=harmonics).collect(), rows, &context.gear)
+        GearPeriodic::with_options(joint, (1..=harmonics).collect(), data.rows(), &context.gear)
     }
 
     /// A series of the joint's own angle up to the diagnosis's longest order, for a revolute
@@ -405,7 +404,7 @@ impl NewEffect for GearPeriodic {
         if !context.moving.contains(&joint) || context.robot.joints[joint].kind != robot::JointType::Revolute {
             return Ok(Vec::new());
         }
-        let gear = GearPeriodic::new(joint, (1..=context.longest_order).collect(), context.rows)?;
+        let gear = GearPeriodic::new(joint, (1..=context.longest_order).collect(), context.data.rows())?;
         Ok(vec![CandidateModel { series: true, ..CandidateModel::plain(IdentifiedEffect::GearPeriodic(gear), 4) }])
     }
 }

@@ -18,6 +18,7 @@
 //! ```
 #![deny(missing_docs)]
 
+mod bound;
 mod column_map;
 mod dialect;
 mod input_files;
@@ -27,6 +28,7 @@ mod output_file;
 mod quantity;
 mod row;
 mod writer;
+pub use bound::{BoundSet, model_tool};
 pub use input_files::InputFiles;
 pub use outliers::{OutlierLine, list_lines, without};
 pub use output_file::{FileKind, MAX_SYMLINKS, OutputFile, output_target, write_file};
