@@ -129,10 +129,10 @@ impl<'a> BoundSet<'a> {
         self.set.rows.is_empty()
     }
 
-    /// These rows without those `report` names as gross outliers (by row, as
+    /// These rows without the gross `outliers` an identification of them named (by row, as
     /// [`crate::without`]), bound as these are.
-    pub fn without(&self, report: &poe::identify::RobustReport) -> BoundSet<'static> {
-        let named: std::collections::HashSet<usize> = report.outliers.iter().map(|o| o.observation).collect();
+    pub fn without(&self, outliers: &[poe::identify::OutlierRow]) -> BoundSet<'static> {
+        let named: std::collections::HashSet<usize> = outliers.iter().map(|o| o.observation).collect();
         let kept: Vec<usize> = (0..self.len()).filter(|i| !named.contains(i)).collect();
         self.subset(&kept)
     }
@@ -154,5 +154,87 @@ impl<'a> From<&'a MeasurementSet> for Cow<'a, MeasurementSet> {
 impl From<MeasurementSet> for Cow<'_, MeasurementSet> {
     fn from(set: MeasurementSet) -> Self {
         Cow::Owned(set)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::BoundSet;
+    use crate::{Measurement, ReadOptions, parse_measurements};
+    use errors::ErrorKind;
+    use lie::Vector3;
+    use poe::JointKind;
+
+    const REVOLUTE: [JointKind; 2] = [JointKind::Revolute; 2];
+
+    fn read(csv: &str) -> crate::MeasurementSet {
+        parse_measurements(csv.as_bytes(), "poses.csv", &ReadOptions::default()).unwrap()
+    }
+
+    fn names(tools: &[&str]) -> Vec<String> {
+        tools.iter().map(|t| (*t).to_owned()).collect()
+    }
+
+    #[test]
+    fn tools_are_matched_by_name_whatever_order_the_file_meets_them() {
+        let data = read("q1_rad,q2_rad,x_mm,y_mm,z_mm,tool\n0,0,1,0,0,B\n0,0,1,0,0,\n0,0,1,0,0,B\n0,0,1,0,0,A\n");
+        let bound = BoundSet::to_model(&data, &REVOLUTE, &names(&["A", "", "B"])).unwrap();
+        assert_eq!(bound.tools(), &[2, 1, 2, 0]);
+        assert_eq!(bound.len(), 4);
+    }
+
+    #[test]
+    fn an_unknown_tool_is_refused_at_its_line_and_the_tool_column() {
+        let data = read("tool,q1_rad,q2_rad,x_mm,y_mm,z_mm\nA,0,0,1,0,0\nZ,0,0,1,0,0\n");
+        let error = BoundSet::to_model(&data, &REVOLUTE, &names(&["A"])).unwrap_err();
+        assert!(matches!(error.kind(), ErrorKind::UnknownTool { tool, .. } if tool == "Z"), "{error}");
+        assert_eq!(error.position(), Some((3, 1)));
+        assert!(error.to_string().starts_with("poses.csv:3:1:"), "{error}");
+    }
+
+    #[test]
+    fn joints_are_checked_by_count_and_by_unit() {
+        let data = read("q1_rad,q2_mm,x_mm,y_mm,z_mm\n0,0,1,0,0\n");
+        let count = BoundSet::to_robot(&data, &[JointKind::Revolute; 3]).unwrap_err();
+        assert!(matches!(count.kind(), ErrorKind::JointCountMismatch { found: 2, expected: 3 }), "{count}");
+        let unit = BoundSet::to_model(&data, &REVOLUTE, &names(&[""])).unwrap_err();
+        assert!(matches!(unit.kind(), ErrorKind::JointUnit { joint: 2, .. }), "{unit}");
+        assert_eq!(unit.position(), Some((1, 2)));
+        assert!(BoundSet::to_robot(&data, &[JointKind::Revolute, JointKind::Prismatic]).is_ok());
+    }
+
+    #[test]
+    fn a_fit_s_binding_keeps_each_row_s_own_tool() {
+        let data = read("q1_rad,q2_rad,x_mm,y_mm,z_mm,tool\n0,0,1,0,0,B\n0,0,1,0,0,A\n0,0,1,0,0,B\n");
+        let bound = BoundSet::to_robot(data.clone(), &REVOLUTE).unwrap();
+        assert_eq!(bound.tools(), &[0, 1, 0]);
+        assert_eq!(bound.set(), &data);
+    }
+
+    #[test]
+    fn a_subset_keeps_the_model_tools_of_its_rows() {
+        let data = read("q1_rad,q2_rad,x_mm,y_mm,z_mm,tool\n0,0,1,0,0,B\n0,0,1,0,0,A\n0,0,1,0,0,B\n");
+        let bound = BoundSet::to_model(&data, &REVOLUTE, &names(&["A", "B"])).unwrap();
+        let part = bound.subset(&[2, 1]);
+        assert_eq!(part.tools(), &[1, 0]);
+        assert_eq!(part.rows().iter().map(|r| r.line).collect::<Vec<_>>(), [4, 3]);
+        let outlier = poe::identify::OutlierRow {
+            observation: 1,
+            position_m: 1.0,
+            position_sigmas: 100.0,
+            rotation_rad: None,
+            rotation_sigmas: None,
+        };
+        let kept = bound.without(&[outlier]);
+        assert_eq!((kept.tools(), kept.rows()[1].line), (&[1, 1][..], 4));
+    }
+
+    #[test]
+    fn rows_made_for_a_model_keep_their_tool_index() {
+        let rows = (0..3).map(|k| Measurement { tool: k, ..Measurement::at(vec![0.0; 2], Vector3::zeros()) });
+        let bound = BoundSet::made_for_model("probe", rows.collect());
+        assert_eq!(bound.tools(), &[0, 1, 2]);
+        assert_eq!(bound.set().source, "probe");
+        assert_eq!(bound.iter().map(|(_, t)| t).collect::<Vec<_>>(), [0, 1, 2]);
     }
 }

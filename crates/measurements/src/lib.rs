@@ -5,6 +5,10 @@
 //! `column_map` the `--columns` renaming, `row` the cells of one row, `writer` writes a set back
 //! as SPEC CSV.
 //!
+//! A set meets a model only bound to it: [`BoundSet`] holds the rows with each one's model tool
+//! index, made once by the constructor that checks the joints and maps the tools, and is what
+//! every function that applies a model or an effect to rows takes.
+//!
 //! ```
 //! use measurements::{ReadOptions, parse_measurements};
 //! let csv = "q1_rad,q2_rad,x_mm,y_mm,z_mm\n0.1,0.2,1000,0,500\n0.3,-0.1,990,12,510\n";
