@@ -388,14 +388,30 @@ pub fn diagnose(
     options.validate()?;
     // The one binding of the diagnosis: the joints checked, each row's tool its own index (the
     // geometry fitted here takes the data's tools in their order).
-    let bound = BoundSet::to_robot(data, &robot.joint_kinds())?;
+    diagnosis(robot, &BoundSet::to_robot(data, &robot.joint_kinds())?, options)
+}
+
+/// [`diagnose`] of data already bound to `robot` ([`BoundSet::to_robot`]: the fit's
+/// `--effects auto` passes its own binding).
+pub fn diagnose_bound(
+    robot: &RobotDescription,
+    bound: &BoundSet<'_>,
+    options: &DiagnoseOptions,
+) -> Result<Diagnosis, Error> {
+    options.validate()?;
+    diagnosis(robot, bound, options)
+}
+
+/// The diagnosis of `bound`, its options validated.
+fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseOptions) -> Result<Diagnosis, Error> {
+    let data = bound.set();
     let folds = options.folds;
     let needed = folds * 10;
     if data.rows.len() < needed {
         return Err(Error::in_file(data.source.clone(), ErrorKind::TooFewRows { rows: data.rows.len(), needed }));
     }
     let nominal = robot.nominal_model()?;
-    let screened = outliers::screen(&nominal, &bound, &options.outliers)?;
+    let screened = outliers::screen(&nominal, bound, &options.outliers)?;
     let bound = screened.data.as_ref();
     let data = bound.set();
     let geometry = fit_geometry(&nominal, data, Scope::Full, &IdentificationOptions::default())?;

@@ -249,7 +249,7 @@ pub fn fit(
         EffectSelection::None => Vec::new(),
         EffectSelection::List(list) => list.clone(),
         EffectSelection::Auto => {
-            let choice = crate::auto::choose(robot, data, &options.effects.diagnose)?;
+            let choice = crate::auto::choose(robot, &bound, &options.effects.diagnose)?;
             let chosen = choice.chosen.clone();
             auto = Some(choice);
             chosen
