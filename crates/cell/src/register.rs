@@ -274,7 +274,10 @@ mod tests {
             |cell, rows, seed| campaign::simulate(cell, &effects, &ranges, &config(rows, seed), full_pose).unwrap();
         let train = simulate(&original, 200, 1);
         let (model, _) = pipeline::fit(&robot, &train, method, &FitOptions::default()).unwrap();
-        let heldout = model::evaluate(&model, &model.bind(&simulate(&original, 300, 2)).unwrap()).unwrap().summary.mean_position_error_mm;
+        let heldout = model::evaluate(&model, &model.bind(simulate(&original, 300, 2)).unwrap())
+            .unwrap()
+            .summary
+            .mean_position_error_mm;
         let rename = |mut set: MeasurementSet| {
             set.tools = vec!["probe2".into()];
             set
@@ -287,7 +290,10 @@ mod tests {
         let (model, few, test, heldout) = scenario(true, Method::Poe);
         let refit = Refit { base: true, tools: true };
         let registered = register(&model, &few, refit, Some(heldout), &RegisterOptions::default()).unwrap();
-        let after = model::evaluate(&registered.model, &registered.model.bind(&test).unwrap()).unwrap().summary.mean_position_error_mm;
+        let after = model::evaluate(&registered.model, &registered.model.bind(&test).unwrap())
+            .unwrap()
+            .summary
+            .mean_position_error_mm;
         assert!(after < 1.3 * heldout, "{after} mm against {heldout} mm: {:#?}", registered.report);
         assert_eq!(registered.report.verdict, Verdict::Consistent);
         assert!(registered.report.warnings.is_empty(), "{:?}", registered.report.warnings);
@@ -389,7 +395,10 @@ mod tests {
         let (model, few, test, heldout) = scenario(false, Method::Poe);
         let refit = Refit { base: true, tools: true };
         let registered = register(&model, &few, refit, Some(heldout), &RegisterOptions::default()).unwrap();
-        let after = model::evaluate(&registered.model, &registered.model.bind(&test).unwrap()).unwrap().summary.mean_position_error_mm;
+        let after = model::evaluate(&registered.model, &registered.model.bind(&test).unwrap())
+            .unwrap()
+            .summary
+            .mean_position_error_mm;
         assert!(registered.report.warnings.contains(&RegisterWarning::PositionModelToolPoint));
         let expected = if after > RegisterOptions::default().changed_ratio * heldout {
             Verdict::RobotChanged

@@ -142,7 +142,11 @@ pub(crate) fn screen<'a>(
         let rows: Vec<usize> = robust.outliers.iter().map(|o| o.observation).collect();
         (rows, robust.position.median + robust.outlier_threshold * robust.position.sigma)
     });
-    let data = if outliers.rows.is_empty() || many { Cow::Borrowed(bound) } else { Cow::Owned(bound.without(&robust.outliers)) };
+    let data = if outliers.rows.is_empty() || many {
+        Cow::Borrowed(bound)
+    } else {
+        Cow::Owned(bound.without(&robust.outliers))
+    };
     Ok(Screened { data, outliers, kept, max_fraction: options.max_left_out_fraction })
 }
 

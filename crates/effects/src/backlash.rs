@@ -61,8 +61,7 @@ impl Backlash {
     /// Backlash of `joint` (1-based) whose side is set by `sign`, scaled on the training rows.
     pub fn new(joint: usize, sign: TorqueSign, data: &BoundSet<'_>) -> Result<Self, Error> {
         let mut model = Self { joint, sign, scale: vec![1.0], theta: vec![0.0] };
-        let raw: Vec<Vec<f64>> =
-            data.iter().map(|(row, tool)| model.features(row, tool)).collect::<Result<_, _>>()?;
+        let raw: Vec<Vec<f64>> = data.iter().map(|(row, tool)| model.features(row, tool)).collect::<Result<_, _>>()?;
         model.scale = rms_scales(&raw);
         Ok(model)
     }
@@ -181,11 +180,7 @@ impl NewEffect for Backlash {
 
     /// The sign of the measured torque where every row has one, of the robot's static torque
     /// otherwise (its mass model, or a stand-in).
-    fn build(
-        spec: &EffectSpec,
-        context: &EffectContext<'_>,
-        data: &BoundSet<'_>,
-    ) -> Result<Self, Error> {
+    fn build(spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
         let joint = spec.joint_index()?;
         let sign = if has_torques(data.rows()) {
             TorqueSign::Measured
@@ -203,10 +198,7 @@ impl NewEffect for Backlash {
         let stated = TorqueSign::Stated { load: context.load.clone(), dynamics: context.dynamics.clone() };
         let mut out = vec![CandidateModel {
             only_if_nonzero: true,
-            ..CandidateModel::plain(
-                IdentifiedEffect::Backlash(Backlash::new(joint, stated, context.data)?),
-                0,
-            )
+            ..CandidateModel::plain(IdentifiedEffect::Backlash(Backlash::new(joint, stated, context.data)?), 0)
         }];
         if context.measured {
             let measured = Backlash::new(joint, TorqueSign::Measured, context.data)?;

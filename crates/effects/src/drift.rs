@@ -110,11 +110,7 @@ impl EffectTerm for TimeDrift {
 impl NewEffect for TimeDrift {
     const ARGUMENTS: &'static [Argument] = &[];
 
-    fn build(
-        _spec: &EffectSpec,
-        context: &EffectContext<'_>,
-        data: &BoundSet<'_>,
-    ) -> Result<Self, Error> {
+    fn build(_spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
         TimeDrift::new(data.rows(), context.hold_beyond_span)
     }
 

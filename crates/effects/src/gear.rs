@@ -385,11 +385,7 @@ impl NewEffect for GearPeriodic {
 
     /// Harmonics `1..=harmonics` of a revolute joint (on a linear axis the period of a screw or
     /// rack is a length, which this series has no parameter for), faded as `context.gear` says.
-    fn build(
-        spec: &EffectSpec,
-        context: &EffectContext<'_>,
-        data: &BoundSet<'_>,
-    ) -> Result<Self, Error> {
+    fn build(spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
         let joint = spec.joint_index()?;
         if context.robot.joints[joint].kind == robot::JointType::Prismatic {
             return Err(Error::new(ErrorKind::EffectJointKind { effect: "gear_periodic", joint: joint + 1 }));

@@ -224,11 +224,7 @@ impl IdentifiedEffect {
     /// The effect `spec` names, its features scaled on the rows of `data`, its parameters at
     /// zero. Backlash takes the sign of the measured torque where every row has
     /// one, of the robot's static torque otherwise (its mass model, or a stand-in).
-    pub fn new(
-        spec: &EffectSpec,
-        context: &EffectContext<'_>,
-        data: &BoundSet<'_>,
-    ) -> Result<Self, Error> {
+    pub fn new(spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
         let joint_count = context.robot.joint_count();
         if let Some(joint) = spec.joint.filter(|&j| j == 0 || j > joint_count) {
             return Err(Error::new(ErrorKind::EffectJoint { joint, joint_count }));

@@ -57,8 +57,7 @@ impl LinkDeflection {
     /// carry a moment on the rows of `data`, scaled there, its parameters at zero.
     pub fn new(joint: usize, load: LoadFrame, dynamics: RobotDynamics, data: &BoundSet<'_>) -> Result<Self, Error> {
         let mut model = Self { joint, load, dynamics, axes: vec![0, 1], scale: vec![1.0, 1.0], theta: vec![] };
-        let raw: Vec<Vec<f64>> =
-            data.iter().map(|(row, tool)| model.features(row, tool)).collect::<Result<_, _>>()?;
+        let raw: Vec<Vec<f64>> = data.iter().map(|(row, tool)| model.features(row, tool)).collect::<Result<_, _>>()?;
         let rms = rms_scales(&raw);
         let carries = |a: usize| raw.iter().any(|r| r[a] != 0.0) && rms[a] > AXIS_RMS_FLOOR_NM2;
         model.axes = (0..2).filter(|&a| carries(a)).collect();

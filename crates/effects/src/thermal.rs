@@ -105,11 +105,7 @@ impl EffectTerm for Thermal {
 impl NewEffect for Thermal {
     const ARGUMENTS: &'static [Argument] = &[];
 
-    fn build(
-        _spec: &EffectSpec,
-        context: &EffectContext<'_>,
-        data: &BoundSet<'_>,
-    ) -> Result<Self, Error> {
+    fn build(_spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
         Thermal::new(data.rows(), context.hold_beyond_span)
     }
 

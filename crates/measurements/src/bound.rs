@@ -12,7 +12,12 @@ use std::borrow::Cow;
 /// is refused at `file`, `line`, `column` with the tools it knows.
 pub fn model_tool(tools: &[String], name: &str, file: &str, line: u64, column: usize) -> Result<usize, Error> {
     tools.iter().position(|t| t == name).ok_or_else(|| {
-        Error::at_line(file.to_owned(), line, column, ErrorKind::UnknownTool { tool: name.to_owned(), known: tools.to_vec() })
+        Error::at_line(
+            file.to_owned(),
+            line,
+            column,
+            ErrorKind::UnknownTool { tool: name.to_owned(), known: tools.to_vec() },
+        )
     })
 }
 

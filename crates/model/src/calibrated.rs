@@ -7,9 +7,9 @@ use effects::IdentifiedEffect;
 use errors::Error;
 use lie::SE3;
 use measurements::{BoundSet, Measurement, MeasurementSet};
-use std::borrow::Cow;
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 
 /// What `calib fit` produces and `calib eval` / `calib predict` use.
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -92,7 +92,9 @@ impl<'a> Part<'a> {
                 if let Some((uncertainty, effects)) = walk.uncertainty {
                     let kinematics = walk.kinematics.ok_or(Error::new(ErrorKind::PartOrder { part: "fallback" }))?;
                     let mut variances = Vec::with_capacity(walk.data.len());
-                    for ((coverage, row), &tool) in walk.coverage.iter_mut().zip(walk.data.rows()).zip(walk.data.tools()) {
+                    for ((coverage, row), &tool) in
+                        walk.coverage.iter_mut().zip(walk.data.rows()).zip(walk.data.tools())
+                    {
                         let sigma = uncertainty.sigma(kinematics, effects, row, tool)?;
                         *coverage *= uncertainty.weight(EffectUncertainty::position(&sigma));
                         variances.push(sigma.map(|s| s * s * *coverage * *coverage));

@@ -303,7 +303,8 @@ pub fn fit(
         let with_payload = method == Method::PoeGpLoad;
         // The GP learns what the geometry leaves on the rows the geometry was fitted to: an
         // outlier's metre would otherwise be its largest "structure".
-        let kept = if left_out { Cow::Owned(bound.without(&identification.robust.outliers)) } else { Cow::Borrowed(&bound) };
+        let kept =
+            if left_out { Cow::Owned(bound.without(&identification.robust.outliers)) } else { Cow::Borrowed(&bound) };
         let poses = model.geometric_poses(&kept)?;
         let repeats = model::RepeatGroups::of(kept.rows(), options.heldout.repeat_tolerance);
         let (fitted, report) = ResidualGp::fit(&poses, kept.set(), with_payload, &options.residual_gp, &repeats)?;

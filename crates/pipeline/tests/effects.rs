@@ -238,7 +238,9 @@ fn a_model_is_its_parts_applied_in_order_and_export_reports_each_one() {
     let not_in_urdf: Vec<String> = names.iter().filter(|n| !n.starts_with("geometry")).cloned().collect();
     assert_eq!(model.non_geometric_parts(), not_in_urdf);
     // Every part matters on held-out rows, and leaving one out costs what it explained.
-    let error = |m: &model::CalibratedModel| model::evaluate(m, &m.bind(&test).unwrap()).unwrap().summary.mean_position_error_mm;
+    let error = |m: &model::CalibratedModel| {
+        model::evaluate(m, &m.bind(&test).unwrap()).unwrap().summary.mean_position_error_mm
+    };
     let whole = error(&model);
     for (k, name) in names.iter().enumerate().take(3).skip(1) {
         let without = error(&model.without_part(k));
@@ -288,7 +290,10 @@ fn a_gear_series_warns_where_it_is_used_outside_the_angles_it_was_fitted_on() {
         // The gaps of the joint's turn (angles modulo 2π): around 0 and the rest of the circle
         // beyond ±0.6 rad.
         assert_eq!(warnings[0].gaps_rad.len(), 2, "{what}: {:?}", warnings[0].gaps_rad);
-        let report = { let bound = &model.bind(set).unwrap(); model::EvalReport::new(&model, &bound, &model::evaluate(&model, &bound).unwrap()) };
+        let report = {
+            let bound = model.bind(set).unwrap();
+            model::EvalReport::new(&model, &bound, &model::evaluate(&model, &bound).unwrap())
+        };
         assert_eq!(report.warnings, warnings, "{what}: eval --json carries them");
     }
 }
@@ -366,7 +371,10 @@ fn a_gear_series_falls_back_to_the_geometry_in_a_gap_and_past_the_end_of_its_ang
         assert_eq!((joint_2[0].rows_outside, joint_2[0].unit), (beyond.rows.len(), "rad"));
         assert!(joint_2[0].to_string().contains("outside the range the model was fitted on"));
         assert!(model.outside_training_range(&inside.rows).is_empty());
-        let report = { let bound = model.bind(&beyond).unwrap(); model::EvalReport::new(model, &bound, &model::evaluate(model, &bound).unwrap()) };
+        let report = {
+            let bound = model.bind(&beyond).unwrap();
+            model::EvalReport::new(model, &bound, &model::evaluate(model, &bound).unwrap())
+        };
         assert_eq!(report.out_of_range, warnings, "eval --json carries them");
     }
     let IdentifiedEffect::GearPeriodic(series) = &gear.effects[0] else { panic!("{:?}", gear.effects) };

@@ -74,8 +74,7 @@ impl Report {
         let bound = model.bind(data)?;
         let evaluation = model::evaluate(model, &bound)?;
         let eval = EvalReport::new(model, &bound, &evaluation);
-        let predicted: Vec<[f64; 3]> =
-            model.predict(&bound)?.iter().map(|p| p.pose.translation().into()).collect();
+        let predicted: Vec<[f64; 3]> = model.predict(&bound)?.iter().map(|p| p.pose.translation().into()).collect();
         let before = before_calibration(inputs, &bound, options)?;
         let rows = data
             .rows
