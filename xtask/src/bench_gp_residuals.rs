@@ -39,8 +39,7 @@ pub fn residuals(
 ) -> anyhow::Result<Residuals> {
     let (model, _) = pipeline::fit(robot, train, Method::Poe, &FitOptions::default())?;
     let set = |data: &MeasurementSet| -> anyhow::Result<ResidualSet> {
-        let tools = model::tool_indices(&model, data)?;
-        let poses = model.geometric_poses(&data.rows, &tools)?;
+        let poses = model.geometric_poses(&model.bind(data)?)?;
         Ok(ResidualSet::new(&poses, data, with_payload, ResidualFrame::ToolPoint))
     };
     Ok(Residuals { name, train: set(train)?, test: set(test)? })

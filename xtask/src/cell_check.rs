@@ -89,7 +89,7 @@ fn read(robot: &RobotDescription, path: &Path) -> Result<MeasurementSet> {
 }
 
 fn mean_error(model: &CalibratedModel, data: &MeasurementSet) -> Result<f64> {
-    Ok(model::evaluate(model, data)?.summary.mean_position_error_mm)
+    Ok(model::evaluate(model, &model.bind(data)?)?.summary.mean_position_error_mm)
 }
 
 fn fit_and_test(
@@ -135,8 +135,7 @@ fn scipy_reference(
     picked: &[usize],
     rotation_weight: f64,
 ) -> Result<Option<f64>> {
-    let tools = model::tool_indices(model, data)?;
-    let predicted = model.predict(&data.rows, &tools)?;
+    let predicted = model.predict(&model.bind(data)?)?;
     let dir = std::env::temp_dir().join(format!("cell-check-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let file = dir.join("predicted.csv");

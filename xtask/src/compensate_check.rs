@@ -161,7 +161,7 @@ fn run_case(
     };
     let (train, test) = (data(args.train, args.seed)?, data(args.test, args.seed + 1000)?);
     let (model, _) = pipeline::fit(robot, &train, case.method, &FitOptions::default())?;
-    let heldout = model::evaluate(&model, &test)?.summary;
+    let heldout = model::evaluate(&model, &model.bind(&test)?)?.summary;
     let rows = program(cell, robot, args.program, args.seed + 2000, &case.payloads_kg)?;
     let targets = targets(&model, robot, &rows)?;
     let solved = cell::solve_targets(&model, &targets, Some(&robot.limits()), &InverseOptions::default())?;

@@ -205,6 +205,7 @@ fn use_model(model: &model::CalibratedModel) -> Outcome {
     let rows: Vec<Measurement> = (0..4)
         .map(|k| Measurement {
             line: k + 2,
+            tool: k as usize % tools.max(1),
             payload_kg: 2.0,
             temp_c: Some(20.0),
             t_s: Some(k as f64),
@@ -214,8 +215,7 @@ fn use_model(model: &model::CalibratedModel) -> Outcome {
             )
         })
         .collect();
-    let indices: Vec<usize> = (0..rows.len()).map(|k| k % tools.max(1)).collect();
-    match model.predict(&rows, &indices) {
+    match model.predict(&measurements::BoundSet::made_for_model("the fuzz rows", rows)) {
         Err(e) => Outcome::Late(e.to_string()),
         Ok(poses) if poses.iter().all(|p| p.pose.translation().iter().all(|v| v.is_finite())) => Outcome::Accepted,
         Ok(poses) => Outcome::Late(format!("non-finite prediction {:?}", poses[0].pose)),

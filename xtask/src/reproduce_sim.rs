@@ -176,7 +176,8 @@ fn fit_and_test(
     let errors = tests
         .iter()
         .map(|test| {
-            model::evaluate(&model, test).map(|e| e.summary.mean_position_error_mm).map_err(anyhow::Error::from)
+            let evaluation = model.bind(*test).and_then(|bound| model::evaluate(&model, &bound));
+            evaluation.map(|e| e.summary.mean_position_error_mm).map_err(anyhow::Error::from)
         })
         .collect::<anyhow::Result<Vec<f64>>>()?;
     let loo = report.residual_gp.as_ref().and_then(|c| c.leave_one_out.as_ref()).map(|l| l.mean_position_error_mm);

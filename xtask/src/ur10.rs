@@ -139,7 +139,7 @@ fn methods(args: &Args, robot: &RobotDescription) -> Result<String> {
             let start = Instant::now();
             let (model, _) = pipeline::fit(robot, &train, *method, options)?;
             let fit_s = start.elapsed().as_secs_f64();
-            let s = model::evaluate(&model, &test)?.summary;
+            let s = model::evaluate(&model, &model.bind(&test)?)?.summary;
             rows.push(Row {
                 data: label,
                 method: name.clone(),
@@ -241,7 +241,7 @@ fn check_series(args: &Args, robot: &RobotDescription, series: &str) -> Result<C
     seconds.sort_by(f64::total_cmp);
     cpu_seconds.sort_by(f64::total_cmp);
     let (poe, _) = pipeline::fit(robot, &train, Method::Poe, &FitOptions::default())?;
-    let poe_test_mm = model::evaluate(&poe, &test)?.summary.mean_position_error_mm;
+    let poe_test_mm = model::evaluate(&poe, &poe.bind(&test)?)?.summary.mean_position_error_mm;
     let verdict: Vec<_> = diagnosis.selected.iter().filter(|s| s.effect == diagnosis.verdict.effect).cloned().collect();
     let specs = effects_of(&verdict);
     let effects = specs.iter().map(ToString::to_string).collect::<Vec<_>>().join(",");
@@ -256,10 +256,10 @@ fn check_series(args: &Args, robot: &RobotDescription, series: &str) -> Result<C
             if rows.is_empty() {
                 return Ok(None);
             }
-            Ok(Some(model::evaluate(&model, &test.subset(rows))?.summary.mean_position_error_mm))
+            Ok(Some(model::evaluate(&model, &model.bind(test.subset(rows))?)?.summary.mean_position_error_mm))
         };
         Some(Fitted {
-            all_mm: model::evaluate(&model, &test)?.summary.mean_position_error_mm,
+            all_mm: model::evaluate(&model, &model.bind(&test)?)?.summary.mean_position_error_mm,
             inside: (inside.len(), mean(&inside)?),
             outside: (outside.len(), mean(&outside)?),
         })

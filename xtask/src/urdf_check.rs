@@ -65,7 +65,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         for form in FORMS {
             let robot = RobotDescription::read(&PathBuf::from(form))?;
             let (model, _) = pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default())?;
-            let s = model::evaluate(&model, &test)?.summary;
+            let s = model::evaluate(&model, &model.bind(&test)?)?.summary;
             let _ = writeln!(
                 md,
                 "| {label} | `{form}` | {:.6} | {:.6} | {:.6} | {} |",

@@ -28,12 +28,14 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     // Angles a turn away from the fitted range are taken into it, as `calib register` does.
     let (rows, wrapped) = model::wrapped(&model, &data.rows);
     let data = measurements::MeasurementSet { rows, ..data };
-    let evaluation = model::evaluate(&model, &data)?;
+    // The one binding of `eval`: joints checked, tools mapped.
+    let bound = model.bind(&data)?;
+    let evaluation = model::evaluate(&model, &bound)?;
     let finite = |e: &model::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
     if let Some((row, _)) = data.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
         return Err(crate::predict::non_finite(&args.model, &data.source, row.line).into());
     }
-    let report = EvalReport { wrapped, ..EvalReport::new(&model, &data, &evaluation) };
+    let report = EvalReport { wrapped, ..EvalReport::new(&model, &bound, &evaluation) };
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
         eprintln!("{}", data.read_summary());

@@ -27,8 +27,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     // CSV's columns are the same, the note on stderr says which rows.
     let (rows, wrapped) = model::wrapped(&model, &read.rows);
     let data = measurements::MeasurementSet { rows, ..read };
-    let tools = model::tool_indices(&model, &data)?;
-    let predictions = model.predict(&data.rows, &tools)?;
+    // The one binding of `predict`: joints checked, tools mapped.
+    let bound = model.bind(&data)?;
+    let predictions = model.predict(&bound)?;
     let finite = |p: &model::PredictedPose| {
         let pose = p.pose;
         pose.translation().iter().chain(pose.rotation().matrix().iter()).all(|v| v.is_finite())
@@ -48,7 +49,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     for warning in model.beyond_joint_limits(&data.rows) {
         eprintln!("warning: {warning}");
     }
-    if let Some(fallen) = model.sigma_fallback(&data.rows, &tools)? {
+    if let Some(fallen) = model.sigma_fallback(&bound)? {
         eprintln!("warning: {fallen}");
     }
     model::write_predictions(std::io::stdout().lock(), "stdout", &model, &data, &predictions)?;

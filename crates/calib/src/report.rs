@@ -47,7 +47,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     };
     let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
     let data = measurements::read_measurements(&args.data, &options)?;
-    let evaluation = model::evaluate(&model, &data)?;
+    let evaluation = model::evaluate(&model, &model.bind(&data)?)?;
     let finite = |e: &model::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
     if let Some((row, _)) = data.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
         return Err(crate::predict::non_finite(&args.model, &data.source, row.line).into());

@@ -11,7 +11,7 @@
 
 use errors::Error;
 use lie::{SE3, Vector3};
-use measurements::Measurement;
+use measurements::{BoundSet, Measurement};
 use model::CalibratedModel;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -223,9 +223,9 @@ pub fn solve_targets(
         torques_nm: None,
     };
     loop {
-        let rows: Vec<Measurement> = open.iter().map(|&i| row(i, &q[i])).collect();
-        let tools: Vec<usize> = open.iter().map(|&i| targets[i].tool).collect();
-        let poses = model.predict(&rows, &tools)?;
+        // Made here from the targets, each row on its target's model tool.
+        let rows = BoundSet::made_for_model("the targets", open.iter().map(|&i| row(i, &q[i])).collect());
+        let poses = model.predict(&rows)?;
         let mut still = Vec::with_capacity(open.len());
         for (&i, predicted) in open.iter().zip(&poses) {
             residual[i] = errors(&targets[i], &predicted.pose);

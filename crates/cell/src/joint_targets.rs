@@ -16,7 +16,7 @@
 use crate::inverse::{InverseOptions, PoseTarget, Solved, TargetStatus, solve_targets};
 use errors::{Error, ErrorKind};
 use lie::{SE3, SO3};
-use measurements::{Cells, ColumnMap, MeasurementSet, ReadOptions};
+use measurements::{BoundSet, Cells, ColumnMap, MeasurementSet, ReadOptions};
 use model::CalibratedModel;
 use poe::LocalPoe;
 use poe::identify::{IdentificationOptions, Observation, Scope, Target};
@@ -206,18 +206,26 @@ pub fn pose_targets(
     frame: TargetFrame,
     options: &CompensateOptions,
 ) -> Result<(Vec<PoseTarget>, Option<RegisteredNominal>), Error> {
-    let tools = model::tool_indices(model, &file.set)?;
+    targets_of(model, &model.bind(&file.set)?, file, robot, frame, options)
+}
+
+/// [`pose_targets`] of `file`'s rows bound to `model` (`bound`).
+fn targets_of(
+    model: &CalibratedModel,
+    bound: &BoundSet<'_>,
+    file: &TargetFile,
+    robot: Option<(&RobotDescription, &str)>,
+    frame: TargetFrame,
+    options: &CompensateOptions,
+) -> Result<(Vec<PoseTarget>, Option<RegisteredNominal>), Error> {
     let need_robot =
         || Error::at_line(file.set.source.clone(), 1, 1, ErrorKind::TargetsNeedRobot { poses: file.poses() });
     if !file.poses() {
         let (robot, robot_file) = robot.ok_or_else(need_robot)?;
         let registered = registered_nominal(model, robot, robot_file, options)?;
-        let targets = file
-            .set
-            .rows
+        let targets = bound
             .iter()
-            .zip(&tools)
-            .map(|(row, &tool)| {
+            .map(|(row, tool)| {
                 Ok(PoseTarget {
                     seed: row.q.clone(),
                     pose: registered.model.forward(&row.q, tool).map_err(Error::kinematics)?,
@@ -239,12 +247,9 @@ pub fn pose_targets(
             tracker_from_base(&model.kinematics, Some(&nominal))
         }
     };
-    let targets = file
-        .set
-        .rows
+    let targets = bound
         .iter()
-        .zip(&tools)
-        .map(|(row, &tool)| PoseTarget {
+        .map(|(row, tool)| PoseTarget {
             seed: row.q.clone(),
             pose: placement * SE3::new(row.orientation.unwrap_or_else(SO3::identity), row.position),
             orientation: row.orientation.is_some(),
@@ -263,11 +268,11 @@ pub fn compensate(
     frame: TargetFrame,
     options: &CompensateOptions,
 ) -> Result<(Vec<Solved>, CompensationSummary), Error> {
-    let (targets, registered) = pose_targets(model, file, robot, frame, options)?;
+    let bound = model.bind(&file.set)?;
+    let (targets, registered) = targets_of(model, &bound, file, robot, frame, options)?;
     let limits = robot.map(|(r, _)| r.limits());
     let solved = solve_targets(model, &targets, limits.as_deref(), &options.inverse)?;
-    let tools: Vec<usize> = targets.iter().map(|t| t.tool).collect();
-    let before = model.predict(&file.set.rows, &tools)?;
+    let before = model.predict(&bound)?;
     let before_mean_mm = before
         .iter()
         .zip(&targets)

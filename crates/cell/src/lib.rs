@@ -32,8 +32,9 @@
 //!     robot_description: None,
 //! };
 //! // Joint values that reach five poses the model predicts, from seeds 0.02 rad off.
-//! let rows = &data.rows[..5];
-//! let predicted = model.predict(rows, &[0; 5])?;
+//! let bound = model.bind(data.subset(&[0, 1, 2, 3, 4]))?;
+//! let rows = bound.rows();
+//! let predicted = model.predict(&bound)?;
 //! let targets: Vec<cell::PoseTarget> = rows
 //!     .iter()
 //!     .zip(&predicted)

@@ -13,7 +13,7 @@ use crate::registration::{Registration, RegistrationRow, Unknowns, register_rows
 use crate::report::{Fitted, Heldout, HeldoutFrom, RegisterReport, RegisterWarning, RegisteredTool, Verdict};
 use errors::{Error, ErrorKind};
 use lie::{SE3, Vector3};
-use measurements::MeasurementSet;
+use measurements::{BoundSet, Measurement, MeasurementSet};
 use model::CalibratedModel;
 
 /// The registered model and what the registration found.
@@ -78,8 +78,10 @@ pub fn register(
     // Angles one turn away from the training poses are taken back into the fitted range.
     let (rows, wrapped) = model::wrapped(model, &data.rows);
     let data = &MeasurementSet { rows, ..data.clone() };
-    let reference: Vec<usize> = data.rows.iter().map(|r| known[r.tool].unwrap_or(0)).collect();
-    let predicted = model.predict(&data.rows, &reference)?;
+    // Each row on its model tool, a new tool measured against the model's first (`known`): the
+    // binding of this path, made here since new tools are allowed.
+    let on_model_tools = data.rows.iter().map(|r| Measurement { tool: known[r.tool].unwrap_or(0), ..r.clone() });
+    let predicted = model.predict(&BoundSet::made_for_model(&data.source, on_model_tools.collect()))?;
     let rows: Vec<RegistrationRow> = data
         .rows
         .iter()
@@ -272,7 +274,10 @@ mod tests {
             |cell, rows, seed| campaign::simulate(cell, &effects, &ranges, &config(rows, seed), full_pose).unwrap();
         let train = simulate(&original, 200, 1);
         let (model, _) = pipeline::fit(&robot, &train, method, &FitOptions::default()).unwrap();
-        let heldout = model::evaluate(&model, &simulate(&original, 300, 2)).unwrap().summary.mean_position_error_mm;
+        let heldout = model::evaluate(&model, &model.bind(simulate(&original, 300, 2)).unwrap())
+            .unwrap()
+            .summary
+            .mean_position_error_mm;
         let rename = |mut set: MeasurementSet| {
             set.tools = vec!["probe2".into()];
             set
@@ -285,7 +290,10 @@ mod tests {
         let (model, few, test, heldout) = scenario(true, Method::Poe);
         let refit = Refit { base: true, tools: true };
         let registered = register(&model, &few, refit, Some(heldout), &RegisterOptions::default()).unwrap();
-        let after = model::evaluate(&registered.model, &test).unwrap().summary.mean_position_error_mm;
+        let after = model::evaluate(&registered.model, &registered.model.bind(&test).unwrap())
+            .unwrap()
+            .summary
+            .mean_position_error_mm;
         assert!(after < 1.3 * heldout, "{after} mm against {heldout} mm: {:#?}", registered.report);
         assert_eq!(registered.report.verdict, Verdict::Consistent);
         assert!(registered.report.warnings.is_empty(), "{:?}", registered.report.warnings);
@@ -349,7 +357,9 @@ mod tests {
         // correction misses the lever arm between the two (10 % of held-out on the IRB 4400).
         let (model, few, _, _) = scenario(true, Method::PoeGp);
         assert_eq!(model.residual_gp.as_ref().unwrap().residual_frame, model::ResidualFrame::ToolPoint);
-        let predicted = model.predict(&few.rows, &vec![0; few.rows.len()]).unwrap();
+        // The new tool measured against the model's first, as `register` does.
+        let on_tool = |t: usize| few.rows.iter().map(move |r| Measurement { tool: t, ..r.clone() }).collect();
+        let predicted = model.predict(&BoundSet::made_for_model("few", on_tool(0))).unwrap();
         let rows: Vec<RegistrationRow> = few
             .rows
             .iter()
@@ -365,8 +375,7 @@ mod tests {
         let fit = register_rows(&rows, unknowns, &Default::default()).unwrap();
         let (carried, tools) = carried(&model, &few, &[None], &[Some(0)], &fit);
         assert!(tools[0].new && tools[0].point_change_mm > 50.0, "{tools:?}");
-        let new_tool = vec![carried.tools.len() - 1; few.rows.len()];
-        let poses = carried.predict(&few.rows, &new_tool).unwrap();
+        let poses = carried.predict(&BoundSet::made_for_model("few", on_tool(carried.tools.len() - 1))).unwrap();
         for (row, pose) in rows.iter().zip(&poses) {
             let wanted = fit.pose(row);
             assert!((pose.pose.translation() - wanted.translation()).norm() < 1e-9, "{pose:?} {wanted:?}");
@@ -386,7 +395,10 @@ mod tests {
         let (model, few, test, heldout) = scenario(false, Method::Poe);
         let refit = Refit { base: true, tools: true };
         let registered = register(&model, &few, refit, Some(heldout), &RegisterOptions::default()).unwrap();
-        let after = model::evaluate(&registered.model, &test).unwrap().summary.mean_position_error_mm;
+        let after = model::evaluate(&registered.model, &registered.model.bind(&test).unwrap())
+            .unwrap()
+            .summary
+            .mean_position_error_mm;
         assert!(registered.report.warnings.contains(&RegisterWarning::PositionModelToolPoint));
         let expected = if after > RegisterOptions::default().changed_ratio * heldout {
             Verdict::RobotChanged

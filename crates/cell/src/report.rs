@@ -175,7 +175,7 @@ impl RegisterReport {
         // A held-out error that is not a positive finite number is no reference.
         let heldout = heldout.filter(|h| h.mm.is_finite() && h.mm > 0.0);
         let heldout_mm = heldout.map(|h| h.mm);
-        let evaluation = model::evaluate(registered, data)?;
+        let evaluation = model::evaluate(registered, &registered.bind(data)?)?;
         let full_pose = data.full_pose && registered.full_pose;
         let residual_rows = data.rows.len() * if full_pose { 6 } else { 3 };
         let dof = residual_rows.saturating_sub(parameters).max(1) as f64;

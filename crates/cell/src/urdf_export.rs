@@ -118,6 +118,8 @@ pub fn export_urdf(
     let not_in_urdf: Vec<String> = model.non_geometric_parts();
     let training_error = match training {
         Some(data) => {
+            // Every model below is this one with parts left out: the same joints and tools.
+            let data = &model.bind(data)?;
             let parts = model.parts();
             let without_each = (0..parts.len())
                 .filter(|&k| !parts[k].in_urdf())

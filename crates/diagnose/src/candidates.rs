@@ -16,7 +16,7 @@ use effects::{
     LoadFrame, has_torques, stand_in_dynamics,
 };
 use errors::Error;
-use measurements::MeasurementSet;
+use measurements::BoundSet;
 use poe::LocalPoe;
 use rayon::prelude::*;
 use robot::RobotDescription;
@@ -119,11 +119,10 @@ pub(crate) fn columns_of(
     design: &Design,
     effect: &IdentifiedEffect,
     model: &LocalPoe,
-    data: &MeasurementSet,
+    data: &BoundSet<'_>,
 ) -> Result<Vec<Vec<f64>>, Error> {
     let k = design.rows_per_pose;
-    let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
-    let twists = effect.parameter_twists(model, &data.rows, &tools)?;
+    let twists = effect.parameter_twists(model, data)?;
     Ok(twists
         .iter()
         .map(|per_row| {
@@ -147,12 +146,11 @@ pub(crate) fn columns_of(
 pub(crate) fn build_candidates(
     robot: &RobotDescription,
     model: &LocalPoe,
-    data: &MeasurementSet,
+    data: &BoundSet<'_>,
     design: &Design,
     settings: &Settings<'_>,
 ) -> Result<(Vec<Candidate>, Vec<SideSource>), Error> {
     let n = robot.joint_count();
-    let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
     // The nominal arm in the base frame, where gravity is known, with the calibrated tools placed
     // on its flange (the payload hangs from them).
     let load = EffectContext {
@@ -161,15 +159,14 @@ pub(crate) fn build_candidates(
         gear: effects::GearOptions::default(),
         hold_beyond_span: effects::HOLD_BEYOND_SPAN,
     }
-    .load_frame(&data.rows, &tools)?;
+    .load_frame(data)?;
     let dynamics = robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(robot));
     let context = CandidateContext {
         robot,
-        rows: &data.rows,
-        tools: &tools,
+        data,
         load: &load,
         dynamics: &dynamics,
-        measured: has_torques(&data.rows),
+        measured: has_torques(data.rows()),
         moving: settings.moving,
         longest_order: settings.orders.iter().copied().max().unwrap_or(1),
         options: settings.inputs,

@@ -14,7 +14,7 @@ use super::design::Design;
 use super::pool::Pool;
 use effects::{Backlash, GearPeriodic, IdentifiedEffect, TorqueSign};
 use errors::Error;
-use measurements::MeasurementSet;
+use measurements::BoundSet;
 use poe::LocalPoe;
 
 /// Alternations of the side and the classifier (the sides settle in two or three).
@@ -44,19 +44,19 @@ fn learn(
     compliance: &Candidate,
     compliance_columns: &[usize],
     twist_rows: &[f64],
-    data: &MeasurementSet,
+    data: &BoundSet<'_>,
     left_out: &[usize],
 ) -> Result<IdentifiedEffect, Error> {
-    let k = twist_rows.len() / data.rows.len().max(1);
+    let k = twist_rows.len() / data.len().max(1);
     let scalars: Vec<Vec<f64>> =
-        data.rows.iter().map(|row| compliance.model.features(row, row.tool)).collect::<Result<_, _>>()?;
+        data.iter().map(|(row, tool)| compliance.model.features(row, tool)).collect::<Result<_, _>>()?;
     let train: Vec<usize> = (0..pool.folds()).filter(|f| !left_out.contains(f)).collect();
     let torque = |theta: &[f64], i: usize| -> f64 { scalars[i].iter().zip(theta).map(|(s, t)| s * t).sum() };
     let kinematic = pool.kinematic_columns();
     let with: Vec<usize> = kinematic.iter().chain(compliance_columns).copied().collect();
     let beta = pool.solve(left_out, &with)?;
     let mut pi: Vec<f64> = beta[kinematic.len()..].to_vec();
-    let mut signs: Vec<f64> = (0..data.rows.len()).map(|i| sign(torque(&pi, i))).collect();
+    let mut signs: Vec<f64> = (0..data.len()).map(|i| sign(torque(&pi, i))).collect();
     // What the kinematics alone leave on the training rows, pose by pose.
     let beta0 = pool.solve(left_out, &kinematic)?;
     let residual: Vec<(usize, Vec<f64>)> = train
@@ -93,7 +93,7 @@ fn learn(
             break;
         };
         pi = solution.iter().zip(&norms).map(|(p, n)| p / n).collect();
-        let next: Vec<f64> = (0..data.rows.len()).map(|i| sign(torque(&pi, i))).collect();
+        let next: Vec<f64> = (0..data.len()).map(|i| sign(torque(&pi, i))).collect();
         if next == signs {
             break;
         }
@@ -104,8 +104,7 @@ fn learn(
         columns: source.terms.iter().map(|t| t.column).collect(),
         coefficients: pi.iter().zip(&source.terms).map(|(c, t)| c / t.scale).collect(),
     };
-    let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
-    Ok(IdentifiedEffect::Backlash(Backlash::new(source.joint, learnt, &data.rows, &tools)?))
+    Ok(IdentifiedEffect::Backlash(Backlash::new(source.joint, learnt, data)?))
 }
 
 /// The learnt side of every source joint: per fold, and on every row.
@@ -113,7 +112,7 @@ pub(crate) fn learnt_sides(
     pool: &Pool,
     design: &Design,
     model: &LocalPoe,
-    data: &MeasurementSet,
+    data: &BoundSet<'_>,
     candidates: &[Candidate],
     candidate_columns: &[Vec<usize>],
     sources: &[SideSource],
@@ -123,7 +122,7 @@ pub(crate) fn learnt_sides(
         let compliance = &candidates[source.compliance];
         let columns = &candidate_columns[source.compliance];
         // The joint's bare twist: order 0's cosine feature is 1 on every row.
-        let bare = IdentifiedEffect::GearPeriodic(GearPeriodic::new(source.joint, vec![0], &data.rows)?);
+        let bare = IdentifiedEffect::GearPeriodic(GearPeriodic::new(source.joint, vec![0], data.rows())?);
         let twist_rows = columns_of(design, &bare, model, data)?.swap_remove(0);
         let mut per_fold = Vec::with_capacity(pool.folds());
         for f in 0..pool.folds() {
@@ -174,7 +173,8 @@ mod tests {
         let design = Design::new(&model, &data, Weights { position_m: 1e-4, rotation_rad: 1.0 }).unwrap();
         let settings =
             Settings { moving: &[], orders: &[1], series_sd: 1e-3, inputs: effects::CandidateOptions::default() };
-        let (candidates, sources) = build_candidates(&blind, &model, &data, &design, &settings).unwrap();
+        let bound = measurements::BoundSet::to_robot(&data, &blind.joint_kinds()).unwrap();
+        let (candidates, sources) = build_candidates(&blind, &model, &bound, &design, &settings).unwrap();
         assert!(!sources.is_empty());
         let fold = fold_assignment(data.rows.len(), 5, 0);
         let prior = PriorOptions::default();
@@ -182,7 +182,7 @@ mod tests {
             let (terms, blocks) = terms_of(&candidates, design.kinematic.ncols());
             let columns: Vec<Vec<usize>> = terms.iter().map(|t| t.columns.clone()).collect();
             let pool = Pool::new(design, &KinematicPrior::new(&nominal, &model, &prior), &blocks, &fold, 5, &prior);
-            learnt_sides(&pool, design, &model, &data, &candidates, &columns, &sources).unwrap()
+            learnt_sides(&pool, design, &model, &bound, &candidates, &columns, &sources).unwrap()
         };
         let before = sides(&design);
         // Other measurements on the poses of fold 0 only.

@@ -61,7 +61,7 @@ use design::{Design, Weights};
 use effects::IdentifiedEffect;
 use errors::{Error, ErrorKind};
 use lie::Vector3;
-use measurements::MeasurementSet;
+use measurements::{BoundSet, MeasurementSet};
 use model::geometric::{fit_geometry, observations};
 use poe::identify::{IdentificationOptions, Scope};
 use pool::Pool;
@@ -386,15 +386,34 @@ pub fn diagnose(
     options: &DiagnoseOptions,
 ) -> Result<Diagnosis, Error> {
     options.validate()?;
-    data.check_joint_count(robot.joint_count())?;
+    // The one binding of the diagnosis: the joints checked, each row's tool its own index (the
+    // geometry fitted here takes the data's tools in their order).
+    diagnosis(robot, &BoundSet::to_robot(data, &robot.joint_kinds())?, options)
+}
+
+/// [`diagnose`] of data already bound to `robot` ([`BoundSet::to_robot`]: the fit's
+/// `--effects auto` passes its own binding).
+pub fn diagnose_bound(
+    robot: &RobotDescription,
+    bound: &BoundSet<'_>,
+    options: &DiagnoseOptions,
+) -> Result<Diagnosis, Error> {
+    options.validate()?;
+    diagnosis(robot, bound, options)
+}
+
+/// The diagnosis of `bound`, its options validated.
+fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseOptions) -> Result<Diagnosis, Error> {
+    let data = bound.set();
     let folds = options.folds;
     let needed = folds * 10;
     if data.rows.len() < needed {
         return Err(Error::in_file(data.source.clone(), ErrorKind::TooFewRows { rows: data.rows.len(), needed }));
     }
     let nominal = robot.nominal_model()?;
-    let screened = outliers::screen(&nominal, data, &options.outliers)?;
-    let data = screened.data.as_ref();
+    let screened = outliers::screen(&nominal, bound, &options.outliers)?;
+    let bound = screened.data.as_ref();
+    let data = bound.set();
     let geometry = fit_geometry(&nominal, data, Scope::Full, &IdentificationOptions::default())?;
     let model = geometry.model;
     let stats = poe::identify::evaluate(&model, &observations(data)).map_err(Error::kinematics)?;
@@ -411,7 +430,7 @@ pub fn diagnose(
         series_sd: options.prior.series_rad,
         inputs: options.candidates,
     };
-    let (candidates, sides) = candidates::build_candidates(robot, &model, data, &design, &settings)?;
+    let (candidates, sides) = candidates::build_candidates(robot, &model, bound, &design, &settings)?;
     let (mut terms, blocks) = terms_of(&candidates, design.kinematic.ncols());
     let fold = fold_assignment(data.rows.len(), folds, options.seed);
     let kinematic_prior = pool::KinematicPrior::new(&nominal, &model, &options.prior);
@@ -419,7 +438,7 @@ pub fn diagnose(
     // Backlash sides learnt inside each fold: a column per fold and one on every row.
     let candidate_columns: Vec<Vec<usize>> = terms.iter().map(|t| t.columns.clone()).collect();
     let mut side_columns: Vec<Vec<f64>> = Vec::new();
-    for side in learnt_side::learnt_sides(&pool, &design, &model, data, &candidates, &candidate_columns, &sides)? {
+    for side in learnt_side::learnt_sides(&pool, &design, &model, bound, &candidates, &candidate_columns, &sides)? {
         let mut columns = side.per_fold;
         side_columns.push(side.all.clone());
         columns.push(side.all);

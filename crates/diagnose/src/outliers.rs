@@ -19,8 +19,7 @@
 use super::Verdict;
 use super::candidates::Effect;
 use errors::Error;
-use measurements::MeasurementSet;
-use measurements::{OutlierLine, list_lines, without};
+use measurements::{BoundSet, OutlierLine, list_lines};
 use model::geometric::fit_geometry;
 use poe::LocalPoe;
 use poe::identify::{IdentificationOptions, Scope};
@@ -112,7 +111,8 @@ impl GrossOutliers {
 
 /// The data the diagnosis works on and the gross outliers left out of it (or kept).
 pub(crate) struct Screened<'a> {
-    pub data: Cow<'a, MeasurementSet>,
+    /// The rows kept, bound as the diagnosis's data is.
+    pub data: Cow<'a, BoundSet<'a>>,
     pub outliers: GrossOutliers,
     /// Where they are kept: their 0-based rows and the position distance beyond which a row is
     /// one, m (median plus the threshold in robust sigmas).
@@ -123,9 +123,10 @@ pub(crate) struct Screened<'a> {
 /// Fits the geometry to every row with the robust loss and leaves out the rows it names.
 pub(crate) fn screen<'a>(
     nominal: &LocalPoe,
-    data: &'a MeasurementSet,
+    bound: &'a BoundSet<'a>,
     options: &OutlierOptions,
 ) -> Result<Screened<'a>, Error> {
+    let data = bound.set();
     let identification = IdentificationOptions::default();
     let robust = fit_geometry(nominal, data, Scope::Full, &identification)?.report.robust;
     let rows = OutlierLine::of(&robust, data);
@@ -141,7 +142,11 @@ pub(crate) fn screen<'a>(
         let rows: Vec<usize> = robust.outliers.iter().map(|o| o.observation).collect();
         (rows, robust.position.median + robust.outlier_threshold * robust.position.sigma)
     });
-    let data = if outliers.rows.is_empty() || many { Cow::Borrowed(data) } else { Cow::Owned(without(data, &robust)) };
+    let data = if outliers.rows.is_empty() || many {
+        Cow::Borrowed(bound)
+    } else {
+        Cow::Owned(bound.without(&robust.outliers))
+    };
     Ok(Screened { data, outliers, kept, max_fraction: options.max_left_out_fraction })
 }
 

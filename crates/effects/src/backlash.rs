@@ -11,7 +11,7 @@ use crate::{
 };
 use errors::{Error, ErrorKind};
 use loadsim::{Payload, RobotDynamics};
-use measurements::Measurement;
+use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};
 
 /// Where the sign of the joint's torque comes from.
@@ -59,10 +59,9 @@ fn sign(x: f64) -> f64 {
 
 impl Backlash {
     /// Backlash of `joint` (1-based) whose side is set by `sign`, scaled on the training rows.
-    pub fn new(joint: usize, sign: TorqueSign, rows: &[Measurement], tools: &[usize]) -> Result<Self, Error> {
+    pub fn new(joint: usize, sign: TorqueSign, data: &BoundSet<'_>) -> Result<Self, Error> {
         let mut model = Self { joint, sign, scale: vec![1.0], theta: vec![0.0] };
-        let raw: Vec<Vec<f64>> =
-            rows.iter().zip(tools).map(|(row, &tool)| model.features(row, tool)).collect::<Result<_, _>>()?;
+        let raw: Vec<Vec<f64>> = data.iter().map(|(row, tool)| model.features(row, tool)).collect::<Result<_, _>>()?;
         model.scale = rms_scales(&raw);
         Ok(model)
     }
@@ -181,20 +180,15 @@ impl NewEffect for Backlash {
 
     /// The sign of the measured torque where every row has one, of the robot's static torque
     /// otherwise (its mass model, or a stand-in).
-    fn build(
-        spec: &EffectSpec,
-        context: &EffectContext<'_>,
-        rows: &[Measurement],
-        tools: &[usize],
-    ) -> Result<Self, Error> {
+    fn build(spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
         let joint = spec.joint_index()?;
-        let sign = if has_torques(rows) {
+        let sign = if has_torques(data.rows()) {
             TorqueSign::Measured
         } else {
             let dynamics = context.robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(context.robot));
-            TorqueSign::Stated { load: context.load_frame(rows, tools)?, dynamics }
+            TorqueSign::Stated { load: context.load_frame(data)?, dynamics }
         };
-        Backlash::new(joint, sign, rows, tools)
+        Backlash::new(joint, sign, data)
     }
 
     /// `δq_j = b_j sign(τ_j)`: the sign of the stated (or stand-in) static torque, first among the
@@ -204,13 +198,10 @@ impl NewEffect for Backlash {
         let stated = TorqueSign::Stated { load: context.load.clone(), dynamics: context.dynamics.clone() };
         let mut out = vec![CandidateModel {
             only_if_nonzero: true,
-            ..CandidateModel::plain(
-                IdentifiedEffect::Backlash(Backlash::new(joint, stated, context.rows, context.tools)?),
-                0,
-            )
+            ..CandidateModel::plain(IdentifiedEffect::Backlash(Backlash::new(joint, stated, context.data)?), 0)
         }];
         if context.measured {
-            let measured = Backlash::new(joint, TorqueSign::Measured, context.rows, context.tools)?;
+            let measured = Backlash::new(joint, TorqueSign::Measured, context.data)?;
             out.push(CandidateModel {
                 only_if_nonzero: true,
                 ..CandidateModel::plain(IdentifiedEffect::Backlash(measured), 3)

@@ -12,7 +12,7 @@ use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpe
 
 use crate::Direction;
 use errors::{Error, ErrorKind};
-use measurements::Measurement;
+use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};
 
 /// Which torque drives the deflection.
@@ -46,13 +46,13 @@ pub struct TorqueFit {
 }
 
 impl TorqueFit {
-    /// Fits joint `joint`'s measured torque on `rows` over the regressor columns that are not
+    /// Fits joint `joint`'s measured torque on the rows of `data` over the regressor columns that are not
     /// zero on every row (SVD least squares, directions below 1e-10 of the largest dropped: the
     /// regressor columns of neighbouring links are often exactly collinear).
-    fn new(load: &LoadFrame, joint: usize, rows: &[Measurement], tools: &[usize]) -> Result<Self, Error> {
-        let mut regressors = Vec::with_capacity(rows.len());
-        let mut measured = Vec::with_capacity(rows.len());
-        for (row, &tool) in rows.iter().zip(tools) {
+    fn new(load: &LoadFrame, joint: usize, data: &BoundSet<'_>) -> Result<Self, Error> {
+        let mut regressors = Vec::with_capacity(data.len());
+        let mut measured = Vec::with_capacity(data.len());
+        for (row, tool) in data.iter() {
             let all = load.regressors(row, tool)?;
             regressors.push(all.get(joint).cloned().unwrap_or_default());
             let tau = row.torques_nm.as_ref().and_then(|t| t.get(joint)).copied().ok_or(Error::new(
@@ -63,7 +63,7 @@ impl TorqueFit {
         let width = regressors.first().map_or(0, Vec::len);
         let columns: Vec<usize> =
             (0..width).filter(|&c| regressors.iter().any(|r| r.get(c).is_some_and(|v| v.abs() > 1e-12))).collect();
-        if columns.is_empty() || rows.is_empty() {
+        if columns.is_empty() || data.is_empty() {
             // Gravity never loads this joint (a vertical first axis): no torque to model.
             return Ok(Self { columns: Vec::new(), coefficients: Vec::new() });
         }
@@ -71,7 +71,7 @@ impl TorqueFit {
             .iter()
             .map(|&c| regressors.iter().map(|r| r[c] * r[c]).sum::<f64>().sqrt().max(f64::MIN_POSITIVE))
             .collect();
-        let a = nalgebra::DMatrix::from_fn(rows.len(), columns.len(), |i, k| regressors[i][columns[k]] / norms[k]);
+        let a = nalgebra::DMatrix::from_fn(data.len(), columns.len(), |i, k| regressors[i][columns[k]] / norms[k]);
         let b = nalgebra::DVector::from_vec(measured);
         let coefficients = match a.svd(true, true).solve(&b, 1e-10) {
             Ok(x) => x.iter().zip(&norms).map(|(x, n)| x / n).collect(),
@@ -114,17 +114,12 @@ pub struct JointCompliance {
 }
 
 impl JointCompliance {
-    /// The terms of `joints` (0-based) seen on `rows` driven by `torque`: every regressor that is
-    /// not zero on every row.
-    pub fn new(
-        torque: ComplianceTorque,
-        joints: &[usize],
-        rows: &[Measurement],
-        tools: &[usize],
-    ) -> Result<Self, Error> {
+    /// The terms of `joints` (0-based) seen on the rows of `data` driven by `torque`: every
+    /// regressor that is not zero on every row.
+    pub fn new(torque: ComplianceTorque, joints: &[usize], data: &BoundSet<'_>) -> Result<Self, Error> {
         let mut model = Self { torque, terms: Vec::new(), theta: Vec::new() };
         let raw: Vec<Vec<Vec<f64>>> =
-            rows.iter().zip(tools).map(|(row, &tool)| model.torques(row, tool)).collect::<Result<_, _>>()?;
+            data.iter().map(|(row, tool)| model.torques(row, tool)).collect::<Result<_, _>>()?;
         for &joint in joints {
             let width = raw.first().and_then(|r| r.get(joint)).map_or(0, Vec::len);
             for column in 0..width {
@@ -144,10 +139,10 @@ impl JointCompliance {
     /// Joint compliance driven by the measured torques as the gravity-torque regressors explain
     /// them ([`ComplianceTorque::Modelled`]), one parameter per joint of `joints` whose modelled
     /// torque is not zero on every row.
-    pub fn modelled(load: LoadFrame, joints: &[usize], rows: &[Measurement], tools: &[usize]) -> Result<Self, Error> {
+    pub fn modelled(load: LoadFrame, joints: &[usize], data: &BoundSet<'_>) -> Result<Self, Error> {
         let n = load.base_model.joint_count();
-        let fits = (0..n).map(|j| TorqueFit::new(&load, j, rows, tools)).collect::<Result<_, _>>()?;
-        Self::new(ComplianceTorque::Modelled { load, fits }, joints, rows, tools)
+        let fits = (0..n).map(|j| TorqueFit::new(&load, j, data)).collect::<Result<_, _>>()?;
+        Self::new(ComplianceTorque::Modelled { load, fits }, joints, data)
     }
 
     /// The torque regressors of one row, joint by joint (one column for a measured or modelled
@@ -315,18 +310,13 @@ impl NewEffect for JointCompliance {
 
     /// Every joint, through measured torques where every row has them, the gravity-torque
     /// regressors otherwise.
-    fn build(
-        _spec: &EffectSpec,
-        context: &EffectContext<'_>,
-        rows: &[Measurement],
-        tools: &[usize],
-    ) -> Result<Self, Error> {
+    fn build(_spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
         let joints: Vec<usize> = (0..context.robot.joint_count()).collect();
-        let load = context.load_frame(rows, tools)?;
-        if has_torques(rows) {
-            JointCompliance::modelled(load, &joints, rows, tools)
+        let load = context.load_frame(data)?;
+        if has_torques(data.rows()) {
+            JointCompliance::modelled(load, &joints, data)
         } else {
-            JointCompliance::new(ComplianceTorque::GravityRegressor(load), &joints, rows, tools)
+            JointCompliance::new(ComplianceTorque::GravityRegressor(load), &joints, data)
         }
     }
 
@@ -337,11 +327,11 @@ impl NewEffect for JointCompliance {
     fn joint_candidates(context: &CandidateContext<'_>, joint: usize) -> Result<Vec<CandidateModel>, Error> {
         let gravity = ComplianceTorque::GravityRegressor(context.load.clone());
         let mut out = vec![CandidateModel::plain(
-            IdentifiedEffect::JointCompliance(JointCompliance::new(gravity, &[joint], context.rows, context.tools)?),
+            IdentifiedEffect::JointCompliance(JointCompliance::new(gravity, &[joint], context.data)?),
             1,
         )];
         if context.measured {
-            let modelled = JointCompliance::modelled(context.load.clone(), &[joint], context.rows, context.tools)?;
+            let modelled = JointCompliance::modelled(context.load.clone(), &[joint], context.data)?;
             if !modelled.terms.is_empty() {
                 out.push(CandidateModel::plain(IdentifiedEffect::JointCompliance(modelled), 2));
             }

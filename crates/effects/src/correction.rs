@@ -4,7 +4,7 @@
 use super::{Direction, IdentifiedEffect, RowTwists};
 use errors::Error;
 use lie::Vector6;
-use measurements::Measurement;
+use measurements::BoundSet;
 use poe::LocalPoe;
 use poe::identify::PoseCorrection;
 
@@ -20,19 +20,13 @@ pub struct EffectCorrection {
 }
 
 impl EffectCorrection {
-    /// The correction of `effects` on `rows` (`tools`: each row's model tool), every parameter
-    /// with the prior standard deviation `prior_sigma` about zero.
-    pub fn new(
-        effects: &[IdentifiedEffect],
-        rows: &[Measurement],
-        tools: &[usize],
-        prior_sigma: f64,
-    ) -> Result<Self, Error> {
+    /// The correction of `effects` on the rows of `data`, every parameter with the prior
+    /// standard deviation `prior_sigma` about zero.
+    pub fn new(effects: &[IdentifiedEffect], data: &BoundSet<'_>, prior_sigma: f64) -> Result<Self, Error> {
         let directions: Vec<Direction> = effects.iter().flat_map(IdentifiedEffect::directions).collect();
-        let features = rows
+        let features = data
             .iter()
-            .zip(tools)
-            .map(|(row, &tool)| {
+            .map(|(row, tool)| {
                 let mut all = Vec::with_capacity(directions.len());
                 for effect in effects {
                     all.extend(effect.features(row, tool)?);
@@ -44,8 +38,8 @@ impl EffectCorrection {
             prior_sigma: effects.iter().flat_map(IdentifiedEffect::prior_scale).map(|s| s * prior_sigma).collect(),
             directions,
             features,
-            q: rows.iter().map(|r| r.q.clone()).collect(),
-            tools: tools.to_vec(),
+            q: data.rows().iter().map(|r| r.q.clone()).collect(),
+            tools: data.tools().to_vec(),
         })
     }
 

@@ -7,7 +7,7 @@ use crate::check::{Cursor, EffectFault};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect};
 use errors::{Error, ErrorKind};
-use measurements::Measurement;
+use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};
 
 /// Linear drift of the placement with `t_s`.
@@ -110,26 +110,21 @@ impl EffectTerm for TimeDrift {
 impl NewEffect for TimeDrift {
     const ARGUMENTS: &'static [Argument] = &[];
 
-    fn build(
-        _spec: &EffectSpec,
-        context: &EffectContext<'_>,
-        rows: &[Measurement],
-        _tools: &[usize],
-    ) -> Result<Self, Error> {
-        TimeDrift::new(rows, context.hold_beyond_span)
+    fn build(_spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
+        TimeDrift::new(data.rows(), context.hold_beyond_span)
     }
 
     /// Where every row has `t_s` and some row lies more than `CandidateOptions::drift_min_offset_s`
     /// from their mean.
     fn global_candidates(context: &CandidateContext<'_>) -> Result<Vec<CandidateModel>, Error> {
-        let Some(times) = context.rows.iter().map(|r| r.t_s).collect::<Option<Vec<f64>>>() else {
+        let Some(times) = context.data.rows().iter().map(|r| r.t_s).collect::<Option<Vec<f64>>>() else {
             return Ok(Vec::new());
         };
-        let mean = times.iter().sum::<f64>() / context.rows.len() as f64;
+        let mean = times.iter().sum::<f64>() / context.data.rows().len() as f64;
         if !times.iter().any(|t| (t - mean).abs() > context.options.drift_min_offset_s) {
             return Ok(Vec::new());
         }
-        let drift = TimeDrift::new(context.rows, crate::HOLD_BEYOND_SPAN)?;
+        let drift = TimeDrift::new(context.data.rows(), crate::HOLD_BEYOND_SPAN)?;
         Ok(vec![CandidateModel::plain(IdentifiedEffect::TimeDrift(drift), 0)])
     }
 }

@@ -18,7 +18,7 @@ use crate::check::{Cursor, EffectFault, FaultKind};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect, MAX_HARMONICS};
 use errors::{Error, ErrorKind};
-use measurements::Measurement;
+use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};
 
 /// A periodic error of one joint in its own angle.
@@ -385,18 +385,13 @@ impl NewEffect for GearPeriodic {
 
     /// Harmonics `1..=harmonics` of a revolute joint (on a linear axis the period of a screw or
     /// rack is a length, which this series has no parameter for), faded as `context.gear` says.
-    fn build(
-        spec: &EffectSpec,
-        context: &EffectContext<'_>,
-        rows: &[Measurement],
-        _tools: &[usize],
-    ) -> Result<Self, Error> {
+    fn build(spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
         let joint = spec.joint_index()?;
         if context.robot.joints[joint].kind == robot::JointType::Prismatic {
             return Err(Error::new(ErrorKind::EffectJointKind { effect: "gear_periodic", joint: joint + 1 }));
         }
         let harmonics = spec.required_harmonics()?;
-        GearPeriodic::with_options(joint, (1..=harmonics).collect(), rows, &context.gear)
+        GearPeriodic::with_options(joint, (1..=harmonics).collect(), data.rows(), &context.gear)
     }
 
     /// A series of the joint's own angle up to the diagnosis's longest order, for a revolute
@@ -405,7 +400,7 @@ impl NewEffect for GearPeriodic {
         if !context.moving.contains(&joint) || context.robot.joints[joint].kind != robot::JointType::Revolute {
             return Ok(Vec::new());
         }
-        let gear = GearPeriodic::new(joint, (1..=context.longest_order).collect(), context.rows)?;
+        let gear = GearPeriodic::new(joint, (1..=context.longest_order).collect(), context.data.rows())?;
         Ok(vec![CandidateModel { series: true, ..CandidateModel::plain(IdentifiedEffect::GearPeriodic(gear), 4) }])
     }
 }

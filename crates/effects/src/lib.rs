@@ -63,7 +63,7 @@ pub use direction::RowTwists;
 
 use errors::{Error, ErrorKind};
 use lie::Vector6;
-use measurements::Measurement;
+use measurements::{BoundSet, Measurement};
 use poe::LocalPoe;
 use robot::RobotDescription;
 use serde::{Deserialize, Serialize};
@@ -164,15 +164,10 @@ macro_rules! identified_effect {
                 }
             }
 
-            fn build(
-                spec: &EffectSpec,
-                context: &EffectContext<'_>,
-                rows: &[Measurement],
-                tools: &[usize],
-            ) -> Result<Self, Error> {
+            fn build(spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
                 match spec.kind {
                     $( EffectKind::$kind => {
-                        <$kind as NewEffect>::build(spec, context, rows, tools).map(IdentifiedEffect::$kind)
+                        <$kind as NewEffect>::build(spec, context, data).map(IdentifiedEffect::$kind)
                     } )*
                     _ => Err(Error::at_line("--effects", 1, 1, ErrorKind::EffectList { text: spec.to_string(), fault: EffectListFault::UnknownEffect })),
                 }
@@ -219,27 +214,22 @@ pub struct EffectContext<'a> {
 }
 
 impl EffectContext<'_> {
-    /// The load frame, its tools placed from `rows` (`tools`: each row's model tool).
-    pub fn load_frame(&self, rows: &[Measurement], tools: &[usize]) -> Result<LoadFrame, Error> {
-        LoadFrame::new(self.robot, self.kinematics, rows, tools)
+    /// The load frame, its tools placed from the rows of `data`.
+    pub fn load_frame(&self, data: &BoundSet<'_>) -> Result<LoadFrame, Error> {
+        LoadFrame::new(self.robot, self.kinematics, data)
     }
 }
 
 impl IdentifiedEffect {
-    /// The effect `spec` names, its features scaled on `rows` (`tools`: each row's model tool),
-    /// its parameters at zero. Backlash takes the sign of the measured torque where every row has
+    /// The effect `spec` names, its features scaled on the rows of `data`, its parameters at
+    /// zero. Backlash takes the sign of the measured torque where every row has
     /// one, of the robot's static torque otherwise (its mass model, or a stand-in).
-    pub fn new(
-        spec: &EffectSpec,
-        context: &EffectContext<'_>,
-        rows: &[Measurement],
-        tools: &[usize],
-    ) -> Result<Self, Error> {
+    pub fn new(spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
         let joint_count = context.robot.joint_count();
         if let Some(joint) = spec.joint.filter(|&j| j == 0 || j > joint_count) {
             return Err(Error::new(ErrorKind::EffectJoint { joint, joint_count }));
         }
-        Self::build(spec, context, rows, tools)
+        Self::build(spec, context, data)
     }
 
     fn regressor(&self) -> &dyn EffectTerm {
@@ -359,16 +349,12 @@ impl IdentifiedEffect {
         Ok(total)
     }
 
-    /// The twist per unit of each parameter at every row: `[parameter][row]`, for the diagnosis.
-    pub fn parameter_twists(
-        &self,
-        kinematics: &LocalPoe,
-        rows: &[Measurement],
-        tools: &[usize],
-    ) -> Result<Vec<Vec<Vector6>>, Error> {
+    /// The twist per unit of each parameter at every row of `data`: `[parameter][row]`, for the
+    /// diagnosis.
+    pub fn parameter_twists(&self, kinematics: &LocalPoe, data: &BoundSet<'_>) -> Result<Vec<Vec<Vector6>>, Error> {
         let directions = self.directions();
-        let mut out = vec![Vec::with_capacity(rows.len()); directions.len()];
-        for (row, &tool) in rows.iter().zip(tools) {
+        let mut out = vec![Vec::with_capacity(data.len()); directions.len()];
+        for (row, tool) in data.iter() {
             let features = self.features(row, tool)?;
             let mut twists = RowTwists::new(kinematics, &row.q, tool);
             for (l, (direction, f)) in directions.iter().zip(features).enumerate() {

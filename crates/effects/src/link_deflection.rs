@@ -21,7 +21,7 @@ use crate::{
 };
 use errors::Error;
 use loadsim::{Payload, RobotDynamics};
-use measurements::Measurement;
+use measurements::{BoundSet, Measurement};
 use robot::JointType;
 use serde::{Deserialize, Serialize};
 
@@ -54,17 +54,10 @@ pub struct LinkDeflection {
 
 impl LinkDeflection {
     /// The bending of `joint`'s link (0-based) with the moment of `dynamics`, its axes those that
-    /// carry a moment on `rows`, scaled there, its parameters at zero.
-    pub fn new(
-        joint: usize,
-        load: LoadFrame,
-        dynamics: RobotDynamics,
-        rows: &[Measurement],
-        tools: &[usize],
-    ) -> Result<Self, Error> {
+    /// carry a moment on the rows of `data`, scaled there, its parameters at zero.
+    pub fn new(joint: usize, load: LoadFrame, dynamics: RobotDynamics, data: &BoundSet<'_>) -> Result<Self, Error> {
         let mut model = Self { joint, load, dynamics, axes: vec![0, 1], scale: vec![1.0, 1.0], theta: vec![] };
-        let raw: Vec<Vec<f64>> =
-            rows.iter().zip(tools).map(|(row, &tool)| model.features(row, tool)).collect::<Result<_, _>>()?;
+        let raw: Vec<Vec<f64>> = data.iter().map(|(row, tool)| model.features(row, tool)).collect::<Result<_, _>>()?;
         let rms = rms_scales(&raw);
         let carries = |a: usize| raw.iter().any(|r| r[a] != 0.0) && rms[a] > AXIS_RMS_FLOOR_NM2;
         model.axes = (0..2).filter(|&a| carries(a)).collect();
@@ -152,15 +145,10 @@ impl NewEffect for LinkDeflection {
     const ARGUMENTS: &'static [Argument] = &[Argument::Joint];
 
     /// The link of the item's joint, with the robot's mass model or a stand-in.
-    fn build(
-        spec: &EffectSpec,
-        context: &EffectContext<'_>,
-        rows: &[Measurement],
-        tools: &[usize],
-    ) -> Result<Self, Error> {
+    fn build(spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
         let joint = spec.joint_index()?;
         let dynamics = context.robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(context.robot));
-        LinkDeflection::new(joint, context.load_frame(rows, tools)?, dynamics, rows, tools)
+        LinkDeflection::new(joint, context.load_frame(data)?, dynamics, data)
     }
 
     /// One candidate per prismatic joint (module doc), after every joint's compliance.
@@ -170,13 +158,7 @@ impl NewEffect for LinkDeflection {
             if description.kind != JointType::Prismatic {
                 continue;
             }
-            let bend = LinkDeflection::new(
-                joint,
-                context.load.clone(),
-                context.dynamics.clone(),
-                context.rows,
-                context.tools,
-            )?;
+            let bend = LinkDeflection::new(joint, context.load.clone(), context.dynamics.clone(), context.data)?;
             if !bend.axes.is_empty() {
                 out.push(CandidateModel {
                     only_if_nonzero: true,

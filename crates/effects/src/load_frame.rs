@@ -15,7 +15,7 @@
 use errors::Error;
 use lie::{SE3, Vector3};
 use loadsim::Payload;
-use measurements::Measurement;
+use measurements::{BoundSet, Measurement};
 use poe::LocalPoe;
 use robot::RobotDescription;
 use serde::{Deserialize, Serialize};
@@ -32,20 +32,15 @@ pub struct LoadFrame {
 
 impl LoadFrame {
     /// The frame of `robot` for the calibrated `kinematics` (reference frame: the tracker), its
-    /// tools placed from `rows` (`tools`: each row's model tool).
-    pub fn new(
-        robot: &RobotDescription,
-        kinematics: &LocalPoe,
-        rows: &[Measurement],
-        tools: &[usize],
-    ) -> Result<Self, Error> {
+    /// tools placed from the rows of `data` that carry each.
+    pub fn new(robot: &RobotDescription, kinematics: &LocalPoe, data: &BoundSet<'_>) -> Result<Self, Error> {
         let mut base_model = robot.nominal_model()?;
         let in_base = robot::in_base_frame(kinematics, Some(&base_model));
         let mut placed = Vec::with_capacity(in_base.tool_count());
         let zero = vec![0.0; base_model.joint_count()];
         for tool in 0..in_base.tool_count() {
             let mut carried: Vec<&[f64]> =
-                rows.iter().zip(tools).filter(|(_, t)| **t == tool).map(|(r, _)| r.q.as_slice()).collect();
+                data.iter().filter(|(_, t)| *t == tool).map(|(r, _)| r.q.as_slice()).collect();
             if carried.is_empty() {
                 carried.push(&zero);
             }

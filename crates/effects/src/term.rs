@@ -7,7 +7,7 @@
 use crate::check::{Cursor, EffectFault};
 use crate::{Argument, Direction, EffectContext, EffectSpec, IdentifiedEffect, LoadFrame, Regressor};
 use errors::Error;
-use measurements::Measurement;
+use measurements::{BoundSet, Measurement};
 use robot::RobotDescription;
 use serde::{Deserialize, Serialize};
 
@@ -16,10 +16,8 @@ use serde::{Deserialize, Serialize};
 pub struct CandidateContext<'a> {
     /// The robot description.
     pub robot: &'a RobotDescription,
-    /// The measurements.
-    pub rows: &'a [Measurement],
-    /// Each row's model tool.
-    pub tools: &'a [usize],
+    /// The measurements, bound to the model the diagnosis fits (each row's model tool).
+    pub data: &'a BoundSet<'a>,
     /// The nominal arm in the base frame, where gravity is known, with the calibrated tools.
     pub load: &'a LoadFrame,
     /// The robot's mass model, or [`crate::stand_in_dynamics`].
@@ -123,14 +121,9 @@ pub(crate) trait NewEffect: EffectTerm + Sized {
     /// The arguments of its `--effects` item, in order.
     const ARGUMENTS: &'static [Argument];
 
-    /// The effect an `--effects` item names, its features scaled on `rows` (`tools`: each row's
-    /// model tool), its parameters at zero. Its joint, if any, is within the robot.
-    fn build(
-        spec: &EffectSpec,
-        context: &EffectContext<'_>,
-        rows: &[Measurement],
-        tools: &[usize],
-    ) -> Result<Self, Error>;
+    /// The effect an `--effects` item names, its features scaled on the rows of `data`, its
+    /// parameters at zero. Its joint, if any, is within the robot.
+    fn build(spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error>;
 
     /// The diagnosis's candidates of this kind on 0-based joint `joint`.
     fn joint_candidates(_context: &CandidateContext<'_>, _joint: usize) -> Result<Vec<CandidateModel>, Error> {

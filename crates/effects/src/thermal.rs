@@ -7,7 +7,7 @@ use crate::check::{Cursor, EffectFault};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect};
 use errors::{Error, ErrorKind};
-use measurements::Measurement;
+use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};
 
 /// Thermal growth of the arm with `temp_c`.
@@ -105,27 +105,22 @@ impl EffectTerm for Thermal {
 impl NewEffect for Thermal {
     const ARGUMENTS: &'static [Argument] = &[];
 
-    fn build(
-        _spec: &EffectSpec,
-        context: &EffectContext<'_>,
-        rows: &[Measurement],
-        _tools: &[usize],
-    ) -> Result<Self, Error> {
-        Thermal::new(rows, context.hold_beyond_span)
+    fn build(_spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
+        Thermal::new(data.rows(), context.hold_beyond_span)
     }
 
     /// One expansion coefficient for the whole arm (every link but the tracker-to-base placement
     /// grows by `α ΔT`), where every row has `temp_c` and it spans more than
     /// `CandidateOptions::thermal_min_span_k`.
     fn global_candidates(context: &CandidateContext<'_>) -> Result<Vec<CandidateModel>, Error> {
-        let Some(temps) = context.rows.iter().map(|r| r.temp_c).collect::<Option<Vec<f64>>>() else {
+        let Some(temps) = context.data.rows().iter().map(|r| r.temp_c).collect::<Option<Vec<f64>>>() else {
             return Ok(Vec::new());
         };
         let (low, high) = temps.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| (a.min(t), b.max(t)));
         if high - low <= context.options.thermal_min_span_k {
             return Ok(Vec::new());
         }
-        let thermal = Thermal::new(context.rows, crate::HOLD_BEYOND_SPAN)?;
+        let thermal = Thermal::new(context.data.rows(), crate::HOLD_BEYOND_SPAN)?;
         Ok(vec![CandidateModel::plain(IdentifiedEffect::Thermal(thermal), 0)])
     }
 }

@@ -5,6 +5,10 @@
 //! `column_map` the `--columns` renaming, `row` the cells of one row, `writer` writes a set back
 //! as SPEC CSV.
 //!
+//! A set meets a model only bound to it: [`BoundSet`] holds the rows with each one's model tool
+//! index, made once by the constructor that checks the joints and maps the tools, and is what
+//! every function that applies a model or an effect to rows takes.
+//!
 //! ```
 //! use measurements::{ReadOptions, parse_measurements};
 //! let csv = "q1_rad,q2_rad,x_mm,y_mm,z_mm\n0.1,0.2,1000,0,500\n0.3,-0.1,990,12,510\n";
@@ -18,6 +22,7 @@
 //! ```
 #![deny(missing_docs)]
 
+mod bound;
 mod column_map;
 mod dialect;
 mod input_files;
@@ -27,6 +32,7 @@ mod output_file;
 mod quantity;
 mod row;
 mod writer;
+pub use bound::{BoundSet, model_tool};
 pub use input_files::InputFiles;
 pub use outliers::{OutlierLine, list_lines, without};
 pub use output_file::{FileKind, MAX_SYMLINKS, OutputFile, output_target, write_file};

@@ -4,11 +4,12 @@
 use crate::Method;
 use crate::model_parts::{Part, Walk};
 use effects::IdentifiedEffect;
-use errors::{Error, ErrorKind};
+use errors::Error;
 use lie::SE3;
-use measurements::Measurement;
+use measurements::{BoundSet, Measurement, MeasurementSet};
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 
 /// What `calib fit` produces and `calib eval` / `calib predict` use.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -94,14 +95,14 @@ impl CalibratedModel {
     /// file without the column), matched like any other name, as in the fit (SPEC v2); an
     /// identifier the model was not fitted with is refused.
     pub fn tool_index(&self, name: &str, file: &str, line: u64, column: usize) -> Result<usize, Error> {
-        self.tools.iter().position(|t| t == name).ok_or_else(|| {
-            Error::at_line(
-                file.to_owned(),
-                line,
-                column,
-                ErrorKind::UnknownTool { tool: name.to_owned(), known: self.tools.clone() },
-            )
-        })
+        measurements::model_tool(&self.tools, name, file, line, column)
+    }
+
+    /// `data` bound to this model ([`BoundSet::to_model`]): its joint columns checked against the
+    /// model's joints, each row's tool matched by identifier, an unknown one refused at its line.
+    /// Every function that applies the model to rows takes the result, so a command binds once.
+    pub fn bind<'a>(&self, data: impl Into<Cow<'a, MeasurementSet>>) -> Result<BoundSet<'a>, Error> {
+        BoundSet::to_model(data, &self.joint_kinds(), &self.tools)
     }
 
     /// The posterior uncertainty and the effects it is of, where the model keeps it.
@@ -159,8 +160,8 @@ impl CalibratedModel {
     }
 
     /// The poses of the geometry and the effects, before any GP.
-    pub fn geometric_poses(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<SE3>, Error> {
-        let mut walk = Walk::new(rows, tools, self.uncertainty());
+    pub fn geometric_poses(&self, data: &BoundSet<'_>) -> Result<Vec<SE3>, Error> {
+        let mut walk = Walk::new(data, self.uncertainty());
         for part in self.parts().iter().filter(|p| !matches!(p, Part::GaussianProcess(_))) {
             part.apply(&mut walk)?;
         }
@@ -170,8 +171,8 @@ impl CalibratedModel {
 
     /// Predicts the tool pose of rows of a measurement set by applying every part in turn; the
     /// GP is placed before the POE model as in the paper's Eq. 9: `T = exp(ĝ(q, m)) · T_POE(q)`.
-    pub fn predict(&self, rows: &[Measurement], tools: &[usize]) -> Result<Vec<PredictedPose>, Error> {
-        let mut walk = Walk::new(rows, tools, self.uncertainty());
+    pub fn predict(&self, data: &BoundSet<'_>) -> Result<Vec<PredictedPose>, Error> {
+        let mut walk = Walk::new(data, self.uncertainty());
         for part in self.parts() {
             part.apply(&mut walk)?;
         }
@@ -316,13 +317,13 @@ impl CalibratedModel {
         crate::beyond_limits(&self.joint_limits, &prismatic, rows)
     }
 
-    /// How fully the effects apply at each of `rows` (model tools `tools`) by the model's σ there
+    /// How fully the effects apply at each row of `data` by the model's σ there
     /// ([`crate::EffectUncertainty::weight`]) and that σ of the tool point's position (m); `None`
     /// for a model that keeps no uncertainty.
-    pub fn sigma_weights(&self, rows: &[Measurement], tools: &[usize]) -> Result<Option<Vec<(f64, f64)>>, Error> {
+    pub fn sigma_weights(&self, data: &BoundSet<'_>) -> Result<Option<Vec<(f64, f64)>>, Error> {
         let Some(uncertainty) = &self.effect_uncertainty else { return Ok(None) };
-        let mut weights = Vec::with_capacity(rows.len());
-        for (row, &tool) in rows.iter().zip(tools) {
+        let mut weights = Vec::with_capacity(data.len());
+        for (row, tool) in data.iter() {
             let sigma = uncertainty.sigma(&self.kinematics, &self.effects, row, tool)?;
             let position = crate::EffectUncertainty::position(&sigma);
             weights.push((uncertainty.weight(position), position));
@@ -330,14 +331,14 @@ impl CalibratedModel {
         Ok(Some(weights))
     }
 
-    /// The rows of `rows` (model tools `tools`) at which the model's σ is above its fallback limit,
+    /// The rows of `data` at which the model's σ is above its fallback limit,
     /// where it falls back to the geometry fitted alone ([`crate::EffectUncertainty`]); `None`
     /// when there are none or the model keeps no uncertainty.
-    pub fn sigma_fallback(&self, rows: &[Measurement], tools: &[usize]) -> Result<Option<SigmaFallback>, Error> {
-        let (Some(uncertainty), Some(weights)) = (&self.effect_uncertainty, self.sigma_weights(rows, tools)?) else {
+    pub fn sigma_fallback(&self, data: &BoundSet<'_>) -> Result<Option<SigmaFallback>, Error> {
+        let (Some(uncertainty), Some(weights)) = (&self.effect_uncertainty, self.sigma_weights(data)?) else {
             return Ok(None);
         };
-        Ok(SigmaFallback::of(rows, &weights, uncertainty))
+        Ok(SigmaFallback::of(data.rows(), &weights, uncertainty))
     }
 
     /// Whether any effect records the joint angles it was fitted on.

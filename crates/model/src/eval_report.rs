@@ -4,7 +4,7 @@
 
 use crate::Evaluation;
 use crate::{CalibratedModel, ErrorSummary, ExtrapolationWarning, Method, PoseError};
-use measurements::{FileFormat, MeasurementSet};
+use measurements::{BoundSet, FileFormat, MeasurementSet};
 use serde::{Deserialize, Serialize};
 
 /// What `eval` says when the data has orientations that a position-only model cannot be judged on.
@@ -99,12 +99,11 @@ impl CoverageSplit {
 }
 
 impl EvalReport {
-    /// The report of `evaluation`, the result of `model` on `data`.
-    pub fn new(model: &CalibratedModel, data: &MeasurementSet, evaluation: &Evaluation) -> Self {
+    /// The report of `evaluation`, the result of `model` on `bound` (bound to it).
+    pub fn new(model: &CalibratedModel, bound: &BoundSet<'_>, evaluation: &Evaluation) -> Self {
         // The evaluation has walked the same rows: the σ cannot fail where it did not.
-        let weights = crate::tool_indices(model, data)
-            .ok()
-            .and_then(|tools| model.sigma_weights(&data.rows, &tools).ok().flatten());
+        let weights = model.sigma_weights(bound).ok().flatten();
+        let data = bound.set();
         let held = |i: usize| weights.as_ref().is_none_or(|w| w[i].0 == 1.0);
         let sigma_fallback = match (&model.effect_uncertainty, &weights) {
             (Some(uncertainty), Some(weights)) => crate::SigmaFallback::of(&data.rows, weights, uncertainty),

@@ -27,7 +27,9 @@
 //!     fit_warnings: None,
 //!     robot_description: Some(robot.clone()),
 //! };
-//! let evaluation = model::evaluate(&model, &data)?;
+//! // The data bound to the model once (joints checked, tools mapped), then passed as one value.
+//! let bound = model.bind(&data)?;
+//! let evaluation = model::evaluate(&model, &bound)?;
 //! assert!(evaluation.summary.mean_position_error_mm < 0.01); // no noise, no effect: the geometry is all
 //! # Ok::<(), errors::Error>(())
 //! ```
@@ -52,7 +54,7 @@ mod suspect_rows;
 mod training_range;
 mod unit_name;
 mod wrap;
-pub use evaluate::{Evaluation, evaluate, tool_indices};
+pub use evaluate::{Evaluation, evaluate};
 pub use predictions::write_predictions;
 
 pub use calibrated::{CalibratedModel, ExtrapolationWarning, PredictedPose, SigmaFallback};

@@ -245,8 +245,9 @@ impl CalibratedModel {
             return Err(at.part("effect_uncertainty", message));
         }
         let (rows, where_) = self.probe_rows();
-        let tools = vec![0; rows.len()];
-        let mut walk = Walk::new(&rows, &tools, self.uncertainty());
+        // Made here from the model, every row on its first tool.
+        let probe = measurements::BoundSet::made_for_model("the model check", rows);
+        let mut walk = Walk::new(&probe, self.uncertainty());
         for (k, part) in self.parts().iter().enumerate() {
             let applied = part.apply(&mut walk);
             if applied.is_ok() && walk.is_bounded(MAX_TRANSLATION_M) {

@@ -13,7 +13,7 @@ use crate::effect_sigma::EffectUncertainty;
 use effects::IdentifiedEffect;
 use errors::{Error, ErrorKind};
 use lie::{SE3, Twist, Vector6};
-use measurements::Measurement;
+use measurements::BoundSet;
 use poe::LocalPoe;
 
 /// One part of a calibrated model, in the order the parts apply.
@@ -55,28 +55,27 @@ impl<'a> Part<'a> {
             Part::Geometry(kinematics) => {
                 walk.kinematics = Some(kinematics);
                 walk.poses = walk
-                    .rows
+                    .data
                     .iter()
-                    .zip(walk.tools)
-                    .map(|(row, &tool)| kinematics.forward(&row.q, tool))
+                    .map(|(row, tool)| kinematics.forward(&row.q, tool))
                     .collect::<Result<_, _>>()
                     .map_err(Error::kinematics)?;
-                walk.pending = vec![Vector6::zeros(); walk.rows.len()];
-                walk.coverage = vec![1.0; walk.rows.len()];
+                walk.pending = vec![Vector6::zeros(); walk.data.len()];
+                walk.coverage = vec![1.0; walk.data.len()];
                 walk.posterior_variance = None;
             }
             Part::Effect(effect) => {
                 let kinematics = walk.kinematics.ok_or(Error::new(ErrorKind::PartOrder { part: "effect" }))?;
                 for (((pending, coverage), row), &tool) in
-                    walk.pending.iter_mut().zip(&mut walk.coverage).zip(walk.rows).zip(walk.tools)
+                    walk.pending.iter_mut().zip(&mut walk.coverage).zip(walk.data.rows()).zip(walk.data.tools())
                 {
                     *pending += effect.twist(kinematics, row, tool)?;
                     *coverage *= effect.coverage_weight(row);
                 }
                 if effect.has_sigma() {
-                    let variance = walk.effect_variance.get_or_insert_with(|| vec![[0.0; 6]; walk.rows.len()]);
+                    let variance = walk.effect_variance.get_or_insert_with(|| vec![[0.0; 6]; walk.data.len()]);
                     for (((variance, pose), row), &tool) in
-                        variance.iter_mut().zip(&walk.poses).zip(walk.rows).zip(walk.tools)
+                        variance.iter_mut().zip(&walk.poses).zip(walk.data.rows()).zip(walk.data.tools())
                     {
                         let sigma = effect.sigma(kinematics, row, tool, &pose.translation())?;
                         for (v, s) in variance.iter_mut().zip(sigma.iter()) {
@@ -92,8 +91,10 @@ impl<'a> Part<'a> {
                 // the σ of what is still applied shrinks with it.
                 if let Some((uncertainty, effects)) = walk.uncertainty {
                     let kinematics = walk.kinematics.ok_or(Error::new(ErrorKind::PartOrder { part: "fallback" }))?;
-                    let mut variances = Vec::with_capacity(walk.rows.len());
-                    for ((coverage, row), &tool) in walk.coverage.iter_mut().zip(walk.rows).zip(walk.tools) {
+                    let mut variances = Vec::with_capacity(walk.data.len());
+                    for ((coverage, row), &tool) in
+                        walk.coverage.iter_mut().zip(walk.data.rows()).zip(walk.data.tools())
+                    {
                         let sigma = uncertainty.sigma(kinematics, effects, row, tool)?;
                         *coverage *= uncertainty.weight(EffectUncertainty::position(&sigma));
                         variances.push(sigma.map(|s| s * s * *coverage * *coverage));
@@ -101,7 +102,7 @@ impl<'a> Part<'a> {
                     walk.posterior_variance = Some(variances);
                 }
                 for (((pose, coverage), row), &tool) in
-                    walk.poses.iter_mut().zip(&walk.coverage).zip(walk.rows).zip(walk.tools)
+                    walk.poses.iter_mut().zip(&walk.coverage).zip(walk.data.rows()).zip(walk.data.tools())
                 {
                     if *coverage < 1.0 {
                         // T = exp(w · log(T_e T_g⁻¹)) T_g: the geometry alone at w = 0.
@@ -113,7 +114,7 @@ impl<'a> Part<'a> {
             }
             Part::GaussianProcess(residual_gp) => {
                 walk.flush();
-                let corrections = residual_gp.predict(walk.rows, &walk.poses, walk.tools)?;
+                let corrections = residual_gp.predict(walk.data, &walk.poses)?;
                 let mut std = Vec::with_capacity(corrections.len());
                 for (pose, (g, s)) in walk.poses.iter_mut().zip(corrections) {
                     *pose = g * *pose;
@@ -130,8 +131,8 @@ impl<'a> Part<'a> {
 /// standard deviations.
 #[derive(Debug)]
 pub(crate) struct Walk<'a> {
-    rows: &'a [Measurement],
-    tools: &'a [usize],
+    /// The rows with their model tools.
+    data: &'a BoundSet<'a>,
     kinematics: Option<&'a LocalPoe>,
     pub(crate) poses: Vec<SE3>,
     pending: Vec<Vector6>,
@@ -152,13 +153,11 @@ pub(crate) struct Walk<'a> {
 
 impl<'a> Walk<'a> {
     pub(crate) fn new(
-        rows: &'a [Measurement],
-        tools: &'a [usize],
+        data: &'a BoundSet<'a>,
         uncertainty: Option<(&'a EffectUncertainty, &'a [IdentifiedEffect])>,
     ) -> Self {
         Self {
-            rows,
-            tools,
+            data,
             kinematics: None,
             poses: Vec::new(),
             pending: Vec::new(),
@@ -189,7 +188,7 @@ impl<'a> Walk<'a> {
         }
         let at = |v: &Option<Vec<[f64; 6]>>, i: usize| v.as_ref().map_or([0.0; 6], |v| v[i]);
         Some(
-            (0..self.rows.len())
+            (0..self.data.len())
                 .map(|i| {
                     let (gp, faded, posterior) =
                         (at(&self.std, i), at(&self.effect_variance, i), at(&self.posterior_variance, i));

@@ -5,7 +5,7 @@
 use errors::Error;
 use faer::Mat;
 use lie::{SE3, Twist, Vector3, Vector6};
-use measurements::{Measurement, MeasurementSet};
+use measurements::{BoundSet, Measurement, MeasurementSet};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
@@ -621,15 +621,11 @@ impl ResidualGp {
     }
 
     /// The correction of every row: `G(q, m)` to put before the model pose, and the GP's standard
-    /// deviation of each error component `(v, ω)` (m, rad; zeros where not modelled). `tools`:
-    /// each row's model tool ([`ResidualGp::tool_points`]).
-    pub fn predict(
-        &self,
-        rows: &[Measurement],
-        model_poses: &[SE3],
-        tools: &[usize],
-    ) -> Result<Vec<(SE3, [f64; 6])>, Error> {
-        let prediction = self.gp.predict(inputs(rows, self.with_payload).as_ref()).map_err(Error::gp)?;
+    /// deviation of each error component `(v, ω)` (m, rad; zeros where not modelled). Each row's
+    /// model tool in `data` picks its tool point ([`ResidualGp::tool_points`]).
+    pub fn predict(&self, data: &BoundSet<'_>, model_poses: &[SE3]) -> Result<Vec<(SE3, [f64; 6])>, Error> {
+        let tools = data.tools();
+        let prediction = self.gp.predict(inputs(data.rows(), self.with_payload).as_ref()).map_err(Error::gp)?;
         let outputs = prediction.mean.ncols();
         Ok(model_poses
             .iter()

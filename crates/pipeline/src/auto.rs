@@ -1,10 +1,10 @@
 //! `--effects auto`: the effects `calib diagnose` selects on the training data, as a list the fit
 //! identifies (its `selected` effects, with their joints and harmonic orders).
 
-use diagnose::{DiagnoseOptions, SelectedEffect, Verdict, diagnose};
+use diagnose::{DiagnoseOptions, SelectedEffect, Verdict, diagnose_bound};
 use effects::{Argument, EffectSpec};
 use errors::Error;
-use measurements::MeasurementSet;
+use measurements::BoundSet;
 use robot::RobotDescription;
 use serde::Serialize;
 
@@ -66,9 +66,10 @@ pub fn effects_of(selected: &[SelectedEffect]) -> Vec<EffectSpec> {
     specs
 }
 
-/// Runs the diagnosis on the training data and returns what its selection keeps.
-pub fn choose(robot: &RobotDescription, data: &MeasurementSet, options: &DiagnoseOptions) -> Result<AutoChoice, Error> {
-    let diagnosis = diagnose(robot, data, options)?;
+/// Runs the diagnosis on the training data, bound to `robot` as the fit binds it
+/// ([`measurements::BoundSet::to_robot`]), and returns what its selection keeps.
+pub fn choose(robot: &RobotDescription, data: &BoundSet<'_>, options: &DiagnoseOptions) -> Result<AutoChoice, Error> {
+    let diagnosis = diagnose_bound(robot, data, options)?;
     Ok(AutoChoice {
         chosen: effects_of(&diagnosis.selected),
         verdict: diagnosis.verdict,

@@ -7,7 +7,7 @@ use effects::{
 };
 use errors::{Error, ErrorKind};
 use measurements::MeasurementSet;
-use measurements::{OutlierLine, list_lines, without};
+use measurements::{BoundSet, OutlierLine, list_lines};
 use model::geometric::{fit_geometry_with_prior, observations};
 use model::{
     CalibratedModel, ErrorSummary, HeldoutEstimate, HeldoutSource, Method, ResidualGp, ResidualGpReport,
@@ -160,16 +160,16 @@ fn effect_uncertainty(
     effects: &[IdentifiedEffect],
     free: Vec<usize>,
     covariance: &[f64],
-    data: &MeasurementSet,
+    data: &BoundSet<'_>,
     options: &crate::EffectOptions,
 ) -> Result<Option<model::EffectUncertainty>, Error> {
     let p = free.len() + effects.iter().map(IdentifiedEffect::parameter_count).sum::<usize>();
     let Some(factor) = model::EffectUncertainty::factor_of(covariance, p) else { return Ok(None) };
     let mut uncertainty =
         model::EffectUncertainty { free, factor, training_sigma_m: [0.0; 2], fallback_sigma_m: f64::MAX / 2.0 };
-    let mut sigmas = Vec::with_capacity(data.rows.len());
-    for row in &data.rows {
-        let sigma = uncertainty.sigma(kinematics, effects, row, row.tool)?;
+    let mut sigmas = Vec::with_capacity(data.len());
+    for (row, tool) in data.iter() {
+        let sigma = uncertainty.sigma(kinematics, effects, row, tool)?;
         sigmas.push(model::EffectUncertainty::position(&sigma));
     }
     sigmas.sort_by(f64::total_cmp);
@@ -187,12 +187,11 @@ fn build_effects(
     specs: &[EffectSpec],
     robot: &RobotDescription,
     kinematics: &poe::LocalPoe,
-    data: &MeasurementSet,
+    data: &BoundSet<'_>,
     options: &crate::EffectOptions,
 ) -> Result<Vec<IdentifiedEffect>, Error> {
     let context = EffectContext { robot, kinematics, gear: options.gear, hold_beyond_span: options.hold_beyond_span };
-    let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
-    specs.iter().map(|spec| IdentifiedEffect::new(spec, &context, &data.rows, &tools)).collect()
+    specs.iter().map(|spec| IdentifiedEffect::new(spec, &context, data)).collect()
 }
 
 /// Fits `method` to `data` for `robot` (paper Section III: step 1, then step 2 for the GP
@@ -205,10 +204,12 @@ pub fn fit(
     method: Method,
     options: &FitOptions,
 ) -> Result<(CalibratedModel, FitReport), Error> {
-    data.check_joints(&robot.joint_kinds())?;
+    // The one binding of the fit: the joints checked, each row's tool its own index, since the
+    // model takes the data's tools in their order.
+    let bound = BoundSet::to_robot(data, &robot.joint_kinds())?;
     // Before anything is fitted: a unit mistake or a mirrored frame fits as well as the right
     // data (issue 31), so it is refused here, or with `force` reported as a warning.
-    let findings = crate::plausibility::check(robot, data, &options.plausibility)?;
+    let findings = crate::plausibility::check(robot, &bound, &options.plausibility)?;
     let mut warnings = Vec::new();
     for refusal in findings.refusals {
         if !options.plausibility.force {
@@ -248,16 +249,15 @@ pub fn fit(
         EffectSelection::None => Vec::new(),
         EffectSelection::List(list) => list.clone(),
         EffectSelection::Auto => {
-            let choice = crate::auto::choose(robot, data, &options.effects.diagnose)?;
+            let choice = crate::auto::choose(robot, &bound, &options.effects.diagnose)?;
             let chosen = choice.chosen.clone();
             auto = Some(choice);
             chosen
         }
     };
     if !specs.is_empty() {
-        let mut effects = build_effects(&specs, robot, &model.kinematics, data, &options.effects)?;
-        let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
-        let correction = EffectCorrection::new(&effects, &data.rows, &tools, options.effects.prior_sigma)?;
+        let mut effects = build_effects(&specs, robot, &model.kinematics, &bound, &options.effects)?;
+        let correction = EffectCorrection::new(&effects, &bound, options.effects.prior_sigma)?;
         let layout = model.kinematics.layout();
         let mask = if scope == Scope::BaseTool { ParameterMask::base_tool(layout) } else { ParameterMask::all(layout) };
         let id_options = IdentificationOptions {
@@ -290,7 +290,7 @@ pub fn fit(
             &effects,
             mask.free_indices(),
             &fitted.covariance,
-            data,
+            &bound,
             &options.effects,
         )?;
         model.effects = effects;
@@ -303,11 +303,11 @@ pub fn fit(
         let with_payload = method == Method::PoeGpLoad;
         // The GP learns what the geometry leaves on the rows the geometry was fitted to: an
         // outlier's metre would otherwise be its largest "structure".
-        let kept = if left_out { Cow::Owned(without(data, &identification.robust)) } else { Cow::Borrowed(data) };
-        let tools: Vec<usize> = kept.rows.iter().map(|r| r.tool).collect();
-        let poses = model.geometric_poses(&kept.rows, &tools)?;
-        let repeats = model::RepeatGroups::of(&kept.rows, options.heldout.repeat_tolerance);
-        let (fitted, report) = ResidualGp::fit(&poses, &kept, with_payload, &options.residual_gp, &repeats)?;
+        let kept =
+            if left_out { Cow::Owned(bound.without(&identification.robust.outliers)) } else { Cow::Borrowed(&bound) };
+        let poses = model.geometric_poses(&kept)?;
+        let repeats = model::RepeatGroups::of(kept.rows(), options.heldout.repeat_tolerance);
+        let (fitted, report) = ResidualGp::fit(&poses, kept.set(), with_payload, &options.residual_gp, &repeats)?;
         model.residual_gp = Some(fitted);
         residual_gp = Some(report);
     }
@@ -324,8 +324,9 @@ pub fn fit(
         residual_gp: None,
         ..model.clone()
     };
-    let before = evaluate(&registered, data)?.summary;
-    let after = evaluate(&model, data)?.summary;
+    // `registered` and `model` share the data's tools, so the one binding serves both.
+    let before = evaluate(&registered, &bound)?.summary;
+    let after = evaluate(&model, &bound)?.summary;
     let distinct = model::RepeatGroups::of(&data.rows, options.heldout.repeat_tolerance).groups.len();
     model.heldout = heldout_estimate(&after, &identification, residual_gp.as_ref(), (distinct, data.rows.len()));
     if identification.redundancy() < options.min_redundancy {

@@ -25,7 +25,7 @@
 //! let data = simulate(&cell, &paper_effects(), &joint_ranges(&robot), &config, false)?;
 //! let (model, report) = pipeline::fit(&robot, &data, Method::Poe, &FitOptions::default())?;
 //! assert_eq!(model.method, Method::Poe);
-//! assert!(model::evaluate(&model, &data)?.summary.mean_position_error_mm < 1.0, "{report:?}");
+//! assert!(model::evaluate(&model, &model.bind(&data)?)?.summary.mean_position_error_mm < 1.0, "{report:?}");
 //! # Ok(())
 //! # }
 //! ```

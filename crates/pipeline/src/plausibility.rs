@@ -13,7 +13,7 @@
 
 use errors::{Error, ErrorKind};
 use lie::{Matrix3, Vector3};
-use measurements::MeasurementSet;
+use measurements::{BoundSet, MeasurementSet};
 use poe::JointKind;
 use robot::RobotDescription;
 use serde::{Deserialize, Serialize};
@@ -161,13 +161,14 @@ pub(crate) struct Findings {
     pub refusals: Vec<Error>,
 }
 
-/// Runs the checks on `data` for `robot`. An `Err` is a failure to compute (a kinematics error),
+/// Runs the checks on `bound`, the data bound to `robot`. An `Err` is a failure to compute (a kinematics error),
 /// not a refusal: those are in [`Findings::refusals`].
 pub(crate) fn check(
     robot: &RobotDescription,
-    data: &MeasurementSet,
+    bound: &BoundSet<'_>,
     options: &PlausibilityOptions,
 ) -> Result<Findings, Error> {
+    let data = bound.set();
     let mut refusals = Vec::new();
     if let Some(refusal) = joint_limits(robot, data, options) {
         refusals.push(refusal);
@@ -205,9 +206,9 @@ pub(crate) fn check(
             ));
         }
     }
-    let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
+    let tools = bound.tools();
     let tool_count = data.tools.len().max(1 + tools.iter().copied().max().unwrap_or(0));
-    let problem = Alignment { flanges: &flanges, tools: &tools, measured: &measured, tool_count, options };
+    let problem = Alignment { flanges: &flanges, tools, measured: &measured, tool_count, options };
     let rotation = problem.fit(start, 1.0);
     let reflection = problem.fit(start, -1.0);
     let measured_spread = spread(&measured);

@@ -38,7 +38,7 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 
 fn predicted(model: &CalibratedModel, q: &[f64], payload_kg: f64) -> SE3 {
     let row = measurements::Measurement { payload_kg, ..measurements::Measurement::at(q.to_vec(), Vector3::zeros()) };
-    model.predict(&[row], &[0]).unwrap()[0].pose
+    model.predict(&measurements::BoundSet::made_for_model("a pose", vec![row])).unwrap()[0].pose
 }
 
 const PROGRAM: &str = "q1_deg,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,payload_kg,speed,tool\n\

@@ -25,7 +25,7 @@ fn heldout(robot: &RobotDescription, train: &MeasurementSet, test: &MeasurementS
     let (model, report) =
         pipeline::fit(robot, train, Method::Poe, &FitOptions::default().with_effects(selection)).unwrap();
     assert!(report.identification.converged, "{effects}: {}", report.identification.termination);
-    model::evaluate(&model, test).unwrap().summary.mean_position_error_mm
+    model::evaluate(&model, &model.bind(test).unwrap()).unwrap().summary.mean_position_error_mm
 }
 
 /// The held-out error the tracker noise alone leaves on the same poses.
@@ -124,8 +124,8 @@ fn a_model_with_every_effect_reads_back_and_predicts_the_same() {
     for (a, b) in again.effects.iter().zip(&model.effects) {
         assert_eq!(a.theta(), b.theta());
     }
-    let before = model::evaluate(&model, &test).unwrap().errors;
-    let after = model::evaluate(&again, &test).unwrap().errors;
+    let before = model::evaluate(&model, &model.bind(&test).unwrap()).unwrap().errors;
+    let after = model::evaluate(&again, &again.bind(&test).unwrap()).unwrap().errors;
     for (a, b) in before.iter().zip(&after) {
         assert!((a.position_mm - b.position_mm).abs() < 1e-9, "{a:?} {b:?}");
     }
@@ -238,7 +238,9 @@ fn a_model_is_its_parts_applied_in_order_and_export_reports_each_one() {
     let not_in_urdf: Vec<String> = names.iter().filter(|n| !n.starts_with("geometry")).cloned().collect();
     assert_eq!(model.non_geometric_parts(), not_in_urdf);
     // Every part matters on held-out rows, and leaving one out costs what it explained.
-    let error = |m: &model::CalibratedModel| model::evaluate(m, &test).unwrap().summary.mean_position_error_mm;
+    let error = |m: &model::CalibratedModel| {
+        model::evaluate(m, &m.bind(&test).unwrap()).unwrap().summary.mean_position_error_mm
+    };
     let whole = error(&model);
     for (k, name) in names.iter().enumerate().take(3).skip(1) {
         let without = error(&model.without_part(k));
@@ -288,7 +290,10 @@ fn a_gear_series_warns_where_it_is_used_outside_the_angles_it_was_fitted_on() {
         // The gaps of the joint's turn (angles modulo 2π): around 0 and the rest of the circle
         // beyond ±0.6 rad.
         assert_eq!(warnings[0].gaps_rad.len(), 2, "{what}: {:?}", warnings[0].gaps_rad);
-        let report = model::EvalReport::new(&model, set, &model::evaluate(&model, set).unwrap());
+        let report = {
+            let bound = model.bind(set).unwrap();
+            model::EvalReport::new(&model, &bound, &model::evaluate(&model, &bound).unwrap())
+        };
         assert_eq!(report.warnings, warnings, "{what}: eval --json carries them");
     }
 }
@@ -328,7 +333,7 @@ fn a_gear_series_falls_back_to_the_geometry_in_a_gap_and_past_the_end_of_its_ang
     };
     let (poe, gear) = (fit(""), fit("gear_periodic:2:24"));
     let error = |model: &model::CalibratedModel, set: &MeasurementSet| {
-        model::evaluate(model, set).unwrap().summary.mean_position_error_mm
+        model::evaluate(model, &model.bind(set).unwrap()).unwrap().summary.mean_position_error_mm
     };
     for (set, what) in [(&gap, "in the gap"), (&beyond, "past the end")] {
         assert!(set.rows.len() >= 20, "{what}: {} rows", set.rows.len());
@@ -343,8 +348,7 @@ fn a_gear_series_falls_back_to_the_geometry_in_a_gap_and_past_the_end_of_its_ang
     // standard deviation of the size of the fitted error's RMS times the joint's lever; where it
     // was fitted, none.
     let position_sigma = |set: &MeasurementSet| -> Vec<f64> {
-        let tools = model::tool_indices(&gear, set).unwrap();
-        gear.predict(&set.rows, &tools)
+        gear.predict(&gear.bind(set).unwrap())
             .unwrap()
             .iter()
             .map(|p| p.std.map_or(f64::NAN, |s| (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt()))
@@ -367,7 +371,10 @@ fn a_gear_series_falls_back_to_the_geometry_in_a_gap_and_past_the_end_of_its_ang
         assert_eq!((joint_2[0].rows_outside, joint_2[0].unit), (beyond.rows.len(), "rad"));
         assert!(joint_2[0].to_string().contains("outside the range the model was fitted on"));
         assert!(model.outside_training_range(&inside.rows).is_empty());
-        let report = model::EvalReport::new(model, &beyond, &model::evaluate(model, &beyond).unwrap());
+        let report = {
+            let bound = model.bind(&beyond).unwrap();
+            model::EvalReport::new(model, &bound, &model::evaluate(model, &bound).unwrap())
+        };
         assert_eq!(report.out_of_range, warnings, "eval --json carries them");
     }
     let IdentifiedEffect::GearPeriodic(series) = &gear.effects[0] else { panic!("{:?}", gear.effects) };
@@ -391,7 +398,7 @@ fn the_diagnosis_predicts_the_error_in_a_gap_and_past_the_end_from_arcs_of_the_j
     let chosen = pipeline::effects_of(&diagnosis.selected);
     let selection = EffectSelection::List(chosen.clone());
     let model = pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default().with_effects(selection)).unwrap().0;
-    let fitted = model::evaluate(&model, &off).unwrap().summary.mean_position_error_mm;
+    let fitted = model::evaluate(&model, &model.bind(&off).unwrap()).unwrap().summary.mean_position_error_mm;
     let joint_2 = diagnosis.arcs.iter().find(|a| a.joint == 2).expect("joint 2 moves");
     eprintln!(
         "chosen {chosen:?}; random folds {:.4} -> {:.4} mm; joint 2's arcs {:.4} -> {:.4} mm; fitted, off the poses: {fitted:.4} mm ({} rows)",
@@ -447,7 +454,7 @@ fn a_drift_fitted_in_one_session_is_not_carried_into_another_days_later() {
             options.effects.fallback_sigma_ratio = f64::INFINITY;
         }
         let model = pipeline::fit(&robot, &first, Method::Poe, &options).unwrap().0;
-        model::evaluate(&model, &later).unwrap().summary.mean_position_error_mm
+        model::evaluate(&model, &model.bind(&later).unwrap()).unwrap().summary.mean_position_error_mm
     };
     let (alone, with, line) = (fit("", 1.0), fit("time_drift", 1.0), fit("time_drift", 1e9));
     eprintln!("eight days later: poe {alone:.4} mm, with the drift {with:.4} mm, the drift as a line {line:.4} mm");
@@ -485,7 +492,7 @@ fn rows_that_excite_what_no_training_row_did_have_a_large_sigma_and_fall_back_to
             pipeline::fit(&robot, &train, Method::Poe, &options).unwrap().0
         };
         let error = |model: &model::CalibratedModel, set: &MeasurementSet| {
-            model::evaluate(model, set).unwrap().summary.mean_position_error_mm
+            model::evaluate(model, &model.bind(set).unwrap()).unwrap().summary.mean_position_error_mm
         };
         let geometry = fit("", f64::INFINITY);
         // The simulated arm has only geometric errors: what the geometry leaves on its own
@@ -509,7 +516,7 @@ fn rows_that_excite_what_no_training_row_did_have_a_large_sigma_and_fall_back_to
             let uncertainty = model.effect_uncertainty.as_ref().unwrap();
             assert!(uncertainty.training_sigma_m[1] < uncertainty.fallback_sigma_m);
             assert_eq!(error(&model, &train), error(&never, &train), "seed {seed}, {effects}");
-            let fallen = model.sigma_fallback(&off.rows, &model::tool_indices(&model, &off).unwrap()).unwrap();
+            let fallen = model.sigma_fallback(&model.bind(&off).unwrap()).unwrap();
             let fallen = fallen.expect("rows off the band fall back");
             assert!(fallen.rows > off.rows.len() / 4, "seed {seed}, {effects}: {fallen:?}");
         }
@@ -534,9 +541,10 @@ fn the_sigmas_columns_are_the_derivatives_of_the_prediction() {
     let uncertainty = model.effect_uncertainty.clone().expect("a fit with effects keeps its uncertainty");
     // The plain sum of the parts: no fallback, so the prediction is the geometry and the effects.
     let plain = model::CalibratedModel { effect_uncertainty: None, fallback_kinematics: None, ..model.clone() };
-    let rows = &test.rows[..3];
-    let tools = vec![0; rows.len()];
-    let poses = |m: &model::CalibratedModel| m.geometric_poses(rows, &tools).unwrap();
+    let first = test.rows[..3].iter().map(|r| measurements::Measurement { tool: 0, ..r.clone() }).collect();
+    let bound = measurements::BoundSet::made_for_model("the first rows", first);
+    let rows = bound.rows();
+    let poses = |m: &model::CalibratedModel| m.geometric_poses(&bound).unwrap();
     let base = poses(&plain);
     let layout = plain.kinematics.layout().len();
     let h = 1e-7;

@@ -64,7 +64,7 @@ fn poe_fit_through_csv_and_model_file_reproduces_held_out_poses() {
         let path = dir.path().join("model.ron");
         model::write_model(&path, &model).unwrap();
         let model = model::read_model(&path).unwrap();
-        let evaluation = model::evaluate(&model, &test).unwrap();
+        let evaluation = model::evaluate(&model, &model.bind(&test).unwrap()).unwrap();
         assert!(evaluation.summary.mean_position_error_mm < 1e-6, "{:?}", evaluation.summary);
         assert_eq!(evaluation.summary.mean_rotation_error_mrad.is_some(), full_pose);
     }
@@ -79,18 +79,18 @@ fn base_tool_fit_cannot_absorb_joint_errors_but_poe_can() {
     let (base_tool, report) = pipeline::fit(&robot, &train, Method::BaseTool, &FitOptions::default()).unwrap();
     assert_eq!(report.identification.rank, 12);
     let (poe, _) = pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default()).unwrap();
-    let bt = model::evaluate(&base_tool, &test).unwrap().summary.mean_position_error_mm;
-    let full = model::evaluate(&poe, &test).unwrap().summary.mean_position_error_mm;
+    let bt = model::evaluate(&base_tool, &base_tool.bind(&test).unwrap()).unwrap().summary.mean_position_error_mm;
+    let full = model::evaluate(&poe, &poe.bind(&test).unwrap()).unwrap().summary.mean_position_error_mm;
     assert!(bt > 0.1 && full < 1e-6, "base-tool {bt} mm, poe {full} mm");
 }
 
 #[test]
-fn evaluation_refuses_a_tool_the_model_does_not_know() {
+fn binding_refuses_a_tool_the_model_does_not_know() {
     let robot = testkit::robot("irb4400.ron");
     let train = through_csv(&synthetic(&robot, 60, &["A"], true, 7));
     let (model, _) = pipeline::fit(&robot, &train, Method::BaseTool, &FitOptions::default()).unwrap();
     let other = through_csv(&synthetic(&robot, 10, &["Z"], true, 8));
-    let error = model::evaluate(&model, &other).unwrap_err();
+    let error = model.bind(&other).unwrap_err();
     assert!(
         matches!(error.kind(), ErrorKind::UnknownTool { .. }) && matches!(error.position(), Some((2, _))),
         "{error}"
@@ -138,7 +138,7 @@ fn a_blank_tool_is_the_default_tool_in_the_fit_its_report_and_the_evaluation() {
     // The fit's own "after" report once sent the blank rows to tool "A": hundreds of mm.
     assert!(report.after.max_position_error_mm < 1e-6, "{:?}", report.after);
     let test = all.subset(&(100..160).collect::<Vec<_>>());
-    let evaluation = model::evaluate(&model, &test).unwrap();
+    let evaluation = model::evaluate(&model, &model.bind(&test).unwrap()).unwrap();
     assert!(evaluation.summary.max_position_error_mm < 1e-6, "{:?}", evaluation.summary);
 
     // A file without a tool column is the default tool too: the blank rows alone, written
@@ -149,7 +149,7 @@ fn a_blank_tool_is_the_default_tool_in_the_fit_its_report_and_the_evaluation() {
     blank.rows.iter_mut().for_each(|r| r.tool = 0);
     let blank = through_csv(&blank);
     assert_eq!(blank.tool_column, None);
-    let evaluation = model::evaluate(&model, &blank).unwrap();
+    let evaluation = model::evaluate(&model, &model.bind(&blank).unwrap()).unwrap();
     assert!(evaluation.summary.max_position_error_mm < 1e-6, "{:?}", evaluation.summary);
 }
 
@@ -159,7 +159,7 @@ fn the_default_tool_is_refused_by_a_model_fitted_only_with_named_tools() {
     let train = through_csv(&synthetic(&robot, 60, &["A", "B"], true, 11));
     let (model, _) = pipeline::fit(&robot, &train, Method::BaseTool, &FitOptions::default()).unwrap();
     let unnamed = through_csv(&synthetic(&robot, 10, &[""], true, 12));
-    let error = model::evaluate(&model, &unnamed).unwrap_err();
+    let error = model.bind(&unnamed).unwrap_err();
     assert!(
         matches!(error.kind(), ErrorKind::UnknownTool { tool, .. } if tool.is_empty())
             && matches!(error.position(), Some((2, _))),

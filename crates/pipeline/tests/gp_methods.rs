@@ -29,7 +29,7 @@ fn with_a_load_effect_poe_gp_load_beats_poe_gp_which_beats_poe() {
         let test = all.subset(&(250..400).collect::<Vec<_>>());
         let error = |method| {
             let (model, _) = pipeline::fit(&robot, &train, method, &FitOptions::default()).unwrap();
-            model::evaluate(&model, &test).unwrap().summary.mean_position_error_mm
+            model::evaluate(&model, &model.bind(&test).unwrap()).unwrap().summary.mean_position_error_mm
         };
         let (poe, gp, load) = (error(Method::Poe), error(Method::PoeGp), error(Method::PoeGpLoad));
         eprintln!("seed {seed} full pose {full_pose}: poe {poe:.4} poe-gp {gp:.4} poe-gp-load {load:.4} mm");
@@ -49,7 +49,7 @@ fn identified_joint_compliance_leaves_little_more_than_the_noise() {
             let effects = if joint_compliance { "joint_compliance".parse().unwrap() } else { Default::default() };
             let options = FitOptions::default().with_effects(effects);
             let (model, _) = pipeline::fit(&robot, &train, method, &options).unwrap();
-            model::evaluate(&model, &test).unwrap().summary.mean_position_error_mm
+            model::evaluate(&model, &model.bind(&test).unwrap()).unwrap().summary.mean_position_error_mm
         };
         let load = error(Method::PoeGpLoad, false);
         let compliance = error(Method::Poe, true);
@@ -100,7 +100,7 @@ fn fit_report_gives_the_gp_leave_one_out_error_near_the_held_out_error() {
         let mut options = FitOptions::default();
         options.residual_gp.rotation_follows_position = true;
         let (model, report) = pipeline::fit(&robot, &train, Method::PoeGpLoad, &options).unwrap();
-        let held_out = model::evaluate(&model, &test).unwrap().summary.mean_position_error_mm;
+        let held_out = model::evaluate(&model, &model.bind(&test).unwrap()).unwrap().summary.mean_position_error_mm;
         let residual_gp = report.residual_gp.as_ref().expect("a GP method reports its GP");
         let loo = residual_gp.leave_one_out.as_ref().expect("the exact GP has a leave-one-out error");
         let training = report.after.mean_position_error_mm;
@@ -155,7 +155,7 @@ fn repeated_configurations_are_left_out_together_in_the_stored_heldout_estimate(
             train.rows.push(twin);
         }
         let (model, report) = pipeline::fit(&robot, &train, Method::PoeGpLoad, &FitOptions::default()).unwrap();
-        let held_out = model::evaluate(&model, &test).unwrap().summary.mean_position_error_mm;
+        let held_out = model::evaluate(&model, &model.bind(&test).unwrap()).unwrap().summary.mean_position_error_mm;
         let gp = report.residual_gp.as_ref().expect("a GP method reports its GP");
         let per_row = gp.leave_one_out.as_ref().expect("exact GP").mean_position_error_mm;
         let grouped = gp.leave_group_out.as_ref().expect("repeats give a grouped error").mean_position_error_mm;

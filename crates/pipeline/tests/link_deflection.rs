@@ -46,7 +46,7 @@ fn fitted(robot: &RobotDescription, train: &MeasurementSet, selection: EffectSel
 }
 
 fn heldout(model: &model::CalibratedModel, test: &MeasurementSet) -> f64 {
-    model::evaluate(model, test).unwrap().summary.mean_position_error_mm
+    model::evaluate(model, &model.bind(test).unwrap()).unwrap().summary.mean_position_error_mm
 }
 
 /// What the tracker's noise alone leaves held out on the same poses.
@@ -76,9 +76,9 @@ fn a_column_deflection_is_identified_down_to_the_noise_and_its_model_file_reads_
     model::write_model(&path, &model).unwrap();
     assert!(std::fs::read_to_string(&path).unwrap().contains("link_deflection("));
     let again = model::read_model(&path).unwrap();
-    let tools: Vec<usize> = test.rows.iter().map(|r| r.tool).collect();
-    let before = model.predict(&test.rows, &tools).unwrap();
-    let after = again.predict(&test.rows, &tools).unwrap();
+    let bound = model.bind(&test).unwrap();
+    let before = model.predict(&bound).unwrap();
+    let after = again.predict(&bound).unwrap();
     for (a, b) in before.iter().zip(&after) {
         let moved = (a.pose.translation() - b.pose.translation()).norm();
         assert!(moved < 1e-10, "{moved} m apart after reading back");

@@ -181,8 +181,8 @@ fn a_version_1_file_with_joint_compliance_reads_and_predicts_as_before() {
         true,
     )
     .unwrap();
-    let now = model::evaluate(&model, &data).unwrap().errors;
-    let then = model::evaluate(&read, &data).unwrap().errors;
+    let now = model::evaluate(&model, &model.bind(&data).unwrap()).unwrap().errors;
+    let then = model::evaluate(&read, &read.bind(&data).unwrap()).unwrap().errors;
     for (a, b) in now.iter().zip(&then) {
         assert!((a.position_mm - b.position_mm).abs() < 1e-9, "{a:?} {b:?}");
     }

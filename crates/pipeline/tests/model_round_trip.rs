@@ -59,7 +59,6 @@ fn every_model_fit_writes_reads_back_and_predicts_the_same() {
     let dir = tempfile::tempdir().unwrap();
     let methods = [Method::BaseTool, Method::Poe, Method::PoeGp, Method::PoeGpLoad];
     for shape in shapes() {
-        let tools: Vec<usize> = shape.data.rows.iter().map(|r| r.tool).collect();
         for method in methods {
             for effects in ["", "auto", shape.effects] {
                 let case = format!("{} / {method} / effects '{effects}'", shape.name);
@@ -71,8 +70,9 @@ fn every_model_fit_writes_reads_back_and_predicts_the_same() {
                 let path = dir.path().join("m.ron");
                 model::write_model(&path, &model).unwrap();
                 let again = model::read_model(&path).unwrap_or_else(|e| panic!("{case}: eval would refuse: {e}"));
-                let before = model.predict(&shape.data.rows, &tools).unwrap();
-                let after = again.predict(&shape.data.rows, &tools).unwrap();
+                let bound = model.bind(&shape.data).unwrap();
+                let before = model.predict(&bound).unwrap();
+                let after = again.predict(&bound).unwrap();
                 for (a, b) in before.iter().zip(&after) {
                     let moved = (a.pose.translation() - b.pose.translation()).norm();
                     assert!(moved < 1e-10, "{case}: {moved} m apart after reading back");

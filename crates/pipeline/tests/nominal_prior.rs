@@ -74,8 +74,9 @@ fn heldout_with(
 ) -> (f64, EvalReport) {
     let selection: EffectSelection = if effects.is_empty() { EffectSelection::None } else { effects.parse().unwrap() };
     let (model, _) = pipeline::fit(robot, train, method, &options.with_effects(selection)).unwrap();
-    let evaluation = model::evaluate(&model, test).unwrap();
-    let report = EvalReport::new(&model, test, &evaluation);
+    let bound = model.bind(test).unwrap();
+    let evaluation = model::evaluate(&model, &bound).unwrap();
+    let report = EvalReport::new(&model, &bound, &evaluation);
     (evaluation.summary.rms_position_error_mm, report)
 }
 
@@ -152,8 +153,9 @@ fn eval_splits_the_error_at_the_fitted_range_and_names_a_glitch_inside_it() {
     test.rows[10].position.x += 1e-2;
     let flipped = wrist(5, 20, true);
     test.rows.extend(flipped.rows.iter().map(|r| measurements::Measurement { line: r.line + 1000, ..r.clone() }));
-    let evaluation = model::evaluate(&model, &test).unwrap();
-    let report = EvalReport::new(&model, &test, &evaluation);
+    let bound = model.bind(&test).unwrap();
+    let evaluation = model::evaluate(&model, &bound).unwrap();
+    let report = EvalReport::new(&model, &bound, &evaluation);
     let split = report.range_split.expect("rows outside the fitted range: a split");
     assert_eq!((split.inside.n, split.outside.n), (inside, 20));
     let suspects = report.suspect_rows.expect("the glitch is named");

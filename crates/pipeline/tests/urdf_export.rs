@@ -160,7 +160,8 @@ fn what_a_urdf_cannot_hold_is_measured_on_the_training_data_or_refused() {
     assert_eq!(export.report.not_in_urdf, ["gaussian_process"]);
     assert!(!export.report.tool_orientation_calibrated);
     let errors = export.report.training_error.unwrap();
-    let geometric = model::evaluate(&model.geometry_only(), &training).unwrap().summary;
+    let geometric =
+        model::evaluate(&model.geometry_only(), &model.geometry_only().bind(&training).unwrap()).unwrap().summary;
     assert_eq!(errors.urdf, geometric);
     assert_eq!(errors.model.n, 150);
 }

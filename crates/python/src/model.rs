@@ -6,7 +6,7 @@ use crate::robot::Robot;
 use crate::types::{Measurements, Model, matrix};
 use cell::CompensateOptions;
 use effects::EffectSelection;
-use measurements::Measurement;
+use measurements::{BoundSet, Measurement};
 use model::{CalibratedModel, EvalReport, GpChoice, Method, PredictedPose};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pipeline::FitOptions;
@@ -148,8 +148,9 @@ impl Model {
         let (model, set) = (&self.model, &data.set);
         let (evaluation, report) = py
             .detach(|| {
-                let evaluation = model::evaluate(model, set)?;
-                let report = EvalReport::new(model, set, &evaluation);
+                let bound = model.bind(set)?;
+                let evaluation = model::evaluate(model, &bound)?;
+                let report = EvalReport::new(model, &bound, &evaluation);
                 Ok::<_, errors::Error>((evaluation, report))
             })
             .map_err(to_py)?;
@@ -173,8 +174,8 @@ impl Model {
     /// `calib predict` on a measurement set (tools matched by name, as the CLI matches them).
     fn predict_set<'py>(&self, py: Python<'py>, data: &Measurements) -> PyResult<Predicted<'py>> {
         let (model, set) = (&self.model, &data.set);
-        let tools = model::tool_indices(model, set).map_err(to_py)?;
-        self.predict_rows(py, &set.rows, &tools, &set.source)
+        let bound = model.bind(set).map_err(to_py)?;
+        self.predict_rows(py, &bound)
     }
 
     /// `calib predict` on arrays: `q` `(n, joints)` rad (m), and per row `payload_kg`, the tool
@@ -222,7 +223,6 @@ impl Model {
         let source = "predict";
         let line = |i: usize| i as u64 + 2;
         let mut rows = Vec::with_capacity(n);
-        let mut indices = Vec::with_capacity(n);
         for i in 0..n {
             let row_q: Vec<f64> = q.row(i).to_vec();
             let payload = payload.as_ref().map_or(0.0, |p| p[i]);
@@ -235,20 +235,21 @@ impl Model {
                 return Err(argument("payload_kg", format!("row {i} has {payload} kg: a payload is not negative")));
             }
             let tool_name = tools.as_ref().map_or("", |t| t[i].as_str());
-            indices.push(self.model.tool_index(tool_name, source, line(i), 0).map_err(to_py)?);
+            let tool = self.model.tool_index(tool_name, source, line(i), 0).map_err(to_py)?;
             rows.push(Measurement {
                 line: line(i),
                 q: row_q,
                 position: lie::Vector3::zeros(),
                 orientation: None,
                 payload_kg: payload,
-                tool: 0,
+                tool,
                 temp_c: temp.as_ref().map(|t| t[i]),
                 t_s: time.as_ref().map(|t| t[i]),
                 torques_nm: torques.as_ref().map(|t| t.row(i).to_vec()),
             });
         }
-        self.predict_rows(py, &rows, &indices, source)
+        // Made here, each row's tool the model's index found above.
+        self.predict_rows(py, &BoundSet::made_for_model(source, rows))
     }
 
     /// `calib compensate`: targets rewritten so that the model reaches what they mean. Returns the
@@ -324,17 +325,11 @@ impl Model {
     /// The prediction of `rows` as `calib predict` makes it: poses `[x_mm, y_mm, z_mm]` and, for a
     /// full-pose model, `qw, qx, qy, qz`; standard deviations in mm (and mrad); the refusal of a
     /// non-finite pose; the warnings.
-    fn predict_rows<'py>(
-        &self,
-        py: Python<'py>,
-        rows: &[Measurement],
-        tools: &[usize],
-        source: &str,
-    ) -> PyResult<Predicted<'py>> {
-        let model = &self.model;
+    fn predict_rows<'py>(&self, py: Python<'py>, data: &BoundSet<'_>) -> PyResult<Predicted<'py>> {
+        let (model, rows, source) = (&self.model, data.rows(), data.set().source.as_str());
         let (predictions, warnings) = py
             .detach(|| {
-                let predictions = model.predict(rows, tools)?;
+                let predictions = model.predict(data)?;
                 let mut warnings: Vec<String> = model.extrapolation(rows).iter().map(ToString::to_string).collect();
                 warnings.extend(model.outside_training_range(rows).iter().map(ToString::to_string));
                 warnings.extend(model.beyond_joint_limits(rows).iter().map(ToString::to_string));

@@ -30,12 +30,12 @@ pub fn diagnose(
     }
     let options = DiagnoseOptions { folds, seed, noise_mm, ..DiagnoseOptions::default() };
     let (description, set) = (&robot.description, &data.set);
-    // As the CLI, which reads the data against the robot's joints.
-    set.check_joints(&description.joint_kinds()).map_err(to_py)?;
+    // As the CLI, which reads the data against the robot's joints: bound once, here.
+    let bound = measurements::BoundSet::to_robot(set, &description.joint_kinds()).map_err(to_py)?;
     let robot_path = PathBuf::from(&robot.path);
     let data_path = PathBuf::from(&set.source);
     py.detach(|| {
-        let diagnosis = ::diagnose::diagnose(description, set, &options)?;
+        let diagnosis = ::diagnose::diagnose_bound(description, &bound, &options)?;
         let inputs = measurements::InputFiles::new().with("robot", &robot_path).with("data", &data_path);
         // The folder `calib diagnose --report` writes, through the report crate's one writer.
         let written = report

@@ -10,7 +10,7 @@ use crate::{Iso9283, RepeatOptions};
 use cell::CompensateOptions;
 use diagnose::Diagnosis;
 use effects::{GearPeriodic, IdentifiedEffect};
-use measurements::MeasurementSet;
+use measurements::{BoundSet, MeasurementSet};
 use model::{CalibratedModel, ErrorSummary, EvalReport, Evaluation, GpModel, PoseError};
 use robot::{JointType, RobotDescription};
 use serde::Serialize;
@@ -71,12 +71,11 @@ impl Report {
         options: &ReportOptions,
     ) -> Result<Self, errors::Error> {
         let ReportInputs { model, data, .. } = *inputs;
-        let evaluation = model::evaluate(model, data)?;
-        let eval = EvalReport::new(model, data, &evaluation);
-        let tools = model::tool_indices(model, data)?;
-        let predicted: Vec<[f64; 3]> =
-            model.predict(&data.rows, &tools)?.iter().map(|p| p.pose.translation().into()).collect();
-        let before = before_calibration(inputs, options)?;
+        let bound = model.bind(data)?;
+        let evaluation = model::evaluate(model, &bound)?;
+        let eval = EvalReport::new(model, &bound, &evaluation);
+        let predicted: Vec<[f64; 3]> = model.predict(&bound)?.iter().map(|p| p.pose.translation().into()).collect();
+        let before = before_calibration(inputs, &bound, options)?;
         let rows = data
             .rows
             .iter()
@@ -130,6 +129,7 @@ impl Report {
 /// determined, so that placement can overstate the error before calibration.
 fn before_calibration(
     inputs: &ReportInputs<'_>,
+    bound: &BoundSet<'_>,
     options: &ReportOptions,
 ) -> Result<Option<(String, Evaluation)>, errors::Error> {
     let model = inputs.model;
@@ -140,7 +140,8 @@ fn before_calibration(
              as `calib fit` reports its \"before\"",
             inputs.robot.name
         );
-        return Ok(Some((how, model::evaluate(&placed, inputs.data)?)));
+        // Its tools are the training data's: the test data bound to it on their own.
+        return Ok(Some((how, model::evaluate(&placed, &placed.bind(inputs.data)?)?)));
     }
     let placed = match cell::registered_nominal(model, inputs.robot, inputs.robot_file, &options.nominal) {
         Ok(placed) => placed,
@@ -163,7 +164,8 @@ fn before_calibration(
         options.nominal.registration_configurations,
         placed.rms_m * 1e3
     );
-    Ok(Some((how, model::evaluate(&nominal, inputs.data)?)))
+    // The calibrated model's tools, so the data bound to it serve.
+    Ok(Some((how, model::evaluate(&nominal, bound)?)))
 }
 
 fn tool_name(data: &MeasurementSet, tool: usize) -> String {

@@ -53,8 +53,9 @@ fn rendered() -> &'static Rendered {
         };
         let built = report::Report::build(&inputs, Some(diagnosis), &report::ReportOptions::default()).unwrap();
         let html = report::render_html(&built).unwrap();
-        let evaluation = model::evaluate(&model, &test).unwrap();
-        let eval = EvalReport::new(&model, &test, &evaluation);
+        let bound = model.bind(&test).unwrap();
+        let evaluation = model::evaluate(&model, &bound).unwrap();
+        let eval = EvalReport::new(&model, &bound, &evaluation);
         let errors = test.rows.iter().zip(&evaluation.errors).map(|(r, e)| (r.line, e.position_mm)).collect();
         Rendered { html, eval, errors, diagnosis_plot_names }
     })
