@@ -39,6 +39,7 @@ mod gear;
 mod link_deflection;
 mod load_frame;
 mod report;
+mod screw;
 mod spec;
 mod term;
 mod thermal;
@@ -53,7 +54,8 @@ pub use load_frame::LoadFrame;
 pub use loadsim::EffectKind;
 pub use report::{EffectReport, ParameterReport};
 pub use report::{effect_reports, reported_label, reported_parameters};
-pub use spec::{Argument, EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS};
+pub use screw::ScrewPeriodic;
+pub use spec::{Argument, EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS, PITCH_BOUNDS_MM};
 pub use term::{CandidateContext, CandidateModel, CandidateOptions};
 pub use thermal::Thermal;
 
@@ -428,6 +430,6 @@ mod tests {
         assert!(text.starts_with("thermal("), "{text}");
         assert_eq!(thermal.effect_kind(), EffectKind::Thermal);
         assert_eq!(thermal.kind(), "thermal");
-        assert!(EffectKind::IDENTIFIED.iter().all(|&k| IdentifiedEffect::arguments(k).len() <= 2));
+        assert!(EffectKind::IDENTIFIED.iter().all(|&k| IdentifiedEffect::arguments(k).len() <= 3));
     }
 }

@@ -279,8 +279,10 @@ pub fn fit(
         .map_err(Error::kinematics)?;
         EffectCorrection::distribute(&mut effects, &fitted.correction);
         for effect in &mut effects {
-            if let IdentifiedEffect::GearPeriodic(gear) = effect {
-                gear.record_rms(&data.rows);
+            match effect {
+                IdentifiedEffect::GearPeriodic(gear) => gear.record_rms(&data.rows),
+                IdentifiedEffect::ScrewPeriodic(screw) => screw.record_rms(&data.rows),
+                _ => {}
             }
         }
         effect_report = effect_reports(&effects, &fitted.report.held_at_prior, &robot.joint_kinds());
