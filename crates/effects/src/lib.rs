@@ -30,6 +30,7 @@
 pub const HOLD_BEYOND_SPAN: f64 = 1.0;
 
 mod backlash;
+mod beyond_span;
 mod check;
 mod compliance;
 mod correction;
@@ -45,6 +46,7 @@ mod term;
 mod thermal;
 
 pub use backlash::{Backlash, TorqueSign};
+pub use beyond_span::BeyondSpan;
 pub use compliance::{ComplianceTerm, ComplianceTorque, JointCompliance, TorqueFit};
 pub use direction::Direction;
 pub use drift::TimeDrift;
@@ -295,6 +297,17 @@ impl IdentifiedEffect {
         self.term().has_sigma()
     }
 
+    /// What the effect is beyond the span of the input it was fitted on (`t_s`, `temp_c`); `None`
+    /// for an effect of no such input.
+    pub fn beyond_span(&self) -> Option<BeyondSpan> {
+        self.term().beyond_span()
+    }
+
+    /// Sets [`IdentifiedEffect::beyond_span`] (nothing for an effect of no such input).
+    pub fn set_beyond_span(&mut self, rule: BeyondSpan) {
+        self.term_mut().set_beyond_span(rule);
+    }
+
     /// The 1-based joints the effect acts on (empty for thermal growth and drift).
     pub fn joints(&self) -> Vec<usize> {
         self.term().joints()
@@ -425,6 +438,7 @@ mod tests {
             scale: vec![1.0],
             theta: vec![0.0],
             fitted_span: None,
+            beyond_span: BeyondSpan::Hold,
         });
         let text = ron::to_string(&thermal).unwrap();
         assert!(text.starts_with("thermal("), "{text}");

@@ -56,6 +56,11 @@ pub struct FitReport {
     /// What `--effects auto` chose and why.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub auto: Option<AutoChoice>,
+    /// What each drift or thermal growth is beyond the span of `t_s` / `temp_c` it was fitted on,
+    /// held or zero, and why: chosen by leaving one session out at a time where the training rows
+    /// hold several, the kind's own rule with one (issue 30). Empty without such an effect.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub beyond_span: Vec<crate::SpanChoice>,
     /// What the plausibility checks measured (absent below 4 rows).
     pub plausibility: Option<crate::PlausibilityReport>,
     /// The rows the identification named as gross outliers (`identification.robust` has the
@@ -244,6 +249,7 @@ pub fn fit(
     let mut identification = geometry.report;
     let mut auto = None;
     let mut effect_report = Vec::new();
+    let mut beyond_span = Vec::new();
     let specs: Vec<EffectSpec> = match &options.effects.selection {
         EffectSelection::None => Vec::new(),
         EffectSelection::List(list) => list.clone(),
@@ -295,6 +301,7 @@ pub fn fit(
             data,
             &options.effects,
         )?;
+        beyond_span = crate::sessions::choose(robot, data, &specs, &mut effects, options)?;
         model.effects = effects;
         identification = fitted.report;
     }
@@ -371,6 +378,7 @@ pub fn fit(
         residual_gp,
         nominal_prior,
         auto,
+        beyond_span,
         plausibility: findings.report,
         outliers,
         warnings,
