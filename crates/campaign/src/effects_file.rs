@@ -302,7 +302,8 @@ mod tests {
     fn a_screw_error_is_taken_on_a_linear_axis_and_a_pitch_out_of_bounds_is_refused_at_its_entry() {
         let robot = testkit::robot("column_ur10.ron");
         let check = |text: &str| parse_effects(text, "e.ron").and_then(|e| check_effects(&e, &robot, text, "e.ron"));
-        let good = "(screw: (harmonics: [(joint_index: 0, pitch_m: 0.01, order: 1.0, amplitude_m: 2e-5, phase_rad: 0.0)]))";
+        let good =
+            "(screw: (harmonics: [(joint_index: 0, pitch_m: 0.01, order: 1.0, amplitude_m: 2e-5, phase_rad: 0.0)]))";
         check(good).unwrap();
         for (text, words) in [
             (

@@ -65,8 +65,7 @@ impl ScrewPeriodic {
     /// Records the series' RMS over the training rows, after the fit (see
     /// [`GearPeriodic::record_rms`]).
     pub fn record_rms(&mut self, rows: &[Measurement]) {
-        let phases: Vec<f64> =
-            rows.iter().filter_map(|r| r.q.get(self.series.joint)).map(|&q| self.phase(q)).collect();
+        let phases: Vec<f64> = rows.iter().filter_map(|r| r.q.get(self.series.joint)).map(|&q| self.phase(q)).collect();
         self.series.record_rms_at(&phases);
     }
 

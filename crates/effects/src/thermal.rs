@@ -2,10 +2,10 @@
 //! (`loadsim::ThermalGrowth`, one coefficient for the whole arm, `loadsim::thermal_regressor`).
 
 use super::{Regressor, check_column_varies, rms_scales};
-use crate::{BeyondSpan, Direction};
 use crate::check::{Cursor, EffectFault};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect};
+use crate::{BeyondSpan, Direction};
 use errors::{Error, ErrorKind};
 use measurements::Measurement;
 use serde::{Deserialize, Serialize};

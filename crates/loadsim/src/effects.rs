@@ -4,8 +4,8 @@
 
 use crate::{
     Backlash, BaseDrift, Error, JointBacklash, JointCompliance, JointCoupling, LinkDeflection, PeriodicError,
-    PoseContext, ScrewError, SimulatedCell, ThermalGrowth, TrackerNoise, compliance::compliance_deflection, gravity::static_torque,
-    periodic::Harmonic,
+    PoseContext, ScrewError, SimulatedCell, ThermalGrowth, TrackerNoise, compliance::compliance_deflection,
+    gravity::static_torque, periodic::Harmonic,
 };
 use lie::SE3;
 use rand::Rng;
@@ -60,7 +60,11 @@ impl JointOffsets {
     pub fn total(&self) -> Vec<f64> {
         (0..self.compliance_rad.len())
             .map(|j| {
-                self.compliance_rad[j] + self.backlash_rad[j] + self.periodic_rad[j] + self.coupling_rad[j] + self.screw_m[j]
+                self.compliance_rad[j]
+                    + self.backlash_rad[j]
+                    + self.periodic_rad[j]
+                    + self.coupling_rad[j]
+                    + self.screw_m[j]
             })
             .collect()
     }

@@ -74,7 +74,13 @@ mod tests {
     #[test]
     fn the_error_repeats_with_every_pitch_of_travel_and_is_refused_on_a_revolute_joint() {
         let screw = ScrewError {
-            harmonics: vec![ScrewHarmonic { joint_index: 0, pitch_m: 0.01, order: 1.0, amplitude_m: 5e-6, phase_rad: 0.3 }],
+            harmonics: vec![ScrewHarmonic {
+                joint_index: 0,
+                pitch_m: 0.01,
+                order: 1.0,
+                amplitude_m: 5e-6,
+                phase_rad: 0.3,
+            }],
         };
         assert!(screw.validate(&[true, false]).is_ok());
         let a = screw.deflection(&[0.1234, 0.5])[0];

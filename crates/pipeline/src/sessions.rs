@@ -178,7 +178,9 @@ pub(crate) fn choose(
                 model.effects[k].set_beyond_span(rule);
                 let evaluation = match model::evaluate(&model, &test) {
                     Ok(evaluation) => evaluation,
-                    Err(e) => return Ok(keep(effects, format!("a left-out session was not predicted ({e}): its own rule"))),
+                    Err(e) => {
+                        return Ok(keep(effects, format!("a left-out session was not predicted ({e}): its own rule")));
+                    }
                 };
                 errors.extend(evaluation.errors.iter().map(|e| e.position_mm));
             }
@@ -209,7 +211,10 @@ pub(crate) fn choose(
             if switch {
                 format!("{} lower by more than one standard error, {standard_error:.4} mm", chosen.name())
             } else {
-                format!("{} kept, the other not lower by more than one standard error, {standard_error:.4} mm", rule.name())
+                format!(
+                    "{} kept, the other not lower by more than one standard error, {standard_error:.4} mm",
+                    rule.name()
+                )
             }
         );
         effects[k].set_beyond_span(chosen);
@@ -229,7 +234,10 @@ mod tests {
     use super::*;
 
     fn at(times: &[f64]) -> Vec<Measurement> {
-        times.iter().map(|&t| Measurement { t_s: Some(t), ..Measurement::at(vec![0.0], lie::Vector3::zeros()) }).collect()
+        times
+            .iter()
+            .map(|&t| Measurement { t_s: Some(t), ..Measurement::at(vec![0.0], lie::Vector3::zeros()) })
+            .collect()
     }
 
     #[test]
@@ -255,7 +263,10 @@ mod tests {
     fn the_gap_ratio_is_validated() {
         assert!(SessionOptions::default().validate().is_ok());
         for ratio in [1.0, 0.5, f64::NAN, f64::INFINITY] {
-            assert_eq!(SessionOptions { gap_ratio: ratio, ..SessionOptions::default() }.validate().unwrap_err().0, "gap_ratio");
+            assert_eq!(
+                SessionOptions { gap_ratio: ratio, ..SessionOptions::default() }.validate().unwrap_err().0,
+                "gap_ratio"
+            );
         }
     }
 }

@@ -49,9 +49,8 @@ fn a_vertical_column_whose_force_never_changes_sign_is_offered_no_backlash() {
         .map(|c| format!("{} {:?}", c.effect.name(), c.joints))
         .collect();
     eprintln!("candidates on the column: {on_column:?}\n{}", diagnosis.summary());
-    let backlash_on = |joint: usize| {
-        diagnosis.candidates.iter().any(|c| c.effect == Effect::Backlash && c.joints.contains(&joint))
-    };
+    let backlash_on =
+        |joint: usize| diagnosis.candidates.iter().any(|c| c.effect == Effect::Backlash && c.joints.contains(&joint));
     assert!(!backlash_on(1), "a backlash of the column is offered: {on_column:?}");
     assert!(backlash_on(3), "the shoulder's backlash is not offered:\n{}", diagnosis.summary());
     assert!(

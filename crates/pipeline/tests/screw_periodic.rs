@@ -35,7 +35,11 @@ fn split(robot: &RobotDescription, effects: &Effects, seed: u64) -> (Measurement
     (all.subset(&(0..300).collect::<Vec<_>>()), all.subset(&(300..500).collect::<Vec<_>>()))
 }
 
-fn fit(robot: &RobotDescription, train: &MeasurementSet, selection: &str) -> (model::CalibratedModel, pipeline::FitReport) {
+fn fit(
+    robot: &RobotDescription,
+    train: &MeasurementSet,
+    selection: &str,
+) -> (model::CalibratedModel, pipeline::FitReport) {
     let selection = if selection.is_empty() { EffectSelection::None } else { selection.parse().unwrap() };
     let options = FitOptions::default().with_effects(selection);
     pipeline::fit(robot, train, Method::Poe, &options).unwrap_or_else(|e| panic!("{e}"))
@@ -63,10 +67,11 @@ fn a_screw_error_is_identified_down_to_the_noise_and_its_model_file_reads_back()
         let reported = report.effects.iter().find(|e| e.effect == "screw_periodic").unwrap();
         assert_eq!(reported.label, "screw_periodic:1:10:4");
         assert!(reported.parameters.iter().all(|p| p.unit == "mm"), "{:?}", reported.parameters);
-        let Some(IdentifiedEffect::ScrewPeriodic(fitted)) = model.effects.first() else { panic!("{:?}", model.effects) };
-        let amplitude = (0..100)
-            .map(|k| fitted.position_error(1.0 + 0.01 * f64::from(k) / 100.0).abs())
-            .fold(0.0, f64::max);
+        let Some(IdentifiedEffect::ScrewPeriodic(fitted)) = model.effects.first() else {
+            panic!("{:?}", model.effects)
+        };
+        let amplitude =
+            (0..100).map(|k| fitted.position_error(1.0 + 0.01 * f64::from(k) / 100.0).abs()).fold(0.0, f64::max);
         assert!((amplitude - 65e-6).abs() < 15e-6, "seed {seed}: largest fitted error {amplitude} m");
 
         let dir = tempfile::tempdir().unwrap();
@@ -76,7 +81,8 @@ fn a_screw_error_is_identified_down_to_the_noise_and_its_model_file_reads_back()
         assert!(text.contains("screw_periodic(") && text.contains("pitch_m: 0.01"), "{text}");
         let again = model::read_model(&path).unwrap();
         let tools: Vec<usize> = test.rows.iter().map(|r| r.tool).collect();
-        for (a, b) in model.predict(&test.rows, &tools).unwrap().iter().zip(&again.predict(&test.rows, &tools).unwrap()) {
+        for (a, b) in model.predict(&test.rows, &tools).unwrap().iter().zip(&again.predict(&test.rows, &tools).unwrap())
+        {
             assert!((a.pose.translation() - b.pose.translation()).norm() < 1e-10);
         }
         // A pitch of zero in the file is refused at its line.

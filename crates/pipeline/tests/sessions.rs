@@ -44,9 +44,14 @@ fn campaign(robot: &RobotDescription, offsets_mm: [[f64; 3]; 4], seed: u64) -> (
     (train, session(3))
 }
 
-fn fit(robot: &RobotDescription, train: &MeasurementSet, selection: &str) -> (model::CalibratedModel, pipeline::FitReport) {
+fn fit(
+    robot: &RobotDescription,
+    train: &MeasurementSet,
+    selection: &str,
+) -> (model::CalibratedModel, pipeline::FitReport) {
     let selection = if selection.is_empty() { EffectSelection::None } else { selection.parse().unwrap() };
-    pipeline::fit(robot, train, Method::Poe, &FitOptions::default().with_effects(selection)).unwrap_or_else(|e| panic!("{e}"))
+    pipeline::fit(robot, train, Method::Poe, &FitOptions::default().with_effects(selection))
+        .unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn error(model: &model::CalibratedModel, test: &MeasurementSet) -> f64 {
