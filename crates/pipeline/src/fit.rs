@@ -112,6 +112,15 @@ pub enum FitWarning {
         /// Whether the fit left them out (the Huber loss) or kept them (plain least squares).
         left_out: bool,
     },
+    /// An effect whose features have one value on every training row (a backlash of a joint whose
+    /// torque or force never changes sign, such as a vertical column's weight): it is a constant
+    /// the geometry already holds, so its parameters mean nothing (issue 30). The diagnosis does
+    /// not offer such a term; named in `--effects`, it is fitted and its split from the geometry is
+    /// the priors'.
+    ConstantEffect {
+        /// The effect's label.
+        effect: String,
+    },
     /// The fitted model misses the training positions by more than the nominal robot placed by a
     /// rigid transform ([`crate::PlausibilityOptions::wrong_minimum_ratio`]): the identification
     /// stopped in a wrong minimum, and the model is not to be used.
@@ -146,6 +155,11 @@ impl std::fmt::Display for FitWarning {
                 rows.len(),
                 list_lines(rows),
                 if *left_out { "left out of the fit" } else { "KEPT in the fit (least-squares loss)" }
+            ),
+            FitWarning::ConstantEffect { effect } => write!(
+                f,
+                "effect {effect} has the same value on every training row (a torque or force that never changes \
+                 sign): a constant offset the geometry already holds, so its parameters mean nothing; leave it out"
             ),
             FitWarning::WrongMinimum { rms_mm, rigid_rms_mm } => write!(
                 f,
@@ -263,6 +277,11 @@ pub fn fit(
     if !specs.is_empty() {
         let mut effects = build_effects(&specs, robot, &model.kinematics, data, &options.effects)?;
         let tools: Vec<usize> = data.rows.iter().map(|r| r.tool).collect();
+        for effect in &effects {
+            if constant_features(effect, data, &tools)? {
+                warnings.push(FitWarning::ConstantEffect { effect: effect.label() });
+            }
+        }
         let correction = EffectCorrection::new(&effects, &data.rows, &tools, options.effects.prior_sigma)?;
         let layout = model.kinematics.layout();
         let mask = if scope == Scope::BaseTool { ParameterMask::base_tool(layout) } else { ParameterMask::all(layout) };
@@ -384,6 +403,20 @@ pub fn fit(
         warnings,
     };
     Ok((model, report))
+}
+
+/// Whether `effect`'s features are the same on every row of `data` (two rows at least).
+fn constant_features(effect: &IdentifiedEffect, data: &MeasurementSet, tools: &[usize]) -> Result<bool, Error> {
+    let mut first: Option<Vec<f64>> = None;
+    for (row, &tool) in data.rows.iter().zip(tools) {
+        let features = effect.features(row, tool)?;
+        match &first {
+            None => first = Some(features),
+            Some(f) if *f != features => return Ok(false),
+            Some(_) => {}
+        }
+    }
+    Ok(data.rows.len() > 1)
 }
 
 /// The warning for a fit whose training RMS (`rms_mm`) is above `ratio` times that of the rigidly

@@ -58,4 +58,19 @@ fn a_vertical_column_whose_force_never_changes_sign_is_offered_no_backlash() {
         "{}",
         diagnosis.summary()
     );
+
+    // Named in `--effects`, the column's backlash is fitted, with a warning that it means nothing.
+    let options = pipeline::FitOptions::default().with_effects("backlash:1,backlash:3".parse().unwrap());
+    let (_, report) = pipeline::fit(&robot, &data, model::Method::Poe, &options).unwrap();
+    let constant: Vec<&str> = report
+        .warnings
+        .iter()
+        .filter_map(|w| match w {
+            pipeline::FitWarning::ConstantEffect { effect } => Some(effect.as_str()),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(constant.len(), 1, "{:?}", report.warnings);
+    assert!(constant[0].starts_with("backlash:1 "), "{constant:?}");
+    assert!(report.warnings.iter().any(|w| w.to_string().contains("its parameters mean nothing; leave it out")));
 }
