@@ -149,6 +149,9 @@ pub(crate) fn choose(
     if !settings.choose {
         return Ok(keep(effects, "its own rule (effects.sessions.choose is false)".into()));
     }
+    if found.is_empty() {
+        return Ok(keep(effects, "sessions unknown (a row has no t_s): its own rule".into()));
+    }
     if found.len() < 2 {
         let reason = format!(
             "one session (no gap in t_s longer than {} times the median spacing): nothing to leave out, its own rule",
