@@ -124,7 +124,7 @@ class Diagnosis:
 
     effect: str
     """The verdict's effect: joint_compliance, backlash, gear_periodic, thermal, time_drift,
-    link_deflection, none or unknown."""
+    link_deflection, screw_periodic, none or unknown."""
     joints: List[int]
     """The 1-based joints the verdict involves."""
     heldout_before_mm: float

@@ -125,16 +125,12 @@ fn report(cases: &[Case]) -> String {
             ratios[ratios.len() / 2]
         );
     }
-    let labels = [
-        Effect::None,
-        Effect::JointCompliance,
-        Effect::Backlash,
-        Effect::GearPeriodic,
-        Effect::Thermal,
-        Effect::TimeDrift,
-        Effect::LinkDeflection,
-        Effect::Unknown,
-    ];
+    // Every verdict the diagnosis can give, from the one list of kinds: a kind added there gets
+    // its column, so that no verdict is left out of the matrix unseen.
+    let labels: Vec<Effect> = std::iter::once(Effect::None)
+        .chain(loadsim::EffectKind::IDENTIFIED.iter().map(|&kind| Effect::from(kind)))
+        .chain(std::iter::once(Effect::Unknown))
+        .collect();
     let _ = writeln!(out, "\n## Confusion matrix (rows: class, columns: verdict)\n");
     let _ = write!(out, "| class \\ verdict |");
     for l in &labels {

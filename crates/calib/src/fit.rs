@@ -26,7 +26,8 @@ pub struct Args {
     out: PathBuf,
     /// Non-geometric effects identified with the geometry, applied before any GP (beyond the
     /// paper): a comma-separated list of joint_compliance, gear_periodic:JOINT:HARMONICS,
-    /// backlash:JOINT, thermal, time_drift, link_deflection:JOINT; or auto, what `calib diagnose`
+    /// backlash:JOINT, thermal, time_drift, link_deflection:JOINT,
+    /// screw_periodic:JOINT:PITCH_MM:HARMONICS; or auto, what `calib diagnose`
     /// selects on the data.
     #[arg(long, value_name = "LIST|auto")]
     effects: Option<EffectSelection>,
@@ -168,6 +169,9 @@ fn summarise(
                 s.heldout_after_mm
             );
         }
+    }
+    for choice in &report.beyond_span {
+        let _ = writeln!(out, "  {choice}");
     }
     for effect in &report.effects {
         let held: Vec<&str> = effect.parameters.iter().filter(|p| p.held_at_prior).map(|p| p.name.as_str()).collect();

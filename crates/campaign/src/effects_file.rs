@@ -4,7 +4,7 @@
 
 use errors::ron_position::{field_position, field_position_in, ron_options};
 use errors::{Error, ErrorKind};
-use loadsim::{Backlash, Effects, JointCoupling, LinkDeflection, PeriodicError};
+use loadsim::{Backlash, Effects, JointCoupling, LinkDeflection, PeriodicError, ScrewError};
 use robot::RobotDescription;
 use ron::Value;
 use std::path::Path;
@@ -14,6 +14,11 @@ use std::path::Path;
 /// (5.7°) is past any joint that still works, and far below where the sums of many terms could
 /// overflow into a NaN pose.
 pub const MAX_JOINT_ERROR_RAD: f64 = 0.1;
+
+/// Largest amplitude of a linear axis's screw (or rack) error, m: ground ball screws err
+/// periodically by a few µm per turn (ISO 3408-3's `v_2π` of class 5 to 10: 8 to 40 µm), rolled
+/// screws and racks by tens of µm; a millimetre per turn is a broken drive.
+pub const MAX_SCREW_ERROR_M: f64 = 1e-3;
 
 /// Largest harmonic order (periods per joint turn): gear errors appear up to the tooth count of
 /// the last stage, a few hundred; beyond 1e3 the angle `order · q` loses its digits.
@@ -175,6 +180,24 @@ pub fn check_effects(effects: &Effects, robot: &RobotDescription, text: &str, fi
             }
         }
     }
+    if let Some(screw) = &effects.screw {
+        let prismatic: Vec<bool> = robot.joints.iter().map(|j| j.kind == robot::JointType::Prismatic).collect();
+        let (low, high) = errors::PITCH_BOUNDS_MM;
+        for (k, h) in screw.harmonics.iter().enumerate() {
+            let alone = ScrewError { harmonics: vec![*h] };
+            let fault = alone.validate(&prismatic).err().map(|e| e.to_string()).or_else(|| {
+                beyond(&[("amplitude_m", h.amplitude_m, MAX_SCREW_ERROR_M), ("order", h.order, MAX_ORDER)])
+            });
+            let pitch_mm = h.pitch_m * 1e3;
+            let fault = fault.or_else(|| {
+                (!(low..=high).contains(&pitch_mm))
+                    .then(|| format!("pitch_m is {}, expected {} to {} m", short(h.pitch_m), low * 1e-3, high * 1e-3))
+            });
+            if let Some(fault) = fault {
+                return Err(at("screw", "joint_index", k, format!("harmonic {}: {fault}", k + 1)));
+            }
+        }
+    }
     if let Some(backlash) = &effects.backlash {
         for (k, joint) in backlash.joints.iter().enumerate() {
             let alone = Backlash { joints: vec![*joint] };
@@ -276,6 +299,28 @@ mod tests {
     }
 
     #[test]
+    fn a_screw_error_is_taken_on_a_linear_axis_and_a_pitch_out_of_bounds_is_refused_at_its_entry() {
+        let robot = testkit::robot("column_ur10.ron");
+        let check = |text: &str| parse_effects(text, "e.ron").and_then(|e| check_effects(&e, &robot, text, "e.ron"));
+        let good =
+            "(screw: (harmonics: [(joint_index: 0, pitch_m: 0.01, order: 1.0, amplitude_m: 2e-5, phase_rad: 0.0)]))";
+        check(good).unwrap();
+        for (text, words) in [
+            (
+                "(screw: (harmonics: [\n  (joint_index: 0, pitch_m: 20.0, order: 1.0, amplitude_m: 2e-5, phase_rad: 0.0)]))",
+                "e.ron:2:4: screw: harmonic 1: pitch_m is 20, expected 0.00001 to 10 m",
+            ),
+            (
+                "(screw: (harmonics: [\n  (joint_index: 0, pitch_m: 0.01, order: 1.0, amplitude_m: 0.5, phase_rad: 0.0)]))",
+                "e.ron:2:4: screw: harmonic 1: amplitude_m is 0.5, at most 0.001",
+            ),
+        ] {
+            let message = check(text).expect_err(text).to_string();
+            assert!(message.starts_with(words), "{message}");
+        }
+    }
+
+    #[test]
     fn effect_values_the_robot_cannot_take_are_refused_at_their_entry() {
         let robot = testkit::robot("irb4400.ron");
         let check = |text: &str| parse_effects(text, "e.ron").and_then(|e| check_effects(&e, &robot, text, "e.ron"));
@@ -287,6 +332,11 @@ mod tests {
                 "periodic: harmonic 2: ",
             ),
             ("(backlash: (joints: [\n  (joint_index: 0, half_band_rad: NaN)]))", (2, 4), "backlash: entry 1: "),
+            (
+                "(screw: (harmonics: [\n  (joint_index: 1, pitch_m: 0.005, order: 1.0, amplitude_m: 1e-6, phase_rad: 0.0)]))",
+                (2, 4),
+                "screw: harmonic 1: screw: joint 2 is revolute",
+            ),
             ("(compliance: (\n  fixed_point_iterations: 1000000000000))", (2, 3), "at most 100"),
             ("(\n thermal: (reference_temp_c: inf))", (2, 12), "thermal: "),
             (

@@ -42,7 +42,7 @@ use serde::{Deserialize, Serialize};
 
 pub use effects_file::{
     MAX_DRIFT_PER_S, MAX_EXPANSION_PER_K, MAX_FIXED_POINT_ITERATIONS, MAX_JOINT_ERROR_RAD, MAX_NOISE, MAX_ORDER,
-    MAX_TEMPERATURE_C, check_effects, parse_effects, read_effects,
+    MAX_SCREW_ERROR_M, MAX_TEMPERATURE_C, check_effects, parse_effects, read_effects,
 };
 pub use loadsim::{
     CouplingFactor, CouplingTerm, EffectKind, Effects, GeneratorConfig, JointCompliance, JointCoupling, JointRange,

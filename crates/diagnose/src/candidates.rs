@@ -200,12 +200,17 @@ pub(crate) fn build_candidates(
     let mut sides = Vec::new();
     for (j, built) in per_joint.into_iter().enumerate() {
         // A balancer or an unknown mass moves the torque's zero: the backlash side is also learnt,
-        // from the joint's gravity-regressor compliance.
+        // from the joint's gravity-regressor compliance. Not on a prismatic joint whose stated
+        // force keeps its sign: its force is its load's weight along the axis, `−(g·a) Σ m`, whose
+        // sign no mass model changes (a balancer of the robot file is in the stated force), so a
+        // learnt side would only follow the noise or the payload (issue 30: a vertical column).
+        let constant_force =
+            robot.joints[j].kind == robot::JointType::Prismatic && !built.iter().any(|c| c.effect == Effect::Backlash);
         let side = built.iter().position(|c| {
             matches!(&c.model, IdentifiedEffect::JointCompliance(jc)
                 if matches!(jc.torque, ComplianceTorque::GravityRegressor(_)))
         });
-        if let Some(at) = side
+        if let Some(at) = side.filter(|_| !constant_force)
             && let IdentifiedEffect::JointCompliance(jc) = &built[at].model
         {
             let terms = jc.terms.clone();

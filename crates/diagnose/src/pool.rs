@@ -589,6 +589,7 @@ mod tests {
             scale: vec![1.0],
             theta: vec![0.0],
             fitted_span: None,
+            beyond_span: effects::BeyondSpan::Hold,
         });
         let term = Term {
             effect: Effect::JointCompliance,

@@ -2,10 +2,10 @@
 //! (`loadsim::BaseDrift`, `loadsim::drift_regressor`): six parameters, `(v, ω)`.
 
 use super::{Regressor, check_column_varies, rms_scales};
-use crate::Direction;
 use crate::check::{Cursor, EffectFault};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect};
+use crate::{BeyondSpan, Direction};
 use errors::{Error, ErrorKind};
 use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};
@@ -25,6 +25,11 @@ pub struct TimeDrift {
     /// line into another (issue 30). Absent in older model files: applied as fitted, everywhere.
     #[serde(default)]
     pub fitted_span: Option<[f64; 2]>,
+    /// Beyond `fitted_span`: zero (the default, and what files written before the choice mean)
+    /// or held at the value at its nearer end, chosen by the fit by leaving one session out at a
+    /// time where the training rows hold several.
+    #[serde(default = "crate::beyond_span::zero", skip_serializing_if = "crate::beyond_span::is_zero")]
+    pub beyond_span: BeyondSpan,
 }
 
 impl TimeDrift {
@@ -49,6 +54,7 @@ impl TimeDrift {
             scale: rms_scales(&raw),
             theta: vec![0.0; 6],
             fitted_span: super::span_of(&times, hold_beyond_span),
+            beyond_span: BeyondSpan::Zero,
         })
     }
 }
@@ -64,12 +70,11 @@ impl Regressor for TimeDrift {
             effect: "time_drift",
             column: "t_s",
         }))?;
-        // Past the span (and its margin) the drift falls back to the placement the geometry holds:
-        // a later session starts from a placement of its own, which no line from this one knows.
-        if self.fitted_span.is_some_and(|[low, high]| !(low..=high).contains(&t)) {
-            return Ok(vec![0.0; self.scale.len()]);
-        }
-        Ok(self.scale.iter().map(|s| (t - self.reference_s) / s).collect())
+        // Past the span (and its margin) the drift falls back to the placement the geometry holds
+        // (a later session starts from a placement of its own, which no line from this one knows),
+        // or, where the sessions of the training data said so, is held at the end's placement.
+        let at = |t: f64| self.scale.iter().map(|s| (t - self.reference_s) / s).collect();
+        Ok(self.beyond_span.features(t, self.fitted_span, self.scale.len(), at))
     }
 
     fn theta(&self) -> &[f64] {
@@ -104,6 +109,14 @@ impl EffectTerm for TimeDrift {
     fn count_fields(&self, add: &mut dyn FnMut(&'static str, usize)) {
         add("reference_s", 1);
         add("scale", 1);
+    }
+
+    fn beyond_span(&self) -> Option<BeyondSpan> {
+        Some(self.beyond_span)
+    }
+
+    fn set_beyond_span(&mut self, rule: BeyondSpan) {
+        self.beyond_span = rule;
     }
 }
 
@@ -165,5 +178,29 @@ mod tests {
         // A model file written before the span was recorded applies the line as it did.
         let old = TimeDrift { fitted_span: None, ..drift.clone() };
         assert!(old.features(&week_later, 0).unwrap()[0] > 100.0);
+    }
+
+    /// The other rule of each, as the session choice may set it, and the model file: the default
+    /// rule is not written, so that a file without the field (older, or of one session) means it.
+    #[test]
+    fn a_drift_may_be_held_and_a_growth_zeroed_beyond_the_span_and_the_default_rule_is_not_written() {
+        let session: Vec<Measurement> = (0..50).map(|i| row(f64::from(i) * 88.0, 20.0 + f64::from(i) * 0.05)).collect();
+        let mut drift = TimeDrift::new(&session, 0.0).unwrap();
+        let mut thermal = Thermal::new(&session, 0.0).unwrap();
+        let week_later = row(8.0 * 86_400.0, 9.0);
+        let (end, first) = (session.last().unwrap(), &session[0]);
+        let drift_text = ron::to_string(&drift).unwrap();
+        let thermal_text = ron::to_string(&thermal).unwrap();
+        assert!(!drift_text.contains("beyond_span") && !thermal_text.contains("beyond_span"), "{drift_text}");
+        drift.beyond_span = BeyondSpan::Hold;
+        thermal.beyond_span = BeyondSpan::Zero;
+        assert_eq!(drift.features(&week_later, 0).unwrap(), drift.features(end, 0).unwrap());
+        assert_eq!(thermal.features(&week_later, 0).unwrap(), vec![0.0]);
+        assert_ne!(thermal.features(first, 0).unwrap(), vec![0.0], "inside the span the growth is applied");
+        let text = ron::to_string(&drift).unwrap();
+        assert!(text.contains("beyond_span:hold"), "{text}");
+        assert_eq!(ron::from_str::<TimeDrift>(&text).unwrap(), drift);
+        assert_eq!(ron::from_str::<TimeDrift>(&drift_text).unwrap().beyond_span, BeyondSpan::Zero);
+        assert_eq!(ron::from_str::<Thermal>(&thermal_text).unwrap().beyond_span, BeyondSpan::Hold);
     }
 }

@@ -131,12 +131,17 @@ impl GearPeriodic {
         rows: &[Measurement],
         options: &GearOptions,
     ) -> Result<Self, Error> {
-        let angles = rows.iter().filter_map(|row| row.q.get(joint).copied());
-        let fitted_range = angles.fold(None, |range: Option<[f64; 2]>, q| {
+        let angles: Vec<f64> = rows.iter().filter_map(|row| row.q.get(joint).copied()).collect();
+        Ok(Self::from_angles(joint, orders, &angles, options))
+    }
+
+    /// The series of `joint` fitted on the angles `angles` (rad; for a screw, its phases,
+    /// `crate::ScrewPeriodic`), with the taper of `options`.
+    pub(crate) fn from_angles(joint: usize, orders: Vec<u32>, angles: &[f64], options: &GearOptions) -> Self {
+        let fitted_range = angles.iter().fold(None, |range: Option<[f64; 2]>, &q| {
             Some(range.map_or([q, q], |[low, high]| [low.min(q), high.max(q)]))
         });
-        let mut turn: Vec<f64> =
-            rows.iter().filter_map(|row| row.q.get(joint).map(|q| q.rem_euclid(std::f64::consts::TAU))).collect();
+        let mut turn: Vec<f64> = angles.iter().map(|q| q.rem_euclid(std::f64::consts::TAU)).collect();
         turn.sort_by(f64::total_cmp);
         let h_max = f64::from(orders.iter().copied().max().unwrap_or(1).max(1));
         let spacing = std::f64::consts::PI / h_max;
@@ -163,7 +168,7 @@ impl GearPeriodic {
         };
         let width = 2 * model.orders.len();
         model.scale = vec![1.0; width];
-        let raw: Vec<Vec<f64>> = rows.iter().map(|row| model.features(row, 0)).collect::<Result<_, _>>()?;
+        let raw: Vec<Vec<f64>> = angles.iter().map(|&q| model.features_at(q)).collect();
         let count = raw.len().max(1) as f64;
         // Order 0 is the joint's bare twist (the diagnosis's backlash side uses it): a constant
         // by definition, kept as it is.
@@ -174,7 +179,7 @@ impl GearPeriodic {
             raw.iter().map(|r| r.iter().zip(&model.mean).map(|(v, m)| v - m).collect()).collect();
         model.scale = rms_scales(&centred);
         model.theta = vec![0.0; width];
-        Ok(model)
+        model
     }
 }
 
@@ -195,7 +200,7 @@ impl GearPeriodic {
     }
 
     /// The scaled features at the joint angle `q`: held, faded, centred and scaled.
-    fn features_at(&self, q: f64) -> Vec<f64> {
+    pub(crate) fn features_at(&self, q: f64) -> Vec<f64> {
         let (held, weight) = self.held_and_weight(q);
         if weight == 0.0 {
             return vec![0.0; 2 * self.orders.len()];
@@ -212,7 +217,13 @@ impl GearPeriodic {
 
     /// Records [`GearPeriodic::fitted_rms_rad`] over the training rows, after the fit.
     pub fn record_rms(&mut self, rows: &[Measurement]) {
-        let values: Vec<f64> = rows.iter().filter_map(|r| r.q.get(self.joint)).map(|&q| self.joint_error(q)).collect();
+        let angles: Vec<f64> = rows.iter().filter_map(|r| r.q.get(self.joint).copied()).collect();
+        self.record_rms_at(&angles);
+    }
+
+    /// Records [`GearPeriodic::fitted_rms_rad`] over the training angles `angles`.
+    pub(crate) fn record_rms_at(&mut self, angles: &[f64]) {
+        let values: Vec<f64> = angles.iter().map(|&q| self.joint_error(q)).collect();
         let rms = (values.iter().map(|v| v * v).sum::<f64>() / values.len().max(1) as f64).sqrt();
         self.fitted_rms_rad = rms.is_finite().then_some(rms);
     }

@@ -30,6 +30,7 @@
 pub const HOLD_BEYOND_SPAN: f64 = 1.0;
 
 mod backlash;
+mod beyond_span;
 mod check;
 mod compliance;
 mod correction;
@@ -39,11 +40,13 @@ mod gear;
 mod link_deflection;
 mod load_frame;
 mod report;
+mod screw;
 mod spec;
 mod term;
 mod thermal;
 
 pub use backlash::{Backlash, TorqueSign};
+pub use beyond_span::BeyondSpan;
 pub use compliance::{ComplianceTerm, ComplianceTorque, JointCompliance, TorqueFit};
 pub use direction::Direction;
 pub use drift::TimeDrift;
@@ -53,7 +56,8 @@ pub use load_frame::LoadFrame;
 pub use loadsim::EffectKind;
 pub use report::{EffectReport, ParameterReport};
 pub use report::{effect_reports, reported_label, reported_parameters};
-pub use spec::{Argument, EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS};
+pub use screw::ScrewPeriodic;
+pub use spec::{Argument, EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS, PITCH_BOUNDS_MM};
 pub use term::{CandidateContext, CandidateModel, CandidateOptions};
 pub use thermal::Thermal;
 
@@ -283,6 +287,17 @@ impl IdentifiedEffect {
         self.term().has_sigma()
     }
 
+    /// What the effect is beyond the span of the input it was fitted on (`t_s`, `temp_c`); `None`
+    /// for an effect of no such input.
+    pub fn beyond_span(&self) -> Option<BeyondSpan> {
+        self.term().beyond_span()
+    }
+
+    /// Sets [`IdentifiedEffect::beyond_span`] (nothing for an effect of no such input).
+    pub fn set_beyond_span(&mut self, rule: BeyondSpan) {
+        self.term_mut().set_beyond_span(rule);
+    }
+
     /// The 1-based joints the effect acts on (empty for thermal growth and drift).
     pub fn joints(&self) -> Vec<usize> {
         self.term().joints()
@@ -409,11 +424,12 @@ mod tests {
             scale: vec![1.0],
             theta: vec![0.0],
             fitted_span: None,
+            beyond_span: BeyondSpan::Hold,
         });
         let text = ron::to_string(&thermal).unwrap();
         assert!(text.starts_with("thermal("), "{text}");
         assert_eq!(thermal.effect_kind(), EffectKind::Thermal);
         assert_eq!(thermal.kind(), "thermal");
-        assert!(EffectKind::IDENTIFIED.iter().all(|&k| IdentifiedEffect::arguments(k).len() <= 2));
+        assert!(EffectKind::IDENTIFIED.iter().all(|&k| IdentifiedEffect::arguments(k).len() <= 3));
     }
 }

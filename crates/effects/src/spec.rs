@@ -1,6 +1,7 @@
 //! `--effects LIST|auto` (SPEC v2): which non-geometric effects a fit identifies with the
 //! geometry. Items are `joint_compliance`, `gear_periodic:JOINT:HARMONICS`, `backlash:JOINT`,
-//! `thermal` and `time_drift`, comma separated; joints are 1-based. A bad item is refused with its
+//! `thermal`, `time_drift`, `link_deflection:JOINT` and `screw_periodic:JOINT:PITCH_MM:HARMONICS`,
+//! comma separated; joints are 1-based. A bad item is refused with its
 //! position in the argument and what is wrong with it. The names are those of
 //! [`EffectKind::IDENTIFIED`] and each kind's arguments its `NewEffect::ARGUMENTS` (module `term`),
 //! so a new effect is parsed and printed without a change here.
@@ -11,7 +12,7 @@ use loadsim::EffectKind;
 use std::fmt;
 use std::str::FromStr;
 
-pub use errors::{EffectListFault, MAX_HARMONICS};
+pub use errors::{EffectListFault, MAX_HARMONICS, PITCH_BOUNDS_MM};
 
 /// What an `--effects` item takes after its name, in order (`gear_periodic:JOINT:HARMONICS`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -20,11 +21,14 @@ pub enum Argument {
     Joint,
     /// The highest harmonic order of a series, `1..=MAX_HARMONICS` ([`EffectListFault::Harmonics`]).
     Harmonics,
+    /// A linear axis's screw lead (or rack pinion's circumference), mm, within [`PITCH_BOUNDS_MM`]
+    /// ([`EffectListFault::Pitch`]).
+    Pitch,
 }
 
 /// One effect of an `--effects` list, as the user names it: a kind the fit identifies and the
 /// arguments its item takes ([`EffectSpec::arguments`], in that order after the name).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EffectSpec {
     /// The kind (one of [`EffectKind::IDENTIFIED`]).
     pub kind: EffectKind,
@@ -32,12 +36,24 @@ pub struct EffectSpec {
     pub joint: Option<usize>,
     /// The highest harmonic order (harmonics `1..=harmonics`), for a kind that takes it.
     pub harmonics: Option<u32>,
+    /// The pitch, mm, for a kind that takes it (`screw_periodic`); `None` in an item made by
+    /// `--effects auto`, whose fit takes the robot file's `pitch_mm` of the joint.
+    pub pitch_mm: Option<f64>,
+}
+
+// The parser admits only finite pitches (within `PITCH_BOUNDS_MM`), so equality is reflexive.
+impl Eq for EffectSpec {}
+
+impl std::hash::Hash for EffectSpec {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        (self.kind, self.joint, self.harmonics, self.pitch_mm.map(f64::to_bits)).hash(state);
+    }
 }
 
 impl EffectSpec {
     /// An item of `kind` with no arguments (`joint_compliance`, `thermal`, `time_drift`).
     pub fn new(kind: EffectKind) -> Self {
-        Self { kind, joint: None, harmonics: None }
+        Self { kind, joint: None, harmonics: None, pitch_mm: None }
     }
 
     /// An item of `kind` on 1-based joint `joint` (`backlash:JOINT`).
@@ -70,9 +86,10 @@ impl fmt::Display for EffectSpec {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.kind.name())?;
         for argument in self.arguments() {
-            match (argument, self.joint, self.harmonics) {
-                (Argument::Joint, Some(joint), _) => write!(f, ":{joint}")?,
-                (Argument::Harmonics, _, Some(harmonics)) => write!(f, ":{harmonics}")?,
+            match (argument, self.joint, self.harmonics, self.pitch_mm) {
+                (Argument::Joint, Some(joint), _, _) => write!(f, ":{joint}")?,
+                (Argument::Harmonics, _, Some(harmonics), _) => write!(f, ":{harmonics}")?,
+                (Argument::Pitch, _, _, Some(pitch)) => write!(f, ":{pitch}")?,
                 _ => {}
             }
         }
@@ -91,9 +108,16 @@ impl EffectSpec {
         self.harmonics.ok_or_else(|| self.missing())
     }
 
+    /// The pitch of an item that takes one, m: the item's, else `stated` (the robot file's, mm).
+    pub(crate) fn required_pitch_m(&self, stated: Option<f64>) -> Result<f64, Error> {
+        self.pitch_mm.or(stated).map(|mm| mm * 1e-3).ok_or_else(|| self.missing())
+    }
+
     fn missing(&self) -> Error {
         let expected = self.arguments().len();
-        let found = usize::from(self.joint.is_some()) + usize::from(self.harmonics.is_some());
+        let found = usize::from(self.joint.is_some())
+            + usize::from(self.harmonics.is_some())
+            + usize::from(self.pitch_mm.is_some());
         Error::at_line(
             "--effects",
             1,
@@ -161,6 +185,10 @@ fn parse_item(item: &str) -> Result<EffectSpec, EffectListFault> {
             Argument::Harmonics => match text.trim().parse::<u32>() {
                 Ok(h) if (1..=MAX_HARMONICS).contains(&h) => spec.harmonics = Some(h),
                 _ => return Err(EffectListFault::Harmonics),
+            },
+            Argument::Pitch => match text.trim().parse::<f64>() {
+                Ok(p) if (PITCH_BOUNDS_MM.0..=PITCH_BOUNDS_MM.1).contains(&p) => spec.pitch_mm = Some(p),
+                _ => return Err(EffectListFault::Pitch),
             },
         }
     }
@@ -270,6 +298,20 @@ mod tests {
             (19, "gear_periodic:1:5".into(), EffectListFault::Duplicate)
         );
         assert_eq!(fault_of("thermal,auto"), (9, "auto".into(), EffectListFault::AutoWithOthers));
+        // A screw's pitch: a number of millimetres within the bounds, the harmonics after it.
+        for bad in ["screw_periodic:1:0:4", "screw_periodic:1:x:4", "screw_periodic:1:-5:4", "screw_periodic:1:NaN:4"] {
+            assert_eq!(fault_of(bad), (1, bad.into(), EffectListFault::Pitch), "{bad}");
+        }
+        assert_eq!(
+            fault_of("screw_periodic:1:4"),
+            (1, "screw_periodic:1:4".into(), EffectListFault::Arguments { expected: 3, found: 2 })
+        );
+        assert_eq!(fault_of("screw_periodic:1:5:0"), (1, "screw_periodic:1:5:0".into(), EffectListFault::Harmonics));
+        let message = "screw_periodic:1:20000:4".parse::<EffectSelection>().unwrap_err().to_string();
+        assert!(message.contains("has a pitch that is not a number of millimetres from 0.01 to 10000"), "{message}");
+        let screw: EffectSelection = "screw_periodic:1:2.5:8".parse().unwrap();
+        assert_eq!(screw.listed()[0].pitch_mm, Some(2.5));
+        assert_eq!(screw.to_string(), "screw_periodic:1:2.5:8");
         let message = "thermal,backlash:-1".parse::<EffectSelection>().unwrap_err().to_string();
         assert!(message.starts_with("--effects:1:9: 'backlash:-1'"), "{message}");
     }
@@ -283,11 +325,12 @@ mod tests {
     #[test]
     fn every_identified_kind_is_an_item_and_no_other_kind_is() {
         for &kind in EffectKind::IDENTIFIED {
-            let spec = EffectSpec { kind, joint: Some(2), harmonics: Some(3) };
+            let spec = EffectSpec { kind, joint: Some(2), harmonics: Some(3), pitch_mm: Some(5.0) };
             let text: String = std::iter::once(kind.name().to_owned())
                 .chain(spec.arguments().iter().map(|a| match a {
                     Argument::Joint => ":2".to_owned(),
                     Argument::Harmonics => ":3".to_owned(),
+                    Argument::Pitch => ":5".to_owned(),
                 }))
                 .collect();
             let parsed: EffectSelection = text.parse().unwrap();

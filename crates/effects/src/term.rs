@@ -114,6 +114,15 @@ pub(crate) trait EffectTerm: Regressor + std::fmt::Debug + Send + Sync {
     fn prior_scale(&self) -> Vec<f64> {
         vec![1.0; self.theta().len()]
     }
+
+    /// What the effect is beyond the span of its input (`t_s`, `temp_c`); `None` for an effect
+    /// of no such input.
+    fn beyond_span(&self) -> Option<crate::BeyondSpan> {
+        None
+    }
+
+    /// Sets [`EffectTerm::beyond_span`]; nothing for an effect of no such input.
+    fn set_beyond_span(&mut self, _rule: crate::BeyondSpan) {}
 }
 
 /// How an effect is made. Implemented by the type of every identified kind.

@@ -2,10 +2,10 @@
 //! (`loadsim::ThermalGrowth`, one coefficient for the whole arm, `loadsim::thermal_regressor`).
 
 use super::{Regressor, check_column_varies, rms_scales};
-use crate::Direction;
 use crate::check::{Cursor, EffectFault};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect};
+use crate::{BeyondSpan, Direction};
 use errors::{Error, ErrorKind};
 use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};
@@ -24,6 +24,11 @@ pub struct Thermal {
     /// line (issue 30). Absent in older model files: applied as fitted, everywhere.
     #[serde(default)]
     pub fitted_span: Option<[f64; 2]>,
+    /// Beyond `fitted_span`: held at the nearer end's temperature (the default, and what files
+    /// written before the choice mean) or zero, chosen by the fit by leaving one session out at a
+    /// time where the training rows hold several.
+    #[serde(default = "crate::beyond_span::hold", skip_serializing_if = "crate::beyond_span::is_hold")]
+    pub beyond_span: BeyondSpan,
 }
 
 impl Thermal {
@@ -48,6 +53,7 @@ impl Thermal {
             scale: rms_scales(&raw),
             theta: vec![0.0],
             fitted_span: super::span_of(&temps, hold_beyond_span),
+            beyond_span: BeyondSpan::Hold,
         })
     }
 }
@@ -63,8 +69,8 @@ impl Regressor for Thermal {
             effect: "thermal",
             column: "temp_c",
         }))?;
-        let t = super::held_in(t, self.fitted_span);
-        Ok(vec![(t - self.reference_c) / self.scale[0]])
+        let at = |t: f64| vec![(t - self.reference_c) / self.scale[0]];
+        Ok(self.beyond_span.features(t, self.fitted_span, 1, at))
     }
 
     fn theta(&self) -> &[f64] {
@@ -99,6 +105,14 @@ impl EffectTerm for Thermal {
     fn count_fields(&self, add: &mut dyn FnMut(&'static str, usize)) {
         add("reference_c", 1);
         add("scale", 1);
+    }
+
+    fn beyond_span(&self) -> Option<BeyondSpan> {
+        Some(self.beyond_span)
+    }
+
+    fn set_beyond_span(&mut self, rule: BeyondSpan) {
+        self.beyond_span = rule;
     }
 }
 

@@ -8,6 +8,11 @@ use std::fmt;
 /// UR10 analysis of issue #11 found 24–32 enough). It also bounds the work a typo can ask for.
 pub const MAX_HARMONICS: u32 = 256;
 
+/// The range of a `screw_periodic` item's pitch, mm: the finest ball-screw leads sold are 0.5 mm
+/// (miniature screws, THK/NSK catalogues), and a rack's pinion turns once in well under 10 m; a
+/// value outside is a unit mistake (metres for millimetres, or the reverse) or a typing error.
+pub const PITCH_BOUNDS_MM: (f64, f64) = (0.01, 10_000.0);
+
 /// Why a cell's decimal mark is refused.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DecimalFault {
@@ -122,6 +127,8 @@ pub enum EffectListFault {
     Joint,
     /// A harmonic count that is not a whole number from 1 to [`MAX_HARMONICS`].
     Harmonics,
+    /// A pitch that is not a number of millimetres within [`PITCH_BOUNDS_MM`].
+    Pitch,
     /// The same effect (on the same joint) is named twice.
     Duplicate,
     /// `auto` together with other items.
@@ -132,16 +139,20 @@ impl fmt::Display for EffectListFault {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
             EffectListFault::Empty => f.write_str(
-                "is empty (expected auto, or a list of joint_compliance, gear_periodic:JOINT:HARMONICS, backlash:JOINT, thermal, time_drift, link_deflection:JOINT)",
+                "is empty (expected auto, or a list of joint_compliance, gear_periodic:JOINT:HARMONICS, screw_periodic:JOINT:PITCH_MM:HARMONICS, backlash:JOINT, thermal, time_drift, link_deflection:JOINT)",
             ),
             EffectListFault::UnknownEffect => f.write_str(
-                "is not an effect (joint_compliance, gear_periodic:JOINT:HARMONICS, backlash:JOINT, thermal, time_drift, link_deflection:JOINT)",
+                "is not an effect (joint_compliance, gear_periodic:JOINT:HARMONICS, screw_periodic:JOINT:PITCH_MM:HARMONICS, backlash:JOINT, thermal, time_drift, link_deflection:JOINT)",
             ),
             EffectListFault::Arguments { expected, found } => {
                 write!(f, "takes {expected} ':' argument(s), {found} given")
             }
             EffectListFault::Joint => f.write_str("has a joint that is not a whole number from 1"),
             EffectListFault::Harmonics => write!(f, "has a harmonic count that is not a whole number from 1 to {MAX_HARMONICS}"),
+            EffectListFault::Pitch => {
+                let (low, high) = PITCH_BOUNDS_MM;
+                write!(f, "has a pitch that is not a number of millimetres from {low} to {high}")
+            }
             EffectListFault::Duplicate => f.write_str("is named twice (the same effect on the same joint)"),
             EffectListFault::AutoWithOthers => f.write_str("stands alone: auto chooses every effect itself"),
         }

@@ -366,6 +366,13 @@ pub enum ErrorKind {
         /// The 1-based joint named.
         joint: usize,
     },
+    /// An effect of a linear axis (a screw's or a rack's periodic error) named on a revolute joint.
+    EffectNeedsPrismatic {
+        /// The effect's name.
+        effect: &'static str,
+        /// The 1-based joint named.
+        joint: usize,
+    },
     /// A fit produced a model that the model file's check refuses: `fit` says so rather than
     /// write a file that `eval` would refuse.
     FittedModelRefused {
@@ -759,7 +766,17 @@ impl fmt::Display for ErrorKind {
             }
             ErrorKind::EffectJointKind { effect, joint } => write!(
                 f,
-                "{effect} on joint {joint}: joint {joint} is prismatic, and a {effect} is a function of a revolute joint's angle"
+                "{effect} on joint {joint}: joint {joint} is prismatic, and a {effect} is a function of a revolute joint's angle{}",
+                if *effect == "gear_periodic" {
+                    " (a linear axis's periodic error per screw or rack pitch is screw_periodic:JOINT:PITCH_MM:HARMONICS)"
+                } else {
+                    ""
+                }
+            ),
+            ErrorKind::EffectNeedsPrismatic { effect, joint } => write!(
+                f,
+                "{effect} on joint {joint}: joint {joint} is revolute, and a {effect} is a function of a linear axis's \
+                 position per screw or rack pitch (a periodic error in a revolute joint's angle is gear_periodic:JOINT:HARMONICS)"
             ),
             ErrorKind::FittedModelRefused { method, source } => write!(
                 f,

@@ -4,8 +4,8 @@
 
 use crate::{
     Backlash, BaseDrift, Error, JointBacklash, JointCompliance, JointCoupling, LinkDeflection, PeriodicError,
-    PoseContext, SimulatedCell, ThermalGrowth, TrackerNoise, compliance::compliance_deflection, gravity::static_torque,
-    periodic::Harmonic,
+    PoseContext, ScrewError, SimulatedCell, ThermalGrowth, TrackerNoise, compliance::compliance_deflection,
+    gravity::static_torque, periodic::Harmonic,
 };
 use lie::SE3;
 use rand::Rng;
@@ -33,6 +33,8 @@ pub struct Effects {
     /// Links bending under the gravity moment of everything beyond them (masses from the robot's
     /// dynamics; module [`LinkDeflection`]).
     pub deflection: Option<LinkDeflection>,
+    /// Periodic error of linear axes per screw or rack pitch (module [`ScrewError`]).
+    pub screw: Option<ScrewError>,
 }
 
 /// The joint-space part of the forward model at one pose, each effect apart.
@@ -49,13 +51,21 @@ pub struct JointOffsets {
     pub periodic_rad: Vec<f64>,
     /// Coupled joint error, rad.
     pub coupling_rad: Vec<f64>,
+    /// Screw (or rack) periodic error of the linear axes, m (0 on revolute joints).
+    pub screw_m: Vec<f64>,
 }
 
 impl JointOffsets {
     /// The sum of the joint-space effects, rad.
     pub fn total(&self) -> Vec<f64> {
         (0..self.compliance_rad.len())
-            .map(|j| self.compliance_rad[j] + self.backlash_rad[j] + self.periodic_rad[j] + self.coupling_rad[j])
+            .map(|j| {
+                self.compliance_rad[j]
+                    + self.backlash_rad[j]
+                    + self.periodic_rad[j]
+                    + self.coupling_rad[j]
+                    + self.screw_m[j]
+            })
             .collect()
     }
 }
@@ -90,6 +100,7 @@ impl Effects {
             tracker_noise: Some(TrackerNoise::default()),
             coupling: None,
             deflection: None,
+            screw: None,
         }
     }
 
@@ -123,6 +134,11 @@ impl Effects {
         }
         if let Some(coupling) = &self.coupling {
             coupling.validate(n)?;
+        }
+        if let Some(screw) = &self.screw {
+            let prismatic: Vec<bool> =
+                cell.robot.joints().iter().map(|j| j.kind == poe::JointKind::Prismatic).collect();
+            screw.validate(&prismatic)?;
         }
         if let Some(deflection) = &self.deflection {
             deflection.validate(n)?;
@@ -177,7 +193,11 @@ impl Effects {
             Some(coupling) => coupling.deflection(q),
             None => vec![0.0; n],
         };
-        Ok(JointOffsets { static_torque_nm, compliance_rad, backlash_rad, periodic_rad, coupling_rad })
+        let screw_m = match &self.screw {
+            Some(screw) => screw.deflection(q),
+            None => vec![0.0; n],
+        };
+        Ok(JointOffsets { static_torque_nm, compliance_rad, backlash_rad, periodic_rad, coupling_rad, screw_m })
     }
 
     /// The true `tracker_from_tool` at commanded joints `q`, every active effect applied except the

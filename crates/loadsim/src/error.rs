@@ -62,6 +62,13 @@ pub enum Error {
         /// The 0-based joint index.
         joint_index: usize,
     },
+    /// A screw's or rack's periodic error on a revolute joint (its period is a length).
+    NotPrismatic {
+        /// Which setting carried it, e.g. `"screw"`.
+        field: &'static str,
+        /// The 0-based joint index.
+        joint_index: usize,
+    },
     /// A campaign setting that does not fit the cell or the other settings.
     Campaign {
         /// Which setting, e.g. `"tool_per_run"`.
@@ -120,6 +127,12 @@ impl fmt::Display for Error {
             Error::SelfCoupling { joint_index } => write!(
                 f,
                 "coupling: joint {} is coupled to its own angle (a periodic error of its own angle is `periodic`)",
+                joint_index.saturating_add(1)
+            ),
+            Error::NotPrismatic { field, joint_index } => write!(
+                f,
+                "{field}: joint {} is revolute, and a screw's or rack's error is periodic in a linear axis's position \
+                 (a periodic error of a revolute joint's angle is `periodic`)",
                 joint_index.saturating_add(1)
             ),
             Error::Campaign { field, needs, given, expected } => {

@@ -44,6 +44,8 @@ macro_rules! effect_kinds {
                 TimeDrift "time_drift" drift,
                 /// A link bending under the gravity moment of everything beyond it.
                 LinkDeflection "link_deflection" deflection,
+                /// A periodic error of a linear axis in its own position, per screw or rack pitch.
+                ScrewPeriodic "screw_periodic" screw,
             }
             simulated {
                 /// Tracker measurement noise.

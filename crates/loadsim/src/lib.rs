@@ -1,6 +1,6 @@
 //! Non-geometric error models of a serial robot: payload and gravity deflection through joint
 //! compliance (the paper's ref. \[15\], Tao, Yang & Tomizuka 2013), a joint-2 spring balancer,
-//! backlash, gear periodic error, thermal growth, base drift, link deflection, tracker noise, and a coupled joint
+//! backlash, gear periodic error, a linear axis's screw (or rack) periodic error, thermal growth, base drift, link deflection, tracker noise, and a coupled joint
 //! error that no diagnosis candidate models; measured joint torques; and a seeded dataset
 //! generator that also draws the shapes of real campaigns (some joints fixed, payload runs with a
 //! tool each).
@@ -54,6 +54,7 @@ mod gravity_regressor;
 mod kinds;
 mod periodic;
 mod regressor;
+mod screw;
 mod singularity;
 mod thermal;
 mod torque_sensor;
@@ -83,6 +84,7 @@ pub use regressor::{
     EffectParameter, RegressorColumn, backlash_regressor, compliance_regressor, drift_regressor, periodic_regressor,
     thermal_regressor,
 };
+pub use screw::{ScrewError, ScrewHarmonic};
 pub use singularity::{smallest_singular_value, smallest_singular_value_of_joints, tool_point_jacobian};
 pub use thermal::ThermalGrowth;
 pub use torque_sensor::TorqueSensorNoise;

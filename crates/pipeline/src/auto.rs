@@ -70,8 +70,16 @@ pub fn effects_of(selected: &[SelectedEffect]) -> Vec<EffectSpec> {
 /// ([`measurements::BoundSet::to_robot`]), and returns what its selection keeps.
 pub fn choose(robot: &RobotDescription, data: &BoundSet<'_>, options: &DiagnoseOptions) -> Result<AutoChoice, Error> {
     let diagnosis = diagnose_bound(robot, data, options)?;
+    let mut chosen = effects_of(&diagnosis.selected);
+    // A screw's pitch is the robot file's (the diagnosis offers the screw only where it is stated),
+    // written into the item so that the report shows one that `--effects` reads back.
+    for spec in &mut chosen {
+        if spec.arguments().contains(&Argument::Pitch) && spec.pitch_mm.is_none() {
+            spec.pitch_mm = spec.joint.and_then(|j| robot.joints.get(j - 1)).and_then(|j| j.pitch_mm);
+        }
+    }
     Ok(AutoChoice {
-        chosen: effects_of(&diagnosis.selected),
+        chosen,
         verdict: diagnosis.verdict,
         selected: diagnosis.selected,
         heldout_before_mm: diagnosis.heldout_before_mm,

@@ -56,6 +56,11 @@ pub struct FitReport {
     /// What `--effects auto` chose and why.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub auto: Option<AutoChoice>,
+    /// What each drift or thermal growth is beyond the span of `t_s` / `temp_c` it was fitted on,
+    /// held or zero, and why: chosen by leaving one session out at a time where the training rows
+    /// hold several, the kind's own rule with one (issue 30). Empty without such an effect.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub beyond_span: Vec<crate::SpanChoice>,
     /// What the plausibility checks measured (absent below 4 rows).
     pub plausibility: Option<crate::PlausibilityReport>,
     /// The rows the identification named as gross outliers (`identification.robust` has the
@@ -107,6 +112,15 @@ pub enum FitWarning {
         /// Whether the fit left them out (the Huber loss) or kept them (plain least squares).
         left_out: bool,
     },
+    /// An effect whose features have one value on every training row (a backlash of a joint whose
+    /// torque or force never changes sign, such as a vertical column's weight): it is a constant
+    /// the geometry already holds, so its parameters mean nothing (issue 30). The diagnosis does
+    /// not offer such a term; named in `--effects`, it is fitted and its split from the geometry is
+    /// the priors'.
+    ConstantEffect {
+        /// The effect's label.
+        effect: String,
+    },
     /// The fitted model misses the training positions by more than the nominal robot placed by a
     /// rigid transform ([`crate::PlausibilityOptions::wrong_minimum_ratio`]): the identification
     /// stopped in a wrong minimum, and the model is not to be used.
@@ -141,6 +155,11 @@ impl std::fmt::Display for FitWarning {
                 rows.len(),
                 list_lines(rows),
                 if *left_out { "left out of the fit" } else { "KEPT in the fit (least-squares loss)" }
+            ),
+            FitWarning::ConstantEffect { effect } => write!(
+                f,
+                "effect {effect} has the same value on every training row (a torque or force that never changes \
+                 sign): a constant offset the geometry already holds, so its parameters mean nothing; leave it out"
             ),
             FitWarning::WrongMinimum { rms_mm, rigid_rms_mm } => write!(
                 f,
@@ -245,6 +264,7 @@ pub fn fit(
     let mut identification = geometry.report;
     let mut auto = None;
     let mut effect_report = Vec::new();
+    let mut beyond_span = Vec::new();
     let specs: Vec<EffectSpec> = match &options.effects.selection {
         EffectSelection::None => Vec::new(),
         EffectSelection::List(list) => list.clone(),
@@ -257,6 +277,11 @@ pub fn fit(
     };
     if !specs.is_empty() {
         let mut effects = build_effects(&specs, robot, &model.kinematics, &bound, &options.effects)?;
+        for effect in &effects {
+            if constant_features(effect, &bound)? {
+                warnings.push(FitWarning::ConstantEffect { effect: effect.label() });
+            }
+        }
         let correction = EffectCorrection::new(&effects, &bound, options.effects.prior_sigma)?;
         let layout = model.kinematics.layout();
         let mask = if scope == Scope::BaseTool { ParameterMask::base_tool(layout) } else { ParameterMask::all(layout) };
@@ -279,8 +304,10 @@ pub fn fit(
         .map_err(Error::kinematics)?;
         EffectCorrection::distribute(&mut effects, &fitted.correction);
         for effect in &mut effects {
-            if let IdentifiedEffect::GearPeriodic(gear) = effect {
-                gear.record_rms(&data.rows);
+            match effect {
+                IdentifiedEffect::GearPeriodic(gear) => gear.record_rms(&data.rows),
+                IdentifiedEffect::ScrewPeriodic(screw) => screw.record_rms(&data.rows),
+                _ => {}
             }
         }
         effect_report = effect_reports(&effects, &fitted.report.held_at_prior, &robot.joint_kinds());
@@ -293,6 +320,7 @@ pub fn fit(
             &bound,
             &options.effects,
         )?;
+        beyond_span = crate::sessions::choose(robot, data, &specs, &mut effects, options)?;
         model.effects = effects;
         identification = fitted.report;
     }
@@ -370,11 +398,26 @@ pub fn fit(
         residual_gp,
         nominal_prior,
         auto,
+        beyond_span,
         plausibility: findings.report,
         outliers,
         warnings,
     };
     Ok((model, report))
+}
+
+/// Whether `effect`'s features are the same on every row of `data` (two rows at least).
+fn constant_features(effect: &IdentifiedEffect, data: &BoundSet<'_>) -> Result<bool, Error> {
+    let mut first: Option<Vec<f64>> = None;
+    for (row, tool) in data.iter() {
+        let features = effect.features(row, tool)?;
+        match &first {
+            None => first = Some(features),
+            Some(f) if *f != features => return Ok(false),
+            Some(_) => {}
+        }
+    }
+    Ok(data.rows().len() > 1)
 }
 
 /// The warning for a fit whose training RMS (`rms_mm`) is above `ratio` times that of the rigidly

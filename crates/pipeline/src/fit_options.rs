@@ -63,6 +63,9 @@ pub struct EffectOptions {
     /// and drift campaigns of `tests/effects.rs` are tested 0.6 of their span past the training
     /// rows, where the simulated physics is linear); a day later it is held.
     pub hold_beyond_span: f64,
+    /// The measuring sessions of the training rows (split by gaps in `t_s`), from which the fit
+    /// chooses whether a drift or a thermal growth is held or zero beyond the span above (issue 30).
+    pub sessions: crate::SessionOptions,
     /// Where the posterior σ of the geometry-and-effects model at a row (the tool point's
     /// position) exceeds this multiple of the largest σ over the training rows, the model falls
     /// back to the geometry fitted alone, fully from twice it (issue 23; `model::EffectUncertainty`).
@@ -90,6 +93,7 @@ impl Default for EffectOptions {
             max_iterations: 300,
             gear: effects::GearOptions::default(),
             hold_beyond_span: effects::HOLD_BEYOND_SPAN,
+            sessions: crate::SessionOptions::default(),
             fallback_sigma_ratio: 2.0,
             diagnose: DiagnoseOptions::default(),
         }
@@ -205,6 +209,7 @@ impl FitOptions {
                 format!("effects.hold_beyond_span is {hold}, expected a number of at least 0"),
             ));
         }
+        self.effects.sessions.validate()?;
         let ratio = self.effects.fallback_sigma_ratio;
         if ratio.is_nan() || ratio < 1.0 {
             return Err((

@@ -4,8 +4,9 @@
 //!
 //! The crate holds the fit ([`fit()`], [`FitOptions`], [`FitReport`]), the plausibility checks
 //! that run before it ([`PlausibilityOptions`]), the prior toward the nominal geometry
-//! ([`choose_prior`], [`NominalPriorOptions`]) and `--effects auto` ([`choose_effects`],
-//! [`effects_of`]). Every other item is named by the crate that owns it, not re-exported here:
+//! ([`choose_prior`], [`NominalPriorOptions`]), `--effects auto` ([`choose_effects`],
+//! [`effects_of`]) and the measuring sessions that choose what a drift or a thermal growth is
+//! beyond the span it was fitted on ([`sessions()`], [`SessionOptions`], [`SpanChoice`]). Every other item is named by the crate that owns it, not re-exported here:
 //! `errors` (the one `Error`), `robot` (`RobotDescription`), `measurements` (the CSV,
 //! `MeasurementSet`, `OutputFile`), `model` (`CalibratedModel`, `Method`, `evaluate`, the model
 //! file), `effects`, `diagnose`, `campaign` (simulated data) and `cell` (inverse, `compensate`,
@@ -37,6 +38,7 @@ mod fit;
 mod fit_options;
 mod fit_prior;
 mod plausibility;
+mod sessions;
 
 pub use auto::{AutoChoice, choose as choose_effects, effects_of};
 pub use clusters::{BranchJoint, Cluster, HeightSplit};
@@ -44,3 +46,4 @@ pub use fit::{FitReport, FitWarning, fit};
 pub use fit_options::{EffectOptions, FitOptions};
 pub use fit_prior::{NominalPriorOptions, PriorCandidate, PriorChoice, choose as choose_prior};
 pub use plausibility::{PlausibilityOptions, PlausibilityReport};
+pub use sessions::{SessionOptions, SpanChoice, SpanErrors, sessions};

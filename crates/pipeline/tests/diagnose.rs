@@ -196,7 +196,8 @@ fn a_lifting_column_is_reported_in_millimetres_and_offered_no_series_of_its_angl
     let error = pipeline::fit(&robot, &data, model::Method::Poe, &options).unwrap_err();
     assert_eq!(
         error.to_string(),
-        "gear_periodic on joint 1: joint 1 is prismatic, and a gear_periodic is a function of a revolute joint's angle"
+        "gear_periodic on joint 1: joint 1 is prismatic, and a gear_periodic is a function of a revolute joint's angle \
+         (a linear axis's periodic error per screw or rack pitch is screw_periodic:JOINT:PITCH_MM:HARMONICS)"
     );
 }
 

@@ -229,3 +229,19 @@ fn finite_but_absurd_geometry_is_refused_at_its_field() {
         "{error}"
     );
 }
+
+/// Issue 30: a linear axis may state its screw lead; older files without it read as before, and a
+/// lead on a revolute joint or out of bounds is refused at it.
+#[test]
+fn a_screw_pitch_reads_on_a_prismatic_joint_and_is_refused_elsewhere_or_out_of_bounds() {
+    assert_eq!(RobotDescription::parse(GOOD, "robot.ron").unwrap().joints[1].pitch_mm, None);
+    let pitched = GOOD.replace("limits_m: (0.0, 0.5)", "limits_m: (0.0, 0.5), pitch_mm: 10.0");
+    assert_eq!(RobotDescription::parse(&pitched, "robot.ron").unwrap().joints[1].pitch_mm, Some(10.0));
+    let (line, column, message) =
+        refuse(&GOOD.replace("limits_deg: (-90.0, 90.0)", "limits_deg: (-90.0, 90.0), pitch_mm: 5.0"));
+    assert_eq!((line, column), (5, 100), "{message}");
+    assert!(message.contains("joint 1: pitch_mm is a linear axis's screw lead, and joint 1 is Revolute"), "{message}");
+    let (line, _, message) = refuse(&GOOD.replace("limits_m: (0.0, 0.5)", "limits_m: (0.0, 0.5), pitch_mm: 0.0"));
+    assert_eq!(line, 6, "{message}");
+    assert!(message.contains("pitch_mm 0e0 must be a number from 0.01 to 10000 mm"), "{message}");
+}

@@ -37,6 +37,12 @@ pub struct JointDescription {
     /// joint ([`FoldedJoint`]). The limits are the joint value's.
     #[serde(default = "unit_scale", skip_serializing_if = "is_unit_scale")]
     pub scale: f64,
+    /// A linear axis's screw lead (or its rack pinion's circumference): the travel per turn of
+    /// the part whose error repeats, mm. Where given, the diagnosis offers a `screw_periodic`
+    /// candidate on the joint and `--effects auto` fits it with this pitch; absent (older files,
+    /// URDFs, DH tables) no such candidate is offered. Only on a prismatic joint.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pitch_mm: Option<f64>,
 }
 
 fn unit_scale() -> f64 {

@@ -140,6 +140,23 @@ impl RobotDescription {
                 let before = self.joints[..i].iter().filter(|j| j.scale != 1.0).count();
                 return Err(at("scale", before, message));
             }
+            if let Some(pitch) = joint.pitch_mm {
+                let before = self.joints[..i].iter().filter(|j| j.pitch_mm.is_some()).count();
+                let (lo, hi) = errors::PITCH_BOUNDS_MM;
+                if joint.kind != JointType::Prismatic {
+                    let message = format!(
+                        "joint {}: pitch_mm is a linear axis's screw lead, and joint {} is {:?}",
+                        i + 1,
+                        i + 1,
+                        joint.kind
+                    );
+                    return Err(at("pitch_mm", before, message));
+                }
+                if !(lo..=hi).contains(&pitch) {
+                    let message = format!("joint {}: pitch_mm {pitch:e} must be a number from {lo} to {hi} mm", i + 1);
+                    return Err(at("pitch_mm", before, message));
+                }
+            }
             if !joint.axis.iter().chain(&joint.point).all(|v| v.is_finite()) {
                 return Err(at("axis", i, format!("joint {}: axis or point is not finite", i + 1)));
             }

@@ -126,6 +126,7 @@ impl DhTable {
                     limits_deg: row.limits_deg,
                     limits_m: row.limits_m,
                     scale: 1.0,
+                    pitch_mm: None,
                 }
             })
             .collect();

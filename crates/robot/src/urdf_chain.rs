@@ -566,6 +566,7 @@ impl UrdfChain {
                 limits_deg,
                 limits_m,
                 scale: joint.scale,
+                pitch_mm: None,
             });
         }
         let folded =

@@ -1,0 +1,275 @@
+//! Measuring sessions in the training rows, and what a term driven by time or temperature
+//! (`time_drift`, `thermal`) is beyond the span it was fitted on, chosen by leaving one session out
+//! at a time (issue 30): held at its value at the span's end ([`BeyondSpan::Hold`]) or fallen back
+//! to the geometry ([`BeyondSpan::Zero`]). A robot re-measured days later starts from a placement
+//! of its own: whether the end of the last session or the geometry's average placement is nearer
+//! to it is a property of the cell (a foundation that settles one way, or a tracker re-sighted
+//! anywhere), which only other sessions of the same cell can tell. With one session nothing can,
+//! and each kind keeps the rule it had (drift: zero; growth: held).
+
+use crate::FitOptions;
+use effects::{BeyondSpan, EffectSelection, EffectSpec, IdentifiedEffect};
+use errors::Error;
+use measurements::{Measurement, MeasurementSet};
+use model::Method;
+use robot::RobotDescription;
+use serde::{Deserialize, Serialize};
+
+/// How the training rows are split into sessions, and whether the rule beyond the span is chosen
+/// from them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SessionOptions {
+    /// Choose the rule by leaving one session out at a time where there are several; `false`:
+    /// each kind's own rule (drift: zero; growth: held), as for one session.
+    pub choose: bool,
+    /// A gap in `t_s` between rows consecutive in time longer than this many times the median
+    /// gap starts a new session. 20: within a session a robot moves to a pose and settles in
+    /// seconds to a minute, and pauses for a tool change or a re-sighting of the tracker last a
+    /// few times that (the generator's 30 s per pose; issue 30's campaign, 444 poses in 73
+    /// minutes, ~10 s apart); a new session starts hours to days later, a thousand times the
+    /// spacing and more. Any ratio between the two splits the same way.
+    pub gap_ratio: f64,
+}
+
+impl Default for SessionOptions {
+    fn default() -> Self {
+        Self { choose: true, gap_ratio: 20.0 }
+    }
+}
+
+impl SessionOptions {
+    /// Refuses a ratio that is not a finite number above 1 (every gap would split). The field at
+    /// fault and why, for the options file's error.
+    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+        let r = self.gap_ratio;
+        if !(r.is_finite() && r > 1.0) {
+            return Err(("gap_ratio", format!("effects.sessions.gap_ratio is {r}, expected a finite number above 1")));
+        }
+        Ok(())
+    }
+}
+
+/// The sessions of `rows` (row indices, each session in time order, sessions in time order):
+/// rows split where the gap in `t_s` exceeds `gap_ratio` times the median positive gap. Empty
+/// where a row has no `t_s`; one session where no gap is that long.
+pub fn sessions(rows: &[Measurement], gap_ratio: f64) -> Vec<Vec<usize>> {
+    let Some(times) = rows.iter().map(|r| r.t_s).collect::<Option<Vec<f64>>>() else { return Vec::new() };
+    let mut order: Vec<usize> = (0..rows.len()).collect();
+    order.sort_by(|&a, &b| times[a].total_cmp(&times[b]));
+    let gaps: Vec<f64> = order.windows(2).map(|w| times[w[1]] - times[w[0]]).collect();
+    let mut positive: Vec<f64> = gaps.iter().copied().filter(|&g| g > 0.0).collect();
+    positive.sort_by(f64::total_cmp);
+    let limit = positive.get(positive.len() / 2).map_or(f64::INFINITY, |median| gap_ratio * median);
+    let mut out: Vec<Vec<usize>> = Vec::new();
+    let mut current: Vec<usize> = Vec::new();
+    for (k, &row) in order.iter().enumerate() {
+        if k > 0 && gaps[k - 1] > limit {
+            out.push(std::mem::take(&mut current));
+        }
+        current.push(row);
+    }
+    if !current.is_empty() {
+        out.push(current);
+    }
+    out
+}
+
+/// The rule of one effect beyond its span, and why (`calib fit --json`'s `beyond_span`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SpanChoice {
+    /// The effect's label (`time_drift`, `thermal`).
+    pub effect: String,
+    /// The rule the model keeps.
+    pub rule: BeyondSpan,
+    /// The sessions found in the training rows (0 where a row has no `t_s`).
+    pub sessions: usize,
+    /// Mean position error of the left-out sessions' rows, held and zero beyond the span, mm
+    /// (absent where nothing was left out).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub heldout_mm: Option<SpanErrors>,
+    /// Why.
+    pub reason: String,
+}
+
+/// The left-out sessions' mean position error under either rule.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SpanErrors {
+    /// Held at the span's end, mm.
+    pub hold: f64,
+    /// Zero beyond the span, mm.
+    pub zero: f64,
+}
+
+impl std::fmt::Display for SpanChoice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "beyond its fitted span, {} is {}: {}", self.effect, describe(self.rule), self.reason)
+    }
+}
+
+fn describe(rule: BeyondSpan) -> &'static str {
+    match rule {
+        BeyondSpan::Hold => "held at the span's end",
+        BeyondSpan::Zero => "zero (the geometry alone)",
+    }
+}
+
+/// Chooses the rule beyond the span for every effect of `effects` that has one (fitted with the
+/// items `specs` on `data`) and sets it: with several sessions, each left out in turn, the rest
+/// fitted (`poe` with the same items; no prior strength chosen, and no sessions inside a fold),
+/// and the left-out rows predicted under either rule, the others' kept as fitted. The kind's own
+/// rule stays unless the other's mean error is lower by more than one standard error of the rows'
+/// paired differences (Breiman's one-standard-error rule, as the nominal prior's strength), so
+/// that a difference the rows cannot tell from noise does not change the model.
+pub(crate) fn choose(
+    robot: &RobotDescription,
+    data: &MeasurementSet,
+    specs: &[EffectSpec],
+    effects: &mut [IdentifiedEffect],
+    options: &FitOptions,
+) -> Result<Vec<SpanChoice>, Error> {
+    let targets: Vec<usize> = (0..effects.len()).filter(|&k| effects[k].beyond_span().is_some()).collect();
+    if targets.is_empty() {
+        return Ok(Vec::new());
+    }
+    let settings = options.effects.sessions;
+    let found = sessions(&data.rows, settings.gap_ratio);
+    let keep = |effects: &[IdentifiedEffect], reason: String| -> Vec<SpanChoice> {
+        targets
+            .iter()
+            .map(|&k| SpanChoice {
+                effect: effects[k].label(),
+                rule: effects[k].beyond_span().unwrap_or(BeyondSpan::Zero),
+                sessions: found.len(),
+                heldout_mm: None,
+                reason: reason.clone(),
+            })
+            .collect()
+    };
+    if !settings.choose {
+        return Ok(keep(effects, "its own rule (effects.sessions.choose is false)".into()));
+    }
+    if found.is_empty() {
+        return Ok(keep(effects, "sessions unknown (a row has no t_s): its own rule".into()));
+    }
+    if found.len() < 2 {
+        let reason = format!(
+            "one session (no gap in t_s longer than {} times the median spacing): nothing to leave out, its own rule",
+            settings.gap_ratio
+        );
+        return Ok(keep(effects, reason));
+    }
+    let mut fold_options = options.clone().with_effects(EffectSelection::List(specs.to_vec()));
+    fold_options.effects.sessions.choose = false;
+    fold_options.nominal_prior.choose = false;
+    fold_options.plausibility.force = true;
+    // Per target, the left-out rows' errors under the kind's own rule and under the other.
+    let mut own: Vec<Vec<f64>> = vec![Vec::new(); targets.len()];
+    let mut other: Vec<Vec<f64>> = vec![Vec::new(); targets.len()];
+    for session in &found {
+        let left_out: std::collections::BTreeSet<usize> = session.iter().copied().collect();
+        let train: Vec<usize> = (0..data.rows.len()).filter(|i| !left_out.contains(i)).collect();
+        let test = data.subset(session);
+        let fitted = match crate::fit(robot, &data.subset(&train), Method::Poe, &fold_options) {
+            Ok((model, _)) => model,
+            Err(e) => return Ok(keep(effects, format!("the fit without a session failed ({e}): its own rule"))),
+        };
+        for (t, &k) in targets.iter().enumerate() {
+            let rule = effects[k].beyond_span().unwrap_or(BeyondSpan::Zero);
+            for (errors, rule) in [(&mut own[t], rule), (&mut other[t], rule.other())] {
+                let mut model = fitted.clone();
+                model.effects[k].set_beyond_span(rule);
+                let evaluation = match model.bind(&test).and_then(|bound| model::evaluate(&model, &bound)) {
+                    Ok(evaluation) => evaluation,
+                    Err(e) => {
+                        return Ok(keep(effects, format!("a left-out session was not predicted ({e}): its own rule")));
+                    }
+                };
+                errors.extend(evaluation.errors.iter().map(|e| e.position_mm));
+            }
+        }
+    }
+    let mut out = Vec::with_capacity(targets.len());
+    for (t, &k) in targets.iter().enumerate() {
+        let rule = effects[k].beyond_span().unwrap_or(BeyondSpan::Zero);
+        let n = own[t].len().max(1) as f64;
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / n;
+        let differences: Vec<f64> = other[t].iter().zip(&own[t]).map(|(o, s)| o - s).collect();
+        let gain = mean(&differences);
+        let spread = (differences.iter().map(|d| (d - gain).powi(2)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt();
+        let standard_error = spread / n.sqrt();
+        let switch = gain < -standard_error;
+        let chosen = if switch { rule.other() } else { rule };
+        let (own_mm, other_mm) = (mean(&own[t]), mean(&other[t]));
+        let errors = match rule {
+            BeyondSpan::Hold => SpanErrors { hold: own_mm, zero: other_mm },
+            BeyondSpan::Zero => SpanErrors { hold: other_mm, zero: own_mm },
+        };
+        let reason = format!(
+            "{} sessions, each left out in turn: {:.4} mm held, {:.4} mm zero beyond the span ({} rows; {})",
+            found.len(),
+            errors.hold,
+            errors.zero,
+            own[t].len(),
+            if switch {
+                format!("{} lower by more than one standard error, {standard_error:.4} mm", chosen.name())
+            } else {
+                format!(
+                    "{} kept, the other not lower by more than one standard error, {standard_error:.4} mm",
+                    rule.name()
+                )
+            }
+        );
+        effects[k].set_beyond_span(chosen);
+        out.push(SpanChoice {
+            effect: effects[k].label(),
+            rule: chosen,
+            sessions: found.len(),
+            heldout_mm: Some(errors),
+            reason,
+        });
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(times: &[f64]) -> Vec<Measurement> {
+        times
+            .iter()
+            .map(|&t| Measurement { t_s: Some(t), ..Measurement::at(vec![0.0], lie::Vector3::zeros()) })
+            .collect()
+    }
+
+    #[test]
+    fn rows_split_into_sessions_at_gaps_far_longer_than_their_spacing() {
+        // Two sessions of 30 s spacing with a 5-minute pause inside the first, a day apart, given
+        // out of time order.
+        let mut times: Vec<f64> = (0..20).map(|i| f64::from(i) * 30.0).collect();
+        times.extend((0..10).map(|i| 900.0 + f64::from(i) * 30.0));
+        times.extend((0..15).map(|i| 86_400.0 + f64::from(i) * 30.0));
+        times.reverse();
+        let found = sessions(&at(&times), SessionOptions::default().gap_ratio);
+        assert_eq!(found.iter().map(Vec::len).collect::<Vec<_>>(), vec![30, 15]);
+        assert!(found[1].iter().all(|&i| times[i] >= 86_400.0));
+        // One session, a row without a time, and a constant time stamp.
+        assert_eq!(sessions(&at(&[0.0, 30.0, 60.0]), 20.0).len(), 1);
+        let mut rows = at(&[0.0, 30.0]);
+        rows[1].t_s = None;
+        assert!(sessions(&rows, 20.0).is_empty());
+        assert_eq!(sessions(&at(&[5.0, 5.0, 5.0]), 20.0).len(), 1);
+    }
+
+    #[test]
+    fn the_gap_ratio_is_validated() {
+        assert!(SessionOptions::default().validate().is_ok());
+        for ratio in [1.0, 0.5, f64::NAN, f64::INFINITY] {
+            assert_eq!(
+                SessionOptions { gap_ratio: ratio, ..SessionOptions::default() }.validate().unwrap_err().0,
+                "gap_ratio"
+            );
+        }
+    }
+}
