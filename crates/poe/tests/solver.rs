@@ -67,7 +67,11 @@ fn lm(prior: f64) -> IdentificationOptions {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 12, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig {
+        cases: 12,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(20261126),
+        ..ProptestConfig::default()
+    })]
 
     /// Started from the smaller model's solution with the new parameters at zero, the larger fit's
     /// data cost ends at or below the smaller one's, with or without a prior.
