@@ -176,7 +176,12 @@ pub(crate) fn build_candidates(
         let mut kept = Vec::new();
         for offer in offered {
             let columns = columns_of(design, &offer.effect, model, data)?;
-            if columns.is_empty() || (offer.only_if_nonzero && !nonzero(&columns)) {
+            // Columns that are all zero, or features the same on every row (a constant joint offset
+            // or frame change, which the geometry holds): nothing this candidate could explain.
+            if columns.is_empty()
+                || (offer.only_if_nonzero && !nonzero(&columns))
+                || offer.effect.features_constant(data)?
+            {
                 continue;
             }
             kept.push(Candidate {

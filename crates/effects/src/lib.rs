@@ -124,6 +124,12 @@ pub fn has_torques(rows: &[Measurement]) -> bool {
     !rows.is_empty() && rows.iter().all(|r| r.torques_nm.is_some())
 }
 
+/// Features that differ between rows by less than this, relative to their size (plus one), are
+/// the same ([`IdentifiedEffect::features_constant`]): rounding of the same force computed
+/// through each row's rotations (1e-16 per operation, a few hundred operations), far below any
+/// change a row could identify.
+pub const CONSTANT_FEATURES: f64 = 1e-9;
+
 /// Generates [`IdentifiedEffect`] from the identified kinds of `loadsim::effect_kinds!`: a variant
 /// per kind holding the type of the same name, every method delegated to its `EffectTerm` /
 /// `NewEffect` (module `term`).
@@ -345,6 +351,30 @@ impl IdentifiedEffect {
     /// The scaled features of one row.
     pub fn features(&self, row: &Measurement, tool: usize) -> Result<Vec<f64>, Error> {
         self.regressor().features(row, tool)
+    }
+
+    /// Whether the features are the same on every row of `data` (two rows at least), to rounding
+    /// ([`CONSTANT_FEATURES`]). Such an effect adds a constant twist along its directions: a joint
+    /// offset or a fixed frame change, which the geometry already holds, so its parameters mean
+    /// nothing (a backlash whose torque never changes sign, a compliance under the constant weight
+    /// on a vertical column with one payload). The diagnosis does not offer it; the fit warns.
+    pub fn features_constant(&self, data: &BoundSet<'_>) -> Result<bool, Error> {
+        let mut first: Option<Vec<f64>> = None;
+        for (row, tool) in data.iter() {
+            let features = self.features(row, tool)?;
+            match &first {
+                None => first = Some(features),
+                Some(f) => {
+                    let scale = 1.0 + f.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+                    if f.len() != features.len()
+                        || f.iter().zip(&features).any(|(a, b)| (a - b).abs() > CONSTANT_FEATURES * scale)
+                    {
+                        return Ok(false);
+                    }
+                }
+            }
+        }
+        Ok(data.rows().len() > 1)
     }
 
     /// The twist the effect adds at one row under `kinematics`: `Σ_l θ_l f_l c_l`.

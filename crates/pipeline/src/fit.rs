@@ -278,7 +278,7 @@ pub fn fit(
     if !specs.is_empty() {
         let mut effects = build_effects(&specs, robot, &model.kinematics, &bound, &options.effects)?;
         for effect in &effects {
-            if constant_features(effect, &bound)? {
+            if effect.features_constant(&bound)? {
                 warnings.push(FitWarning::ConstantEffect { effect: effect.label() });
             }
         }
@@ -404,20 +404,6 @@ pub fn fit(
         warnings,
     };
     Ok((model, report))
-}
-
-/// Whether `effect`'s features are the same on every row of `data` (two rows at least).
-fn constant_features(effect: &IdentifiedEffect, data: &BoundSet<'_>) -> Result<bool, Error> {
-    let mut first: Option<Vec<f64>> = None;
-    for (row, tool) in data.iter() {
-        let features = effect.features(row, tool)?;
-        match &first {
-            None => first = Some(features),
-            Some(f) if *f != features => return Ok(false),
-            Some(_) => {}
-        }
-    }
-    Ok(data.rows().len() > 1)
 }
 
 /// The warning for a fit whose training RMS (`rms_mm`) is above `ratio` times that of the rigidly

@@ -52,6 +52,12 @@ fn a_vertical_column_whose_force_never_changes_sign_is_offered_no_backlash() {
     let backlash_on =
         |joint: usize| diagnosis.candidates.iter().any(|c| c.effect == Effect::Backlash && c.joints.contains(&joint));
     assert!(!backlash_on(1), "a backlash of the column is offered: {on_column:?}");
+    // The paper's five payloads, drawn per pose, change the column's force: its axial compliance
+    // is offered.
+    assert!(
+        diagnosis.candidates.iter().any(|c| c.effect == Effect::JointCompliance && c.joints.contains(&1)),
+        "no compliance of the column with five payloads: {on_column:?}"
+    );
     assert!(backlash_on(3), "the shoulder's backlash is not offered:\n{}", diagnosis.summary());
     assert!(
         !diagnosis.selected.iter().any(|s| s.effect == Effect::Backlash && s.joints.contains(&1)),
@@ -73,4 +79,23 @@ fn a_vertical_column_whose_force_never_changes_sign_is_offered_no_backlash() {
     assert_eq!(constant.len(), 1, "{:?}", report.warnings);
     assert!(constant[0].starts_with("backlash:1 "), "{constant:?}");
     assert!(report.warnings.iter().any(|w| w.to_string().contains("its parameters mean nothing; leave it out")));
+}
+
+/// With one payload the column's force is the same weight on every row: its axial compliance is
+/// then one constant offset, like the backlash, and is not offered (the filter is on features
+/// that never change, not on the joint's kind: with several payloads it is, test above).
+#[test]
+fn a_column_carrying_one_payload_is_offered_no_compliance() {
+    let robot = testkit::robot("column_arm.urdf");
+    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+    let cell = simulated_cell(&robot, &Perturbation::default(), 48).unwrap();
+    let config = GeneratorConfig { sample_count: 150, seed: 48, payloads_kg: vec![5.0], ..GeneratorConfig::default() };
+    let data = simulate(&cell, &effects, &joint_ranges(&robot), &config, false).unwrap();
+    let diagnosis = diagnose(&robot, &data, &DiagnoseOptions::default()).unwrap();
+    let on = |effect: Effect, joint: usize| {
+        diagnosis.candidates.iter().any(|c| c.effect == effect && c.joints.contains(&joint))
+    };
+    assert!(!on(Effect::JointCompliance, 1), "{}", diagnosis.summary());
+    // The shoulder's compliance, whose torque changes with the arm's pose, stays.
+    assert!(on(Effect::JointCompliance, 3), "{}", diagnosis.summary());
 }
