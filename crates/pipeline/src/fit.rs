@@ -320,7 +320,9 @@ pub fn fit(
             &bound,
             &options.effects,
         )?;
-        beyond_span = crate::sessions::choose(robot, data, &specs, &mut effects, options)?;
+        beyond_span = crate::sessions::choose(data, &specs, &mut effects, options, |train, fold_options| {
+            fit(robot, train, Method::Poe, fold_options).map(|(model, _)| model)
+        })?;
         model.effects = effects;
         identification = fitted.report;
     }

@@ -65,7 +65,7 @@ pub struct EffectOptions {
     pub hold_beyond_span: f64,
     /// The measuring sessions of the training rows (split by gaps in `t_s`), from which the fit
     /// chooses whether a drift or a thermal growth is held or zero beyond the span above (issue 30).
-    pub sessions: crate::SessionOptions,
+    pub sessions: SessionOptions,
     /// Where the posterior σ of the geometry-and-effects model at a row (the tool point's
     /// position) exceeds this multiple of the largest σ over the training rows, the model falls
     /// back to the geometry fitted alone, fully from twice it (issue 23; `model::EffectUncertainty`).
@@ -93,7 +93,7 @@ impl Default for EffectOptions {
             max_iterations: 300,
             gear: effects::GearOptions::default(),
             hold_beyond_span: effects::HOLD_BEYOND_SPAN,
-            sessions: crate::SessionOptions::default(),
+            sessions: SessionOptions::default(),
             fallback_sigma_ratio: 2.0,
             diagnose: DiagnoseOptions::default(),
         }
@@ -226,6 +226,41 @@ impl FitOptions {
                 "prior_sigma",
                 format!("effects.prior_sigma is {prior}, expected a number above 0 (inf for none)"),
             ));
+        }
+        Ok(())
+    }
+}
+
+/// How the training rows are split into sessions, and whether the rule beyond the span is chosen
+/// from them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SessionOptions {
+    /// Choose the rule by leaving one session out at a time where there are several; `false`:
+    /// each kind's own rule (drift: zero; growth: held), as for one session.
+    pub choose: bool,
+    /// A gap in `t_s` between rows consecutive in time longer than this many times the median
+    /// gap starts a new session. 20: within a session a robot moves to a pose and settles in
+    /// seconds to a minute, and pauses for a tool change or a re-sighting of the tracker last a
+    /// few times that (the generator's 30 s per pose; issue 30's campaign, 444 poses in 73
+    /// minutes, ~10 s apart); a new session starts hours to days later, a thousand times the
+    /// spacing and more. Any ratio between the two splits the same way.
+    pub gap_ratio: f64,
+}
+
+impl Default for SessionOptions {
+    fn default() -> Self {
+        Self { choose: true, gap_ratio: 20.0 }
+    }
+}
+
+impl SessionOptions {
+    /// Refuses a ratio that is not a finite number above 1 (every gap would split). The field at
+    /// fault and why, for the options file's error.
+    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+        let r = self.gap_ratio;
+        if !(r.is_finite() && r > 1.0) {
+            return Err(("gap_ratio", format!("effects.sessions.gap_ratio is {r}, expected a finite number above 1")));
         }
         Ok(())
     }

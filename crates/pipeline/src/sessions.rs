@@ -7,48 +7,12 @@
 //! anywhere), which only other sessions of the same cell can tell. With one session nothing can,
 //! and each kind keeps the rule it had (drift: zero; growth: held).
 
-use crate::FitOptions;
+use crate::fit_options::FitOptions;
 use effects::{BeyondSpan, EffectSelection, EffectSpec, IdentifiedEffect};
 use errors::Error;
 use measurements::{Measurement, MeasurementSet};
-use model::Method;
-use robot::RobotDescription;
-use serde::{Deserialize, Serialize};
-
-/// How the training rows are split into sessions, and whether the rule beyond the span is chosen
-/// from them.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct SessionOptions {
-    /// Choose the rule by leaving one session out at a time where there are several; `false`:
-    /// each kind's own rule (drift: zero; growth: held), as for one session.
-    pub choose: bool,
-    /// A gap in `t_s` between rows consecutive in time longer than this many times the median
-    /// gap starts a new session. 20: within a session a robot moves to a pose and settles in
-    /// seconds to a minute, and pauses for a tool change or a re-sighting of the tracker last a
-    /// few times that (the generator's 30 s per pose; issue 30's campaign, 444 poses in 73
-    /// minutes, ~10 s apart); a new session starts hours to days later, a thousand times the
-    /// spacing and more. Any ratio between the two splits the same way.
-    pub gap_ratio: f64,
-}
-
-impl Default for SessionOptions {
-    fn default() -> Self {
-        Self { choose: true, gap_ratio: 20.0 }
-    }
-}
-
-impl SessionOptions {
-    /// Refuses a ratio that is not a finite number above 1 (every gap would split). The field at
-    /// fault and why, for the options file's error.
-    pub fn validate(&self) -> Result<(), (&'static str, String)> {
-        let r = self.gap_ratio;
-        if !(r.is_finite() && r > 1.0) {
-            return Err(("gap_ratio", format!("effects.sessions.gap_ratio is {r}, expected a finite number above 1")));
-        }
-        Ok(())
-    }
-}
+use model::CalibratedModel;
+use serde::Serialize;
 
 /// The sessions of `rows` (row indices, each session in time order, sessions in time order):
 /// rows split where the gap in `t_s` exceeds `gap_ratio` times the median positive gap. Empty
@@ -121,12 +85,15 @@ fn describe(rule: BeyondSpan) -> &'static str {
 /// rule stays unless the other's mean error is lower by more than one standard error of the rows'
 /// paired differences (Breiman's one-standard-error rule, as the nominal prior's strength), so
 /// that a difference the rows cannot tell from noise does not change the model.
+///
+/// `fit` fits a fold (`crate::fit` with `poe`, passed in so that this module does not import the
+/// fit that calls it).
 pub(crate) fn choose(
-    robot: &RobotDescription,
     data: &MeasurementSet,
     specs: &[EffectSpec],
     effects: &mut [IdentifiedEffect],
     options: &FitOptions,
+    fit: impl Fn(&MeasurementSet, &FitOptions) -> Result<CalibratedModel, Error>,
 ) -> Result<Vec<SpanChoice>, Error> {
     let targets: Vec<usize> = (0..effects.len()).filter(|&k| effects[k].beyond_span().is_some()).collect();
     if targets.is_empty() {
@@ -170,8 +137,8 @@ pub(crate) fn choose(
         let left_out: std::collections::BTreeSet<usize> = session.iter().copied().collect();
         let train: Vec<usize> = (0..data.rows.len()).filter(|i| !left_out.contains(i)).collect();
         let test = data.subset(session);
-        let fitted = match crate::fit(robot, &data.subset(&train), Method::Poe, &fold_options) {
-            Ok((model, _)) => model,
+        let fitted = match fit(&data.subset(&train), &fold_options) {
+            Ok(model) => model,
             Err(e) => return Ok(keep(effects, format!("the fit without a session failed ({e}): its own rule"))),
         };
         for (t, &k) in targets.iter().enumerate() {
@@ -235,6 +202,7 @@ pub(crate) fn choose(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::SessionOptions;
 
     fn at(times: &[f64]) -> Vec<Measurement> {
         times
