@@ -193,7 +193,7 @@ pub struct Checkpoint {
     pub predicted_error_mm: f64,
     /// The same with the unmodelled error of `PlanOptions::unmodelled_mm` in it: what the fit
     /// on these poses is expected to leave where the robot is used, mm (absent with
-    /// `unmodelled_mm` 0).
+    /// `unmodelled_mm` 0, or where it is not finite).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub predicted_with_unmodelled_mm: Option<f64>,
     /// RMS over the candidates of the orientation error the parameters leave, mrad (full pose).
@@ -293,7 +293,9 @@ fn checkpoint(
         parameter_error_mm: sigma * mean.sqrt(),
         max_parameter_error_mm: sigma * max.sqrt(),
         predicted_error_mm: sigma * (3.0 + mean).sqrt(),
-        predicted_with_unmodelled_mm: unmodelled.map(|u| sigma * u.expected(design.chosen()).max(0.0).sqrt()),
+        predicted_with_unmodelled_mm: unmodelled
+            .map(|u| sigma * u.expected(design.chosen()).max(0.0).sqrt())
+            .filter(|e| e.is_finite()),
         parameter_rotation_error_mrad: if full_pose {
             design.predicted_rotation_variance().map(|(m, _)| options.rotation_noise_mrad * m.sqrt())
         } else {
