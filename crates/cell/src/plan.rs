@@ -216,6 +216,9 @@ pub struct PlanReport {
     pub directions: usize,
     /// The noise the errors are predicted for, mm per axis.
     pub position_noise_mm: f64,
+    /// The unmodelled error the errors with it are predicted for, mm per axis
+    /// ([`PlanOptions::unmodelled_mm`]; 0: none).
+    pub unmodelled_mm: f64,
     /// Exchanges made after the greedy choice.
     pub exchanges: usize,
     /// Exchanges made for the unmodelled error ([`PlanOptions::unmodelled_mm`]).
@@ -247,8 +250,17 @@ impl PlanReport {
             lines.push(format!("  {}: {} of {} bins covered", c.input, c.covered, c.possible));
         }
         lines.push(format!(
-            "  predicted error (tracker noise {:.3} mm per axis; rms over the candidates):",
-            self.position_noise_mm
+            "  predicted error (tracker noise {:.3} mm per axis{}; rms over the candidates):",
+            self.position_noise_mm,
+            if self.unmodelled_mm > 0.0 {
+                format!(
+                    ", unmodelled error {:.3} mm per axis (PlanOptions::unmodelled_mm: set it from a fit's held-out \
+                     error on this robot)",
+                    self.unmodelled_mm
+                )
+            } else {
+                String::new()
+            }
         ));
         for c in &self.checkpoints {
             lines.push(format!(
@@ -376,6 +388,7 @@ pub fn plan(
         parameters: rows.p,
         directions: rows.r,
         position_noise_mm: options.position_noise_mm,
+        unmodelled_mm: options.unmodelled_mm,
         exchanges,
         unmodelled_exchanges,
         coverage_swaps,
