@@ -192,47 +192,25 @@ impl NewEffect for Backlash {
     }
 
     /// `δq_j = b_j sign(τ_j)`: the sign of the stated (or stand-in) static torque, first among the
-    /// joint's candidates; with measured torques also their sign, fourth. Each only where the
-    /// sign changes over the rows: a sign that never changes (the weight on a vertical column,
-    /// whatever the masses) makes `b_j` a constant joint offset, which the geometry already holds,
-    /// so the candidate would mean nothing (issue 30). A learnt side is the diagnosis's own
-    /// (module `learnt_side`).
+    /// joint's candidates; with measured torques also their sign, fourth. A sign that never
+    /// changes over the rows (the weight on a vertical column, whatever the masses) makes `b_j` a
+    /// constant joint offset, which the geometry already holds (issue 30): the diagnosis drops
+    /// such a candidate, as every candidate whose features never change
+    /// ([`IdentifiedEffect::features_constant`]). A learnt side is the diagnosis's own (module
+    /// `learnt_side`).
     fn joint_candidates(context: &CandidateContext<'_>, joint: usize) -> Result<Vec<CandidateModel>, Error> {
         let stated = TorqueSign::Stated { load: context.load.clone(), dynamics: context.dynamics.clone() };
-        let mut out = Vec::new();
-        let stated = Backlash::new(joint, stated, context.data)?;
-        if stated.sign_changes(context.data)? {
-            out.push(CandidateModel {
-                only_if_nonzero: true,
-                ..CandidateModel::plain(IdentifiedEffect::Backlash(stated), 0)
-            });
-        }
+        let mut out = vec![CandidateModel {
+            only_if_nonzero: true,
+            ..CandidateModel::plain(IdentifiedEffect::Backlash(Backlash::new(joint, stated, context.data)?), 0)
+        }];
         if context.measured {
             let measured = Backlash::new(joint, TorqueSign::Measured, context.data)?;
-            if measured.sign_changes(context.data)? {
-                out.push(CandidateModel {
-                    only_if_nonzero: true,
-                    ..CandidateModel::plain(IdentifiedEffect::Backlash(measured), 3)
-                });
-            }
+            out.push(CandidateModel {
+                only_if_nonzero: true,
+                ..CandidateModel::plain(IdentifiedEffect::Backlash(measured), 3)
+            });
         }
         Ok(out)
-    }
-}
-
-impl Backlash {
-    /// Whether the side differs between some of `rows` (`tools`: each row's model tool): with
-    /// one side on every row the feature is a constant, and the band a joint offset.
-    pub fn sign_changes(&self, data: &BoundSet<'_>) -> Result<bool, Error> {
-        let mut first = None;
-        for (row, tool) in data.iter() {
-            let side = sign(self.torque(row, tool)?);
-            match first {
-                None => first = Some(side),
-                Some(f) if f != side => return Ok(true),
-                Some(_) => {}
-            }
-        }
-        Ok(false)
     }
 }
