@@ -307,15 +307,15 @@ fn a_gear_series_warns_where_it_is_used_outside_the_angles_it_was_fitted_on() {
 
 /// 1,500 poses of the IRB 4400 with the gear error of joint 2 and the tracker's noise (seed 53),
 /// over the whole range of every joint: the tests of issue 23 cut gaps into it.
-fn joint_2_gear_campaign() -> (RobotDescription, MeasurementSet) {
+fn joint_2_gear_campaign(seed: u64) -> (RobotDescription, MeasurementSet) {
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
         periodic: Some(joint_2_gear_error()),
         tracker_noise: Some(TrackerNoise::default()),
         ..Effects::default()
     };
-    let cell = simulated_cell(&robot, &Perturbation::default(), 53).unwrap();
-    let config = GeneratorConfig { sample_count: 1500, seed: 53, ..GeneratorConfig::default() };
+    let cell = simulated_cell(&robot, &Perturbation::default(), seed).unwrap();
+    let config = GeneratorConfig { sample_count: 1500, seed, ..GeneratorConfig::default() };
     let all = simulate(&cell, &effects, &joint_ranges(&robot), &config, false).unwrap();
     (robot, all)
 }
@@ -326,7 +326,7 @@ fn joint_2_gear_campaign() -> (RobotDescription, MeasurementSet) {
 /// fitted.
 #[test]
 fn a_gear_series_falls_back_to_the_geometry_in_a_gap_and_past_the_end_of_its_angles() {
-    let (robot, all) = joint_2_gear_campaign();
+    let (robot, all) = joint_2_gear_campaign(53);
     // Trained on joint 2 in -0.9 … -0.35 and 0.35 … 0.9 rad: a 0.7 rad (40°) gap, and nothing
     // beyond ±0.9 rad.
     let train = rows_where(&all, |q| (0.35..=0.9).contains(&q.abs()));
@@ -398,33 +398,38 @@ fn a_gear_series_falls_back_to_the_geometry_in_a_gap_and_past_the_end_of_its_ang
 /// than it, and within 30 % (the issue asks 25 %; seed 53 is 26 % pessimistic).
 #[test]
 fn the_diagnosis_predicts_the_error_in_a_gap_and_past_the_end_from_arcs_of_the_joint_held_out() {
-    let (robot, all) = joint_2_gear_campaign();
-    let train = rows_where(&all, |q| (0.35..=0.9).contains(&q.abs()));
-    let off = rows_where(&all, |q| q.abs() < 0.3 || q.abs() > 0.95);
-    let diagnosis = diagnose::diagnose(&robot, &train, &Default::default()).unwrap();
-    let chosen = pipeline::effects_of(&diagnosis.selected);
-    let selection = EffectSelection::List(chosen.clone());
-    let model = pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default().with_effects(selection)).unwrap().0;
-    let fitted = model::evaluate(&model, &model.bind(&off).unwrap()).unwrap().summary.mean_position_error_mm;
-    let joint_2 = diagnosis.arcs.iter().find(|a| a.joint == 2).expect("joint 2 moves");
-    eprintln!(
-        "chosen {chosen:?}; random folds {:.4} -> {:.4} mm; joint 2's arcs {:.4} -> {:.4} mm; fitted, off the poses: {fitted:.4} mm ({} rows)",
-        diagnosis.heldout_before_mm,
-        diagnosis.heldout_after_selected_mm,
-        joint_2.before_mm,
-        joint_2.after_mm,
-        off.rows.len()
-    );
-    assert!(!chosen.is_empty(), "the gear error is found");
-    // Random folds promise about a tenth of what the fit gives there; the arcs must not promise
-    // less than the fit delivers, nor be uselessly pessimistic. Seeds 53, 7, 91 (orders 32, 12,
-    // 12): predicted 0.316, 0.305, 0.271 mm; fitted 0.234, 0.240, 0.244 mm.
-    assert!(diagnosis.heldout_after_selected_mm < 0.5 * fitted, "random folds see the gap now?");
-    assert!(
-        fitted <= joint_2.after_mm && fitted >= 0.7 * joint_2.after_mm,
-        "predicted {} mm, fitted {fitted} mm",
-        joint_2.after_mm
-    );
+    // Three campaigns (seeds 53, 7, 91; the diagnosis picks orders 32, 12, 12). With 10 arcs:
+    // predicted 0.2645, 0.2698, 0.2528 mm; fitted 0.2342, 0.2394, 0.2441 mm (5 arcs predicted
+    // 0.316, 0.305, 0.271 mm: 35 % too high on seed 53).
+    for seed in [53, 7, 91] {
+        let (robot, all) = joint_2_gear_campaign(seed);
+        let train = rows_where(&all, |q| (0.35..=0.9).contains(&q.abs()));
+        let off = rows_where(&all, |q| q.abs() < 0.3 || q.abs() > 0.95);
+        let diagnosis = diagnose::diagnose(&robot, &train, &Default::default()).unwrap();
+        let chosen = pipeline::effects_of(&diagnosis.selected);
+        let selection = EffectSelection::List(chosen.clone());
+        let model =
+            pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default().with_effects(selection)).unwrap().0;
+        let fitted = model::evaluate(&model, &model.bind(&off).unwrap()).unwrap().summary.mean_position_error_mm;
+        let joint_2 = diagnosis.arcs.iter().find(|a| a.joint == 2).expect("joint 2 moves");
+        eprintln!(
+            "seed {seed}: chosen {chosen:?}; random folds {:.4} -> {:.4} mm; joint 2's arcs {:.4} -> {:.4} mm; fitted, off the poses: {fitted:.4} mm ({} rows)",
+            diagnosis.heldout_before_mm,
+            diagnosis.heldout_after_selected_mm,
+            joint_2.before_mm,
+            joint_2.after_mm,
+            off.rows.len()
+        );
+        assert!(!chosen.is_empty(), "seed {seed}: the gear error is found");
+        // Random folds promise about a tenth of what the fit gives there; the arcs' prediction is
+        // within 25 % of the fitted error (issue 23).
+        assert!(diagnosis.heldout_after_selected_mm < 0.5 * fitted, "seed {seed}: random folds see the gap now?");
+        assert!(
+            (joint_2.after_mm - fitted).abs() <= 0.25 * fitted,
+            "seed {seed}: predicted {} mm, fitted {fitted} mm",
+            joint_2.after_mm
+        );
+    }
 }
 
 /// Issue 30: a drift fitted within one session was applied as a straight line eight days later.
