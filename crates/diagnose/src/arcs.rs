@@ -145,3 +145,67 @@ pub(crate) fn arc_checks(
 pub(crate) fn mean_of(arcs: &[ArcCheck], value: impl Fn(&ArcCheck) -> f64) -> Option<f64> {
     (!arcs.is_empty()).then(|| arcs.iter().map(value).sum::<f64>() / arcs.len() as f64)
 }
+
+/// For each selected step that is a Fourier series of a joint's own angle, its mean held-out
+/// position error (m) at each of its orders when arcs of every *other* moving joint are left out
+/// in turn (the other selected steps at their chosen orders); `None` for other steps or where no
+/// other joint moves. The series' own joint's arcs are left out of this: there the model fades
+/// the series whole, whatever its order.
+pub(crate) fn order_curves(
+    inputs: &ArcInputs<'_>,
+    data: &MeasurementSet,
+    moving: &[usize],
+    terms: &[Term],
+    selection: &Selection,
+    columns_of: &dyn Fn(usize) -> (Vec<Vec<f64>>, Option<f64>),
+) -> Result<Vec<Option<(Vec<u32>, Vec<f64>)>>, Error> {
+    let kinematic = inputs.design.kinematic.ncols();
+    let mut out = Vec::with_capacity(selection.steps.len());
+    for (s, step) in selection.steps.iter().enumerate() {
+        let term = &terms[step.term];
+        let (Some(orders), IdentifiedEffect::GearPeriodic(gear)) = (&term.orders, &term.model) else {
+            out.push(None);
+            continue;
+        };
+        let others: Vec<usize> = moving.iter().copied().filter(|&k| k != gear.joint).collect();
+        if others.is_empty() {
+            out.push(None);
+            continue;
+        }
+        // Columns: the kinematics, the other steps at their orders, then this series in full.
+        let mut owned: Vec<(Vec<Vec<f64>>, Option<f64>)> = Vec::new();
+        for (_, other) in selection.steps.iter().enumerate().filter(|&(t, _)| t != s) {
+            let (mut columns, sd) = columns_of(other.term);
+            if let Some(h) = other.scored.order {
+                columns.truncate(2 * h as usize);
+            }
+            owned.push((columns, sd));
+        }
+        let (own, own_sd) = columns_of(step.term);
+        let orders: Vec<u32> = orders.iter().copied().filter(|&h| 2 * h as usize <= own.len()).collect();
+        let base_width: usize = owned.iter().map(|(c, _)| c.len()).sum();
+        let own_width = own.len();
+        owned.push((own, own_sd));
+        let blocks: Vec<Block<'_>> = owned.iter().map(|(c, sd)| (c.as_slice(), *sd)).collect();
+        let base: Vec<usize> = (0..kinematic + base_width).collect();
+        let series: Vec<usize> = (kinematic + base_width..kinematic + base_width + own_width).collect();
+        let mut sum = vec![0.0; orders.len()];
+        let mut count = 0usize;
+        for &k in &others {
+            let fold = arc_folds(data, k, inputs.folds);
+            let pool = Pool::new(inputs.design, inputs.kinematic_prior, &blocks, &fold, inputs.folds, inputs.prior);
+            for f in 0..inputs.folds {
+                if pool.fold_poses(f).is_empty() {
+                    continue;
+                }
+                let residuals = pool.series_residuals(&[f], &[f], &base, &series, &orders)?;
+                for (total, r) in sum.iter_mut().zip(&residuals[0]) {
+                    *total += r.iter().map(|v| v.fixed_rows::<3>(0).norm()).sum::<f64>();
+                }
+                count += pool.fold_poses(f).len();
+            }
+        }
+        out.push(Some((orders, sum.iter().map(|v| v / count.max(1) as f64).collect())));
+    }
+    Ok(out)
+}

@@ -52,7 +52,7 @@ pub use noise::{NoiseFloor, NoiseSource};
 pub use outliers::{GrossOutliers, OutlierOptions};
 pub use pool::PriorOptions;
 pub use regions::{PoseDiagnosis, Region};
-pub use report::{CandidateScore, DominantHarmonic, SelectedEffect, SeriesShape};
+pub use report::{CandidateScore, DominantHarmonic, OrderScore, SelectedEffect, SeriesShape};
 pub use selection::SelectionOptions;
 pub use structure::{GpInput, StructureOptions};
 pub use verdict::{GpCheck, InputScale, Verdict, VerdictOptions};
@@ -170,6 +170,10 @@ impl DiagnoseOptions {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(Error::new(ErrorKind::DiagnoseOption { field, value }));
             }
+        }
+        let weight = self.selection.arc_order_weight;
+        if !(0.0..=1.0).contains(&weight) {
+            return Err(Error::new(ErrorKind::DiagnoseOption { field: "selection.arc_order_weight", value: weight }));
         }
         if self.arc_folds < 2 {
             return Err(Error::new(ErrorKind::DiagnoseOption { field: "arc_folds", value: self.arc_folds as f64 }));
@@ -458,8 +462,7 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
             model: side.model,
         });
     }
-    let selection = selection::select(&pool, &terms, &options.selection)?;
-    let all_selected = selection.last();
+    let mut selection = selection::select(&pool, &terms, &options.selection)?;
     let arc_inputs = arcs::ArcInputs {
         design: &design,
         kinematic_prior: &kinematic_prior,
@@ -471,7 +474,39 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
         Some(c) => (c.columns.clone(), c.prior_sd),
         None => (vec![side_columns[t - candidates.len()].clone()], None),
     };
+    // Each selected series' order: its random folds' curve and its curve over the other joints'
+    // arcs, weighed (`SelectionOptions::arc_order_weight`).
+    let weight = options.selection.arc_order_weight;
+    let arc_curves = if weight > 0.0 {
+        arcs::order_curves(&arc_inputs, data, &moving, &terms, &selection, &columns_of)?
+    } else {
+        vec![None; selection.steps.len()]
+    };
+    let mut order_curves: Vec<Vec<OrderScore>> = Vec::with_capacity(selection.steps.len());
+    for (step, arc_curve) in selection.steps.iter_mut().zip(&arc_curves) {
+        let scores: Vec<OrderScore> = step
+            .scored
+            .curve
+            .iter()
+            .map(|&(order, random)| OrderScore {
+                order,
+                random_folds_mm: random * 1e3,
+                arcs_mm: arc_curve
+                    .as_ref()
+                    .and_then(|(orders, c)| orders.iter().position(|&h| h == order).map(|i| c[i] * 1e3)),
+            })
+            .collect();
+        if arc_curve.is_some() && !scores.is_empty() {
+            let combined: Vec<f64> = scores
+                .iter()
+                .map(|s| (1.0 - weight) * s.random_folds_mm + weight * s.arcs_mm.unwrap_or(s.random_folds_mm))
+                .collect();
+            step.scored.order = Some(scores[selection::argmin(&combined)].order);
+        }
+        order_curves.push(scores);
+    }
     let arcs = arcs::arc_checks(&arc_inputs, data, &moving, &terms, &selection, &columns_of)?;
+    let all_selected = selection.last();
 
     // What any smooth function of the joint angles explains, before and after the effects.
     let single_critical = statistics::normal_quantile(1.0 - options.selection.significance);
@@ -615,11 +650,13 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
         .steps
         .iter()
         .zip(shapes)
-        .map(|(s, shape)| SelectedEffect {
+        .zip(order_curves)
+        .map(|((s, shape), order_curve)| SelectedEffect {
             effect: terms[s.term].effect,
             joints: terms[s.term].joints.clone(),
             harmonic: s.scored.order,
             fold_orders: s.scored.fold_orders.clone(),
+            order_curve,
             shape,
             heldout_after_mm: s.scored.result.mean_error() * 1e3,
             z: s.z,

@@ -48,6 +48,19 @@ pub struct SeriesShape {
     pub dominant: Vec<DominantHarmonic>,
 }
 
+/// One order of a selected series and its held-out errors.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OrderScore {
+    /// Harmonics 1 to this.
+    pub order: u32,
+    /// Mean held-out position error over the random folds, mm.
+    pub random_folds_mm: f64,
+    /// Mean held-out position error over arcs of every other moving joint, mm; `None` where no
+    /// other joint moves.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub arcs_mm: Option<f64>,
+}
+
 /// An effect the selection kept.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SelectedEffect {
@@ -62,6 +75,11 @@ pub struct SelectedEffect {
     /// For gear periodic error: the order each fold chose by cross-validation on its own rows.
     #[serde(skip_serializing_if = "Vec::is_empty", default)]
     pub fold_orders: Vec<u32>,
+    /// For gear periodic error: every order it may take, with its held-out error over the random
+    /// folds and over the other joints' arcs; `harmonic` minimises their weighted sum
+    /// (`SelectionOptions::arc_order_weight`).
+    #[serde(skip_serializing_if = "Vec::is_empty", default)]
+    pub order_curve: Vec<OrderScore>,
     /// For gear periodic error: its size and strongest periods.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub shape: Option<SeriesShape>,

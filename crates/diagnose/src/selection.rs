@@ -73,6 +73,9 @@ pub(crate) struct Scored {
     pub order: Option<u32>,
     /// For a series: the order each fold chose on its own training rows.
     pub fold_orders: Vec<u32>,
+    /// For a series: each order it may take, with its mean held-out position error over every
+    /// fold (m): the outer curve `order` was the minimum of.
+    pub curve: Vec<(u32, f64)>,
 }
 
 /// One accepted step of the selection.
@@ -121,6 +124,12 @@ pub struct SelectionOptions {
     /// cross-validation on its training rows. Up to 48: the blind check draws harmonics up to 40,
     /// and a real UR10's joint errors need 24–32 (issue 11).
     pub series_orders: Vec<u32>,
+    /// The order a fit on every row uses for a selected series minimises
+    /// `(1 − w) · random folds + w · arcs`: its mean held-out error over the random folds, and
+    /// over arcs of every other moving joint left out in turn (module `arcs`; issue 23: order
+    /// selection that also sees gaps). 0.5 weighs poses like the training poses and poses off
+    /// them alike (no measurement chose it); 0 is the random folds alone, as before.
+    pub arc_order_weight: f64,
 }
 
 impl Default for SelectionOptions {
@@ -130,11 +139,12 @@ impl Default for SelectionOptions {
             min_relative_gain: 0.03,
             max_effects: 4,
             series_orders: vec![1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 40, 48],
+            arc_order_weight: 0.5,
         }
     }
 }
 
-fn argmin(values: &[f64]) -> usize {
+pub(crate) fn argmin(values: &[f64]) -> usize {
     values.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map_or(0, |(i, _)| i)
 }
 
@@ -145,7 +155,12 @@ pub(crate) fn score(pool: &Pool, base: &[Vec<usize>], term: &Term) -> Result<Sco
         let fold_columns: Vec<Vec<usize>> =
             base.iter().enumerate().map(|(f, b)| b.iter().chain(term.columns_for(f)).copied().collect()).collect();
         let residuals = pool.cross_validate(&|f| fold_columns[f].clone())?;
-        return Ok(Scored { result: CrossValidated::new(residuals, fold_columns), order: None, fold_orders: vec![] });
+        return Ok(Scored {
+            result: CrossValidated::new(residuals, fold_columns),
+            order: None,
+            fold_orders: vec![],
+            curve: vec![],
+        });
     };
     let orders: Vec<u32> = orders.iter().copied().filter(|&h| 2 * h as usize <= term.columns.len()).collect();
     let position_sum = |residuals: &[Vector6]| residuals.iter().map(|r| r.fixed_rows::<3>(0).norm()).sum::<f64>();
@@ -191,10 +206,12 @@ pub(crate) fn score(pool: &Pool, base: &[Vec<usize>], term: &Term) -> Result<Sco
         }
         fold_columns.push(base[f].iter().chain(&term.columns[..2 * chosen as usize]).copied().collect());
     }
+    let rows = pool.poses().max(1) as f64;
     Ok(Scored {
         result: CrossValidated::new(residuals, fold_columns),
         order: Some(orders[argmin(&outer_sum)]),
         fold_orders,
+        curve: orders.iter().zip(&outer_sum).map(|(&h, &sum)| (h, sum / rows)).collect(),
     })
 }
 
