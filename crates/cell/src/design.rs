@@ -178,6 +178,18 @@ impl<'a> Design<'a> {
         design
     }
 
+    /// The design of `chosen` (kept in that order), computed once rather than by one update per
+    /// pose (the same state, to rounding).
+    pub fn of(rows: &'a CandidateRows, prior: f64, criterion: Criterion, chosen: &[usize]) -> Self {
+        let mut design = Self::new(rows, prior, criterion);
+        for &c in chosen {
+            design.in_design[c] = true;
+        }
+        design.chosen = chosen.to_vec();
+        design.refresh();
+        design
+    }
+
     /// The chosen candidates, in the order they were chosen (exchanges keep the position).
     pub fn chosen(&self) -> &[usize] {
         &self.chosen
@@ -546,7 +558,10 @@ mod tests {
         }
         design.replace(1, 22);
         let (log_det, variance, reach) = (design.log_det(), design.variance.clone(), design.reach.clone());
+        let at_once = Design::of(&rows, 1e-3, criterion, &[3, 22, 17, 4, 30]);
+        assert_eq!(at_once.chosen(), design.chosen());
         design.refresh();
+        assert_eq!(at_once.log_det().to_bits(), design.log_det().to_bits());
         assert!((log_det - design.log_det()).abs() < 1e-8 * log_det.abs().max(1.0));
         for (a, b) in variance.iter().zip(&design.variance).chain(reach.iter().zip(&design.reach)) {
             assert!((a - b).abs() < 1e-8 * b.abs().max(1.0), "{criterion:?}: {a} {b}");

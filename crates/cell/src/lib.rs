@@ -86,6 +86,7 @@
 #![deny(missing_docs)]
 
 mod bias;
+mod bias_trial;
 mod candidates;
 mod coverage;
 mod design;

@@ -365,10 +365,7 @@ pub fn plan(
         let mut chosen = design.chosen().to_vec();
         unmodelled_exchanges = unmodelled.exchange(&mut chosen);
         if unmodelled_exchanges > 0 {
-            design = Design::new(&rows, prior, options.criterion);
-            for c in chosen {
-                design.add(c);
-            }
+            design = Design::of(&rows, prior, options.criterion, &chosen);
         }
     }
     let axes = axes(candidates, options.coverage_bins.min(poses), options.min_joint_span);
