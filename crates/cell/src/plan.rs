@@ -11,6 +11,7 @@ use crate::bias::{BiasModel, Unmodelled};
 use crate::coverage::{Axis, AxisCoverage, cover, coverage};
 use crate::design::{Criterion, Design};
 use crate::information::{Candidate, RowWeights, candidate_rows};
+use crate::unmodelled_setting::{UnmodelledFrom, UnmodelledSetting};
 use errors::{Error, ErrorKind};
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
@@ -219,6 +220,16 @@ pub struct PlanReport {
     /// The unmodelled error the errors with it are predicted for, mm per axis
     /// ([`PlanOptions::unmodelled_mm`]; 0: none).
     pub unmodelled_mm: f64,
+    /// Where `unmodelled_mm` came from ([`UnmodelledFrom`]; [`plan()`] says the options,
+    /// `calib plan` whether they are the defaults or a model's held-out error).
+    pub unmodelled_from: UnmodelledFrom,
+    /// The unmodelled orientation error, mrad per axis ([`PlanOptions::unmodelled_mrad`]; full
+    /// pose only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unmodelled_mrad: Option<f64>,
+    /// Where it came from.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unmodelled_mrad_from: Option<UnmodelledFrom>,
     /// Exchanges made after the greedy choice.
     pub exchanges: usize,
     /// Exchanges made for the unmodelled error ([`PlanOptions::unmodelled_mm`]).
@@ -232,6 +243,14 @@ pub struct PlanReport {
 }
 
 impl PlanReport {
+    /// Says where the unmodelled errors came from ([`PlanOptions::set_unmodelled_from`]).
+    pub fn set_unmodelled_from(&mut self, setting: UnmodelledSetting) {
+        self.unmodelled_from = setting.position;
+        if self.unmodelled_mrad.is_some() {
+            self.unmodelled_mrad_from = Some(setting.rotation);
+        }
+    }
+
     /// The report as lines of text.
     pub fn lines(&self) -> Vec<String> {
         let mut lines = vec![format!(
@@ -249,15 +268,18 @@ impl PlanReport {
         for c in &self.coverage {
             lines.push(format!("  {}: {} of {} bins covered", c.input, c.covered, c.possible));
         }
+        if self.unmodelled_mm > 0.0 {
+            lines.push(format!("  unmodelled error {:.3} mm per axis ({})", self.unmodelled_mm, self.unmodelled_from));
+            if let (Some(mrad), Some(from)) = (self.unmodelled_mrad, self.unmodelled_mrad_from) {
+                let lever = if matches!(from, UnmodelledFrom::Model { .. }) { "; mm at the 1 m lever" } else { "" };
+                lines.push(format!("  unmodelled orientation error {mrad:.3} mrad per axis ({from}{lever})"));
+            }
+        }
         lines.push(format!(
             "  predicted error (tracker noise {:.3} mm per axis{}; rms over the candidates):",
             self.position_noise_mm,
             if self.unmodelled_mm > 0.0 {
-                format!(
-                    ", unmodelled error {:.3} mm per axis (PlanOptions::unmodelled_mm: set it from a fit's held-out \
-                     error on this robot)",
-                    self.unmodelled_mm
-                )
+                format!(", unmodelled error {:.3} mm per axis", self.unmodelled_mm)
             } else {
                 String::new()
             }
@@ -386,6 +408,9 @@ pub fn plan(
         directions: rows.r,
         position_noise_mm: options.position_noise_mm,
         unmodelled_mm: options.unmodelled_mm,
+        unmodelled_from: UnmodelledFrom::Options,
+        unmodelled_mrad: full_pose.then_some(options.unmodelled_mrad),
+        unmodelled_mrad_from: full_pose.then_some(UnmodelledFrom::Options),
         exchanges,
         unmodelled_exchanges,
         coverage_swaps,
