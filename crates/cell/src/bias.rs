@@ -23,8 +23,9 @@
 //! ```
 //!
 //! `P` keeps the position rows. With `β = 0` this is the I-criterion. The design is improved by
-//! exchanges from the I-optimal one, each trial evaluated exactly (`O(r³)`); the same value gives
-//! the plan's predicted held-out error with the unmodelled error in it.
+//! exchanges from the I-optimal one, each trial a rank-2k update ([`crate::bias_trial`],
+//! `O(r² k)`), the one taken evaluated afresh (`O(r³)`); the same value gives the plan's
+//! predicted held-out error with the unmodelled error in it.
 
 use crate::bias_trial::Position;
 use crate::information::{Candidate, CandidateRows};

@@ -56,7 +56,8 @@ pub struct PlanOptions {
     /// mm: 0.2. After `poe` the UR10 of Landgraf et al. keeps 0.44 mm (3-D mean) on series C,
     /// 0.41 on B and 0.37 on D, about 0.2–0.25 per axis. The design is then exchanged to lower
     /// the expected held-out error with that error in it ([`crate::bias`]), and the report
-    /// predicts it. 0: tracker noise alone (the plain criterion).
+    /// predicts it. 0: tracker noise alone (the plain criterion). `calib plan --model` sets it
+    /// from the model's held-out error where the options do not ([`PlanOptions::set_unmodelled_from`]).
     pub unmodelled_mm: f64,
     /// The same for the orientation, mrad: 0.2, the position's at the 1 m lever of an arm's
     /// reach.
@@ -71,9 +72,10 @@ pub struct PlanOptions {
     /// Candidates (evenly strided over those not chosen) tried in each position of an exchange
     /// for the unmodelled error: 500, at most `unmodelled_evaluations / poses`.
     pub unmodelled_trials: usize,
-    /// Trials in one pass of those exchanges, over all positions: 30,000. Each costs a few `r³`
-    /// (`r` ≈ 40 directions for a 6-axis arm's full pose); this keeps 100 of 10,000 candidates
-    /// within seconds (`cargo xtask cell-check --only timing`), and 30 or 50 poses at 500
+    /// Trials in one pass of those exchanges, over all positions: 30,000. Each is a rank-2k
+    /// update (`O(r² k)`, `r` ≈ 30–40 directions for a 6-axis arm's full pose, [`crate::bias`]);
+    /// this kept 100 of 10,000 candidates within seconds when each trial was still a
+    /// refactorisation (`cargo xtask cell-check --only timing`), and 30 or 50 poses at 500
     /// trials each.
     pub unmodelled_evaluations: usize,
     /// Passes of those exchanges: 2 (a third changed no pose on the UR10 series).
