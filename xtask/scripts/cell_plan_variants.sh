@@ -3,10 +3,18 @@
 # tested on its odd rows. Usage (from the worktree root, release build):
 #   xtask/scripts/cell_plan_variants.sh plan SERIES N 'PLAN_OPTIONS_RON' [label]
 #   xtask/scripts/cell_plan_variants.sh random SERIES N SEEDS
+#   xtask/scripts/cell_plan_variants.sh model SERIES N ['PLAN_OPTIONS_RON'] [label]
+# `model`: `poe` fitted on all the even rows first and the plan made with `--model` (its geometry,
+# and its held-out error as the unmodelled error unless the options set it).
 C=${CALIB:-target/release/calib}; R=fixtures/robots/ur10.ron; D=${DATA:-/work/data}; T=$(mktemp -d)
 ev() { $C eval --model $1 --data $2 --json 2>/dev/null | python3 -c "import json,sys; print('%.4f' % json.load(sys.stdin)['mean_position_error_mm'])"; }
 S=$2; N=$3
-if [ "$1" = plan ]; then
+if [ "$1" = model ]; then
+  echo "${4:-()}" > $T/o.ron
+  $C fit --robot $R --data $D/ur10_${S}_full_even.csv --method poe --out $T/even.ron >/dev/null 2>&1
+  $C plan --robot $R --model $T/even.ron --candidates $D/ur10_${S}_full_even.csv --poses $N --options $T/o.ron --out $T/c.csv >/dev/null
+  $C fit --robot $R --data $T/c.csv --method poe --out $T/m.ron >/dev/null 2>&1 && echo "$S N=$N --model ${5:-${4:-()}}: $(ev $T/m.ron $D/ur10_${S}_full_odd.csv)"
+elif [ "$1" = plan ]; then
   echo "$4" > $T/o.ron
   $C plan --robot $R --candidates $D/ur10_${S}_full_even.csv --poses $N --full-pose --options $T/o.ron --out $T/c.csv >/dev/null
   $C fit --robot $R --data $T/c.csv --method poe --out $T/m.ron >/dev/null 2>&1 && echo "$S N=$N ${5:-$4}: $(ev $T/m.ron $D/ur10_${S}_full_odd.csv)"

@@ -9,7 +9,9 @@ use std::path::PathBuf;
 pub struct Args {
     #[command(flatten)]
     robot: RobotArgs,
-    /// A calibrated model (RON): plan with its geometry and tools (else the robot's nominal model).
+    /// A calibrated model (RON): plan with its geometry and tools (else the robot's nominal
+    /// model), and, unless the options set them, with its held-out error as the unmodelled error
+    /// (`unmodelled_mm`, `unmodelled_mrad`: mean 3-D error × √(π/8) per axis).
     #[arg(long)]
     model: Option<PathBuf>,
     /// Candidate configurations (the measurement CSV; position columns may be left out; every
@@ -59,13 +61,16 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let robot = args.robot.read()?;
     let model = args.model.as_deref().map(model::read_model).transpose()?;
     let full_pose = args.full_pose || model.as_ref().is_some_and(|m| m.full_pose);
-    let mut options = match &args.options {
+    let (mut options, given) = match &args.options {
         Some(path) => {
             let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-            cell::PlanOptions::parse(&text, &path.display().to_string())?
+            let file = path.display().to_string();
+            (cell::PlanOptions::parse(&text, &file)?, cell::UnmodelledGiven::of_text(&text, &file)?)
         }
-        None => cell::PlanOptions::default(),
+        None => (cell::PlanOptions::default(), cell::UnmodelledGiven::default()),
     };
+    // Unless the options set it, the unmodelled error is the model's own held-out error.
+    let unmodelled = options.set_unmodelled_from(model.as_ref(), given);
     options.criterion = args.criterion.unwrap_or(options.criterion);
     options.position_noise_mm = args.noise_mm.unwrap_or(options.position_noise_mm);
     options.validate()?;
@@ -87,7 +92,8 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     for tool in &set.unknown_tools {
         notes.push(format!("warning: tool '{tool}' is not in the model: planned with its first tool"));
     }
-    let plan = cell::plan(&set.model, &set.candidates, args.poses, full_pose, &options)?;
+    let mut plan = cell::plan(&set.model, &set.candidates, args.poses, full_pose, &options)?;
+    plan.report.set_unmodelled_from(unmodelled);
     let seconds = started.elapsed().as_secs_f64();
     let mut out = measurements::OutputFile::create(&args.out)?;
     match &file {

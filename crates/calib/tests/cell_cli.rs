@@ -216,6 +216,53 @@ fn plan_writes_chosen_candidate_rows_unchanged() {
     }
 }
 
+/// With `--model`, the plan's unmodelled error is the model's held-out error (mean 3-D × √(π/8)
+/// per axis) unless the options set it, and the report says where each came from.
+#[test]
+fn plan_takes_the_unmodelled_error_from_the_models_heldout_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let (data, model) = setup(dir.path(), 250);
+    let content = std::fs::read_to_string(&model).unwrap();
+    let at = content.find("mean_position_error_mm: ").expect("a poe fit keeps its held-out estimate") + 24;
+    let heldout: f64 = content[at..at + content[at..].find(',').unwrap()].parse().unwrap();
+    let sigma = heldout * (std::f64::consts::PI / 8.0).sqrt();
+    let plan = |options: Option<&str>| {
+        let chosen = dir.path().join("chosen.csv");
+        let mut args: Vec<String> = ["plan", "--robot", &fixture("irb4400.ron"), "--model", &text(&model)]
+            .into_iter()
+            .map(String::from)
+            .collect();
+        args.extend(["--candidates", &text(&data), "--poses", "12", "--out", &text(&chosen)].map(String::from));
+        if let Some(options) = options {
+            let file = dir.path().join("options.ron");
+            std::fs::write(&file, options).unwrap();
+            args.extend(["--options".to_owned(), text(&file)]);
+        }
+        let json =
+            succeeds_with_stderr(&[args.iter().map(String::as_str).collect::<Vec<_>>(), vec!["--json"]].concat()).0;
+        std::fs::remove_file(&chosen).unwrap();
+        let lines = succeeds_with_stderr(&args.iter().map(String::as_str).collect::<Vec<_>>()).0;
+        std::fs::remove_file(&chosen).unwrap();
+        (json, lines)
+    };
+    let (json, lines) = plan(None);
+    assert!((json_number(&json, "unmodelled_mm") - sigma).abs() < 1e-12, "{json}");
+    assert!((json_number(&json, "unmodelled_mrad") - sigma).abs() < 1e-12, "{json}");
+    assert!(json.contains("\"unmodelled_from\":{\"from\":\"model\""), "{json}");
+    assert!(json.contains("\"heldout_source\":\"degrees_of_freedom\""), "{json}");
+    assert!(
+        lines.contains(&format!("unmodelled error {sigma:.3} mm per axis (from the poe model's held-out error")),
+        "{lines}"
+    );
+    // Set in the options: kept, and said so; the orientation's still from the model.
+    let (json, lines) = plan(Some("(unmodelled_mm: 0.3)"));
+    assert_eq!(json_number(&json, "unmodelled_mm"), 0.3);
+    assert!((json_number(&json, "unmodelled_mrad") - sigma).abs() < 1e-12, "{json}");
+    assert!(json.contains("\"unmodelled_from\":{\"from\":\"options\"}"), "{json}");
+    assert!(json.contains("\"unmodelled_mrad_from\":{\"from\":\"model\""), "{json}");
+    assert!(lines.contains("unmodelled error 0.300 mm per axis (set in the options)"), "{lines}");
+}
+
 #[test]
 fn plan_refuses_more_poses_than_candidates_with_the_counts() {
     let dir = tempfile::tempdir().unwrap();

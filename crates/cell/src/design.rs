@@ -34,20 +34,6 @@ fn cholesky(m: &mut [f64], k: usize) -> Option<f64> {
     Some(log_det)
 }
 
-/// `a · b` in four running sums, which the compiler can keep in vector registers (one sum is a
-/// chain of dependent additions it may not reorder): the candidates' update is these products.
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut sums = [0.0; 4];
-    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = a4.remainder().iter().zip(b4.remainder()).map(|(x, y)| x * y).sum();
-    for (x, y) in a4.zip(b4) {
-        for l in 0..4 {
-            sums[l] += x[l] * y[l];
-        }
-    }
-    (sums[0] + sums[1]) + (sums[2] + sums[3]) + tail
-}
-
 /// `log det(I + sign · G)` of a `k × k` block, `-∞` where not positive definite.
 fn log_det_shifted(g: &[f64], k: usize, sign: f64) -> f64 {
     let mut m = [0.0; 36];
@@ -140,6 +126,10 @@ pub struct Design<'a> {
 /// stay of one order and 50 updates lose less than a digit.
 const REFRESH_EVERY: usize = 50;
 
+/// Candidates whose `A_c W` one matrix product gives in an update: enough rows (256 × k) for the
+/// matrix kernel's blocking, few enough for rayon to share 10,000 candidates among the cores.
+const UPDATE_BLOCK: usize = 256;
+
 impl<'a> Design<'a> {
     /// An empty design with the ridge `prior · I`.
     pub fn new(rows: &'a CandidateRows, prior: f64, criterion: Criterion) -> Self {
@@ -174,6 +164,18 @@ impl<'a> Design<'a> {
             log_det: 0.0,
             updates: 0,
         };
+        design.refresh();
+        design
+    }
+
+    /// The design of `chosen` (kept in that order), computed once rather than by one update per
+    /// pose (the same state, to rounding).
+    pub fn of(rows: &'a CandidateRows, prior: f64, criterion: Criterion, chosen: &[usize]) -> Self {
+        let mut design = Self::new(rows, prior, criterion);
+        for &c in chosen {
+            design.in_design[c] = true;
+        }
+        design.chosen = chosen.to_vec();
         design.refresh();
         design
     }
@@ -395,22 +397,12 @@ impl<'a> Design<'a> {
             (Vec::new(), [0.0; 36])
         };
         let rows = self.rows;
-        // Wᵀ and Zᵀ (k × r), so that every product below is a dot product of contiguous rows.
-        let transpose = |x: &[f64]| -> Vec<f64> {
-            if x.is_empty() {
-                return Vec::new();
-            }
-            (0..k * r).map(|at| x[(at % r) * k + at / r]).collect()
-        };
-        let (wt, zt) = (transpose(&w), transpose(&z));
-        let update_one = |c: usize, g: &mut [f64], f: Option<&mut [f64]>| {
-            let a = rows.rows(c);
-            let mut h = [0.0; 36];
-            for i in 0..k {
-                for j in 0..k {
-                    h[i * k + j] = dot(&a[i * r..(i + 1) * r], &wt[j * r..(j + 1) * r]);
-                }
-            }
+        let with_reach = self.criterion == Criterion::I;
+        // [W | Z]ᵀ (k or 2k rows × r): one product with a block of candidates' rows gives every
+        // candidate's `A_c W` and `A_c Z` in a matrix kernel, not k² dot products each.
+        let width = if with_reach { 2 * k } else { k };
+        let factors = nalgebra::DMatrix::from_fn(width, r, |j, l| if j < k { w[l * k + j] } else { z[l * k + j - k] });
+        let update_one = |g: &mut [f64], f: Option<&mut [f64]>, h: &[f64; 36], e: &[f64; 36]| {
             for i in 0..k {
                 for j in 0..k {
                     let hh: f64 = (0..k).map(|m| h[i * k + m] * h[j * k + m]).sum();
@@ -418,12 +410,6 @@ impl<'a> Design<'a> {
                 }
             }
             if let Some(f) = f {
-                let mut e = [0.0; 36];
-                for i in 0..k {
-                    for j in 0..k {
-                        e[i * k + j] = dot(&a[i * r..(i + 1) * r], &zt[j * r..(j + 1) * r]);
-                    }
-                }
                 let mut ht = [0.0; 36];
                 for i in 0..k {
                     for j in 0..k {
@@ -440,14 +426,38 @@ impl<'a> Design<'a> {
                 }
             }
         };
-        if self.criterion == Criterion::I {
+        let kk = k * k;
+        let update_block = |block: usize, g: &mut [f64], mut f: Option<&mut [f64]>| {
+            let count = g.len() / kk;
+            let first = block * UPDATE_BLOCK;
+            // The block's rows, row-major `count·k × r`: column-major `r × count·k`.
+            let a = nalgebra::DMatrixView::from_slice(&rows.a[first * k * r..(first + count) * k * r], r, count * k);
+            let products = &factors * a;
+            for c in 0..count {
+                let (mut h, mut e) = ([0.0; 36], [0.0; 36]);
+                for i in 0..k {
+                    for j in 0..k {
+                        h[i * k + j] = products[(j, c * k + i)];
+                        if with_reach {
+                            e[i * k + j] = products[(k + j, c * k + i)];
+                        }
+                    }
+                }
+                let reach = f.as_deref_mut().map(|f| &mut f[c * kk..(c + 1) * kk]);
+                update_one(&mut g[c * kk..(c + 1) * kk], reach, &h, &e);
+            }
+        };
+        if with_reach {
             self.variance
-                .par_chunks_mut(k * k)
-                .zip(self.reach.par_chunks_mut(k * k))
+                .par_chunks_mut(UPDATE_BLOCK * kk)
+                .zip(self.reach.par_chunks_mut(UPDATE_BLOCK * kk))
                 .enumerate()
-                .for_each(|(c, (g, f))| update_one(c, g, Some(f)));
+                .for_each(|(block, (g, f))| update_block(block, g, Some(f)));
         } else {
-            self.variance.par_chunks_mut(k * k).enumerate().for_each(|(c, g)| update_one(c, g, None));
+            self.variance
+                .par_chunks_mut(UPDATE_BLOCK * kk)
+                .enumerate()
+                .for_each(|(block, g)| update_block(block, g, None));
         }
     }
 
@@ -539,14 +549,24 @@ mod tests {
     }
 
     fn updates_match_a_recomputation_for(criterion: Criterion) {
-        let rows = random_rows(40, 3, 7, 1);
+        // More candidates than one block of the update (UPDATE_BLOCK), poses in three of them;
+        // more poses than `keep_accurate` recomputes after each (2⌈r/k⌉ = 6), so that the last
+        // additions and the replacement are updates.
+        let rows = random_rows(600, 3, 7, 1);
         let mut design = Design::new(&rows, 1e-3, criterion);
-        for c in [3, 9, 17, 4, 30] {
+        let poses = [3, 9, 317, 4, 530, 41, 260, 599, 100, 12];
+        for c in poses {
             design.add(c);
         }
+        assert!(design.updates > 0, "the last additions were not updates");
         design.replace(1, 22);
         let (log_det, variance, reach) = (design.log_det(), design.variance.clone(), design.reach.clone());
+        let mut replaced = poses;
+        replaced[1] = 22;
+        let at_once = Design::of(&rows, 1e-3, criterion, &replaced);
+        assert_eq!(at_once.chosen(), design.chosen());
         design.refresh();
+        assert_eq!(at_once.log_det().to_bits(), design.log_det().to_bits());
         assert!((log_det - design.log_det()).abs() < 1e-8 * log_det.abs().max(1.0));
         for (a, b) in variance.iter().zip(&design.variance).chain(reach.iter().zip(&design.reach)) {
             assert!((a - b).abs() < 1e-8 * b.abs().max(1.0), "{criterion:?}: {a} {b}");

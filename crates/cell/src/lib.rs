@@ -86,6 +86,7 @@
 #![deny(missing_docs)]
 
 mod bias;
+mod bias_trial;
 mod candidates;
 mod coverage;
 mod design;
@@ -98,6 +99,7 @@ mod register;
 mod register_options;
 pub mod registration;
 mod report;
+mod unmodelled_setting;
 mod urdf_export;
 mod urdf_like;
 mod urdf_text;
@@ -118,6 +120,7 @@ pub use plan::{Checkpoint, Plan, PlanOptions, PlanReport, measuring_order, plan}
 pub use register::{Registered, register};
 pub use register_options::{Refit, RegisterOptions};
 pub use report::{FrameChange, HeldoutFrom, RegisterReport, RegisterWarning, RegisteredTool, Verdict};
+pub use unmodelled_setting::{UnmodelledFrom, UnmodelledGiven, UnmodelledSetting, per_axis_from_mean};
 pub use urdf_export::{
     AxisChange, PartError, TrainingErrors, UrdfExport, UrdfExportReport, UrdfTemplate, export_urdf, write_urdf,
 };

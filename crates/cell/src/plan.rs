@@ -11,6 +11,7 @@ use crate::bias::{BiasModel, Unmodelled};
 use crate::coverage::{Axis, AxisCoverage, cover, coverage};
 use crate::design::{Criterion, Design};
 use crate::information::{Candidate, RowWeights, candidate_rows};
+use crate::unmodelled_setting::{UnmodelledFrom, UnmodelledSetting};
 use errors::{Error, ErrorKind};
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
@@ -55,7 +56,8 @@ pub struct PlanOptions {
     /// mm: 0.2. After `poe` the UR10 of Landgraf et al. keeps 0.44 mm (3-D mean) on series C,
     /// 0.41 on B and 0.37 on D, about 0.2–0.25 per axis. The design is then exchanged to lower
     /// the expected held-out error with that error in it ([`crate::bias`]), and the report
-    /// predicts it. 0: tracker noise alone (the plain criterion).
+    /// predicts it. 0: tracker noise alone (the plain criterion). `calib plan --model` sets it
+    /// from the model's held-out error where the options do not ([`PlanOptions::set_unmodelled_from`]).
     pub unmodelled_mm: f64,
     /// The same for the orientation, mrad: 0.2, the position's at the 1 m lever of an arm's
     /// reach.
@@ -70,9 +72,10 @@ pub struct PlanOptions {
     /// Candidates (evenly strided over those not chosen) tried in each position of an exchange
     /// for the unmodelled error: 500, at most `unmodelled_evaluations / poses`.
     pub unmodelled_trials: usize,
-    /// Trials in one pass of those exchanges, over all positions: 30,000. Each costs a few `r³`
-    /// (`r` ≈ 40 directions for a 6-axis arm's full pose); this keeps 100 of 10,000 candidates
-    /// within seconds (`cargo xtask cell-check --only timing`), and 30 or 50 poses at 500
+    /// Trials in one pass of those exchanges, over all positions: 30,000. Each is a rank-2k
+    /// update (`O(r² k)`, `r` ≈ 30–40 directions for a 6-axis arm's full pose, [`crate::bias`]);
+    /// this kept 100 of 10,000 candidates within seconds when each trial was still a
+    /// refactorisation (`cargo xtask cell-check --only timing`), and 30 or 50 poses at 500
     /// trials each.
     pub unmodelled_evaluations: usize,
     /// Passes of those exchanges: 2 (a third changed no pose on the UR10 series).
@@ -219,6 +222,16 @@ pub struct PlanReport {
     /// The unmodelled error the errors with it are predicted for, mm per axis
     /// ([`PlanOptions::unmodelled_mm`]; 0: none).
     pub unmodelled_mm: f64,
+    /// Where `unmodelled_mm` came from ([`UnmodelledFrom`]; [`plan()`] says the options,
+    /// `calib plan` whether they are the defaults or a model's held-out error).
+    pub unmodelled_from: UnmodelledFrom,
+    /// The unmodelled orientation error, mrad per axis ([`PlanOptions::unmodelled_mrad`]; full
+    /// pose only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unmodelled_mrad: Option<f64>,
+    /// Where it came from.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unmodelled_mrad_from: Option<UnmodelledFrom>,
     /// Exchanges made after the greedy choice.
     pub exchanges: usize,
     /// Exchanges made for the unmodelled error ([`PlanOptions::unmodelled_mm`]).
@@ -232,6 +245,14 @@ pub struct PlanReport {
 }
 
 impl PlanReport {
+    /// Says where the unmodelled errors came from ([`PlanOptions::set_unmodelled_from`]).
+    pub fn set_unmodelled_from(&mut self, setting: UnmodelledSetting) {
+        self.unmodelled_from = setting.position;
+        if self.unmodelled_mrad.is_some() {
+            self.unmodelled_mrad_from = Some(setting.rotation);
+        }
+    }
+
     /// The report as lines of text.
     pub fn lines(&self) -> Vec<String> {
         let mut lines = vec![format!(
@@ -249,15 +270,18 @@ impl PlanReport {
         for c in &self.coverage {
             lines.push(format!("  {}: {} of {} bins covered", c.input, c.covered, c.possible));
         }
+        if self.unmodelled_mm > 0.0 {
+            lines.push(format!("  unmodelled error {:.3} mm per axis ({})", self.unmodelled_mm, self.unmodelled_from));
+            if let (Some(mrad), Some(from)) = (self.unmodelled_mrad, self.unmodelled_mrad_from) {
+                let lever = if matches!(from, UnmodelledFrom::Model { .. }) { "; mm at the 1 m lever" } else { "" };
+                lines.push(format!("  unmodelled orientation error {mrad:.3} mrad per axis ({from}{lever})"));
+            }
+        }
         lines.push(format!(
             "  predicted error (tracker noise {:.3} mm per axis{}; rms over the candidates):",
             self.position_noise_mm,
             if self.unmodelled_mm > 0.0 {
-                format!(
-                    ", unmodelled error {:.3} mm per axis (PlanOptions::unmodelled_mm: set it from a fit's held-out \
-                     error on this robot)",
-                    self.unmodelled_mm
-                )
+                format!(", unmodelled error {:.3} mm per axis", self.unmodelled_mm)
             } else {
                 String::new()
             }
@@ -365,10 +389,7 @@ pub fn plan(
         let mut chosen = design.chosen().to_vec();
         unmodelled_exchanges = unmodelled.exchange(&mut chosen);
         if unmodelled_exchanges > 0 {
-            design = Design::new(&rows, prior, options.criterion);
-            for c in chosen {
-                design.add(c);
-            }
+            design = Design::of(&rows, prior, options.criterion, &chosen);
         }
     }
     let axes = axes(candidates, options.coverage_bins.min(poses), options.min_joint_span);
@@ -389,6 +410,9 @@ pub fn plan(
         directions: rows.r,
         position_noise_mm: options.position_noise_mm,
         unmodelled_mm: options.unmodelled_mm,
+        unmodelled_from: UnmodelledFrom::Options,
+        unmodelled_mrad: full_pose.then_some(options.unmodelled_mrad),
+        unmodelled_mrad_from: full_pose.then_some(UnmodelledFrom::Options),
         exchanges,
         unmodelled_exchanges,
         coverage_swaps,
