@@ -138,7 +138,11 @@ impl Cursor<'_> {
     pub(crate) fn payload_span(&self, span: Option<&crate::PayloadSpan>) -> Result<(), EffectFault> {
         let Some(span) = span else { return Ok(()) };
         let ranges = std::iter::once(("kg", 0, "payload_span.kg".to_owned(), span.kg));
-        let torques = span.torque_nm.iter().enumerate().map(|(k, r)| ("torque_nm", 0, format!("payload_span.torque_nm[{k}]"), *r));
+        let torques = span
+            .torque_nm
+            .iter()
+            .enumerate()
+            .map(|(k, r)| ("torque_nm", 0, format!("payload_span.torque_nm[{k}]"), *r));
         for (field, within, path, [low, high]) in ranges.chain(torques) {
             if let Some(&value) = [low, high].iter().find(|v| !v.is_finite()) {
                 return Err(self.fault(field, within, path, FaultKind::NotFinite { value }));

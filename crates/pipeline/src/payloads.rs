@@ -142,16 +142,16 @@ pub(crate) fn choose(
     }
     let fold_options = crate::rule_choice::fold_options(options, specs);
     let trials: Vec<Target> = targets.iter().map(|&k| Target { effect: k, rules: RULES.to_vec() }).collect();
-    let errors =
-        match held_out_errors(data, &folds, &fold_options, &trials, IdentifiedEffect::set_beyond_payload, fit) {
-            Ok(errors) => errors,
-            Err(FoldFailure::Fit(e)) => {
-                return Ok(keep(effects, format!("the fit without a payload failed ({e}): its own rule")));
-            }
-            Err(FoldFailure::Predict(e)) => {
-                return Ok(keep(effects, format!("a left-out payload was not predicted ({e}): its own rule")));
-            }
-        };
+    let errors = match held_out_errors(data, &folds, &fold_options, &trials, IdentifiedEffect::set_beyond_payload, fit)
+    {
+        Ok(errors) => errors,
+        Err(FoldFailure::Fit(e)) => {
+            return Ok(keep(effects, format!("the fit without a payload failed ({e}): its own rule")));
+        }
+        Err(FoldFailure::Predict(e)) => {
+            return Ok(keep(effects, format!("a left-out payload was not predicted ({e}): its own rule")));
+        }
+    };
     let (lightest, heaviest) = (data.rows[folds[0][0]].payload_kg, data.rows[folds[1][0]].payload_kg);
     let mut out = Vec::with_capacity(targets.len());
     for (trial, errors) in trials.iter().zip(&errors) {
@@ -168,7 +168,10 @@ pub(crate) fn choose(
             heldout.extend,
             decision.rows,
             if decision.switched {
-                format!("{} lower than held by more than one standard error, {standard_error:.4} mm", decision.chosen.name())
+                format!(
+                    "{} lower than held by more than one standard error, {standard_error:.4} mm",
+                    decision.chosen.name()
+                )
             } else {
                 format!("held, no other rule lower by more than one standard error, {standard_error:.4} mm")
             }
@@ -205,7 +208,10 @@ mod tests {
     fn the_fewest_payload_groups_are_validated() {
         assert!(PayloadOptions::default().validate().is_ok());
         for n in [0, 1] {
-            assert_eq!(PayloadOptions { min_groups: n, ..PayloadOptions::default() }.validate().unwrap_err().0, "min_groups");
+            assert_eq!(
+                PayloadOptions { min_groups: n, ..PayloadOptions::default() }.validate().unwrap_err().0,
+                "min_groups"
+            );
         }
     }
 }

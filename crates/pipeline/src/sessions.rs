@@ -128,8 +128,7 @@ pub(crate) fn choose(
             Target { effect: k, rules: vec![rule, rule.other()] }
         })
         .collect();
-    let errors = match held_out_errors(data, &found, &fold_options, &trials, IdentifiedEffect::set_beyond_span, fit)
-    {
+    let errors = match held_out_errors(data, &found, &fold_options, &trials, IdentifiedEffect::set_beyond_span, fit) {
         Ok(errors) => errors,
         Err(FoldFailure::Fit(e)) => {
             return Ok(keep(effects, format!("the fit without a session failed ({e}): its own rule")));
