@@ -173,6 +173,9 @@ fn summarise(
     for choice in &report.beyond_span {
         let _ = writeln!(out, "  {choice}");
     }
+    for choice in &report.beyond_payload {
+        let _ = writeln!(out, "  {choice}");
+    }
     for effect in &report.effects {
         let held: Vec<&str> = effect.parameters.iter().filter(|p| p.held_at_prior).map(|p| p.name.as_str()).collect();
         let _ = writeln!(

@@ -134,6 +134,35 @@ impl Cursor<'_> {
         self.finite("gravity_m_per_s2", &load.gravity_m_per_s2, false)
     }
 
+    /// The payload span of a load-driven effect: every end finite, the lower not above the upper.
+    pub(crate) fn payload_span(&self, span: Option<&crate::PayloadSpan>) -> Result<(), EffectFault> {
+        let Some(span) = span else { return Ok(()) };
+        let ranges = std::iter::once(("kg", 0, "payload_span.kg".to_owned(), span.kg));
+        let torques = span
+            .torque_nm
+            .iter()
+            .enumerate()
+            .map(|(k, r)| ("torque_nm", 0, format!("payload_span.torque_nm[{k}]"), *r));
+        for (field, within, path, [low, high]) in ranges.chain(torques) {
+            if let Some(&value) = [low, high].iter().find(|v| !v.is_finite()) {
+                return Err(self.fault(field, within, path, FaultKind::NotFinite { value }));
+            }
+            if low > high {
+                return Err(self.fault(field, within, path, FaultKind::Order { low, high }));
+            }
+        }
+        Ok(())
+    }
+
+    /// Counts the fields of a payload span ([`Cursor::payload_span`]).
+    pub(crate) fn count_payload_span(span: Option<&crate::PayloadSpan>, add: &mut dyn FnMut(&'static str, usize)) {
+        if let Some(span) = span {
+            add("payload_span", 1);
+            add("kg", 1);
+            add("torque_nm", usize::from(!span.torque_nm.is_empty()));
+        }
+    }
+
     /// Counts the fields of one effect, so that the next effect's occurrences start after them.
     fn advance(&mut self, effect: &IdentifiedEffect) {
         let mut add = |field: &'static str, count: usize| *self.seen.entry(field).or_insert(0) += count;

@@ -10,7 +10,7 @@ use crate::check::{Cursor, EffectFault, FaultKind};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect, has_torques};
 
-use crate::Direction;
+use crate::{BeyondSpan, Direction, PayloadSpan};
 use errors::{Error, ErrorKind};
 use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};
@@ -111,15 +111,21 @@ pub struct JointCompliance {
     pub terms: Vec<ComplianceTerm>,
     /// Their values: radians of deflection per unit of the scaled regressor.
     pub theta: Vec<f64>,
+    /// The payloads (and measured torques) of the training rows and the rule beyond them
+    /// (issue 30, `PayloadSpan`: held at the nearer end unless the fit chose otherwise). Absent
+    /// in model files written before it was recorded: extended as fitted, as they were.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub payload_span: Option<PayloadSpan>,
 }
 
 impl JointCompliance {
     /// The terms of `joints` (0-based) seen on the rows of `data` driven by `torque`: every
     /// regressor that is not zero on every row.
     pub fn new(torque: ComplianceTorque, joints: &[usize], data: &BoundSet<'_>) -> Result<Self, Error> {
-        let mut model = Self { torque, terms: Vec::new(), theta: Vec::new() };
+        let measured = matches!(torque, ComplianceTorque::Measured);
+        let mut model = Self { torque, terms: Vec::new(), theta: Vec::new(), payload_span: None };
         let raw: Vec<Vec<Vec<f64>>> =
-            data.iter().map(|(row, tool)| model.torques(row, tool)).collect::<Result<_, _>>()?;
+            data.iter().map(|(row, tool)| model.torques(row, tool, None)).collect::<Result<_, _>>()?;
         for &joint in joints {
             let width = raw.first().and_then(|r| r.get(joint)).map_or(0, Vec::len);
             for column in 0..width {
@@ -133,6 +139,7 @@ impl JointCompliance {
             }
         }
         model.theta = vec![0.0; model.terms.len()];
+        model.payload_span = PayloadSpan::of(data.rows(), measured);
         Ok(model)
     }
 
@@ -146,22 +153,27 @@ impl JointCompliance {
     }
 
     /// The torque regressors of one row, joint by joint (one column for a measured or modelled
-    /// torque).
-    fn torques(&self, row: &Measurement, tool: usize) -> Result<Vec<Vec<f64>>, Error> {
+    /// torque), under the rule `rule` beyond the payload span (`None` inside it): the payload, or
+    /// each measured torque, held in its span for a hold.
+    fn torques(&self, row: &Measurement, tool: usize, rule: Option<BeyondSpan>) -> Result<Vec<Vec<f64>>, Error> {
+        let span = self.payload_span.as_ref();
+        let payload_kg = span.map_or(row.payload_kg, |s| s.payload(rule, row.payload_kg));
         match &self.torque {
             ComplianceTorque::Modelled { load, fits } => {
-                let regressors = load.regressors(row, tool)?;
+                let regressors = load.regressors_with(&row.q, tool, payload_kg)?;
                 Ok(fits.iter().zip(&regressors).map(|(fit, r)| vec![fit.torque(r)]).collect())
             }
             ComplianceTorque::Measured => match &row.torques_nm {
-                Some(tau) => Ok(tau.iter().map(|t| vec![*t]).collect()),
+                Some(tau) => {
+                    Ok(tau.iter().enumerate().map(|(j, t)| vec![span.map_or(*t, |s| s.torque(rule, j, *t))]).collect())
+                }
                 None => Err(Error::new(ErrorKind::EffectNeedsColumn {
                     line: row.line,
                     effect: "joint_compliance",
                     column: "tau1_nm",
                 })),
             },
-            ComplianceTorque::GravityRegressor(load) => load.regressors(row, tool),
+            ComplianceTorque::GravityRegressor(load) => load.regressors_with(&row.q, tool, payload_kg),
         }
     }
 
@@ -179,7 +191,11 @@ impl Regressor for JointCompliance {
     }
 
     fn features(&self, row: &Measurement, tool: usize) -> Result<Vec<f64>, Error> {
-        let torques = self.torques(row, tool)?;
+        let rule = self.payload_span.as_ref().and_then(|s| s.rule_at(row.payload_kg));
+        let torques = self.torques(row, tool, rule)?;
+        if rule == Some(BeyondSpan::Zero) {
+            return Ok(vec![0.0; self.terms.len()]);
+        }
         self.terms
             .iter()
             .map(|t| {
@@ -281,6 +297,7 @@ impl EffectTerm for JointCompliance {
                 return Err(cursor.fault("scale", k, format!("terms[{k}].scale"), kind));
             }
         }
+        cursor.payload_span(self.payload_span.as_ref())?;
         cursor.count("theta", self.theta.len(), self.terms.len())
     }
 
@@ -301,6 +318,17 @@ impl EffectTerm for JointCompliance {
                 add("columns", fits.len());
                 add("coefficients", fits.len());
             }
+        }
+        Cursor::count_payload_span(self.payload_span.as_ref(), add);
+    }
+
+    fn payload_span(&self) -> Option<&PayloadSpan> {
+        self.payload_span.as_ref()
+    }
+
+    fn set_beyond_payload(&mut self, rule: BeyondSpan) {
+        if let Some(span) = &mut self.payload_span {
+            span.beyond = rule;
         }
     }
 }

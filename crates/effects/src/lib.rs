@@ -39,6 +39,7 @@ mod drift;
 mod gear;
 mod link_deflection;
 mod load_frame;
+mod payload_span;
 mod report;
 mod screw;
 mod spec;
@@ -54,6 +55,7 @@ pub use gear::{GearOptions, GearPeriodic};
 pub use link_deflection::LinkDeflection;
 pub use load_frame::LoadFrame;
 pub use loadsim::EffectKind;
+pub use payload_span::PayloadSpan;
 pub use report::{EffectReport, ParameterReport};
 pub use report::{effect_reports, reported_label, reported_parameters};
 pub use screw::ScrewPeriodic;
@@ -302,6 +304,23 @@ impl IdentifiedEffect {
     /// Sets [`IdentifiedEffect::beyond_span`] (nothing for an effect of no such input).
     pub fn set_beyond_span(&mut self, rule: BeyondSpan) {
         self.term_mut().set_beyond_span(rule);
+    }
+
+    /// The payloads an effect driven by the payload's load (joint compliance, link deflection) was
+    /// fitted on, and its rule beyond them ([`PayloadSpan`]); `None` for other effects and for
+    /// model files written before the span was recorded (extended as fitted, as they were).
+    pub fn payload_span(&self) -> Option<&PayloadSpan> {
+        self.term().payload_span()
+    }
+
+    /// The rule of [`IdentifiedEffect::payload_span`] beyond the span; `None` where there is none.
+    pub fn beyond_payload(&self) -> Option<BeyondSpan> {
+        self.payload_span().map(|s| s.beyond)
+    }
+
+    /// Sets the rule of [`IdentifiedEffect::payload_span`] (nothing where there is none).
+    pub fn set_beyond_payload(&mut self, rule: BeyondSpan) {
+        self.term_mut().set_beyond_payload(rule);
     }
 
     /// The 1-based joints the effect acts on (empty for thermal growth and drift).

@@ -16,8 +16,8 @@ use super::{LoadFrame, Regressor, rms_scales};
 use crate::check::{Cursor, EffectFault, FaultKind};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{
-    Argument, CandidateContext, CandidateModel, Direction, EffectContext, EffectSpec, IdentifiedEffect,
-    stand_in_dynamics,
+    Argument, BeyondSpan, CandidateContext, CandidateModel, Direction, EffectContext, EffectSpec, IdentifiedEffect,
+    PayloadSpan, stand_in_dynamics,
 };
 use errors::Error;
 use loadsim::{Payload, RobotDynamics};
@@ -50,25 +50,34 @@ pub struct LinkDeflection {
     pub scale: Vec<f64>,
     /// The far end's rotation about each axis, rad per unit of the scaled feature.
     pub theta: Vec<f64>,
+    /// The payloads of the training rows and the rule beyond them (issue 30, `PayloadSpan`: the
+    /// moment held at the nearer end's payload unless the fit chose otherwise). Absent in model
+    /// files written before it was recorded: extended as fitted, as they were.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub payload_span: Option<PayloadSpan>,
 }
 
 impl LinkDeflection {
     /// The bending of `joint`'s link (0-based) with the moment of `dynamics`, its axes those that
     /// carry a moment on the rows of `data`, scaled there, its parameters at zero.
     pub fn new(joint: usize, load: LoadFrame, dynamics: RobotDynamics, data: &BoundSet<'_>) -> Result<Self, Error> {
-        let mut model = Self { joint, load, dynamics, axes: vec![0, 1], scale: vec![1.0, 1.0], theta: vec![] };
+        let mut model =
+            Self { joint, load, dynamics, axes: vec![0, 1], scale: vec![1.0, 1.0], theta: vec![], payload_span: None };
         let raw: Vec<Vec<f64>> = data.iter().map(|(row, tool)| model.features(row, tool)).collect::<Result<_, _>>()?;
         let rms = rms_scales(&raw);
         let carries = |a: usize| raw.iter().any(|r| r[a] != 0.0) && rms[a] > AXIS_RMS_FLOOR_NM2;
         model.axes = (0..2).filter(|&a| carries(a)).collect();
         model.scale = model.axes.iter().map(|&a| rms[a]).collect();
         model.theta = vec![0.0; model.axes.len()];
+        model.payload_span = PayloadSpan::of(data.rows(), false);
         Ok(model)
     }
 
-    /// `L (e_a · M)` of every bending axis at one row, unscaled, N·m².
-    fn raw_features(&self, row: &Measurement, tool: usize) -> Result<[f64; 2], Error> {
-        let payload = Payload::at_tool(row.payload_kg);
+    /// `L (e_a · M)` of every bending axis at one row, unscaled, N·m², with the payload held in
+    /// its span where the rule beyond it (`rule`) says so.
+    fn raw_features(&self, row: &Measurement, tool: usize, rule: Option<BeyondSpan>) -> Result<[f64; 2], Error> {
+        let payload_kg = self.payload_span.as_ref().map_or(row.payload_kg, |s| s.payload(rule, row.payload_kg));
+        let payload = Payload::at_tool(payload_kg);
         loadsim::link_deflection_features(&self.load.base_model, &self.dynamics, &row.q, tool, &payload, self.joint)
             .map_err(Error::load)
     }
@@ -80,7 +89,11 @@ impl Regressor for LinkDeflection {
     }
 
     fn features(&self, row: &Measurement, tool: usize) -> Result<Vec<f64>, Error> {
-        let raw = self.raw_features(row, tool)?;
+        let rule = self.payload_span.as_ref().and_then(|s| s.rule_at(row.payload_kg));
+        let raw = self.raw_features(row, tool, rule)?;
+        if rule == Some(BeyondSpan::Zero) {
+            return Ok(vec![0.0; self.axes.len()]);
+        }
         Ok(self.axes.iter().zip(&self.scale).map(|(&a, s)| raw[a.min(1)] / s).collect())
     }
 
@@ -127,6 +140,7 @@ impl EffectTerm for LinkDeflection {
             let kind = FaultKind::Count { what: "links", found: self.dynamics.links.len(), expected: n };
             cursor.fault("dynamics", 0, "dynamics".into(), kind)
         })?;
+        cursor.payload_span(self.payload_span.as_ref())?;
         cursor.finite("scale", &self.scale, true)
     }
 
@@ -138,6 +152,17 @@ impl EffectTerm for LinkDeflection {
         add("dynamics", 1);
         add("axes", 1);
         add("scale", 1);
+        Cursor::count_payload_span(self.payload_span.as_ref(), add);
+    }
+
+    fn payload_span(&self) -> Option<&PayloadSpan> {
+        self.payload_span.as_ref()
+    }
+
+    fn set_beyond_payload(&mut self, rule: BeyondSpan) {
+        if let Some(span) = &mut self.payload_span {
+            span.beyond = rule;
+        }
     }
 }
 

@@ -69,11 +69,16 @@ impl LoadFrame {
     /// payload's gravity torque appended to each row: `n × (4n + 1)`. Joint `j`'s gravity torque
     /// is `Y_j(q) π + τ_payload,j` with `π` the links' unknown mass moments.
     pub fn regressors(&self, row: &Measurement, tool: usize) -> Result<Vec<Vec<f64>>, Error> {
+        self.regressors_with(&row.q, tool, row.payload_kg)
+    }
+
+    /// [`LoadFrame::regressors`] at joint values `q` with a payload of `payload_kg` at tool `tool`
+    /// (a payload held at the end of a term's span, `crate::PayloadSpan`).
+    pub fn regressors_with(&self, q: &[f64], tool: usize, payload_kg: f64) -> Result<Vec<Vec<f64>>, Error> {
         let g = self.gravity();
-        let y = loadsim::gravity_regressor(&self.base_model, &row.q, &g).map_err(Error::load)?;
-        let payload =
-            loadsim::payload_gravity_torque(&self.base_model, &row.q, tool, &Payload::at_tool(row.payload_kg), &g)
-                .map_err(Error::load)?;
+        let y = loadsim::gravity_regressor(&self.base_model, q, &g).map_err(Error::load)?;
+        let payload = loadsim::payload_gravity_torque(&self.base_model, q, tool, &Payload::at_tool(payload_kg), &g)
+            .map_err(Error::load)?;
         Ok((0..y.nrows())
             .map(|j| (0..y.ncols()).map(|c| y[(j, c)]).chain(std::iter::once(payload[j])).collect())
             .collect())

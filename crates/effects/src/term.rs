@@ -123,6 +123,15 @@ pub(crate) trait EffectTerm: Regressor + std::fmt::Debug + Send + Sync {
 
     /// Sets [`EffectTerm::beyond_span`]; nothing for an effect of no such input.
     fn set_beyond_span(&mut self, _rule: crate::BeyondSpan) {}
+
+    /// The payloads the effect was fitted on and its rule beyond them; `None` for an effect not
+    /// driven by the payload's load, or read from a file written before the span was recorded.
+    fn payload_span(&self) -> Option<&crate::PayloadSpan> {
+        None
+    }
+
+    /// Sets the rule of [`EffectTerm::payload_span`]; nothing where there is none.
+    fn set_beyond_payload(&mut self, _rule: crate::BeyondSpan) {}
 }
 
 /// How an effect is made. Implemented by the type of every identified kind.

@@ -108,6 +108,7 @@ mod version_1 {
                         torque: ComplianceTorque::GravityRegressor(load),
                         terms: c.terms,
                         theta: c.theta,
+                        payload_span: None,
                     })
                 })
                 .into_iter()

@@ -61,6 +61,12 @@ pub struct FitReport {
     /// hold several, the kind's own rule with one (issue 30). Empty without such an effect.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub beyond_span: Vec<crate::SpanChoice>,
+    /// What each joint compliance or link deflection is beyond the payloads it was fitted on,
+    /// held, zero or extended as fitted, and why: chosen by leaving out the lightest and the
+    /// heaviest payload in turn where the training rows hold several, held otherwise (issue 30).
+    /// Empty without such an effect.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub beyond_payload: Vec<crate::PayloadChoice>,
     /// What the plausibility checks measured (absent below 4 rows).
     pub plausibility: Option<crate::PlausibilityReport>,
     /// The rows the identification named as gross outliers (`identification.robust` has the
@@ -265,6 +271,7 @@ pub fn fit(
     let mut auto = None;
     let mut effect_report = Vec::new();
     let mut beyond_span = Vec::new();
+    let mut beyond_payload = Vec::new();
     let specs: Vec<EffectSpec> = match &options.effects.selection {
         EffectSelection::None => Vec::new(),
         EffectSelection::List(list) => list.clone(),
@@ -321,6 +328,9 @@ pub fn fit(
             &options.effects,
         )?;
         beyond_span = crate::sessions::choose(data, &specs, &mut effects, options, |train, fold_options| {
+            fit(robot, train, Method::Poe, fold_options).map(|(model, _)| model)
+        })?;
+        beyond_payload = crate::payloads::choose(data, &specs, &mut effects, options, |train, fold_options| {
             fit(robot, train, Method::Poe, fold_options).map(|(model, _)| model)
         })?;
         model.effects = effects;
@@ -401,6 +411,7 @@ pub fn fit(
         nominal_prior,
         auto,
         beyond_span,
+        beyond_payload,
         plausibility: findings.report,
         outliers,
         warnings,

@@ -66,6 +66,10 @@ pub struct EffectOptions {
     /// The measuring sessions of the training rows (split by gaps in `t_s`), from which the fit
     /// chooses whether a drift or a thermal growth is held or zero beyond the span above (issue 30).
     pub sessions: SessionOptions,
+    /// The payload groups of the training rows, from which the fit chooses whether a term driven
+    /// by the payload's load (joint compliance, link deflection) is held, zero or extended beyond
+    /// the payloads it was fitted on (issue 30).
+    pub payloads: PayloadOptions,
     /// Where the posterior σ of the geometry-and-effects model at a row (the tool point's
     /// position) exceeds this multiple of the largest σ over the training rows, the model falls
     /// back to the geometry fitted alone, fully from twice it (issue 23; `model::EffectUncertainty`).
@@ -94,6 +98,7 @@ impl Default for EffectOptions {
             gear: effects::GearOptions::default(),
             hold_beyond_span: effects::HOLD_BEYOND_SPAN,
             sessions: SessionOptions::default(),
+            payloads: PayloadOptions::default(),
             fallback_sigma_ratio: 2.0,
             diagnose: DiagnoseOptions::default(),
         }
@@ -210,6 +215,7 @@ impl FitOptions {
             ));
         }
         self.effects.sessions.validate()?;
+        self.effects.payloads.validate()?;
         let ratio = self.effects.fallback_sigma_ratio;
         if ratio.is_nan() || ratio < 1.0 {
             return Err((
@@ -261,6 +267,40 @@ impl SessionOptions {
         let r = self.gap_ratio;
         if !(r.is_finite() && r > 1.0) {
             return Err(("gap_ratio", format!("effects.sessions.gap_ratio is {r}, expected a finite number above 1")));
+        }
+        Ok(())
+    }
+}
+
+/// Whether the rule of a payload-driven term beyond its payloads is chosen from the training rows'
+/// payload groups (rows of one `payload_kg` value).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PayloadOptions {
+    /// Choose the rule by leaving out the lightest and the heaviest payload group in turn where
+    /// there are `min_groups` or more; `false`: held (the kinds' own rule), as with fewer groups.
+    pub choose: bool,
+    /// The fewest distinct payloads that allow the choice. 3: leaving out the lightest or the
+    /// heaviest of two leaves one payload to fit on, and at one payload its share of a joint's
+    /// torque is a point mass at the tool, the same columns as the last link's own mass moments
+    /// (`loadsim::gravity_regressor`), so the fold's term has not seen the load change while the
+    /// full fit's has; with three the fold keeps two. The issue's own threshold ("several").
+    pub min_groups: usize,
+}
+
+impl Default for PayloadOptions {
+    fn default() -> Self {
+        Self { choose: true, min_groups: 3 }
+    }
+}
+
+impl PayloadOptions {
+    /// Refuses fewer than 2 groups (a fold would leave nothing to fit on). The field at fault and
+    /// why, for the options file's error.
+    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+        if self.min_groups < 2 {
+            let n = self.min_groups;
+            return Err(("min_groups", format!("effects.payloads.min_groups is {n}, expected at least 2")));
         }
         Ok(())
     }

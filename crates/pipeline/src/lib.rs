@@ -6,7 +6,9 @@
 //! that run before it ([`PlausibilityOptions`]), the prior toward the nominal geometry
 //! ([`choose_prior`], [`NominalPriorOptions`]), `--effects auto` ([`choose_effects`],
 //! [`effects_of`]) and the measuring sessions that choose what a drift or a thermal growth is
-//! beyond the span it was fitted on ([`sessions()`], [`SessionOptions`], [`SpanChoice`]). Every other item is named by the crate that owns it, not re-exported here:
+//! beyond the span it was fitted on ([`sessions()`], [`SessionOptions`], [`SpanChoice`]), and the
+//! payload groups that choose what a compliance or a link deflection is beyond the payloads it
+//! was fitted on ([`payload_groups`], [`PayloadOptions`], [`PayloadChoice`]). Every other item is named by the crate that owns it, not re-exported here:
 //! `errors` (the one `Error`), `robot` (`RobotDescription`), `measurements` (the CSV,
 //! `MeasurementSet`, `OutputFile`), `model` (`CalibratedModel`, `Method`, `evaluate`, the model
 //! file), `effects`, `diagnose`, `campaign` (simulated data) and `cell` (inverse, `compensate`,
@@ -37,14 +39,17 @@ mod clusters;
 mod fit;
 mod fit_options;
 mod fit_prior;
+mod payloads;
 mod plausibility;
+mod rule_choice;
 mod sessions;
 
 pub use auto::{AutoChoice, choose as choose_effects, effects_of};
 pub use clusters::{BranchJoint, Cluster, HeightSplit};
 pub use fit::{FitReport, FitWarning, fit};
-pub use fit_options::SessionOptions;
 pub use fit_options::{EffectOptions, FitOptions};
+pub use fit_options::{PayloadOptions, SessionOptions};
 pub use fit_prior::{NominalPriorOptions, PriorCandidate, PriorChoice, choose as choose_prior};
+pub use payloads::{PayloadChoice, PayloadErrors, payload_groups};
 pub use plausibility::{PlausibilityOptions, PlausibilityReport};
 pub use sessions::{SpanChoice, SpanErrors, sessions};

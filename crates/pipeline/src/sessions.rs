@@ -8,7 +8,8 @@
 //! and each kind keeps the rule it had (drift: zero; growth: held).
 
 use crate::fit_options::FitOptions;
-use effects::{BeyondSpan, EffectSelection, EffectSpec, IdentifiedEffect};
+use crate::rule_choice::{FoldFailure, Target, held_out_errors, one_standard_error};
+use effects::{BeyondSpan, EffectSpec, IdentifiedEffect};
 use errors::Error;
 use measurements::{Measurement, MeasurementSet};
 use model::CalibratedModel;
@@ -67,24 +68,16 @@ pub struct SpanErrors {
 
 impl std::fmt::Display for SpanChoice {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "beyond its fitted span, {} is {}: {}", self.effect, describe(self.rule), self.reason)
-    }
-}
-
-fn describe(rule: BeyondSpan) -> &'static str {
-    match rule {
-        BeyondSpan::Hold => "held at the span's end",
-        BeyondSpan::Zero => "zero (the geometry alone)",
+        write!(f, "beyond its fitted span, {} is {}: {}", self.effect, self.rule.describe(), self.reason)
     }
 }
 
 /// Chooses the rule beyond the span for every effect of `effects` that has one (fitted with the
 /// items `specs` on `data`) and sets it: with several sessions, each left out in turn, the rest
-/// fitted (`poe` with the same items; no prior strength chosen, and no sessions inside a fold),
-/// and the left-out rows predicted under either rule, the others' kept as fitted. The kind's own
-/// rule stays unless the other's mean error is lower by more than one standard error of the rows'
-/// paired differences (Breiman's one-standard-error rule, as the nominal prior's strength), so
-/// that a difference the rows cannot tell from noise does not change the model.
+/// fitted (`poe` with the same items; no prior strength chosen, and no sessions or payloads chosen
+/// inside a fold), and the left-out rows predicted under either rule, the others' kept as fitted.
+/// The kind's own rule stays unless the other's mean error is lower by more than one standard
+/// error of the rows' paired differences (`rule_choice::one_standard_error`).
 ///
 /// `fit` fits a fold (`crate::fit` with `poe`, passed in so that this module does not import the
 /// fit that calls it).
@@ -126,60 +119,43 @@ pub(crate) fn choose(
         );
         return Ok(keep(effects, reason));
     }
-    let mut fold_options = options.clone().with_effects(EffectSelection::List(specs.to_vec()));
-    fold_options.effects.sessions.choose = false;
-    fold_options.nominal_prior.choose = false;
-    fold_options.plausibility.force = true;
+    let fold_options = crate::rule_choice::fold_options(options, specs);
     // Per target, the left-out rows' errors under the kind's own rule and under the other.
-    let mut own: Vec<Vec<f64>> = vec![Vec::new(); targets.len()];
-    let mut other: Vec<Vec<f64>> = vec![Vec::new(); targets.len()];
-    for session in &found {
-        let left_out: std::collections::BTreeSet<usize> = session.iter().copied().collect();
-        let train: Vec<usize> = (0..data.rows.len()).filter(|i| !left_out.contains(i)).collect();
-        let test = data.subset(session);
-        let fitted = match fit(&data.subset(&train), &fold_options) {
-            Ok(model) => model,
-            Err(e) => return Ok(keep(effects, format!("the fit without a session failed ({e}): its own rule"))),
-        };
-        for (t, &k) in targets.iter().enumerate() {
+    let trials: Vec<Target> = targets
+        .iter()
+        .map(|&k| {
             let rule = effects[k].beyond_span().unwrap_or(BeyondSpan::Zero);
-            for (errors, rule) in [(&mut own[t], rule), (&mut other[t], rule.other())] {
-                let mut model = fitted.clone();
-                model.effects[k].set_beyond_span(rule);
-                let evaluation = match model.bind(&test).and_then(|bound| model::evaluate(&model, &bound)) {
-                    Ok(evaluation) => evaluation,
-                    Err(e) => {
-                        return Ok(keep(effects, format!("a left-out session was not predicted ({e}): its own rule")));
-                    }
-                };
-                errors.extend(evaluation.errors.iter().map(|e| e.position_mm));
-            }
+            Target { effect: k, rules: vec![rule, rule.other()] }
+        })
+        .collect();
+    let errors = match held_out_errors(data, &found, &fold_options, &trials, IdentifiedEffect::set_beyond_span, fit) {
+        Ok(errors) => errors,
+        Err(FoldFailure::Fit(e)) => {
+            return Ok(keep(effects, format!("the fit without a session failed ({e}): its own rule")));
         }
-    }
+        Err(FoldFailure::Predict(e)) => {
+            return Ok(keep(effects, format!("a left-out session was not predicted ({e}): its own rule")));
+        }
+    };
     let mut out = Vec::with_capacity(targets.len());
-    for (t, &k) in targets.iter().enumerate() {
-        let rule = effects[k].beyond_span().unwrap_or(BeyondSpan::Zero);
-        let n = own[t].len().max(1) as f64;
-        let mean = |v: &[f64]| v.iter().sum::<f64>() / n;
-        let differences: Vec<f64> = other[t].iter().zip(&own[t]).map(|(o, s)| o - s).collect();
-        let gain = mean(&differences);
-        let spread = (differences.iter().map(|d| (d - gain).powi(2)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt();
-        let standard_error = spread / n.sqrt();
-        let switch = gain < -standard_error;
-        let chosen = if switch { rule.other() } else { rule };
-        let (own_mm, other_mm) = (mean(&own[t]), mean(&other[t]));
+    for (trial, errors) in trials.iter().zip(&errors) {
+        let k = trial.effect;
+        let rule = trial.rules[0];
+        let decision = one_standard_error(&trial.rules, errors);
+        let (own_mm, other_mm) = (decision.means[0], decision.means[1]);
         let errors = match rule {
             BeyondSpan::Hold => SpanErrors { hold: own_mm, zero: other_mm },
-            BeyondSpan::Zero => SpanErrors { hold: other_mm, zero: own_mm },
+            BeyondSpan::Zero | BeyondSpan::Extend => SpanErrors { hold: other_mm, zero: own_mm },
         };
+        let standard_error = decision.standard_error;
         let reason = format!(
             "{} sessions, each left out in turn: {:.4} mm held, {:.4} mm zero beyond the span ({} rows; {})",
             found.len(),
             errors.hold,
             errors.zero,
-            own[t].len(),
-            if switch {
-                format!("{} lower by more than one standard error, {standard_error:.4} mm", chosen.name())
+            decision.rows,
+            if decision.switched {
+                format!("{} lower by more than one standard error, {standard_error:.4} mm", decision.chosen.name())
             } else {
                 format!(
                     "{} kept, the other not lower by more than one standard error, {standard_error:.4} mm",
@@ -187,10 +163,10 @@ pub(crate) fn choose(
                 )
             }
         );
-        effects[k].set_beyond_span(chosen);
+        effects[k].set_beyond_span(decision.chosen);
         out.push(SpanChoice {
             effect: effects[k].label(),
-            rule: chosen,
+            rule: decision.chosen,
             sessions: found.len(),
             heldout_mm: Some(errors),
             reason,
