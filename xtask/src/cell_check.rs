@@ -48,7 +48,7 @@ pub struct Args {
     /// Also 300 planned against 300 random rows for `poe-gp --effects auto` (10 seeds; minutes).
     #[arg(long)]
     effects: bool,
-    /// Planning options (RON, `cell::PlanOptions`) for every plan of the check; the criterion is
+    /// Planning options (RON, `planning::PlanOptions`) for every plan of the check; the criterion is
     /// set per column.
     #[arg(long)]
     plan_options: Option<String>,
@@ -281,10 +281,10 @@ fn register_simulated(args: &Args, md: &mut String) -> Result<()> {
 }
 
 /// The planning options of `--plan-options`, or the defaults.
-fn plan_options(args: &Args) -> Result<cell::PlanOptions> {
+fn plan_options(args: &Args) -> Result<planning::PlanOptions> {
     Ok(match &args.plan_options {
-        Some(text) => cell::PlanOptions::parse(text, "--plan-options")?,
-        None => cell::PlanOptions::default(),
+        Some(text) => planning::PlanOptions::parse(text, "--plan-options")?,
+        None => planning::PlanOptions::default(),
     })
 }
 
@@ -293,10 +293,10 @@ fn plan_rows(
     set: &MeasurementSet,
     n: usize,
     full_pose: bool,
-    options: &cell::PlanOptions,
+    options: &planning::PlanOptions,
 ) -> Result<Vec<usize>> {
-    let candidates = cell::file_candidates(set, robot, None)?;
-    Ok(cell::plan(&candidates.model, &candidates.candidates, n, full_pose, options)?.order)
+    let candidates = planning::file_candidates(set, robot, None)?;
+    Ok(planning::plan(&candidates.model, &candidates.candidates, n, full_pose, options)?.order)
 }
 
 fn plan_ur10(args: &Args, md: &mut String) -> Result<()> {
@@ -328,8 +328,8 @@ fn plan_ur10(args: &Args, md: &mut String) -> Result<()> {
             })
             .collect::<Result<_>>()?;
         let mut planned = Vec::new();
-        for criterion in [cell::Criterion::I, cell::Criterion::D] {
-            let plan_options = cell::PlanOptions { criterion, ..plan_options(args)? };
+        for criterion in [planning::Criterion::I, planning::Criterion::D] {
+            let plan_options = planning::PlanOptions { criterion, ..plan_options(args)? };
             let order = plan_rows(&robot, &even, n, true, &plan_options)?;
             planned.push(fit_and_test(&robot, &even.subset(&order), &odd, &options, Method::Poe)?);
         }
@@ -382,8 +382,8 @@ fn plan_irb4400(args: &Args, md: &mut String) -> Result<()> {
         list(&random_25),
         r25 / reference
     );
-    for criterion in [cell::Criterion::I, cell::Criterion::D] {
-        let plan_options = cell::PlanOptions { criterion, ..plan_options(args)? };
+    for criterion in [planning::Criterion::I, planning::Criterion::D] {
+        let plan_options = planning::PlanOptions { criterion, ..plan_options(args)? };
         let order = plan_rows(&robot, &candidates, 25, false, &plan_options)?;
         let planned = fit_and_test(&robot, &candidates.subset(&order), &test, &options, Method::Poe)?;
         let _ = writeln!(md, "| 25 planned ({criterion:?}) | {planned:.4} | {:.3} |", planned / reference);
@@ -402,12 +402,12 @@ fn plan_timing(args: &Args, md: &mut String) -> Result<()> {
     let _ = writeln!(md, "| --- | --- | --- | ---: | ---: |");
     for (name, path) in [("UR10", &args.ur10), ("IRB 4400", &args.irb4400)] {
         let robot = RobotDescription::read(path)?;
-        let set = cell::generated_candidates(&robot, None, 10_000, 0)?;
+        let set = planning::generated_candidates(&robot, None, 10_000, 0)?;
         for full_pose in [false, true] {
-            for criterion in [cell::Criterion::I, cell::Criterion::D] {
-                let options = cell::PlanOptions { criterion, ..plan_options(args)? };
+            for criterion in [planning::Criterion::I, planning::Criterion::D] {
+                let options = planning::PlanOptions { criterion, ..plan_options(args)? };
                 let (start, cpu) = (Instant::now(), crate::ur10::process_cpu_seconds());
-                cell::plan(&set.model, &set.candidates, 100, full_pose, &options)?;
+                planning::plan(&set.model, &set.candidates, 100, full_pose, &options)?;
                 let _ = writeln!(
                     md,
                     "| {name} | {} | {criterion:?} | {:.2} | {:.2} |",

@@ -35,11 +35,11 @@ pub struct Args {
     seed: u64,
     /// The criterion: i (the mean predicted variance over the candidates; the default) or d (log det).
     #[arg(long, value_parser = parse_criterion)]
-    criterion: Option<cell::Criterion>,
+    criterion: Option<planning::Criterion>,
     /// Tracker position noise per axis, mm: scales the predicted errors.
     #[arg(long)]
     noise_mm: Option<f64>,
-    /// Every planning setting (RON, `cell::PlanOptions`: criterion, noise, bins, exchanges…);
+    /// Every planning setting (RON, `planning::PlanOptions`: criterion, noise, bins, exchanges…);
     /// --criterion and --noise-mm override it.
     #[arg(long)]
     options: Option<PathBuf>,
@@ -65,9 +65,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         Some(path) => {
             let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
             let file = path.display().to_string();
-            (cell::PlanOptions::parse(&text, &file)?, cell::UnmodelledGiven::of_text(&text, &file)?)
+            (planning::PlanOptions::parse(&text, &file)?, planning::UnmodelledGiven::of_text(&text, &file)?)
         }
-        None => (cell::PlanOptions::default(), cell::UnmodelledGiven::default()),
+        None => (planning::PlanOptions::default(), planning::UnmodelledGiven::default()),
     };
     // Unless the options set it, the unmodelled error is the model's own held-out error.
     let unmodelled = options.set_unmodelled_from(model.as_ref(), given);
@@ -82,25 +82,28 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             let read = ReadOptions::for_joints(kinds).with_columns(args.columns.clone().unwrap_or_default());
             let (data, cells) = measurements::read_configurations_with_cells(path, &read)?;
             notes.push(data.read_summary());
-            (cell::file_candidates(&data, &robot, model.as_ref())?, Some((cells, data.format.dialect.delimiter.byte())))
+            (
+                planning::file_candidates(&data, &robot, model.as_ref())?,
+                Some((cells, data.format.dialect.delimiter.byte())),
+            )
         }
         None => {
             notes.push(format!("drew {} candidates within the joint limits (seed {})", args.generate, args.seed));
-            (cell::generated_candidates(&robot, model.as_ref(), args.generate, args.seed)?, None)
+            (planning::generated_candidates(&robot, model.as_ref(), args.generate, args.seed)?, None)
         }
     };
     for tool in &set.unknown_tools {
         notes.push(format!("warning: tool '{tool}' is not in the model: planned with its first tool"));
     }
-    let mut plan = cell::plan(&set.model, &set.candidates, args.poses, full_pose, &options)?;
+    let mut plan = planning::plan(&set.model, &set.candidates, args.poses, full_pose, &options)?;
     plan.report.set_unmodelled_from(unmodelled);
     let seconds = started.elapsed().as_secs_f64();
     let mut out = measurements::OutputFile::create(&args.out)?;
     match &file {
-        Some((cells, delimiter)) => cell::write_chosen_rows(&mut out, cells, *delimiter, &plan.order)?,
+        Some((cells, delimiter)) => planning::write_chosen_rows(&mut out, cells, *delimiter, &plan.order)?,
         None => {
             let kinds: Vec<_> = set.model.joints().iter().map(|j| j.kind).collect();
-            cell::write_generated_rows(&mut out, &kinds, &set.candidates, &plan.order)?;
+            planning::write_generated_rows(&mut out, &kinds, &set.candidates, &plan.order)?;
         }
     }
     out.finish()?;
@@ -121,10 +124,10 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
-fn parse_criterion(s: &str) -> Result<cell::Criterion, String> {
+fn parse_criterion(s: &str) -> Result<planning::Criterion, String> {
     match s {
-        "d" | "D" => Ok(cell::Criterion::D),
-        "i" | "I" => Ok(cell::Criterion::I),
+        "d" | "D" => Ok(planning::Criterion::D),
+        "i" | "I" => Ok(planning::Criterion::I),
         other => Err(format!("unknown criterion '{other}': expected d or i")),
     }
 }

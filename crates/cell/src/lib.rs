@@ -3,8 +3,8 @@
 //! geometry exported as a URDF.
 //!
 //! Every function returns `errors::Error`, the one error of the calibration crates (its message
-//! names the file, line and column where there is one); the refusals only registration and
-//! planning raise are kinds of it (`errors::ErrorKind::TooFewPoses`, `PosesUndetermined`, …).
+//! names the file, line and column where there is one); the refusals only registration
+//! raises are kinds of it (`errors::ErrorKind::TooFewPoses`, `PosesUndetermined`, …).
 //!
 //! ```
 //! # let fixture = |name: &str| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name);
@@ -51,20 +51,16 @@
 //! # Ok::<(), errors::Error>(())
 //! ```
 //!
-//! Re-registration and planning (issue 26): carry a calibrated model to a moved tracker or
-//! a new tool from a few measured poses (`calib register`), and choose the poses worth measuring
-//! (`calib plan`).
+//! Re-registration (issue 26): carry a calibrated model to a moved tracker or a new tool from a
+//! few measured poses (`calib register`). Choosing the poses worth measuring (`calib plan`) is
+//! the crate `planning`.
 //!
 //! **Registration** ([`register()`]): the calibrated model predicts every pose in the frame it was
 //! fitted in, all its parts applied; a new tracker frame `X` and tool changes `D_t` are fitted so
 //! that the measured poses are `X · P_i · D_t` (closed-form start, then Levenberg–Marquardt), and
 //! put into the model exactly (geometry, effects and GP carried along). The residual on the poses
 //! is judged against the model's held-out error.
-//!
-//! **Planning** ([`plan()`]): D-optimal choice of poses for the identification (log det of the
-//! information of the column-scaled identification Jacobian of `poe`, on the directions it can
-//! determine), greedy with rank-k updates of every candidate's predicted variance and Fedorov
-//! exchanges, then every moving joint's range covered, in the order to measure them.
+
 //!
 //! ```
 //! use cell::registration::{register_rows, RegistrationOptions, RegistrationRow, Unknowns};
@@ -85,29 +81,17 @@
 //! ```
 #![deny(missing_docs)]
 
-mod bias;
-mod bias_trial;
-mod candidates;
-mod coverage;
-mod design;
-mod information;
 mod inverse;
 mod joint_targets;
 mod model_text;
-mod plan;
 mod register;
 mod register_options;
 pub mod registration;
 mod report;
-mod unmodelled_setting;
 mod urdf_export;
 mod urdf_like;
 mod urdf_text;
 
-pub use candidates::{CandidateSet, file_candidates, generated_candidates, write_chosen_rows, write_generated_rows};
-pub use coverage::AxisCoverage;
-pub use design::Criterion;
-pub use information::Candidate;
 pub use inverse::{InverseOptions, PoseTarget, Solved, TargetStatus, solve_targets};
 pub use joint_targets::{
     CompensateOptions, CompensationSummary, RegisteredNominal, TargetFile, TargetFrame, compensate, pose_targets,
@@ -116,11 +100,9 @@ pub use joint_targets::{
 /// Moved to `model` (shared with `calib eval` and `predict`); re-exported where it was.
 pub use model::{WrappedJoint, wrapped};
 pub use model_text::checked_model_text;
-pub use plan::{Checkpoint, Plan, PlanOptions, PlanReport, measuring_order, plan};
 pub use register::{Registered, register};
 pub use register_options::{Refit, RegisterOptions};
 pub use report::{FrameChange, HeldoutFrom, RegisterReport, RegisterWarning, RegisteredTool, Verdict};
-pub use unmodelled_setting::{UnmodelledFrom, UnmodelledGiven, UnmodelledSetting, per_axis_from_mean};
 pub use urdf_export::{
     AxisChange, PartError, TrainingErrors, UrdfExport, UrdfExportReport, UrdfTemplate, export_urdf, write_urdf,
 };

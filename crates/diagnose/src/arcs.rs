@@ -146,6 +146,9 @@ pub(crate) fn mean_of(arcs: &[ArcCheck], value: impl Fn(&ArcCheck) -> f64) -> Op
     (!arcs.is_empty()).then(|| arcs.iter().map(value).sum::<f64>() / arcs.len() as f64)
 }
 
+/// A series' orders and its mean held-out position error at each, m.
+pub(crate) type OrderCurve = (Vec<u32>, Vec<f64>);
+
 /// For each selected step that is a Fourier series of a joint's own angle, its mean held-out
 /// position error (m) at each of its orders when arcs of every *other* moving joint are left out
 /// in turn (the other selected steps at their chosen orders); `None` for other steps or where no
@@ -158,7 +161,7 @@ pub(crate) fn order_curves(
     terms: &[Term],
     selection: &Selection,
     columns_of: &dyn Fn(usize) -> (Vec<Vec<f64>>, Option<f64>),
-) -> Result<Vec<Option<(Vec<u32>, Vec<f64>)>>, Error> {
+) -> Result<Vec<Option<OrderCurve>>, Error> {
     let kinematic = inputs.design.kinematic.ncols();
     let mut out = Vec::with_capacity(selection.steps.len());
     for (s, step) in selection.steps.iter().enumerate() {

@@ -9,16 +9,15 @@
 //! orientation's is taken as the position's at the 1 m lever, as the defaults assume
 //! ([`crate::PlanOptions::unmodelled_mrad`]).
 
-use crate::plan::PlanOptions;
 use errors::{Error, ErrorKind};
-use model::{CalibratedModel, HeldoutSource, Method};
+use model::{HeldoutSource, Method};
 use serde::{Deserialize, Serialize};
 
 /// Where one of the plan's unmodelled errors came from.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case", tag = "from")]
 pub enum UnmodelledFrom {
-    /// [`PlanOptions`]' default.
+    /// [`crate::PlanOptions`]' default.
     Default,
     /// Set in the options.
     Options,
@@ -64,7 +63,7 @@ pub fn per_axis_from_mean(mean: f64) -> f64 {
     mean * (std::f64::consts::PI / 8.0).sqrt()
 }
 
-/// Which unmodelled errors a RON options text sets (the others are [`PlanOptions`]' defaults).
+/// Which unmodelled errors a RON options text sets (the others are [`crate::PlanOptions`]' defaults).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct UnmodelledGiven {
     /// `unmodelled_mm` is set.
@@ -73,7 +72,7 @@ pub struct UnmodelledGiven {
     pub rotation: bool,
 }
 
-/// The two fields as the text has them (every other field ignored: [`PlanOptions::parse`]
+/// The two fields as the text has them (every other field ignored: [`crate::PlanOptions::parse`]
 /// checks them).
 #[derive(Deserialize)]
 #[serde(rename = "PlanOptions")]
@@ -103,48 +102,17 @@ impl UnmodelledGiven {
 /// Where a plan's unmodelled position and orientation errors came from.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct UnmodelledSetting {
-    /// The position's ([`PlanOptions::unmodelled_mm`]).
+    /// The position's ([`crate::PlanOptions::unmodelled_mm`]).
     pub position: UnmodelledFrom,
-    /// The orientation's ([`PlanOptions::unmodelled_mrad`]).
+    /// The orientation's ([`crate::PlanOptions::unmodelled_mrad`]).
     pub rotation: UnmodelledFrom,
-}
-
-impl PlanOptions {
-    /// Sets the unmodelled errors the options do not `given` from `model`'s held-out error
-    /// where it keeps one ([`per_axis_from_mean`]), and says where each came from. A model
-    /// without a held-out estimate (written before it was kept, or a sparse GP's) leaves the
-    /// defaults.
-    pub fn set_unmodelled_from(
-        &mut self,
-        model: Option<&CalibratedModel>,
-        given: UnmodelledGiven,
-    ) -> UnmodelledSetting {
-        let fallback = |set: bool| if set { UnmodelledFrom::Options } else { UnmodelledFrom::Default };
-        let mut setting = UnmodelledSetting { position: fallback(given.position), rotation: fallback(given.rotation) };
-        let Some((model, heldout)) = model.and_then(|m| m.heldout.map(|h| (m, h))) else { return setting };
-        let from = UnmodelledFrom::Model {
-            heldout_mm: heldout.mean_position_error_mm,
-            heldout_source: heldout.source,
-            method: model.method,
-            beyond_geometry: !model.effects.is_empty() || model.residual_gp.is_some(),
-        };
-        let sigma = per_axis_from_mean(heldout.mean_position_error_mm);
-        if !given.position {
-            self.unmodelled_mm = sigma;
-            setting.position = from;
-        }
-        if !given.rotation {
-            // mm per axis at the 1 m lever, in mrad.
-            self.unmodelled_mrad = sigma;
-            setting.rotation = from;
-        }
-        setting
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::PlanOptions;
+    use model::CalibratedModel;
 
     /// The mean norm of draws of an isotropic Gaussian of σ 1 per axis is `1 / √(π/8)`.
     #[test]

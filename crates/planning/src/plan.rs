@@ -11,8 +11,9 @@ use crate::bias::{BiasModel, Unmodelled};
 use crate::coverage::{Axis, AxisCoverage, cover, coverage};
 use crate::design::{Criterion, Design};
 use crate::information::{Candidate, RowWeights, candidate_rows};
-use crate::unmodelled_setting::{UnmodelledFrom, UnmodelledSetting};
+use crate::unmodelled_setting::{UnmodelledFrom, UnmodelledGiven, UnmodelledSetting, per_axis_from_mean};
 use errors::{Error, ErrorKind};
+use model::CalibratedModel;
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
 
@@ -478,6 +479,39 @@ pub fn measuring_order(candidates: &[Candidate], chosen: &[usize]) -> Vec<usize>
         }
     }
     order
+}
+
+impl PlanOptions {
+    /// Sets the unmodelled errors the options do not `given` from `model`'s held-out error
+    /// where it keeps one ([`per_axis_from_mean`]), and says where each came from. A model
+    /// without a held-out estimate (written before it was kept, or a sparse GP's) leaves the
+    /// defaults.
+    pub fn set_unmodelled_from(
+        &mut self,
+        model: Option<&CalibratedModel>,
+        given: UnmodelledGiven,
+    ) -> UnmodelledSetting {
+        let fallback = |set: bool| if set { UnmodelledFrom::Options } else { UnmodelledFrom::Default };
+        let mut setting = UnmodelledSetting { position: fallback(given.position), rotation: fallback(given.rotation) };
+        let Some((model, heldout)) = model.and_then(|m| m.heldout.map(|h| (m, h))) else { return setting };
+        let from = UnmodelledFrom::Model {
+            heldout_mm: heldout.mean_position_error_mm,
+            heldout_source: heldout.source,
+            method: model.method,
+            beyond_geometry: !model.effects.is_empty() || model.residual_gp.is_some(),
+        };
+        let sigma = per_axis_from_mean(heldout.mean_position_error_mm);
+        if !given.position {
+            self.unmodelled_mm = sigma;
+            setting.position = from;
+        }
+        if !given.rotation {
+            // mm per axis at the 1 m lever, in mrad.
+            self.unmodelled_mrad = sigma;
+            setting.rotation = from;
+        }
+        setting
+    }
 }
 
 #[cfg(test)]
