@@ -38,6 +38,16 @@ impl Error {
         Error::at(Place::new(file, line, column), kind)
     }
 
+    /// RON text of `file` that does not parse: the parser's message at its line and column.
+    pub fn ron(file: impl Into<String>, e: &ron::error::SpannedError) -> Error {
+        Error::at_line(
+            file,
+            e.span.start.line as u64,
+            e.span.start.col,
+            ErrorKind::RonFormat { message: e.code.to_string() },
+        )
+    }
+
     /// A file that could not be read or written.
     pub fn io(path: impl Into<String>, source: std::io::Error) -> Error {
         Error::in_file(path, ErrorKind::Io { source })

@@ -35,14 +35,7 @@ pub fn parse_model(text: &str, file: &str) -> Result<CalibratedModel, Error> {
     struct Version {
         schema_version: u32,
     }
-    let position_error = |e: ron::error::SpannedError| {
-        Error::at_line(
-            file.to_owned(),
-            e.span.start.line as u64,
-            e.span.start.col,
-            ErrorKind::RonFormat { message: e.code.to_string() },
-        )
-    };
+    let position_error = |e: ron::error::SpannedError| Error::ron(file, &e);
     // Read the version alone first so that a model from another version is refused with that
     // reason rather than with whichever field changed.
     let options = errors::ron_position::ron_options();

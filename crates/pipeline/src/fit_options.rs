@@ -164,14 +164,8 @@ impl FitOptions {
 
     /// Parses options from RON text and checks them; `file` names it in errors.
     pub fn parse(text: &str, file: &str) -> Result<Self, Error> {
-        let options: FitOptions = errors::ron_position::ron_options().from_str(text).map_err(|e| {
-            Error::at_line(
-                file.to_owned(),
-                e.span.start.line as u64,
-                e.span.start.col,
-                ErrorKind::RonFormat { message: e.code.to_string() },
-            )
-        })?;
+        let options: FitOptions =
+            errors::ron_position::ron_options().from_str(text).map_err(|e| Error::ron(file, &e))?;
         options.validate().map_err(|(field, message)| {
             let (line, column) = errors::ron_position::field_position(text, field, 0);
             Error::at_line(file.to_owned(), line as u64, column, ErrorKind::RonFormat { message })

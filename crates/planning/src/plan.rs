@@ -110,14 +110,7 @@ impl PlanOptions {
     /// Options from the RON text of a file (`calib plan --options`): every field optional,
     /// unknown ones refused, each value validated; errors name the file, line and column.
     pub fn parse(text: &str, file: &str) -> Result<Self, Error> {
-        let options: PlanOptions = ron::from_str(text).map_err(|e| {
-            Error::at_line(
-                file.to_owned(),
-                e.span.start.line as u64,
-                e.span.start.col,
-                ErrorKind::RonFormat { message: e.code.to_string() },
-            )
-        })?;
+        let options: PlanOptions = ron::from_str(text).map_err(|e| Error::ron(file, &e))?;
         options.validate()?;
         Ok(options)
     }

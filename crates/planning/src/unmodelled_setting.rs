@@ -9,7 +9,7 @@
 //! orientation's is taken as the position's at the 1 m lever, as the defaults assume
 //! ([`crate::PlanOptions::unmodelled_mrad`]).
 
-use errors::{Error, ErrorKind};
+use errors::Error;
 use model::{HeldoutSource, Method};
 use serde::{Deserialize, Serialize};
 
@@ -84,17 +84,7 @@ struct Given {
 impl UnmodelledGiven {
     /// What the text of an options file sets; errors name the file, line and column.
     pub fn of_text(text: &str, file: &str) -> Result<Self, Error> {
-        let given: Given = ron::Options::default()
-            .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
-            .from_str(text)
-            .map_err(|e| {
-                Error::at_line(
-                    file.to_owned(),
-                    e.span.start.line as u64,
-                    e.span.start.col,
-                    ErrorKind::RonFormat { message: e.code.to_string() },
-                )
-            })?;
+        let given: Given = errors::ron_position::ron_options().from_str(text).map_err(|e| Error::ron(file, &e))?;
         Ok(Self { position: given.unmodelled_mm.is_some(), rotation: given.unmodelled_mrad.is_some() })
     }
 }

@@ -97,14 +97,7 @@ impl RobotDescription {
     /// Parses and validates a robot description; `file` names it in errors. The kinematics may be
     /// zero-configuration axes or a DH table (turned into axes, see [`DhTable`]).
     pub fn parse(text: &str, file: &str) -> Result<Self, Error> {
-        let form: RobotFile = ron_options().from_str(text).map_err(|e| {
-            Error::at_line(
-                file.to_owned(),
-                e.span.start.line as u64,
-                e.span.start.col,
-                ErrorKind::RonFormat { message: e.code.to_string() },
-            )
-        })?;
+        let form: RobotFile = ron_options().from_str(text).map_err(|e| Error::ron(file, &e))?;
         let robot = form.into_description(text, file)?;
         robot.validate(text, file)?;
         Ok(robot)
