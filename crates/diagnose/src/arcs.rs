@@ -20,7 +20,7 @@
 
 use super::design::Design;
 use super::pool::{Block, KinematicPrior, Pool, PriorOptions};
-use super::selection::{Selection, Term};
+use super::selection::{Selection, Step, Term};
 use effects::{GearOptions, GearPeriodic, IdentifiedEffect};
 use errors::Error;
 use lie::Vector6;
@@ -78,10 +78,7 @@ pub(crate) fn arc_checks(
     let mut owned: Vec<(Vec<Vec<f64>>, Option<f64>)> = Vec::new();
     let mut series: Vec<Option<(usize, u32)>> = Vec::new();
     for step in &selection.steps {
-        let (mut columns, sd) = columns_of(step.term);
-        if let Some(h) = step.scored.order {
-            columns.truncate(2 * h as usize);
-        }
+        let (columns, sd) = at_its_order(step, columns_of);
         let gear = match &terms[step.term].model {
             IdentifiedEffect::GearPeriodic(g) => step.scored.order.map(|h| (g.joint, h)),
             _ => None,
@@ -146,6 +143,19 @@ pub(crate) fn mean_of(arcs: &[ArcCheck], value: impl Fn(&ArcCheck) -> f64) -> Op
     (!arcs.is_empty()).then(|| arcs.iter().map(value).sum::<f64>() / arcs.len() as f64)
 }
 
+/// A step's weighted columns (`columns_of`) and prior sd, a series' cut to the order the fit on
+/// every row uses.
+fn at_its_order(
+    step: &Step,
+    columns_of: &dyn Fn(usize) -> (Vec<Vec<f64>>, Option<f64>),
+) -> (Vec<Vec<f64>>, Option<f64>) {
+    let (mut columns, sd) = columns_of(step.term);
+    if let Some(h) = step.scored.order {
+        columns.truncate(2 * h as usize);
+    }
+    (columns, sd)
+}
+
 /// A series' orders and its mean held-out position error at each, m.
 pub(crate) type OrderCurve = (Vec<u32>, Vec<f64>);
 
@@ -176,14 +186,13 @@ pub(crate) fn order_curves(
             continue;
         }
         // Columns: the kinematics, the other steps at their orders, then this series in full.
-        let mut owned: Vec<(Vec<Vec<f64>>, Option<f64>)> = Vec::new();
-        for (_, other) in selection.steps.iter().enumerate().filter(|&(t, _)| t != s) {
-            let (mut columns, sd) = columns_of(other.term);
-            if let Some(h) = other.scored.order {
-                columns.truncate(2 * h as usize);
-            }
-            owned.push((columns, sd));
-        }
+        let mut owned: Vec<(Vec<Vec<f64>>, Option<f64>)> = selection
+            .steps
+            .iter()
+            .enumerate()
+            .filter(|&(t, _)| t != s)
+            .map(|(_, o)| at_its_order(o, columns_of))
+            .collect();
         let (own, own_sd) = columns_of(step.term);
         let orders: Vec<u32> = orders.iter().copied().filter(|&h| 2 * h as usize <= own.len()).collect();
         let base_width: usize = owned.iter().map(|(c, _)| c.len()).sum();
