@@ -110,8 +110,12 @@ fn a_xacro_file_or_another_root_is_refused() {
 }
 
 #[test]
-fn a_value_urdf_rs_refuses_is_found_in_the_text() {
-    assert_refused(&ARM.replace("xyz=\"0.4 0 0\"", "xyz=\"0.4 0 x\""), (16, 18), "Wrong vector element count");
+fn a_value_that_is_not_three_numbers_is_refused_at_the_value() {
+    assert_refused(
+        &ARM.replace("xyz=\"0.4 0 0\"", "xyz=\"0.4 0 x\""),
+        (16, 18),
+        "joint 'elbow': <origin xyz=\"0.4 0 x\"> must be three numbers",
+    );
 }
 
 #[test]

@@ -1,8 +1,8 @@
 //! A URDF as a robot description (SPEC version 2, `--robot arm.urdf`): the kinematic chain from a
 //! base link to a tip link, fixed joints folded in, turned exactly into zero-configuration axes.
 //!
-//! The file is parsed by `urdf-rs`; its [`xml_outline`](crate::xml_outline) gives every refusal
-//! its line and column. The base link defaults to the one root link; the tip to the leaf with the
+//! The file is read once, into its [`xml_outline`](crate::xml_outline), which gives every refusal
+//! its line and column; `urdf_model.rs` reads the links and joints from it. The base link defaults to the one root link; the tip to the leaf with the
 //! most movable joints on the way down from the base (or from the link the base hangs from by
 //! fixed joints); several such leaves are ambiguous and need `--tip-link`. The chain may run up
 //! through fixed joints (a base link below the root, such as the ROS-Industrial `base` frame),
@@ -12,6 +12,7 @@
 
 use crate::urdf_inertial::{ChainMasses, LinkInertial, LinkTree, chain_masses, read_inertials};
 use crate::urdf_mimic::{ChainJoint, fold, folded_joint};
+use crate::urdf_model::{UrdfJoint, UrdfJointType, UrdfRobot, read_robot};
 use crate::urdf_steps::{ChainStep, StepMimic, StepMotion};
 use crate::xml_outline::{Element, Position, outline};
 use crate::{FlangeDescription, JointDescription, JointType, RobotDescription};
@@ -54,7 +55,7 @@ pub struct UrdfChain {
 pub struct UrdfDocument {
     file: String,
     text: String,
-    robot: urdf_rs::Robot,
+    robot: UrdfRobot,
     outline: Element,
     /// Each link's `<inertial>`, read from the outline so that a bad value is placed.
     inertials: HashMap<String, LinkInertial>,
@@ -101,20 +102,8 @@ impl UrdfDocument {
         }) {
             return Err(at(xacro.position, "a xacro file: expand it first (`xacro arm.urdf.xacro > arm.urdf`)".into()));
         }
-        // Before urdf-rs, which reads a malformed `xyz` by skipping the words that are no numbers.
         let inertials = read_inertials(&root, file)?;
-        let robot = urdf_rs::read_from_string(text).map_err(|e| {
-            let message = e.to_string();
-            // The XML parser's own position where it gives one; else urdf-rs quotes the offending
-            // value in brackets where it can: find it in the text.
-            let quoted = || {
-                let (_, rest) = message.split_once('[')?;
-                let (quoted, _) = rest.split_once(']')?;
-                text.find(quoted).map(|offset| line_column(text, offset))
-            };
-            let position = parser_position(&message, text).or_else(quoted).unwrap_or(root.position);
-            at(position, format!("URDF: {message}"))
-        })?;
+        let robot = read_robot(&root, text).map_err(|(position, message)| at(position, message))?;
         let mut document = Self {
             file: file.to_owned(),
             text: text.to_owned(),
@@ -143,7 +132,7 @@ impl UrdfDocument {
     }
 
     /// The parsed robot.
-    pub fn robot(&self) -> &urdf_rs::Robot {
+    pub fn robot(&self) -> &UrdfRobot {
         &self.robot
     }
 
@@ -182,7 +171,7 @@ impl UrdfDocument {
         for (j, (joint, element)) in
             self.robot.joints.iter().zip(self.outline.children.iter().filter(|e| e.name == "joint")).enumerate()
         {
-            for link in [&joint.parent.link, &joint.child.link] {
+            for link in [&joint.parent, &joint.child] {
                 if !index.links.contains(link) {
                     return Err(self.at(
                         element.position,
@@ -190,14 +179,14 @@ impl UrdfDocument {
                     ));
                 }
             }
-            if let Some(other) = index.parent_joint.insert(joint.child.link.clone(), j) {
+            if let Some(other) = index.parent_joint.insert(joint.child.clone(), j) {
                 let other = &self.robot.joints[other].name;
                 return Err(self.at(
                     element.position,
-                    format!("link '{}' is the child of joints '{other}' and '{}'", joint.child.link, joint.name),
+                    format!("link '{}' is the child of joints '{other}' and '{}'", joint.child, joint.name),
                 ));
             }
-            index.child_joints.entry(joint.parent.link.clone()).or_default().push(j);
+            index.child_joints.entry(joint.parent.clone()).or_default().push(j);
         }
         self.index = index;
         Ok(())
@@ -208,7 +197,7 @@ impl UrdfDocument {
     }
 
     /// The joint of which `link` is the child.
-    fn parent_joint(&self, link: &str) -> Option<&urdf_rs::Joint> {
+    fn parent_joint(&self, link: &str) -> Option<&UrdfJoint> {
         self.index.parent_joint.get(link).and_then(|&j| self.robot.joints.get(j))
     }
 
@@ -241,10 +230,10 @@ impl UrdfDocument {
             let mut path = vec![from.to_owned()];
             let mut on_path: HashSet<String> = path.iter().cloned().collect();
             while let Some(joint) = self.parent_joint(path.last().map_or("", String::as_str)) {
-                if !on_path.insert(joint.parent.link.clone()) {
+                if !on_path.insert(joint.parent.clone()) {
                     break;
                 }
-                path.push(joint.parent.link.clone());
+                path.push(joint.parent.clone());
             }
             (path, on_path)
         };
@@ -309,11 +298,11 @@ impl UrdfDocument {
     fn fixed_top(&self, link: &str) -> String {
         let mut top = link.to_owned();
         let mut seen = HashSet::from([top.clone()]);
-        while let Some(joint) = self.parent_joint(&top).filter(|j| j.joint_type == urdf_rs::JointType::Fixed) {
-            if !seen.insert(joint.parent.link.clone()) {
+        while let Some(joint) = self.parent_joint(&top).filter(|j| j.joint_type == UrdfJointType::Fixed) {
+            if !seen.insert(joint.parent.clone()) {
                 break;
             }
-            top = joint.parent.link.clone();
+            top = joint.parent.clone();
         }
         top
     }
@@ -330,13 +319,13 @@ impl UrdfDocument {
                 continue;
             }
             let below = self.index.child_joints.get(&link).map_or(&[][..], Vec::as_slice);
-            let children: Vec<&urdf_rs::Joint> = below.iter().filter_map(|&j| self.robot.joints.get(j)).collect();
+            let children: Vec<&UrdfJoint> = below.iter().filter_map(|&j| self.robot.joints.get(j)).collect();
             if children.is_empty() {
                 leaves.push((link, movable));
             }
             for joint in children.into_iter().rev() {
-                let moves = usize::from(joint.joint_type != urdf_rs::JointType::Fixed);
-                stack.push((joint.child.link.clone(), movable + moves));
+                let moves = usize::from(joint.joint_type != UrdfJointType::Fixed);
+                stack.push((joint.child.clone(), movable + moves));
             }
         }
         let most = leaves.iter().map(|(_, m)| *m).max().unwrap_or(0);
@@ -363,11 +352,11 @@ impl UrdfDocument {
         let refuse =
             |message: String| self.error_at("joint", &joint.name, format!("joint '{}': {message}", joint.name));
         let numbers = joint.origin.xyz.iter().chain(joint.origin.rpy.iter());
-        if !numbers.chain(joint.axis.xyz.iter()).all(|v| v.is_finite()) {
+        if !numbers.chain(joint.axis.iter()).all(|v| v.is_finite()) {
             return Err(refuse("origin and axis must be finite".into()));
         }
         let has_limit = self.element("joint", &joint.name).is_some_and(|e| e.child("limit").is_some());
-        let mimic = match (&joint.mimic, joint.joint_type == urdf_rs::JointType::Fixed) {
+        let mimic = match (&joint.mimic, joint.joint_type == UrdfJointType::Fixed) {
             (Some(m), false) => {
                 let (multiplier, offset) = (m.multiplier.unwrap_or(1.0), m.offset.unwrap_or(0.0));
                 if !(multiplier.is_finite() && offset.is_finite()) {
@@ -394,7 +383,7 @@ impl UrdfDocument {
             if !(lower.is_finite() && upper.is_finite() && lower < upper) {
                 return Err(format!("limits lower {lower} upper {upper} must be finite and increasing"));
             }
-            let kind = if joint.joint_type == urdf_rs::JointType::Prismatic {
+            let kind = if joint.joint_type == UrdfJointType::Prismatic {
                 crate::JointType::Prismatic
             } else {
                 crate::JointType::Revolute
@@ -407,7 +396,7 @@ impl UrdfDocument {
             }
             Ok((lower, upper))
         };
-        use urdf_rs::JointType as T;
+        use UrdfJointType as T;
         let motion = match joint.joint_type {
             T::Fixed => StepMotion::Fixed,
             T::Continuous => StepMotion::Revolute { limits_rad: None },
@@ -419,10 +408,10 @@ impl UrdfDocument {
             T::Revolute => StepMotion::Revolute { limits_rad: Some(limits().map_err(refuse)?) },
             T::Prismatic if unlimited_mimic => StepMotion::Prismatic { limits_m: (f64::NEG_INFINITY, f64::INFINITY) },
             T::Prismatic => StepMotion::Prismatic { limits_m: limits().map_err(refuse)? },
-            ref other => {
+            other => {
                 return Err(refuse(format!(
                     "{} joints cannot be calibrated (only revolute, continuous, prismatic and fixed); choose the chain's ends with --base-link/--tip-link",
-                    format!("{other:?}").to_lowercase()
+                    other.name()
                 )));
             }
         };
@@ -431,18 +420,18 @@ impl UrdfDocument {
                 "the chain from '{base}' to '{tip}' runs through this movable joint from child to parent; choose a base link above it"
             )));
         }
-        let axis = Vector3::from(*joint.axis.xyz);
+        let axis = Vector3::from(joint.axis);
         if motion != StepMotion::Fixed && axis.norm() < ZERO_AXIS {
             return Err(refuse("the axis is zero".into()));
         }
         // Each angle brought into one turn first: the rotation is the same, and an angle such as
         // 1e308 no longer overflows the exponential map into NaN (found by `cargo xtask fuzz`).
         let [roll, pitch, yaw] = joint.origin.rpy.map(|a| a.rem_euclid(std::f64::consts::TAU));
-        let origin = SE3::new(SO3::from_rpy(roll, pitch, yaw), Vector3::from(*joint.origin.xyz));
+        let origin = SE3::new(SO3::from_rpy(roll, pitch, yaw), Vector3::from(joint.origin.xyz));
         let (from_link, to_link) = if reversed {
-            (joint.child.link.clone(), joint.parent.link.clone())
+            (joint.child.clone(), joint.parent.clone())
         } else {
-            (joint.parent.link.clone(), joint.child.link.clone())
+            (joint.parent.clone(), joint.child.clone())
         };
         Ok(ChainStep {
             joint: joint.name.clone(),
@@ -468,7 +457,7 @@ impl LinkTree for UrdfDocument {
         let below = self.index.child_joints.get(link).map_or(&[][..], Vec::as_slice);
         let mut children = Vec::new();
         for joint in below.iter().filter_map(|&j| self.robot.joints.get(j)) {
-            if joint.joint_type != urdf_rs::JointType::Fixed {
+            if joint.joint_type != UrdfJointType::Fixed {
                 continue;
             }
             if !joint.origin.xyz.iter().chain(joint.origin.rpy.iter()).all(|v| v.is_finite()) {
@@ -476,8 +465,8 @@ impl LinkTree for UrdfDocument {
                 return Err(self.error_at("joint", &joint.name, message));
             }
             let [roll, pitch, yaw] = joint.origin.rpy.map(|a| a.rem_euclid(std::f64::consts::TAU));
-            let origin = SE3::new(SO3::from_rpy(roll, pitch, yaw), Vector3::from(*joint.origin.xyz));
-            children.push((joint.child.link.clone(), origin));
+            let origin = SE3::new(SO3::from_rpy(roll, pitch, yaw), Vector3::from(joint.origin.xyz));
+            children.push((joint.child.clone(), origin));
         }
         Ok(children)
     }
@@ -489,34 +478,6 @@ fn find<'a>(element: &'a Element, matches: &dyn Fn(&Element) -> bool) -> Option<
         return Some(element);
     }
     element.children.iter().find_map(|c| find(c, matches))
-}
-
-/// The position an XML parser's message gives, 1-based, if it is inside `text`: serde-xml-rs
-/// writes `Line: 3, Column: 22` (1-based), xml-rs `Syntax: 1:684587` (0-based row and column).
-fn parser_position(message: &str, text: &str) -> Option<Position> {
-    let number = |s: &str| -> Option<usize> {
-        let digits: String = s.chars().take_while(char::is_ascii_digit).collect();
-        digits.parse().ok()
-    };
-    let position = if let Some((_, rest)) = message.split_once("Line: ") {
-        let line = number(rest)?;
-        let (_, rest) = rest.split_once("Column: ")?;
-        (line, number(rest)?)
-    } else {
-        let (_, rest) = message.split_once("Syntax: ")?;
-        let (row, rest) = rest.split_once(':')?;
-        (number(row)? + 1, number(rest)? + 1)
-    };
-    let lines = text.lines().count().max(1);
-    (position.0 >= 1 && position.0 <= lines && position.1 >= 1).then_some(position)
-}
-
-/// 1-based line and column of a byte offset.
-fn line_column(text: &str, offset: usize) -> Position {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (line, column)
 }
 
 /// `base_from_link` at the zero configuration of every step's `to_link`, in chain order: the
@@ -585,22 +546,5 @@ impl UrdfChain {
             dynamics: self.dynamics.clone(),
             folded,
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::parser_position;
-
-    #[test]
-    fn the_xml_parsers_positions_are_read_in_either_form_and_only_inside_the_text() {
-        let text = "<robot>\n  <link/>\n  <link/>\n</robot>";
-        assert_eq!(
-            parser_position("Parse error; Line: 3, Column: 22, Reason: Found invalid entity", text),
-            Some((3, 22))
-        );
-        assert_eq!(parser_position("URDF: Syntax: 1:6 This document is larger", text), Some((2, 7)));
-        assert_eq!(parser_position("Syntax: 9:6 beyond the end", text), None);
-        assert_eq!(parser_position("custom: missing field `name`", text), None);
     }
 }

@@ -1,7 +1,7 @@
 //! The outline of an XML document: its elements with their attributes, byte spans and 1-based
-//! line and column. `urdf-rs` parses a URDF into types but keeps no positions; this outline lets a
-//! refusal name the line and column of the element at fault, finds syntax errors that `urdf-rs`
-//! reports without a position, and lets the URDF export edit a file in place (so that what it does
+//! line and column: the one reading of a URDF's XML (`urdf_model.rs` reads the links and joints
+//! from it). It lets a refusal name the line and column of the element at fault, and lets the URDF
+//! export edit a file in place (so that what it does
 //! not understand, `<transmission>`, `<gazebo>`, `<ros2_control>`, comments, stays as it was).
 
 /// A 1-based line and column.
@@ -102,8 +102,37 @@ impl Cursor<'_> {
     }
 }
 
-fn decode(value: &str) -> String {
-    value.replace("&quot;", "\"").replace("&apos;", "'").replace("&lt;", "<").replace("&gt;", ">").replace("&amp;", "&")
+/// An attribute value with its references decoded: the five predefined entities and character
+/// references (`&#65;`, `&#x41;`). Any other `&` is refused, as an XML parser refuses it.
+fn decode(value: &str) -> Result<String, String> {
+    let mut decoded = String::with_capacity(value.len());
+    let mut rest = value;
+    while let Some(i) = rest.find('&') {
+        decoded.push_str(&rest[..i]);
+        rest = &rest[i..];
+        let Some(end) = rest.find(';') else {
+            return Err("'&' that starts no entity (write '&amp;')".into());
+        };
+        let name = &rest[1..end];
+        let character = match name {
+            "quot" => Some('"'),
+            "apos" => Some('\''),
+            "lt" => Some('<'),
+            "gt" => Some('>'),
+            "amp" => Some('&'),
+            _ => match name.strip_prefix("#x").or_else(|| name.strip_prefix("#X")) {
+                Some(hex) => u32::from_str_radix(hex, 16).ok().and_then(char::from_u32),
+                None => name.strip_prefix('#').and_then(|d| d.parse::<u32>().ok()).and_then(char::from_u32),
+            },
+        };
+        let Some(character) = character else {
+            return Err(format!("invalid entity '&{name};'"));
+        };
+        decoded.push(character);
+        rest = &rest[end + 1..];
+    }
+    decoded.push_str(rest);
+    Ok(decoded)
 }
 
 /// A start tag: name, attributes, and whether it closes itself (`<a/>`).
@@ -158,7 +187,10 @@ fn start_tag(cursor: &mut Cursor<'_>, position: Position) -> Result<StartTag, Sy
                 message: format!("the value of attribute '{attribute}' is not closed"),
             });
         };
-        let value = decode(&cursor.rest()[..end]);
+        let value = decode(&cursor.rest()[..end]).map_err(|why| SyntaxError {
+            position: attribute_at.position,
+            message: format!("attribute '{attribute}' of <{name}>: {why}"),
+        })?;
         cursor.advance(end + 1);
         if !seen.insert(attribute.clone()) {
             return Err(SyntaxError {
@@ -252,7 +284,7 @@ mod tests {
 
     #[test]
     fn the_outline_has_positions_spans_and_decoded_attributes() {
-        let text = "<?xml version=\"1.0\"?>\n<!-- a <fake> one -->\n<robot name='r&amp;d'>\n  <link name=\"a\"/>\n  <joint name=\"j\">\n    <parent link=\"a\" />\n  </joint>\n</robot>\n";
+        let text = "<?xml version=\"1.0\"?>\n<!-- a <fake> one -->\n<robot name='r&amp;&#x64;'>\n  <link name=\"a\"/>\n  <joint name=\"j\">\n    <parent link=\"a\" />\n  </joint>\n</robot>\n";
         let root = outline(text).unwrap();
         assert_eq!((root.name.as_str(), root.attribute("name"), root.position), ("robot", Some("r&d"), (3, 1)));
         let joint = &root.children[1];
@@ -273,6 +305,8 @@ mod tests {
             ("<robot>\n <!-- open\n</robot>", (2, 2), "comment is not closed"),
             ("<robot/>\n<robot/>", (2, 1), "follows the root element"),
             ("<robot>\n  <link name=\"a\" name=\"b\"/>\n</robot>", (2, 18), "appears twice"),
+            ("<robot>\n  <link name=\"t&foo;ip\"/>\n</robot>", (2, 9), "invalid entity '&foo;'"),
+            ("<robot>\n  <link name=\"a & b\"/>\n</robot>", (2, 9), "'&' that starts no entity"),
             (deep.as_str(), (1, 1 + 3 * MAX_DEPTH), "nested 257 elements deep"),
         ] {
             let error = outline(text).unwrap_err();
