@@ -8,7 +8,6 @@
 //! root's re-exports is found too.
 
 use anyhow::{Context, Result, bail};
-use regex::Regex;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -78,19 +77,16 @@ fn workspace_crates(root: &Path) -> Result<Vec<Crate>> {
         .collect();
     dirs.sort();
     dirs.push(root.join("xtask"));
-    let name_line = Regex::new(r#"(?m)^name\s*=\s*"([^"]+)""#)?;
-    let dependency = Regex::new(r"(?m)^([A-Za-z0-9_-]+)(?:\.workspace\s*=\s*true|\s*=)")?;
     dirs.iter()
         .map(|dir| {
             let manifest = std::fs::read_to_string(dir.join("Cargo.toml"))
                 .with_context(|| format!("reading {}", dir.join("Cargo.toml").display()))?;
-            let name = name_line
-                .captures(&manifest)
-                .map(|c| c[1].to_owned())
+            let name = package_name(&manifest)
+                .map(str::to_owned)
                 .with_context(|| format!("{}: no package name", dir.display()))?;
             // The `[dependencies]` section only: dev-dependencies may point anywhere.
             let section = manifest.split("\n[").find(|s| s.starts_with("dependencies]")).unwrap_or("");
-            let depends_on = dependency.captures_iter(section).map(|c| c[1].to_owned()).collect();
+            let depends_on = dependencies(section).into_iter().map(str::to_owned).collect();
             let src = dir.join("src");
             let lines = rust_files(&src)?
                 .iter()
@@ -121,7 +117,6 @@ fn rust_files(dir: &Path) -> Result<Vec<PathBuf>> {
 /// Each module's path (`identify::solver`; the crate root is `""`) and its code without tests
 /// and comments.
 fn read_modules(src: &Path) -> Result<BTreeMap<String, String>> {
-    let comment = Regex::new(r"//[^\n]*")?;
     rust_files(src)?
         .into_iter()
         .map(|file| {
@@ -132,28 +127,124 @@ fn read_modules(src: &Path) -> Result<BTreeMap<String, String>> {
             }
             let text = std::fs::read_to_string(&file)?;
             let code = text.split("#[cfg(test)]").next().unwrap_or("");
-            Ok((parts.join("::"), comment.replace_all(code, "").into_owned()))
+            Ok((parts.join("::"), without_comments(code)))
+        })
+        .collect()
+}
+
+/// Whether `c` is a word character (the `\w` of a path segment).
+fn is_word(c: char) -> bool {
+    c.is_alphanumeric() || c == '_'
+}
+
+/// The longest path `word(::word)*` at the start of `text` (empty if `text` starts with no word).
+fn path_at(text: &str) -> &str {
+    let mut end = 0;
+    loop {
+        let segment = text[end..].find(|c: char| !is_word(c)).unwrap_or(text.len() - end);
+        if segment == 0 {
+            // `a::` followed by no word: the path ends before the `::`.
+            return &text[..end.saturating_sub(2)];
+        }
+        end += segment;
+        if !text[end..].starts_with("::") {
+            return &text[..end];
+        }
+        end += 2;
+    }
+}
+
+/// Every path `word(::word)*` in `text`, left to right, none overlapping.
+fn paths(text: &str) -> Vec<&str> {
+    let mut found = Vec::new();
+    let mut at = 0;
+    while let Some(i) = text[at..].find(is_word) {
+        let path = path_at(&text[at + i..]);
+        found.push(path);
+        at += i + path.len();
+    }
+    found
+}
+
+/// The path after each `prefix` (`crate::`) in `code` that starts with a word.
+fn paths_after<'a>(code: &'a str, prefix: &str) -> Vec<&'a str> {
+    code.match_indices(prefix).map(|(i, _)| path_at(&code[i + prefix.len()..])).filter(|p| !p.is_empty()).collect()
+}
+
+/// The inside of each `{…}` after `prefix` (`use crate::{`) that closes with `};` before any other `;`.
+fn groups_after<'a>(code: &'a str, prefix: &str) -> Vec<&'a str> {
+    code.match_indices(prefix)
+        .filter_map(|(i, _)| {
+            let inside = &code[i + prefix.len()..];
+            let end = inside.find(';')?;
+            inside[..end].strip_suffix('}')
+        })
+        .collect()
+}
+
+/// The root's `pub use module::{A, B};` and `pub use module::A;` (also `pub(crate)`): each module
+/// with the text after its `::`.
+fn re_exports(code: &str) -> Vec<(&str, &str)> {
+    let mut found: Vec<(usize, &str, &str)> = Vec::new();
+    for prefix in ["pub use ", "pub(crate) use "] {
+        for (i, _) in code.match_indices(prefix) {
+            let rest = &code[i + prefix.len()..];
+            let module_end = rest.find(|c: char| !is_word(c)).unwrap_or(rest.len());
+            let (module, rest) = rest.split_at(module_end);
+            let Some(rest) = rest.strip_prefix("::").filter(|_| !module.is_empty()) else { continue };
+            let Some(end) = rest.find(';') else { continue };
+            let item = &rest[..end];
+            let single = !item.is_empty() && item.chars().all(is_word);
+            if single || (item.starts_with('{') && item.ends_with('}')) {
+                found.push((i, module, item));
+            }
+        }
+    }
+    // In the order they are written: a name exported twice resolves to the later module.
+    found.sort_by_key(|(i, _, _)| *i);
+    found.into_iter().map(|(_, module, item)| (module, item)).collect()
+}
+
+/// `code` without its `//` comments (to the end of each line).
+fn without_comments(code: &str) -> String {
+    code.split('\n').map(|line| line.find("//").map_or(line, |i| &line[..i])).collect::<Vec<_>>().join("\n")
+}
+
+/// The value of the first line `name = "…"` of a manifest.
+fn package_name(manifest: &str) -> Option<&str> {
+    manifest.lines().find_map(|line| {
+        let rest = line.strip_prefix("name")?.trim_start().strip_prefix('=')?.trim_start().strip_prefix('"')?;
+        let name = &rest[..rest.find('"')?];
+        (!name.is_empty()).then_some(name)
+    })
+}
+
+/// The dependencies a `[dependencies]` section names: each line's leading `name` followed by
+/// `.workspace = true` or `=`.
+fn dependencies(section: &str) -> Vec<&str> {
+    section
+        .lines()
+        .filter_map(|line| {
+            let end = line.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '-')).unwrap_or(line.len());
+            let (name, rest) = line.split_at(end);
+            let workspace = rest
+                .strip_prefix(".workspace")
+                .and_then(|r| r.trim_start().strip_prefix('='))
+                .is_some_and(|r| r.trim_start().starts_with("true"));
+            (!name.is_empty() && (workspace || rest.trim_start().starts_with('='))).then_some(name)
         })
         .collect()
 }
 
 /// Which module imports which.
 fn module_graph(modules: &BTreeMap<String, String>) -> BTreeMap<String, BTreeSet<String>> {
-    let crate_path = Regex::new(r"crate::((?:\w+::)*\w+)").expect("a valid pattern");
-    let crate_group = Regex::new(r"use crate::\{([^;]*)\};").expect("a valid pattern");
-    let super_path = Regex::new(r"super::((?:\w+::)*\w+)").expect("a valid pattern");
-    let super_group = Regex::new(r"use super::\{([^;]*)\};").expect("a valid pattern");
-    let path = Regex::new(r"\w+(?:::\w+)*").expect("a valid pattern");
-    let re_export = Regex::new(r"pub(?:\(crate\))? use (\w+)::(\{[^;]*?\}|\w+);").expect("a valid pattern");
-    let word = Regex::new(r"\w+").expect("a valid pattern");
-
     // Names the crate root re-exports, and the module each comes from.
     let mut exported: BTreeMap<String, String> = BTreeMap::new();
     if let Some(root) = modules.get("") {
-        for c in re_export.captures_iter(root) {
-            if modules.contains_key(&c[1]) {
-                for name in word.find_iter(&c[2]) {
-                    exported.insert(name.as_str().to_owned(), c[1].to_owned());
+        for (module, items) in re_exports(root) {
+            if modules.contains_key(module) {
+                for name in items.split(|c: char| !is_word(c)).filter(|w| !w.is_empty()) {
+                    exported.insert(name.to_owned(), module.to_owned());
                 }
             }
         }
@@ -162,14 +253,14 @@ fn module_graph(modules: &BTreeMap<String, String>) -> BTreeMap<String, BTreeSet
     for (module, code) in modules {
         let parent = module.rsplit_once("::").map_or("", |(p, _)| p);
         let from_super = |p: &str| if parent.is_empty() { p.to_owned() } else { format!("{parent}::{p}") };
-        let mut paths: Vec<String> = crate_path.captures_iter(code).map(|c| c[1].to_owned()).collect();
-        for group in crate_group.captures_iter(code) {
-            paths.extend(path.find_iter(&group[1]).map(|m| m.as_str().to_owned()));
+        let mut paths: Vec<String> = paths_after(code, "crate::").into_iter().map(str::to_owned).collect();
+        for group in groups_after(code, "use crate::{") {
+            paths.extend(self::paths(group).into_iter().map(str::to_owned));
         }
         if !module.is_empty() {
-            paths.extend(super_path.captures_iter(code).map(|c| from_super(&c[1])));
-            for group in super_group.captures_iter(code) {
-                paths.extend(path.find_iter(&group[1]).map(|m| from_super(m.as_str())));
+            paths.extend(paths_after(code, "super::").into_iter().map(from_super));
+            for group in groups_after(code, "use super::{") {
+                paths.extend(self::paths(group).into_iter().map(from_super));
             }
         }
         let mut targets = BTreeSet::new();
