@@ -385,3 +385,32 @@ mod tests {
         assert_eq!(circles(&module_graph(&m)), vec![vec!["p::x".to_owned(), "p::y".to_owned()]]);
     }
 }
+
+#[cfg(test)]
+mod scanner_tests {
+    use super::*;
+
+    #[test]
+    fn paths_end_before_a_trailing_separator_and_groups_close_at_the_first_semicolon() {
+        assert_eq!(path_at("a::b::{c, d}"), "a::b");
+        assert_eq!(path_at("a::b;"), "a::b");
+        assert_eq!(path_at("{a}"), "");
+        assert_eq!(paths("x::y, z::{w}"), ["x::y", "z", "w"]);
+        assert_eq!(paths_after("use crate::m::f; crate::{", "crate::"), ["m::f"]);
+        assert_eq!(groups_after("use crate::{a, b::c}; use crate::{d; }", "use crate::{"), ["a, b::c"]);
+        assert_eq!(
+            re_exports("pub use m::{A, B};\npub(crate) use n::C;\npub use o::{D; pub use p::*;"),
+            [("m", "{A, B}"), ("n", "C")]
+        );
+        assert_eq!(without_comments("a // b\nc\n// d"), "a \nc\n");
+    }
+
+    #[test]
+    fn manifests_give_their_name_and_workspace_dependencies() {
+        let manifest = "[package]\nname = \"poe\"\n[dependencies]\nlie.workspace = true\nfaer = { workspace = true }\n# x = 1\nrayon.workspace = false\n";
+        assert_eq!(package_name(manifest), Some("poe"));
+        assert_eq!(package_name("[package]\nname = \"\"\n"), None);
+        let section = manifest.split("\n[").find(|s| s.starts_with("dependencies]")).unwrap();
+        assert_eq!(dependencies(section), ["lie", "faer"]);
+    }
+}
