@@ -136,8 +136,8 @@ pub const CONSTANT_FEATURES: f64 = 1e-9;
 /// per kind holding the type of the same name, every method delegated to its `EffectTerm` /
 /// `NewEffect` (module `term`).
 macro_rules! identified_effect {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident, )* }
-     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident, )* }) => {
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident: $sim:ty, )* }
+     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident: $ssim:ty, )* }) => {
         /// An effect of a calibrated model, with its identified parameters: one variant per
         /// identified kind of `loadsim::effect_kinds!`, holding the type of the same name,
         /// written in model files under the kind's SPEC name.
