@@ -181,7 +181,7 @@ macro_rules! identified_effect {
                     $( EffectKind::$kind => {
                         <$kind as NewEffect>::build(spec, context, data).map(IdentifiedEffect::$kind)
                     } )*
-                    _ => Err(Error::at_line("--effects", 1, 1, ErrorKind::EffectList { text: spec.to_string(), fault: EffectListFault::UnknownEffect })),
+                    _ => Err(Error::at_line("--effects", 1, 1, ErrorKind::EffectList { text: spec.to_string(), fault: EffectListFault::UnknownEffect { items: spec::items() } })),
                 }
             }
 
@@ -321,6 +321,13 @@ impl IdentifiedEffect {
     /// Sets the rule of [`IdentifiedEffect::payload_span`] (nothing where there is none).
     pub fn set_beyond_payload(&mut self, rule: BeyondSpan) {
         self.term_mut().set_beyond_payload(rule);
+    }
+
+    /// Records what the effect keeps of its training rows `rows` once its parameters are fitted
+    /// (a series' RMS on them, for [`IdentifiedEffect::sigma`]); called by the fit after
+    /// [`IdentifiedEffect::set_theta`].
+    pub fn after_fit(&mut self, rows: &[Measurement]) {
+        self.term_mut().after_fit(rows);
     }
 
     /// The 1-based joints the effect acts on (empty for thermal growth and drift).
