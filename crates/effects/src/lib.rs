@@ -59,7 +59,7 @@ pub use payload_span::PayloadSpan;
 pub use report::{EffectReport, ParameterReport};
 pub use report::{effect_reports, reported_label, reported_parameters};
 pub use screw::ScrewPeriodic;
-pub use spec::{Argument, EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS, PITCH_BOUNDS_MM};
+pub use spec::{Argument, EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS, PITCH_BOUNDS_MM, effect_items};
 pub use term::{CandidateContext, CandidateModel, CandidateOptions};
 pub use thermal::Thermal;
 
@@ -181,7 +181,7 @@ macro_rules! identified_effect {
                     $( EffectKind::$kind => {
                         <$kind as NewEffect>::build(spec, context, data).map(IdentifiedEffect::$kind)
                     } )*
-                    _ => Err(Error::at_line("--effects", 1, 1, ErrorKind::EffectList { text: spec.to_string(), fault: EffectListFault::UnknownEffect { items: spec::items() } })),
+                    _ => Err(Error::at_line("--effects", 1, 1, ErrorKind::EffectList { text: spec.to_string(), fault: EffectListFault::UnknownEffect { items: spec::effect_items() } })),
                 }
             }
 
