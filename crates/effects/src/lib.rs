@@ -13,7 +13,8 @@
 //! `term`. [`IdentifiedEffect`] is generated from the one list of kinds, `loadsim::effect_kinds!`
 //! ([`EffectKind`]), a variant per identified kind holding the type of the same name; the
 //! `--effects` parser ([`EffectSpec`]) reads the kinds' names and arguments from it. Adding an
-//! effect: one line in that list, one file here (docs/ARCHITECTURE.md, "Adding an effect").
+//! effect: one line in that list, one file here and its simulation in a file of `loadsim`
+//! (`loadsim::SimulatedEffect`), each with its `mod` line (docs/ARCHITECTURE.md, "Adding an effect").
 //!
 //! ```
 //! use effects::EffectSelection;
