@@ -24,12 +24,8 @@ pub struct Args {
     /// Where to write the calibrated model (RON).
     #[arg(long)]
     out: PathBuf,
-    /// Non-geometric effects identified with the geometry, applied before any GP (beyond the
-    /// paper): a comma-separated list of joint_compliance, gear_periodic:JOINT:HARMONICS,
-    /// backlash:JOINT, thermal, time_drift, link_deflection:JOINT,
-    /// screw_periodic:JOINT:PITCH_MM:HARMONICS; or auto, what `calib diagnose`
-    /// selects on the data.
-    #[arg(long, value_name = "LIST|auto")]
+    // The help lists the items from the one list of kinds (`effects_help`).
+    #[arg(long, value_name = "LIST|auto", help = effects_help())]
     effects: Option<EffectSelection>,
     /// The same as --effects joint_compliance: joint compliance through measured torques
     /// (tauN_nm) where the data has them, gravity-torque regressors otherwise (no masses needed).
@@ -50,6 +46,15 @@ pub struct Args {
     /// a mirror-image frame, joint values beyond the limits), with a warning instead.
     #[arg(long)]
     force: bool,
+}
+
+/// The help of `--effects`: its items, each kind of the one list with its arguments.
+fn effects_help() -> String {
+    format!(
+        "Non-geometric effects identified with the geometry, applied before any GP (beyond the paper): a \
+         comma-separated list of {}; or auto, what `calib diagnose` selects on the data",
+        effects::effect_items()
+    )
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {

@@ -293,6 +293,10 @@ impl Regressor for GearPeriodic {
 }
 
 impl EffectTerm for GearPeriodic {
+    fn after_fit(&mut self, rows: &[Measurement]) {
+        self.record_rms(rows);
+    }
+
     fn label(&self) -> String {
         let consecutive = self.orders.iter().enumerate().all(|(k, &h)| h as usize == k + 1);
         match (consecutive, self.orders.last()) {

@@ -13,7 +13,8 @@
 //! `term`. [`IdentifiedEffect`] is generated from the one list of kinds, `loadsim::effect_kinds!`
 //! ([`EffectKind`]), a variant per identified kind holding the type of the same name; the
 //! `--effects` parser ([`EffectSpec`]) reads the kinds' names and arguments from it. Adding an
-//! effect: one line in that list, one file here (docs/ARCHITECTURE.md, "Adding an effect").
+//! effect: one line in that list, one file here and its simulation in a file of `loadsim`
+//! (`loadsim::SimulatedEffect`), each with its `mod` line (docs/ARCHITECTURE.md, "Adding an effect").
 //!
 //! ```
 //! use effects::EffectSelection;
@@ -59,7 +60,7 @@ pub use payload_span::PayloadSpan;
 pub use report::{EffectReport, ParameterReport};
 pub use report::{effect_reports, reported_label, reported_parameters};
 pub use screw::ScrewPeriodic;
-pub use spec::{Argument, EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS, PITCH_BOUNDS_MM};
+pub use spec::{Argument, EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS, PITCH_BOUNDS_MM, effect_items};
 pub use term::{CandidateContext, CandidateModel, CandidateOptions};
 pub use thermal::Thermal;
 
@@ -136,8 +137,8 @@ pub const CONSTANT_FEATURES: f64 = 1e-9;
 /// per kind holding the type of the same name, every method delegated to its `EffectTerm` /
 /// `NewEffect` (module `term`).
 macro_rules! identified_effect {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident, )* }
-     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident, )* }) => {
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident: $sim:ty, )* }
+     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident: $ssim:ty, )* }) => {
         /// An effect of a calibrated model, with its identified parameters: one variant per
         /// identified kind of `loadsim::effect_kinds!`, holding the type of the same name,
         /// written in model files under the kind's SPEC name.
@@ -181,7 +182,7 @@ macro_rules! identified_effect {
                     $( EffectKind::$kind => {
                         <$kind as NewEffect>::build(spec, context, data).map(IdentifiedEffect::$kind)
                     } )*
-                    _ => Err(Error::at_line("--effects", 1, 1, ErrorKind::EffectList { text: spec.to_string(), fault: EffectListFault::UnknownEffect })),
+                    _ => Err(Error::at_line("--effects", 1, 1, ErrorKind::EffectList { text: spec.to_string(), fault: EffectListFault::UnknownEffect { items: spec::effect_items() } })),
                 }
             }
 
@@ -321,6 +322,13 @@ impl IdentifiedEffect {
     /// Sets the rule of [`IdentifiedEffect::payload_span`] (nothing where there is none).
     pub fn set_beyond_payload(&mut self, rule: BeyondSpan) {
         self.term_mut().set_beyond_payload(rule);
+    }
+
+    /// Records what the effect keeps of its training rows `rows` once its parameters are fitted
+    /// (a series' RMS on them, for [`IdentifiedEffect::sigma`]); called by the fit after
+    /// [`IdentifiedEffect::set_theta`].
+    pub fn after_fit(&mut self, rows: &[Measurement]) {
+        self.term_mut().after_fit(rows);
     }
 
     /// The 1-based joints the effect acts on (empty for thermal growth and drift).

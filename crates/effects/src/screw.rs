@@ -106,6 +106,10 @@ impl Regressor for ScrewPeriodic {
 }
 
 impl EffectTerm for ScrewPeriodic {
+    fn after_fit(&mut self, rows: &[Measurement]) {
+        self.record_rms(rows);
+    }
+
     fn label(&self) -> String {
         let (j, pitch_mm) = (self.series.joint + 1, self.pitch_m * 1e3);
         let consecutive = self.series.orders.iter().enumerate().all(|(k, &h)| h as usize == k + 1);

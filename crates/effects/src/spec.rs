@@ -162,14 +162,32 @@ impl fmt::Display for EffectSelection {
     }
 }
 
+/// The items `--effects` takes, as its refusals list them: every identified kind with its
+/// arguments (`joint_compliance, backlash:JOINT, gear_periodic:JOINT:HARMONICS, …`), in the list's
+/// order.
+pub fn effect_items() -> &'static str {
+    static ITEMS: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    ITEMS.get_or_init(|| {
+        let item = |&kind: &EffectKind| {
+            let arguments = IdentifiedEffect::arguments(kind).iter().map(|argument| match argument {
+                Argument::Joint => ":JOINT",
+                Argument::Harmonics => ":HARMONICS",
+                Argument::Pitch => ":PITCH_MM",
+            });
+            std::iter::once(kind.name()).chain(arguments).collect::<String>()
+        };
+        EffectKind::IDENTIFIED.iter().map(item).collect::<Vec<_>>().join(", ")
+    })
+}
+
 fn parse_item(item: &str) -> Result<EffectSpec, EffectListFault> {
     let mut parts = item.split(':');
     let name = parts.next().unwrap_or("").trim();
     let arguments: Vec<&str> = parts.collect();
     let kind = match EffectKind::from_name(name) {
         Some(kind) if kind.is_identified() => kind,
-        _ if name.is_empty() => return Err(EffectListFault::Empty),
-        _ => return Err(EffectListFault::UnknownEffect),
+        _ if name.is_empty() => return Err(EffectListFault::Empty { items: effect_items() }),
+        _ => return Err(EffectListFault::UnknownEffect { items: effect_items() }),
     };
     let mut spec = EffectSpec::new(kind);
     let expected = spec.arguments();
@@ -208,7 +226,7 @@ impl FromStr for EffectSelection {
             )
         };
         if text.trim().is_empty() {
-            return Err(fault(0, text, EffectListFault::Empty));
+            return Err(fault(0, text, EffectListFault::Empty { items: effect_items() }));
         }
         let mut offset = 0;
         let mut items = Vec::new();
@@ -275,9 +293,15 @@ mod tests {
 
     #[test]
     fn each_bad_item_is_refused_at_its_column_with_its_fault() {
-        assert_eq!(fault_of(""), (1, String::new(), EffectListFault::Empty));
-        assert_eq!(fault_of("thermal,,time_drift"), (9, String::new(), EffectListFault::Empty));
-        assert_eq!(fault_of("thermal,gear:1:3"), (9, "gear:1:3".into(), EffectListFault::UnknownEffect));
+        assert_eq!(fault_of(""), (1, String::new(), EffectListFault::Empty { items: effect_items() }));
+        assert_eq!(
+            fault_of("thermal,,time_drift"),
+            (9, String::new(), EffectListFault::Empty { items: effect_items() })
+        );
+        assert_eq!(
+            fault_of("thermal,gear:1:3"),
+            (9, "gear:1:3".into(), EffectListFault::UnknownEffect { items: effect_items() })
+        );
         assert_eq!(
             fault_of("gear_periodic:2"),
             (1, "gear_periodic:2".into(), EffectListFault::Arguments { expected: 2, found: 1 })
@@ -338,15 +362,23 @@ mod tests {
             assert_eq!(parsed.to_string(), text);
         }
         for &kind in EffectKind::ALL.iter().filter(|k| !k.is_identified()) {
-            assert_eq!(fault_of(kind.name()).2, EffectListFault::UnknownEffect, "{kind:?}");
+            assert_eq!(fault_of(kind.name()).2, EffectListFault::UnknownEffect { items: effect_items() }, "{kind:?}");
         }
     }
 
     #[test]
     fn the_refusals_list_every_identified_kind() {
-        // The list in the messages is written out in `errors` (a leaf that knows no kinds): a
-        // kind added to `effect_kinds!` must be added there too.
-        for fault in [EffectListFault::Empty, EffectListFault::UnknownEffect] {
+        // The list in the messages is written from the one list of kinds (`errors`, a leaf, knows
+        // none), each kind with its arguments.
+        assert!(
+            effect_items().starts_with("joint_compliance, backlash:JOINT, gear_periodic:JOINT:HARMONICS, "),
+            "{}",
+            effect_items()
+        );
+        assert!(effect_items().contains("screw_periodic:JOINT:PITCH_MM:HARMONICS"), "{}", effect_items());
+        for fault in
+            [EffectListFault::Empty { items: effect_items() }, EffectListFault::UnknownEffect { items: effect_items() }]
+        {
             let message = fault.to_string();
             for &kind in EffectKind::IDENTIFIED {
                 assert!(message.contains(kind.name()), "{message} lacks {}", kind.name());

@@ -132,6 +132,10 @@ pub(crate) trait EffectTerm: Regressor + std::fmt::Debug + Send + Sync {
 
     /// Sets the rule of [`EffectTerm::payload_span`]; nothing where there is none.
     fn set_beyond_payload(&mut self, _rule: crate::BeyondSpan) {}
+
+    /// Records what the effect keeps of its training rows once its parameters are fitted (a
+    /// series' RMS, for [`EffectTerm::uncovered`]); nothing by default.
+    fn after_fit(&mut self, _rows: &[Measurement]) {}
 }
 
 /// How an effect is made. Implemented by the type of every identified kind.

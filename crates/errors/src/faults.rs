@@ -113,9 +113,17 @@ impl fmt::Display for FileKind {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EffectListFault {
     /// The argument or an item is empty.
-    Empty,
+    Empty {
+        /// The items `--effects` takes, as the message lists them (`joint_compliance,
+        /// gear_periodic:JOINT:HARMONICS, …`): written by the effects crate from its one list of
+        /// kinds, which this leaf does not know.
+        items: &'static str,
+    },
     /// Not one of the SPEC's effect names.
-    UnknownEffect,
+    UnknownEffect {
+        /// The items `--effects` takes, as for [`EffectListFault::Empty`].
+        items: &'static str,
+    },
     /// An effect that takes no `:` argument was given one, or one that needs them lacks them.
     Arguments {
         /// How many `:`-separated arguments the effect takes.
@@ -138,17 +146,15 @@ pub enum EffectListFault {
 impl fmt::Display for EffectListFault {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
-            EffectListFault::Empty => f.write_str(
-                "is empty (expected auto, or a list of joint_compliance, gear_periodic:JOINT:HARMONICS, screw_periodic:JOINT:PITCH_MM:HARMONICS, backlash:JOINT, thermal, time_drift, link_deflection:JOINT)",
-            ),
-            EffectListFault::UnknownEffect => f.write_str(
-                "is not an effect (joint_compliance, gear_periodic:JOINT:HARMONICS, screw_periodic:JOINT:PITCH_MM:HARMONICS, backlash:JOINT, thermal, time_drift, link_deflection:JOINT)",
-            ),
+            EffectListFault::Empty { items } => write!(f, "is empty (expected auto, or a list of {items})"),
+            EffectListFault::UnknownEffect { items } => write!(f, "is not an effect ({items})"),
             EffectListFault::Arguments { expected, found } => {
                 write!(f, "takes {expected} ':' argument(s), {found} given")
             }
             EffectListFault::Joint => f.write_str("has a joint that is not a whole number from 1"),
-            EffectListFault::Harmonics => write!(f, "has a harmonic count that is not a whole number from 1 to {MAX_HARMONICS}"),
+            EffectListFault::Harmonics => {
+                write!(f, "has a harmonic count that is not a whole number from 1 to {MAX_HARMONICS}")
+            }
             EffectListFault::Pitch => {
                 let (low, high) = PITCH_BOUNDS_MM;
                 write!(f, "has a pitch that is not a number of millimetres from {low} to {high}")

@@ -3,6 +3,9 @@
 //! carries (the hysteresis model of backlash at rest; Nordin & Gutman, *Automatica* 2002).
 
 use crate::Error;
+use crate::{
+    DynamicsNeed, EntryFault, MAX_JOINT_ERROR_RAD, PoseInput, RobotFacts, SimulatedCell, SimulatedEffect, beyond,
+};
 use serde::{Deserialize, Serialize};
 
 /// The play of one joint.
@@ -67,4 +70,34 @@ pub fn backlash_joint_regressor(torque: &[f64]) -> Vec<f64> {
             }
         })
         .collect()
+}
+
+impl SimulatedEffect for Backlash {
+    fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
+        let n = cell.robot.joint_count();
+        Backlash::validate(self, n)?;
+        cell.dynamics_for("backlash")?.validate(n)
+    }
+
+    fn needs_dynamics(&self) -> DynamicsNeed {
+        DynamicsNeed::Masses
+    }
+
+    fn check_entries(&self, robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
+        for (k, joint) in self.joints.iter().enumerate() {
+            let alone = Backlash { joints: vec![*joint] };
+            let fault = Backlash::validate(&alone, robot.joints.len())
+                .err()
+                .map(|e| e.to_string())
+                .or_else(|| beyond(&[("half_band_rad", joint.half_band_rad, MAX_JOINT_ERROR_RAD)]));
+            if let Some(fault) = fault {
+                return Err(EntryFault::entry(k, format!("entry {}: {fault}", k + 1)));
+            }
+        }
+        Ok(())
+    }
+
+    fn joint_offset(&self, at: &PoseInput<'_>) -> Result<Option<Vec<f64>>, Error> {
+        Ok(Some(self.deflection(at.static_torque_nm)))
+    }
 }

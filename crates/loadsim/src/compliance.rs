@@ -3,6 +3,7 @@
 //! Tao, Yang & Tomizuka 2013, the paper's ref. \[15\]; links taken as rigid, which Dumas et al.,
 //! *Robotica* 2011, found adequate for 6R industrial arms).
 
+use crate::{DynamicsNeed, EntryFault, PoseInput, RobotFacts, SimulatedCell, SimulatedEffect};
 use crate::{Error, Payload, RobotDynamics, gravity::payload_gravity_torque, gravity::static_torque};
 use lie::Vector3;
 use poe::LocalPoe;
@@ -57,4 +58,45 @@ pub fn compliance_deflection(
         dq = deflect(spring_torque(model, dynamics, &moved, tool, payload, settings)?);
     }
     Ok(dq)
+}
+
+/// Most fixed-point steps of the compliance equilibrium an effects file may ask for. Each step
+/// shrinks the error by the factor `C·∂τ/∂q`, below 1e-2 for industrial arms ([`JointCompliance`]),
+/// so 100 steps are far past double precision; more is a typo or a hostile file.
+pub const MAX_FIXED_POINT_ITERATIONS: usize = 100;
+
+impl SimulatedEffect for JointCompliance {
+    fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
+        let dynamics = cell.dynamics_for("joint compliance")?;
+        dynamics.validate(cell.robot.joint_count())?;
+        dynamics.stiffness("joint compliance")?;
+        Ok(())
+    }
+
+    fn needs_dynamics(&self) -> DynamicsNeed {
+        DynamicsNeed::MassesAndStiffness
+    }
+
+    fn check_entries(&self, robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
+        // A URDF's masses come without stiffness: joint compliance has nothing to deflect by.
+        if let Some(Err(error)) = robot.dynamics.map(|d| d.stiffness("joint compliance")) {
+            return Err(EntryFault { field: "compliance".into(), index: 0, message: error.to_string() });
+        }
+        if self.fixed_point_iterations > MAX_FIXED_POINT_ITERATIONS {
+            let message = format!(
+                "fixed_point_iterations is {}, at most {MAX_FIXED_POINT_ITERATIONS} (each step gains about two digits)",
+                self.fixed_point_iterations
+            );
+            return Err(EntryFault { field: "fixed_point_iterations".into(), index: 0, message });
+        }
+        Ok(())
+    }
+
+    fn joint_offset(&self, at: &PoseInput<'_>) -> Result<Option<Vec<f64>>, Error> {
+        let n = at.model.joint_count();
+        Ok(Some(match &at.cell.dynamics {
+            Some(d) => compliance_deflection(at.model, d, at.q, at.cell.tool, &at.context.payload, self)?,
+            None => vec![0.0; n],
+        }))
+    }
 }

@@ -10,6 +10,9 @@
 //! `δq_j = A · Π_f cos(h_f q_{s_f} + φ_f)`, summed over terms.
 
 use crate::Error;
+use crate::{
+    EntryFault, MAX_JOINT_ERROR_RAD, MAX_ORDER, PoseInput, RobotFacts, SimulatedCell, SimulatedEffect, beyond,
+};
 use serde::{Deserialize, Serialize};
 
 /// One factor of a coupling term: a harmonic of another joint's angle.
@@ -86,5 +89,31 @@ impl JointCoupling {
             dq[term.joint_index] += term.amplitude_rad * product;
         }
         dq
+    }
+}
+
+impl SimulatedEffect for JointCoupling {
+    fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
+        JointCoupling::validate(self, cell.robot.joint_count())
+    }
+
+    fn check_entries(&self, robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
+        for (k, term) in self.terms.iter().enumerate() {
+            let alone = JointCoupling { terms: vec![term.clone()] };
+            let mut bounds = vec![("amplitude_rad", term.amplitude_rad, MAX_JOINT_ERROR_RAD)];
+            bounds.extend(term.factors.iter().map(|f| ("order", f.order, MAX_ORDER)));
+            let fault = JointCoupling::validate(&alone, robot.joints.len())
+                .err()
+                .map(|e| e.to_string())
+                .or_else(|| beyond(&bounds));
+            if let Some(fault) = fault {
+                return Err(EntryFault::entry(k, format!("term {}: {fault}", k + 1)));
+            }
+        }
+        Ok(())
+    }
+
+    fn joint_offset(&self, at: &PoseInput<'_>) -> Result<Option<Vec<f64>>, Error> {
+        Ok(Some(self.deflection(at.q)))
     }
 }

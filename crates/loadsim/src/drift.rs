@@ -5,6 +5,7 @@
 //! `log(T' T⁻¹)^∨ = t ξ`.
 
 use crate::Error;
+use crate::{EntryFault, PoseContext, RobotFacts, SimulatedCell, SimulatedEffect, beyond};
 use lie::{SE3, Twist, Vector6};
 use serde::{Deserialize, Serialize};
 
@@ -41,5 +42,28 @@ impl BaseDrift {
     /// The rigid motion `exp(t ξ̂)` that left-multiplies the tracker-frame pose at time `t_s`.
     pub fn motion_at(&self, t_s: f64) -> SE3 {
         self.twist_at(t_s).exp()
+    }
+}
+
+/// Largest drift rate per component an effects file may give, m/s or rad/s: a settling cell
+/// drifts by micrometres per hour; a base moving a metre per second is not drifting.
+pub const MAX_DRIFT_PER_S: f64 = 1.0;
+
+impl SimulatedEffect for BaseDrift {
+    fn validate(&self, _cell: &SimulatedCell) -> Result<(), Error> {
+        BaseDrift::validate(self)
+    }
+
+    fn check_entries(&self, _robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
+        BaseDrift::validate(self).map_err(|e| EntryFault::of_section(&e))?;
+        let bounds: Vec<_> = self.twist_per_s.iter().map(|&v| ("twist_per_s", v, MAX_DRIFT_PER_S)).collect();
+        match beyond(&bounds) {
+            Some(message) => Err(EntryFault { field: "twist_per_s".into(), index: 0, message }),
+            None => Ok(()),
+        }
+    }
+
+    fn tracker_motion(&self, context: &PoseContext) -> Option<SE3> {
+        Some(self.motion_at(context.t_s))
     }
 }

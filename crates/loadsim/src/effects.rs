@@ -1,41 +1,61 @@
 //! All effects together: which are on, and the forward model from commanded joint values to the
-//! measured tool pose. [`Effects::only`] and [`Effects::is_on`] are generated with
-//! [`crate::EffectKind`] from the one list of kinds (module `kinds`).
+//! measured tool pose. [`Effects`] is generated from the one list of kinds (module `kinds`): a
+//! field per kind, named and typed as its line says; the forward model walks the effects that are
+//! on through [`SimulatedEffect`], in the list's order.
 
 use crate::{
-    Backlash, BaseDrift, Error, JointBacklash, JointCompliance, JointCoupling, LinkDeflection, PeriodicError,
-    PoseContext, ScrewError, SimulatedCell, ThermalGrowth, TrackerNoise, compliance::compliance_deflection,
-    gravity::static_torque, periodic::Harmonic,
+    Backlash, EffectKind, Error, JointBacklash, JointCompliance, PeriodicError, PoseContext, PoseInput, SimulatedCell,
+    SimulatedEffect, ThermalGrowth, TrackerNoise, gravity::static_torque, periodic::Harmonic,
 };
+use crate::{BaseDrift, effect_kinds};
 use lie::SE3;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-/// Which effects act and with which parameters; `None` switches an effect off. The default has
-/// none: the measured pose is then the geometric model's.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(default)]
-pub struct Effects {
-    /// Joint compliance (stiffness from the robot's dynamics).
-    pub compliance: Option<JointCompliance>,
-    /// Backlash (torque sign from the robot's dynamics).
-    pub backlash: Option<Backlash>,
-    /// Periodic transmission error.
-    pub periodic: Option<PeriodicError>,
-    /// Thermal growth of the links against `temp_c`.
-    pub thermal: Option<ThermalGrowth>,
-    /// Base drift against `t_s`.
-    pub drift: Option<BaseDrift>,
-    /// Tracker noise.
-    pub tracker_noise: Option<TrackerNoise>,
-    /// A joint error driven by other joints' angles (module [`JointCoupling`]).
-    pub coupling: Option<JointCoupling>,
-    /// Links bending under the gravity moment of everything beyond them (masses from the robot's
-    /// dynamics; module [`LinkDeflection`]).
-    pub deflection: Option<LinkDeflection>,
-    /// Periodic error of linear axes per screw or rack pitch (module [`ScrewError`]).
-    pub screw: Option<ScrewError>,
+macro_rules! effects_struct {
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident: $sim:ty, )* }
+     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident: $ssim:ty, )* }) => {
+        /// Which effects act and with which parameters, a field per kind of
+        /// [`effect_kinds!`](crate::effect_kinds) (named as its line says); `None` switches an
+        /// effect off. The default has none: the measured pose is then the geometric model's.
+        #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+        #[serde(default)]
+        pub struct Effects {
+            $( $(#[$doc])* pub $field: Option<$sim>, )*
+            $( $(#[$sdoc])* pub $sfield: Option<$ssim>, )*
+        }
+
+        impl Effects {
+            /// The effects that are on, with their kinds, in the list's order.
+            pub fn active(&self) -> Vec<(EffectKind, &dyn SimulatedEffect)> {
+                let mut on: Vec<(EffectKind, &dyn SimulatedEffect)> = Vec::new();
+                $( if let Some(effect) = &self.$field { on.push((EffectKind::$kind, effect)); } )*
+                $( if let Some(effect) = &self.$sfield { on.push((EffectKind::$skind, effect)); } )*
+                on
+            }
+
+            /// These effects with only `kind` left on (with its parameters here; off if it is off here).
+            pub fn only(&self, kind: EffectKind) -> Self {
+                let mut alone = Effects::default();
+                match kind {
+                    $( EffectKind::$kind => alone.$field = self.$field.clone(), )*
+                    $( EffectKind::$skind => alone.$sfield = self.$sfield.clone(), )*
+                }
+                alone
+            }
+
+            /// Whether `kind` is on.
+            pub fn is_on(&self, kind: EffectKind) -> bool {
+                match kind {
+                    $( EffectKind::$kind => self.$field.is_some(), )*
+                    $( EffectKind::$skind => self.$sfield.is_some(), )*
+                }
+            }
+        }
+    };
 }
+
+effect_kinds!(effects_struct);
 
 /// The joint-space part of the forward model at one pose, each effect apart.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,30 +63,27 @@ pub struct JointOffsets {
     /// Static torque (gravity, payload, balancer) at the commanded joints, N·m; empty when the
     /// robot has no dynamics.
     pub static_torque_nm: Vec<f64>,
-    /// Compliance deflection, rad.
-    pub compliance_rad: Vec<f64>,
-    /// Backlash offset, rad.
-    pub backlash_rad: Vec<f64>,
-    /// Periodic transmission error, rad.
-    pub periodic_rad: Vec<f64>,
-    /// Coupled joint error, rad.
-    pub coupling_rad: Vec<f64>,
-    /// Screw (or rack) periodic error of the linear axes, m (0 on revolute joints).
-    pub screw_m: Vec<f64>,
+    /// The joint offsets of each effect that is on and moves the joints, in the list's order
+    /// (rad, m on a prismatic joint).
+    pub by_kind: Vec<(EffectKind, Vec<f64>)>,
+    joint_count: usize,
 }
 
 impl JointOffsets {
-    /// The sum of the joint-space effects, rad.
+    /// The joint offsets of `kind` (zero where it is off or moves no joint).
+    pub fn of(&self, kind: EffectKind) -> Vec<f64> {
+        self.by_kind.iter().find(|(k, _)| *k == kind).map_or_else(|| vec![0.0; self.joint_count], |(_, dq)| dq.clone())
+    }
+
+    /// The sum of the joint-space effects (rad, m on a prismatic joint), in the list's order.
     pub fn total(&self) -> Vec<f64> {
-        (0..self.compliance_rad.len())
-            .map(|j| {
-                self.compliance_rad[j]
-                    + self.backlash_rad[j]
-                    + self.periodic_rad[j]
-                    + self.coupling_rad[j]
-                    + self.screw_m[j]
-            })
-            .collect()
+        let mut total = vec![0.0; self.joint_count];
+        for (_, dq) in &self.by_kind {
+            for (t, d) in total.iter_mut().zip(dq) {
+                *t += d;
+            }
+        }
+        total
     }
 }
 
@@ -98,61 +115,31 @@ impl Effects {
             thermal: Some(ThermalGrowth::default()),
             drift: Some(BaseDrift::default()),
             tracker_noise: Some(TrackerNoise::default()),
-            coupling: None,
-            deflection: None,
-            screw: None,
+            ..Effects::default()
         }
     }
 
     /// Checks every active effect against the cell: indices inside the robot, finite values,
     /// dynamics present where an effect needs them.
     pub fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
-        let n = cell.robot.joint_count();
         if cell.tool >= cell.robot.tool_count() {
             return Err(poe::Error::UnknownTool { tool: cell.tool, tool_count: cell.robot.tool_count() }.into());
         }
-        if self.compliance.is_some() {
-            let dynamics = cell.dynamics_for("joint compliance")?;
-            dynamics.validate(n)?;
-            dynamics.stiffness("joint compliance")?;
-        }
-        if let Some(backlash) = &self.backlash {
-            backlash.validate(n)?;
-            cell.dynamics_for("backlash")?.validate(n)?;
-        }
-        if let Some(periodic) = &self.periodic {
-            periodic.validate(n)?;
-        }
-        if let Some(thermal) = &self.thermal {
-            thermal.validate(n)?;
-        }
-        if let Some(drift) = &self.drift {
-            drift.validate()?;
-        }
-        if let Some(noise) = &self.tracker_noise {
-            noise.validate()?;
-        }
-        if let Some(coupling) = &self.coupling {
-            coupling.validate(n)?;
-        }
-        if let Some(screw) = &self.screw {
-            let prismatic: Vec<bool> =
-                cell.robot.joints().iter().map(|j| j.kind == poe::JointKind::Prismatic).collect();
-            screw.validate(&prismatic)?;
-        }
-        if let Some(deflection) = &self.deflection {
-            deflection.validate(n)?;
-            cell.dynamics_for("link deflection")?.validate(n)?;
+        for (_, effect) in self.active() {
+            effect.validate(cell)?;
         }
         Ok(())
     }
 
     /// The base-frame model at this pose's temperature (grown if thermal growth is on).
     fn model_at(&self, cell: &SimulatedCell, context: &PoseContext) -> Result<poe::LocalPoe, Error> {
-        match &self.thermal {
-            Some(thermal) => thermal.grown_model(&cell.robot, context.temp_c),
-            None => Ok(cell.robot.clone()),
+        let mut model = cell.robot.clone();
+        for (_, effect) in self.active() {
+            if let Some(grown) = effect.grown_model(&model, context)? {
+                model = grown;
+            }
         }
+        Ok(model)
     }
 
     /// The joint-space effects at commanded joints `q`, each apart.
@@ -177,27 +164,14 @@ impl Effects {
             Some(d) => static_torque(model, d, q, cell.tool, &context.payload)?,
             None => Vec::new(),
         };
-        let compliance_rad = match (&self.compliance, &cell.dynamics) {
-            (Some(settings), Some(d)) => compliance_deflection(model, d, q, cell.tool, &context.payload, settings)?,
-            _ => vec![0.0; n],
-        };
-        let backlash_rad = match &self.backlash {
-            Some(backlash) => backlash.deflection(&static_torque_nm),
-            None => vec![0.0; n],
-        };
-        let periodic_rad = match &self.periodic {
-            Some(periodic) => periodic.deflection(q),
-            None => vec![0.0; n],
-        };
-        let coupling_rad = match &self.coupling {
-            Some(coupling) => coupling.deflection(q),
-            None => vec![0.0; n],
-        };
-        let screw_m = match &self.screw {
-            Some(screw) => screw.deflection(q),
-            None => vec![0.0; n],
-        };
-        Ok(JointOffsets { static_torque_nm, compliance_rad, backlash_rad, periodic_rad, coupling_rad, screw_m })
+        let at = PoseInput { model, cell, q, context, static_torque_nm: &static_torque_nm };
+        let mut by_kind = Vec::new();
+        for (kind, effect) in self.active() {
+            if let Some(dq) = effect.joint_offset(&at)? {
+                by_kind.push((kind, dq));
+            }
+        }
+        Ok(JointOffsets { static_torque_nm, by_kind, joint_count: n })
     }
 
     /// The true `tracker_from_tool` at commanded joints `q`, every active effect applied except the
@@ -209,15 +183,20 @@ impl Effects {
         let offsets = self.joint_offsets_on(&model, cell, q, context)?;
         let moved: Vec<f64> = q.iter().zip(offsets.total()).map(|(a, b)| a + b).collect();
         let mut base_from_tool = model.forward(&moved, cell.tool)?;
-        if let (Some(deflection), Some(dynamics)) = (&self.deflection, &cell.dynamics) {
-            let bend = deflection.twist(&model, dynamics, q, cell.tool, &context.payload)?;
-            base_from_tool = lie::Twist::from_vector(&bend).exp() * base_from_tool;
+        let at = PoseInput { model: &model, cell, q, context, static_torque_nm: &offsets.static_torque_nm };
+        let active = self.active();
+        for (_, effect) in &active {
+            if let Some(bend) = effect.pose_twist(&at)? {
+                base_from_tool = lie::Twist::from_vector(&bend).exp() * base_from_tool;
+            }
         }
-        let tracker_from_tool = cell.tracker_from_base * base_from_tool;
-        Ok(match &self.drift {
-            Some(drift) => drift.motion_at(context.t_s) * tracker_from_tool,
-            None => tracker_from_tool,
-        })
+        let mut tracker_from_tool = cell.tracker_from_base * base_from_tool;
+        for (_, effect) in &active {
+            if let Some(motion) = effect.tracker_motion(context) {
+                tracker_from_tool = motion * tracker_from_tool;
+            }
+        }
+        Ok(tracker_from_tool)
     }
 
     /// What the tracker reports: [`Effects::true_pose`] with the tracker noise drawn from `rng`.

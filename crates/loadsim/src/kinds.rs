@@ -7,20 +7,22 @@
 /// Calls the macro `$callback` with the list of effect kinds, in a fixed order:
 ///
 /// ```text
-/// identified { $( #[doc] Kind "spec_name" simulated_field, )* }
-/// simulated { $( #[doc] Kind "spec_name" simulated_field, )* }
+/// identified { $( #[doc] Kind "spec_name" simulated_field: SimulatedType, )* }
+/// simulated { $( #[doc] Kind "spec_name" simulated_field: SimulatedType, )* }
 /// ```
 ///
 /// `identified` kinds have a regressor in the `effects` crate (a type named `Kind` implementing
 /// its `EffectTerm`), are an item of `--effects` and a candidate the diagnosis can name;
 /// `simulated` kinds exist only in the simulator. `spec_name` is the SPEC's name (serde, the
 /// `--effects` item, the diagnosis JSON); `simulated_field` is the field of [`crate::Effects`] (and of
-/// the effects file of `calib simulate`) that switches the kind on in a simulation.
+/// the effects file of `calib simulate`) that switches the kind on in a simulation, and
+/// `SimulatedType` the type it holds there, which implements [`crate::SimulatedEffect`] (the
+/// effect's simulation: its checks and its place in the forward model).
 ///
 /// ```
 /// macro_rules! names {
-///     (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident, )* }
-///      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident, )* }) => {
+///     (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident: $sim:ty, )* }
+///      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident: $ssim:ty, )* }) => {
 ///         [$($name),*]
 ///     };
 /// }
@@ -33,33 +35,33 @@ macro_rules! effect_kinds {
         $callback! {
             identified {
                 /// Joint compliance under gravity and payload.
-                JointCompliance "joint_compliance" compliance,
+                JointCompliance "joint_compliance" compliance: $crate::JointCompliance,
                 /// Backlash following the sign of the static torque.
-                Backlash "backlash" backlash,
+                Backlash "backlash" backlash: $crate::Backlash,
                 /// A periodic error of a joint in its own angle (gear or encoder).
-                GearPeriodic "gear_periodic" periodic,
+                GearPeriodic "gear_periodic" periodic: $crate::PeriodicError,
                 /// Thermal growth of the links with `temp_c`.
-                Thermal "thermal" thermal,
+                Thermal "thermal" thermal: $crate::ThermalGrowth,
                 /// Drift of the robot's placement with `t_s`.
-                TimeDrift "time_drift" drift,
+                TimeDrift "time_drift" drift: $crate::BaseDrift,
                 /// A link bending under the gravity moment of everything beyond it.
-                LinkDeflection "link_deflection" deflection,
+                LinkDeflection "link_deflection" deflection: $crate::LinkDeflection,
                 /// A periodic error of a linear axis in its own position, per screw or rack pitch.
-                ScrewPeriodic "screw_periodic" screw,
+                ScrewPeriodic "screw_periodic" screw: $crate::ScrewError,
             }
             simulated {
                 /// Tracker measurement noise.
-                TrackerNoise "tracker_noise" tracker_noise,
+                TrackerNoise "tracker_noise" tracker_noise: $crate::TrackerNoise,
                 /// A joint error driven by other joints' angles; no candidate of the diagnosis models it.
-                Coupling "coupling" coupling,
+                Coupling "coupling" coupling: $crate::JointCoupling,
             }
         }
     };
 }
 
 macro_rules! effect_kind_enum {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident, )* }
-     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident, )* }) => {
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident: $sim:ty, )* }
+     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident: $ssim:ty, )* }) => {
         /// The kinds of effect, named as in the SPEC (`--effects`, the model file, the `calib
         /// diagnose` JSON), generated from [`effect_kinds!`](crate::effect_kinds).
         #[non_exhaustive]
@@ -103,30 +105,9 @@ macro_rules! effect_kind_enum {
                 }
             }
         }
-
-        impl Effects {
-            /// These effects with only `kind` left on (with its parameters here; off if it is off here).
-            pub fn only(&self, kind: EffectKind) -> Self {
-                let mut alone = Effects::default();
-                match kind {
-                    $( EffectKind::$kind => alone.$field = self.$field.clone(), )*
-                    $( EffectKind::$skind => alone.$sfield = self.$sfield.clone(), )*
-                }
-                alone
-            }
-
-            /// Whether `kind` is on.
-            pub fn is_on(&self, kind: EffectKind) -> bool {
-                match kind {
-                    $( EffectKind::$kind => self.$field.is_some(), )*
-                    $( EffectKind::$skind => self.$sfield.is_some(), )*
-                }
-            }
-        }
     };
 }
 
-use crate::Effects;
 use serde::{Deserialize, Serialize};
 
 effect_kinds!(effect_kind_enum);

@@ -55,6 +55,7 @@ mod kinds;
 mod periodic;
 mod regressor;
 mod screw;
+mod simulated;
 mod singularity;
 mod thermal;
 mod torque_sensor;
@@ -62,11 +63,13 @@ mod tracker_noise;
 
 pub use backlash::{Backlash, JointBacklash, backlash_joint_regressor};
 pub use cell::{PoseContext, SimulatedCell};
-pub use compliance::{JointCompliance, compliance_deflection, spring_torque};
+pub use compliance::{JointCompliance, MAX_FIXED_POINT_ITERATIONS, compliance_deflection, spring_torque};
 pub use counterbalance::Counterbalance;
 pub use coupling::{CouplingFactor, CouplingTerm, JointCoupling};
-pub use deflection::{BentLink, LinkBend, LinkDeflection, link_bend, link_deflection_features, moment_beyond};
-pub use drift::BaseDrift;
+pub use deflection::{
+    BentLink, LinkBend, LinkDeflection, MAX_FLEXIBILITY_PER_NM2, link_bend, link_deflection_features, moment_beyond,
+};
+pub use drift::{BaseDrift, MAX_DRIFT_PER_S};
 pub use dynamics::{FLOOR_GRAVITY_M_PER_S2, LinkInertia, RobotDynamics, tilted_base_gravity};
 pub use effects::{Effects, JointOffsets};
 pub use error::Error;
@@ -84,8 +87,11 @@ pub use regressor::{
     EffectParameter, RegressorColumn, backlash_regressor, compliance_regressor, drift_regressor, periodic_regressor,
     thermal_regressor,
 };
-pub use screw::{ScrewError, ScrewHarmonic};
+pub use screw::{MAX_SCREW_ERROR_M, ScrewError, ScrewHarmonic};
+pub use simulated::{
+    DynamicsNeed, EntryFault, MAX_JOINT_ERROR_RAD, MAX_ORDER, PoseInput, RobotFacts, SimulatedEffect, beyond, short,
+};
 pub use singularity::{smallest_singular_value, smallest_singular_value_of_joints, tool_point_jacobian};
-pub use thermal::ThermalGrowth;
+pub use thermal::{MAX_EXPANSION_PER_K, MAX_TEMPERATURE_C, ThermalGrowth};
 pub use torque_sensor::TorqueSensorNoise;
-pub use tracker_noise::TrackerNoise;
+pub use tracker_noise::{MAX_NOISE, TrackerNoise};

@@ -6,6 +6,9 @@
 //! for output-side eccentricity, the reduction ratio or a multiple of it for motor-side error).
 
 use crate::Error;
+use crate::{
+    EntryFault, MAX_JOINT_ERROR_RAD, MAX_ORDER, PoseInput, RobotFacts, SimulatedCell, SimulatedEffect, beyond,
+};
 use serde::{Deserialize, Serialize};
 
 /// One harmonic of one joint's transmission error.
@@ -72,4 +75,28 @@ impl PeriodicError {
 pub fn periodic_joint_regressor(joint_value: f64, order: f64) -> [f64; 2] {
     let (s, c) = (order * joint_value).sin_cos();
     [c, s]
+}
+
+impl SimulatedEffect for PeriodicError {
+    fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
+        PeriodicError::validate(self, cell.robot.joint_count())
+    }
+
+    fn check_entries(&self, robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
+        for (k, h) in self.harmonics.iter().enumerate() {
+            let alone = PeriodicError { harmonics: vec![*h] };
+            let fault =
+                PeriodicError::validate(&alone, robot.joints.len()).err().map(|e| e.to_string()).or_else(|| {
+                    beyond(&[("amplitude_rad", h.amplitude_rad, MAX_JOINT_ERROR_RAD), ("order", h.order, MAX_ORDER)])
+                });
+            if let Some(fault) = fault {
+                return Err(EntryFault::entry(k, format!("harmonic {}: {fault}", k + 1)));
+            }
+        }
+        Ok(())
+    }
+
+    fn joint_offset(&self, at: &PoseInput<'_>) -> Result<Option<Vec<f64>>, Error> {
+        Ok(Some(self.deflection(at.q)))
+    }
 }

@@ -7,6 +7,7 @@
 //! ([`crate::PeriodicError`]) in the phase `2π q_j / p` of the screw.
 
 use crate::Error;
+use crate::{EntryFault, MAX_ORDER, PoseInput, RobotFacts, SimulatedCell, SimulatedEffect, beyond, short};
 use serde::{Deserialize, Serialize};
 
 /// One harmonic of one linear axis's screw (or rack) error.
@@ -64,6 +65,42 @@ impl ScrewError {
             dq[h.joint_index] += h.amplitude_m * (h.order * phase + h.phase_rad).cos();
         }
         dq
+    }
+}
+
+/// Largest amplitude of a linear axis's screw (or rack) error, m: ground ball screws err
+/// periodically by a few µm per turn (ISO 3408-3's `v_2π` of class 5 to 10: 8 to 40 µm), rolled
+/// screws and racks by tens of µm; a millimetre per turn is a broken drive.
+pub const MAX_SCREW_ERROR_M: f64 = 1e-3;
+
+impl SimulatedEffect for ScrewError {
+    fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
+        let prismatic: Vec<bool> = cell.robot.joints().iter().map(|j| j.kind == poe::JointKind::Prismatic).collect();
+        ScrewError::validate(self, &prismatic)
+    }
+
+    fn check_entries(&self, robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
+        let prismatic: Vec<bool> = robot.joints.iter().map(|&kind| kind == poe::JointKind::Prismatic).collect();
+        let (low, high) = robot.pitch_bounds_mm;
+        for (k, h) in self.harmonics.iter().enumerate() {
+            let alone = ScrewError { harmonics: vec![*h] };
+            let fault = ScrewError::validate(&alone, &prismatic).err().map(|e| e.to_string()).or_else(|| {
+                beyond(&[("amplitude_m", h.amplitude_m, MAX_SCREW_ERROR_M), ("order", h.order, MAX_ORDER)])
+            });
+            let pitch_mm = h.pitch_m * 1e3;
+            let fault = fault.or_else(|| {
+                (!(low..=high).contains(&pitch_mm))
+                    .then(|| format!("pitch_m is {}, expected {} to {} m", short(h.pitch_m), low * 1e-3, high * 1e-3))
+            });
+            if let Some(fault) = fault {
+                return Err(EntryFault::entry(k, format!("harmonic {}: {fault}", k + 1)));
+            }
+        }
+        Ok(())
+    }
+
+    fn joint_offset(&self, at: &PoseInput<'_>) -> Result<Option<Vec<f64>>, Error> {
+        Ok(Some(self.deflection(at.q)))
     }
 }
 

@@ -9,6 +9,7 @@
 //! change is `Σ_i s_i (R_{i-1}(q) t_i, 0)`, which [`crate::thermal_regressor`] returns.
 
 use crate::Error;
+use crate::{EntryFault, PoseContext, RobotFacts, SimulatedCell, SimulatedEffect, beyond};
 use lie::SE3;
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
@@ -78,5 +79,35 @@ impl ThermalGrowth {
         let tool_alpha = coefficients[model.joint_count()];
         grown.set_tools(model.tools().iter().map(|t| grow(t, tool_alpha)).collect());
         Ok(grown)
+    }
+}
+
+/// Largest thermal expansion coefficient an effects file may give, 1/K: engineering solids lie
+/// below 2e-4 (steel 1.2e-5, aluminium 2.3e-5, plastics up to 2e-4).
+pub const MAX_EXPANSION_PER_K: f64 = 1e-3;
+
+/// Largest magnitude of a reference temperature an effects file may give, °C.
+pub const MAX_TEMPERATURE_C: f64 = 1e4;
+
+impl SimulatedEffect for ThermalGrowth {
+    fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
+        ThermalGrowth::validate(self, cell.robot.joint_count())
+    }
+
+    fn check_entries(&self, robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
+        ThermalGrowth::validate(self, robot.joints.len()).map_err(|e| EntryFault::of_section(&e))?;
+        let mut bounds = vec![
+            ("reference_temp_c", self.reference_temp_c, MAX_TEMPERATURE_C),
+            ("expansion_per_k", self.expansion_per_k, MAX_EXPANSION_PER_K),
+        ];
+        bounds.extend(self.link_expansion_per_k.iter().map(|&a| ("link_expansion_per_k", a, MAX_EXPANSION_PER_K)));
+        match bounds.iter().find_map(|b| beyond(&[*b]).map(|f| (b.0, f))) {
+            Some((field, message)) => Err(EntryFault { field: field.into(), index: 0, message }),
+            None => Ok(()),
+        }
+    }
+
+    fn grown_model(&self, model: &LocalPoe, context: &PoseContext) -> Result<Option<LocalPoe>, Error> {
+        self.grown_model(model, context.temp_c).map(Some)
     }
 }

@@ -6,6 +6,7 @@
 //! MPE; the T-Mac 6-DOF probe adds an orientation MPE of about 0.01°. The defaults take σ = MPE/2.
 
 use crate::Error;
+use crate::{EntryFault, RobotFacts, SimulatedCell, SimulatedEffect, beyond};
 use lie::{Matrix3, SE3, SO3, Vector3};
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -84,5 +85,31 @@ impl TrackerNoise {
         let moved = p + radial * (self.radial_sigma_m * normal()) + first * (t * normal()) + second * (t * normal());
         let tilt = Vector3::new(normal(), normal(), normal()) * self.orientation_sigma_rad;
         SE3::new(SO3::exp(&tilt) * tracker_from_tool.rotation(), moved)
+    }
+}
+
+/// Largest tracker noise an effects file may give, m (and m per m of range for the transverse
+/// part, rad for the orientation): trackers and photogrammetry err by micrometres to a
+/// millimetre, a metre is none.
+pub const MAX_NOISE: f64 = 1.0;
+
+/// The noise acts where the tracker measures (`Effects::measured_pose`), not on the robot.
+impl SimulatedEffect for TrackerNoise {
+    fn validate(&self, _cell: &SimulatedCell) -> Result<(), Error> {
+        TrackerNoise::validate(self)
+    }
+
+    fn check_entries(&self, _robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
+        TrackerNoise::validate(self).map_err(|e| EntryFault::of_section(&e))?;
+        let bounds = [
+            ("radial_sigma_m", self.radial_sigma_m, MAX_NOISE),
+            ("transverse_sigma_m", self.transverse_sigma_m, MAX_NOISE),
+            ("transverse_sigma_per_m", self.transverse_sigma_per_m, MAX_NOISE),
+            ("orientation_sigma_rad", self.orientation_sigma_rad, MAX_NOISE),
+        ];
+        match bounds.iter().find_map(|b| beyond(&[*b]).map(|f| (b.0, f))) {
+            Some((field, message)) => Err(EntryFault { field: field.into(), index: 0, message }),
+            None => Ok(()),
+        }
     }
 }

@@ -311,11 +311,7 @@ pub fn fit(
         .map_err(Error::kinematics)?;
         EffectCorrection::distribute(&mut effects, &fitted.correction);
         for effect in &mut effects {
-            match effect {
-                IdentifiedEffect::GearPeriodic(gear) => gear.record_rms(&data.rows),
-                IdentifiedEffect::ScrewPeriodic(screw) => screw.record_rms(&data.rows),
-                _ => {}
-            }
+            effect.after_fit(&data.rows);
         }
         effect_report = effect_reports(&effects, &fitted.report.held_at_prior, &robot.joint_kinds());
         model.fallback_kinematics = Some(std::mem::replace(&mut model.kinematics, fitted.model));

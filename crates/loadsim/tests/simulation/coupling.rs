@@ -3,8 +3,8 @@
 
 use crate::robot::{iiwa7, irb4400, random_q, with_tool};
 use loadsim::{
-    CouplingFactor, CouplingTerm, Effects, Error, Harmonic, JointCoupling, Payload, PeriodicError, PoseContext,
-    RobotDynamics, SimulatedCell, gravity_torque, periodic_joint_regressor, tilted_base_gravity,
+    CouplingFactor, CouplingTerm, EffectKind, Effects, Error, Harmonic, JointCoupling, Payload, PeriodicError,
+    PoseContext, RobotDynamics, SimulatedCell, gravity_torque, periodic_joint_regressor, tilted_base_gravity,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -33,17 +33,17 @@ fn a_coupled_error_moves_only_its_joint_by_the_product_of_its_factors() {
         let q = random_q(&robot.ranges, &mut rng);
         let offsets = effects.joint_offsets(&cell, &q, &PoseContext::default()).unwrap();
         let expected = 1e-3 * (2.0 * q[1] + 0.4).cos() * (q[3] - 1.1).cos();
-        for (j, dq) in offsets.coupling_rad.iter().enumerate() {
+        for (j, dq) in offsets.of(EffectKind::Coupling).iter().enumerate() {
             let want = if j == 2 { expected } else { 0.0 };
             assert!((dq - want).abs() < 1e-18, "joint {}: {dq} vs {want}", j + 1);
         }
-        assert_eq!(offsets.total(), offsets.coupling_rad);
+        assert_eq!(offsets.total(), offsets.of(EffectKind::Coupling));
         // It does not depend on joint 3's own angle.
         let mut turned = q.clone();
         turned[2] += rng.random_range(-1.0..1.0);
         assert_eq!(
-            effects.joint_offsets(&cell, &turned, &PoseContext::default()).unwrap().coupling_rad,
-            offsets.coupling_rad
+            effects.joint_offsets(&cell, &turned, &PoseContext::default()).unwrap().of(EffectKind::Coupling),
+            offsets.of(EffectKind::Coupling)
         );
     }
 }
@@ -111,8 +111,8 @@ fn a_gear_error_of_order_forty_with_any_phase_on_joint_1_is_its_cos_sin_regresso
                 a * c + b * s
             })
             .sum();
-        assert!((offsets.periodic_rad[0] - linear).abs() < 1e-15);
-        assert!(offsets.periodic_rad[1..].iter().all(|v| *v == 0.0));
+        assert!((offsets.of(EffectKind::GearPeriodic)[0] - linear).abs() < 1e-15);
+        assert!(offsets.of(EffectKind::GearPeriodic)[1..].iter().all(|v| *v == 0.0));
     }
 }
 

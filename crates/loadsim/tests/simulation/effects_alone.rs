@@ -59,9 +59,9 @@ fn backlash_alone_flips_with_the_sign_of_the_joint_torque() {
         for j in 0..6 {
             // Joint 1 is vertical: no gravity torque, the gear sits in the middle of its play.
             let side = if torque[j] == 0.0 { 0.0 } else { torque[j].signum() };
-            assert_eq!(offsets.backlash_rad[j], b * side, "joint {}", j + 1);
-            assert_eq!(offsets.compliance_rad[j], 0.0);
-            assert_eq!(offsets.periodic_rad[j], 0.0);
+            assert_eq!(offsets.of(EffectKind::Backlash)[j], b * side, "joint {}", j + 1);
+            assert_eq!(offsets.of(EffectKind::JointCompliance)[j], 0.0);
+            assert_eq!(offsets.of(EffectKind::GearPeriodic)[j], 0.0);
         }
         if torque[1] > 0.0 { positive += 1 } else { negative += 1 }
     }
