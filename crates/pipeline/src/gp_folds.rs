@@ -31,6 +31,18 @@ pub struct PredictedWithGp {
     /// Off them (the arcs of each moving joint's angles held out, the mean over the joints as
     /// `off_poses_mm` is), mm; `None` where no joint moves.
     pub off_poses_mm: Option<f64>,
+    /// Per moving joint, its arcs' mean held-out position error with the GP (as
+    /// `diagnose::ArcCheck::after_mm` is without it).
+    pub arcs: Vec<ArcWithGp>,
+}
+
+/// One moving joint's arcs held out, with the GP on top.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ArcWithGp {
+    /// The 1-based joint whose arcs are held out.
+    pub joint: usize,
+    /// Mean held-out position error, mm.
+    pub mean_mm: f64,
 }
 
 /// The prediction for `gp` (the final GP, `config` its fit's configuration, for the jitter) over
@@ -81,10 +93,11 @@ pub(crate) fn predicted_with_gp(
     let random = folds.random.len();
     let mut start = random;
     let mut per_joint = Vec::with_capacity(folds.arcs.len());
-    for (_, arcs) in &folds.arcs {
-        per_joint.push(mean_mm(&errors[start..start + arcs.len()]));
+    for (joint, arcs) in &folds.arcs {
+        per_joint.push(ArcWithGp { joint: *joint, mean_mm: mean_mm(&errors[start..start + arcs.len()]) });
         start += arcs.len();
     }
-    let off_poses_mm = (!per_joint.is_empty()).then(|| per_joint.iter().sum::<f64>() / per_joint.len() as f64);
-    Ok(Some(PredictedWithGp { on_poses_mm: mean_mm(&errors[..random]), off_poses_mm }))
+    let off_poses_mm =
+        (!per_joint.is_empty()).then(|| per_joint.iter().map(|a| a.mean_mm).sum::<f64>() / per_joint.len() as f64);
+    Ok(Some(PredictedWithGp { on_poses_mm: mean_mm(&errors[..random]), off_poses_mm, arcs: per_joint }))
 }
