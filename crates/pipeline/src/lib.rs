@@ -5,7 +5,7 @@
 //! The crate holds the fit ([`fit()`], [`FitOptions`], [`FitReport`]), the plausibility checks
 //! that run before it ([`PlausibilityOptions`]), the prior toward the nominal geometry
 //! ([`choose_prior`], [`NominalPriorOptions`]), `--effects auto` ([`choose_effects`],
-//! [`effects_of`]) and the measuring sessions that choose what a drift or a thermal growth is
+//! [`effects_of`]; with a GP, its held-out prediction with the GP on top, [`PredictedWithGp`]) and the measuring sessions that choose what a drift or a thermal growth is
 //! beyond the span it was fitted on ([`sessions()`], [`SessionOptions`], [`SpanChoice`]), and the
 //! payload groups that choose what a compliance or a link deflection is beyond the payloads it
 //! was fitted on ([`payload_groups`], [`PayloadOptions`], [`PayloadChoice`]). Every other item is named by the crate that owns it, not re-exported here:
