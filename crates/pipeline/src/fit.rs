@@ -350,8 +350,12 @@ pub fn fit(
         let (fitted, report) = ResidualGp::fit(&poses, kept.set(), with_payload, &options.residual_gp, &repeats)?;
         // `--effects auto`'s prediction with this GP on top, its hyperparameters held fixed.
         if let Some(choice) = &mut auto {
-            choice.predicted_with_gp =
-                crate::gp_folds::predicted_with_gp(&fitted, &choice.folds, &options.residual_gp.gp)?;
+            choice.predicted_with_gp = crate::gp_folds::predicted_with_gp(
+                &fitted,
+                &choice.folds,
+                &options.residual_gp.gp,
+                options.heldout.repeat_tolerance,
+            )?;
         }
         model.residual_gp = Some(fitted);
         residual_gp = Some(report);

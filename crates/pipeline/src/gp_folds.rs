@@ -46,12 +46,14 @@ pub struct ArcWithGp {
 }
 
 /// The prediction for `gp` (the final GP, `config` its fit's configuration, for the jitter) over
-/// the diagnosis's `folds`; `None` where it cannot be made (see the module doc) or there are no
+/// the diagnosis's `folds`, rows within `repeat_tolerance` in every joint one configuration
+/// ([`model::RepeatGroups`]); `None` where it cannot be made (see the module doc) or there are no
 /// folds.
 pub(crate) fn predicted_with_gp(
     gp: &ResidualGp,
     folds: &HeldoutFolds,
     config: &gp::GpConfig,
+    repeat_tolerance: f64,
 ) -> Result<Option<PredictedWithGp>, Error> {
     let GpModel::Exact(exact) = &gp.gp else { return Ok(None) };
     if (gp.full_pose && gp.residual_frame != ResidualFrame::ToolPoint) || gp.moved_by.is_some() {
@@ -66,8 +68,35 @@ pub(crate) fn predicted_with_gp(
     let all: Vec<&FoldResiduals> = folds.random.iter().chain(folds.arcs.iter().flat_map(|(_, f)| f)).collect();
     let targets: Vec<Mat<f64>> =
         all.iter().map(|f| Mat::from_fn(n, m, |i, c| f.residuals.get(i).map_or(0.0, |r| r[c]))).collect();
+    // A held-out row's repeats (the same configuration measured again) are kept from its fold's
+    // GP too, as the fit's leave-group-out error keeps them (issue 26): the GP would return the
+    // twin's value. They are the first rows' company only: predicted, never counted.
+    let repeats = model::RepeatGroups::of(&folds.rows, repeat_tolerance);
+    let mut group_of = vec![0; n];
+    for (g, rows) in repeats.groups.iter().enumerate() {
+        for &i in rows {
+            group_of[i] = g;
+        }
+    }
+    let kept_from_gp: Vec<Vec<usize>> = all
+        .iter()
+        .map(|f| {
+            let mut rows = f.held_out.clone();
+            let mut taken = vec![false; n];
+            rows.iter().for_each(|&i| taken[i] = true);
+            for &i in &f.held_out {
+                for &j in &repeats.groups[group_of[i]] {
+                    if !taken[j] {
+                        taken[j] = true;
+                        rows.push(j);
+                    }
+                }
+            }
+            rows
+        })
+        .collect();
     let fold_targets: Vec<gp::FoldTargets<'_>> =
-        all.iter().zip(&targets).map(|(f, y)| gp::FoldTargets { held_out: &f.held_out, y: y.as_ref() }).collect();
+        kept_from_gp.iter().zip(&targets).map(|(rows, y)| gp::FoldTargets { held_out: rows, y: y.as_ref() }).collect();
     // Only the position outputs: the position error is what is predicted.
     let predicted =
         exact.held_out_with_fixed_hyperparameters(x.as_ref(), &fold_targets, &[0, 1, 2], config).map_err(Error::gp)?;
