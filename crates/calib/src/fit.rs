@@ -163,6 +163,14 @@ fn summarise(
                 auto.heldout_before_mm, auto.heldout_after_mm
             );
         }
+        if let Some(with_gp) = &auto.predicted_with_gp {
+            let off = with_gp.off_poses_mm.map_or(String::new(), |off| format!("; {off:.4} mm off them"));
+            let _ = writeln!(
+                out,
+                "    predicted held out with the GP on top: {:.4} mm on poses like these{off} (the same folds, each fold's GP conditioned on the residuals its geometry and effects leave on its training rows, the final GP's hyperparameters held fixed: a standard approximation, searching them again in every fold would be too slow)",
+                with_gp.on_poses_mm
+            );
+        }
         for s in &auto.selected {
             let joints: Vec<String> = s.joints.iter().map(ToString::to_string).collect();
             let harmonic = s.harmonic.map_or(String::new(), |h| format!(", harmonics 1 to {h}"));

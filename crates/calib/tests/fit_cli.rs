@@ -159,3 +159,34 @@ fn few_rows_per_parameter_fit_with_a_warning_and_enough_without() {
     assert_eq!(json["warnings"].as_array().map(Vec::len), Some(0), "{json}");
     assert!(!String::from_utf8_lossy(&out.stderr).contains("warning:"));
 }
+
+/// Issue 23: `--effects auto` with a GP method also predicts the held-out error with the GP on
+/// top (a line, and `auto.predicted_with_gp` in `--json`); a method without a GP prints and carries
+/// nothing new.
+#[test]
+fn effects_auto_with_a_gp_predicts_the_held_out_error_with_the_gp_on_top() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 120, 45);
+    let (robot, data) = (fixture("irb4400.ron"), text(&data));
+    let model = text(&dir.path().join("m.ron"));
+    let run = |method: &str| {
+        let args = ["fit", "--robot", &robot, "--data", &data, "--method", method, "--effects", "auto"];
+        let out = calib(&[&args[..], &["--out", &model, "--json"]].concat());
+        assert!(out.status.success(), "{method}: {}", String::from_utf8_lossy(&out.stderr));
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (json, String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (json, summary) = run("poe-gp");
+    let with_gp = &json["auto"]["predicted_with_gp"];
+    let on = with_gp["on_poses_mm"].as_f64().unwrap();
+    assert!(on.is_finite() && on > 0.0, "{with_gp}");
+    let arcs = with_gp["arcs"].as_array().unwrap();
+    assert!(!arcs.is_empty() && arcs.iter().all(|a| a["joint"].as_u64().is_some() && a["mean_mm"].as_f64().is_some()));
+    let mean = arcs.iter().map(|a| a["mean_mm"].as_f64().unwrap()).sum::<f64>() / arcs.len() as f64;
+    assert!((with_gp["off_poses_mm"].as_f64().unwrap() - mean).abs() < 1e-12, "{with_gp}");
+    assert!(summary.contains("predicted held out with the GP on top:"), "{summary}");
+    assert!(summary.contains("hyperparameters held fixed"), "{summary}");
+    let (json, summary) = run("poe");
+    assert!(json["auto"].is_object() && json["auto"].get("predicted_with_gp").is_none(), "{}", json["auto"]);
+    assert!(!summary.contains("with the GP on top"), "{summary}");
+}

@@ -19,6 +19,7 @@
 //! amplitude fitted on the other arcs.
 
 use super::design::Design;
+use super::fold_residuals::FoldResiduals;
 use super::pool::{Block, KinematicPrior, Pool, PriorOptions};
 use super::selection::{Selection, Step, Term};
 use effects::{GearOptions, GearPeriodic, IdentifiedEffect};
@@ -65,7 +66,9 @@ pub(crate) struct ArcInputs<'a> {
 }
 
 /// The arc check of every joint in `moving` (0-based) for the selection's effects; `columns_of`
-/// gives a term's weighted columns and prior sd.
+/// gives a term's weighted columns and prior sd. Beside each check, its folds: the blended
+/// residual each arc's fit leaves on every row (its training rows blended as the fold's model
+/// would blend them, the series' coverage of their own angles).
 pub(crate) fn arc_checks(
     inputs: &ArcInputs<'_>,
     data: &MeasurementSet,
@@ -73,7 +76,7 @@ pub(crate) fn arc_checks(
     terms: &[Term],
     selection: &Selection,
     columns_of: &dyn Fn(usize) -> (Vec<Vec<f64>>, Option<f64>),
-) -> Result<Vec<ArcCheck>, Error> {
+) -> Result<Vec<(ArcCheck, Vec<FoldResiduals>)>, Error> {
     // The selected terms' columns, each at the order the fit on every row uses.
     let mut owned: Vec<(Vec<Vec<f64>>, Option<f64>)> = Vec::new();
     let mut series: Vec<Option<(usize, u32)>> = Vec::new();
@@ -96,6 +99,7 @@ pub(crate) fn arc_checks(
         let pool = Pool::new(inputs.design, inputs.kinematic_prior, &blocks, &fold, inputs.folds, inputs.prior);
         let mut before = Vec::with_capacity(data.rows.len());
         let mut after = Vec::with_capacity(data.rows.len());
+        let mut folds = Vec::with_capacity(inputs.folds);
         for f in 0..inputs.folds {
             let poses = pool.fold_poses(f);
             if poses.is_empty() {
@@ -103,7 +107,8 @@ pub(crate) fn arc_checks(
             }
             let base = pool.solve(&[f], &all[..kinematic])?;
             let full = if width == 0 { base.clone() } else { pool.solve(&[f], &all)? };
-            let residuals = pool.residuals(f, &all, &[base, full]);
+            let betas = [base, full];
+            let residuals = pool.residuals(f, &all, &betas);
             // Each series' coverage as its fit on this fold's training rows records it.
             let training: Vec<measurements::Measurement> =
                 (0..data.rows.len()).filter(|&i| fold[i] != f).map(|i| data.rows[i].clone()).collect();
@@ -112,6 +117,16 @@ pub(crate) fn arc_checks(
                 .flatten()
                 .map(|&(j, h)| GearPeriodic::with_options(j, (1..=h).collect(), &training, inputs.gear))
                 .collect::<Result<_, _>>()?;
+            // The training rows, blended as this fold's model blends them: each series by the
+            // coverage of its own fit's angles.
+            let mut fold_residuals = vec![Vector6::zeros(); data.rows.len()];
+            for g in (0..inputs.folds).filter(|&g| g != f) {
+                let fitted = pool.residuals(g, &all, &betas);
+                for ((&i, b), a) in pool.fold_poses(g).iter().zip(&fitted[0]).zip(&fitted[1]) {
+                    let w: f64 = coverage.iter().map(|s| s.held_and_weight(data.rows[i].q[s.joint]).1).product();
+                    fold_residuals[i] = a * w + b * (1.0 - w);
+                }
+            }
             for ((&i, b), a) in poses.iter().zip(&residuals[0]).zip(&residuals[1]) {
                 // A held-out arc of the joint's own angles is where its series knows nothing:
                 // faded whole, whatever the width of the arc (the model fades it in a gap wider
@@ -123,17 +138,20 @@ pub(crate) fn arc_checks(
                 let blended: Vector6 = a * w + b * (1.0 - w);
                 before.push(b.fixed_rows::<3>(0).norm());
                 after.push(blended.fixed_rows::<3>(0).norm());
+                fold_residuals[i] = blended;
             }
+            folds.push(FoldResiduals { held_out: poses.to_vec(), residuals: fold_residuals });
         }
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64 * 1e3;
         let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max) * 1e3;
-        out.push(ArcCheck {
+        let check = ArcCheck {
             joint: joint + 1,
             before_mm: mean(&before),
             after_mm: mean(&after),
             before_max_mm: max(&before),
             after_max_mm: max(&after),
-        });
+        };
+        out.push((check, folds));
     }
     Ok(out)
 }

@@ -34,6 +34,7 @@ mod arcs;
 mod candidates;
 pub mod chart;
 mod design;
+mod fold_residuals;
 mod learnt_side;
 mod noise;
 mod outliers;
@@ -48,6 +49,7 @@ mod verdict;
 
 pub use arcs::ArcCheck;
 pub use candidates::Effect;
+pub use fold_residuals::{FoldResiduals, HeldoutFolds};
 pub use noise::{NoiseFloor, NoiseSource};
 pub use outliers::{GrossOutliers, OutlierOptions};
 pub use pool::PriorOptions;
@@ -247,6 +249,10 @@ pub struct Diagnosis {
     /// Every pose (not in the JSON).
     #[serde(skip)]
     pub poses: Vec<PoseDiagnosis>,
+    /// The random folds and the arcs fold by fold, for a stage fitted on top of the selected
+    /// effects (not in the JSON).
+    #[serde(skip)]
+    pub folds: HeldoutFolds,
 }
 
 /// Assigns each of `n` rows to one of `folds` folds, shuffled by `seed`, sizes differing by one.
@@ -505,8 +511,20 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
         }
         order_curves.push(scores);
     }
-    let arcs = arcs::arc_checks(&arc_inputs, data, &moving, &terms, &selection, &columns_of)?;
+    let (arcs, arc_folds): (Vec<ArcCheck>, Vec<(usize, Vec<FoldResiduals>)>) =
+        arcs::arc_checks(&arc_inputs, data, &moving, &terms, &selection, &columns_of)?
+            .into_iter()
+            .map(|(check, folds)| {
+                let joint = check.joint;
+                (check, (joint, folds))
+            })
+            .unzip();
     let all_selected = selection.last();
+    let heldout_folds = HeldoutFolds {
+        rows: data.rows.clone(),
+        random: fold_residuals::random_folds(&pool, &all_selected.fold_columns)?,
+        arcs: arc_folds,
+    };
 
     // What any smooth function of the joint angles explains, before and after the effects.
     let single_critical = statistics::normal_quantile(1.0 - options.selection.significance);
@@ -686,5 +704,6 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
         arcs,
         poses,
         gross_outliers,
+        folds: heldout_folds,
     })
 }

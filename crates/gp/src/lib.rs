@@ -36,6 +36,7 @@ mod dense;
 mod elbo;
 mod error;
 mod exact;
+mod fixed_folds;
 mod gram;
 mod inducing;
 mod kernel;
@@ -53,6 +54,7 @@ pub use config::{GpConfig, JitterConfig, OptimiserConfig, OutputMode, Parallelis
 pub use elbo::sparse_evidence_lower_bound;
 pub use error::Error;
 pub use exact::{AdditiveChoice, ComponentReport, ExactGp, FitReport, IsotropicChoice};
+pub use fixed_folds::FoldTargets;
 pub use inducing::InducingSelection;
 pub use kernel::{
     AdditiveTerm, Bounds, CompositeKernel, Kernel, KernelChoice, Matern52Ard, QuadraticKernel, SquaredExponentialArd,

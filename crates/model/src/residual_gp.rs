@@ -584,6 +584,12 @@ impl ResidualGp {
         Ok((residual_gp, report))
     }
 
+    /// The GP's inputs for `rows`: `(q_1 … q_n[, m])`, the payload where the GP takes it, as its
+    /// fit and its prediction build them.
+    pub fn inputs_of(&self, rows: &[Measurement]) -> Mat<f64> {
+        inputs(rows, self.with_payload)
+    }
+
     /// `G` for the GP's output `g` at a model pose: a translation for position-only data, else the
     /// twist's exponential, at the tool point or in the tracker frame as the residuals were taken.
     fn correction(&self, pose: &SE3, g: &Vector6) -> SE3 {

@@ -27,6 +27,14 @@ pub struct AutoChoice {
     /// The effects the fit identifies.
     #[serde(serialize_with = "as_text")]
     pub chosen: Vec<EffectSpec>,
+    /// For a method with a GP stage: the same two predictions with the fit's GP on top of each
+    /// fold's geometry and effects (module `gp_folds`; absent without a GP, for the sparse GP and
+    /// for the tracker-frame residual).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub predicted_with_gp: Option<crate::PredictedWithGp>,
+    /// The diagnosis's folds, for the GP's prediction (not in the JSON).
+    #[serde(skip)]
+    pub folds: diagnose::HeldoutFolds,
 }
 
 fn as_text<S: serde::Serializer>(specs: &[EffectSpec], serializer: S) -> Result<S::Ok, S::Error> {
@@ -85,5 +93,7 @@ pub fn choose(robot: &RobotDescription, data: &BoundSet<'_>, options: &DiagnoseO
         heldout_before_mm: diagnosis.heldout_before_mm,
         heldout_after_mm: diagnosis.heldout_after_selected_mm,
         off_poses_mm: diagnosis.off_poses_before_mm.zip(diagnosis.off_poses_after_mm).map(|(b, a)| [b, a]),
+        predicted_with_gp: None,
+        folds: diagnosis.folds,
     })
 }

@@ -344,6 +344,15 @@ pub fn fit(
         let poses = model.geometric_poses(&kept)?;
         let repeats = model::RepeatGroups::of(kept.rows(), options.heldout.repeat_tolerance);
         let (fitted, report) = ResidualGp::fit(&poses, kept.set(), with_payload, &options.residual_gp, &repeats)?;
+        // `--effects auto`'s prediction with this GP on top, its hyperparameters held fixed.
+        if let Some(choice) = &mut auto {
+            choice.predicted_with_gp = crate::gp_folds::predicted_with_gp(
+                &fitted,
+                &choice.folds,
+                &options.residual_gp.gp,
+                options.heldout.repeat_tolerance,
+            )?;
+        }
         model.residual_gp = Some(fitted);
         residual_gp = Some(report);
     }

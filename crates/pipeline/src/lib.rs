@@ -5,7 +5,7 @@
 //! The crate holds the fit ([`fit()`], [`FitOptions`], [`FitReport`]), the plausibility checks
 //! that run before it ([`PlausibilityOptions`]), the prior toward the nominal geometry
 //! ([`choose_prior`], [`NominalPriorOptions`]), `--effects auto` ([`choose_effects`],
-//! [`effects_of`]) and the measuring sessions that choose what a drift or a thermal growth is
+//! [`effects_of`]; with a GP, its held-out prediction with the GP on top, [`PredictedWithGp`]) and the measuring sessions that choose what a drift or a thermal growth is
 //! beyond the span it was fitted on ([`sessions()`], [`SessionOptions`], [`SpanChoice`]), and the
 //! payload groups that choose what a compliance or a link deflection is beyond the payloads it
 //! was fitted on ([`payload_groups`], [`PayloadOptions`], [`PayloadChoice`]). Every other item is named by the crate that owns it, not re-exported here:
@@ -39,6 +39,7 @@ mod clusters;
 mod fit;
 mod fit_options;
 mod fit_prior;
+mod gp_folds;
 mod payloads;
 mod plausibility;
 mod rule_choice;
@@ -50,6 +51,7 @@ pub use fit::{FitReport, FitWarning, fit};
 pub use fit_options::{EffectOptions, FitOptions};
 pub use fit_options::{PayloadOptions, SessionOptions};
 pub use fit_prior::{NominalPriorOptions, PriorCandidate, PriorChoice, choose as choose_prior};
+pub use gp_folds::{ArcWithGp, PredictedWithGp};
 pub use payloads::{PayloadChoice, PayloadErrors, payload_groups};
 pub use plausibility::{PlausibilityOptions, PlausibilityReport};
 pub use sessions::{SpanChoice, SpanErrors, sessions};

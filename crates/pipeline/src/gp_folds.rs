@@ -1,0 +1,132 @@
+//! `--effects auto`'s held-out prediction with the GP stage on top (issue 23): the diagnosis
+//! predicts the error of the geometry and the selected effects on held-out rows (random folds, and
+//! arcs of each moving joint's angles); a method with a GP fits a GP on what they leave, which the
+//! diagnosis never sees. Here, after the final GP's hyperparameters are chosen, the same folds are
+//! used again: in each, a GP with those hyperparameters (and its input standardisation and output
+//! normalisation) is conditioned on the residuals that fold's geometry and effects leave on its
+//! training rows, and predicts its held-out rows; the held-out position error after it is the
+//! prediction.
+//!
+//! The hyperparameters are held fixed across the folds, a standard approximation (R&W Section
+//! 5.4.2 does the same for leave-one-out): searching them again in every fold would repeat the
+//! GP's whole search 5 + 10 × (moving joints) times. With them fixed, every fold is predicted in
+//! closed form from one factorisation per kernel ([`gp::ExactGp::held_out_with_fixed_hyperparameters`]).
+//!
+//! The residuals are the diagnosis's linearised ones, measured minus modelled position (m) and
+//! orientation (rad): to first order the GP's outputs in its default tool-point frame, whose `v`
+//! part is the position error. The GP's tracker-frame residual mixes the orientation times the
+//! lever arm into `v`, and the sparse GP has no closed form: for those, no prediction (`None`).
+
+use diagnose::{FoldResiduals, HeldoutFolds};
+use errors::Error;
+use faer::Mat;
+use model::{GpModel, ResidualFrame, ResidualGp};
+use serde::Serialize;
+
+/// The held-out error predicted with the GP on top of the geometry and the selected effects.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PredictedWithGp {
+    /// Mean held-out position error on poses like the training poses (the random folds), mm.
+    pub on_poses_mm: f64,
+    /// Off them (the arcs of each moving joint's angles held out, the mean over the joints as
+    /// `off_poses_mm` is), mm; `None` where no joint moves.
+    pub off_poses_mm: Option<f64>,
+    /// Per moving joint, its arcs' mean held-out position error with the GP (as
+    /// `diagnose::ArcCheck::after_mm` is without it).
+    pub arcs: Vec<ArcWithGp>,
+}
+
+/// One moving joint's arcs held out, with the GP on top.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ArcWithGp {
+    /// The 1-based joint whose arcs are held out.
+    pub joint: usize,
+    /// Mean held-out position error, mm.
+    pub mean_mm: f64,
+}
+
+/// The prediction for `gp` (the final GP, `config` its fit's configuration, for the jitter) over
+/// the diagnosis's `folds`, rows within `repeat_tolerance` in every joint one configuration
+/// ([`model::RepeatGroups`]); `None` where it cannot be made (see the module doc) or there are no
+/// folds.
+pub(crate) fn predicted_with_gp(
+    gp: &ResidualGp,
+    folds: &HeldoutFolds,
+    config: &gp::GpConfig,
+    repeat_tolerance: f64,
+) -> Result<Option<PredictedWithGp>, Error> {
+    let GpModel::Exact(exact) = &gp.gp else { return Ok(None) };
+    if (gp.full_pose && gp.residual_frame != ResidualFrame::ToolPoint) || gp.moved_by.is_some() {
+        return Ok(None);
+    }
+    if folds.random.is_empty() || folds.rows.is_empty() {
+        return Ok(None);
+    }
+    let n = folds.rows.len();
+    let m = exact.output_count();
+    let x = gp.inputs_of(&folds.rows);
+    let all: Vec<&FoldResiduals> = folds.random.iter().chain(folds.arcs.iter().flat_map(|(_, f)| f)).collect();
+    let targets: Vec<Mat<f64>> =
+        all.iter().map(|f| Mat::from_fn(n, m, |i, c| f.residuals.get(i).map_or(0.0, |r| r[c]))).collect();
+    // A held-out row's repeats (the same configuration measured again) are kept from its fold's
+    // GP too, as the fit's leave-group-out error keeps them (issue 26): the GP would return the
+    // twin's value. They are the first rows' company only: predicted, never counted.
+    let repeats = model::RepeatGroups::of(&folds.rows, repeat_tolerance);
+    let mut group_of = vec![0; n];
+    for (g, rows) in repeats.groups.iter().enumerate() {
+        for &i in rows {
+            group_of[i] = g;
+        }
+    }
+    let kept_from_gp: Vec<Vec<usize>> = all
+        .iter()
+        .map(|f| {
+            let mut rows = f.held_out.clone();
+            let mut taken = vec![false; n];
+            rows.iter().for_each(|&i| taken[i] = true);
+            for &i in &f.held_out {
+                for &j in &repeats.groups[group_of[i]] {
+                    if !taken[j] {
+                        taken[j] = true;
+                        rows.push(j);
+                    }
+                }
+            }
+            rows
+        })
+        .collect();
+    let fold_targets: Vec<gp::FoldTargets<'_>> =
+        kept_from_gp.iter().zip(&targets).map(|(rows, y)| gp::FoldTargets { held_out: rows, y: y.as_ref() }).collect();
+    // Only the position outputs: the position error is what is predicted.
+    let predicted =
+        exact.held_out_with_fixed_hyperparameters(x.as_ref(), &fold_targets, &[0, 1, 2], config).map_err(Error::gp)?;
+    // Per fold, the held-out position errors after the GP, m.
+    let errors: Vec<Vec<f64>> = all
+        .iter()
+        .zip(&predicted)
+        .map(|(f, g)| {
+            f.held_out
+                .iter()
+                .enumerate()
+                .map(|(a, &i)| {
+                    let r = f.residuals[i];
+                    ((r[0] - g[(a, 0)]).powi(2) + (r[1] - g[(a, 1)]).powi(2) + (r[2] - g[(a, 2)]).powi(2)).sqrt()
+                })
+                .collect()
+        })
+        .collect();
+    let mean_mm = |folds: &[Vec<f64>]| {
+        let count: usize = folds.iter().map(Vec::len).sum();
+        folds.iter().flatten().sum::<f64>() / count.max(1) as f64 * 1e3
+    };
+    let random = folds.random.len();
+    let mut start = random;
+    let mut per_joint = Vec::with_capacity(folds.arcs.len());
+    for (joint, arcs) in &folds.arcs {
+        per_joint.push(ArcWithGp { joint: *joint, mean_mm: mean_mm(&errors[start..start + arcs.len()]) });
+        start += arcs.len();
+    }
+    let off_poses_mm =
+        (!per_joint.is_empty()).then(|| per_joint.iter().map(|a| a.mean_mm).sum::<f64>() / per_joint.len() as f64);
+    Ok(Some(PredictedWithGp { on_poses_mm: mean_mm(&errors[..random]), off_poses_mm, arcs: per_joint }))
+}
