@@ -106,9 +106,7 @@ pub(crate) fn read_inertials(root: &Element, file: &str) -> Result<HashMap<Strin
 
 /// Three finite numbers separated by white space, every word a number.
 fn triple(text: &str) -> Option<[f64; 3]> {
-    let values: Vec<f64> = text.split_whitespace().map(|w| w.parse::<f64>().ok()).collect::<Option<_>>()?;
-    let values: [f64; 3] = values.try_into().ok()?;
-    values.iter().all(|v| v.is_finite()).then_some(values)
+    crate::urdf_model::numbers(text).filter(|values| values.iter().all(|v| v.is_finite()))
 }
 
 /// The masses of a chain: the load model's data, or the joints (1-based) whose body states no

@@ -274,7 +274,7 @@ fn required<'a>(element: &'a Element, attribute: &str) -> Result<&'a str, Refusa
 
 /// Three numbers separated by white space (non-finite ones included: the chain refuses them with
 /// the joint's name).
-fn numbers(text: &str) -> Option<[f64; 3]> {
+pub(crate) fn numbers(text: &str) -> Option<[f64; 3]> {
     let values: Vec<f64> = text.split_whitespace().map(|w| w.parse::<f64>().ok()).collect::<Option<_>>()?;
     values.try_into().ok()
 }
