@@ -189,5 +189,9 @@ fn shape_lines(config: &GeneratorConfig) -> Vec<String> {
 
 /// The names of the effects that are on, as the RON file spells them.
 fn effect_names(effects: &campaign::Effects) -> Vec<&'static str> {
-    campaign::EffectKind::ALL.iter().filter(|&&kind| effects.is_on(kind)).map(|kind| kind.simulated_field()).collect()
+    campaign::EffectKind::ALL
+        .iter()
+        .filter(|&&kind| effects.is_on(kind))
+        .filter_map(|kind| kind.simulated_field())
+        .collect()
 }

@@ -87,7 +87,8 @@ pub fn check_effects(effects: &Effects, robot: &RobotDescription, text: &str, fi
     };
     let active = effects.active();
     for (kind, effect) in &active {
-        let section = kind.simulated_field();
+        // `active` holds only simulated kinds, which all have a field.
+        let section = kind.simulated_field().unwrap_or(kind.name());
         let what = match effect.needs_dynamics() {
             DynamicsNeed::Nothing => continue,
             DynamicsNeed::Masses => "link masses",
@@ -106,7 +107,8 @@ pub fn check_effects(effects: &Effects, robot: &RobotDescription, text: &str, fi
     let facts =
         RobotFacts { joints: &joints, dynamics: robot.dynamics.as_ref(), pitch_bounds_mm: errors::PITCH_BOUNDS_MM };
     for (kind, effect) in &active {
-        effect.check_entries(&facts).map_err(|f| at(kind.simulated_field(), &f.field, f.index, f.message))?;
+        let section = kind.simulated_field().unwrap_or(kind.name());
+        effect.check_entries(&facts).map_err(|f| at(section, &f.field, f.index, f.message))?;
     }
     Ok(())
 }

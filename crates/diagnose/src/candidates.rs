@@ -25,8 +25,8 @@ use serde::{Deserialize, Serialize};
 /// Generates [`Effect`] from the identified kinds of `loadsim::effect_kinds!`, and `None` and
 /// `Unknown`.
 macro_rules! verdict_effect {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident: $sim:ty, )* }
-     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident: $ssim:ty, )* }) => {
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident $(=> $field:ident: $sim:ty)?, )* }
+     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// An effect a verdict can name (the SPEC's `verdict.effect`): every kind the fit
         /// identifies, in the list's order, then `None` and `Unknown`.
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

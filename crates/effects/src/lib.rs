@@ -12,9 +12,11 @@
 //! `--effects` item, how the fit builds it, its [`CandidateModel`]s for the diagnosis), module
 //! `term`. [`IdentifiedEffect`] is generated from the one list of kinds, `loadsim::effect_kinds!`
 //! ([`EffectKind`]), a variant per identified kind holding the type of the same name; the
-//! `--effects` parser ([`EffectSpec`]) reads the kinds' names and arguments from it. Adding an
-//! effect: one line in that list, one file here and its simulation in a file of `loadsim`
-//! (`loadsim::SimulatedEffect`), each with its `mod` line (docs/ARCHITECTURE.md, "Adding an effect").
+//! `--effects` parser ([`EffectSpec`]) reads the kinds' names and arguments from it; the same
+//! line declares the effect's module here, named as its SPEC name (`gear_periodic.rs`), and
+//! re-exports its type. Adding an effect: one line in that list and one file here; simulating it
+//! too, one file of `loadsim` (`loadsim::SimulatedEffect`) with its `mod` line, and the line's
+//! `=> field: Type` (docs/ARCHITECTURE.md, "Adding an effect").
 //!
 //! ```
 //! use effects::EffectSelection;
@@ -30,39 +32,28 @@
 /// beyond its data as the data reaches (issue 30; see `EffectOptions::hold_beyond_span`).
 pub const HOLD_BEYOND_SPAN: f64 = 1.0;
 
-mod backlash;
 mod beyond_span;
 mod check;
-mod compliance;
 mod correction;
 mod direction;
-mod drift;
-mod gear;
-mod link_deflection;
 mod load_frame;
 mod payload_span;
 mod report;
-mod screw;
 mod spec;
 mod term;
-mod thermal;
 
-pub use backlash::{Backlash, TorqueSign};
+pub use backlash::TorqueSign;
 pub use beyond_span::BeyondSpan;
-pub use compliance::{ComplianceTerm, ComplianceTorque, JointCompliance, TorqueFit};
 pub use direction::Direction;
-pub use drift::TimeDrift;
-pub use gear::{GearOptions, GearPeriodic};
-pub use link_deflection::LinkDeflection;
+pub use gear_periodic::GearOptions;
+pub use joint_compliance::{ComplianceTerm, ComplianceTorque, TorqueFit};
 pub use load_frame::LoadFrame;
 pub use loadsim::EffectKind;
 pub use payload_span::PayloadSpan;
 pub use report::{EffectReport, ParameterReport};
 pub use report::{effect_reports, reported_label, reported_parameters};
-pub use screw::ScrewPeriodic;
 pub use spec::{Argument, EffectListFault, EffectSelection, EffectSpec, MAX_HARMONICS, PITCH_BOUNDS_MM, effect_items};
 pub use term::{CandidateContext, CandidateModel, CandidateOptions};
-pub use thermal::Thermal;
 
 pub use check::{EffectFault, FaultKind, check_effects};
 pub use correction::EffectCorrection;
@@ -133,12 +124,24 @@ pub fn has_torques(rows: &[Measurement]) -> bool {
 /// change a row could identify.
 pub const CONSTANT_FEATURES: f64 = 1e-9;
 
+/// Declares each identified kind's module, named as its SPEC name (`joint_compliance.rs`, …), and
+/// re-exports the type of the kind's name from it: an effect's file is declared by its line in
+/// `loadsim::effect_kinds!`, nowhere else.
+macro_rules! effect_modules {
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident $(=> $field:ident: $sim:ty)?, )* }
+     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
+        $( mod $name; pub use $name::$kind; )*
+    };
+}
+
+loadsim::effect_kinds!(effect_modules);
+
 /// Generates [`IdentifiedEffect`] from the identified kinds of `loadsim::effect_kinds!`: a variant
 /// per kind holding the type of the same name, every method delegated to its `EffectTerm` /
 /// `NewEffect` (module `term`).
 macro_rules! identified_effect {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident: $sim:ty, )* }
-     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident: $ssim:ty, )* }) => {
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident $(=> $field:ident: $sim:ty)?, )* }
+     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// An effect of a calibrated model, with its identified parameters: one variant per
         /// identified kind of `loadsim::effect_kinds!`, holding the type of the same name,
         /// written in model files under the kind's SPEC name.

@@ -6,6 +6,29 @@
 //! Hand-written rather than taken from a crate: argmin's L-BFGS has no bounds, and the wrappers of
 //! the Fortran L-BFGS-B need a Fortran toolchain. The tests check it on bounded quadratics with a
 //! known answer and on the Rosenbrock function.
+//!
+//! ```
+//! use lbfgsb::{Objective, Settings, Termination, minimise};
+//!
+//! /// `(x − 3)² + (y + 1)²`, whose minimum (3, −1) lies outside the box `[0, 2] × [0, 2]`.
+//! struct Bowl(Vec<f64>);
+//! impl Objective for Bowl {
+//!     fn value(&mut self, x: &[f64]) -> Option<f64> {
+//!         self.0 = x.to_vec();
+//!         Some((x[0] - 3.0).powi(2) + (x[1] + 1.0).powi(2))
+//!     }
+//!     fn gradient(&mut self) -> Option<Vec<f64>> {
+//!         Some(vec![2.0 * (self.0[0] - 3.0), 2.0 * (self.0[1] + 1.0)])
+//!     }
+//! }
+//!
+//! let settings =
+//!     Settings { memory: 5, max_iterations: 100, gradient_tolerance: 1e-10, function_tolerance: 1e-15 };
+//! let found = minimise(&mut Bowl(vec![]), &[1.0, 1.0], &[0.0, 0.0], &[2.0, 2.0], &settings).unwrap();
+//! // The constrained minimum is the box's corner nearest (3, −1).
+//! assert!((found.x[0] - 2.0).abs() < 1e-9 && found.x[1].abs() < 1e-9);
+//! assert_ne!(found.termination, Termination::LineSearchFailed);
+//! ```
 
 #![deny(missing_docs)]
 

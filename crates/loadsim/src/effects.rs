@@ -13,15 +13,19 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 macro_rules! effects_struct {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident: $sim:ty, )* }
-     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident: $ssim:ty, )* }) => {
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident $(=> $field:ident: $sim:ty)?, )* }
+     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// Which effects act and with which parameters, a field per kind of
-        /// [`effect_kinds!`](crate::effect_kinds) (named as its line says); `None` switches an
-        /// effect off. The default has none: the measured pose is then the geometric model's.
+        /// [`effect_kinds!`](crate::effect_kinds) that the simulator models (named as its line
+        /// says); `None` switches an effect off. The default has none: the measured pose is then
+        /// the geometric model's.
         #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
         #[serde(default)]
         pub struct Effects {
-            $( $(#[$doc])* pub $field: Option<$sim>, )*
+            $( $(
+                #[doc = concat!("[`EffectKind::", stringify!($kind), "`] (`", stringify!($name), "`): its simulation, `None` when off.")]
+                pub $field: Option<$sim>,
+            )? )*
             $( $(#[$sdoc])* pub $sfield: Option<$ssim>, )*
         }
 
@@ -29,25 +33,26 @@ macro_rules! effects_struct {
             /// The effects that are on, with their kinds, in the list's order.
             pub fn active(&self) -> Vec<(EffectKind, &dyn SimulatedEffect)> {
                 let mut on: Vec<(EffectKind, &dyn SimulatedEffect)> = Vec::new();
-                $( if let Some(effect) = &self.$field { on.push((EffectKind::$kind, effect)); } )*
+                $( $( if let Some(effect) = &self.$field { on.push((EffectKind::$kind, effect)); } )? )*
                 $( if let Some(effect) = &self.$sfield { on.push((EffectKind::$skind, effect)); } )*
                 on
             }
 
-            /// These effects with only `kind` left on (with its parameters here; off if it is off here).
+            /// These effects with only `kind` left on (with its parameters here; off if it is off
+            /// here, or not simulated).
             pub fn only(&self, kind: EffectKind) -> Self {
                 let mut alone = Effects::default();
                 match kind {
-                    $( EffectKind::$kind => alone.$field = self.$field.clone(), )*
+                    $( EffectKind::$kind => { $( alone.$field = self.$field.clone(); )? } )*
                     $( EffectKind::$skind => alone.$sfield = self.$sfield.clone(), )*
                 }
                 alone
             }
 
-            /// Whether `kind` is on.
+            /// Whether `kind` is on (never for a kind the simulator does not model).
             pub fn is_on(&self, kind: EffectKind) -> bool {
                 match kind {
-                    $( EffectKind::$kind => self.$field.is_some(), )*
+                    $( EffectKind::$kind => false $( || self.$field.is_some() )?, )*
                     $( EffectKind::$skind => self.$sfield.is_some(), )*
                 }
             }

@@ -1,29 +1,33 @@
 //! The one list of effect kinds, shared by the simulator ([`crate::Effects`]), the fit and the
 //! model file (`effects::IdentifiedEffect`), the diagnosis (`diagnose::Effect`) and the command
 //! line (`--effects`, `calib simulate`). Everything that enumerates the kinds is generated from
-//! [`effect_kinds!`](crate::effect_kinds), so that adding an effect is one line here plus the
-//! effect's own files (see docs/ARCHITECTURE.md, "Adding an effect").
+//! [`effect_kinds!`](crate::effect_kinds), so that adding an effect is one line here and one file
+//! in `effects` (its module is declared from this line), and simulating it one more file here
+//! (see docs/ARCHITECTURE.md, "Adding an effect").
 
 /// Calls the macro `$callback` with the list of effect kinds, in a fixed order:
 ///
 /// ```text
-/// identified { $( #[doc] Kind "spec_name" simulated_field: SimulatedType, )* }
-/// simulated { $( #[doc] Kind "spec_name" simulated_field: SimulatedType, )* }
+/// identified { $( #[doc] Kind spec_name $( => simulated_field: SimulatedType )?, )* }
+/// simulated { $( #[doc] Kind spec_name => simulated_field: SimulatedType, )* }
 /// ```
 ///
-/// `identified` kinds have a regressor in the `effects` crate (a type named `Kind` implementing
-/// its `EffectTerm`), are an item of `--effects` and a candidate the diagnosis can name;
+/// `identified` kinds have a regressor in the `effects` crate: a type named `Kind` in its module
+/// `spec_name` (the file `crates/effects/src/spec_name.rs`, declared from this list), implementing
+/// its `EffectTerm`; each is an item of `--effects` and a candidate the diagnosis can name.
 /// `simulated` kinds exist only in the simulator. `spec_name` is the SPEC's name (serde, the
-/// `--effects` item, the diagnosis JSON); `simulated_field` is the field of [`crate::Effects`] (and of
-/// the effects file of `calib simulate`) that switches the kind on in a simulation, and
+/// `--effects` item, the diagnosis JSON). Where a kind is simulated, `simulated_field` is the field
+/// of [`crate::Effects`] (and of the effects file of `calib simulate`) that switches it on, and
 /// `SimulatedType` the type it holds there, which implements [`crate::SimulatedEffect`] (the
-/// effect's simulation: its checks and its place in the forward model).
+/// effect's simulation: its checks and its place in the forward model). An identified kind may
+/// have no simulation: it is then fitted, diagnosed and read from model files, and
+/// [`EffectKind::simulated_field`] is `None`.
 ///
 /// ```
 /// macro_rules! names {
-///     (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident: $sim:ty, )* }
-///      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident: $ssim:ty, )* }) => {
-///         [$($name),*]
+///     (identified { $( $(#[$doc:meta])* $kind:ident $name:ident $(=> $field:ident: $sim:ty)?, )* }
+///      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
+///         [$(stringify!($name)),*]
 ///     };
 /// }
 /// let identified = loadsim::effect_kinds!(names);
@@ -35,33 +39,33 @@ macro_rules! effect_kinds {
         $callback! {
             identified {
                 /// Joint compliance under gravity and payload.
-                JointCompliance "joint_compliance" compliance: $crate::JointCompliance,
+                JointCompliance joint_compliance => compliance: $crate::JointCompliance,
                 /// Backlash following the sign of the static torque.
-                Backlash "backlash" backlash: $crate::Backlash,
+                Backlash backlash => backlash: $crate::Backlash,
                 /// A periodic error of a joint in its own angle (gear or encoder).
-                GearPeriodic "gear_periodic" periodic: $crate::PeriodicError,
+                GearPeriodic gear_periodic => periodic: $crate::PeriodicError,
                 /// Thermal growth of the links with `temp_c`.
-                Thermal "thermal" thermal: $crate::ThermalGrowth,
+                Thermal thermal => thermal: $crate::ThermalGrowth,
                 /// Drift of the robot's placement with `t_s`.
-                TimeDrift "time_drift" drift: $crate::BaseDrift,
+                TimeDrift time_drift => drift: $crate::BaseDrift,
                 /// A link bending under the gravity moment of everything beyond it.
-                LinkDeflection "link_deflection" deflection: $crate::LinkDeflection,
+                LinkDeflection link_deflection => deflection: $crate::LinkDeflection,
                 /// A periodic error of a linear axis in its own position, per screw or rack pitch.
-                ScrewPeriodic "screw_periodic" screw: $crate::ScrewError,
+                ScrewPeriodic screw_periodic => screw: $crate::ScrewError,
             }
             simulated {
                 /// Tracker measurement noise.
-                TrackerNoise "tracker_noise" tracker_noise: $crate::TrackerNoise,
+                TrackerNoise tracker_noise => tracker_noise: $crate::TrackerNoise,
                 /// A joint error driven by other joints' angles; no candidate of the diagnosis models it.
-                Coupling "coupling" coupling: $crate::JointCoupling,
+                Coupling coupling => coupling: $crate::JointCoupling,
             }
         }
     };
 }
 
 macro_rules! effect_kind_enum {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:literal $field:ident: $sim:ty, )* }
-     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:literal $sfield:ident: $ssim:ty, )* }) => {
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident $(=> $field:ident: $sim:ty)?, )* }
+     simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// The kinds of effect, named as in the SPEC (`--effects`, the model file, the `calib
         /// diagnose` JSON), generated from [`effect_kinds!`](crate::effect_kinds).
         #[non_exhaustive]
@@ -82,8 +86,8 @@ macro_rules! effect_kind_enum {
             /// The SPEC name (`joint_compliance`, `gear_periodic`, …).
             pub fn name(self) -> &'static str {
                 match self {
-                    $( EffectKind::$kind => $name, )*
-                    $( EffectKind::$skind => $sname, )*
+                    $( EffectKind::$kind => stringify!($name), )*
+                    $( EffectKind::$skind => stringify!($sname), )*
                 }
             }
 
@@ -97,11 +101,15 @@ macro_rules! effect_kind_enum {
                 Self::IDENTIFIED.contains(&self)
             }
 
-            /// The field of [`Effects`] (and of `calib simulate`'s effects file) that holds it.
-            pub fn simulated_field(self) -> &'static str {
+            /// The field of [`Effects`](crate::Effects) (and of `calib simulate`'s effects file)
+            /// that holds it; `None` for a kind the simulator does not model.
+            pub fn simulated_field(self) -> Option<&'static str> {
                 match self {
-                    $( EffectKind::$kind => stringify!($field), )*
-                    $( EffectKind::$skind => stringify!($sfield), )*
+                    $( EffectKind::$kind => {
+                        let field: &[&'static str] = &[$(stringify!($field))?];
+                        field.first().copied()
+                    } )*
+                    $( EffectKind::$skind => Some(stringify!($sfield)), )*
                 }
             }
         }
@@ -126,6 +134,6 @@ mod tests {
         }
         assert_eq!(EffectKind::from_name("gear"), None);
         assert!(EffectKind::GearPeriodic.is_identified() && !EffectKind::Coupling.is_identified());
-        assert_eq!(EffectKind::GearPeriodic.simulated_field(), "periodic");
+        assert_eq!(EffectKind::GearPeriodic.simulated_field(), Some("periodic"));
     }
 }
