@@ -120,11 +120,13 @@ pub(crate) fn arc_checks(
             // The training rows, blended as this fold's model blends them: each series by the
             // coverage of its own fit's angles.
             let mut fold_residuals = vec![Vector6::zeros(); data.rows.len()];
+            let mut alone = vec![(Vector6::zeros(), 1.0); data.rows.len()];
             for g in (0..inputs.folds).filter(|&g| g != f) {
                 let fitted = pool.residuals(g, &all, &betas);
                 for ((&i, b), a) in pool.fold_poses(g).iter().zip(&fitted[0]).zip(&fitted[1]) {
                     let w: f64 = coverage.iter().map(|s| s.held_and_weight(data.rows[i].q[s.joint]).1).product();
                     fold_residuals[i] = a * w + b * (1.0 - w);
+                    alone[i] = (*b, w);
                 }
             }
             for ((&i, b), a) in poses.iter().zip(&residuals[0]).zip(&residuals[1]) {
@@ -139,8 +141,9 @@ pub(crate) fn arc_checks(
                 before.push(b.fixed_rows::<3>(0).norm());
                 after.push(blended.fixed_rows::<3>(0).norm());
                 fold_residuals[i] = blended;
+                alone[i] = (*b, w);
             }
-            folds.push(FoldResiduals { held_out: poses.to_vec(), residuals: fold_residuals });
+            folds.push(FoldResiduals { held_out: poses.to_vec(), residuals: fold_residuals, alone });
         }
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64 * 1e3;
         let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max) * 1e3;

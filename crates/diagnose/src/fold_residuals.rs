@@ -19,6 +19,12 @@ pub struct FoldResiduals {
     /// stage fitted on top learns from. For the arcs, blended toward the geometry where the fitted
     /// model fades its series, as [`crate::ArcCheck::after_mm`] is.
     pub residuals: Vec<Vector6>,
+    /// For the arcs: the residual the geometry fitted alone on the other rows leaves on every
+    /// row, and each row's weight of the effects (the rest is the geometry alone's): where the
+    /// model fades its series, its GP blends to a GP of what the geometry alone leaves
+    /// (`model::ResidualGp::fallback`), which learns from these. Empty for the random folds,
+    /// whose rows the series cover.
+    pub alone: Vec<(Vector6, f64)>,
 }
 
 /// The folds behind `heldout_after_selected_mm` (random) and `off_poses_after_mm` (arcs).
@@ -44,7 +50,7 @@ pub(crate) fn random_folds(pool: &Pool, fold_columns: &[Vec<usize>]) -> Result<V
                 residuals[i] = *r;
             }
         }
-        out.push(FoldResiduals { held_out: pool.fold_poses(f).to_vec(), residuals });
+        out.push(FoldResiduals { held_out: pool.fold_poses(f).to_vec(), residuals, alone: Vec::new() });
     }
     Ok(out)
 }

@@ -63,6 +63,7 @@ impl<'a> Part<'a> {
                 walk.pending = vec![Vector6::zeros(); walk.data.len()];
                 walk.coverage = vec![1.0; walk.data.len()];
                 walk.posterior_variance = None;
+                walk.faded = None;
             }
             Part::Effect(effect) => {
                 let kinematics = walk.kinematics.ok_or(Error::new(ErrorKind::PartOrder { part: "effect" }))?;
@@ -101,30 +102,76 @@ impl<'a> Part<'a> {
                     }
                     walk.posterior_variance = Some(variances);
                 }
-                for (((pose, coverage), row), &tool) in
-                    walk.poses.iter_mut().zip(&walk.coverage).zip(walk.data.rows()).zip(walk.data.tools())
+                if walk.coverage.iter().all(|&w| w >= 1.0) {
+                    return Ok(());
+                }
+                let mut faded = FadedPoses { unblended: walk.poses.clone(), alone: walk.poses.clone() };
+                for ((((pose, alone_pose), coverage), row), &tool) in walk
+                    .poses
+                    .iter_mut()
+                    .zip(&mut faded.alone)
+                    .zip(&walk.coverage)
+                    .zip(walk.data.rows())
+                    .zip(walk.data.tools())
                 {
                     if *coverage < 1.0 {
                         // T = exp(w · log(T_e T_g⁻¹)) T_g: the geometry alone at w = 0.
                         let alone = fallback.forward(&row.q, tool).map_err(Error::kinematics)?;
-                        let towards = (*pose * alone.inverse()).log().to_vector() * *coverage;
-                        *pose = Twist::from_vector(&towards).exp() * alone;
+                        *pose = blend(pose, &alone, *coverage);
+                        *alone_pose = alone;
                     }
                 }
+                walk.faded = Some(faded);
             }
             Part::GaussianProcess(residual_gp) => {
                 walk.flush();
-                let corrections = residual_gp.predict(walk.data, &walk.poses)?;
-                let mut std = Vec::with_capacity(corrections.len());
-                for (pose, (g, s)) in walk.poses.iter_mut().zip(corrections) {
-                    *pose = g * *pose;
-                    std.push(s);
+                let fallback = match &walk.faded {
+                    Some(faded) => residual_gp.predict_fallback(walk.data, &faded.alone).transpose()?,
+                    None => None,
+                };
+                let mut std = Vec::with_capacity(walk.poses.len());
+                match (fallback, &walk.faded) {
+                    (Some(fallback), Some(faded)) => {
+                        // Where the effects fade, the pose blends from the effects' pose with
+                        // this GP's correction to the geometry alone with the fallback GP's.
+                        let corrections = residual_gp.predict(walk.data, &faded.unblended)?;
+                        for (i, ((g, s), (g0, s0))) in corrections.into_iter().zip(fallback).enumerate() {
+                            let w = walk.coverage[i];
+                            walk.poses[i] = if w < 1.0 {
+                                blend(&(g * faded.unblended[i]), &(g0 * faded.alone[i]), w)
+                            } else {
+                                g * faded.unblended[i]
+                            };
+                            std.push(std::array::from_fn(|k| (w * s[k] * s[k] + (1.0 - w) * s0[k] * s0[k]).sqrt()));
+                        }
+                    }
+                    _ => {
+                        let corrections = residual_gp.predict(walk.data, &walk.poses)?;
+                        for (pose, (g, s)) in walk.poses.iter_mut().zip(corrections) {
+                            *pose = g * *pose;
+                            std.push(s);
+                        }
+                    }
                 }
                 walk.std = Some(std);
             }
         }
         Ok(())
     }
+}
+
+/// `exp(w · log(T_e T_g⁻¹)) T_g`: `geometry` at `w = 0`, `effects` at `w = 1`.
+fn blend(effects: &SE3, geometry: &SE3, w: f64) -> SE3 {
+    let towards = (*effects * geometry.inverse()).log().to_vector() * w;
+    Twist::from_vector(&towards).exp() * *geometry
+}
+
+/// Where some row's effects fade ([`Part::Fallback`]): every row's pose before the blend, and the
+/// geometry fitted alone's (the pose before the blend where a row does not fade).
+#[derive(Debug)]
+pub(crate) struct FadedPoses {
+    unblended: Vec<SE3>,
+    alone: Vec<SE3>,
 }
 
 /// The state of a walk over the parts: the poses so far, the effects' pending twist, the GP's
@@ -149,6 +196,8 @@ pub(crate) struct Walk<'a> {
     /// per component (`None` without [`Walk::uncertainty`]).
     pub(crate) posterior_variance: Option<Vec<[f64; 6]>>,
     pub(crate) std: Option<Vec<[f64; 6]>>,
+    /// Set by [`Part::Fallback`] where some row fades: the poses the GP part blends between.
+    faded: Option<FadedPoses>,
 }
 
 impl<'a> Walk<'a> {
@@ -166,6 +215,7 @@ impl<'a> Walk<'a> {
             uncertainty,
             posterior_variance: None,
             std: None,
+            faded: None,
         }
     }
 

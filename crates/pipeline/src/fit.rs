@@ -343,7 +343,17 @@ pub fn fit(
             if left_out { Cow::Owned(bound.without(&identification.robust.outliers)) } else { Cow::Borrowed(&bound) };
         let poses = model.geometric_poses(&kept)?;
         let repeats = model::RepeatGroups::of(kept.rows(), options.heldout.repeat_tolerance);
-        let (fitted, report) = ResidualGp::fit(&poses, kept.set(), with_payload, &options.residual_gp, &repeats)?;
+        let (mut fitted, report) = ResidualGp::fit(&poses, kept.set(), with_payload, &options.residual_gp, &repeats)?;
+        if let (Some(alone), false) = (&model.fallback_kinematics, model.effects.is_empty()) {
+            let alone_poses = kept
+                .rows()
+                .iter()
+                .zip(kept.tools())
+                .map(|(row, &tool)| alone.forward(&row.q, tool))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(Error::kinematics)?;
+            fitted.fit_fallback(&alone_poses, kept.set(), &options.residual_gp)?;
+        }
         // `--effects auto`'s prediction with this GP on top, its hyperparameters held fixed.
         if let Some(choice) = &mut auto {
             choice.predicted_with_gp = crate::gp_folds::predicted_with_gp(

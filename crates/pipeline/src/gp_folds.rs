@@ -5,7 +5,9 @@
 //! used again: in each, a GP with those hyperparameters (and its input standardisation and output
 //! normalisation) is conditioned on the residuals that fold's geometry and effects leave on its
 //! training rows, and predicts its held-out rows; the held-out position error after it is the
-//! prediction.
+//! prediction. In an arc, where the model fades its series and blends to the geometry fitted
+//! alone, the correction blends likewise to the model's fallback GP (`ResidualGp::fallback`)
+//! conditioned on what the fold's geometry alone leaves, as the model's does.
 //!
 //! The hyperparameters are held fixed across the folds, a standard approximation (R&W Section
 //! 5.4.2 does the same for leave-one-out): searching them again in every fold would repeat the
@@ -100,17 +102,70 @@ pub(crate) fn predicted_with_gp(
     // Only the position outputs: the position error is what is predicted.
     let predicted =
         exact.held_out_with_fixed_hyperparameters(x.as_ref(), &fold_targets, &[0, 1, 2], config).map_err(Error::gp)?;
+    // Where the model keeps a GP of what the geometry alone leaves (`ResidualGp::fallback`), a
+    // faded row's correction blends to it as the model's does: the same folds, conditioned on
+    // what each fold's geometry alone leaves, with that GP's hyperparameters.
+    let alone = match &gp.fallback {
+        Some(GpModel::Exact(fallback)) if all.iter().any(|f| !f.alone.is_empty()) => {
+            let targets: Vec<Mat<f64>> =
+                all.iter().map(|f| Mat::from_fn(n, m, |i, c| f.alone.get(i).map_or(0.0, |(r, _)| r[c]))).collect();
+            // An arc's own rows and, beside them, the rows within one arc's width of it on either
+            // side: a GP bridges a narrow arc of the joint it learns, which a model meeting a
+            // wider gap or the end of the range cannot (blocked cross-validation with a buffer,
+            // Roberts et al., Ecography 40, 2017). The geometry and effects keep their folds.
+            let joint_of: Vec<Option<usize>> = std::iter::repeat_n(None, folds.random.len())
+                .chain(folds.arcs.iter().flat_map(|(joint, arcs)| std::iter::repeat_n(Some(joint - 1), arcs.len())))
+                .collect();
+            let buffered: Vec<Vec<usize>> = kept_from_gp
+                .iter()
+                .zip(&all)
+                .zip(&joint_of)
+                .map(|((rows, f), joint)| {
+                    let Some(j) = *joint else { return rows.clone() };
+                    let angles = f.held_out.iter().map(|&i| folds.rows[i].q[j]);
+                    let (lo, hi) = angles.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| (a.min(q), b.max(q)));
+                    let width = hi - lo;
+                    let mut taken = vec![false; n];
+                    rows.iter().for_each(|&i| taken[i] = true);
+                    let mut rows = rows.clone();
+                    for (i, row) in folds.rows.iter().enumerate() {
+                        if !taken[i] && (lo - width..=hi + width).contains(&row.q[j]) {
+                            rows.push(i);
+                        }
+                    }
+                    rows
+                })
+                .collect();
+            let fold_targets: Vec<gp::FoldTargets<'_>> = buffered
+                .iter()
+                .zip(&targets)
+                .map(|(rows, y)| gp::FoldTargets { held_out: rows, y: y.as_ref() })
+                .collect();
+            Some(
+                fallback
+                    .held_out_with_fixed_hyperparameters(x.as_ref(), &fold_targets, &[0, 1, 2], config)
+                    .map_err(Error::gp)?,
+            )
+        }
+        _ => None,
+    };
     // Per fold, the held-out position errors after the GP, m.
     let errors: Vec<Vec<f64>> = all
         .iter()
-        .zip(&predicted)
-        .map(|(f, g)| {
+        .enumerate()
+        .map(|(k, f)| {
+            let g = &predicted[k];
             f.held_out
                 .iter()
                 .enumerate()
                 .map(|(a, &i)| {
                     let r = f.residuals[i];
-                    ((r[0] - g[(a, 0)]).powi(2) + (r[1] - g[(a, 1)]).powi(2) + (r[2] - g[(a, 2)]).powi(2)).sqrt()
+                    let w = f.alone.get(i).map_or(1.0, |&(_, w)| w);
+                    let correction = |c: usize| match &alone {
+                        Some(g0) if w < 1.0 => w * g[(a, c)] + (1.0 - w) * g0[k][(a, c)],
+                        _ => g[(a, c)],
+                    };
+                    (0..3).map(|c| (r[c] - correction(c)).powi(2)).sum::<f64>().sqrt()
                 })
                 .collect()
         })
