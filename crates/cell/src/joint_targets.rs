@@ -293,14 +293,23 @@ pub fn compensate(
     Ok((solved, summary))
 }
 
-/// Writes the compensated targets as CSV: `q1_rad … qN_rad` (empty for a refused row), every
+/// Writes the compensated targets as CSV: `q1_rad … qN_rad` (`qK_m` for a prismatic joint;
+/// empty for a refused row), every
 /// input column as written (joint columns renamed `nominal_…`), `residual_mm`, `residual_mrad`
 /// (empty without an orientation) and `status`.
 pub fn write_compensated<W: Write>(writer: W, file: &TargetFile, solved: &[Solved]) -> Result<(), std::io::Error> {
     let mut out = csv::Writer::from_writer(writer);
     let joint_columns: Vec<usize> = file.set.joint_columns.iter().map(|c| c.column - 1).collect();
     let n = file.set.joint_count;
-    let mut header: Vec<String> = (1..=n).map(|k| format!("q{k}_rad")).collect();
+    // A prismatic joint's value is in metres (SI inside, as the reader takes `_m`): `q{k}_m`, so
+    // that the output reads back as a measurement or targets file.
+    let kind = |k: usize| file.set.joint_columns.get(k - 1).map(|c| c.kind);
+    let mut header: Vec<String> = (1..=n)
+        .map(|k| match kind(k) {
+            Some(poe::JointKind::Prismatic) => format!("q{k}_m"),
+            _ => format!("q{k}_rad"),
+        })
+        .collect();
     header.extend(
         file.cells
             .header

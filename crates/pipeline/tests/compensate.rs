@@ -222,3 +222,35 @@ fn targets_files_that_cannot_be_compensated_are_refused_at_their_place() {
         cell::compensate(&model, &poses, Some((&irb, "irb4400.ron")), TargetFrame::Base, &options).unwrap();
     assert_eq!(solved.len(), 1);
 }
+
+/// A prismatic joint's compensated value is in metres and its column says so (`qK_m`), so that
+/// the output reads back as a targets file (it was written `q1_rad`, which the reader refuses on
+/// a prismatic joint).
+#[test]
+fn a_prismatic_joints_compensated_column_is_in_metres_and_reads_back() {
+    let robot = testkit::robot("column_ur10.ron");
+    let cell = campaign::simulated_cell(&robot, &Perturbation::default(), 23).unwrap();
+    let config = GeneratorConfig { sample_count: 120, seed: 23, ..GeneratorConfig::default() };
+    let set = campaign::simulate(&cell, &noise_only(), &campaign::joint_ranges(&robot), &config, true).unwrap();
+    let (model, _) = pipeline::fit(&robot, &set, Method::Poe, &FitOptions::default()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let program = "q1_mm,q2_deg,q3_deg,q4_deg,q5_deg,q6_deg,q7_deg\n300,10,-60,40,-30,40,20\n";
+    let file = cell::read_targets(&write(dir.path(), "program.csv", program), &model, ColumnMap::default()).unwrap();
+    let (solved, summary) = cell::compensate(
+        &model,
+        &file,
+        Some((&robot, "column_ur10.ron")),
+        TargetFrame::Tracker,
+        &CompensateOptions::default(),
+    )
+    .unwrap();
+    assert_eq!((summary.rows, summary.ok), (1, 1), "{summary:?}");
+    let mut csv = Vec::new();
+    cell::write_compensated(&mut csv, &file, &solved).unwrap();
+    let csv = String::from_utf8(csv).unwrap();
+    assert!(csv.starts_with("q1_m,q2_rad,"), "{csv}");
+    let q1: f64 = csv.lines().nth(1).unwrap().split(',').next().unwrap().parse().unwrap();
+    assert!((q1 - 0.3).abs() < 0.01, "{q1} m");
+    let back = cell::read_targets(&write(dir.path(), "out.csv", &csv), &model, ColumnMap::default()).unwrap();
+    assert!((back.set.rows[0].q[0] - q1).abs() < 1e-12);
+}
