@@ -8,7 +8,7 @@ use std::path::PathBuf;
 ///
 /// TARGETS holds either joint columns alone (a program taught on the nominal model: the intended
 /// pose is where the nominal model, placed on the calibrated one by base and tool, puts the tool;
-/// needs --robot), or tool poses (x_mm … and optionally an orientation) with seed joint columns.
+/// needs the robot description: --robot, or the one the model keeps), or tool poses (x_mm … and optionally an orientation) with seed joint columns.
 /// The whole model counts: geometry, joint compliance and the GP, with each row's payload_kg.
 /// Output CSV on stdout: q1_rad … qN_rad (empty where refused), the input columns (joint columns
 /// as nominal_…), residual_mm, residual_mrad and status (ok, or why the row was refused).

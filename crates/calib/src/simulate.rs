@@ -34,7 +34,7 @@ pub struct Args {
     #[arg(long)]
     full_pose: bool,
     /// Effects (RON, loadsim's `Effects`: compliance, backlash, periodic, thermal, drift,
-    /// tracker_noise, coupling; a field left out is off) [default: joint compliance and tracker noise].
+    /// deflection, screw, tracker_noise, coupling; a field left out is off) [default: joint compliance and tracker noise].
     #[arg(long)]
     effects: Option<PathBuf>,
     /// Payloads, kg, one drawn per pose [default: the paper's 1,2.5,3.5,5,7.5].
