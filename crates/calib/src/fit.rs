@@ -170,6 +170,20 @@ fn summarise(
                 "    predicted held out with the GP on top: {:.4} mm on poses like these{off} (the same folds, each fold's GP conditioned on the residuals its geometry and effects leave on its training rows, the final GP's hyperparameters held fixed: a standard approximation, searching them again in every fold would be too slow)",
                 with_gp.on_poses_mm
             );
+            if let Some(choice) = &with_gp.fallback_gp {
+                let mm = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.4} mm"));
+                let _ = writeln!(
+                    out,
+                    "    where the effects fade: {} (arcs off the poses: {} with a GP of what the geometry alone leaves, {} with the GP of what the effects leave)",
+                    if choice.kept {
+                        "the GP falls back with the geometry to one fitted on what the geometry alone leaves"
+                    } else {
+                        "the GP of what the effects leave stays (it predicted the arcs better)"
+                    },
+                    mm(choice.off_poses_with_mm),
+                    mm(choice.off_poses_without_mm)
+                );
+            }
         }
         for s in &auto.selected {
             let joints: Vec<String> = s.joints.iter().map(ToString::to_string).collect();

@@ -469,6 +469,10 @@ fn is_zero(n: &usize) -> bool {
     *n == 0
 }
 
+/// A row's correction `G` to put before its model pose, and the standard deviation of each error
+/// component `(v, ω)` (m, rad).
+pub type Correction = (SE3, [f64; 6]);
+
 /// The exact GP of the stage on inputs `x` and residuals `y`: `options.gp`, with the rotation
 /// outputs following the position outputs' kernel for full-pose data where the options ask.
 fn exact_fit(x: &Mat<f64>, y: &Mat<f64>, full_pose: bool, options: &ResidualGpOptions) -> Result<gp::ExactGp, Error> {
@@ -651,11 +655,7 @@ impl ResidualGp {
 
     /// [`ResidualGp::predict`] with the [`ResidualGp::fallback`] GP at the poses of the geometry
     /// fitted alone; `None` where the model has none.
-    pub fn predict_fallback(
-        &self,
-        data: &BoundSet<'_>,
-        alone_poses: &[SE3],
-    ) -> Option<Result<Vec<(SE3, [f64; 6])>, Error>> {
+    pub fn predict_fallback(&self, data: &BoundSet<'_>, alone_poses: &[SE3]) -> Option<Result<Vec<Correction>, Error>> {
         self.fallback.as_ref().map(|gp| self.predict_with(gp, data, alone_poses))
     }
 

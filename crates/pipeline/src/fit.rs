@@ -362,6 +362,9 @@ pub fn fit(
                 &options.residual_gp.gp,
                 options.heldout.repeat_tolerance,
             )?;
+            if choice.predicted_with_gp.as_ref().and_then(|p| p.fallback_gp).is_some_and(|c| !c.kept) {
+                fitted.fallback = None;
+            }
         }
         model.residual_gp = Some(fitted);
         residual_gp = Some(report);

@@ -51,7 +51,7 @@ pub use fit::{FitReport, FitWarning, fit};
 pub use fit_options::{EffectOptions, FitOptions};
 pub use fit_options::{PayloadOptions, SessionOptions};
 pub use fit_prior::{NominalPriorOptions, PriorCandidate, PriorChoice, choose as choose_prior};
-pub use gp_folds::{ArcWithGp, PredictedWithGp};
+pub use gp_folds::{ArcWithGp, FallbackGpChoice, PredictedWithGp};
 pub use payloads::{PayloadChoice, PayloadErrors, payload_groups};
 pub use plausibility::{PlausibilityOptions, PlausibilityReport};
 pub use sessions::{SpanChoice, SpanErrors, sessions};
