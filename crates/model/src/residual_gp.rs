@@ -429,12 +429,13 @@ pub struct ResidualGp {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub tool_points: Vec<Option<Vector3>>,
     /// The GP of what the geometry fitted alone ([`crate::CalibratedModel::fallback_kinematics`])
-    /// leaves on the same training rows, with this GP's hyperparameters held (issue 23): where the
-    /// effects fade out and the pose blends to the geometry alone, the correction blends to this
-    /// GP's, so that off the effects' angles the model is the GP-corrected geometry (what `poe-gp`
-    /// without effects would give) rather than the geometry with a GP learnt on what the effects
-    /// left. Absent without effects, for the sparse GP and in older files (there the GP applies
-    /// to the blended pose).
+    /// leaves on the same training rows, its hyperparameters searched on those residuals
+    /// ([`ResidualGp::fit_fallback`]; issue 23): where the effects fade out and the pose blends to
+    /// the geometry alone, the correction blends to this GP's, so that off the effects' angles the
+    /// model is the GP-corrected geometry (what `poe-gp` without effects would give) rather than
+    /// the geometry with a GP learnt on what the effects left. Absent without effects, for the
+    /// sparse GP, where `--effects auto`'s arcs predicted the faded rows better without it, and in
+    /// older files (there the GP applies to the blended pose).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fallback: Option<GpModel>,
 }
@@ -649,7 +650,7 @@ impl ResidualGp {
     /// The correction of every row: `G(q, m)` to put before the model pose, and the GP's standard
     /// deviation of each error component `(v, ω)` (m, rad; zeros where not modelled). Each row's
     /// model tool in `data` picks its tool point ([`ResidualGp::tool_points`]).
-    pub fn predict(&self, data: &BoundSet<'_>, model_poses: &[SE3]) -> Result<Vec<(SE3, [f64; 6])>, Error> {
+    pub fn predict(&self, data: &BoundSet<'_>, model_poses: &[SE3]) -> Result<Vec<Correction>, Error> {
         self.predict_with(&self.gp, data, model_poses)
     }
 
@@ -681,12 +682,7 @@ impl ResidualGp {
         Ok(())
     }
 
-    fn predict_with(
-        &self,
-        gp: &GpModel,
-        data: &BoundSet<'_>,
-        model_poses: &[SE3],
-    ) -> Result<Vec<(SE3, [f64; 6])>, Error> {
+    fn predict_with(&self, gp: &GpModel, data: &BoundSet<'_>, model_poses: &[SE3]) -> Result<Vec<Correction>, Error> {
         let tools = data.tools();
         let prediction = gp.predict(inputs(data.rows(), self.with_payload).as_ref()).map_err(Error::gp)?;
         let outputs = prediction.mean.ncols();
