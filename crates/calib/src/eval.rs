@@ -60,6 +60,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         if let Some(fallen) = &report.sigma_fallback {
             eprintln!("warning: {fallen}");
         }
+        if let Some(faded) = &report.gp_fade {
+            eprintln!("warning: {faded}");
+        }
         return Ok(());
     }
     let s = &evaluation.summary;
@@ -99,6 +102,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Some(fallen) = &report.sigma_fallback {
         println!("  warning: {fallen}");
+    }
+    if let Some(faded) = &report.gp_fade {
+        println!("  warning: {faded}");
     }
     Ok(())
 }

@@ -52,6 +52,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(fallen) = model.sigma_fallback(&bound)? {
         eprintln!("warning: {fallen}");
     }
+    if let Some(faded) = model.gp_fade(&data.rows)? {
+        eprintln!("warning: {faded}");
+    }
     model::write_predictions(std::io::stdout().lock(), "stdout", &model, &data, &predictions)?;
     std::io::stdout().flush()?;
     eprintln!("{}", data.read_summary());

@@ -37,6 +37,10 @@ pub struct Prediction {
     /// Posterior covariance between the query points, one `n* × n*` matrix per output (empty when
     /// not requested).
     pub covariance: Vec<Mat<f64>>,
+    /// Prior variance of the latent function, `k(x*, x*)`, `n* × m` (with the variance; `0 × 0`
+    /// otherwise): [`Prediction::variance`] over it is the share of the prior uncertainty the
+    /// training data leave at each query point (1 where they say nothing of it).
+    pub prior_variance: Mat<f64>,
 }
 
 impl ExactGp {
@@ -58,6 +62,7 @@ impl ExactGp {
         let (ns, m) = (z.len(), self.output_count());
         let mut mean = Mat::zeros(ns, m);
         let mut variance = if options.variance { Mat::zeros(ns, m) } else { Mat::zeros(0, 0) };
+        let mut prior_variance = variance.clone();
         let mut covariance = if options.full_covariance { vec![Mat::zeros(0, 0); m] } else { Vec::new() };
         for c in &self.components {
             let (_, zp) = c.kernel.prepare(&z);
@@ -72,19 +77,15 @@ impl ExactGp {
                 // V = L⁻¹ K(X, X*) (R&W Algorithm 2.1, line 5), in place.
                 c.factor.solve_lower_in_place(ks.as_mut(), par);
             }
-            let latent_variance: Vec<f64> = if options.variance {
-                let prior = prior_variances(&c.evaluator, &zp);
-                (0..ns)
-                    .map(|j| {
-                        let vj = ks.col(j);
-                        let explained: f64 = vj.iter().map(|v| v * v).sum();
-                        // Round-off can make k** − vᵀv slightly negative at training points.
-                        (prior[j] - explained).max(0.0) + noise
-                    })
-                    .collect()
-            } else {
-                Vec::new()
-            };
+            let prior = if options.variance { prior_variances(&c.evaluator, &zp) } else { Vec::new() };
+            let latent_variance: Vec<f64> = (0..prior.len())
+                .map(|j| {
+                    let vj = ks.col(j);
+                    let explained: f64 = vj.iter().map(|v| v * v).sum();
+                    // Round-off can make k** − vᵀv slightly negative at training points.
+                    (prior[j] - explained).max(0.0) + noise
+                })
+                .collect();
             let latent_covariance = options.full_covariance.then(|| {
                 // K** − VᵀV (R&W Eq. 2.26).
                 let mut cov = full_covariance(&c.evaluator, &zp, self.parallelism);
@@ -100,8 +101,9 @@ impl ExactGp {
                     mean[(i, out)] = f[(i, k)] * s + mu;
                 }
                 if options.variance {
-                    for (i, v) in latent_variance.iter().enumerate() {
+                    for (i, (v, p)) in latent_variance.iter().zip(&prior).enumerate() {
                         variance[(i, out)] = v * s * s;
+                        prior_variance[(i, out)] = p * s * s;
                     }
                 }
                 if let Some(cov) = &latent_covariance {
@@ -109,6 +111,6 @@ impl ExactGp {
                 }
             }
         }
-        Ok(Prediction { mean, variance, covariance })
+        Ok(Prediction { mean, variance, covariance, prior_variance })
     }
 }

@@ -333,6 +333,7 @@ impl SparseGp {
         let (ns, m) = (z.len(), self.output_count());
         let mut mean = Mat::zeros(ns, m);
         let mut variance = if options.variance { Mat::zeros(ns, m) } else { Mat::zeros(0, 0) };
+        let mut prior_variance = variance.clone();
         let mut covariance = if options.full_covariance { vec![Mat::zeros(0, 0); m] } else { Vec::new() };
         for c in &self.components {
             let post = &c.posterior;
@@ -354,18 +355,14 @@ impl SparseGp {
                     b = a.clone();
                     post.l_b.solve_lower_in_place(b.as_mut(), par);
                 }
-                let latent_variance: Vec<f64> = if options.variance {
-                    let prior = prior_variances(&post.evaluator, &zp);
-                    (0..nc)
-                        .map(|j| {
-                            let qa: f64 = a.col(j).iter().map(|v| v * v).sum();
-                            let qb: f64 = b.col(j).iter().map(|v| v * v).sum();
-                            (prior[j] - qa + qb).max(0.0) + noise
-                        })
-                        .collect()
-                } else {
-                    Vec::new()
-                };
+                let prior = if options.variance { prior_variances(&post.evaluator, &zp) } else { Vec::new() };
+                let latent_variance: Vec<f64> = (0..prior.len())
+                    .map(|j| {
+                        let qa: f64 = a.col(j).iter().map(|v| v * v).sum();
+                        let qb: f64 = b.col(j).iter().map(|v| v * v).sum();
+                        (prior[j] - qa + qb).max(0.0) + noise
+                    })
+                    .collect();
                 let latent_covariance = options.full_covariance.then(|| {
                     let mut cov = full_covariance(&post.evaluator, &zp, self.parallelism);
                     product(cov.as_mut(), Accum::Add, a.transpose(), a.as_ref(), -1.0, par);
@@ -380,8 +377,9 @@ impl SparseGp {
                     for i in 0..nc {
                         mean[(r.start + i, out)] = f[(i, k)] * s + mu;
                     }
-                    for (i, v) in latent_variance.iter().enumerate() {
+                    for (i, (v, p)) in latent_variance.iter().zip(&prior).enumerate() {
                         variance[(r.start + i, out)] = v * s * s;
+                        prior_variance[(r.start + i, out)] = p * s * s;
                     }
                     if let Some(cov) = &latent_covariance {
                         covariance[out] = Mat::from_fn(nc, nc, |i, j| cov[(i, j)] * s * s);
@@ -389,7 +387,7 @@ impl SparseGp {
                 }
             }
         }
-        Ok(Prediction { mean, variance, covariance })
+        Ok(Prediction { mean, variance, covariance, prior_variance })
     }
 }
 

@@ -81,3 +81,28 @@ fn full_covariance_diagonal_equals_the_variance_and_is_symmetric() {
         }
     }
 }
+
+#[test]
+fn the_prior_variance_bounds_the_posterior_and_is_reached_far_from_the_data() {
+    let (n, d) = (30, 2);
+    let mut r = rng(4);
+    let x = uniform_points(&mut r, n, d, -3.0, 3.0);
+    let y = Mat::from_fn(n, 1, |i, _| 40.0 * x[(i, 0)].sin() * x[(i, 1)].cos() + 7.0);
+    for kernel in kernels(d).into_iter().skip(1) {
+        let model = ExactGp::fit_fixed(x.as_ref(), y.as_ref(), std::slice::from_ref(&kernel), &GpConfig::default())
+            .expect("fit");
+        let queries = Mat::from_fn(3, d, |i, c| if i == 0 { x[(0, c)] } else { [0.5, 40.0][i - 1] * (c as f64 + 1.0) });
+        let p = model.predict(queries.as_ref()).expect("predict");
+        assert_eq!((p.prior_variance.nrows(), p.prior_variance.ncols()), (3, 1));
+        // A stationary kernel's prior variance is the same everywhere.
+        let prior = p.prior_variance[(0, 0)];
+        assert!(prior > 0.0 && (p.prior_variance[(2, 0)] - prior).abs() < 1e-12 * prior, "{kernel:?}");
+        // At a training point the data explain nearly all of it; between them some; far away none.
+        let ratio = |i: usize| p.variance[(i, 0)] / p.prior_variance[(i, 0)];
+        assert!(ratio(0) < 1e-6 && ratio(1) < 1.0 && (ratio(2) - 1.0).abs() < 1e-9, "{kernel:?}: {:?}", [0, 1, 2].map(ratio));
+    }
+    // Without the variance, no prior variance either.
+    let model = ExactGp::fit_fixed(x.as_ref(), y.as_ref(), &kernels(d)[1..2], &GpConfig::default()).expect("fit");
+    let options = PredictOptions { variance: false, full_covariance: false, include_noise: false };
+    assert_eq!(model.predict_with(x.as_ref(), &options).expect("predict").prior_variance.nrows(), 0);
+}

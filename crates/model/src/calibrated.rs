@@ -250,6 +250,67 @@ impl std::fmt::Display for SigmaFallback {
     }
 }
 
+/// Rows at which the GP's posterior keeps so much of its prior variance that its correction fades
+/// toward the geometry ([`crate::ResidualGpOptions::fade_above_variance_ratio`]): the training rows
+/// say little of them, and the GP's mean there would be its prior's extrapolation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GpFade {
+    /// How many rows fade, in part or fully.
+    pub rows: usize,
+    /// How many of them fully (no GP correction).
+    pub fully: usize,
+    /// How many rows there are.
+    pub of_rows: usize,
+    /// The file line of the first.
+    pub first_line: u64,
+    /// The share of the prior variance (beyond the training rows', as a fraction of what they
+    /// leave unexplained) above which the correction fades.
+    pub fade_above: f64,
+    /// The largest share the posterior keeps among these rows.
+    pub largest_share: f64,
+}
+
+impl GpFade {
+    /// The rows whose weight (of [`crate::ResidualGp::weights`]) is below 1; `None` if none.
+    pub fn of(rows: &[Measurement], weights: &[(f64, f64)], fade_above: f64) -> Option<Self> {
+        let mut faded: Option<GpFade> = None;
+        for (row, &(weight, share)) in rows.iter().zip(weights) {
+            if weight < 1.0 {
+                let entry = faded.get_or_insert(GpFade {
+                    rows: 0,
+                    fully: 0,
+                    of_rows: rows.len(),
+                    first_line: row.line,
+                    fade_above,
+                    largest_share: 0.0,
+                });
+                entry.rows += 1;
+                entry.fully += usize::from(weight == 0.0);
+                entry.largest_share = entry.largest_share.max(share);
+            }
+        }
+        faded
+    }
+}
+
+impl std::fmt::Display for GpFade {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} of {} rows (the first at line {}) lie where the GP's training rows say little: its posterior keeps \
+             up to {:.0} % of its prior variance there, above the {:.0} % from which its correction fades, so there \
+             the model falls back toward the geometry ({} fully, {} blended; the σ counts what it no longer corrects)",
+            self.rows,
+            self.of_rows,
+            self.first_line,
+            self.largest_share * 100.0,
+            self.fade_above * 100.0,
+            self.fully,
+            self.rows - self.fully
+        )
+    }
+}
+
 /// Rows at which an effect of the model is used outside the joint angles it was fitted on: there
 /// the model extrapolates, and its error on them is not what the fit measured.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -339,6 +400,14 @@ impl CalibratedModel {
             return Ok(None);
         };
         Ok(SigmaFallback::of(data.rows(), &weights, uncertainty))
+    }
+
+    /// The rows of `rows` at which the GP's correction fades ([`GpFade`]); `None` when there are
+    /// none or the model has no GP that fades.
+    pub fn gp_fade(&self, rows: &[Measurement]) -> Result<Option<GpFade>, Error> {
+        let Some(gp) = &self.residual_gp else { return Ok(None) };
+        let Some(fade) = gp.fade else { return Ok(None) };
+        Ok(GpFade::of(rows, &gp.weights(rows)?, fade.above))
     }
 
     /// Whether any effect records the joint angles it was fitted on.

@@ -66,6 +66,10 @@ pub struct EvalReport {
     /// geometry fitted alone ([`crate::SigmaFallback`]); `None` where there are none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sigma_fallback: Option<crate::SigmaFallback>,
+    /// Rows at which the GP's correction fades toward the geometry ([`crate::GpFade`]); `None`
+    /// where there are none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gp_fade: Option<crate::GpFade>,
     /// Revolute joints whose angles some rows had wrapped by whole turns into the range the model
     /// was fitted on before it was applied ([`crate::wrapped`], as `calib register` does); empty
     /// where none was (and left out of the JSON).
@@ -130,6 +134,8 @@ impl EvalReport {
                 .filter(|split| split.outside.n > 0),
             suspect_rows: suspects(model, data, evaluation, &held),
             sigma_fallback,
+            // The evaluation has predicted the same rows with the same GP: it cannot fail here.
+            gp_fade: model.gp_fade(&data.rows).ok().flatten(),
             wrapped: Vec::new(),
         }
     }

@@ -57,7 +57,7 @@ mod wrap;
 pub use evaluate::{Evaluation, evaluate};
 pub use predictions::write_predictions;
 
-pub use calibrated::{CalibratedModel, ExtrapolationWarning, PredictedPose, SigmaFallback};
+pub use calibrated::{CalibratedModel, ExtrapolationWarning, GpFade, PredictedPose, SigmaFallback};
 pub use effect_sigma::EffectUncertainty;
 pub use eval_report::{CoverageSplit, EvalReport, ORIENTATIONS_NOT_EVALUATED};
 pub use heldout::{HeldoutEstimate, HeldoutSource};
@@ -68,7 +68,7 @@ pub use model_file::{SCHEMA_VERSION, model_text, parse_model, read_model, write_
 pub use model_parts::Part;
 pub use repeats::{HeldoutOptions, RepeatGroups};
 pub use residual_gp::{
-    GpChoice, GpFitReport, GpModel, ResidualFrame, ResidualGp, ResidualGpOptions, ResidualGpReport, ResidualSet,
+    GpChoice, GpFadeRule, GpFitReport, GpModel, ResidualFrame, gp_weight, ResidualGp, ResidualGpOptions, ResidualGpReport, ResidualSet,
     UnknownGpChoice,
 };
 pub use suspect_rows::{SuspectRows, suspect_rows};

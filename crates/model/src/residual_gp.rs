@@ -107,6 +107,14 @@ pub struct ResidualGpOptions {
     /// from the position output kernel that explains them best ([`gp::GpConfig::follower_groups`]),
     /// instead of three searches of their own; the position outputs are fitted as `gp` says.
     pub rotation_follows_position: bool,
+    /// Where the GP knows little of a row, its correction fades out and the model falls back to
+    /// the geometry (issue 23): with `s` the share of the GP's prior variance of the position
+    /// outputs that its posterior keeps at the row, measured from what it keeps at its training
+    /// rows ([`GpFadeRule`]: 0 at a typical training row, 1 where the training rows say nothing
+    /// of it), the correction applies in full while `s` is at most this value and fades linearly
+    /// to none at `s = 1`. `None`: never fades (the GP's posterior mean everywhere, as before).
+    /// Within `[0, 1)`.
+    pub fade_above_variance_ratio: Option<f64>,
 }
 
 impl Default for ResidualGpOptions {
@@ -191,6 +199,30 @@ impl Default for ResidualGpOptions {
             // rotation kernel cut the GP's CPU time from 25.9 to 17.5 s but made the held-out
             // rotation error 22 % worse (0.302 → 0.368 mrad); accuracy first.
             rotation_follows_position: false,
+            // One half: where the posterior keeps more than half of the prior variance, the
+            // prediction is more the prior's extrapolation than the data's. On the UR10 (issue 23,
+            // full pose, `poe-gp`, release; docs/results/splits.md) the GP fitted on all of series
+            // C meets series B with r = 0.5 … 1 on every row but one, and corrected B's rows to
+            // 1.467 mm against the geometry's 1.421; faded from one half, 1.428. On B's own splits
+            // the GP's extrapolation past the end of a joint's range helped, and fading from one
+            // half cost 0.2–3.6 % there (j1-end 0.314 → 0.315, j3-end 0.390 → 0.392, elbow
+            // − → + 0.794 → 0.823) and gained 0.5 % in a gap (j2-gap 0.332 → 0.331); from three
+            // quarters C → B stayed 1.456 (1.024× the geometry). Fading each output by its own
+            // ratio instead cost up to 8 % on B's splits.
+            fade_above_variance_ratio: Some(0.5),
+        }
+    }
+}
+
+impl ResidualGpOptions {
+    /// The first option outside its range: its name and a message.
+    pub fn validate_fade(&self) -> Result<(), (&'static str, String)> {
+        match self.fade_above_variance_ratio {
+            Some(r) if !(0.0..1.0).contains(&r) => Err((
+                "fade_above_variance_ratio",
+                format!("residual_gp.fade_above_variance_ratio is {r}, expected a number in [0, 1) or None"),
+            )),
+            _ => Ok(()),
         }
     }
 }
@@ -438,6 +470,72 @@ pub struct ResidualGp {
     /// older files (there the GP applies to the blended pose).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fallback: Option<GpModel>,
+    /// Where the GP's correction fades ([`ResidualGpOptions::fade_above_variance_ratio`]), as
+    /// fitted. Absent in older files and where the options turn it off: it never fades there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fade: Option<GpFadeRule>,
+}
+
+/// Where a GP's correction fades: from the share `r` of its prior variance (of the position
+/// outputs, pooled) its posterior keeps at a row, measured from what it keeps at its own training
+/// rows, `s = (r − t) / (1 − t)` (0 at a typical training row, 1 where the training rows say
+/// nothing), the correction applies in full while `s` is at most [`GpFadeRule::above`] and
+/// fades linearly to none at `s = 1`. From the training rows' share, not from 0: a GP whose
+/// signal is weak beside its noise keeps much of its prior variance even at its training rows
+/// (UR10 B, what the effects leave: more than half at 478 of 747 interleaved held-out rows), and
+/// there its small mean is the data's, not an extrapolation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GpFadeRule {
+    /// [`ResidualGpOptions::fade_above_variance_ratio`].
+    pub above: f64,
+    /// The median share `t` of the GP's prior variance its posterior keeps at its training rows.
+    pub training_share: f64,
+    /// The same for the [`ResidualGp::fallback`] GP, where there is one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback_training_share: Option<f64>,
+}
+
+impl GpFadeRule {
+    /// The training share of the GP (`fallback`: of the fallback GP; the GP's where a file
+    /// lacks it).
+    pub fn training_share_of(&self, fallback: bool) -> f64 {
+        if fallback { self.fallback_training_share.unwrap_or(self.training_share) } else { self.training_share }
+    }
+
+    /// The weight of the correction at a row where the posterior keeps the share `ratio` of the
+    /// prior variance, for a GP whose training rows keep `training_share`.
+    pub fn weight(&self, ratio: f64, training_share: f64) -> f64 {
+        let t = training_share.clamp(0.0, 1.0);
+        let s = if t < 1.0 { ((ratio - t) / (1.0 - t)).max(0.0) } else { 0.0 };
+        gp_weight(Some(self.above), s)
+    }
+}
+
+/// The median over the rows of `x` of the share of its prior variance `gp`'s posterior keeps.
+fn median_share(gp: &GpModel, x: &Mat<f64>) -> Result<f64, Error> {
+    let prediction = gp.predict(x.as_ref()).map_err(Error::gp)?;
+    let mut shares: Vec<f64> = (0..x.nrows()).map(|i| kept_share(&prediction, i)).collect();
+    shares.sort_by(f64::total_cmp);
+    Ok(shares.get(shares.len() / 2).copied().unwrap_or(0.0))
+}
+
+/// How far the GP's correction applies at a row: 1 in full, 0 not at all (the geometry), from the
+/// share `r` of its prior variance the posterior keeps there.
+pub fn gp_weight(fade_above: Option<f64>, ratio: f64) -> f64 {
+    match fade_above {
+        Some(r0) if ratio > r0 => ((1.0 - ratio) / (1.0 - r0)).clamp(0.0, 1.0),
+        _ => 1.0,
+    }
+}
+
+/// The share of the prior variance of the position outputs (the first three) the posterior keeps
+/// at row `i`, pooled over them; 0 where the prior has none.
+fn kept_share(prediction: &gp::Prediction, i: usize) -> f64 {
+    let outputs = prediction.mean.ncols().min(3);
+    let kept: f64 = (0..outputs).map(|c| prediction.variance[(i, c)].max(0.0)).sum();
+    let prior: f64 = (0..outputs).map(|c| prediction.prior_variance[(i, c)]).sum();
+    if prior > 0.0 { (kept / prior).min(1.0) } else { 0.0 }
 }
 
 /// What the GP stage reports.
@@ -573,6 +671,10 @@ impl ResidualGp {
                 (GpModel::Exact(model), report, Some(loo.mean), grouped)
             }
         };
+        let fade = match options.fade_above_variance_ratio {
+            Some(above) => Some(GpFadeRule { above, training_share: median_share(&gp, &x)?, fallback_training_share: None }),
+            None => None,
+        };
         let residual_gp = Self {
             with_payload,
             full_pose: data.full_pose,
@@ -581,6 +683,7 @@ impl ResidualGp {
             moved_by: None,
             tool_points: Vec::new(),
             fallback: None,
+            fade,
         };
         let summary = |mean: Mat<f64>| {
             let errors: Vec<crate::PoseError> = poses
@@ -651,13 +754,13 @@ impl ResidualGp {
     /// deviation of each error component `(v, ω)` (m, rad; zeros where not modelled). Each row's
     /// model tool in `data` picks its tool point ([`ResidualGp::tool_points`]).
     pub fn predict(&self, data: &BoundSet<'_>, model_poses: &[SE3]) -> Result<Vec<Correction>, Error> {
-        self.predict_with(&self.gp, data, model_poses)
+        self.predict_with(&self.gp, false, data, model_poses)
     }
 
     /// [`ResidualGp::predict`] with the [`ResidualGp::fallback`] GP at the poses of the geometry
     /// fitted alone; `None` where the model has none.
     pub fn predict_fallback(&self, data: &BoundSet<'_>, alone_poses: &[SE3]) -> Option<Result<Vec<Correction>, Error>> {
-        self.fallback.as_ref().map(|gp| self.predict_with(gp, data, alone_poses))
+        self.fallback.as_ref().map(|gp| self.predict_with(gp, true, data, alone_poses))
     }
 
     /// Fits [`ResidualGp::fallback`]: an exact GP, searched as this one was, on the error that
@@ -678,11 +781,40 @@ impl ResidualGp {
         }
         let ResidualSet { inputs: x, outputs: y } =
             ResidualSet::new(alone_poses, data, self.with_payload, self.residual_frame);
-        self.fallback = Some(GpModel::Exact(exact_fit(&x, &y, data.full_pose, options)?));
+        let fallback = GpModel::Exact(exact_fit(&x, &y, data.full_pose, options)?);
+        if let Some(fade) = &mut self.fade {
+            fade.fallback_training_share = Some(median_share(&fallback, &x)?);
+        }
+        self.fallback = Some(fallback);
         Ok(())
     }
 
-    fn predict_with(&self, gp: &GpModel, data: &BoundSet<'_>, model_poses: &[SE3]) -> Result<Vec<Correction>, Error> {
+    /// How far the GP's correction applies at each row of `rows` ([`gp_weight`]), and the share
+    /// of its prior variance the posterior keeps there: of the GP, and with a
+    /// [`ResidualGp::fallback`] the smaller of the two weights.
+    pub fn weights(&self, rows: &[Measurement]) -> Result<Vec<(f64, f64)>, Error> {
+        let x = inputs(rows, self.with_payload);
+        let mut out = vec![(1.0, 0.0); rows.len()];
+        for (gp, fallback) in std::iter::once((&self.gp, false)).chain(self.fallback.iter().map(|f| (f, true))) {
+            let prediction = gp.predict(x.as_ref()).map_err(Error::gp)?;
+            for (i, slot) in out.iter_mut().enumerate() {
+                let share = kept_share(&prediction, i);
+                let w = self.fade.map_or(1.0, |fade| fade.weight(share, fade.training_share_of(fallback)));
+                if w < slot.0 || (w == slot.0 && share > slot.1) {
+                    *slot = (w, share);
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    fn predict_with(
+        &self,
+        gp: &GpModel,
+        fallback: bool,
+        data: &BoundSet<'_>,
+        model_poses: &[SE3],
+    ) -> Result<Vec<Correction>, Error> {
         let tools = data.tools();
         let prediction = gp.predict(inputs(data.rows(), self.with_payload).as_ref()).map_err(Error::gp)?;
         let outputs = prediction.mean.ncols();
@@ -690,11 +822,16 @@ impl ResidualGp {
             .iter()
             .enumerate()
             .map(|(i, pose)| {
+                // Where the GP knows little, its correction fades (weight w); what it no longer
+                // corrects joins its σ: E[(f − w m)²] = σ² + ((1 − w) m)².
+                let share = kept_share(&prediction, i);
+                let w = self.fade.map_or(1.0, |fade| fade.weight(share, fade.training_share_of(fallback)));
                 let mut g = Vector6::zeros();
                 let mut std = [0.0; 6];
                 for c in 0..outputs {
-                    g[c] = prediction.mean[(i, c)];
-                    std[c] = prediction.variance[(i, c)].max(0.0).sqrt();
+                    let (m, v) = (prediction.mean[(i, c)], prediction.variance[(i, c)].max(0.0));
+                    g[c] = w * m;
+                    std[c] = (v + ((1.0 - w) * m).powi(2)).sqrt();
                 }
                 if let Some(moved) = self.moved_by {
                     (g, std) = self.carried(&moved, &g, &std);
@@ -703,5 +840,20 @@ impl ResidualGp {
                 (self.correction_about(pose, &g, point), std)
             })
             .collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::gp_weight;
+
+    #[test]
+    fn the_gp_weight_is_whole_up_to_the_ratio_and_falls_linearly_to_none_where_the_data_say_nothing() {
+        assert_eq!(gp_weight(None, 1.0), 1.0);
+        assert_eq!(gp_weight(Some(0.5), 0.0), 1.0);
+        assert_eq!(gp_weight(Some(0.5), 0.5), 1.0);
+        assert!((gp_weight(Some(0.5), 0.75) - 0.5).abs() < 1e-15);
+        assert_eq!(gp_weight(Some(0.5), 1.0), 0.0);
+        assert!((gp_weight(Some(0.0), 0.25) - 0.75).abs() < 1e-15);
     }
 }

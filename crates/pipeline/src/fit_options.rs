@@ -188,6 +188,7 @@ impl FitOptions {
                 format!("min_redundancy is {value}, expected a finite number of at least 1"),
             ));
         }
+        self.residual_gp.validate_fade()?;
         if let Err(gp::Error::InvalidConfig { field, value }) = self.residual_gp.gp.validate() {
             // The field's own name, where the file gives it (`function_tolerance:` for
             // `optimiser.function_tolerance`).
@@ -350,6 +351,19 @@ mod tests {
         assert!(message.contains("fit.ron:2:3") && message.contains("min_cluster_share is 0.9"), "{message}");
         let error = FitOptions::parse("(nominal_prior: (translations_m: [0.0]))", "fit.ron").unwrap_err();
         assert!(error.to_string().contains("translations_m"), "{error}");
+    }
+
+    #[test]
+    fn the_gp_fade_can_be_given_or_turned_off_and_a_ratio_outside_zero_to_one_is_refused_at_its_field() {
+        let options = FitOptions::parse("(compensation: (fade_above_variance_ratio: Some(0.25)))", "fit.ron").unwrap();
+        assert_eq!(options.residual_gp.fade_above_variance_ratio, Some(0.25));
+        let options = FitOptions::parse("(compensation: (fade_above_variance_ratio: None))", "fit.ron").unwrap();
+        assert_eq!(options.residual_gp.fade_above_variance_ratio, None);
+        for bad in ["1.0", "-0.1", "NaN"] {
+            let text = format!("(compensation: (\n  fade_above_variance_ratio: Some({bad})))");
+            let message = FitOptions::parse(&text, "fit.ron").unwrap_err().to_string();
+            assert!(message.contains("fit.ron:2:3") && message.contains("fade_above_variance_ratio is"), "{message}");
+        }
     }
 
     #[test]

@@ -172,3 +172,52 @@ fn repeated_configurations_are_left_out_together_in_the_stored_heldout_estimate(
         );
     }
 }
+
+/// Issue 23: where the GP's training rows say nothing of a pose, its correction fades and the
+/// model is the geometry it was fitted with, with a σ that counts what it no longer corrects; at
+/// the training poses nothing fades.
+#[test]
+fn where_the_gp_knows_nothing_its_correction_fades_to_the_geometry() {
+    let robot = testkit::robot("irb4400.ron");
+    let all = loaded_data(&robot, 200, true, 21);
+    let (model, _) = pipeline::fit(&robot, &all, Method::PoeGp, &FitOptions::default()).unwrap();
+    let gp = model.residual_gp.as_ref().unwrap();
+    let fade = gp.fade.expect("the default options fade");
+    assert_eq!(Some(fade.above), FitOptions::default().residual_gp.fade_above_variance_ratio);
+    assert!((0.0..1.0).contains(&fade.training_share), "{fade:?}");
+    assert!(model.gp_fade(&all.rows).unwrap().is_none(), "no training row fades");
+    // Every joint a whole radian beyond its sampled range: nothing the GP has seen.
+    let mut far = all.subset(&(0..20).collect::<Vec<_>>());
+    let top: Vec<f64> =
+        (0..6).map(|j| all.rows.iter().map(|r| r.q[j]).fold(f64::NEG_INFINITY, f64::max)).collect();
+    for row in &mut far.rows {
+        for (q, top) in row.q.iter_mut().zip(&top) {
+            *q = top + 1.0 + 0.1 * (*q).sin();
+        }
+    }
+    let faded = model.gp_fade(&far.rows).unwrap().expect("the far rows fade");
+    assert_eq!((faded.rows, faded.of_rows), (20, 20), "{faded}");
+    let weights = gp.weights(&far.rows).unwrap();
+    assert!(weights.iter().filter(|(w, _)| *w < 0.05).count() >= 18, "{weights:?}");
+    let predict = |m: &model::CalibratedModel| m.predict(&m.bind(&far).unwrap()).unwrap();
+    let with = predict(&model);
+    let mut geometry = model.clone();
+    geometry.residual_gp = None;
+    let mut never = model.clone();
+    never.residual_gp.as_mut().unwrap().fade = None;
+    let (alone, unfaded) = (predict(&geometry), predict(&never));
+    let gap = |a: &[model::PredictedPose], b: &[model::PredictedPose], i: usize| {
+        (a[i].pose.translation() - b[i].pose.translation()).norm()
+    };
+    let mut moved = 0.0_f64;
+    for i in 0..far.rows.len() {
+        let w = gp.weights(&far.rows[i..=i]).unwrap()[0].0;
+        // The correction scales with the weight: none where it is 0.
+        assert!(gap(&with, &alone, i) <= w * gap(&unfaded, &alone, i) * (1.0 + 1e-3) + 1e-12, "row {i}: weight {w}");
+        moved = moved.max(gap(&unfaded, &alone, i));
+        // What is not corrected is in the σ.
+        let (sigma, sigma_never) = (with[i].std.unwrap(), unfaded[i].std.unwrap());
+        assert!((0..3).all(|k| sigma[k] >= sigma_never[k] - 1e-15), "row {i}: {sigma:?} {sigma_never:?}");
+    }
+    assert!(moved > 1e-7, "without the fade the GP moves the far poses: {moved} m (the test is not vacuous)");
+}
