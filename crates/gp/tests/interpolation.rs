@@ -99,7 +99,11 @@ fn the_prior_variance_bounds_the_posterior_and_is_reached_far_from_the_data() {
         assert!(prior > 0.0 && (p.prior_variance[(2, 0)] - prior).abs() < 1e-12 * prior, "{kernel:?}");
         // At a training point the data explain nearly all of it; between them some; far away none.
         let ratio = |i: usize| p.variance[(i, 0)] / p.prior_variance[(i, 0)];
-        assert!(ratio(0) < 1e-6 && ratio(1) < 1.0 && (ratio(2) - 1.0).abs() < 1e-9, "{kernel:?}: {:?}", [0, 1, 2].map(ratio));
+        assert!(
+            ratio(0) < 1e-6 && ratio(1) < 1.0 && (ratio(2) - 1.0).abs() < 1e-9,
+            "{kernel:?}: {:?}",
+            [0, 1, 2].map(ratio)
+        );
     }
     // Without the variance, no prior variance either.
     let model = ExactGp::fit_fixed(x.as_ref(), y.as_ref(), &kernels(d)[1..2], &GpConfig::default()).expect("fit");

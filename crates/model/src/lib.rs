@@ -68,8 +68,8 @@ pub use model_file::{SCHEMA_VERSION, model_text, parse_model, read_model, write_
 pub use model_parts::Part;
 pub use repeats::{HeldoutOptions, RepeatGroups};
 pub use residual_gp::{
-    GpChoice, GpFadeRule, GpFitReport, GpModel, ResidualFrame, gp_weight, ResidualGp, ResidualGpOptions, ResidualGpReport, ResidualSet,
-    UnknownGpChoice,
+    GpChoice, GpFadeRule, GpFitReport, GpModel, ResidualFrame, ResidualGp, ResidualGpOptions, ResidualGpReport,
+    ResidualSet, UnknownGpChoice, gp_weight,
 };
 pub use suspect_rows::{SuspectRows, suspect_rows};
 pub use training_range::{OutOfRangeWarning, TrainingRange};

@@ -489,7 +489,8 @@ pub struct ResidualGp {
 pub struct GpFadeRule {
     /// [`ResidualGpOptions::fade_above_variance_ratio`].
     pub above: f64,
-    /// The median share `t` of the GP's prior variance its posterior keeps at its training rows.
+    /// The median share `t` of the GP's prior variance its posterior keeps at its training rows,
+    /// each left out of it.
     pub training_share: f64,
     /// The same for the [`ResidualGp::fallback`] GP, where there is one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -512,9 +513,25 @@ impl GpFadeRule {
     }
 }
 
-/// The median over the rows of `x` of the share of its prior variance `gp`'s posterior keeps.
+/// The median over the training rows `x` of the share of its prior variance `gp`'s posterior
+/// keeps at a row it has not seen there: for the exact GP, each row left out of it (R&W
+/// Eq. 5.12, the noise taken off: a row's own noisy value would count as knowledge of its
+/// neighbours, and a held-out pose between two training poses has none); for the sparse GP, which
+/// has no closed form, at the row itself.
 fn median_share(gp: &GpModel, x: &Mat<f64>) -> Result<f64, Error> {
-    let prediction = gp.predict(x.as_ref()).map_err(Error::gp)?;
+    let mut prediction = gp.predict(x.as_ref()).map_err(Error::gp)?;
+    if let GpModel::Exact(exact) = gp {
+        let loo = exact.leave_one_out().map_err(Error::gp)?;
+        let scale = &exact.output_normaliser().scale;
+        for component in &exact.report().components {
+            let noise = component.kernel.noise_variance();
+            for &out in &component.outputs {
+                for i in 0..x.nrows() {
+                    prediction.variance[(i, out)] = loo.variance[(i, out)] - noise * scale[out] * scale[out];
+                }
+            }
+        }
+    }
     let mut shares: Vec<f64> = (0..x.nrows()).map(|i| kept_share(&prediction, i)).collect();
     shares.sort_by(f64::total_cmp);
     Ok(shares.get(shares.len() / 2).copied().unwrap_or(0.0))
@@ -672,7 +689,9 @@ impl ResidualGp {
             }
         };
         let fade = match options.fade_above_variance_ratio {
-            Some(above) => Some(GpFadeRule { above, training_share: median_share(&gp, &x)?, fallback_training_share: None }),
+            Some(above) => {
+                Some(GpFadeRule { above, training_share: median_share(&gp, &x)?, fallback_training_share: None })
+            }
             None => None,
         };
         let residual_gp = Self {

@@ -188,8 +188,7 @@ fn where_the_gp_knows_nothing_its_correction_fades_to_the_geometry() {
     assert!(model.gp_fade(&all.rows).unwrap().is_none(), "no training row fades");
     // Every joint a whole radian beyond its sampled range: nothing the GP has seen.
     let mut far = all.subset(&(0..20).collect::<Vec<_>>());
-    let top: Vec<f64> =
-        (0..6).map(|j| all.rows.iter().map(|r| r.q[j]).fold(f64::NEG_INFINITY, f64::max)).collect();
+    let top: Vec<f64> = (0..6).map(|j| all.rows.iter().map(|r| r.q[j]).fold(f64::NEG_INFINITY, f64::max)).collect();
     for row in &mut far.rows {
         for (q, top) in row.q.iter_mut().zip(&top) {
             *q = top + 1.0 + 0.1 * (*q).sin();
