@@ -207,3 +207,55 @@ def test_a_saved_model_predicts_as_the_fitted_one(robot, campaign, tmp_path):
     assert model.predict(q[0])[0].shape == (1, 7)
     with pytest.raises(ValueError, match="joints"):
         model.predict(q[:, :5])
+
+
+def test_angles_a_turn_away_are_wrapped_as_the_cli_wraps_them(cli, tmp_path):
+    """A UR10's joints turn ±360°: rows one turn beyond the fitted range are the same link
+    positions, and `calib predict` and `eval` apply the model at the wrapped angles. The package
+    must give the same numbers, not the GP's (or the effects') answer at angles never fitted."""
+    from conftest import ROOT
+
+    ur10 = ROOT / "fixtures" / "robots" / "ur10.ron"
+    effects = tmp_path / "effects.ron"
+    effects.write_text("(tracker_noise: Some(()))")
+    whole = tmp_path / "whole.csv"
+    cli.run("simulate", "--robot", ur10, "--rows", "300", "--seed", "3", "--full-pose", "--effects", effects,
+            "--out", whole)
+    header, *rows = whole.read_text().splitlines(keepends=True)
+    q1 = [float(r.split(",")[0]) for r in rows]
+    # Trained on joint 1 within ±180°; tested on the rest of those rows' kind, a turn away.
+    inside = [r for r, q in zip(rows, q1) if abs(q) <= np.pi]
+    train, test = tmp_path / "train.csv", tmp_path / "test.csv"
+    assert len(inside) > 130, len(inside)
+    train.write_text(header + "".join(inside[:100]))
+    fitted = [float(r.split(",")[0]) for r in inside[:100]]
+    shifted = []
+    for r in inside[100:]:
+        first, rest = r.split(",", 1)
+        q = float(first)
+        if not min(fitted) <= q <= max(fitted):
+            continue  # a turn away and outside the fitted range either way: not wrapped
+        shifted.append(f"{q + 2 * np.pi if q < 0 else q - 2 * np.pi!r},{rest}")
+    assert len(shifted) > 20, len(shifted)
+    test.write_text(header + "".join(shifted))
+    path = tmp_path / "m.ron"
+    cli.run("fit", "--robot", ur10, "--data", train, "--method", "poe-gp", "--out", path)
+    printed = list(csv.DictReader(io.StringIO(cli.run("predict", "--model", path, "--data", test).stdout)))
+    model = calib.Model.load(path)
+    data = calib.Measurements.read(test)
+    with pytest.warns(UserWarning, match="modulo 2π"):
+        poses, _ = model.predict(data.q)
+    keys = ["x_mm", "y_mm", "z_mm"]
+    np.testing.assert_allclose(poses[:, :3], [[float(r[k]) for k in keys] for r in printed], rtol=0, atol=5.1e-7)
+    with pytest.warns(UserWarning, match="modulo 2π"):
+        from_set, _ = model.predict(data)
+    np.testing.assert_array_equal(from_set, poses)
+    # The same link positions: the prediction at the angles a turn back.
+    back = data.q.copy()
+    back[:, 0] = np.where(back[:, 0] > 0, back[:, 0] - 2 * np.pi, back[:, 0] + 2 * np.pi)
+    unwrapped, _ = model.predict(back)
+    np.testing.assert_allclose(poses[:, :3], unwrapped[:, :3], rtol=0, atol=1e-6)
+    theirs = cli.json("eval", "--model", path, "--data", test, "--json")
+    with pytest.warns(UserWarning, match="modulo 2π"):
+        report = model.eval(test)
+    assert report.as_dict() == theirs and theirs["wrapped"][0]["joint"] == 1

@@ -145,12 +145,15 @@ impl Model {
         py: Python<'py>,
         data: &Measurements,
     ) -> PyResult<(String, Bound<'py, PyArray1<f64>>, Option<Bound<'py, PyArray1<f64>>>, Vec<String>)> {
-        let (model, set) = (&self.model, &data.set);
+        let model = &self.model;
+        // Angles a turn away from the fitted range are taken into it, as `calib eval` does.
+        let (rows, wrapped) = model::wrapped(model, &data.set.rows);
+        let set = &measurements::MeasurementSet { rows, ..data.set.clone() };
         let (evaluation, report) = py
             .detach(|| {
                 let bound = model.bind(set)?;
                 let evaluation = model::evaluate(model, &bound)?;
-                let report = EvalReport::new(model, &bound, &evaluation);
+                let report = EvalReport { wrapped, ..EvalReport::new(model, &bound, &evaluation) };
                 Ok::<_, errors::Error>((evaluation, report))
             })
             .map_err(to_py)?;
@@ -158,13 +161,15 @@ impl Model {
         if let Some((row, _)) = set.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
             return Err(crate::error::CalibError::new_err(non_finite(&self.name, &set.source, row.line)));
         }
-        let mut warnings = Vec::new();
+        let mut warnings: Vec<String> = report.wrapped.iter().map(ToString::to_string).collect();
         if report.orientations_not_evaluated {
             warnings.push(model::ORIENTATIONS_NOT_EVALUATED.to_owned());
         }
         warnings.extend(report.warnings.iter().map(ToString::to_string));
         warnings.extend(report.out_of_range.iter().map(ToString::to_string));
         warnings.extend(report.beyond_joint_limits.iter().map(ToString::to_string));
+        warnings.extend(report.sigma_fallback.iter().map(ToString::to_string));
+        warnings.extend(report.gp_fade.iter().map(ToString::to_string));
         let json = serde_json::to_string(&report).map_err(|e| argument("report", e))?;
         let position = PyArray1::from_vec(py, evaluation.errors.iter().map(|e| e.position_mm).collect());
         let rotation: Option<Vec<f64>> = evaluation.errors.iter().map(|e| e.rotation_mrad).collect();
@@ -173,9 +178,10 @@ impl Model {
 
     /// `calib predict` on a measurement set (tools matched by name, as the CLI matches them).
     fn predict_set<'py>(&self, py: Python<'py>, data: &Measurements) -> PyResult<Predicted<'py>> {
-        let (model, set) = (&self.model, &data.set);
-        let bound = model.bind(set).map_err(to_py)?;
-        self.predict_rows(py, &bound)
+        let (rows, wrapped) = model::wrapped(&self.model, &data.set.rows);
+        let set = measurements::MeasurementSet { rows, ..data.set.clone() };
+        let bound = self.model.bind(&set).map_err(to_py)?;
+        self.predict_rows(py, &bound, &wrapped)
     }
 
     /// `calib predict` on arrays: `q` `(n, joints)` rad (m), and per row `payload_kg`, the tool
@@ -248,8 +254,10 @@ impl Model {
                 torques_nm: torques.as_ref().map(|t| t.row(i).to_vec()),
             });
         }
+        // Angles a turn away from the fitted range are taken into it, as `calib predict` does.
+        let (rows, wrapped) = model::wrapped(&self.model, &rows);
         // Made here, each row's tool the model's index found above.
-        self.predict_rows(py, &BoundSet::made_for_model(source, rows))
+        self.predict_rows(py, &BoundSet::made_for_model(source, rows), &wrapped)
     }
 
     /// `calib compensate`: targets rewritten so that the model reaches what they mean. Returns the
@@ -324,15 +332,24 @@ impl Model {
 impl Model {
     /// The prediction of `rows` as `calib predict` makes it: poses `[x_mm, y_mm, z_mm]` and, for a
     /// full-pose model, `qw, qx, qy, qz`; standard deviations in mm (and mrad); the refusal of a
-    /// non-finite pose; the warnings.
-    fn predict_rows<'py>(&self, py: Python<'py>, data: &BoundSet<'_>) -> PyResult<Predicted<'py>> {
+    /// non-finite pose; the warnings (first the joints `wrapped` into the fitted range, as the
+    /// CLI's notes).
+    fn predict_rows<'py>(
+        &self,
+        py: Python<'py>,
+        data: &BoundSet<'_>,
+        wrapped: &[model::WrappedJoint],
+    ) -> PyResult<Predicted<'py>> {
         let (model, rows, source) = (&self.model, data.rows(), data.set().source.as_str());
         let (predictions, warnings) = py
             .detach(|| {
                 let predictions = model.predict(data)?;
-                let mut warnings: Vec<String> = model.extrapolation(rows).iter().map(ToString::to_string).collect();
+                let mut warnings: Vec<String> = wrapped.iter().map(ToString::to_string).collect();
+                warnings.extend(model.extrapolation(rows).iter().map(ToString::to_string));
                 warnings.extend(model.outside_training_range(rows).iter().map(ToString::to_string));
                 warnings.extend(model.beyond_joint_limits(rows).iter().map(ToString::to_string));
+                warnings.extend(model.sigma_fallback(data)?.iter().map(ToString::to_string));
+                warnings.extend(model.gp_fade(rows)?.iter().map(ToString::to_string));
                 Ok::<_, errors::Error>((predictions, warnings))
             })
             .map_err(to_py)?;
