@@ -70,10 +70,15 @@ impl Report {
         diagnosis: Option<Diagnosis>,
         options: &ReportOptions,
     ) -> Result<Self, errors::Error> {
-        let ReportInputs { model, data, .. } = *inputs;
+        let ReportInputs { model, data: given, .. } = *inputs;
+        // Angles a turn away from the fitted range are taken into it, as `calib eval` does: the
+        // same link positions, and the model's answer where it was fitted. The rows keep the
+        // angles given for display.
+        let (rows, wrapped) = model::wrapped(model, &given.rows);
+        let data = &MeasurementSet { rows, ..given.clone() };
         let bound = model.bind(data)?;
         let evaluation = model::evaluate(model, &bound)?;
-        let eval = EvalReport::new(model, &bound, &evaluation);
+        let eval = EvalReport { wrapped, ..EvalReport::new(model, &bound, &evaluation) };
         let predicted: Vec<[f64; 3]> = model.predict(&bound)?.iter().map(|p| p.pose.translation().into()).collect();
         let before = before_calibration(inputs, &bound, options)?;
         let rows = data
@@ -84,7 +89,7 @@ impl Report {
             .map(|(i, (row, e))| RowError {
                 line: row.line,
                 position_m: row.position.into(),
-                q: row.q.clone(),
+                q: given.rows[i].q.clone(),
                 payload_kg: row.payload_kg,
                 tool: tool_name(data, row.tool),
                 after_mm: e.position_mm,
@@ -95,7 +100,7 @@ impl Report {
             .collect();
         Ok(Self {
             robot: robot_summary(inputs.robot, inputs.robot_file),
-            data: data_summary(data, inputs.robot),
+            data: data_summary(given, inputs.robot),
             training: inputs.training.map(|t| data_summary(t, inputs.robot)),
             model: ModelSummary {
                 method: model.method.to_string(),
