@@ -199,16 +199,17 @@ impl Default for ResidualGpOptions {
             // rotation kernel cut the GP's CPU time from 25.9 to 17.5 s but made the held-out
             // rotation error 22 % worse (0.302 → 0.368 mrad); accuracy first.
             rotation_follows_position: false,
-            // One half: where the posterior keeps more than half of the prior variance, the
-            // prediction is more the prior's extrapolation than the data's. On the UR10 (issue 23,
-            // full pose, `poe-gp`, release; docs/results/splits.md) the GP fitted on all of series
-            // C meets series B with r = 0.5 … 1 on every row but one, and corrected B's rows to
-            // 1.467 mm against the geometry's 1.421; faded from one half, 1.428. On B's own splits
-            // the GP's extrapolation past the end of a joint's range helped, and fading from one
-            // half cost 0.2–3.6 % there (j1-end 0.314 → 0.315, j3-end 0.390 → 0.392, elbow
-            // − → + 0.794 → 0.823) and gained 0.5 % in a gap (j2-gap 0.332 → 0.331); from three
-            // quarters C → B stayed 1.456 (1.024× the geometry). Fading each output by its own
-            // ratio instead cost up to 8 % on B's splits.
+            // One half: where the posterior keeps more than half of the prior variance a training
+            // pose leaves, the prediction is more the prior's extrapolation than the data's. On the
+            // UR10 (issue 23, full pose, release; docs/results/splits.md) the GP fitted on all of
+            // series C meets series B with r = 0.5 … 1 on every row but one, and corrected B's rows
+            // to 1.467 mm against the geometry's 1.421. Replayed offline first (`poe-gp`, share
+            // from 0): fading from one half gave 1.428 and cost 0.2–3.6 % on B's own splits, where
+            // the GP's extrapolation past the end of a joint's range helped (elbow − → + 0.794 →
+            // 0.823); from three quarters C → B stayed 1.456 (1.024× the geometry); each output by
+            // its own share cost up to 8 %. As built (share from the training rows' left-out
+            // share): `poe-gp --effects auto` C → B 1.4334, B even → odd 0.2213 → 0.2214, B's
+            // j3-end, elbow and j2-gap splits within 0.3 %.
             fade_above_variance_ratio: Some(0.5),
         }
     }
@@ -518,10 +519,18 @@ impl GpFadeRule {
 /// Eq. 5.12, the noise taken off: a row's own noisy value would count as knowledge of its
 /// neighbours, and a held-out pose between two training poses has none); for the sparse GP, which
 /// has no closed form, at the row itself.
-fn median_share(gp: &GpModel, x: &Mat<f64>) -> Result<f64, Error> {
+/// `loo`: the exact GP's leave-one-out where the caller has it already.
+fn median_share(gp: &GpModel, x: &Mat<f64>, loo: Option<&gp::LeaveOneOut>) -> Result<f64, Error> {
     let mut prediction = gp.predict(x.as_ref()).map_err(Error::gp)?;
     if let GpModel::Exact(exact) = gp {
-        let loo = exact.leave_one_out().map_err(Error::gp)?;
+        let computed;
+        let loo = match loo {
+            Some(loo) => loo,
+            None => {
+                computed = exact.leave_one_out().map_err(Error::gp)?;
+                &computed
+            }
+        };
         let scale = &exact.output_normaliser().scale;
         for component in &exact.report().components {
             let noise = component.kernel.noise_variance();
@@ -663,7 +672,7 @@ impl ResidualGp {
         repeats: &crate::RepeatGroups,
     ) -> Result<(Self, ResidualGpReport), Error> {
         let ResidualSet { inputs: x, outputs: y } = ResidualSet::new(poses, data, with_payload, options.residual_frame);
-        let (gp, report, leave_one_out, leave_group_out) = match options.choice_for(x.nrows()) {
+        let (gp, report, loo, leave_group_out) = match options.choice_for(x.nrows()) {
             GpChoice::Sparse => {
                 let inducing_points = options.sparse.inducing_points.min(x.nrows());
                 let gp = gp::GpConfig {
@@ -685,13 +694,15 @@ impl ResidualGp {
                 } else {
                     None
                 };
-                (GpModel::Exact(model), report, Some(loo.mean), grouped)
+                (GpModel::Exact(model), report, Some(loo), grouped)
             }
         };
         let fade = match options.fade_above_variance_ratio {
-            Some(above) => {
-                Some(GpFadeRule { above, training_share: median_share(&gp, &x)?, fallback_training_share: None })
-            }
+            Some(above) => Some(GpFadeRule {
+                above,
+                training_share: median_share(&gp, &x, loo.as_ref())?,
+                fallback_training_share: None,
+            }),
             None => None,
         };
         let residual_gp = Self {
@@ -719,7 +730,7 @@ impl ResidualGp {
         };
         let report = ResidualGpReport {
             gp: report,
-            leave_one_out: leave_one_out.map(&summary),
+            leave_one_out: loo.map(|loo| summary(loo.mean)),
             leave_group_out: leave_group_out.map(&summary),
             repeated_rows: repeats.repeated_rows(),
             repeated_configurations: repeats.groups.iter().filter(|g| g.len() > 1).count(),
@@ -802,7 +813,7 @@ impl ResidualGp {
             ResidualSet::new(alone_poses, data, self.with_payload, self.residual_frame);
         let fallback = GpModel::Exact(exact_fit(&x, &y, data.full_pose, options)?);
         if let Some(fade) = &mut self.fade {
-            fade.fallback_training_share = Some(median_share(&fallback, &x)?);
+            fade.fallback_training_share = Some(median_share(&fallback, &x, None)?);
         }
         self.fallback = Some(fallback);
         Ok(())
