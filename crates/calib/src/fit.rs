@@ -64,9 +64,36 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         .with("--data", &args.data)
         .with_optional("--options", args.options.as_deref())
         .check_output("--out", &args.out)?;
-    let robot = args.robot.read()?;
-    let options = ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
-    let data = measurements::read_measurements(&args.data, &options)?;
+    let progress = crate::progress::Progress::on_terminal("fit");
+    let (fitted, timings) = timings::record_with(progress.feed(), || fit_and_write(args));
+    progress.finish();
+    let (robot, data, model, mut report) = fitted?;
+    report.timings = timings.phases;
+    // With --json the report is the one object on stdout and the summary goes to stderr.
+    let mut summary = String::new();
+    summary.push_str(&data.read_summary());
+    summary.push('\n');
+    summarise(&mut summary, args, &robot.name, &data, &model, &report);
+    if args.json {
+        eprint!("{summary}");
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print!("{summary}");
+    }
+    Ok(())
+}
+
+type Fitted = (robot::RobotDescription, measurements::MeasurementSet, model::CalibratedModel, FitReport);
+
+/// The command's work, in the phases its report times: reading, the fit, writing the model.
+fn fit_and_write(args: &Args) -> Result<Fitted, Box<dyn std::error::Error>> {
+    let (robot, data) = timings::phase("read", || -> Result<_, Box<dyn std::error::Error>> {
+        let robot = args.robot.read()?;
+        let options =
+            ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
+        let data = measurements::read_measurements(&args.data, &options)?;
+        Ok((robot, data))
+    })?;
     let mut options = match &args.options {
         Some(path) => FitOptions::read(path)?,
         None => FitOptions::default(),
@@ -84,20 +111,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(choice) = args.gp {
         options.residual_gp.method = choice;
     }
-    let (model, report) = pipeline::fit(&robot, &data, args.method, &options)?;
-    model::write_model(&args.out, &model)?;
-    // With --json the report is the one object on stdout and the summary goes to stderr.
-    let mut summary = String::new();
-    summary.push_str(&data.read_summary());
-    summary.push('\n');
-    summarise(&mut summary, args, &robot.name, &data, &model, &report);
-    if args.json {
-        eprint!("{summary}");
-        println!("{}", serde_json::to_string(&report)?);
-    } else {
-        print!("{summary}");
-    }
-    Ok(())
+    let (model, report) = timings::phase("fit", || pipeline::fit(&robot, &data, args.method, &options))?;
+    timings::phase("write", || model::write_model(&args.out, &model))?;
+    Ok((robot, data, model, report))
 }
 
 fn summarise(
@@ -282,6 +298,19 @@ fn summarise(
     }
     for warning in &report.warnings {
         let _ = writeln!(out, "  warning: {warning}");
+    }
+    // Where a fit of more than a second spent it (every phase is in --json's `timings`).
+    let slow: Vec<String> = report
+        .timings
+        .iter()
+        .filter(|p| p.wall_s >= 1.0)
+        .map(|p| {
+            let calls = if p.calls > 1 { format!(" ({} calls)", p.calls) } else { String::new() };
+            format!("    {}: {:.1} s, {:.1} s CPU{calls}", p.phase, p.wall_s, p.cpu_s)
+        })
+        .collect();
+    if !slow.is_empty() {
+        let _ = writeln!(out, "  time (phases of a second or more):\n{}", slow.join("\n"));
     }
     let _ = writeln!(out, "  wrote {}", args.out.display());
 }

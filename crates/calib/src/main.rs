@@ -8,6 +8,7 @@ mod export;
 mod fit;
 mod plan;
 mod predict;
+mod progress;
 mod register;
 mod report;
 mod robot_args;

@@ -425,10 +425,11 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
         return Err(Error::in_file(data.source.clone(), ErrorKind::TooFewRows { rows: data.rows.len(), needed }));
     }
     let nominal = robot.nominal_model()?;
-    let screened = outliers::screen(&nominal, bound, &options.outliers)?;
+    let screened = timings::phase("outlier screen", || outliers::screen(&nominal, bound, &options.outliers))?;
     let bound = screened.data.as_ref();
     let data = bound.set();
-    let geometry = fit_geometry(&nominal, data, Scope::Full, &IdentificationOptions::default())?;
+    let geometry =
+        timings::phase("geometry", || fit_geometry(&nominal, data, Scope::Full, &IdentificationOptions::default()))?;
     let model = geometry.model;
     let stats = poe::identify::evaluate(&model, &observations(data)).map_err(Error::kinematics)?;
     // Weight each kind of row by its own residual scale, so that neither swamps the other.
@@ -444,7 +445,8 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
         series_sd: options.prior.series_rad,
         inputs: options.candidates,
     };
-    let (candidates, sides) = candidates::build_candidates(robot, &model, bound, &design, &settings)?;
+    let (candidates, sides) =
+        timings::phase("candidates", || candidates::build_candidates(robot, &model, bound, &design, &settings))?;
     let (mut terms, blocks) = terms_of(&candidates, design.kinematic.ncols());
     let fold = fold_assignment(data.rows.len(), folds, options.seed);
     let kinematic_prior = pool::KinematicPrior::new(&nominal, &model, &options.prior);
@@ -452,7 +454,10 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
     // Backlash sides learnt inside each fold: a column per fold and one on every row.
     let candidate_columns: Vec<Vec<usize>> = terms.iter().map(|t| t.columns.clone()).collect();
     let mut side_columns: Vec<Vec<f64>> = Vec::new();
-    for side in learnt_side::learnt_sides(&pool, &design, &model, bound, &candidates, &candidate_columns, &sides)? {
+    let learnt = timings::phase("learnt backlash sides", || {
+        learnt_side::learnt_sides(&pool, &design, &model, bound, &candidates, &candidate_columns, &sides)
+    })?;
+    for side in learnt {
         let mut columns = side.per_fold;
         side_columns.push(side.all.clone());
         columns.push(side.all);
@@ -468,7 +473,7 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
             model: side.model,
         });
     }
-    let mut selection = selection::select(&pool, &terms, &options.selection)?;
+    let mut selection = timings::phase("selection", || selection::select(&pool, &terms, &options.selection))?;
     let arc_inputs = arcs::ArcInputs {
         design: &design,
         kinematic_prior: &kinematic_prior,
@@ -484,7 +489,9 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
     // arcs, weighed (`SelectionOptions::arc_order_weight`).
     let weight = options.selection.arc_order_weight;
     let arc_curves = if weight > 0.0 {
-        arcs::order_curves(&arc_inputs, data, &moving, &terms, &selection, &columns_of)?
+        timings::phase("arc order curves", || {
+            arcs::order_curves(&arc_inputs, data, &moving, &terms, &selection, &columns_of)
+        })?
     } else {
         vec![None; selection.steps.len()]
     };
@@ -512,7 +519,7 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
         order_curves.push(scores);
     }
     let (arcs, arc_folds): (Vec<ArcCheck>, Vec<(usize, Vec<FoldResiduals>)>) =
-        arcs::arc_checks(&arc_inputs, data, &moving, &terms, &selection, &columns_of)?
+        timings::phase("arcs", || arcs::arc_checks(&arc_inputs, data, &moving, &terms, &selection, &columns_of))?
             .into_iter()
             .map(|(check, folds)| {
                 let joint = check.joint;
@@ -539,10 +546,12 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
     let (gp_before, gp_after) = if options.structure.enabled {
         // The two are independent (each deterministic): run side by side, so that their ten fold
         // fits share the threads.
-        let (before, after) = rayon::join(
-            || structure(&selection.baseline.residuals),
-            || (!selection.steps.is_empty()).then(|| structure(&all_selected.residuals)).transpose(),
-        );
+        let (before, after) = timings::phase("structure GP", || {
+            rayon::join(
+                || structure(&selection.baseline.residuals),
+                || (!selection.steps.is_empty()).then(|| structure(&all_selected.residuals)).transpose(),
+            )
+        });
         (Some(before?), after?)
     } else {
         (None, None)

@@ -681,16 +681,18 @@ impl ResidualGp {
                     ..options.gp.clone()
                 };
                 let config = gp::SparseConfig { gp, inducing_points, ..options.sparse.clone() };
-                let model = gp::SparseGp::fit(x.as_ref(), y.as_ref(), &config).map_err(Error::gp)?;
+                let model = timings::phase("search", || gp::SparseGp::fit(x.as_ref(), y.as_ref(), &config))
+                    .map_err(Error::gp)?;
                 let report = GpFitReport::Sparse(model.report().clone());
                 (GpModel::Sparse(model), report, None, None)
             }
             GpChoice::Exact | GpChoice::Auto => {
-                let model = exact_fit(&x, &y, data.full_pose, options)?;
+                let model = timings::phase("search", || exact_fit(&x, &y, data.full_pose, options))?;
                 let report = GpFitReport::Exact(model.report().clone());
-                let loo = model.leave_one_out().map_err(Error::gp)?;
+                let loo = timings::phase("leave-one-out", || model.leave_one_out()).map_err(Error::gp)?;
                 let grouped = if repeats.any() {
-                    Some(model.leave_groups_out(&repeats.groups).map_err(Error::gp)?.mean)
+                    let grouped = timings::phase("leave-group-out", || model.leave_groups_out(&repeats.groups));
+                    Some(grouped.map_err(Error::gp)?.mean)
                 } else {
                     None
                 };
@@ -700,7 +702,7 @@ impl ResidualGp {
         let fade = match options.fade_above_variance_ratio {
             Some(above) => Some(GpFadeRule {
                 above,
-                training_share: median_share(&gp, &x, loo.as_ref())?,
+                training_share: timings::phase("fade share", || median_share(&gp, &x, loo.as_ref()))?,
                 fallback_training_share: None,
             }),
             None => None,
@@ -811,9 +813,9 @@ impl ResidualGp {
         }
         let ResidualSet { inputs: x, outputs: y } =
             ResidualSet::new(alone_poses, data, self.with_payload, self.residual_frame);
-        let fallback = GpModel::Exact(exact_fit(&x, &y, data.full_pose, options)?);
+        let fallback = GpModel::Exact(timings::phase("search", || exact_fit(&x, &y, data.full_pose, options))?);
         if let Some(fade) = &mut self.fade {
-            fade.fallback_training_share = Some(median_share(&fallback, &x, None)?);
+            fade.fallback_training_share = Some(timings::phase("fade share", || median_share(&fallback, &x, None))?);
         }
         self.fallback = Some(fallback);
         Ok(())

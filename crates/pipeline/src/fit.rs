@@ -75,6 +75,11 @@ pub struct FitReport {
     pub outliers: Vec<OutlierLine>,
     /// What the user should know before trusting the numbers above.
     pub warnings: Vec<FitWarning>,
+    /// Wall and CPU seconds per phase, where the caller recorded them ([`timings::record`]
+    /// around the fit: `calib fit` and the Python package do); empty otherwise, and then left
+    /// out of the JSON.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub timings: Vec<timings::PhaseTime>,
 }
 
 /// A fit that ran but deserves caution.
@@ -234,7 +239,7 @@ pub fn fit(
     let bound = BoundSet::to_robot(data, &robot.joint_kinds())?;
     // Before anything is fitted: a unit mistake or a mirrored frame fits as well as the right
     // data (issue 31), so it is refused here, or with `force` reported as a warning.
-    let findings = crate::plausibility::check(robot, &bound, &options.plausibility)?;
+    let findings = timings::phase("plausibility", || crate::plausibility::check(robot, &bound, &options.plausibility))?;
     let mut warnings = Vec::new();
     for refusal in findings.refusals {
         if !options.plausibility.force {
@@ -245,11 +250,15 @@ pub fn fit(
     let nominal = robot.nominal_model()?;
     let scope = if method == Method::BaseTool { Scope::BaseTool } else { Scope::Full };
     let nominal_prior = match scope {
-        Scope::Full => Some(crate::choose_prior(&nominal, data, &options.identification, &options.nominal_prior)?),
+        Scope::Full => Some(timings::phase("prior choice", || {
+            crate::choose_prior(&nominal, data, &options.identification, &options.nominal_prior)
+        })?),
         Scope::BaseTool => None,
     };
     let prior_sigmas = nominal_prior.as_ref().and_then(crate::PriorChoice::chosen);
-    let geometry = fit_geometry_with_prior(&nominal, data, scope, prior_sigmas, &options.identification)?;
+    let geometry = timings::phase("identification", || {
+        fit_geometry_with_prior(&nominal, data, scope, prior_sigmas, &options.identification)
+    })?;
     let mut model = CalibratedModel {
         schema_version: SCHEMA_VERSION,
         robot: robot.name.clone(),
@@ -276,7 +285,7 @@ pub fn fit(
         EffectSelection::None => Vec::new(),
         EffectSelection::List(list) => list.clone(),
         EffectSelection::Auto => {
-            let choice = crate::auto::choose(robot, &bound, &options.effects.diagnose)?;
+            let choice = timings::phase("diagnosis", || crate::auto::choose(robot, &bound, &options.effects.diagnose))?;
             let chosen = choice.chosen.clone();
             auto = Some(choice);
             chosen
@@ -300,14 +309,16 @@ pub fn fit(
         // The effects are fitted under the same prior, about the same placed nominal model, as
         // the geometry alone: otherwise they would free what it held.
         let prior = prior_sigmas.map(|(t, r)| KinematicPrior::on_links(geometry.registered.clone(), t, r));
-        let fitted = identify_with_prior(
-            &model.kinematics,
-            &observations(data),
-            &mask,
-            Some(&correction),
-            prior.as_ref(),
-            &id_options,
-        )
+        let fitted = timings::phase("effects identification", || {
+            identify_with_prior(
+                &model.kinematics,
+                &observations(data),
+                &mask,
+                Some(&correction),
+                prior.as_ref(),
+                &id_options,
+            )
+        })
         .map_err(Error::kinematics)?;
         EffectCorrection::distribute(&mut effects, &fitted.correction);
         for effect in &mut effects {
@@ -315,19 +326,25 @@ pub fn fit(
         }
         effect_report = effect_reports(&effects, &fitted.report.held_at_prior, &robot.joint_kinds());
         model.fallback_kinematics = Some(std::mem::replace(&mut model.kinematics, fitted.model));
-        model.effect_uncertainty = effect_uncertainty(
-            &model.kinematics,
-            &effects,
-            mask.free_indices(),
-            &fitted.covariance,
-            &bound,
-            &options.effects,
-        )?;
-        beyond_span = crate::sessions::choose(data, &specs, &mut effects, options, |train, fold_options| {
-            fit(robot, train, Method::Poe, fold_options).map(|(model, _)| model)
+        model.effect_uncertainty = timings::phase("effects uncertainty", || {
+            effect_uncertainty(
+                &model.kinematics,
+                &effects,
+                mask.free_indices(),
+                &fitted.covariance,
+                &bound,
+                &options.effects,
+            )
         })?;
-        beyond_payload = crate::payloads::choose(data, &specs, &mut effects, options, |train, fold_options| {
-            fit(robot, train, Method::Poe, fold_options).map(|(model, _)| model)
+        beyond_span = timings::phase("beyond span (sessions held out)", || {
+            crate::sessions::choose(data, &specs, &mut effects, options, |train, fold_options| {
+                fit(robot, train, Method::Poe, fold_options).map(|(model, _)| model)
+            })
+        })?;
+        beyond_payload = timings::phase("beyond payload (payloads held out)", || {
+            crate::payloads::choose(data, &specs, &mut effects, options, |train, fold_options| {
+                fit(robot, train, Method::Poe, fold_options).map(|(model, _)| model)
+            })
         })?;
         model.effects = effects;
         identification = fitted.report;
@@ -343,7 +360,8 @@ pub fn fit(
             if left_out { Cow::Owned(bound.without(&identification.robust.outliers)) } else { Cow::Borrowed(&bound) };
         let poses = model.geometric_poses(&kept)?;
         let repeats = model::RepeatGroups::of(kept.rows(), options.heldout.repeat_tolerance);
-        let (mut fitted, report) = ResidualGp::fit(&poses, kept.set(), with_payload, &options.residual_gp, &repeats)?;
+        let (mut fitted, report) =
+            timings::phase("GP", || ResidualGp::fit(&poses, kept.set(), with_payload, &options.residual_gp, &repeats))?;
         if let (Some(alone), false) = (&model.fallback_kinematics, model.effects.is_empty()) {
             let alone_poses = kept
                 .rows()
@@ -352,16 +370,18 @@ pub fn fit(
                 .map(|(row, &tool)| alone.forward(&row.q, tool))
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(Error::kinematics)?;
-            fitted.fit_fallback(&alone_poses, kept.set(), &options.residual_gp)?;
+            timings::phase("fallback GP", || fitted.fit_fallback(&alone_poses, kept.set(), &options.residual_gp))?;
         }
         // `--effects auto`'s prediction with this GP on top, its hyperparameters held fixed.
         if let Some(choice) = &mut auto {
-            choice.predicted_with_gp = crate::gp_folds::predicted_with_gp(
-                &fitted,
-                &choice.folds,
-                &options.residual_gp.gp,
-                options.heldout.repeat_tolerance,
-            )?;
+            choice.predicted_with_gp = timings::phase("held-out prediction with the GP", || {
+                crate::gp_folds::predicted_with_gp(
+                    &fitted,
+                    &choice.folds,
+                    &options.residual_gp.gp,
+                    options.heldout.repeat_tolerance,
+                )
+            })?;
             if choice.predicted_with_gp.as_ref().and_then(|p| p.fallback_gp).is_some_and(|c| !c.kept) {
                 fitted.fallback = None;
             }
@@ -371,9 +391,11 @@ pub fn fit(
     }
     // The check `read_model` runs, on the text `write_model` writes: a fit never hands over a
     // model that its own file would be refused for, and the cause shows here (issue 23).
-    let text = model::model_text(&model, "the fitted model")?;
-    model.check(&text, "the fitted model").map_err(|source| {
-        Error::new(ErrorKind::FittedModelRefused { method: method.to_string(), source: Box::new(source) })
+    timings::phase("model file check", || {
+        let text = model::model_text(&model, "the fitted model")?;
+        model.check(&text, "the fitted model").map_err(|source| {
+            Error::new(ErrorKind::FittedModelRefused { method: method.to_string(), source: Box::new(source) })
+        })
     })?;
     let registered = CalibratedModel {
         kinematics: geometry.registered,
@@ -383,8 +405,9 @@ pub fn fit(
         ..model.clone()
     };
     // `registered` and `model` share the data's tools, so the one binding serves both.
-    let before = evaluate(&registered, &bound)?.summary;
-    let after = evaluate(&model, &bound)?.summary;
+    let (before, after) = timings::phase("training errors", || {
+        Ok::<_, Error>((evaluate(&registered, &bound)?.summary, evaluate(&model, &bound)?.summary))
+    })?;
     let distinct = model::RepeatGroups::of(&data.rows, options.heldout.repeat_tolerance).groups.len();
     model.heldout = heldout_estimate(&after, &identification, residual_gp.as_ref(), (distinct, data.rows.len()));
     if identification.redundancy() < options.min_redundancy {
@@ -433,6 +456,7 @@ pub fn fit(
         plausibility: findings.report,
         outliers,
         warnings,
+        timings: Vec::new(),
     };
     Ok((model, report))
 }

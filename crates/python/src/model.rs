@@ -52,8 +52,17 @@ pub fn fit(
     let (robot, data) = (&robot.description, &data.set);
     let ((model, fitted), report) = py
         .detach(|| {
-            let (fitted, report) = pipeline::fit(robot, data, method, &options)?;
-            Ok::<_, errors::Error>(((as_its_file_holds(&fitted)?, fitted), report))
+            // The phases timed as `calib fit` times them (its report's `timings`).
+            let (fitted, timings) = timings::record(|| {
+                let (fitted, report) = timings::phase("fit", || pipeline::fit(robot, data, method, &options))?;
+                let held = timings::phase("write", || as_its_file_holds(&fitted))?;
+                Ok::<_, errors::Error>(((held, fitted), report))
+            });
+            fitted.map(|(models, report)| (models, (report, timings)))
+        })
+        .map(|(models, (report, timings))| {
+            let report = pipeline::FitReport { timings: timings.phases, ..report };
+            (models, report)
         })
         .map_err(to_py)?;
     let json = serde_json::to_string(&report).map_err(|e| argument("report", e))?;
