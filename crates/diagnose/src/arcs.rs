@@ -96,7 +96,8 @@ pub(crate) fn arc_checks(
     let mut out = Vec::with_capacity(moving.len());
     for &joint in moving {
         let fold = arc_folds(data, joint, inputs.folds);
-        let pool = Pool::new(inputs.design, inputs.kinematic_prior, &blocks, &fold, inputs.folds, inputs.prior);
+        let pool =
+            Pool::single_folds(inputs.design, inputs.kinematic_prior, &blocks, &fold, inputs.folds, inputs.prior);
         let mut before = Vec::with_capacity(data.rows.len());
         let mut after = Vec::with_capacity(data.rows.len());
         let mut folds = Vec::with_capacity(inputs.folds);
@@ -185,6 +186,10 @@ pub(crate) type OrderCurve = (Vec<u32>, Vec<f64>);
 /// in turn (the other selected steps at their chosen orders); `None` for other steps or where no
 /// other joint moves. The series' own joint's arcs are left out of this: there the model fades
 /// the series whole, whatever its order.
+///
+/// One pool per moving joint serves every series: it holds every selected step's columns in
+/// full, and each series' fits take the columns of the others at their orders and its own at
+/// each of its orders (a pool per series and joint built the same Gram matrices again for each).
 pub(crate) fn order_curves(
     inputs: &ArcInputs<'_>,
     data: &MeasurementSet,
@@ -194,51 +199,68 @@ pub(crate) fn order_curves(
     columns_of: &dyn Fn(usize) -> (Vec<Vec<f64>>, Option<f64>),
 ) -> Result<Vec<Option<OrderCurve>>, Error> {
     let kinematic = inputs.design.kinematic.ncols();
-    let mut out = Vec::with_capacity(selection.steps.len());
-    for (s, step) in selection.steps.iter().enumerate() {
-        let term = &terms[step.term];
-        let (Some(orders), IdentifiedEffect::GearPeriodic(gear)) = (&term.orders, &term.model) else {
-            out.push(None);
-            continue;
-        };
-        let others: Vec<usize> = moving.iter().copied().filter(|&k| k != gear.joint).collect();
-        if others.is_empty() {
-            out.push(None);
-            continue;
-        }
-        // Columns: the kinematics, the other steps at their orders, then this series in full.
-        let mut owned: Vec<(Vec<Vec<f64>>, Option<f64>)> = selection
-            .steps
-            .iter()
-            .enumerate()
-            .filter(|&(t, _)| t != s)
-            .map(|(_, o)| at_its_order(o, columns_of))
-            .collect();
-        let (own, own_sd) = columns_of(step.term);
-        let orders: Vec<u32> = orders.iter().copied().filter(|&h| 2 * h as usize <= own.len()).collect();
-        let base_width: usize = owned.iter().map(|(c, _)| c.len()).sum();
-        let own_width = own.len();
-        owned.push((own, own_sd));
-        let blocks: Vec<Block<'_>> = owned.iter().map(|(c, sd)| (c.as_slice(), *sd)).collect();
-        let base: Vec<usize> = (0..kinematic + base_width).collect();
-        let series: Vec<usize> = (kinematic + base_width..kinematic + base_width + own_width).collect();
-        let mut sum = vec![0.0; orders.len()];
-        let mut count = 0usize;
-        for &k in &others {
+    let steps = &selection.steps;
+    // Every step's columns in full, and how many of them it takes at its chosen order.
+    let full: Vec<(Vec<Vec<f64>>, Option<f64>)> = steps.iter().map(|step| columns_of(step.term)).collect();
+    let at_order: Vec<usize> = steps.iter().map(|step| at_its_order(step, columns_of).0.len()).collect();
+    let mut offsets = Vec::with_capacity(steps.len());
+    let mut next = kinematic;
+    for (columns, _) in &full {
+        offsets.push(next);
+        next += columns.len();
+    }
+    // The series with a curve: (step, its joint, its orders that its columns reach).
+    let curves: Vec<(usize, usize, Vec<u32>)> = steps
+        .iter()
+        .enumerate()
+        .filter_map(|(s, step)| {
+            let term = &terms[step.term];
+            let (Some(orders), IdentifiedEffect::GearPeriodic(gear)) = (&term.orders, &term.model) else {
+                return None;
+            };
+            if !moving.iter().any(|&k| k != gear.joint) {
+                return None;
+            }
+            let orders = orders.iter().copied().filter(|&h| 2 * h as usize <= full[s].0.len()).collect();
+            Some((s, gear.joint, orders))
+        })
+        .collect();
+    let mut sums: Vec<Vec<f64>> = curves.iter().map(|(_, _, orders)| vec![0.0; orders.len()]).collect();
+    let mut counts = vec![0usize; curves.len()];
+    if !curves.is_empty() {
+        let blocks: Vec<Block<'_>> = full.iter().map(|(c, sd)| (c.as_slice(), *sd)).collect();
+        for &k in moving {
+            if curves.iter().all(|&(_, joint, _)| joint == k) {
+                continue;
+            }
             let fold = arc_folds(data, k, inputs.folds);
-            let pool = Pool::new(inputs.design, inputs.kinematic_prior, &blocks, &fold, inputs.folds, inputs.prior);
-            for f in 0..inputs.folds {
-                if pool.fold_poses(f).is_empty() {
+            let pool =
+                Pool::single_folds(inputs.design, inputs.kinematic_prior, &blocks, &fold, inputs.folds, inputs.prior);
+            for (c, (s, joint, orders)) in curves.iter().enumerate() {
+                if *joint == k {
                     continue;
                 }
-                let residuals = pool.series_residuals(&[f], &[f], &base, &series, &orders)?;
-                for (total, r) in sum.iter_mut().zip(&residuals[0]) {
-                    *total += r.iter().map(|v| v.fixed_rows::<3>(0).norm()).sum::<f64>();
+                // The kinematics, the other steps at their orders, then this series in full.
+                let base: Vec<usize> = (0..kinematic)
+                    .chain((0..steps.len()).filter(|&t| t != *s).flat_map(|t| offsets[t]..offsets[t] + at_order[t]))
+                    .collect();
+                let series: Vec<usize> = (offsets[*s]..offsets[*s] + full[*s].0.len()).collect();
+                for f in 0..inputs.folds {
+                    if pool.fold_poses(f).is_empty() {
+                        continue;
+                    }
+                    let residuals = pool.series_residuals(&[f], &[f], &base, &series, orders)?;
+                    for (total, r) in sums[c].iter_mut().zip(&residuals[0]) {
+                        *total += r.iter().map(|v| v.fixed_rows::<3>(0).norm()).sum::<f64>();
+                    }
+                    counts[c] += pool.fold_poses(f).len();
                 }
-                count += pool.fold_poses(f).len();
             }
         }
-        out.push(Some((orders, sum.iter().map(|v| v / count.max(1) as f64).collect())));
+    }
+    let mut out = vec![None; steps.len()];
+    for ((c, (s, _, orders)), sum) in curves.into_iter().enumerate().zip(sums) {
+        out[s] = Some((orders, sum.iter().map(|v| v / counts[c].max(1) as f64).collect()));
     }
     Ok(out)
 }
