@@ -89,6 +89,45 @@ fn add_squared_exponential(out: &mut [f64], col: &[f64], a: f64, q: f64) {
     }
 }
 
+/// [`add_squared_exponential`] that also writes each `e^{−r²/2}` to `cache` (as long as `out`),
+/// for [`squared_exponential_sums_cached`] to read instead of computing it again.
+#[inline(always)]
+fn add_squared_exponential_caching(out: &mut [f64], cache: &mut [f64], col: &[f64], a: f64, q: f64) {
+    for ((v, c), p) in out.iter_mut().zip(cache.iter_mut()).zip(col) {
+        let t = p - q;
+        let e = exp_nonpositive(-0.5 * t * t);
+        *c = e;
+        *v += a * e;
+    }
+}
+
+/// [`squared_exponential_sums`] with each `e^{−rᵢ²/2}` read from `cache` (as
+/// [`add_squared_exponential_caching`] wrote it): the same sums to the bit.
+#[inline(always)]
+fn squared_exponential_sums_cached(col: &[f64], w: &[f64], cache: &[f64], a: f64, q: f64) -> (f64, f64) {
+    let mut value = [0.0; LANES];
+    let mut length = [0.0; LANES];
+    let (cc, wc, ec) = (col.chunks_exact(LANES), w.chunks_exact(LANES), cache.chunks_exact(LANES));
+    let (c_tail, w_tail, e_tail) = (cc.remainder(), wc.remainder(), ec.remainder());
+    for ((p, wi), e) in cc.zip(wc).zip(ec) {
+        for l in 0..LANES {
+            let t = p[l] - q;
+            let r = t * t;
+            let v = wi[l] * a * e[l];
+            value[l] += v;
+            length[l] += v * r;
+        }
+    }
+    for ((p, wi), e) in c_tail.iter().zip(w_tail).zip(e_tail) {
+        let t = p - q;
+        let r = t * t;
+        let v = wi * a * e;
+        value[0] += v;
+        length[0] += v * r;
+    }
+    (pairwise(&value), pairwise(&length))
+}
+
 /// `(Σᵢ wᵢ a e^{−rᵢ²/2}, Σᵢ wᵢ a e^{−rᵢ²/2} rᵢ²)` in [`LANES`] interleaved partial sums combined
 /// in a fixed order (so that the loop vectorises and the result does not depend on the thread).
 #[inline(always)]
@@ -159,7 +198,77 @@ impl pulp::WithSimd for SquaredExponentialSums<'_> {
     }
 }
 
+/// [`add_squared_exponential_caching`] for `pulp`'s dispatch.
+struct AddSquaredExponentialCaching<'a> {
+    out: &'a mut [f64],
+    cache: &'a mut [f64],
+    col: &'a [f64],
+    a: f64,
+    q: f64,
+}
+
+impl pulp::WithSimd for AddSquaredExponentialCaching<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) {
+        add_squared_exponential_caching(self.out, self.cache, self.col, self.a, self.q)
+    }
+}
+
+/// [`squared_exponential_sums_cached`] for `pulp`'s dispatch.
+struct SquaredExponentialSumsCached<'a> {
+    col: &'a [f64],
+    w: &'a [f64],
+    cache: &'a [f64],
+    a: f64,
+    q: f64,
+}
+
+impl pulp::WithSimd for SquaredExponentialSumsCached<'_> {
+    type Output = (f64, f64);
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) -> (f64, f64) {
+        squared_exponential_sums_cached(self.col, self.w, self.cache, self.a, self.q)
+    }
+}
+
 impl Additive<'_> {
+    /// [`Additive::add_column`] for the squared-exponential shape that also keeps each input's
+    /// exponentials: `cache[k · out.len() ..][.. out.len()]` for input `k`.
+    pub(crate) fn add_column_caching(&self, out: &mut [f64], cache: &mut [f64], j: usize, from: usize) {
+        let len = out.len();
+        let rows = from..from + len;
+        for (((a, col), qcol), cache) in
+            self.variances.iter().zip(self.columns).zip(self.query).zip(cache.chunks_exact_mut(len.max(1)))
+        {
+            let (a, q, col) = (*a, qcol[j], &col[rows.clone()]);
+            ARCH.with(|arch| arch.dispatch(AddSquaredExponentialCaching { out: &mut *out, cache, col, a, q }))
+        }
+    }
+
+    /// [`Additive::gradient_sums`] for the squared-exponential shape with the exponentials read
+    /// from `cache`, laid out as [`Additive::add_column_caching`] wrote them for rows
+    /// `from − skip ..` (`skip` leading rows of each input's block are not summed).
+    pub(crate) fn gradient_sums_cached(
+        &self,
+        sums: &mut [f64],
+        w: &[f64],
+        cache: &[f64],
+        skip: usize,
+        j: usize,
+        from: usize,
+    ) {
+        let d = self.variances.len();
+        let block = w.len() + skip;
+        for (k, ((a, col), qcol)) in self.variances.iter().zip(self.columns).zip(self.query).enumerate() {
+            let (a, q, col) = (*a, qcol[j], &col[from..from + w.len()]);
+            let cache = &cache[k * block + skip..(k + 1) * block];
+            let (value, length) = ARCH.with(|arch| arch.dispatch(SquaredExponentialSumsCached { col, w, cache, a, q }));
+            sums[k] += value;
+            sums[d + k] += length;
+        }
+    }
+
     /// `Σₖ aₖ s((cₖ[i] − qₖ[j])²)` added to `out[i − from]` for `i` in `from..from + out.len()`:
     /// part of column `j` of the kernel matrix.
     pub(crate) fn add_column(&self, out: &mut [f64], j: usize, from: usize) {

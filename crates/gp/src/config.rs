@@ -90,6 +90,23 @@ pub struct OptimiserConfig {
     /// output's search stopped on its function tolerance 35 nats below the optimum it reaches
     /// without (held out 0.1358 → 0.1381 mm).
     pub warm_start_curvature: bool,
+    /// The relative function tolerance of a search that starts from an optimum found elsewhere:
+    /// the full-data search after a warm-start subset, and a refinement from a fitted kernel
+    /// ([`crate::ExactGp::refit`]). `None`: [`OptimiserConfig::function_tolerance`]. Such a
+    /// search starts a few nats from its optimum and then gains a few hundredths of a nat per
+    /// iteration for many iterations, each costing `n³` flops on every row.
+    #[serde(default)]
+    pub refine_function_tolerance: Option<f64>,
+    /// Bytes of the kernel's exponentials an evaluation of the likelihood may keep from its value
+    /// stage for its gradient stage, which otherwise computes every one of them again (the
+    /// squared-exponential shapes: `d + 1` per entry of the lower triangle with an additive term
+    /// on `d` inputs; 0 keeps none). The search's results are the same to the bit either way.
+    #[serde(default = "default_kernel_cache_bytes")]
+    pub kernel_cache_bytes: usize,
+}
+
+fn default_kernel_cache_bytes() -> usize {
+    OptimiserConfig::default().kernel_cache_bytes
 }
 
 impl Default for OptimiserConfig {
@@ -104,6 +121,12 @@ impl Default for OptimiserConfig {
             function_tolerance: 1e7 * f64::EPSILON,
             warm_start_rows: 0,
             warm_start_curvature: false,
+            refine_function_tolerance: None,
+            // 64 MiB: n = 1,387 rows with six additive inputs (UR10 C's even rows) need 54 MB,
+            // small against the two n × n buffers and the GP's own data at that size; at a few
+            // thousand rows the exponentials would be hundreds of MB, written and read again
+            // once per evaluation, where recomputing them costs little beside the n³ factor.
+            kernel_cache_bytes: 64 << 20,
         }
     }
 }
@@ -182,10 +205,12 @@ impl GpConfig {
     pub fn validate(&self) -> Result<(), Error> {
         let o = &self.optimiser;
         let j = &self.jitter;
-        let checks: [(&'static str, f64, bool); 5] = [
+        let refine = o.refine_function_tolerance.unwrap_or(o.function_tolerance);
+        let checks: [(&'static str, f64, bool); 6] = [
             ("optimiser.memory", o.memory as f64, o.memory >= 1),
             ("optimiser.gradient_tolerance", o.gradient_tolerance, o.gradient_tolerance >= 0.0),
             ("optimiser.function_tolerance", o.function_tolerance, o.function_tolerance >= 0.0),
+            ("optimiser.refine_function_tolerance", refine, refine >= 0.0),
             ("jitter.initial_relative", j.initial_relative, j.initial_relative > 0.0 && j.initial_relative.is_finite()),
             ("jitter.growth", j.growth, j.growth > 1.0 && j.growth.is_finite()),
         ];

@@ -69,37 +69,98 @@ fn squared_distance(sq_i: f64, sq_j: f64, dot: f64, same: bool) -> f64 {
     if same { 0.0 } else { (sq_i + sq_j - 2.0 * dot).max(0.0) }
 }
 
+/// The exponentials of a training matrix's lower triangle that [`fill_training_lower`] can keep
+/// for [`contract_gradient`] (squared-exponential shape only): for each column `j`, a block of
+/// `(1 + additive inputs) · (n − j)` values, the stationary term's `σf² e^{−r²/2}` for rows
+/// `j..n` (the first, the diagonal's, unused), then each additive input's `e^{−r²/2}` for the
+/// same rows. `None` where it does not apply or would exceed `budget_bytes`.
+pub(crate) fn cache_len(kernel: &Evaluator, x: &Prepared, budget_bytes: usize) -> Option<usize> {
+    if kernel.shape != StationaryShape::SquaredExponential {
+        return None;
+    }
+    let n = x.len();
+    let per_entry = 1 + x.additive.as_ref().map_or(0, Points::dim);
+    let len = per_entry.checked_mul(n.checked_mul(n + 1)? / 2)?;
+    (len.checked_mul(std::mem::size_of::<f64>())? <= budget_bytes).then_some(len)
+}
+
+/// `cache` (laid out as [`cache_len`] says) cut into one block per column.
+fn cache_blocks<T>(mut cache: &mut [T], n: usize, per_entry: usize) -> Vec<&mut [T]> {
+    let mut blocks = Vec::with_capacity(n);
+    for j in 0..n {
+        let (block, rest) = std::mem::take(&mut cache).split_at_mut(per_entry * (n - j));
+        blocks.push(block);
+        cache = rest;
+    }
+    blocks
+}
+
 /// Lower triangle, diagonal included, of `K(X, X) + diagonal · I` written into `dst` (`n × n`);
 /// the strict upper triangle is left as it was (the Cholesky factorisation reads only the lower).
+/// With `cache` ([`cache_len`] long), the exponentials are kept there too.
 pub(crate) fn fill_training_lower(
     mut dst: MatMut<'_, f64>,
     kernel: &Evaluator,
     x: &Prepared,
     diagonal: f64,
+    cache: Option<&mut [f64]>,
     par: Parallelism,
 ) {
     let sq = squared_norms(&x.stationary);
     lower_inner_products(dst.rb_mut(), &x.stationary, par);
     let (shape, signal, constant) = (kernel.shape, kernel.signal_variance, kernel.constant);
     let additive = x.additive.as_ref().map(additive::columns);
-    for_each_column(dst.rb_mut(), par, |j, col| {
-        let col = slice_mut(col);
-        match shape {
-            StationaryShape::SquaredExponential => {
+    let term = additive.as_ref().map(|a| additive::Additive {
+        shape,
+        variances: &kernel.additive_variances,
+        columns: a,
+        query: a,
+    });
+    match cache {
+        Some(cache) if shape == StationaryShape::SquaredExponential => {
+            let n = x.len();
+            let per_entry = 1 + additive.as_ref().map_or(0, Vec::len);
+            let blocks = cache_blocks(cache, n, per_entry);
+            let column = |(j, (col, block)): (usize, (ColMut<'_, f64>, &mut [f64]))| {
+                let (col, len) = (slice_mut(col), n - j);
+                let (own, rest) = block.split_at_mut(len);
                 col[j] = shape.value(signal, 0.0) + constant;
-                stationary::fill_column(&mut col[j + 1..], &sq[j + 1..], sq[j], signal, constant);
+                own[0] = col[j];
+                stationary::fill_column_caching(
+                    &mut col[j + 1..],
+                    &mut own[1..],
+                    &sq[j + 1..],
+                    sq[j],
+                    signal,
+                    constant,
+                );
+                if let Some(term) = &term {
+                    term.add_column_caching(&mut col[j..], rest, j, j);
+                }
+            };
+            match par {
+                Parallelism::Sequential => dst.rb_mut().col_iter_mut().zip(blocks).enumerate().for_each(column),
+                Parallelism::Rayon => dst.rb_mut().par_col_iter_mut().zip(blocks).enumerate().for_each(column),
             }
-            StationaryShape::Matern52 => {
-                for (i, v) in col.iter_mut().enumerate().skip(j) {
-                    *v = shape.value(signal, squared_distance(sq[i], sq[j], *v, i == j)) + constant;
+        }
+        _ => for_each_column(dst.rb_mut(), par, |j, col| {
+            let col = slice_mut(col);
+            match shape {
+                StationaryShape::SquaredExponential => {
+                    col[j] = shape.value(signal, 0.0) + constant;
+                    stationary::fill_column(&mut col[j + 1..], &sq[j + 1..], sq[j], signal, constant);
+                }
+                StationaryShape::Matern52 => {
+                    for (i, v) in col.iter_mut().enumerate().skip(j) {
+                        *v = shape.value(signal, squared_distance(sq[i], sq[j], *v, i == j)) + constant;
+                    }
                 }
             }
-        }
-        if let Some(a) = &additive {
-            let term = additive::Additive { shape, variances: &kernel.additive_variances, columns: a, query: a };
-            term.add_column(&mut col[j..], j, j);
-        }
-    });
+            if let Some(term) = &term {
+                term.add_column(&mut col[j..], j, j);
+            }
+        }),
+    }
     if let Some(l) = &x.linear {
         let lm = as_matrix(l);
         triangular::matmul(
@@ -122,7 +183,7 @@ pub(crate) fn fill_training_lower(
 /// Lower triangle of `K(X, X) + diagonal · I` in a new matrix (R&W Eq. 2.21's `K + σn² I`).
 pub(crate) fn training_covariance(kernel: &Evaluator, x: &Prepared, diagonal: f64, par: Parallelism) -> Mat<f64> {
     let mut k = Mat::zeros(x.len(), x.len());
-    fill_training_lower(k.as_mut(), kernel, x, diagonal, par);
+    fill_training_lower(k.as_mut(), kernel, x, diagonal, None, par);
     k
 }
 
@@ -219,6 +280,7 @@ pub(crate) fn contract_gradient(
     mut inverse: MatMut<'_, f64>,
     alpha: MatRef<'_, f64>,
     mut scratch: MatMut<'_, f64>,
+    cache: Option<&mut [f64]>,
     par: Parallelism,
 ) -> Vec<f64> {
     let (n, dim, m) = (x.len(), x.stationary.dim(), alpha.ncols());
@@ -233,8 +295,17 @@ pub(crate) fn contract_gradient(
     // Per column: Σ f Wᵢⱼ sᵢⱼ, Σ f Wᵢⱼ, ½ Wⱼⱼ, with f = ½ on the diagonal and 1 below it (each
     // strict-lower entry stands for itself and its mirror); then, with an additive term, for each
     // input k, Σ f Wᵢⱼ aₖ s(rₖ²) and Σ f Wᵢⱼ mₖ rₖ² (its variance's and its length scale's).
-    let column = |j: usize, wc: ColMut<'_, f64>, mc: ColMut<'_, f64>| -> Vec<f64> {
+    // The exponentials [`fill_training_lower`] kept, read instead of computed again: the same
+    // values, so the same sums to the bit.
+    let per_entry = 1 + additive_dim;
+    let cached = cache.filter(|_| shape == StationaryShape::SquaredExponential);
+    let mut blocks: Vec<Option<&mut [f64]>> = match cached {
+        Some(cache) => cache_blocks(cache, n, per_entry).into_iter().map(Some).collect(),
+        None => (0..n).map(|_| None).collect(),
+    };
+    let column = |j: usize, wc: ColMut<'_, f64>, mc: ColMut<'_, f64>, block: Option<&mut [f64]>| -> Vec<f64> {
         let (wc, mc) = (slice_mut(wc), slice_mut(mc));
+        let block = block.map(|b| &*b);
         let aj = &alpha_rows[j * m..(j + 1) * m];
         let mut sums = vec![0.0; 3 + 2 * additive_dim];
         for i in j..n {
@@ -246,7 +317,10 @@ pub(crate) fn contract_gradient(
                 // The diagonal (r = 0, weight ½) apart, the rest of the column vectorised.
                 let (value, weight) = shape.value_and_weight(signal, 0.0);
                 mc[j] = wc[j] * weight;
-                let (v, w) = stationary::weigh_column(&mut mc[j + 1..], &wc[j + 1..], &sq[j + 1..], sq[j], signal);
+                let (v, w) = match block {
+                    Some(b) => stationary::weigh_column_cached(&mut mc[j + 1..], &wc[j + 1..], &b[1..n - j]),
+                    None => stationary::weigh_column(&mut mc[j + 1..], &wc[j + 1..], &sq[j + 1..], sq[j], signal),
+                };
                 sums[0] = 0.5 * wc[j] * value + v;
                 sums[1] = 0.5 * wc[j] + w;
             }
@@ -267,27 +341,33 @@ pub(crate) fn contract_gradient(
             // Below the diagonal each entry stands for itself and its mirror; on it r = 0, so the
             // length scales get nothing and each variance ½ Wⱼⱼ aₖ.
             let term = additive::Additive { shape, variances: &kernel.additive_variances, columns: a, query: a };
-            term.gradient_sums(&mut sums[3..], &wc[j + 1..], j, j + 1);
+            match block {
+                Some(b) => term.gradient_sums_cached(&mut sums[3..], &wc[j + 1..], &b[n - j..], 1, j, j + 1),
+                None => term.gradient_sums(&mut sums[3..], &wc[j + 1..], j, j + 1),
+            }
             for (k, v) in kernel.additive_variances.iter().enumerate() {
                 sums[3 + k] += 0.5 * wc[j] * v;
             }
         }
         sums
     };
+    let blocks: Vec<Option<&mut [f64]>> = std::mem::take(&mut blocks);
     let partial: Vec<Vec<f64>> = match par {
         Parallelism::Sequential => inverse
             .rb_mut()
             .col_iter_mut()
             .zip(scratch.rb_mut().col_iter_mut())
+            .zip(blocks)
             .enumerate()
-            .map(|(j, (w, mc))| column(j, w, mc))
+            .map(|(j, ((w, mc), b))| column(j, w, mc, b))
             .collect(),
         Parallelism::Rayon => inverse
             .rb_mut()
             .par_col_iter_mut()
             .zip(scratch.rb_mut().par_col_iter_mut())
+            .zip(blocks)
             .enumerate()
-            .map(|(j, (w, mc))| column(j, w, mc))
+            .map(|(j, ((w, mc), b))| column(j, w, mc, b))
             .collect(),
     };
     let mut total = vec![0.0; 3 + 2 * additive_dim];

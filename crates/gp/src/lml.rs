@@ -67,6 +67,11 @@ pub struct LmlWorkspace {
     options: FactorOptions,
     factor: Mat<f64>,
     inverse: Mat<f64>,
+    /// The kernel's exponentials from the value stage, for the gradient stage
+    /// ([`crate::gram::cache_len`]), where they fit in [`LmlWorkspace::cache_budget_bytes`].
+    cache: Vec<f64>,
+    /// [`crate::OptimiserConfig::kernel_cache_bytes`].
+    cache_budget_bytes: usize,
     /// Set by a successful [`evaluate_value`], taken by [`evaluate_gradient`].
     last: Option<LastValue>,
 }
@@ -79,11 +84,20 @@ struct LastValue {
     evaluator: Evaluator,
     prepared: Prepared,
     alpha: Mat<f64>,
+    /// Whether `cache` holds this point's exponentials.
+    cached: bool,
 }
 
 impl Default for LmlWorkspace {
     fn default() -> Self {
-        Self { options: FactorOptions::default(), factor: Mat::new(), inverse: Mat::new(), last: None }
+        Self {
+            options: FactorOptions::default(),
+            factor: Mat::new(),
+            inverse: Mat::new(),
+            cache: Vec::new(),
+            cache_budget_bytes: crate::OptimiserConfig::default().kernel_cache_bytes,
+            last: None,
+        }
     }
 }
 
@@ -92,6 +106,12 @@ impl LmlWorkspace {
     pub fn with_options(options: FactorOptions) -> Result<Self, Error> {
         options.validate()?;
         Ok(Self { options, ..Self::default() })
+    }
+
+    /// The same workspace keeping at most `bytes` of the kernel's exponentials between the value
+    /// and the gradient stage ([`crate::OptimiserConfig::kernel_cache_bytes`]; 0: none).
+    pub fn with_cache_budget(self, bytes: usize) -> Self {
+        Self { cache_budget_bytes: bytes, ..self }
     }
 
     /// [`log_marginal_likelihood`] in this workspace's buffers (grown or shrunk to `n × n` as
@@ -147,8 +167,16 @@ pub(crate) fn evaluate_value(
     if workspace.factor.nrows() != n {
         workspace.factor = Mat::zeros(n, n);
     }
+    let cache = match crate::gram::cache_len(&evaluator, &prepared, workspace.cache_budget_bytes) {
+        Some(len) => {
+            workspace.cache.resize(len, 0.0);
+            Some(workspace.cache.as_mut_slice())
+        }
+        None => None,
+    };
+    let cached = cache.is_some();
     let factor = &mut workspace.factor;
-    fill_training_lower(factor.as_mut(), &evaluator, &prepared, evaluator.noise_variance, parallelism);
+    fill_training_lower(factor.as_mut(), &evaluator, &prepared, evaluator.noise_variance, cache, parallelism);
     cholesky_lower_in_place(factor.as_mut(), &workspace.options, par).map_err(|pivot| Error::CholeskyFailed {
         size: n,
         pivot,
@@ -161,7 +189,7 @@ pub(crate) fn evaluate_value(
     let data_fit: f64 = (0..m).map(|c| (0..n).map(|i| y[(i, c)] * alpha[(i, c)]).sum::<f64>()).sum();
     let value =
         -0.5 * data_fit - 0.5 * m as f64 * log_determinant - 0.5 * (n * m) as f64 * (2.0 * std::f64::consts::PI).ln();
-    workspace.last = Some(LastValue { kernel: kernel.clone(), evaluator, prepared, alpha });
+    workspace.last = Some(LastValue { kernel: kernel.clone(), evaluator, prepared, alpha, cached });
     Ok(value)
 }
 
@@ -170,14 +198,14 @@ pub(crate) fn evaluate_value(
 /// contraction for every parameter (R&W Eq. 5.9).
 pub(crate) fn evaluate_gradient(workspace: &mut Workspace, dim: usize, parallelism: Parallelism) -> Vec<f64> {
     let par = parallelism.faer();
-    let Some(LastValue { kernel, evaluator, prepared, alpha }) = workspace.last.take() else {
+    let Some(LastValue { kernel, evaluator, prepared, alpha, cached }) = workspace.last.take() else {
         return Vec::new();
     };
     let n = alpha.nrows();
     if workspace.inverse.nrows() != n {
         workspace.inverse = Mat::zeros(n, n);
     }
-    let Workspace { factor, inverse, .. } = workspace;
+    let Workspace { factor, inverse, cache, .. } = workspace;
     triangular_inverse::invert_lower_triangular(inverse.as_mut(), factor.as_ref(), par);
     triangular::matmul(
         factor.as_mut(),
@@ -190,7 +218,8 @@ pub(crate) fn evaluate_gradient(workspace: &mut Workspace, dim: usize, paralleli
         1.0,
         par,
     );
+    let cache = cached.then_some(cache.as_mut_slice());
     let expanded =
-        contract_gradient(&evaluator, &prepared, factor.as_mut(), alpha.as_ref(), inverse.as_mut(), parallelism);
+        contract_gradient(&evaluator, &prepared, factor.as_mut(), alpha.as_ref(), inverse.as_mut(), cache, parallelism);
     kernel.fold_gradient(&expanded, dim)
 }

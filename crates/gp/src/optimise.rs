@@ -84,6 +84,19 @@ struct NegativeLml<'a> {
     workspace: Workspace,
 }
 
+impl<'a> NegativeLml<'a> {
+    fn new(
+        start: &'a Kernel,
+        x: &'a Points,
+        y: MatRef<'a, f64>,
+        config: &OptimiserConfig,
+        parallelism: Parallelism,
+    ) -> Self {
+        let workspace = Workspace::default().with_cache_budget(config.kernel_cache_bytes);
+        Self { start, x, y, parallelism, workspace }
+    }
+}
+
 impl Objective for NegativeLml<'_> {
     fn value(&mut self, p: &[f64]) -> Option<f64> {
         let kernel = self.start.with_log_parameters(p).ok()?;
@@ -100,13 +113,13 @@ fn search_all(
     start: &Kernel,
     starts: &[Vec<f64>],
     (lower, upper): (&[f64], &[f64]),
-    x: &Points,
-    y: MatRef<'_, f64>,
+    (x, y): (&Points, MatRef<'_, f64>),
     settings: &Settings,
+    config: &OptimiserConfig,
     parallelism: Parallelism,
 ) -> Vec<Option<lbfgsb::Minimum>> {
     let run = |p0: &Vec<f64>| {
-        let mut objective = NegativeLml { start, x, y, parallelism, workspace: Workspace::default() };
+        let mut objective = NegativeLml::new(start, x, y, config, parallelism);
         lbfgsb::minimise(&mut objective, p0, lower, upper, settings)
     };
     match parallelism {
@@ -178,6 +191,12 @@ fn prepare(start: &Kernel, bounds: &Bounds, config: &OptimiserConfig) -> Result<
     Ok(Prepared { lower, upper, starts, settings })
 }
 
+/// `settings` for a search from an optimum found elsewhere
+/// ([`OptimiserConfig::refine_function_tolerance`]).
+fn refining(settings: Settings, config: &OptimiserConfig) -> Settings {
+    Settings { function_tolerance: config.refine_function_tolerance.unwrap_or(settings.function_tolerance), ..settings }
+}
+
 /// Every start searched on the warm-start subset (`None` when the configuration has no subset or
 /// the data are no larger than it).
 pub(crate) fn warm_stage(
@@ -197,7 +216,7 @@ pub(crate) fn warm_stage(
     let idx = random_indices(n, warm, config.seed);
     let xs = x.select(&idx);
     let ys = Mat::from_fn(idx.len(), y.ncols(), |i, j| y[(idx[i], j)]);
-    let results = search_all(start, &starts, (&lower, &upper), &xs, ys.as_ref(), &settings, parallelism);
+    let results = search_all(start, &starts, (&lower, &upper), (&xs, ys.as_ref()), &settings, config, parallelism);
     let Some((best, _)) = best(&results) else {
         return Err(Error::OptimisationFailed { starts: starts.len() });
     };
@@ -249,12 +268,13 @@ pub(crate) fn finish(
                     .collect(),
                 _ => Vec::new(),
             };
-            let mut objective = NegativeLml { start, x, y, parallelism, workspace: Workspace::default() };
+            let mut objective = NegativeLml::new(start, x, y, config, parallelism);
+            let settings = refining(settings, config);
             let full = vec![lbfgsb::minimise_with(&mut objective, &from, &lower, &upper, &settings, &pairs)];
             (stage.results, stage.rows, stage.evaluations, full.into_iter().next().flatten())
         }
         None => {
-            let results = search_all(start, &starts, (&lower, &upper), x, y, &settings, parallelism);
+            let results = search_all(start, &starts, (&lower, &upper), (x, y), &settings, config, parallelism);
             (results, 0, 0, None)
         }
     };
@@ -299,8 +319,8 @@ pub(crate) fn refine(
     let Prepared { lower, upper, settings, .. } = prepare(start, bounds, config)?;
     let from: Vec<f64> =
         start.log_parameters().iter().zip(&lower).zip(&upper).map(|((s, l), u)| s.clamp(*l, *u)).collect();
-    let mut objective = NegativeLml { start, x, y, parallelism, workspace: Workspace::default() };
-    let minimum = lbfgsb::minimise(&mut objective, &from, &lower, &upper, &settings)
+    let mut objective = NegativeLml::new(start, x, y, config, parallelism);
+    let minimum = lbfgsb::minimise(&mut objective, &from, &lower, &upper, &refining(settings, config))
         .ok_or(Error::OptimisationFailed { starts: 1 })?;
     let kernel = start.with_log_parameters(&minimum.x)?;
     let report = OptimisationReport {

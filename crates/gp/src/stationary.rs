@@ -55,6 +55,90 @@ fn weigh(m: &mut [f64], w: &[f64], sq: &[f64], sq_j: f64, signal: f64) -> (f64, 
     (pairwise(&value), pairwise(&weight))
 }
 
+/// [`fill`] that also writes each `σf² e^{−r²/2}` (without the constant) to `cache`, as
+/// [`weigh`] computes it.
+#[inline(always)]
+fn fill_caching(out: &mut [f64], cache: &mut [f64], sq: &[f64], sq_j: f64, signal: f64, constant: f64) {
+    for ((v, c), s) in out.iter_mut().zip(cache.iter_mut()).zip(sq) {
+        let e = signal * exp_nonpositive(-0.5 * squared_distance(*s, sq_j, *v)) + 0.0;
+        *c = e;
+        *v = e + constant;
+    }
+}
+
+/// [`weigh`] with the kernel values read from `cache` (as [`fill_caching`] wrote them).
+#[inline(always)]
+fn weigh_cached(m: &mut [f64], w: &[f64], cache: &[f64]) -> (f64, f64) {
+    m.copy_from_slice(cache);
+    let mut value = [0.0; LANES];
+    let mut weight = [0.0; LANES];
+    let (mc, wc) = (m.chunks_exact_mut(LANES), w.chunks_exact(LANES));
+    let tail = mc.len() * LANES;
+    for (mi, wi) in mc.zip(wc) {
+        for l in 0..LANES {
+            let v = wi[l] * mi[l];
+            mi[l] = v;
+            value[l] += v;
+            weight[l] += wi[l];
+        }
+    }
+    for (mi, wi) in m[tail..].iter_mut().zip(&w[tail..]) {
+        let v = wi * *mi;
+        *mi = v;
+        value[0] += v;
+        weight[0] += wi;
+    }
+    (pairwise(&value), pairwise(&weight))
+}
+
+struct FillCaching<'a> {
+    out: &'a mut [f64],
+    cache: &'a mut [f64],
+    sq: &'a [f64],
+    sq_j: f64,
+    signal: f64,
+    constant: f64,
+}
+
+impl pulp::WithSimd for FillCaching<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) {
+        fill_caching(self.out, self.cache, self.sq, self.sq_j, self.signal, self.constant)
+    }
+}
+
+struct WeighCached<'a> {
+    m: &'a mut [f64],
+    w: &'a [f64],
+    cache: &'a [f64],
+}
+
+impl pulp::WithSimd for WeighCached<'_> {
+    type Output = (f64, f64);
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) -> (f64, f64) {
+        weigh_cached(self.m, self.w, self.cache)
+    }
+}
+
+/// [`fill_caching`] on the widest instruction set of this processor.
+pub(crate) fn fill_column_caching(
+    out: &mut [f64],
+    cache: &mut [f64],
+    sq: &[f64],
+    sq_j: f64,
+    signal: f64,
+    constant: f64,
+) {
+    ARCH.with(|arch| arch.dispatch(FillCaching { out, cache, sq, sq_j, signal, constant }))
+}
+
+/// [`weigh_cached`] on the widest instruction set of this processor.
+pub(crate) fn weigh_column_cached(m: &mut [f64], w: &[f64], cache: &[f64]) -> (f64, f64) {
+    ARCH.with(|arch| arch.dispatch(WeighCached { m, w, cache }))
+}
+
 struct Fill<'a> {
     out: &'a mut [f64],
     sq: &'a [f64],

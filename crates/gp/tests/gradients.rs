@@ -109,6 +109,44 @@ fn a_reused_workspace_gives_the_likelihood_of_fresh_buffers_to_the_bit() {
 }
 
 #[test]
+fn the_gradient_from_the_kept_exponentials_is_the_gradient_computed_afresh_to_the_bit() {
+    // The value stage keeps the kernel's exponentials for the gradient stage within its budget;
+    // with no budget every one is computed again. The default composite kernel (an additive term)
+    // and SE-ARD, serial and rayon, a workspace reused across sizes.
+    let d = 4;
+    let mut r = rng(23);
+    let kernels: Vec<Kernel> = random_kernels(&mut r, d)
+        .into_iter()
+        .chain(
+            [
+                gp::KernelChoice::Composite {
+                    shape: gp::StationaryShape::SquaredExponential,
+                    constant: true,
+                    linear: false,
+                    additive: true,
+                },
+                gp::KernelChoice::SquaredExponentialArd,
+            ]
+            .map(|c| Kernel::start(c, d)),
+        )
+        .collect();
+    let mut kept = LmlWorkspace::default();
+    let mut afresh = LmlWorkspace::default().with_cache_budget(0);
+    for n in [37, 64, 21] {
+        let x = uniform_points(&mut r, n, d, -2.0, 2.0);
+        let y = Mat::from_fn(n, 2, |i, c| (x[(i, 0)] * (c + 1) as f64).sin() + 0.1 * r.random::<f64>());
+        for kernel in &kernels {
+            for parallelism in [Parallelism::Sequential, Parallelism::Rayon] {
+                let with = kept.log_marginal_likelihood(kernel, x.as_ref(), y.as_ref(), true, parallelism).unwrap();
+                let without =
+                    afresh.log_marginal_likelihood(kernel, x.as_ref(), y.as_ref(), true, parallelism).unwrap();
+                assert_eq!(with, without, "n {n} {kernel:?} {parallelism:?}");
+            }
+        }
+    }
+}
+
+#[test]
 fn the_factorisation_block_sizes_change_the_likelihood_only_by_rounding() {
     // Leaves of 3 rows make the factorisation by halves recurse five levels deep at n = 60.
     let (n, d) = (60, 3);

@@ -115,6 +115,12 @@ pub struct ResidualGpOptions {
     /// to none at `s = 1`. `None`: never fades (the GP's posterior mean everywhere, as before).
     /// Within `[0, 1)`.
     pub fade_above_variance_ratio: Option<f64>,
+    /// The sparse GP's training share of the fade ([`GpFadeRule::training_share`]) is the median
+    /// over at most this many of its training rows, every k-th in the file's order: the
+    /// posterior variance at a row costs two `m × m` triangular solves, so at 100,000 rows the
+    /// median of all of them took longer than the sparse GP's own search. The exact GP's comes
+    /// from its leave-one-out over every row, which the fit computes anyway. At least 1.
+    pub fade_share_rows: usize,
 }
 
 impl Default for ResidualGpOptions {
@@ -211,6 +217,10 @@ impl Default for ResidualGpOptions {
             // share): `poe-gp --effects auto` C → B 1.4334, B even → odd 0.2213 → 0.2214, B's
             // j3-end, elbow and j2-gap splits within 0.3 %.
             fade_above_variance_ratio: Some(0.5),
+            // The median of 2,000 rows is within about 3 % of the rows' spread of the median of
+            // all of them (its standard error, 1.25 σ / √2000), far inside the rule's margin:
+            // the share fades the correction only from half-way between it and 1.
+            fade_share_rows: 2000,
         }
     }
 }
@@ -223,6 +233,9 @@ impl ResidualGpOptions {
                 "fade_above_variance_ratio",
                 format!("residual_gp.fade_above_variance_ratio is {r}, expected a number in [0, 1) or None"),
             )),
+            _ if self.fade_share_rows == 0 => {
+                Err(("fade_share_rows", "residual_gp.fade_share_rows is 0, expected at least 1".to_owned()))
+            }
             _ => Ok(()),
         }
     }
@@ -253,6 +266,10 @@ struct OptimiserPatch {
     warm_start_rows: Option<usize>,
     #[serde(default, deserialize_with = "given")]
     warm_start_curvature: Option<bool>,
+    #[serde(default, deserialize_with = "given")]
+    refine_function_tolerance: Option<Option<f64>>,
+    #[serde(default, deserialize_with = "given")]
+    kernel_cache_bytes: Option<usize>,
 }
 
 /// The fields of [`gp::GpConfig`] an options file may set.
@@ -322,6 +339,8 @@ fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<
             function_tolerance,
             warm_start_rows,
             warm_start_curvature,
+            refine_function_tolerance,
+            kernel_cache_bytes,
         } = o;
         let d = &mut gp.optimiser;
         d.restarts = restarts.unwrap_or(d.restarts);
@@ -332,6 +351,8 @@ fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<
         d.function_tolerance = function_tolerance.unwrap_or(d.function_tolerance);
         d.warm_start_rows = warm_start_rows.unwrap_or(d.warm_start_rows);
         d.warm_start_curvature = warm_start_curvature.unwrap_or(d.warm_start_curvature);
+        d.refine_function_tolerance = refine_function_tolerance.unwrap_or(d.refine_function_tolerance);
+        d.kernel_cache_bytes = kernel_cache_bytes.unwrap_or(d.kernel_cache_bytes);
     }
     Ok(gp)
 }
@@ -518,9 +539,17 @@ impl GpFadeRule {
 /// keeps at a row it has not seen there: for the exact GP, each row left out of it (R&W
 /// Eq. 5.12, the noise taken off: a row's own noisy value would count as knowledge of its
 /// neighbours, and a held-out pose between two training poses has none); for the sparse GP, which
-/// has no closed form, at the row itself.
+/// has no closed form, at the row itself, over at most `sparse_rows` of them (every k-th).
 /// `loo`: the exact GP's leave-one-out where the caller has it already.
-fn median_share(gp: &GpModel, x: &Mat<f64>, loo: Option<&gp::LeaveOneOut>) -> Result<f64, Error> {
+fn median_share(gp: &GpModel, x: &Mat<f64>, loo: Option<&gp::LeaveOneOut>, sparse_rows: usize) -> Result<f64, Error> {
+    if let GpModel::Sparse(_) = gp
+        && x.nrows() > sparse_rows
+    {
+        let step = x.nrows().div_ceil(sparse_rows.max(1));
+        let rows: Vec<usize> = (0..x.nrows()).step_by(step).collect();
+        let every_kth = Mat::from_fn(rows.len(), x.ncols(), |i, j| x[(rows[i], j)]);
+        return median_share(gp, &every_kth, None, sparse_rows);
+    }
     let mut prediction = gp.predict(x.as_ref()).map_err(Error::gp)?;
     if let GpModel::Exact(exact) = gp {
         let computed;
@@ -702,7 +731,9 @@ impl ResidualGp {
         let fade = match options.fade_above_variance_ratio {
             Some(above) => Some(GpFadeRule {
                 above,
-                training_share: timings::phase("fade share", || median_share(&gp, &x, loo.as_ref()))?,
+                training_share: timings::phase("fade share", || {
+                    median_share(&gp, &x, loo.as_ref(), options.fade_share_rows)
+                })?,
                 fallback_training_share: None,
             }),
             None => None,
@@ -815,7 +846,8 @@ impl ResidualGp {
             ResidualSet::new(alone_poses, data, self.with_payload, self.residual_frame);
         let fallback = GpModel::Exact(timings::phase("search", || exact_fit(&x, &y, data.full_pose, options))?);
         if let Some(fade) = &mut self.fade {
-            fade.fallback_training_share = Some(timings::phase("fade share", || median_share(&fallback, &x, None))?);
+            fade.fallback_training_share =
+                Some(timings::phase("fade share", || median_share(&fallback, &x, None, options.fade_share_rows))?);
         }
         self.fallback = Some(fallback);
         Ok(())
