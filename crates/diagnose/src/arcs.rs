@@ -9,7 +9,7 @@
 //! of the held-out joint's own angle is faded whole there (the model fades it in any gap wider
 //! than half its shortest period, and a prediction for poses off the training poses must not
 //! count on a gap being narrow), another joint's series is applied with the coverage weight
-//! [`GearPeriodic::held_and_weight`] computed from that fit's own training angles, and the pose
+//! [`effects::GearPeriodic::held_and_weight`] computed from that fit's own training angles, and the pose
 //! is blended to the geometry fitted alone by the product of those weights (the model's
 //! `fallback` part). So the arcs measure how the geometry and the other effects carry into
 //! angles the fit never saw.
@@ -22,7 +22,7 @@ use super::design::Design;
 use super::fold_residuals::FoldResiduals;
 use super::pool::{Block, KinematicPrior, Pool, PriorOptions};
 use super::selection::{Selection, Step, Term};
-use effects::{GearOptions, GearPeriodic, IdentifiedEffect};
+use effects::{AngleCoverage, GearOptions, IdentifiedEffect};
 use errors::Error;
 use lie::Vector6;
 use measurements::MeasurementSet;
@@ -111,13 +111,17 @@ pub(crate) fn arc_checks(
             let betas = [base, full];
             let residuals = pool.residuals(f, &all, &betas);
             // Each series' coverage as its fit on this fold's training rows records it.
-            let training: Vec<measurements::Measurement> =
-                (0..data.rows.len()).filter(|&i| fold[i] != f).map(|i| data.rows[i].clone()).collect();
-            let coverage: Vec<GearPeriodic> = series
+            let coverage: Vec<AngleCoverage> = series
                 .iter()
                 .flatten()
-                .map(|&(j, h)| GearPeriodic::with_options(j, (1..=h).collect(), &training, inputs.gear))
-                .collect::<Result<_, _>>()?;
+                .map(|&(j, h)| {
+                    let angles: Vec<f64> = (0..data.rows.len())
+                        .filter(|&i| fold[i] != f)
+                        .filter_map(|i| data.rows[i].q.get(j).copied())
+                        .collect();
+                    AngleCoverage::of(j, &(1..=h).collect::<Vec<u32>>(), &angles, inputs.gear)
+                })
+                .collect();
             // The training rows, blended as this fold's model blends them: each series by the
             // coverage of its own fit's angles.
             let mut fold_residuals = vec![Vector6::zeros(); data.rows.len()];

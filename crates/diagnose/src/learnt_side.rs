@@ -41,15 +41,12 @@ fn sign(x: f64) -> f64 {
 fn learn(
     pool: &Pool,
     source: &SideSource,
-    compliance: &Candidate,
-    compliance_columns: &[usize],
+    (scalars, compliance_columns): (&[Vec<f64>], &[usize]),
     twist_rows: &[f64],
     data: &BoundSet<'_>,
     left_out: &[usize],
 ) -> Result<IdentifiedEffect, Error> {
     let k = twist_rows.len() / data.len().max(1);
-    let scalars: Vec<Vec<f64>> =
-        data.iter().map(|(row, tool)| compliance.model.features(row, tool)).collect::<Result<_, _>>()?;
     let train: Vec<usize> = (0..pool.folds()).filter(|f| !left_out.contains(f)).collect();
     let torque = |theta: &[f64], i: usize| -> f64 { scalars[i].iter().zip(theta).map(|(s, t)| s * t).sum() };
     let kinematic = pool.kinematic_columns();
@@ -124,12 +121,16 @@ pub(crate) fn learnt_sides(
         // The joint's bare twist: order 0's cosine feature is 1 on every row.
         let bare = IdentifiedEffect::GearPeriodic(GearPeriodic::new(source.joint, vec![0], data.rows())?);
         let twist_rows = columns_of(design, &bare, model, data)?.swap_remove(0);
+        // The compliance's features of every row, once for all the folds' alternations.
+        let scalars: Vec<Vec<f64>> =
+            data.iter().map(|(row, tool)| compliance.model.features(row, tool)).collect::<Result<_, _>>()?;
+        let compliance = (scalars.as_slice(), columns.as_slice());
         let mut per_fold = Vec::with_capacity(pool.folds());
         for f in 0..pool.folds() {
-            let effect = learn(pool, source, compliance, columns, &twist_rows, data, &[f])?;
+            let effect = learn(pool, source, compliance, &twist_rows, data, &[f])?;
             per_fold.push(columns_of(design, &effect, model, data)?.swap_remove(0));
         }
-        let effect = learn(pool, source, compliance, columns, &twist_rows, data, &[])?;
+        let effect = learn(pool, source, compliance, &twist_rows, data, &[])?;
         let all = columns_of(design, &effect, model, data)?.swap_remove(0);
         let nonzero = |c: &Vec<f64>| c.iter().any(|v| v.abs() > 1e-12);
         if nonzero(&all) && per_fold.iter().all(nonzero) {

@@ -482,13 +482,24 @@ impl Pool {
         let m = columns.len();
         let xf = &self.x[fold];
         let rows = xf.nrows();
-        let mut xs = Mat::<f64>::zeros(rows, m);
-        for (j, &c) in columns.iter().enumerate() {
-            xs.col_as_slice_mut(j).copy_from_slice(xf.col_as_slice(c));
-        }
         let b = Mat::<f64>::from_fn(m, betas.len(), |i, s| betas[s].get(i).copied().unwrap_or(0.0));
         let mut predicted = Mat::<f64>::zeros(rows, betas.len());
-        matmul(predicted.as_mut(), Accum::Replace, xs.as_ref(), b.as_ref(), 1.0, Par::Seq);
+        // Columns that are a run of the pool's are read in place; others are copied next to each
+        // other first. Either way the product sees the same matrix, so the same sums.
+        let run = columns.first().filter(|&&first| columns.iter().enumerate().all(|(j, &c)| c == first + j));
+        match run {
+            Some(&first) => {
+                let xs = xf.as_ref().subcols(first, m);
+                matmul(predicted.as_mut(), Accum::Replace, xs, b.as_ref(), 1.0, Par::Seq);
+            }
+            None => {
+                let mut xs = Mat::<f64>::zeros(rows, m);
+                for (j, &c) in columns.iter().enumerate() {
+                    xs.col_as_slice_mut(j).copy_from_slice(xf.col_as_slice(c));
+                }
+                matmul(predicted.as_mut(), Accum::Replace, xs.as_ref(), b.as_ref(), 1.0, Par::Seq);
+            }
+        }
         let y = &self.y[fold];
         (0..betas.len())
             .map(|s| {

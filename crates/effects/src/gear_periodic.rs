@@ -141,18 +141,7 @@ impl GearPeriodic {
         let fitted_range = angles.iter().fold(None, |range: Option<[f64; 2]>, &q| {
             Some(range.map_or([q, q], |[low, high]| [low.min(q), high.max(q)]))
         });
-        let mut turn: Vec<f64> = angles.iter().map(|q| q.rem_euclid(std::f64::consts::TAU)).collect();
-        turn.sort_by(f64::total_cmp);
-        let h_max = f64::from(orders.iter().copied().max().unwrap_or(1).max(1));
-        let spacing = std::f64::consts::PI / h_max;
-        let mut turn_gaps: Vec<[f64; 2]> =
-            turn.windows(2).filter(|w| w[1] - w[0] > spacing).map(|w| [w[0], w[1]]).collect();
-        if let (Some(&first), Some(&last)) = (turn.first(), turn.last())
-            && first + std::f64::consts::TAU - last > spacing
-        {
-            turn_gaps.push([last, first + std::f64::consts::TAU]);
-        }
-        let taper_rad = Some(options.taper_fraction_of_period * std::f64::consts::TAU / h_max);
+        let AngleCoverage { turn_gaps, taper_rad, .. } = AngleCoverage::of(joint, &orders, angles, options);
         let mut model = Self {
             joint,
             orders,
@@ -238,10 +227,7 @@ impl GearPeriodic {
 
     /// The turn gap `q` lies in, with `q`'s angle in that gap's coordinates.
     fn turn_gap(&self, q: f64) -> Option<(f64, [f64; 2])> {
-        let t = q.rem_euclid(std::f64::consts::TAU);
-        self.turn_gaps.iter().find_map(|&[a, b]| {
-            [t, t + std::f64::consts::TAU].into_iter().find(|&x| a < x && x < b).map(|x| (x, [a, b]))
-        })
+        turn_gap(&self.turn_gaps, q)
     }
 
     /// The prior standard deviation of each parameter relative to the effects' `prior_sigma`:
@@ -254,15 +240,66 @@ impl GearPeriodic {
     /// outside them) and the weight it is applied with there (1 on the fitted angles, fading to
     /// 0 over [`GearPeriodic::taper_rad`]). Older files without a taper: `(q, 1)` everywhere.
     pub fn held_and_weight(&self, q: f64) -> (f64, f64) {
-        let Some(width) = self.taper_rad else { return (q, 1.0) };
-        let Some((t, [a, b])) = self.turn_gap(q) else { return (q, 1.0) };
-        let held_t = if t - a <= b - t { a } else { b };
-        let held = q + (held_t - t);
-        let distance = (held_t - t).abs();
-        let weight =
-            if distance >= width { 0.0 } else { 0.5 * (1.0 + (std::f64::consts::PI * distance / width).cos()) };
-        (held, weight)
+        held_and_weight(&self.turn_gaps, self.taper_rad, q)
     }
+}
+
+/// Where a joint's series of the orders up to the highest fitted was fitted on the turn of its
+/// angles, and how it fades beyond: what [`GearPeriodic::held_and_weight`] reads, without the
+/// series' features (their means and scales over the angles cost a sine and cosine per order
+/// and angle). For a caller that needs only the coverage of a fit on some angles (the
+/// diagnosis's arcs, once per fold).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AngleCoverage {
+    /// The 0-based joint.
+    pub joint: usize,
+    turn_gaps: Vec<[f64; 2]>,
+    taper_rad: Option<f64>,
+}
+
+impl AngleCoverage {
+    /// The coverage of a series of `joint` with `orders` fitted on `angles` (rad), as
+    /// [`GearPeriodic`] records it with `options`.
+    pub fn of(joint: usize, orders: &[u32], angles: &[f64], options: &GearOptions) -> Self {
+        let mut turn: Vec<f64> = angles.iter().map(|q| q.rem_euclid(std::f64::consts::TAU)).collect();
+        turn.sort_by(f64::total_cmp);
+        let h_max = f64::from(orders.iter().copied().max().unwrap_or(1).max(1));
+        let spacing = std::f64::consts::PI / h_max;
+        let mut turn_gaps: Vec<[f64; 2]> =
+            turn.windows(2).filter(|w| w[1] - w[0] > spacing).map(|w| [w[0], w[1]]).collect();
+        if let (Some(&first), Some(&last)) = (turn.first(), turn.last())
+            && first + std::f64::consts::TAU - last > spacing
+        {
+            turn_gaps.push([last, first + std::f64::consts::TAU]);
+        }
+        let taper_rad = Some(options.taper_fraction_of_period * std::f64::consts::TAU / h_max);
+        Self { joint, turn_gaps, taper_rad }
+    }
+
+    /// [`GearPeriodic::held_and_weight`] of the series this coverage describes.
+    pub fn held_and_weight(&self, q: f64) -> (f64, f64) {
+        held_and_weight(&self.turn_gaps, self.taper_rad, q)
+    }
+}
+
+/// The held angle and the weight at `q` of a series whose turn has the gaps `turn_gaps` and fades
+/// over `taper_rad` ([`GearPeriodic::held_and_weight`]).
+fn held_and_weight(turn_gaps: &[[f64; 2]], taper_rad: Option<f64>, q: f64) -> (f64, f64) {
+    let Some(width) = taper_rad else { return (q, 1.0) };
+    let Some((t, [a, b])) = turn_gap(turn_gaps, q) else { return (q, 1.0) };
+    let held_t = if t - a <= b - t { a } else { b };
+    let held = q + (held_t - t);
+    let distance = (held_t - t).abs();
+    let weight = if distance >= width { 0.0 } else { 0.5 * (1.0 + (std::f64::consts::PI * distance / width).cos()) };
+    (held, weight)
+}
+
+/// The gap of `turn_gaps` the angle `q` falls in, with `q` on that gap's turn.
+fn turn_gap(turn_gaps: &[[f64; 2]], q: f64) -> Option<(f64, [f64; 2])> {
+    let t = q.rem_euclid(std::f64::consts::TAU);
+    turn_gaps
+        .iter()
+        .find_map(|&[a, b]| [t, t + std::f64::consts::TAU].into_iter().find(|&x| a < x && x < b).map(|x| (x, [a, b])))
 }
 
 impl Regressor for GearPeriodic {

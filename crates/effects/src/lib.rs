@@ -45,7 +45,7 @@ mod term;
 pub use backlash::TorqueSign;
 pub use beyond_span::BeyondSpan;
 pub use direction::Direction;
-pub use gear_periodic::GearOptions;
+pub use gear_periodic::{AngleCoverage, GearOptions};
 pub use joint_compliance::{ComplianceTerm, ComplianceTorque, TorqueFit};
 pub use load_frame::LoadFrame;
 pub use loadsim::EffectKind;
