@@ -134,3 +134,47 @@ fn simulate_bends_the_column_with_the_urdfs_masses_and_refuses_compliance_withou
         "{message}"
     );
 }
+
+#[test]
+fn the_shipped_column_arm_fits_from_its_urdf_as_shipped_and_exports_back_in_its_shape() {
+    let dir = tempfile::tempdir().unwrap();
+    let [effects, all, train, test, model, urdf, again] =
+        ["effects.ron", "all.csv", "train.csv", "test.csv", "poe.ron", "out.urdf", "again.ron"]
+            .map(|n| text(&dir.path().join(n)));
+    std::fs::write(&effects, "(tracker_noise: ())\n").unwrap();
+    let robot = fixture("column_arm_shipped.urdf");
+    let simulate =
+        ["simulate", "--robot", &robot, "--out", &all, "--rows", "160", "--seed", "4", "--effects", &effects];
+    succeeds(&simulate);
+    split(Path::new(&all), 120, Path::new(&train), Path::new(&test));
+    // Issue 45's first step: the motor beside the chain is the data's joint 1.
+    let fit = ["fit", "--robot", &robot, "--tip-link", "prism", "--data", &train, "--method", "poe", "--out", &model];
+    let fitted = succeeds(&fit);
+    let folded = "joint 1 is URDF joint 'column_drive' with its mimic joint(s) 'column_stage_1' (multiplier 0.5), \
+                  'column_stage_2' (multiplier 0.5)";
+    assert!(fitted.contains(folded), "{fitted}");
+    let json = succeeds(&["eval", "--model", &model, "--data", &test, "--json"]);
+    let value: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let held_out = value["mean_position_error_mm"].as_f64().unwrap();
+    assert!(held_out < 0.1, "{held_out} mm");
+    succeeds(&["export", "--model", &model, "--urdf", &urdf, "--like", &robot]);
+    let written = std::fs::read_to_string(&urdf).unwrap();
+    assert_eq!(written.matches("<mimic joint=\"column_drive\" multiplier=\"0.5\"").count(), 2);
+    assert!(written.contains("<child link=\"column_drive_nut\"/>"), "{written}");
+    let refit = [
+        "fit",
+        "--robot",
+        &urdf,
+        "--base-link",
+        "track",
+        "--tip-link",
+        "prism",
+        "--data",
+        &train,
+        "--method",
+        "base-tool",
+        "--out",
+        &again,
+    ];
+    assert!(succeeds(&refit).contains(folded));
+}

@@ -12,7 +12,10 @@
 //! Mimic joints folded into their actuated joint (`urdf_mimic.rs`) keep their origins, axes and
 //! `<mimic>` elements: the stages after the actuated joint's child link move with the folded
 //! joint's POE frame as `W_k(q) = P_i(q) D_k`, so the correction on the actuated joint's origin
-//! carries them exactly, and the multipliers stay as written.
+//! carries them exactly, and the multipliers stay as written. Where the actuated joint is beside
+//! the chain (a column's motor moving a pseudo link), it keeps its origin too, and the correction
+//! goes on the origin of its first stage on the chain, before that stage's offset: the shipped
+//! shape is written back, the motor, its pseudo link and every `<mimic>` as they were.
 
 use crate::urdf_text::{Written, escape, fixed_joint, origin_element};
 use errors::{Error, ErrorKind};
@@ -33,7 +36,7 @@ fn free_link_name(document: &UrdfDocument, name: &str) -> String {
 /// Refuses a model whose joint kinds differ from the URDF chain's, at the first such `<joint>`:
 /// the written file keeps the URDF's joint types, which would not be the model's.
 pub(crate) fn check_joint_kinds(document: &UrdfDocument, chain: &UrdfChain, model: &[JointKind]) -> Result<(), Error> {
-    let actuated = chain.joints.iter().map(|j| &chain.steps[j.actuated]);
+    let actuated = chain.joints.iter().map(|j| j.actuated(&chain.steps));
     for (k, (step, &model_kind)) in actuated.zip(model).enumerate() {
         let urdf_kind = match step.motion {
             StepMotion::Prismatic { .. } => JointKind::Prismatic,
@@ -83,35 +86,36 @@ pub(crate) fn write_like(
     let mut calibrated_link = SE3::identity();
     let mut last: Option<(String, SE3)> = None;
     let mut joint_names = Vec::new();
-    // The description's joint of each step: its actuated joint's, or that of the joint it follows.
-    let mut joint_of: Vec<Option<usize>> = vec![None; chain.steps.len()];
+    // The description's joint of each step (its actuated joint's, or that of the joint it
+    // follows), and whether the step starts that joint on the chain.
+    let mut joint_of: Vec<Option<(usize, bool)>> = vec![None; chain.steps.len()];
     for (i, joint) in chain.joints.iter().enumerate() {
-        for &k in std::iter::once(&joint.actuated).chain(&joint.stages) {
+        for &k in std::iter::once(&joint.first).chain(&joint.stages) {
             if let Some(slot) = joint_of.get_mut(k) {
-                *slot = Some(i);
+                *slot = Some((i, k == joint.first));
             }
         }
     }
-    let mut movable = 0;
     for ((step, nominal_link), joint) in chain.steps.iter().zip(&link_frames).zip(&joint_of) {
         if step.motion == StepMotion::Fixed {
             calibrated_link = calibrated_link * step.from_to;
             continue;
         }
-        if step.mimic.is_some() {
+        let Some((i, first)) = *joint else {
+            return Err(document.error_at("joint", &step.joint, format!("joint '{}' is not folded", step.joint)));
+        };
+        let link_in_poe = nominal_frames[i].inverse() * *nominal_link;
+        if !first {
             // A stage keeps its origin; the tools hang from the last one the chain reaches.
             calibrated_link = calibrated_link * step.from_to * step.zero_motion();
-            let Some(i) = *joint else {
-                return Err(document.error_at("joint", &step.joint, format!("joint '{}' is not folded", step.joint)));
-            };
-            last = Some((step.to_link.clone(), nominal_frames[i].inverse() * *nominal_link));
+            last = Some((step.to_link.clone(), link_in_poe));
             continue;
         }
-        let link_in_poe = nominal_frames[movable].inverse() * *nominal_link;
-        let new_link = calibrated_frames[movable] * link_in_poe;
-        let origin = calibrated_link.inverse() * new_link;
+        // The joint's first step on the chain (its actuated joint, or the first stage of a driver
+        // beside the chain, at its offset at zero) carries the calibrated frame.
+        let new_link = calibrated_frames[i] * link_in_poe;
+        let origin = calibrated_link.inverse() * new_link * step.zero_motion().inverse();
         calibrated_link = new_link;
-        movable += 1;
         let Some(element) = document.element("joint", &step.joint) else {
             return Err(document.error_at(
                 "joint",
@@ -127,7 +131,7 @@ pub(crate) fn write_like(
                 edits.push((at, 0, format!("{replacement}\n    ")));
             }
         }
-        joint_names.push(step.joint.clone());
+        joint_names.push(chain.joints[i].actuated(&chain.steps).joint.clone());
         last = Some((step.to_link.clone(), link_in_poe));
     }
     let Some((flange_link, flange_in_poe)) = last else {

@@ -2,69 +2,14 @@
 //! kinematics equal the URDF chain evaluated joint by joint, every mimic at `multiplier · q +
 //! offset`; chains whose mimic joints do not fold are refused at the `<mimic>` element.
 
+mod mimic_common;
+
 use errors::ErrorKind;
-use lie::{SE3, SO3, Vector3};
+use lie::Vector3;
+use mimic_common::{assert_refused, chain, joint_by_joint, largest_difference, mimic_position, random_q, refusal};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robot::{ChainEnds, JointType, RobotDescription, StepMotion, UrdfChain, UrdfDocument};
-
-fn chain(text: &str, ends: &ChainEnds) -> UrdfChain {
-    UrdfDocument::parse(text, "arm.urdf").and_then(|d| d.chain(ends)).unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// The tip of `chain` at actuated joint values `q`, walking every URDF joint: the actuated ones
-/// (movable joints without `<mimic>`, in chain order) at `q`, each mimic joint at
-/// `multiplier · q_followed + offset`. Written without the fold.
-fn joint_by_joint(chain: &UrdfChain, q: &[f64]) -> SE3 {
-    let actuated: Vec<&str> = chain
-        .steps
-        .iter()
-        .filter(|s| s.motion != StepMotion::Fixed && s.mimic.is_none())
-        .map(|s| s.joint.as_str())
-        .collect();
-    let value_of = |name: &str| q[actuated.iter().position(|a| *a == name).expect("an actuated joint")];
-    let mut frame = SE3::identity();
-    for step in &chain.steps {
-        let value = match &step.mimic {
-            Some(m) => m.multiplier * value_of(&m.joint) + m.offset,
-            None if step.motion == StepMotion::Fixed => 0.0,
-            None => value_of(&step.joint),
-        };
-        let motion = match step.motion {
-            StepMotion::Fixed => SE3::identity(),
-            StepMotion::Revolute { .. } => SE3::new(SO3::exp(&(step.axis * value)), Vector3::zeros()),
-            StepMotion::Prismatic { .. } => SE3::from_translation(step.axis * value),
-        };
-        frame = frame * step.from_to * motion;
-    }
-    frame
-}
-
-fn random_q(robot: &RobotDescription, rng: &mut ChaCha8Rng) -> Vec<f64> {
-    robot
-        .limits()
-        .iter()
-        .map(
-            |&(lo, hi)| {
-                if lo.is_finite() && hi.is_finite() { rng.random_range(lo..hi) } else { rng.random_range(-3.0..3.0) }
-            },
-        )
-        .collect()
-}
-
-/// Largest difference between the description's tool pose and the joint-by-joint walk.
-fn largest_difference(chain: &UrdfChain, seed: u64) -> f64 {
-    let robot = chain.description();
-    let model = robot.nominal_model().unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    (0..50)
-        .map(|_| {
-            let q = random_q(&robot, &mut rng);
-            let folded = model.forward(&q, 0).unwrap();
-            (folded.to_matrix() - joint_by_joint(chain, &q).to_matrix()).norm()
-        })
-        .fold(0.0, f64::max)
-}
+use robot::{ChainEnds, JointType, RobotDescription, UrdfDocument};
 
 #[test]
 fn the_column_arm_folds_its_three_column_stages_into_one_joint_of_scale_three() {
@@ -211,38 +156,6 @@ fn the_scaled_joints_twists_are_the_derivatives_of_the_urdf_chain() {
     }
 }
 
-/// The refusal of `text`: line, column and message, checked to name the file first.
-fn refusal(text: &str) -> (usize, usize, String) {
-    match UrdfDocument::parse(text, "arm.urdf").and_then(|d| d.chain(&ChainEnds::default())) {
-        Err(e) if matches!(e.kind(), ErrorKind::UrdfFormat { .. }) => {
-            let shown = e.to_string();
-            let (Some((line, column)), ErrorKind::UrdfFormat { message }) = (e.position(), e.kind()) else {
-                unreachable!()
-            };
-            assert_eq!(shown, format!("arm.urdf:{line}:{column}: {message}"));
-            (line as usize, column, message.clone())
-        }
-        other => panic!("expected a URDF error, got {other:?}"),
-    }
-}
-
-/// The 1-based line and column of the first `<mimic` after `joint`'s element in `text`.
-fn mimic_position(text: &str, joint: &str) -> (usize, usize) {
-    let start = text.find(&format!("<joint name=\"{joint}\"")).expect("the joint");
-    let at = start + text[start..].find("<mimic").expect("its mimic");
-    let before = &text[..at];
-    (before.matches('\n').count() + 1, before.rsplit('\n').next().unwrap().chars().count() + 1)
-}
-
-fn assert_refused(text: &str, joint: &str, words: &[&str]) {
-    let (line, column, message) = refusal(text);
-    assert_eq!((line, column), mimic_position(text, joint), "{message}");
-    assert!(message.starts_with(&format!("mimic joint '{joint}': ")), "{message}");
-    for word in words {
-        assert!(message.contains(word), "{word:?} not in: {message}");
-    }
-}
-
 #[test]
 fn a_revolute_mimic_on_a_parallel_offset_axis_is_refused_as_a_parallelogram() {
     let wrist =
@@ -258,18 +171,8 @@ fn a_revolute_mimic_on_a_crossing_axis_is_refused() {
 }
 
 #[test]
-fn a_mimic_of_a_joint_off_the_chain_or_undefined_is_refused() {
-    let off_chain = staged(SKEW_STAGE, &COAXIAL_WRIST.replace("joint=\"turn\"", "joint=\"gripper\"")).replace(
-        "</robot>",
-        "  <link name=\"finger\"/>\n  <joint name=\"gripper\" type=\"prismatic\"><parent link=\"tip\"/><child link=\"finger\"/><axis xyz=\"1 0 0\"/><limit lower=\"0\" upper=\"0.1\" effort=\"1\" velocity=\"1\"/></joint>\n</robot>",
-    );
-    let ends = ChainEnds { base_link: None, tip_link: Some("tip".into()) };
-    let error = UrdfDocument::parse(&off_chain, "arm.urdf").and_then(|d| d.chain(&ends)).unwrap_err();
-    let (Some((line, column)), ErrorKind::UrdfFormat { message }) = (error.position(), error.kind()) else {
-        panic!("{error:?}")
-    };
-    assert_eq!((line as usize, column), mimic_position(&off_chain, "turn_stage"), "{message}");
-    assert!(message.contains("follows joint 'gripper', which is not on the calibrated chain"), "{message}");
+fn a_mimic_of_an_undefined_joint_is_refused() {
+    // Joints beside the chain drive stages too (`urdf_mimic_beside.rs`); a name the URDF lacks does not.
     let undefined = staged(SKEW_STAGE, &COAXIAL_WRIST.replace("joint=\"turn\"", "joint=\"nowhere\""));
     assert_refused(&undefined, "turn_stage", &["'nowhere', which the URDF does not define"]);
 }

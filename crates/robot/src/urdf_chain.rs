@@ -11,7 +11,7 @@
 //! load model's data where every joint's body has one (`urdf_inertial.rs`).
 
 use crate::urdf_inertial::{ChainMasses, LinkInertial, LinkTree, chain_masses, read_inertials};
-use crate::urdf_mimic::{ChainJoint, fold, folded_joint};
+use crate::urdf_mimic::{ChainJoint, OffChain, fold, folded_joint};
 use crate::urdf_model::{UrdfJoint, UrdfJointType, UrdfRobot, read_robot};
 use crate::urdf_steps::{ChainStep, StepMimic, StepMotion};
 use crate::xml_outline::{Element, Position, outline};
@@ -72,6 +72,8 @@ struct NameIndex {
     parent_joint: HashMap<String, usize>,
     /// Parent link → the joints below it, in file order.
     child_joints: HashMap<String, Vec<usize>>,
+    /// Joint name → its index into `robot.joints`.
+    joints: HashMap<String, usize>,
     /// `(element name, name attribute)` → index among the outline's children (the first one).
     elements: HashMap<(String, String), usize>,
 }
@@ -187,6 +189,7 @@ impl UrdfDocument {
                 ));
             }
             index.child_joints.entry(joint.parent.clone()).or_default().push(j);
+            index.joints.insert(joint.name.clone(), j);
         }
         self.index = index;
         Ok(())
@@ -257,8 +260,8 @@ impl UrdfDocument {
             ));
         }
         let frames = link_frames(&steps);
-        let defined = |name: &str| self.element("joint", name).is_some();
-        let joints = fold(&steps, &frames, &defined).map_err(|refusal| {
+        let off_chain = self.off_chain_drivers(&steps, &from_base, &base, &tip)?;
+        let joints = fold(&steps, &frames, &off_chain).map_err(|refusal| {
             let name = &steps[refusal.step].joint;
             let element = self.element("joint", name);
             let (line, column) =
@@ -278,6 +281,39 @@ impl UrdfDocument {
             dynamics,
             joints_without_mass,
         })
+    }
+
+    /// The joints the chain's mimic joints follow that are defined but not on the chain, by name:
+    /// above the chain (`above` are the base link and its ancestors), of a kind that drives no
+    /// stage, or beside the chain, read as a step (a bad value refused at its element).
+    fn off_chain_drivers(
+        &self,
+        steps: &[ChainStep],
+        above: &[String],
+        base: &str,
+        tip: &str,
+    ) -> Result<HashMap<String, OffChain>, Error> {
+        let on_chain: HashSet<&str> = steps.iter().map(|s| s.joint.as_str()).collect();
+        let above_base: HashSet<&str> =
+            above.iter().filter_map(|link| self.parent_joint(link)).map(|j| j.name.as_str()).collect();
+        let mut drivers = HashMap::new();
+        for mimic in steps.iter().filter_map(|s| s.mimic.as_ref()) {
+            let name = mimic.joint.as_str();
+            if on_chain.contains(name) || drivers.contains_key(name) {
+                continue;
+            }
+            let Some(joint) = self.index.joints.get(name).and_then(|&j| self.robot.joints.get(j)) else { continue };
+            use UrdfJointType as T;
+            let driver = match joint.joint_type {
+                _ if above_base.contains(name) => OffChain::AboveBase,
+                T::Fixed | T::Revolute | T::Continuous | T::Prismatic => {
+                    OffChain::Beside(Box::new(self.step(&joint.child, false, base, tip)?))
+                }
+                other => OffChain::Unsupported(other.name()),
+            };
+            drivers.insert(name.to_owned(), driver);
+        }
+        Ok(drivers)
     }
 
     fn root_link(&self) -> Result<String, Error> {
@@ -512,7 +548,9 @@ impl UrdfChain {
         let frames = self.link_frames();
         let mut joints = Vec::new();
         for joint in &self.joints {
-            let (step, frame) = (&self.steps[joint.actuated], frames[joint.actuated]);
+            // The kind and limits are the actuated joint's; the point its first step's child link's
+            // origin, on the summed axis (revolute stages are coaxial).
+            let (step, frame) = (joint.actuated(&self.steps), frames[joint.first]);
             let (kind, limits_deg, limits_m) = match step.motion {
                 StepMotion::Fixed => continue,
                 StepMotion::Revolute { limits_rad } => {

@@ -143,7 +143,7 @@ pub(crate) fn chain_masses(
     let mut visited: HashSet<String> = HashSet::new();
     for (k, step) in steps.iter().enumerate() {
         if step.motion != StepMotion::Fixed {
-            carrier = joints.iter().position(|j| j.actuated == k || j.stages.contains(&k));
+            carrier = joints.iter().position(|j| j.first == k || j.stages.contains(&k));
         }
         let Some(body) = carrier.and_then(|i| bodies.get_mut(i)) else { continue };
         let mut stack = vec![(step.to_link.clone(), frames[k])];

@@ -8,26 +8,57 @@
 //! each other, and the fixed rotations between them only turn their directions), or rotations
 //! about one line (coaxial revolute stages: the angles add). The offsets `o_i` go into the fixed
 //! transforms `C` (the zero configuration has the mimics at their offsets). The summed twist is a
-//! unit twist times `|ξ_a + Σ m_i ξ_i|`, the joint's `scale`. Anything else (a parallelogram's
-//! mimic on a parallel but offset axis, a mimic of a joint off the chain, a movable joint between
-//! the stages, a revolute stage on a prismatic joint) does not commute and is refused.
+//! unit twist times `|ξ_a + Σ m_i ξ_i|`, the joint's `scale`.
+//!
+//! Shipped URDFs often draw a telescopic column (or a gripper) as one actuated joint that moves a
+//! pseudo link beside the chain, the chain itself running through two or more mimic stages of it.
+//! The driver's value is still the joint value (the measurements' column for that motor): its
+//! stages fold the same way with `ξ_a` left out of the sum, `exp((Σ m_i ξ_i) q) · C`, and the
+//! joint takes the driver's kind and limits. Anything else (a parallelogram's mimic on a parallel
+//! but offset axis, stages of one driver with another joint moving between them, a driver that is
+//! itself a mimic or moves the chain's base link, a revolute stage on a prismatic joint) does not
+//! commute or does not close on the chain and is refused.
 
 use crate::urdf_steps::{ChainStep, StepMotion};
 use crate::{FoldedJoint, MimicStage};
 use lie::{SE3, SO3, Vector3};
+use std::collections::HashMap;
 
-/// One joint of the description: an actuated joint of the chain and the mimic joints folded into it.
+/// One joint of the description: an actuated joint and the mimic joints folded into it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChainJoint {
-    /// The actuated joint, as an index into the chain's steps.
-    pub actuated: usize,
-    /// The mimic joints that follow it, as indices into the chain's steps.
+    /// The joint's first step on the chain, as an index into the chain's steps: its actuated
+    /// joint, or its first mimic stage where the joint that drives the stages is beside the chain.
+    pub first: usize,
+    /// The mimic joints that follow it, as indices into the chain's steps, base first (`first`
+    /// among them where the driver is beside the chain).
     pub stages: Vec<usize>,
+    /// The actuated joint where it is not on the chain (a column's motor moving a pseudo link):
+    /// read as a step of its own, whose `from_to` means nothing for the chain.
+    pub driver_beside: Option<ChainStep>,
     /// The unit direction of the summed motion in the base link's frame at the zero configuration
     /// (the actuated joint's axis where nothing is folded).
     pub direction: Vector3,
     /// The summed motion per unit of the joint value, `|ξ_a + Σ m_i ξ_i|` (1 where nothing is folded).
     pub scale: f64,
+}
+
+impl ChainJoint {
+    /// The actuated joint: its value is the joint value, its kind and limits the joint's.
+    pub fn actuated<'a>(&'a self, steps: &'a [ChainStep]) -> &'a ChainStep {
+        self.driver_beside.as_ref().unwrap_or(&steps[self.first])
+    }
+}
+
+/// A joint that chain steps follow but that is not on the chain, as the chain's reader found it.
+#[derive(Debug, Clone)]
+pub(crate) enum OffChain {
+    /// A joint above the chain's base link: it moves the base link itself.
+    AboveBase,
+    /// A floating or planar joint (its type's name): it drives no stage the chain can fold.
+    Unsupported(&'static str),
+    /// A joint beside the chain, read as a step.
+    Beside(Box<ChainStep>),
 }
 
 /// Largest angle between two revolute stages' axes, and largest distance of one stage's axis from
@@ -60,21 +91,13 @@ impl ChainStep {
     }
 }
 
-fn kind_name(motion: StepMotion) -> &'static str {
-    match motion {
-        StepMotion::Fixed => "fixed",
-        StepMotion::Revolute { .. } => "revolute",
-        StepMotion::Prismatic { .. } => "prismatic",
-    }
-}
-
 /// The chain's joints with every mimic joint folded into the joint it follows. `frames` are the
-/// steps' `base_from_to_link` at the zero configuration (mimics at their offsets), `defined`
-/// tells whether the URDF has a joint of that name at all.
+/// steps' `base_from_to_link` at the zero configuration (mimics at their offsets), `off_chain`
+/// the joints the chain's mimic joints follow that are defined in the URDF but not on the chain.
 pub(crate) fn fold(
     steps: &[ChainStep],
     frames: &[SE3],
-    defined: &dyn Fn(&str) -> bool,
+    off_chain: &HashMap<String, OffChain>,
 ) -> Result<Vec<ChainJoint>, FoldRefusal> {
     let axis = |k: usize| frames[k].rotation().act(&steps[k].axis);
     let mut joints: Vec<ChainJoint> = Vec::new();
@@ -83,20 +106,19 @@ pub(crate) fn fold(
             continue;
         }
         let Some(mimic) = &step.mimic else {
-            joints.push(ChainJoint { actuated: k, stages: Vec::new(), direction: axis(k), scale: 1.0 });
+            joints.push(ChainJoint {
+                first: k,
+                stages: Vec::new(),
+                driver_beside: None,
+                direction: axis(k),
+                scale: 1.0,
+            });
             continue;
         };
         let refuse = |message: String| FoldRefusal { step: k, message };
         let Some(a) = steps.iter().position(|s| s.joint == mimic.joint) else {
-            return Err(refuse(if defined(&mimic.joint) {
-                format!(
-                    "follows joint '{}', which is not on the calibrated chain: the chain's motion would depend on a \
-                     joint the measurements do not carry; choose the chain's ends with --base-link/--tip-link",
-                    mimic.joint
-                )
-            } else {
-                format!("follows joint '{}', which the URDF does not define", mimic.joint)
-            }));
+            fold_beside(steps, frames, k, off_chain.get(&mimic.joint), &mut joints).map_err(refuse)?;
+            continue;
         };
         let actuated = &steps[a];
         if actuated.motion == StepMotion::Fixed {
@@ -125,37 +147,9 @@ pub(crate) fn fold(
                 mimic.joint, other.joint
             )));
         }
-        let (kind, actuated_kind) = (kind_name(step.motion), kind_name(actuated.motion));
-        if kind != actuated_kind {
-            return Err(refuse(format!(
-                "a {kind} joint following the {actuated_kind} joint '{}': only translations, or rotations about one \
-                 line, add into one joint",
-                mimic.joint
-            )));
-        }
-        if matches!(step.motion, StepMotion::Revolute { .. }) {
-            let (u, v) = (axis(a), axis(k));
-            let angle = u.cross(&v).norm().atan2(u.dot(&v).abs());
-            let offset = frames[k].translation() - frames[a].translation();
-            let distance = (offset - u * u.dot(&offset)).norm();
-            if angle > COAXIAL_ANGLE_RAD {
-                return Err(refuse(format!(
-                    "its axis is at {:.4} deg to the axis of joint '{}': only rotations about one line add into one \
-                     joint",
-                    angle.to_degrees(),
-                    mimic.joint
-                )));
-            }
-            if distance > COAXIAL_DISTANCE_M {
-                return Err(refuse(format!(
-                    "its axis is parallel to the axis of joint '{}' but {:.6} m from it (a parallelogram): rotations \
-                     about different lines do not add into one joint, and the loop they close cannot be calibrated \
-                     as a serial chain",
-                    mimic.joint, distance
-                )));
-            }
-        }
-        let Some(joint) = joints.iter_mut().find(|j| j.actuated == a) else {
+        same_kind(step, actuated).map_err(refuse)?;
+        coaxial(steps, frames, a, k).map_err(refuse)?;
+        let Some(joint) = joints.iter_mut().find(|j| j.first == a && j.driver_beside.is_none()) else {
             return Err(refuse(format!("follows joint '{}', which is not a joint of the chain", mimic.joint)));
         };
         joint.stages.push(k);
@@ -164,20 +158,22 @@ pub(crate) fn fold(
         if joint.stages.is_empty() {
             continue;
         }
-        let sum = joint.stages.iter().fold(axis(joint.actuated), |sum, &k| {
-            sum + axis(k) * steps[k].mimic.as_ref().map_or(0.0, |m| m.multiplier)
-        });
+        // A driver beside the chain moves nothing on it: only its stages' motions add.
+        let own = if joint.driver_beside.is_some() { Vector3::zeros() } else { axis(joint.first) };
+        let sum = joint
+            .stages
+            .iter()
+            .fold(own, |sum, &k| sum + axis(k) * steps[k].mimic.as_ref().map_or(0.0, |m| m.multiplier));
         let scale = sum.norm();
-        let last = joint.stages.last().copied().unwrap_or(joint.actuated);
+        let last = joint.stages.last().copied().unwrap_or(joint.first);
         if !crate::description::scale_in_bounds(scale) {
             let (lo, hi) = crate::description::SCALE_BOUNDS;
+            let name = &joint.actuated(steps).joint;
             return Err(FoldRefusal {
                 step: last,
                 message: format!(
-                    "with joint '{}' and its other stages it moves {scale:e} per unit of '{}', outside {lo:e} … {hi:e}: \
-                     {}",
-                    steps[joint.actuated].joint,
-                    steps[joint.actuated].joint,
+                    "with joint '{name}' and its other stages it moves {scale:e} per unit of '{name}', outside {lo:e} \
+                     … {hi:e}: {}",
                     if scale < lo {
                         "the stages cancel, the motor moves nothing"
                     } else {
@@ -190,6 +186,117 @@ pub(crate) fn fold(
         joint.scale = scale;
     }
     Ok(joints)
+}
+
+/// Folds the mimic step `k`, whose driver is not on the chain (`driver` as the chain's reader
+/// found it, `None` where the URDF does not define it), into the joint of that driver's stages
+/// (made at its first stage). The message says why it does not fold.
+fn fold_beside(
+    steps: &[ChainStep],
+    frames: &[SE3],
+    k: usize,
+    driver: Option<&OffChain>,
+    joints: &mut Vec<ChainJoint>,
+) -> Result<(), String> {
+    let Some(mimic) = &steps[k].mimic else { return Ok(()) };
+    let name = &mimic.joint;
+    let driver = match driver {
+        None => return Err(format!("follows joint '{name}', which the URDF does not define")),
+        Some(OffChain::AboveBase) => {
+            return Err(format!(
+                "follows joint '{name}', which moves the chain's base link itself: the chain's motion would depend \
+                 on a joint whose motion the measurements do not see; choose a base link above it with --base-link"
+            ));
+        }
+        Some(OffChain::Unsupported(kind)) => {
+            return Err(format!(
+                "follows joint '{name}', a {kind} joint: only a revolute, continuous or prismatic joint drives stages"
+            ));
+        }
+        Some(OffChain::Beside(driver)) => driver.as_ref(),
+    };
+    if driver.motion == StepMotion::Fixed {
+        return Err(format!("follows joint '{name}', a fixed joint"));
+    }
+    if let Some(other) = &driver.mimic {
+        return Err(format!(
+            "follows joint '{name}', beside the chain, which is itself a mimic joint of '{}': a stage's motion \
+             would be a second fold away from any joint the measurements carry; name the joint that drives both",
+            other.joint
+        ));
+    }
+    same_kind(&steps[k], driver)?;
+    let Some(joint) = joints.iter_mut().find(|j| j.driver_beside.as_ref().is_some_and(|d| d.joint == *name)) else {
+        joints.push(ChainJoint {
+            first: k,
+            stages: vec![k],
+            driver_beside: Some(driver.clone()),
+            direction: frames[k].rotation().act(&steps[k].axis),
+            scale: 1.0,
+        });
+        return Ok(());
+    };
+    // Stages are pushed base first, so a movable joint after the last one is not a stage of it.
+    let last = joint.stages.last().copied().unwrap_or(joint.first);
+    if let Some(other) = steps[last + 1..k].iter().find(|s| s.motion != StepMotion::Fixed) {
+        return Err(format!(
+            "follows joint '{name}' as stage '{}' does, but joint '{}' moves between them: the stages' motions do \
+             not add into one joint (only stages separated from each other by fixed joints fold)",
+            steps[last].joint, other.joint
+        ));
+    }
+    coaxial(steps, frames, joint.first, k)?;
+    joint.stages.push(k);
+    Ok(())
+}
+
+fn kind_name(motion: StepMotion) -> &'static str {
+    match motion {
+        StepMotion::Fixed => "fixed",
+        StepMotion::Revolute { .. } => "revolute",
+        StepMotion::Prismatic { .. } => "prismatic",
+    }
+}
+
+/// Refuses a stage of another kind than the joint it follows: a turn and a slide do not add.
+fn same_kind(stage: &ChainStep, actuated: &ChainStep) -> Result<(), String> {
+    let (kind, actuated_kind) = (kind_name(stage.motion), kind_name(actuated.motion));
+    if kind != actuated_kind {
+        return Err(format!(
+            "a {kind} joint following the {actuated_kind} joint '{}': only translations, or rotations about one line, \
+             add into one joint",
+            actuated.joint
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a revolute stage `k` whose axis is not the line of step `a` (the joint it follows, or
+/// the first stage of a driver beside the chain); prismatic stages always commute.
+fn coaxial(steps: &[ChainStep], frames: &[SE3], a: usize, k: usize) -> Result<(), String> {
+    if !matches!(steps[k].motion, StepMotion::Revolute { .. }) {
+        return Ok(());
+    }
+    let (u, v) = (frames[a].rotation().act(&steps[a].axis), frames[k].rotation().act(&steps[k].axis));
+    let angle = u.cross(&v).norm().atan2(u.dot(&v).abs());
+    let offset = frames[k].translation() - frames[a].translation();
+    let distance = (offset - u * u.dot(&offset)).norm();
+    let other = &steps[a].joint;
+    if angle > COAXIAL_ANGLE_RAD {
+        return Err(format!(
+            "its axis is at {:.4} deg to the axis of joint '{other}': only rotations about one line add into one \
+             joint",
+            angle.to_degrees()
+        ));
+    }
+    if distance > COAXIAL_DISTANCE_M {
+        return Err(format!(
+            "its axis is parallel to the axis of joint '{other}' but {distance:.6} m from it (a parallelogram): \
+             rotations about different lines do not add into one joint, and the loop they close cannot be \
+             calibrated as a serial chain"
+        ));
+    }
+    Ok(())
 }
 
 /// What a folded joint of the description records: the URDF joints and their multipliers.
@@ -205,5 +312,5 @@ pub(crate) fn folded_joint(index: usize, joint: &ChainJoint, steps: &[ChainStep]
             Some(MimicStage { joint: steps[k].joint.clone(), multiplier: mimic.multiplier, offset: mimic.offset })
         })
         .collect();
-    Some(FoldedJoint { joint: index + 1, actuated: steps[joint.actuated].joint.clone(), stages, scale: joint.scale })
+    Some(FoldedJoint { joint: index + 1, actuated: joint.actuated(steps).joint.clone(), stages, scale: joint.scale })
 }
