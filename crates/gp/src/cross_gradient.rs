@@ -12,9 +12,9 @@ use faer::{Accum, Mat, MatRef};
 use rayon::prelude::*;
 
 use crate::config::Parallelism;
-use crate::dense::product;
 use crate::gram::as_matrix;
 use crate::kernel::{Evaluator, Expanded, Prepared};
+use dense::product;
 
 fn squared_norms(rows: MatRef<'_, f64>) -> Vec<f64> {
     (0..rows.nrows()).map(|i| (0..rows.ncols()).map(|d| rows[(i, d)] * rows[(i, d)]).sum()).collect()

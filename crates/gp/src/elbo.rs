@@ -22,10 +22,10 @@ use crate::Error;
 use crate::cholesky::{Factor, JitterOutcome};
 use crate::config::{JitterConfig, Parallelism};
 use crate::cross_gradient::contract_cross;
-use crate::dense::product;
 use crate::gram::{cross_covariance, prior_variances, training_covariance};
 use crate::kernel::{Evaluator, Expanded, Kernel, Prepared};
 use crate::points::Points;
+use dense::product;
 
 /// Rows per chunk: a `m × 2048` block is 8 MB at `m = 500`, small beside `K_uu`'s factors yet
 /// wide enough for faer's products to run at full speed.

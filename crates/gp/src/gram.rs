@@ -11,7 +11,7 @@
 //! reductions sum one partial vector per column in column order: with faer's products, which
 //! split work by output blocks, the results are the same serial or parallel (tested to the bit).
 
-use crate::dense::product;
+use dense::product;
 use faer::col::ColMut;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::reborrow::{Reborrow, ReborrowMut};
@@ -22,7 +22,7 @@ use crate::additive;
 use crate::config::Parallelism;
 use crate::kernel::{Evaluator, Expanded, Prepared, StationaryShape};
 use crate::points::Points;
-use crate::stationary;
+use dense::stationary;
 
 /// Runs `f(j, column j)` over the columns, in parallel or not.
 fn for_each_column(mat: MatMut<'_, f64>, par: Parallelism, f: impl Fn(usize, ColMut<'_, f64>) + Sync + Send) {
@@ -238,7 +238,7 @@ pub(crate) fn prior_variances(kernel: &Evaluator, z: &Prepared) -> Vec<f64> {
 /// `sym(A) R` where only the lower triangle of `A` is meaningful: `tril(A) R + stril(A)ᵀ R`.
 fn symmetric_product(a: MatRef<'_, f64>, r: MatRef<'_, f64>, par: Parallelism) -> Mat<f64> {
     let mut out = Mat::zeros(a.nrows(), r.ncols());
-    // One column: a matrix–vector product, whose sums faer splits by thread count (crate::dense).
+    // One column: a matrix–vector product, whose sums faer splits by thread count (dense::product).
     let par = if r.ncols() <= 1 { Parallelism::Sequential } else { par };
     triangular::matmul(
         out.as_mut(),

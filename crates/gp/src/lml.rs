@@ -15,12 +15,12 @@ use faer::{Accum, Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
 use crate::Error;
-use crate::cholesky::{FactorOptions, cholesky_lower_in_place};
 use crate::config::Parallelism;
-use crate::dense::{solve_lower, solve_upper_transposed};
 use crate::gram::{contract_gradient, fill_training_lower};
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::points::Points;
+use dense::{FactorOptions, cholesky_lower_in_place};
+use dense::{solve_lower, solve_upper_transposed};
 
 /// The log marginal likelihood and, if asked for, its gradient in the kernel's log-parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -104,7 +104,7 @@ impl Default for LmlWorkspace {
 impl LmlWorkspace {
     /// An empty workspace whose factorisations use `options` (validated here).
     pub fn with_options(options: FactorOptions) -> Result<Self, Error> {
-        options.validate()?;
+        options.validate().map_err(|field| Error::InvalidConfig { field, value: 0.0 })?;
         Ok(Self { options, ..Self::default() })
     }
 

@@ -1,6 +1,6 @@
 //! Posterior prediction of the exact GP (R&W Algorithm 2.1, Eqs. 2.25–2.26).
 
-use crate::dense::product;
+use dense::product;
 use faer::{Accum, Mat, MatRef};
 use serde::{Deserialize, Serialize};
 

@@ -12,7 +12,7 @@
 //! The stored model is the posterior itself (inducing inputs, `w` and `L_B`), not the training
 //! data: a model fitted on 100,000 poses reads back in milliseconds.
 
-use crate::dense::product;
+use dense::product;
 use faer::{Accum, Mat, MatRef};
 use serde::{Deserialize, Serialize};
 

@@ -2,7 +2,7 @@
 //! training matrix's strict lower triangle at a time, with `r² = ‖xᵢ‖² + ‖xⱼ‖² − 2 xᵢᵀxⱼ` from the
 //! inner products a matrix product left in the column.
 //!
-//! As in [`crate::additive`]: [`exp_nonpositive`] instead of the library's `exp`, and `pulp`'s
+//! As in [`crate::one_input`]: [`exp_nonpositive`] instead of the library's `exp`, and `pulp`'s
 //! run-time dispatch so that the loops are compiled for AVX2 + FMA (and AVX-512) and vectorised.
 //! Profiled on the UR10 fit (n = 1,387, d = 6, additive default kernel, serial), the library `exp`
 //! and the scalar closures of these two loops took 17 % of the whole fit. Measured with
@@ -10,7 +10,7 @@
 //! additive 0.093 → 0.085 s, against a floor of 0.051 s. The Matérn shape keeps the scalar path in
 //! `gram.rs`.
 
-use crate::additive::{ARCH, LANES, exp_nonpositive, pairwise};
+use crate::exp::{ARCH, LANES, exp_nonpositive, pairwise};
 
 /// `r²`, never negative (round-off can make the expansion slightly negative).
 #[inline(always)]
@@ -123,19 +123,12 @@ impl pulp::WithSimd for WeighCached<'_> {
 }
 
 /// [`fill_caching`] on the widest instruction set of this processor.
-pub(crate) fn fill_column_caching(
-    out: &mut [f64],
-    cache: &mut [f64],
-    sq: &[f64],
-    sq_j: f64,
-    signal: f64,
-    constant: f64,
-) {
+pub fn fill_column_caching(out: &mut [f64], cache: &mut [f64], sq: &[f64], sq_j: f64, signal: f64, constant: f64) {
     ARCH.with(|arch| arch.dispatch(FillCaching { out, cache, sq, sq_j, signal, constant }))
 }
 
 /// [`weigh_cached`] on the widest instruction set of this processor.
-pub(crate) fn weigh_column_cached(m: &mut [f64], w: &[f64], cache: &[f64]) -> (f64, f64) {
+pub fn weigh_column_cached(m: &mut [f64], w: &[f64], cache: &[f64]) -> (f64, f64) {
     ARCH.with(|arch| arch.dispatch(WeighCached { m, w, cache }))
 }
 
@@ -172,12 +165,12 @@ impl pulp::WithSimd for Weigh<'_> {
 }
 
 /// [`fill`] on the widest instruction set of this processor.
-pub(crate) fn fill_column(out: &mut [f64], sq: &[f64], sq_j: f64, signal: f64, constant: f64) {
+pub fn fill_column(out: &mut [f64], sq: &[f64], sq_j: f64, signal: f64, constant: f64) {
     ARCH.with(|arch| arch.dispatch(Fill { out, sq, sq_j, signal, constant }))
 }
 
 /// [`weigh`] on the widest instruction set of this processor.
-pub(crate) fn weigh_column(m: &mut [f64], w: &[f64], sq: &[f64], sq_j: f64, signal: f64) -> (f64, f64) {
+pub fn weigh_column(m: &mut [f64], w: &[f64], sq: &[f64], sq_j: f64, signal: f64) -> (f64, f64) {
     ARCH.with(|arch| arch.dispatch(Weigh { m, w, sq, sq_j, signal }))
 }
 

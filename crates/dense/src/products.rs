@@ -19,26 +19,19 @@ fn for_columns(columns: usize, par: Par) -> Par {
 }
 
 /// `rhs ← L⁻¹ rhs`.
-pub(crate) fn solve_lower(l: MatRef<'_, f64>, rhs: MatMut<'_, f64>, par: Par) {
+pub fn solve_lower(l: MatRef<'_, f64>, rhs: MatMut<'_, f64>, par: Par) {
     let par = for_columns(rhs.ncols(), par);
     triangular_solve::solve_lower_triangular_in_place(l, rhs, par);
 }
 
 /// `rhs ← L⁻ᵀ rhs`.
-pub(crate) fn solve_upper_transposed(l: MatRef<'_, f64>, rhs: MatMut<'_, f64>, par: Par) {
+pub fn solve_upper_transposed(l: MatRef<'_, f64>, rhs: MatMut<'_, f64>, par: Par) {
     let par = for_columns(rhs.ncols(), par);
     triangular_solve::solve_upper_triangular_in_place(l.transpose(), rhs, par);
 }
 
 /// `dst ← accum(dst) + alpha · a b`.
-pub(crate) fn product(
-    dst: MatMut<'_, f64>,
-    accum: Accum,
-    a: MatRef<'_, f64>,
-    b: MatRef<'_, f64>,
-    alpha: f64,
-    par: Par,
-) {
+pub fn product(dst: MatMut<'_, f64>, accum: Accum, a: MatRef<'_, f64>, b: MatRef<'_, f64>, alpha: f64, par: Par) {
     let par = for_columns(dst.ncols(), par);
     matmul::matmul(dst, accum, a, b, alpha, par);
 }
