@@ -113,4 +113,23 @@ impl ExactGp {
         }
         Ok(Prediction { mean, variance, covariance, prior_variance })
     }
+
+    /// The prior variance of every output at the rows of `x` (`n × m`, output units², noise
+    /// excluded): [`Prediction::prior_variance`] without the cross-covariance and the solves the
+    /// posterior needs, `O(n d)` instead of `O(n² N)`.
+    pub fn prior_variance(&self, x: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
+        let z = self.inputs.apply(x)?;
+        let mut prior_variance = Mat::zeros(z.len(), self.output_count());
+        for c in &self.components {
+            let (_, zp) = c.kernel.prepare(&z);
+            let prior = prior_variances(&c.evaluator, &zp);
+            for &out in &c.outputs {
+                let s = self.outputs.scale[out];
+                for (i, p) in prior.iter().enumerate() {
+                    prior_variance[(i, out)] = p * s * s;
+                }
+            }
+        }
+        Ok(prior_variance)
+    }
 }

@@ -110,3 +110,25 @@ fn the_prior_variance_bounds_the_posterior_and_is_reached_far_from_the_data() {
     let options = PredictOptions { variance: false, full_covariance: false, include_noise: false };
     assert_eq!(model.predict_with(x.as_ref(), &options).expect("predict").prior_variance.nrows(), 0);
 }
+
+#[test]
+fn the_prior_variance_alone_is_the_predictions_to_the_bit() {
+    let (n, d) = (30, 2);
+    let mut r = rng(6);
+    let x = uniform_points(&mut r, n, d, -3.0, 3.0);
+    // Two outputs of different scales, so that each output's normalisation shows.
+    let y = Mat::from_fn(n, 2, |i, j| (40.0 * x[(i, 0)].sin() + 3.0 * x[(i, 1)]) * [1.0, 0.01][j] + 7.0);
+    let queries = uniform_points(&mut r, 9, d, -6.0, 6.0);
+    for kernel in kernels(d) {
+        let model = ExactGp::fit_fixed(x.as_ref(), y.as_ref(), &[kernel.clone(), kernel.clone()], &GpConfig::default())
+            .expect("fit");
+        let full = model.predict(queries.as_ref()).expect("predict").prior_variance;
+        let alone = model.prior_variance(queries.as_ref()).expect("prior variance");
+        assert_eq!((alone.nrows(), alone.ncols()), (9, 2));
+        for i in 0..9 {
+            for j in 0..2 {
+                assert_eq!(alone[(i, j)].to_bits(), full[(i, j)].to_bits(), "{kernel:?} ({i}, {j})");
+            }
+        }
+    }
+}

@@ -147,11 +147,21 @@ impl Default for ResidualGpOptions {
         // 0.1361, B 0.2622 → 0.2600, the simulated sets within 0.0005 mm), and the likelihood
         // reached fell by 4.3 nats summed over the 24 searches. 1e-5 with memory 10 lost 20 nats
         // and memory 30 lost 15; 3e-6 with memory 20 took 13.0 s.
+        //
+        // The full-data search after the subset's starts at the subset's optimum and stops at
+        // 1e-4 (`refine_function_tolerance`, ≈ 0.1–0.3 nats per iteration on these data): from
+        // there it climbed a few hundredths of a nat per iteration for half of its iterations,
+        // each an `n³` factorisation on every row. `calib fit --method poe-gp` on UR10 C and B,
+        // even rows → odd rows, subset seeds 0–3 (docs/results/gp-search-time.md): full-data
+        // evaluations summed over the seeds 833 → 488 (C), 915 → 572 (B); the held-out position
+        // error's mean over the seeds +0.5 % (C), +0.2 % (B), the largest single seed +1.6 %,
+        // inside the spread between seeds (2.5 % on C).
         let optimiser = gp::OptimiserConfig {
             restarts: 0,
             warm_start_rows: 500,
             memory: 20,
             function_tolerance: 1e-5,
+            refine_function_tolerance: Some(1e-4),
             ..gp::OptimiserConfig::default()
         };
         Self {
@@ -550,7 +560,18 @@ fn median_share(gp: &GpModel, x: &Mat<f64>, loo: Option<&gp::LeaveOneOut>, spars
         let every_kth = Mat::from_fn(rows.len(), x.ncols(), |i, j| x[(rows[i], j)]);
         return median_share(gp, &every_kth, None, sparse_rows);
     }
-    let mut prediction = gp.predict(x.as_ref()).map_err(Error::gp)?;
+    let mut prediction = match gp {
+        GpModel::Sparse(_) => gp.predict(x.as_ref()).map_err(Error::gp)?,
+        // The leave-one-out variances stand for the posterior's at the training rows, so only the
+        // prior variance is needed beside them (a posterior variance would cost a solve with
+        // every row as a right-hand side).
+        GpModel::Exact(exact) => gp::Prediction {
+            mean: Mat::zeros(0, 0),
+            variance: Mat::zeros(x.nrows(), exact.output_count()),
+            covariance: Vec::new(),
+            prior_variance: exact.prior_variance(x.as_ref()).map_err(Error::gp)?,
+        },
+    };
     if let GpModel::Exact(exact) = gp {
         let computed;
         let loo = match loo {
@@ -587,7 +608,7 @@ pub fn gp_weight(fade_above: Option<f64>, ratio: f64) -> f64 {
 /// The share of the prior variance of the position outputs (the first three) the posterior keeps
 /// at row `i`, pooled over them; 0 where the prior has none.
 fn kept_share(prediction: &gp::Prediction, i: usize) -> f64 {
-    let outputs = prediction.mean.ncols().min(3);
+    let outputs = prediction.variance.ncols().min(3);
     let kept: f64 = (0..outputs).map(|c| prediction.variance[(i, c)].max(0.0)).sum();
     let prior: f64 = (0..outputs).map(|c| prediction.prior_variance[(i, c)]).sum();
     if prior > 0.0 { (kept / prior).min(1.0) } else { 0.0 }
