@@ -327,16 +327,19 @@ payloads\"; the arm's own weight on joints this soft would leave POE 5 mm)"
                 "{:?} kernel, {:?} residual frame, {:?} outputs, random restarts: {}, inputs standardised: {}",
                 gp.kernel, o.residual_gp.residual_frame, gp.outputs, gp.optimiser.restarts, gp.standardise_inputs
             ),
-            "pipeline `ResidualGpOptions::default()`, but 1 random restart (default 3) and one thread per fit, for \
-the 60 s budget: with 3 restarts the physical preset's table is the same to the micrometre",
+            "pipeline `ResidualGpOptions::default()` (no random restart, as `calib fit`), but one thread per fit: the \
+fits themselves run in parallel",
         );
     }
     if let Some(o) = p.fit_options.get("paper:poe-gp") {
         row(
             "GP (Eq. 5, Eq. 8 rows)",
             format!(
-                "{:?} kernel, {:?} residual frame, {:?} outputs",
-                o.residual_gp.gp.kernel, o.residual_gp.residual_frame, o.residual_gp.gp.outputs
+                "{:?} kernel, {:?} residual frame, {:?} outputs, random restarts: {}",
+                o.residual_gp.gp.kernel,
+                o.residual_gp.residual_frame,
+                o.residual_gp.gp.outputs,
+                o.residual_gp.gp.optimiser.restarts
             ),
             "paper Eq. 5 (Bishop PRML 6.63) and Eq. 8; one kernel for the six components because Eq. 11 uses one K \
 for all (and scikit-learn's regressor shares its kernel across the columns of a multi-output target)",
