@@ -2,7 +2,8 @@
 
 Reads the problem `cargo xtask bench-identify` writes (start model, joint values, measured poses,
 weights), fits every local transform by `scipy.optimize.least_squares` on the same weighted
-residual (point displacement and log(R' R^T)), with SciPy's finite-difference Jacobian and the
+residual (point displacement and log(R' R^T); the displacement alone where the problem says
+"full_pose": false), with SciPy's finite-difference Jacobian and the
 model evaluated for all rows at once with batched numpy products, and prints
 one JSON object: seconds per fit, held-in RMS position error, function evaluations.
 
@@ -53,6 +54,7 @@ def main():
     q = np.array(problem["q"])
     measured = [np.array(m) for m in problem["measured"]]
     wp, wr = 1.0 / problem["position_sigma_m"], 1.0 / problem["rotation_sigma_rad"]
+    full_pose = bool(problem.get("full_pose", True))
     n = q.shape[1]
     measured_p = np.array([m[:3, 3] for m in measured])
     measured_r = [m[:3, :3] for m in measured]
@@ -71,6 +73,8 @@ def main():
     def residual(x):
         t = poses(x)
         dp = (measured_p - t[:, :3, 3]) * wp
+        if not full_pose:
+            return dp.ravel()
         dr = Rotation.from_matrix(measured_r @ np.transpose(t[:, :3, :3], (0, 2, 1))).as_rotvec() * wr
         return np.hstack([dp, dr]).ravel()
 

@@ -339,7 +339,7 @@ fn sklearn(d: &Data, sizes: &[usize], restarts: usize) -> anyhow::Result<Vec<Skl
         .collect()
 }
 
-fn cpu_model() -> String {
+pub(crate) fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {

@@ -7,6 +7,7 @@ use std::path::Path;
 
 use campaign::{GeneratorConfig, Perturbation, Remount, paper_effects, payload_run_campaign, simulate_campaign};
 use faer::Mat;
+use lie::SE3;
 use measurements::{MeasurementSet, ReadOptions};
 use model::{Method, ResidualFrame, ResidualSet};
 use pipeline::FitOptions;
@@ -20,6 +21,8 @@ pub struct Residuals {
     pub train: ResidualSet,
     /// Where it is tested.
     pub test: ResidualSet,
+    /// The geometric model's poses at the test rows: what a predicted residual corrects.
+    pub test_poses: Vec<SE3>,
 }
 
 /// Rows `0, 2, 4, …` and `1, 3, 5, …`.
@@ -38,11 +41,11 @@ pub fn residuals(
     with_payload: bool,
 ) -> anyhow::Result<Residuals> {
     let (model, _) = pipeline::fit(robot, train, Method::Poe, &FitOptions::default())?;
-    let set = |data: &MeasurementSet| -> anyhow::Result<ResidualSet> {
-        let poses = model.geometric_poses(&model.bind(data)?)?;
-        Ok(ResidualSet::new(&poses, data, with_payload, ResidualFrame::ToolPoint))
-    };
-    Ok(Residuals { name, train: set(train)?, test: set(test)? })
+    let poses = |data: &MeasurementSet| -> anyhow::Result<Vec<SE3>> { Ok(model.geometric_poses(&model.bind(data)?)?) };
+    let set =
+        |poses: &[SE3], data: &MeasurementSet| ResidualSet::new(poses, data, with_payload, ResidualFrame::ToolPoint);
+    let test_poses = poses(test)?;
+    Ok(Residuals { name, train: set(&poses(train)?, train), test: set(&test_poses, test), test_poses })
 }
 
 /// A real data set from a SPEC CSV, split into even (train) and odd (test) rows, or from two files.

@@ -70,6 +70,17 @@ pub fn fit_predict(
     x_test: &Mat<f64>,
     options: &SklearnOptions,
 ) -> anyhow::Result<Option<SklearnResult>> {
+    fit_predict_with(&python(), x, y, x_test, options)
+}
+
+/// [`fit_predict`] with the interpreter `python`.
+pub fn fit_predict_with(
+    python: &Path,
+    x: &Mat<f64>,
+    y: &Mat<f64>,
+    x_test: &Mat<f64>,
+    options: &SklearnOptions,
+) -> anyhow::Result<Option<SklearnResult>> {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/bench_gp_sklearn.py");
     let dir = std::env::temp_dir().join(format!("calib-bench-gp-{}", std::process::id()));
     std::fs::create_dir_all(&dir).with_context(|| dir.display().to_string())?;
@@ -88,7 +99,7 @@ pub fn fit_predict(
     let _ = std::fs::remove_file(&response);
     let start = Instant::now();
     // Its own process group, so that a timeout ends the pool's workers with it.
-    let mut child = Command::new(python())
+    let mut child = Command::new(python)
         .process_group(0)
         .arg(&script)
         .arg(&request)

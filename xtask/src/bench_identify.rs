@@ -10,11 +10,12 @@ use anyhow::Context;
 use campaign::{Perturbation, simulated_cell};
 use lie::{Matrix4, SE3, Vector3};
 use poe::identify::{IdentificationOptions, Observation, ParameterMask, Target, identify, register};
+use poe::{JointKind, LocalPoe};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robot::RobotDescription;
 use std::fmt::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
@@ -52,17 +53,75 @@ fn matrix(t: &SE3) -> Vec<Vec<f64>> {
 struct ScipyProblem {
     local_transforms: Vec<Vec<Vec<f64>>>,
     q: Vec<Vec<f64>>,
+    /// Measured poses; for position-only data the rotation part is the identity and unused.
     measured: Vec<Vec<Vec<f64>>>,
+    /// Whether the orientation residual is fitted too (position only otherwise).
+    full_pose: bool,
     position_sigma_m: f64,
     rotation_sigma_rad: f64,
 }
 
 /// What it answers.
 #[derive(Debug, serde::Deserialize)]
-struct ScipyResult {
-    seconds: f64,
-    evaluations: u64,
-    rms_position_m: f64,
+pub struct ScipyResult {
+    /// Seconds of one `least_squares` (the median of the repeats).
+    pub seconds: f64,
+    /// Function evaluations of the last fit.
+    pub evaluations: u64,
+    /// RMS position error of the fitted model on the rows it was fitted to, m.
+    pub rms_position_m: f64,
+}
+
+/// The identification as a SciPy user writes it (`xtask/scripts/identify_scipy.py` run by
+/// `python`): every local transform of `start` and its one tool fitted by `least_squares` to
+/// `observations` (all poses or all points), weighted by the two sigmas; `repeats` fits, the median
+/// timed. The script turns every joint about its local z axis, so only revolute joints moved
+/// directly (scale 1) are accepted.
+pub fn scipy_identify(
+    python: &Path,
+    start: &LocalPoe,
+    observations: &[Observation],
+    position_sigma_m: f64,
+    rotation_sigma_rad: f64,
+    repeats: usize,
+) -> anyhow::Result<ScipyResult> {
+    if let Some(i) = start.joints().iter().position(|j| j.kind != JointKind::Revolute || j.scale != 1.0) {
+        anyhow::bail!("joint {}: identify_scipy.py models revolute joints of scale 1 only", i + 1);
+    }
+    if start.tools().len() != 1 || observations.iter().any(|o| o.tool != 0) {
+        anyhow::bail!("identify_scipy.py models one tool; the data have {}", start.tools().len());
+    }
+    let full_pose = observations.iter().all(|o| matches!(o.target, Target::Pose(_)));
+    let local = start.joints().iter().map(|j| matrix(&j.previous_from_joint_zero));
+    let problem = ScipyProblem {
+        local_transforms: local.chain(std::iter::once(matrix(&start.tools()[0]))).collect(),
+        q: observations.iter().map(|o| o.q.clone()).collect(),
+        measured: observations
+            .iter()
+            .map(|o| match o.target {
+                Target::Pose(p) if full_pose => matrix(&p),
+                Target::Pose(p) => matrix(&SE3::from_translation(p.translation())),
+                Target::Point(p) => matrix(&SE3::from_translation(p)),
+            })
+            .collect(),
+        full_pose,
+        position_sigma_m,
+        rotation_sigma_rad,
+    };
+    let path = std::env::temp_dir().join(format!("calib-identify-{}-{}.json", std::process::id(), observations.len()));
+    std::fs::write(&path, serde_json::to_string(&problem)?).with_context(|| path.display().to_string())?;
+    let script = crate::reproduce_sim::workspace_root().join("xtask/scripts/identify_scipy.py");
+    let output = Command::new(python)
+        .arg(&script)
+        .arg(&path)
+        .arg(repeats.max(1).to_string())
+        .output()
+        .with_context(|| format!("running {}", python.display()))?;
+    let _ = std::fs::remove_file(&path);
+    if !output.status.success() {
+        anyhow::bail!("{}: {}", script.display(), String::from_utf8_lossy(&output.stderr));
+    }
+    serde_json::from_slice(&output.stdout).context("reading SciPy's answer")
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
@@ -123,34 +182,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             ours_rms * 1e3
         );
         if python {
-            let local = start.joints().iter().map(|j| matrix(&j.previous_from_joint_zero));
-            let problem = ScipyProblem {
-                local_transforms: local.chain(std::iter::once(matrix(&start.tools()[0]))).collect(),
-                q: observations.iter().map(|o| o.q.clone()).collect(),
-                measured: observations
-                    .iter()
-                    .map(|o| match o.target {
-                        Target::Pose(p) => matrix(&p),
-                        Target::Point(_) => vec![],
-                    })
-                    .collect(),
-                position_sigma_m: SIGMA,
-                rotation_sigma_rad: SIGMA,
-            };
-            let path = std::env::temp_dir().join(format!("calib-identify-{rows}.json"));
-            std::fs::write(&path, serde_json::to_string(&problem)?)?;
-            let script = crate::reproduce_sim::workspace_root().join("xtask/scripts/identify_scipy.py");
             let repeats = if rows > 300 { 1 } else { args.repeats.clamp(1, 3) };
-            let output = Command::new("python3")
-                .arg(&script)
-                .arg(&path)
-                .arg(repeats.to_string())
-                .output()
-                .context("running python3")?;
-            if !output.status.success() {
-                anyhow::bail!("{}: {}", script.display(), String::from_utf8_lossy(&output.stderr));
-            }
-            let result: ScipyResult = serde_json::from_slice(&output.stdout).context("reading SciPy's answer")?;
+            let result = scipy_identify(Path::new("python3"), &start, &observations, SIGMA, SIGMA, repeats)?;
             let theirs = result.seconds;
             let _ = writeln!(
                 table,

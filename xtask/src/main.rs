@@ -1,6 +1,11 @@
 //! `cargo xtask`: the paper's experiments and project automation. `main` only dispatches; each
 //! command lives in a file of its own.
 
+mod bench_fit;
+mod bench_fit_data;
+mod bench_fit_run;
+mod bench_fit_sklearn;
+mod bench_fit_table;
 mod bench_gp;
 mod bench_gp_compare;
 mod bench_gp_kernels;
@@ -46,6 +51,8 @@ struct Cli {
 enum Command {
     /// The paper's simulation study (Fig. 1, Table I): writes docs/results/reproduce-sim.md and its box plot.
     ReproduceSim(reproduce_sim::Args),
+    /// Time the release `calib` against issue 49's budgets, beside scikit-learn in the same run; print a table.
+    BenchFit(Box<bench_fit::Args>),
     /// Time the gp crate (fit, predict, Cholesky vs peak, sparse vs exact, scikit-learn); print a markdown table.
     BenchGp(Box<bench_gp::Args>),
     /// Time the local POE identification against SciPy's least_squares on the same data; print a table.
@@ -87,6 +94,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::ReproduceSim(args) => reproduce_sim::run(args).map_err(|e| format!("{e:#}")),
+        Command::BenchFit(args) => bench_fit::run(args).map_err(|e| format!("{e:#}")),
         Command::BenchGp(args) => bench_gp::run(args).map_err(|e| format!("{e:#}")),
         Command::BenchIdentify(args) => bench_identify::run(args).map_err(|e| format!("{e:#}")),
         Command::BenchMemory(args) => bench_memory::run(args).map_err(|e| format!("{e:#}")),
