@@ -34,25 +34,7 @@ fn fill(out: &mut [f64], sq: &[f64], sq_j: f64, signal: f64, constant: f64) {
 #[inline(always)]
 fn weigh(m: &mut [f64], w: &[f64], sq: &[f64], sq_j: f64, signal: f64) -> (f64, f64) {
     fill(m, sq, sq_j, signal, 0.0);
-    let mut value = [0.0; LANES];
-    let mut weight = [0.0; LANES];
-    let (mc, wc) = (m.chunks_exact_mut(LANES), w.chunks_exact(LANES));
-    let tail = mc.len() * LANES;
-    for (mi, wi) in mc.zip(wc) {
-        for l in 0..LANES {
-            let v = wi[l] * mi[l];
-            mi[l] = v;
-            value[l] += v;
-            weight[l] += wi[l];
-        }
-    }
-    for (mi, wi) in m[tail..].iter_mut().zip(&w[tail..]) {
-        let v = wi * *mi;
-        *mi = v;
-        value[0] += v;
-        weight[0] += wi;
-    }
-    (pairwise(&value), pairwise(&weight))
+    weigh_in_place(m, w)
 }
 
 /// [`fill`] that also writes each `σf² e^{−r²/2}` (without the constant) to `cache`, as
@@ -70,6 +52,13 @@ fn fill_caching(out: &mut [f64], cache: &mut [f64], sq: &[f64], sq_j: f64, signa
 #[inline(always)]
 fn weigh_cached(m: &mut [f64], w: &[f64], cache: &[f64]) -> (f64, f64) {
     m.copy_from_slice(cache);
+    weigh_in_place(m, w)
+}
+
+/// `m[i] ← wᵢ m[i]`; returns `(Σ wᵢ m[i], Σ wᵢ)` in [`LANES`] partial sums combined in a fixed
+/// order: the second pass of [`weigh`] and [`weigh_cached`].
+#[inline(always)]
+fn weigh_in_place(m: &mut [f64], w: &[f64]) -> (f64, f64) {
     let mut value = [0.0; LANES];
     let mut weight = [0.0; LANES];
     let (mc, wc) = (m.chunks_exact_mut(LANES), w.chunks_exact(LANES));
