@@ -20,6 +20,13 @@ def robot() -> calib.Robot:
     return calib.Robot.load(ROBOT)
 
 
+def untimed(report: dict) -> dict:
+    """A fit report less its `timings`: the wall and CPU seconds of its phases differ between any
+    two runs (and the CLI's add reading and writing files), the rest is equal to the last bit."""
+    assert "timings" in report
+    return {key: value for key, value in report.items() if key != "timings"}
+
+
 def test_simulate_writes_the_file_the_cli_writes(cli, robot, tmp_path):
     theirs, ours = tmp_path / "cli.csv", tmp_path / "py.csv"
     cli.run("simulate", "--robot", ROBOT, "--rows", "50", "--seed", "9", "--full-pose", "--torques", "--out", theirs)
@@ -37,7 +44,7 @@ def test_fit_report_and_model_file_equal_the_clis(cli, robot, campaign, tmp_path
         "--effects", effects, "--out", theirs, "--json",
     )
     model = calib.fit(robot, calib.Measurements.read(campaign["train"]), method=method, effects=effects)
-    assert model.report.as_dict() == report
+    assert untimed(model.report.as_dict()) == untimed(report)
     assert model.report.after.mean_position_error_mm == report["after"]["mean_position_error_mm"]
     ours = tmp_path / "py.ron"
     model.save(ours)
@@ -153,7 +160,7 @@ def test_options_mapping_goes_where_the_ron_file_goes(cli, robot, campaign, tmp_
     from_dict = calib.fit(robot, train, method="poe", effects=None,
                           options={"identification": {"max_iterations": 3}})
     from_file = calib.fit(robot, train, method="poe", effects=None, options=ron)
-    assert from_dict.report.as_dict() == theirs == from_file.report.as_dict()
+    assert untimed(from_dict.report.as_dict()) == untimed(theirs) == untimed(from_file.report.as_dict())
 
 
 def test_diagnose_equals_cli_diagnose_json(cli, robot, campaign):
