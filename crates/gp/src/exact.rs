@@ -12,7 +12,7 @@ use crate::gram::training_covariance;
 use crate::kernel::KernelChoice;
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::lml::check_finite_outputs;
-use crate::optimise::{OptimisationReport, finish, fit_hyperparameters, refine, warm_stage};
+use crate::optimise::{OptimisationReport, finish, fit_hyperparameters, refine, warm_stage, warm_stage_from};
 use crate::points::Points;
 use crate::scaling::{InputStandardiser, OutputNormaliser};
 
@@ -93,6 +93,11 @@ pub struct IsotropicChoice {
     /// Rows on which the isotropic kernel's hyperparameters compared above were searched: the
     /// warm-start subset where the comparison there already lost, else all rows.
     pub isotropic_search_rows: usize,
+    /// Rows the two leave-one-out sums above were computed on: the warm-start subset where the
+    /// isotropic kernel, searched there, predicted those rows no better than the searched kernel
+    /// (and was not compared on all rows); `None`: all rows.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compared_rows: Option<usize>,
 }
 
 /// The Schwarz (BIC) choice between a kernel with an additive term and the same kernel without.
@@ -233,12 +238,41 @@ impl ExactGp {
             let bounds_of = |k: &Kernel| config.bounds.clone().unwrap_or_else(|| k.default_bounds());
             // With a warm-start subset, both kernels are searched there and the choice is made
             // on the subset's likelihoods; only the chosen kernel is searched on all rows.
-            let warm_of = |k: &Kernel| {
+            //
+            // The larger kernel's nested start is the smaller one's subset optimum with the
+            // additive term nearly off ([`Kernel::nested_at`]), searched after it beside the
+            // default start: the same nesting as [`Kernel::nested_starts`] without walking the
+            // smaller model's path a second time.
+            let warm_from = |k: &Kernel, nested: &[Kernel], optimiser: &crate::OptimiserConfig| {
                 k.validate(xs.dim())?;
-                warm_stage(k, &bounds_of(k), &xs, yg.as_ref(), &config.optimiser, config.parallelism)
+                warm_stage_from(k, nested, &bounds_of(k), &xs, yg.as_ref(), optimiser, config.parallelism)
             };
-            let warm = both(config.parallelism, || warm_of(start), || warm_of(&reduced));
-            if let (Some(with), Some(without)) = (warm.0?, warm.1?) {
+            // Random restarts, when configured, belong to the default start's stage alone.
+            let once = crate::OptimiserConfig { restarts: 0, ..config.optimiser.clone() };
+            let warm = both(
+                config.parallelism,
+                || Ok((warm_from(start, &[], &config.optimiser)?, None)),
+                || {
+                    let without = warm_from(&reduced, &[], &config.optimiser)?;
+                    let nested = match &without {
+                        Some(stage) => start
+                            .nested_at(&stage.best_kernel(&reduced)?)
+                            .or_else(|| start.nested_starts().into_iter().next()),
+                        None => None,
+                    };
+                    let nested = match nested {
+                        Some(nested) => warm_from(&nested, &[], &once)?,
+                        None => None,
+                    };
+                    Ok::<_, Error>((without, nested))
+                },
+            );
+            let ((with, _), (without, nested)) = (warm.0?, warm.1?);
+            let with = match (with, nested) {
+                (Some(with), Some(nested)) => Some(with.join(nested)),
+                (with, _) => with,
+            };
+            if let (Some(with), Some(without)) = (with, without) {
                 let rows = with.rows();
                 let (a, b) = (with.best_log_marginal_likelihood(), without.best_log_marginal_likelihood());
                 let kept = a - b > penalty(rows);
@@ -288,15 +322,17 @@ impl ExactGp {
             let yg = Mat::from_fn(n, cols.len(), |i, c| yn[(i, cols[c])]);
             let start = Kernel::start(KernelChoice::Quadratic, xs.dim());
             let bounds = start.default_bounds();
-            let searched_loo = loo(&searched.0);
-            let choose = |searched: (Component, ComponentReport), isotropic: (Component, ComponentReport), rows| {
-                let isotropic_loo = loo(&isotropic.0);
+            let choose = |searched: (Component, ComponentReport),
+                          isotropic: (Component, ComponentReport),
+                          (searched_loo, isotropic_loo): (f64, f64),
+                          rows| {
                 let kept_isotropic = isotropic_loo > searched_loo;
                 let choice = IsotropicChoice {
                     searched: searched_loo,
                     isotropic: isotropic_loo,
                     kept_isotropic,
                     isotropic_search_rows: rows,
+                    compared_rows: None,
                 };
                 let (component, mut report) = if kept_isotropic { isotropic } else { searched };
                 report.isotropic_choice = Some(choice);
@@ -304,16 +340,54 @@ impl ExactGp {
             };
             let stage = warm_stage(&start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism)?;
             if let Some(stage) = &stage {
+                // Screened on the subset first, each kernel's leave-one-out over the subset's own
+                // rows: the isotropic kernel at its subset optimum, fitted to those rows, against
+                // the searched kernel at its all-rows optimum. Where the isotropic kernel predicts
+                // the rows it was fitted to no better, it is not compared on all rows (two
+                // factorisations and an inverse of the full covariance saved).
+                let idx = stage.indices();
+                let sub_x = xs.select(idx);
+                let sub_y = Mat::from_fn(idx.len(), cols.len(), |i, c| yg[(idx[i], c)]);
+                let on_subset = |kernel: Kernel| -> Result<f64, Error> {
+                    let (c, _) = Component::build(
+                        kernel,
+                        cols.clone(),
+                        &sub_x,
+                        sub_y.as_ref(),
+                        None,
+                        config,
+                        config.parallelism,
+                    )?;
+                    Ok(loo(&c))
+                };
+                let (sub_searched, sub_isotropic) =
+                    (on_subset(searched.1.kernel.clone())?, on_subset(stage.best_kernel(&start)?)?);
+                if sub_isotropic <= sub_searched {
+                    let (component, mut report) = searched;
+                    report.isotropic_choice = Some(IsotropicChoice {
+                        searched: sub_searched,
+                        isotropic: sub_isotropic,
+                        kept_isotropic: false,
+                        isotropic_search_rows: stage.rows(),
+                        compared_rows: Some(stage.rows()),
+                    });
+                    return Ok((component, report));
+                }
+            }
+            let searched_loo = loo(&searched.0);
+            if let Some(stage) = &stage {
                 // The subset's optimum compared on all rows first: a full search only when the
                 // isotropic kernel already predicts better from there.
                 let at_subset = build(stage.best_kernel(&start)?, cols, yg.as_ref(), None)?;
-                if loo(&at_subset.0) <= searched_loo {
-                    return Ok(choose(searched, at_subset, stage.rows()));
+                let at_subset_loo = loo(&at_subset.0);
+                if at_subset_loo <= searched_loo {
+                    return Ok(choose(searched, at_subset, (searched_loo, at_subset_loo), stage.rows()));
                 }
             }
             let o = finish(&start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism, stage)?;
             let isotropic = build(o.kernel, cols, yg.as_ref(), Some(o.report))?;
-            Ok(choose(searched, isotropic, n))
+            let isotropic_loo = loo(&isotropic.0);
+            Ok(choose(searched, isotropic, (searched_loo, isotropic_loo), n))
         };
         let fit_group = |(g, cols): (usize, &Vec<usize>)| with_isotropic(fit_searched((g, cols))?, cols);
         let fitted: Vec<_> = match config.parallelism {

@@ -145,6 +145,8 @@ fn best(results: &[Option<lbfgsb::Minimum>]) -> Option<(usize, &lbfgsb::Minimum)
 #[derive(Debug, Clone)]
 pub(crate) struct WarmStage {
     results: Vec<Option<lbfgsb::Minimum>>,
+    /// The subset's rows, in the order the searches saw them.
+    indices: Vec<usize>,
     rows: usize,
     evaluations: usize,
     best: usize,
@@ -159,6 +161,26 @@ impl WarmStage {
     /// Rows of the subset.
     pub(crate) fn rows(&self) -> usize {
         self.rows
+    }
+
+    /// The subset's rows.
+    pub(crate) fn indices(&self) -> &[usize] {
+        &self.indices
+    }
+
+    /// The searches of `self` and then `other` (of one family, on one subset) as one stage.
+    pub(crate) fn join(self, other: WarmStage) -> WarmStage {
+        debug_assert_eq!(self.indices, other.indices);
+        let mut results = self.results;
+        results.extend(other.results);
+        let best = best(&results).map_or(0, |(i, _)| i);
+        WarmStage {
+            results,
+            indices: self.indices,
+            rows: self.rows,
+            evaluations: self.evaluations + other.evaluations,
+            best,
+        }
     }
 
     /// The subset's best optimum as a kernel of `start`'s family.
@@ -177,10 +199,11 @@ struct Prepared {
     settings: Settings,
 }
 
-/// The search's settings and box for `start`.
-fn prepare(start: &Kernel, bounds: &Bounds, config: &OptimiserConfig) -> Result<Prepared, Error> {
+/// The search's settings and box for `start`, with `nested` as its deterministic starts after
+/// `start` itself.
+fn prepare(start: &Kernel, nested: &[Kernel], bounds: &Bounds, config: &OptimiserConfig) -> Result<Prepared, Error> {
     let (lower, upper) = bounds.to_log(start)?;
-    let nested: Vec<Vec<f64>> = start.nested_starts().iter().map(Kernel::log_parameters).collect();
+    let nested: Vec<Vec<f64>> = nested.iter().map(Kernel::log_parameters).collect();
     let starts = starting_points(&start.log_parameters(), &nested, &lower, &upper, config);
     let settings = Settings {
         memory: config.memory,
@@ -207,12 +230,26 @@ pub(crate) fn warm_stage(
     config: &OptimiserConfig,
     parallelism: Parallelism,
 ) -> Result<Option<WarmStage>, Error> {
+    warm_stage_from(start, &start.nested_starts(), bounds, x, y, config, parallelism)
+}
+
+/// [`warm_stage`] with `nested` as the deterministic starts after `start` itself, instead of
+/// [`Kernel::nested_starts`]; `start` and every one of `nested` are of one family.
+pub(crate) fn warm_stage_from(
+    start: &Kernel,
+    nested: &[Kernel],
+    bounds: &Bounds,
+    x: &Points,
+    y: MatRef<'_, f64>,
+    config: &OptimiserConfig,
+    parallelism: Parallelism,
+) -> Result<Option<WarmStage>, Error> {
     let n = x.len();
     let warm = config.warm_start_rows;
     if warm == 0 || n <= warm {
         return Ok(None);
     }
-    let Prepared { lower, upper, starts, settings } = prepare(start, bounds, config)?;
+    let Prepared { lower, upper, starts, settings } = prepare(start, nested, bounds, config)?;
     let idx = random_indices(n, warm, config.seed);
     let xs = x.select(&idx);
     let ys = Mat::from_fn(idx.len(), y.ncols(), |i, j| y[(idx[i], j)]);
@@ -221,7 +258,7 @@ pub(crate) fn warm_stage(
         return Err(Error::OptimisationFailed { starts: starts.len() });
     };
     let evaluations = results.iter().flatten().map(|m| m.evaluations).sum();
-    Ok(Some(WarmStage { results, rows: idx.len(), evaluations, best }))
+    Ok(Some(WarmStage { results, rows: idx.len(), indices: idx, evaluations, best }))
 }
 
 /// Maximises the log marginal likelihood of `y` (n × m, all columns sharing the kernel).
@@ -248,7 +285,7 @@ pub(crate) fn finish(
     parallelism: Parallelism,
     warm: Option<WarmStage>,
 ) -> Result<Optimised, Error> {
-    let Prepared { lower, upper, starts, settings } = prepare(start, bounds, config)?;
+    let Prepared { lower, upper, starts, settings } = prepare(start, &start.nested_starts(), bounds, config)?;
     let (results, warm_rows, warm_evaluations, full) = match warm {
         Some(stage) => {
             let from = stage.results[stage.best]
@@ -316,7 +353,7 @@ pub(crate) fn refine(
     config: &OptimiserConfig,
     parallelism: Parallelism,
 ) -> Result<Optimised, Error> {
-    let Prepared { lower, upper, settings, .. } = prepare(start, bounds, config)?;
+    let Prepared { lower, upper, settings, .. } = prepare(start, &[], bounds, config)?;
     let from: Vec<f64> =
         start.log_parameters().iter().zip(&lower).zip(&upper).map(|((s, l), u)| s.clamp(*l, *u)).collect();
     let mut objective = NegativeLml::new(start, x, y, config, parallelism);

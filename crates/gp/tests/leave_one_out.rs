@@ -189,6 +189,55 @@ fn isotropic_choice_follows_the_data() {
     assert_eq!(kept(&sharp), 0, "the isotropic kernel won on data with one short length scale");
 }
 
+/// With a warm-start subset, the isotropic kernel is screened on the subset's own rows first:
+/// where it loses there, the choice records the subset's sums and rows and no comparison on all
+/// rows is made; where it wins there (data of its own kind), it is compared on all rows as without
+/// a subset, and kept where it wins there too.
+#[test]
+fn isotropic_choice_is_screened_on_the_warm_start_subset() {
+    let mut r = rng(11);
+    let (n, d, warm) = (90, 6, 45);
+    let x = uniform_points(&mut r, n, d, -2.0, 2.0);
+    let noise = uniform_points(&mut r, n, 2, -0.02, 0.02);
+    let radial = Mat::from_fn(n, 2, |i, c| {
+        let s: f64 = (0..d).map(|j| x[(i, j)]).sum();
+        0.5 * s + (0.2 * s).sin() + noise[(i, c)]
+    });
+    let sharp = Mat::from_fn(n, 2, |i, c| (4.0 * x[(i, 2)]).sin() + noise[(i, c)]);
+    let config = GpConfig {
+        kernel: KernelChoice::SquaredExponentialArd,
+        isotropic_by_loo: true,
+        optimiser: OptimiserConfig { warm_start_rows: warm, ..OptimiserConfig::default() },
+        ..GpConfig::default()
+    };
+    let choices = |y: &Mat<f64>| {
+        let model = ExactGp::fit(x.as_ref(), y.as_ref(), &config).expect("fit");
+        let loo = model.leave_one_out().expect("leave-one-out");
+        let mut choices = Vec::new();
+        for c in &model.report().components {
+            let choice = c.isotropic_choice.clone().expect("choice made");
+            assert_eq!(choice.kept_isotropic, matches!(c.kernel, Kernel::Quadratic(_)), "{choice:?}");
+            match choice.compared_rows {
+                Some(rows) => {
+                    assert_eq!((rows, choice.kept_isotropic), (warm, false), "{choice:?}");
+                    assert!(choice.isotropic <= choice.searched, "{choice:?}");
+                }
+                None => {
+                    let kept = if choice.kept_isotropic { choice.isotropic } else { choice.searched };
+                    let out = loo.log_predictive[c.outputs[0]];
+                    assert!((out - kept).abs() < 1e-6 * kept.abs().max(1.0), "{out} vs {kept}");
+                }
+            }
+            choices.push(choice);
+        }
+        choices
+    };
+    let radial = choices(&radial);
+    assert!(radial.iter().any(|c| c.kept_isotropic), "the isotropic kernel lost on its own kind of data: {radial:?}");
+    let sharp = choices(&sharp);
+    assert!(sharp.iter().all(|c| c.compared_rows == Some(warm)), "not screened on the subset: {sharp:?}");
+}
+
 /// A model written before the choice existed (no `isotropic_choice` in its report) still reads.
 #[test]
 fn model_without_isotropic_choice_still_reads() {

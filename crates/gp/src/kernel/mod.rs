@@ -301,6 +301,34 @@ impl Kernel {
         }
     }
 
+    /// The nested start at the smaller model's optimum: this kernel's additive term nearly off
+    /// ([`AdditiveTerm::OFF_VARIANCE`], its length scales this kernel's) on every other
+    /// hyperparameter of `smaller`, the [`Self::without_additive`] form of this kernel fitted
+    /// elsewhere. `None` when this kernel has no additive term or `smaller` is not its form.
+    ///
+    /// The search from there starts where the smaller model's already ended instead of walking
+    /// the same path again from the default start with the term off.
+    pub(crate) fn nested_at(&self, smaller: &Kernel) -> Option<Kernel> {
+        let (Self::Composite(k), Self::Composite(s)) = (self, smaller) else {
+            return None;
+        };
+        let additive = k.additive.as_ref()?;
+        let same_form = s.additive.is_none()
+            && s.shape == k.shape
+            && s.length_scales.len() == k.length_scales.len()
+            && s.constant.is_some() == k.constant.is_some()
+            && s.linear_weights.as_ref().map(Vec::len) == k.linear_weights.as_ref().map(Vec::len);
+        same_form.then(|| {
+            Self::Composite(CompositeKernel {
+                additive: Some(AdditiveTerm {
+                    variances: vec![AdditiveTerm::OFF_VARIANCE; additive.variances.len()],
+                    length_scales: additive.length_scales.clone(),
+                }),
+                ..s.clone()
+            })
+        })
+    }
+
     /// The expanded form of this kernel for `dim` inputs.
     pub(crate) fn terms(&self, dim: usize) -> Terms {
         let stationary = |shape, signal_variance, lengths: &[f64], noise_variance| Terms {
@@ -441,4 +469,38 @@ impl Bounds {
 #[inline]
 pub(crate) fn squared_distance(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The nested start at a smaller model's optimum carries every hyperparameter of that model
+    /// and this kernel's additive term nearly off, and exists only for the form it nests.
+    #[test]
+    fn the_nested_start_at_the_smaller_optimum_carries_its_hyperparameters() {
+        let larger =
+            Kernel::Composite(CompositeKernel::start(StationaryShape::SquaredExponential, 3, true, false, true));
+        let Kernel::Composite(mut fitted) = larger.without_additive().expect("smaller form") else {
+            unreachable!("the smaller form of a composite kernel is composite");
+        };
+        fitted.signal_variance = 2.5;
+        fitted.length_scales = vec![0.4, 1.7, 3.2];
+        fitted.constant = Some(0.03);
+        fitted.noise_variance = 0.002;
+        let fitted = Kernel::Composite(fitted);
+        let Some(Kernel::Composite(nested)) = larger.nested_at(&fitted) else {
+            panic!("no nested start");
+        };
+        let Kernel::Composite(expected_rest) = &fitted else { unreachable!() };
+        assert_eq!(CompositeKernel { additive: None, ..nested.clone() }, *expected_rest);
+        let additive = nested.additive.expect("additive term");
+        assert_eq!(additive.variances, vec![AdditiveTerm::OFF_VARIANCE; 3]);
+        assert_eq!(additive.length_scales, vec![0.3; 3]);
+        let other_form =
+            Kernel::Composite(CompositeKernel::start(StationaryShape::SquaredExponential, 3, false, false, false));
+        assert!(larger.nested_at(&other_form).is_none());
+        assert!(larger.nested_at(&larger).is_none());
+        assert!(fitted.nested_at(&fitted).is_none());
+    }
 }
