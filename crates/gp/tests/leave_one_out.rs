@@ -165,13 +165,12 @@ fn isotropic_choice_keeps_the_kernel_with_the_higher_leave_one_out_probability()
     }
 }
 
-/// Data drawn from the isotropic kernel's own family (a smooth function of the distance, a
-/// constant and a linear trend) on few rows with many inputs: the isotropic kernel is kept for
-/// some output, and data with one short-scale input the ARD kernel sees keep the searched kernel.
-#[test]
-fn isotropic_choice_follows_the_data() {
+/// `n` rows of six inputs and two pairs of outputs: the isotropic kernel's own kind (a smooth
+/// function of the sum of the inputs, so of a distance, with a linear trend) and one short-scale
+/// input the ARD kernel sees.
+fn radial_and_sharp(n: usize) -> (Mat<f64>, Mat<f64>, Mat<f64>) {
+    let d = 6;
     let mut r = rng(11);
-    let (n, d) = (50, 6);
     let x = uniform_points(&mut r, n, d, -2.0, 2.0);
     let noise = uniform_points(&mut r, n, 2, -0.02, 0.02);
     let radial = Mat::from_fn(n, 2, |i, c| {
@@ -179,6 +178,15 @@ fn isotropic_choice_follows_the_data() {
         0.5 * s + (0.2 * s).sin() + noise[(i, c)]
     });
     let sharp = Mat::from_fn(n, 2, |i, c| (4.0 * x[(i, 2)]).sin() + noise[(i, c)]);
+    (x, radial, sharp)
+}
+
+/// Data drawn from the isotropic kernel's own family (a smooth function of the distance, a
+/// constant and a linear trend) on few rows with many inputs: the isotropic kernel is kept for
+/// some output, and data with one short-scale input the ARD kernel sees keep the searched kernel.
+#[test]
+fn isotropic_choice_follows_the_data() {
+    let (x, radial, sharp) = radial_and_sharp(50);
     let config =
         GpConfig { kernel: KernelChoice::SquaredExponentialArd, isotropic_by_loo: true, ..GpConfig::default() };
     let kept = |y: &Mat<f64>| {
@@ -195,15 +203,8 @@ fn isotropic_choice_follows_the_data() {
 /// a subset, and kept where it wins there too.
 #[test]
 fn isotropic_choice_is_screened_on_the_warm_start_subset() {
-    let mut r = rng(11);
-    let (n, d, warm) = (90, 6, 45);
-    let x = uniform_points(&mut r, n, d, -2.0, 2.0);
-    let noise = uniform_points(&mut r, n, 2, -0.02, 0.02);
-    let radial = Mat::from_fn(n, 2, |i, c| {
-        let s: f64 = (0..d).map(|j| x[(i, j)]).sum();
-        0.5 * s + (0.2 * s).sin() + noise[(i, c)]
-    });
-    let sharp = Mat::from_fn(n, 2, |i, c| (4.0 * x[(i, 2)]).sin() + noise[(i, c)]);
+    let warm = 45;
+    let (x, radial, sharp) = radial_and_sharp(90);
     let config = GpConfig {
         kernel: KernelChoice::SquaredExponentialArd,
         isotropic_by_loo: true,
