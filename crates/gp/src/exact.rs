@@ -12,7 +12,9 @@ use crate::gram::training_covariance;
 use crate::kernel::KernelChoice;
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::lml::check_finite_outputs;
-use crate::optimise::{OptimisationReport, finish, fit_hyperparameters, refine, warm_stage, warm_stage_from};
+use crate::optimise::{
+    OptimisationReport, finish, fit_hyperparameters, fit_hyperparameters_from, refine, warm_stage, warm_stage_from,
+};
 use crate::points::Points;
 use crate::scaling::{InputStandardiser, OutputNormaliser};
 
@@ -292,9 +294,23 @@ impl ExactGp {
                 report.additive_choice = Some(choice);
                 return Ok((component, report));
             }
-            let (full, small) =
-                both(config.parallelism, || search(start, yg.as_ref()), || search(&reduced, yg.as_ref()));
-            let ((full_kernel, full_report), (small_kernel, small_report)) = (full?, small?);
+            // Without a subset, the same nesting on all rows: the smaller kernel first, then the
+            // larger one from its default start and from the smaller one's optimum.
+            let (small_kernel, small_report) = search(&reduced, yg.as_ref())?;
+            let nested = start.nested_at(&small_kernel).map_or_else(|| start.nested_starts(), |k| vec![k]);
+            let (full_kernel, full_report) = {
+                start.validate(xs.dim())?;
+                let o = fit_hyperparameters_from(
+                    start,
+                    &nested,
+                    &bounds_of(start),
+                    &xs,
+                    yg.as_ref(),
+                    &config.optimiser,
+                    config.parallelism,
+                )?;
+                (o.kernel, o.report)
+            };
             let with = build(full_kernel, cols, yg.as_ref(), Some(full_report))?;
             let without = build(small_kernel, cols, yg.as_ref(), Some(small_report))?;
             let choice = AdditiveChoice {

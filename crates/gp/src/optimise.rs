@@ -270,8 +270,22 @@ pub(crate) fn fit_hyperparameters(
     config: &OptimiserConfig,
     parallelism: Parallelism,
 ) -> Result<Optimised, Error> {
-    let warm = warm_stage(start, bounds, x, y, config, parallelism)?;
-    finish(start, bounds, x, y, config, parallelism, warm)
+    fit_hyperparameters_from(start, &start.nested_starts(), bounds, x, y, config, parallelism)
+}
+
+/// [`fit_hyperparameters`] with `nested` as the deterministic starts after `start` itself,
+/// instead of [`Kernel::nested_starts`].
+pub(crate) fn fit_hyperparameters_from(
+    start: &Kernel,
+    nested: &[Kernel],
+    bounds: &Bounds,
+    x: &Points,
+    y: MatRef<'_, f64>,
+    config: &OptimiserConfig,
+    parallelism: Parallelism,
+) -> Result<Optimised, Error> {
+    let warm = warm_stage_from(start, nested, bounds, x, y, config, parallelism)?;
+    finish_from(start, nested, bounds, x, y, config, parallelism, warm)
 }
 
 /// The full-data search: from the warm stage's best optimum when there is one, else from every
@@ -285,7 +299,23 @@ pub(crate) fn finish(
     parallelism: Parallelism,
     warm: Option<WarmStage>,
 ) -> Result<Optimised, Error> {
-    let Prepared { lower, upper, starts, settings } = prepare(start, &start.nested_starts(), bounds, config)?;
+    finish_from(start, &start.nested_starts(), bounds, x, y, config, parallelism, warm)
+}
+
+/// [`finish`] with `nested` as the deterministic starts after `start` itself where there is no
+/// warm stage.
+#[allow(clippy::too_many_arguments)]
+fn finish_from(
+    start: &Kernel,
+    nested: &[Kernel],
+    bounds: &Bounds,
+    x: &Points,
+    y: MatRef<'_, f64>,
+    config: &OptimiserConfig,
+    parallelism: Parallelism,
+    warm: Option<WarmStage>,
+) -> Result<Optimised, Error> {
+    let Prepared { lower, upper, starts, settings } = prepare(start, nested, bounds, config)?;
     let (results, warm_rows, warm_evaluations, full) = match warm {
         Some(stage) => {
             let from = stage.results[stage.best]
