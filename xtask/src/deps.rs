@@ -1,6 +1,7 @@
 //! `cargo xtask deps`: the workspace's crate graph with the lines of each crate, and the checks
 //! issue 24 asks to keep true: no crate above a line budget, no circle between crates, and no
-//! module of a crate (or of xtask) that imports a module importing it back.
+//! module of a crate (or of xtask) that imports a module importing it back. And one of issue 49:
+//! the crates CI builds alone share the tests' build (`deps_features`).
 //!
 //! A module's imports are its `crate::…` and `super::…` paths outside `#[cfg(test)]` blocks and
 //! comments, resolved to the longest module prefix; a name the crate root re-exports
@@ -58,8 +59,12 @@ pub fn run(args: &Args) -> Result<()> {
             failures.push(format!("{}: modules import each other: {}", c.name, circle.join(" <-> ")));
         }
     }
+    failures.extend(crate::deps_features::drift(&root)?);
     if failures.is_empty() {
         println!("\nno crate above {} lines; no circle between crates or between the modules of one", args.max_lines);
+        println!(
+            "xtask, calib-python and calib resolve every dependency with the features of `cargo test --workspace`"
+        );
         return Ok(());
     }
     for failure in &failures {

@@ -22,6 +22,7 @@ mod cell_check;
 mod compensate_check;
 mod convert_ur10;
 mod deps;
+mod deps_features;
 mod fuzz;
 mod fuzz_inputs;
 mod fuzz_seeds;
@@ -75,7 +76,7 @@ enum Command {
     Fuzz(fuzz::Args),
     /// The Rust version Cargo.lock needs, checked against Cargo.toml and the README.
     Msrv(msrv::Args),
-    /// The crate graph with lines per crate; fails on a crate above the line budget or a circle of crates or modules.
+    /// The crate graph with lines per crate; fails on a crate above the line budget, a circle of crates or modules, or a crate CI builds alone that would not share the tests' build.
     Deps(deps::Args),
     /// Issue 26: `calib register` and `calib plan` on the real UR10 and simulated truth; print a table.
     CellCheck(cell_check::Args),
