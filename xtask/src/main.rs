@@ -28,6 +28,7 @@ mod fuzz_inputs;
 mod fuzz_seeds;
 mod fuzz_worker;
 mod hostile;
+mod long_tests;
 mod msrv;
 mod report_browser_check;
 mod reproduce_sim;
@@ -78,6 +79,8 @@ enum Command {
     Msrv(msrv::Args),
     /// The crate graph with lines per crate; fails on a crate above the line budget, a circle of crates or modules, or a crate CI builds alone that would not share the tests' build.
     Deps(deps::Args),
+    /// The long tests kept out of CI (`#[ignore]`d, each standing beside a short one): `cargo test --workspace -- --ignored`.
+    LongTests(long_tests::Args),
     /// Issue 26: `calib register` and `calib plan` on the real UR10 and simulated truth; print a table.
     CellCheck(cell_check::Args),
     /// Render calibration reports in headless Chromium: a screenshot each, fail on console messages (not in CI).
@@ -109,6 +112,7 @@ fn main() -> ExitCode {
         Command::Fuzz(args) => fuzz::run(args).map_err(|e| format!("{e:#}")),
         Command::Msrv(args) => msrv::run(args).map_err(|e| format!("{e:#}")),
         Command::Deps(args) => deps::run(args).map_err(|e| format!("{e:#}")),
+        Command::LongTests(args) => long_tests::run(args).map_err(|e| format!("{e:#}")),
         Command::ReportBrowserCheck(args) => report_browser_check::run(args).map_err(|e| format!("{e:#}")),
         Command::FuzzWorker(args) => fuzz_worker::run(args).map_err(|e| format!("{e:#}")),
     };

@@ -57,43 +57,52 @@ fn coupled_campaign(seed: u64) -> (RobotDescription, MeasurementSet) {
 /// what is checked; a GP that saw the held-out rows would predict them near its noise.
 #[test]
 fn the_prediction_with_the_gp_meets_the_fitted_error_like_the_training_poses_and_in_a_gap() {
+    // Seed 53 is the one on which the final GP in place of each fold's fails (0.0272 against
+    // 0.0442) and a GP conditioned without a buffer beside the arcs fails (0.0808 against 0.1939).
+    prediction_with_the_gp_meets_the_fitted_error(53);
+}
+
+/// The same on the gap tests' other seeds: four more `poe-gp --effects auto` fits of 1,500-row
+/// campaigns, a minute in the debug profile, so `cargo xtask long-tests` runs it and CI does not
+/// (issue 49).
+#[test]
+#[ignore = "long (the same property as the test above on two more seeds): cargo xtask long-tests"]
+fn the_prediction_with_the_gp_meets_the_fitted_error_on_more_seeds() {
+    for seed in [7, 91] {
+        prediction_with_the_gp_meets_the_fitted_error(seed);
+    }
+}
+
+fn prediction_with_the_gp_meets_the_fitted_error(seed: u64) {
     // Seeds 53, 7, 91 (the gap tests' seeds); measured on/even->odd fitted: 0.0503/0.0442,
     // 0.0509/0.0491, 0.0458/0.0511 mm (random folds without the GP: 0.0899, 0.0890, 0.0794); joint
     // 2's arcs/gap fitted: 0.2188/0.1939, 0.2263/0.1895, 0.2181/0.1932 mm. Before the model kept a
     // GP of what the geometry alone leaves for where its effects fade, the gap fitted
     // 0.2580, 0.2697, 0.2831 (predicted 0.2692, 0.2675, 0.2505); that GP's arcs conditioned
     // without a buffer beside them predicted 0.0808 on seed 53, a promise the fit broke.
-    for seed in [53, 7, 91] {
-        let (robot, all) = coupled_campaign(seed);
-        let gapped = rows_where(&all, |q| (0.35..=0.9).contains(&q.abs()));
-        let off = rows_where(&all, |q| q.abs() < 0.3 || q.abs() > 0.95);
-        let even = gapped.subset(&(0..gapped.rows.len()).step_by(2).collect::<Vec<_>>());
-        let odd = gapped.subset(&(1..gapped.rows.len()).step_by(2).collect::<Vec<_>>());
-        let options = FitOptions::default().with_effects(EffectSelection::Auto);
-        let fitted = |train: &MeasurementSet, test: &MeasurementSet| {
-            let (model, report) = pipeline::fit(&robot, train, Method::PoeGp, &options).unwrap();
-            let error = model::evaluate(&model, &model.bind(test).unwrap()).unwrap().summary.mean_position_error_mm;
-            let auto = report.auto.expect("--effects auto");
-            let with_gp = auto.predicted_with_gp.clone().expect("a GP method predicts with its GP");
-            (error, auto, with_gp)
-        };
-        let (like, auto, with_gp) = fitted(&even, &odd);
-        eprintln!(
-            "seed {seed}, even -> odd: fitted {like:.4} mm; predicted {:.4} with the GP, {:.4} without",
-            with_gp.on_poses_mm, auto.heldout_after_mm
-        );
-        assert!(!auto.chosen.is_empty(), "seed {seed}: the gear error is found");
-        assert!(
-            (with_gp.on_poses_mm - like).abs() <= 0.25 * like,
-            "seed {seed}: {} against {like}",
-            with_gp.on_poses_mm
-        );
-        assert!(auto.heldout_after_mm > 1.25 * like, "seed {seed}: the GP takes nothing here");
-        let (gap, _, with_gp) = fitted(&gapped, &off);
-        let joint_2 = with_gp.arcs.iter().find(|a| a.joint == 2).expect("joint 2 moves").mean_mm;
-        eprintln!(
-            "seed {seed}, in the gap and past the end: fitted {gap:.4} mm; joint 2's arcs with the GP {joint_2:.4}"
-        );
-        assert!((joint_2 - gap).abs() <= 0.25 * gap, "seed {seed}: {joint_2} against {gap}");
-    }
+    let (robot, all) = coupled_campaign(seed);
+    let gapped = rows_where(&all, |q| (0.35..=0.9).contains(&q.abs()));
+    let off = rows_where(&all, |q| q.abs() < 0.3 || q.abs() > 0.95);
+    let even = gapped.subset(&(0..gapped.rows.len()).step_by(2).collect::<Vec<_>>());
+    let odd = gapped.subset(&(1..gapped.rows.len()).step_by(2).collect::<Vec<_>>());
+    let options = FitOptions::default().with_effects(EffectSelection::Auto);
+    let fitted = |train: &MeasurementSet, test: &MeasurementSet| {
+        let (model, report) = pipeline::fit(&robot, train, Method::PoeGp, &options).unwrap();
+        let error = model::evaluate(&model, &model.bind(test).unwrap()).unwrap().summary.mean_position_error_mm;
+        let auto = report.auto.expect("--effects auto");
+        let with_gp = auto.predicted_with_gp.clone().expect("a GP method predicts with its GP");
+        (error, auto, with_gp)
+    };
+    let (like, auto, with_gp) = fitted(&even, &odd);
+    eprintln!(
+        "seed {seed}, even -> odd: fitted {like:.4} mm; predicted {:.4} with the GP, {:.4} without",
+        with_gp.on_poses_mm, auto.heldout_after_mm
+    );
+    assert!(!auto.chosen.is_empty(), "seed {seed}: the gear error is found");
+    assert!((with_gp.on_poses_mm - like).abs() <= 0.25 * like, "seed {seed}: {} against {like}", with_gp.on_poses_mm);
+    assert!(auto.heldout_after_mm > 1.25 * like, "seed {seed}: the GP takes nothing here");
+    let (gap, _, with_gp) = fitted(&gapped, &off);
+    let joint_2 = with_gp.arcs.iter().find(|a| a.joint == 2).expect("joint 2 moves").mean_mm;
+    eprintln!("seed {seed}, in the gap and past the end: fitted {gap:.4} mm; joint 2's arcs with the GP {joint_2:.4}");
+    assert!((joint_2 - gap).abs() <= 0.25 * gap, "seed {seed}: {joint_2} against {gap}");
 }

@@ -54,31 +54,54 @@ fn shapes() -> Vec<Shape> {
     ]
 }
 
+const METHODS: [Method; 4] = [Method::BaseTool, Method::Poe, Method::PoeGp, Method::PoeGpLoad];
+
+/// Every pair of shape and method, shape and effects, method and effects, in 12 fits of the 36
+/// (the effects list rotates with shape and method); the first shape's `poe-gp-load --effects
+/// auto` is issue 23's case.
 #[test]
+fn every_method_shape_and_effects_pair_writes_reads_back_and_predicts_the_same() {
+    let dir = tempfile::tempdir().unwrap();
+    for (i, shape) in shapes().iter().enumerate() {
+        for (j, method) in METHODS.into_iter().enumerate() {
+            let effects = ["auto", shape.effects, ""][(i + j) % 3];
+            round_trip(shape, method, effects, dir.path());
+        }
+    }
+}
+
+/// All 36 fits of methods × effects × data shapes: the test above covers each pair of them in a
+/// third of the time, so `cargo xtask long-tests` runs this and CI does not (issue 49).
+#[test]
+#[ignore = "long (every combination of the pairs the test above covers): cargo xtask long-tests"]
 fn every_model_fit_writes_reads_back_and_predicts_the_same() {
     let dir = tempfile::tempdir().unwrap();
-    let methods = [Method::BaseTool, Method::Poe, Method::PoeGp, Method::PoeGpLoad];
     for shape in shapes() {
-        for method in methods {
+        for method in METHODS {
             for effects in ["", "auto", shape.effects] {
-                let case = format!("{} / {method} / effects '{effects}'", shape.name);
-                let selection: EffectSelection =
-                    if effects.is_empty() { EffectSelection::None } else { effects.parse().unwrap() };
-                let options = FitOptions::default().with_effects(selection);
-                let (model, _) = pipeline::fit(&shape.robot, &shape.data, method, &options)
-                    .unwrap_or_else(|e| panic!("{case}: fit refused: {e}"));
-                let path = dir.path().join("m.ron");
-                model::write_model(&path, &model).unwrap();
-                let again = model::read_model(&path).unwrap_or_else(|e| panic!("{case}: eval would refuse: {e}"));
-                let bound = model.bind(&shape.data).unwrap();
-                let before = model.predict(&bound).unwrap();
-                let after = again.predict(&bound).unwrap();
-                for (a, b) in before.iter().zip(&after) {
-                    let moved = (a.pose.translation() - b.pose.translation()).norm();
-                    assert!(moved < 1e-10, "{case}: {moved} m apart after reading back");
-                }
+                round_trip(&shape, method, effects, dir.path());
             }
         }
+    }
+}
+
+/// Fits `shape` with `method` and `effects` ("" for none), writes the model, reads it back and
+/// checks that both predict the same poses.
+fn round_trip(shape: &Shape, method: Method, effects: &str, dir: &std::path::Path) {
+    let case = format!("{} / {method} / effects '{effects}'", shape.name);
+    let selection: EffectSelection = if effects.is_empty() { EffectSelection::None } else { effects.parse().unwrap() };
+    let options = FitOptions::default().with_effects(selection);
+    let (model, _) = pipeline::fit(&shape.robot, &shape.data, method, &options)
+        .unwrap_or_else(|e| panic!("{case}: fit refused: {e}"));
+    let path = dir.join("m.ron");
+    model::write_model(&path, &model).unwrap();
+    let again = model::read_model(&path).unwrap_or_else(|e| panic!("{case}: eval would refuse: {e}"));
+    let bound = model.bind(&shape.data).unwrap();
+    let before = model.predict(&bound).unwrap();
+    let after = again.predict(&bound).unwrap();
+    for (a, b) in before.iter().zip(&after) {
+        let moved = (a.pose.translation() - b.pose.translation()).norm();
+        assert!(moved < 1e-10, "{case}: {moved} m apart after reading back");
     }
 }
 
