@@ -342,15 +342,21 @@ mod tests {
     #[test]
     fn the_nominal_prior_block_can_be_given_and_a_bad_value_is_refused_at_its_field() {
         let options =
-            FitOptions::parse("(nominal_prior: (choose: false, translations_m: [inf, 1e-4]))", "fit.ron").unwrap();
+            FitOptions::parse("(nominal_prior: (choose: false, tolerance_translation_m: 5e-4))", "fit.ron").unwrap();
         assert!(!options.nominal_prior.choose);
-        assert_eq!(options.nominal_prior.translations_m, [f64::INFINITY, 1e-4]);
-        assert_eq!(options.nominal_prior.length_m, crate::NominalPriorOptions::default().length_m);
+        assert_eq!(options.nominal_prior.tolerance_translation_m, 5e-4);
+        let default = crate::NominalPriorOptions::default();
+        assert_eq!(options.nominal_prior.tolerance_rotation_rad, default.tolerance_rotation_rad);
         let error = FitOptions::parse("(nominal_prior: (\n  min_cluster_share: 0.9))", "fit.ron").unwrap_err();
         let message = error.to_string();
         assert!(message.contains("fit.ron:2:3") && message.contains("min_cluster_share is 0.9"), "{message}");
         let error = FitOptions::parse("(nominal_prior: (translations_m: [0.0]))", "fit.ron").unwrap_err();
         assert!(error.to_string().contains("translations_m"), "{error}");
+        for bad in ["0.0", "inf", "-1e-3"] {
+            let text = format!("(nominal_prior: (\n  tolerance_rotation_rad: {bad}))");
+            let message = FitOptions::parse(&text, "fit.ron").unwrap_err().to_string();
+            assert!(message.contains("fit.ron:2:3") && message.contains("tolerance_rotation_rad is"), "{message}");
+        }
     }
 
     #[test]

@@ -1,8 +1,14 @@
-//! The prior toward the nominal geometry (issue 30): how strongly the identification holds the
-//! links' local transforms at the nominal model (at its fitted base and tool placement), chosen
-//! by cross-validation that holds out whole configuration clusters (`clusters.rs`). Where the data
-//! lies on one branch of the arm, a fit on it cannot say how it does on another, and nothing is
-//! changed: the fit is the plain least-squares one, and the report says why.
+//! The prior toward the nominal geometry (issues 30 and 45): how strongly the identification holds
+//! the links' local transforms at the nominal model (at its fitted base and tool placement).
+//!
+//! Never weaker than the posterior with the nominal's manufacturing tolerance as the prior's
+//! width (issue 45): one plain solve gives the scale of the residual, the tolerance is weighed
+//! against it (the likelihood's noise is what the geometry leaves, not the tracker's alone), so
+//! that directions of the parameter space the training poses determine poorly stay within the
+//! tolerance of the nominal even where the data has one configuration cluster and nothing can be
+//! held out. Where it has several, stronger candidates are chosen by cross-validation that holds
+//! out whole configuration clusters (`clusters.rs`), as in issue 30: a fit on one branch cannot
+//! say how it does on another, and the held-out clusters say how strongly to hold it.
 
 use crate::clusters::{self, BranchJoint, Cluster, HeightSplit, ScanOptions};
 use errors::Error;
@@ -17,12 +23,24 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct NominalPriorOptions {
-    /// Choose the prior's strength by cross-validation across configuration clusters; `false`:
-    /// never a prior (the paper's plain least squares).
+    /// Hold the links at the nominal geometry: at least within its tolerance (the posterior),
+    /// more strongly where holding out configuration clusters says so; `false`: never a prior
+    /// (the paper's plain least squares).
     pub choose: bool,
-    /// The candidate standard deviations of a link's translation about the nominal, metres; `inf`
-    /// is no prior. The rotation's is the translation's over `length_m`. From 10 mm (a link
-    /// error far beyond any industrial arm's tolerances: no prior in effect) down to 10 µm (the
+    /// The nominal's manufacturing tolerance: the standard deviation of each component of a
+    /// link's translation about the nominal, m: the weakest prior the fit takes. 1 mm: machining
+    /// and assembly leave an industrial arm's link lengths and axis offsets off by tenths of a
+    /// millimetre to a millimetre (the simulated cells' `campaign::Perturbation`, after Nubiola &
+    /// Bonev 2013, ABB IRB 1600: 0.97 mm mean error before calibration), so a correction of
+    /// several millimetres to a link is the fit absorbing something else.
+    pub tolerance_translation_m: f64,
+    /// The same for each component of a link's rotation, rad: 1 mrad, axis alignments off by
+    /// tenths of a milliradian to a milliradian (same source).
+    pub tolerance_rotation_rad: f64,
+    /// The candidate standard deviations of a link's translation about the nominal, metres, held
+    /// out across configuration clusters; those not below the posterior's (the tolerance over
+    /// the residual's scale), and `inf`, are left out: the posterior is the weakest candidate.
+    /// The rotation's is the translation's over `length_m`. From 10 mm down to 10 µm (the
     /// nominal geometry itself, placed), half a decade apart.
     pub translations_m: Vec<f64>,
     /// The length that turns a translation σ into a rotation σ (`σ_rot = σ_trans / length_m`): a
@@ -50,8 +68,7 @@ pub struct NominalPriorOptions {
     /// the arm's gravity and lever arms by as much; a track held at one position varies by
     /// micrometres).
     pub min_height_span_m: f64,
-    /// Above this many rows the strength is not chosen and the fit has no prior (the report says
-    /// so): 20,000. The choice costs an extra fit per candidate and held-out cluster (about 30 on
+    /// Above this many rows the fit has no prior (the report says so): 20,000. The choice costs an extra fit per candidate and held-out cluster (about 30 on
     /// a 6-axis arm with four clusters): on issue 31's 242,000-row, 65.7 MB campaign it took the
     /// fit from 48 s to 265 s and its peak from 253 MB past the 400 MB bound. A campaign of
     /// 20,000 poses is dense over the configurations it will be used in, which is where the prior
@@ -63,6 +80,8 @@ impl Default for NominalPriorOptions {
     fn default() -> Self {
         Self {
             choose: true,
+            tolerance_translation_m: 1e-3,
+            tolerance_rotation_rad: 1e-3,
             translations_m: vec![f64::INFINITY, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5],
             length_m: 1.0,
             min_cluster_share: 0.05,
@@ -87,7 +106,19 @@ impl NominalPriorOptions {
                 ),
             ));
         }
-        let checks: [(&'static str, f64, bool, &str); 4] = [
+        let checks: [(&'static str, f64, bool, &str); 6] = [
+            (
+                "tolerance_translation_m",
+                self.tolerance_translation_m,
+                self.tolerance_translation_m.is_finite() && self.tolerance_translation_m > 0.0,
+                "a finite number above 0",
+            ),
+            (
+                "tolerance_rotation_rad",
+                self.tolerance_rotation_rad,
+                self.tolerance_rotation_rad.is_finite() && self.tolerance_rotation_rad > 0.0,
+                "a finite number above 0",
+            ),
             (
                 "min_height_span_m",
                 self.min_height_span_m,
@@ -155,12 +186,19 @@ pub struct PriorChoice {
     pub height_splits: Vec<HeightSplit>,
     /// The data's configuration clusters, largest first.
     pub clusters: Vec<Cluster>,
+    /// The nominal's tolerance, translation (m) and rotation (rad).
+    pub tolerance: (f64, f64),
+    /// How far the plain fit's weighted residual is above the stated noise, `√(χ² / (rows −
+    /// rank))`, at least 1 (`null`: no plain fit was made): the posterior's σ is the tolerance
+    /// over it.
+    pub residual_scale: Option<f64>,
     /// The clusters held out in turn (labels).
     pub held_out: Vec<String>,
     /// Every candidate with its held-out error (empty where nothing was held out); the chosen one
     /// is the first within one standard error of the lowest (`choose`).
     pub candidates: Vec<PriorCandidate>,
-    /// The chosen σ of a link's translation, m (`null`: no prior, the plain least-squares fit).
+    /// The chosen σ of a link's translation, m: the posterior's or a stronger one held out across
+    /// the clusters (`null`: no prior, the plain least-squares fit).
     pub translation_m: Option<f64>,
     /// The chosen σ of a link's rotation, rad (`null`: no prior).
     pub rotation_rad: Option<f64>,
@@ -174,11 +212,18 @@ impl PriorChoice {
         self.translation_m.zip(self.rotation_rad)
     }
 
-    fn without(branch_joints: Vec<BranchJoint>, clusters: Vec<Cluster>, reason: String) -> Self {
+    fn without(
+        branch_joints: Vec<BranchJoint>,
+        clusters: Vec<Cluster>,
+        prior: &NominalPriorOptions,
+        reason: String,
+    ) -> Self {
         Self {
             branch_joints,
             height_splits: Vec::new(),
             clusters,
+            tolerance: (prior.tolerance_translation_m, prior.tolerance_rotation_rad),
+            residual_scale: None,
             held_out: Vec::new(),
             candidates: Vec::new(),
             translation_m: None,
@@ -233,16 +278,16 @@ pub fn choose(
     prior: &NominalPriorOptions,
 ) -> Result<PriorChoice, Error> {
     if !prior.choose {
-        return Ok(PriorChoice::without(Vec::new(), Vec::new(), "switched off (nominal_prior.choose)".into()));
+        return Ok(PriorChoice::without(Vec::new(), Vec::new(), prior, "switched off (nominal_prior.choose)".into()));
     }
     if data.rows.len() > prior.max_rows {
         let reason = format!(
-            "{} rows, more than nominal_prior.max_rows = {}: the strength is not chosen (an extra fit per candidate \
-             and cluster), the fit as without a prior",
+            "{} rows, more than nominal_prior.max_rows = {}: the fit as without a prior (the prior costs a plain \
+             fit more, and a fit per candidate and cluster)",
             data.rows.len(),
             prior.max_rows
         );
-        return Ok(PriorChoice::without(Vec::new(), Vec::new(), reason));
+        return Ok(PriorChoice::without(Vec::new(), Vec::new(), prior, reason));
     }
     let scan = ScanOptions {
         steps: prior.scan_steps,
@@ -253,9 +298,25 @@ pub fn choose(
     let branch_joints = clusters::branch_joints(nominal, &data.rows, scan)?;
     let height_splits = clusters::height_splits(nominal, &data.rows, scan);
     let found = clusters::clusters(&branch_joints, &height_splits, &data.rows);
+    // The posterior: the tolerance weighed against the residual a plain fit leaves. Below the
+    // stated noise the likelihood is the stated noise's: the prior is never weaker than the
+    // tolerance.
+    let (_, plain) = calibrate_placed_with_prior(nominal, &observations(data), Scope::Full, None, identification)
+        .map_err(Error::kinematics)?;
+    let dof = plain.report.residual_rows.saturating_sub(plain.report.rank).max(1);
+    let scale = (plain.report.final_cost / dof as f64).sqrt().max(1.0);
+    let posterior = (prior.tolerance_translation_m / scale, prior.tolerance_rotation_rad / scale);
+    let tolerance = format!(
+        "the nominal's tolerance {:.3} mm / {:.3} mrad against a residual {scale:.2} times the stated noise",
+        prior.tolerance_translation_m * 1e3,
+        prior.tolerance_rotation_rad * 1e3
+    );
     let without = |reason: String| {
-        let mut choice = PriorChoice::without(branch_joints.clone(), found.clone(), reason);
+        let mut choice =
+            PriorChoice::without(branch_joints.clone(), found.clone(), prior, format!("{tolerance}; {reason}"));
         choice.height_splits = height_splits.clone();
+        choice.residual_scale = Some(scale);
+        (choice.translation_m, choice.rotation_rad) = (Some(posterior.0), Some(posterior.1));
         choice
     };
     if branch_joints.is_empty() && height_splits.is_empty() {
@@ -276,7 +337,7 @@ pub fn choose(
     let folds: Vec<&Cluster> = found.iter().filter(|c| c.n >= least).collect();
     if folds.len() < 2 {
         let reason = format!(
-            "one configuration cluster of at least {:.0} % of the rows ({}): nothing to hold out, the fit as without a prior",
+            "one configuration cluster of at least {:.0} % of the rows ({}): nothing to hold out, the posterior",
             100.0 * prior.min_cluster_share,
             found.first().map_or("no rows".into(), |c| c.label.clone())
         );
@@ -294,8 +355,11 @@ pub fn choose(
             tools_known.then(|| (cluster.label.clone(), data.subset(&train), data.subset(&cluster.rows)))
         })
         .collect();
+    // The posterior first (the weakest, which the one-standard-error rule prefers), then the
+    // stronger candidates.
+    let stronger = prior.translations_m.iter().filter(|&&t| t.is_finite() && t < posterior.0);
     let sigmas: Vec<Option<(f64, f64)>> =
-        prior.translations_m.iter().map(|&t| t.is_finite().then_some((t, t / prior.length_m))).collect();
+        std::iter::once(Some(posterior)).chain(stronger.map(|&t| Some((t, t / prior.length_m)))).collect();
     let work: Vec<(usize, usize)> = (0..splits.len()).flat_map(|s| (0..sigmas.len()).map(move |c| (s, c))).collect();
     let results: Vec<Option<Vec<(f64, f64)>>> = work
         .par_iter()
@@ -313,7 +377,7 @@ pub fn choose(
     if usable.is_empty() {
         let reason =
             "no configuration cluster could be held out (a tool only it carries, or too few rows without it): \
-                      the fit as without a prior"
+                      the posterior"
                 .to_owned();
         return Ok(without(reason));
     }
@@ -343,17 +407,18 @@ pub fn choose(
     };
     let chosen = (0..candidates.len()).find(|&c| within_one_error(c)).unwrap_or(best);
     let held_out: Vec<String> = usable.iter().map(|&s| splits[s].0.clone()).collect();
-    let unprior = candidates.iter().find(|c| c.translation_m.is_none());
     let reason = format!(
-        "{} configuration clusters held out in turn: held-out RMS {:.4} mm{}",
+        "{tolerance}; {} configuration clusters held out in turn: held-out RMS {:.4} mm, {:.4} mm at the tolerance",
         held_out.len(),
         candidates[chosen].heldout_rms_position_mm,
-        unprior.map_or(String::new(), |u| format!(", {:.4} mm without a prior", u.heldout_rms_position_mm))
+        candidates[0].heldout_rms_position_mm
     );
     Ok(PriorChoice {
         branch_joints,
         height_splits,
         clusters: found,
+        tolerance: (prior.tolerance_translation_m, prior.tolerance_rotation_rad),
+        residual_scale: Some(scale),
         held_out,
         translation_m: candidates[chosen].translation_m,
         rotation_rad: candidates[chosen].rotation_rad,
