@@ -249,7 +249,7 @@ pub fn fit(
     }
     let nominal = robot.nominal_model()?;
     let scope = if method == Method::BaseTool { Scope::BaseTool } else { Scope::Full };
-    let nominal_prior = match scope {
+    let mut nominal_prior = match scope {
         Scope::Full => Some(timings::phase("prior choice", || {
             crate::choose_prior(&nominal, data, &options.identification, &options.nominal_prior)
         })?),
@@ -307,8 +307,26 @@ pub fn fit(
             ..options.identification.clone()
         };
         // The effects are fitted under the same prior, about the same placed nominal model, as
-        // the geometry alone: otherwise they would free what it held.
-        let prior = prior_sigmas.map(|(t, r)| KinematicPrior::on_links(geometry.registered.clone(), t, r));
+        // the geometry alone (otherwise they would free what it held), weighed against the
+        // residual the geometry with its effects leaves: one fit without the prior more.
+        let sigmas = match nominal_prior.as_mut().filter(|_| prior_sigmas.is_some()) {
+            Some(choice) => {
+                let plain = timings::phase("effects identification without the prior", || {
+                    identify_with_prior(
+                        &model.kinematics,
+                        &observations(data),
+                        &mask,
+                        Some(&correction),
+                        None,
+                        &id_options,
+                    )
+                })
+                .map_err(Error::kinematics)?;
+                choice.for_effects(&plain.report)
+            }
+            None => None,
+        };
+        let prior = sigmas.map(|(t, r)| KinematicPrior::on_links(geometry.registered.clone(), t, r));
         let fitted = timings::phase("effects identification", || {
             identify_with_prior(
                 &model.kinematics,

@@ -15,7 +15,7 @@ use errors::Error;
 use measurements::MeasurementSet;
 use model::geometric::observations;
 use poe::LocalPoe;
-use poe::identify::{IdentificationOptions, Scope, calibrate_placed_with_prior, evaluate};
+use poe::identify::{IdentificationOptions, IdentificationReport, Scope, calibrate_placed_with_prior, evaluate};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -204,6 +204,28 @@ pub struct PriorChoice {
     pub rotation_rad: Option<f64>,
     /// Why.
     pub reason: String,
+    /// The prior of the fit with effects, where there are effects and a prior: the chosen σ
+    /// weighed against the residual the geometry with its effects leaves ([`EffectsPrior`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub with_effects: Option<EffectsPrior>,
+}
+
+/// The prior toward the nominal geometry in the fit with effects (issue 45). The chosen σ is in
+/// the units of the stated noise, weighed against the residual the geometry alone leaves
+/// (`residual_scale`); with the effects identified that residual is smaller (a compliance the
+/// geometry alone left as millimetres is down to the noise), and the same prior width in
+/// metres is a σ larger by the ratio of the two scales. Kept as it was, it would hold the
+/// geometry that many times (37 on a 7-axis arm with an unmodelled compliance) more tightly
+/// than the tolerance says, and the effects would absorb what the geometry could not reach.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct EffectsPrior {
+    /// `√(χ² / (rows − rank))` of the fit with the effects and no prior, at least 1 and at most
+    /// the geometry's: effects never hold the geometry more tightly than it is held alone.
+    pub residual_scale: f64,
+    /// σ of a link's translation, m.
+    pub translation_m: f64,
+    /// σ of a link's rotation, rad.
+    pub rotation_rad: f64,
 }
 
 impl PriorChoice {
@@ -229,8 +251,39 @@ impl PriorChoice {
             translation_m: None,
             rotation_rad: None,
             reason,
+            with_effects: None,
         }
     }
+
+    /// The prior of the fit with effects, given the report of that fit without a prior
+    /// (`plain`), and records it ([`EffectsPrior`]): the chosen σ times the geometry's residual
+    /// scale over the effects' one. `None` where there is no prior.
+    pub fn for_effects(&mut self, plain: &IdentificationReport) -> Option<(f64, f64)> {
+        self.for_effects_at(residual_scale(plain))
+    }
+
+    /// [`PriorChoice::for_effects`] given the plain fit's residual scale (`plain_scale`, at
+    /// least 1).
+    fn for_effects_at(&mut self, plain_scale: f64) -> Option<(f64, f64)> {
+        let (translation_m, rotation_rad) = self.chosen()?;
+        let alone = self.residual_scale.unwrap_or(1.0);
+        let scale = plain_scale.min(alone);
+        let ratio = alone / scale;
+        let prior = EffectsPrior {
+            residual_scale: scale,
+            translation_m: translation_m * ratio,
+            rotation_rad: rotation_rad * ratio,
+        };
+        self.with_effects = Some(prior);
+        Some((prior.translation_m, prior.rotation_rad))
+    }
+}
+
+/// How far a fit's weighted residual is above the stated noise, `√(χ² / (rows − rank))`, at least
+/// 1: below the stated noise, the likelihood is the stated noise's.
+fn residual_scale(report: &IdentificationReport) -> f64 {
+    let dof = report.residual_rows.saturating_sub(report.rank).max(1);
+    (report.final_cost / dof as f64).sqrt().max(1.0)
 }
 
 impl std::fmt::Display for PriorChoice {
@@ -244,6 +297,16 @@ impl std::fmt::Display for PriorChoice {
                 self.reason
             ),
             None => write!(f, "prior toward the nominal geometry: none ({})", self.reason),
+        }?;
+        match self.with_effects {
+            Some(prior) => write!(
+                f,
+                "; with the effects σ {:.3} mm / {:.3} mrad (their residual {:.2} times the stated noise)",
+                prior.translation_m * 1e3,
+                prior.rotation_rad * 1e3,
+                prior.residual_scale
+            ),
+            None => Ok(()),
         }
     }
 }
@@ -303,8 +366,7 @@ pub fn choose(
     // tolerance.
     let (_, plain) = calibrate_placed_with_prior(nominal, &observations(data), Scope::Full, None, identification)
         .map_err(Error::kinematics)?;
-    let dof = plain.report.residual_rows.saturating_sub(plain.report.rank).max(1);
-    let scale = (plain.report.final_cost / dof as f64).sqrt().max(1.0);
+    let scale = residual_scale(&plain.report);
     let posterior = (prior.tolerance_translation_m / scale, prior.tolerance_rotation_rad / scale);
     let tolerance = format!(
         "the nominal's tolerance {:.3} mm / {:.3} mrad against a residual {scale:.2} times the stated noise",
@@ -424,5 +486,40 @@ pub fn choose(
         rotation_rad: candidates[chosen].rotation_rad,
         candidates,
         reason,
+        with_effects: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{NominalPriorOptions, PriorChoice};
+
+    fn posterior(scale: f64) -> PriorChoice {
+        let prior = NominalPriorOptions::default();
+        let mut choice = PriorChoice::without(Vec::new(), Vec::new(), &prior, "test".into());
+        choice.residual_scale = Some(scale);
+        (choice.translation_m, choice.rotation_rad) = (Some(1e-3 / scale), Some(2e-3 / scale));
+        choice
+    }
+
+    /// The prior in metres stays what the geometry's was: its σ in noise units grows by the
+    /// ratio of the residual scales, back to the tolerance where the effects leave the noise; it
+    /// never tightens (a plain fit with effects whose scale is above the geometry's, by the
+    /// parameters it spends).
+    #[test]
+    fn the_effects_prior_is_the_chosen_one_weighed_against_their_residual_and_never_tighter() {
+        let near = |(t, r): (f64, f64), (a, b): (f64, f64)| (t - a).abs() < 1e-15 && (r - b).abs() < 1e-15;
+        let mut choice = posterior(40.0);
+        let at_noise = choice.for_effects_at(1.0).unwrap();
+        assert!(near(at_noise, (1e-3, 2e-3)), "{at_noise:?}");
+        assert_eq!(choice.with_effects.map(|p| p.residual_scale), Some(1.0));
+        let above = posterior(40.0).for_effects_at(4.0).unwrap();
+        assert!(near(above, (2.5e-4, 5e-4)), "{above:?}");
+        let wider = posterior(4.0).for_effects_at(4.5).unwrap();
+        assert!(near(wider, (2.5e-4, 5e-4)), "{wider:?}");
+        let prior = NominalPriorOptions::default();
+        let mut none = PriorChoice::without(Vec::new(), Vec::new(), &prior, "switched off".into());
+        assert_eq!(none.for_effects_at(1.0), None);
+        assert!(none.with_effects.is_none());
+    }
 }
