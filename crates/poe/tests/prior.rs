@@ -8,7 +8,7 @@ use common::{irb4400, measured_robot, observe, rng};
 use poe::LocalPoe;
 use poe::identify::{
     IdentificationOptions, KinematicPrior, ParameterMask, Scope, Solver, calibrate_placed, calibrate_placed_with_prior,
-    identify_with_prior,
+    identify_with_prior, posterior_covariance,
 };
 
 /// The largest difference of the links' local transforms (joints 2…n), metres of translation.
@@ -80,4 +80,44 @@ fn the_prior_is_about_its_centre_not_the_start() {
     let end = link_distance(&back.model, &placed);
     eprintln!("links from the centre: start {start:.2e} m, end {end:.2e} m");
     assert!(end < 1e-3 * start, "{end} against {start}");
+}
+
+/// The posterior covariance at a fitted model under the prior it was fitted with is the fit's own
+/// (the same linearisation, weights and χ²); under a wider prior, every variance is at least as
+/// large, and a direction the poses hardly see (the joints' range held to a tenth of a turn)
+/// widens toward the wider prior's width.
+#[test]
+fn the_posterior_covariance_at_a_fit_is_its_own_and_widens_with_the_prior() {
+    let (nominal, limits) = irb4400();
+    let mut r = rng(9);
+    let truth = measured_robot(&nominal, &mut r);
+    let narrow: Vec<(f64, f64)> =
+        limits.iter().map(|&(low, high)| (0.05 * (low + high), 0.05 * (low + high) + 0.3)).collect();
+    let observations = observe(&truth, &narrow, 80, true, 1e-5, 1e-5, &mut r);
+    let options = IdentificationOptions { solver: Solver::LevenbergMarquardt, ..IdentificationOptions::default() };
+    let (placed, _) = calibrate_placed(&nominal, &observations, Scope::Full, &options).unwrap();
+    let mask = ParameterMask::all(placed.layout());
+    let tight = KinematicPrior::on_links(placed.clone(), 1e-5, 1e-5);
+    let fit = identify_with_prior(&placed, &observations, &mask, None, Some(&tight), &options).unwrap();
+    let own = posterior_covariance(&fit.model, &observations, &mask, None, &tight, &options).unwrap();
+    let p = mask.free_indices().len();
+    assert_eq!((fit.covariance.len(), own.len()), (p * p, p * p));
+    let largest = fit.covariance.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let differs = fit.covariance.iter().zip(&own).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    assert!(differs <= 1e-6 * largest, "{differs:e} of {largest:e}");
+    let wide = KinematicPrior::on_links(placed.clone(), 1e-3, 1e-3);
+    let wider = posterior_covariance(&fit.model, &observations, &mask, None, &wide, &options).unwrap();
+    let diagonal = |c: &[f64], i: usize| c[i * p + i];
+    for i in 0..p {
+        assert!(
+            diagonal(&wider, i) >= diagonal(&own, i) * (1.0 - 1e-9),
+            "{i}: {} {}",
+            diagonal(&wider, i),
+            diagonal(&own, i)
+        );
+    }
+    let widest = (0..p).map(|i| diagonal(&wider, i).sqrt()).fold(0.0, f64::max);
+    let was = (0..p).map(|i| diagonal(&own, i).sqrt()).fold(0.0, f64::max);
+    eprintln!("largest σ: {was:.2e} under the fit's prior, {widest:.2e} under one 100 times wider");
+    assert!(widest > 5.0 * was, "{widest:e} {was:e}");
 }

@@ -23,7 +23,7 @@ pub use registration::{kabsch, nearest_rotation, register};
 pub use report::{DampingFallback, IdentificationReport, IterationRecord};
 pub use residual::ResidualStats;
 pub use robust::{KindScale, Loss, OutlierRow, RobustOptions, RobustReport, huber_loss, huber_weight, median};
-pub use solver::{Identification, identify, identify_with_correction, identify_with_prior};
+pub use solver::{Identification, identify, identify_with_correction, identify_with_prior, posterior_covariance};
 pub use termination::Termination;
 
 use crate::{Error, LocalPoe};

@@ -6,6 +6,7 @@ use super::correction::PoseCorrection;
 use super::levenberg::{continue_damped, levenberg_marquardt};
 use super::prior::KinematicPrior;
 use super::problem::{Problem, Solved, State, cost, record};
+use super::reduced::Reduced;
 use super::redundancy::find_redundancies;
 use super::residual::row_errors;
 use super::robust::{self, RobustReport};
@@ -104,7 +105,7 @@ pub fn identify_with_prior(
     };
     let unidentifiable =
         find_redundancies(&solved.state.model, observations, mask, solved.a.r.ncols().saturating_sub(rank));
-    let covariance = covariance(&problem, &solved, rows.saturating_sub(rank));
+    let covariance = covariance(&problem, &solved.a, &solved.state.deviation, rows.saturating_sub(rank));
     Ok(Identification {
         model: solved.state.model,
         correction: solved.state.theta,
@@ -128,17 +129,67 @@ pub fn identify_with_prior(
     })
 }
 
+/// The posterior covariance of the free parameters of `model` under `prior`, at `model` itself:
+/// [`Identification::covariance`] of a fit that ended there (the free kinematic parameters in
+/// `mask`'s order, then `correction`'s at its `θ`; the robust loss's weights the residuals at
+/// `model` call for, as the last reweighting of [`identify_with_prior`] takes them), with a
+/// prior other than the one it was fitted under: where a fit held the links more tightly than
+/// their tolerance (a strength chosen by held-out error), what the data and the tolerance alone
+/// say of the geometry. Empty where the decomposition fails, as there.
+pub fn posterior_covariance(
+    model: &LocalPoe,
+    observations: &[Observation],
+    mask: &ParameterMask,
+    correction: Option<(&dyn PoseCorrection, &[f64])>,
+    prior: &KinematicPrior,
+    options: &IdentificationOptions,
+) -> Result<Vec<f64>, Error> {
+    options.validate()?;
+    prior.validate(model)?;
+    let layout = model.layout();
+    if mask.flags().len() != layout.len() {
+        return Err(Error::MaskLength { given: mask.flags().len(), expected: layout.len() });
+    }
+    let theta = correction.map_or_else(Vec::new, |(_, theta)| theta.to_vec());
+    if let Some((c, _)) = correction
+        && c.parameter_count() != theta.len()
+    {
+        return Err(Error::MaskLength { given: theta.len(), expected: c.parameter_count() });
+    }
+    let mut problem = Problem {
+        observations,
+        free: mask.free_indices(),
+        correction: correction.map(|(c, _)| c),
+        options,
+        row_weights: Vec::new(),
+        prior: Some(prior),
+    };
+    if options.robust.loss == robust::Loss::Huber {
+        let errors = row_errors(model, observations, problem.corrected(&theta))?;
+        problem.row_weights = robust::assess(&errors, &options.robust).weights;
+    }
+    let deviation = prior.deviation(model, &problem.free).into_iter().chain(theta.iter().copied()).collect();
+    let state = State { model: model.clone(), theta, deviation };
+    let (a, _) = problem.linearise(&state)?;
+    let svd = normal::Decomposition::new(&a, 0)?;
+    let smax = svd.singular_values.first().copied().unwrap_or(0.0);
+    let rank = svd.singular_values.iter().filter(|&&s| s > options.rcond * smax && s > 0.0).count();
+    let rows = super::residual::row_count(observations);
+    Ok(covariance(&problem, &a, &state.deviation, rows.saturating_sub(rank)))
+}
+
 /// [`Identification::covariance`]: the pseudo-inverse of the normal matrix under the prior the
 /// solver used (none for the pseudo-inverse iteration), the directions below `rcond` dropped as
-/// the rank drops them, times the reduced χ² (`dof`: residual rows less the rank).
-fn covariance(problem: &Problem<'_>, solved: &Solved, dof: usize) -> Vec<f64> {
+/// the rank drops them, times the reduced χ² (`dof`: residual rows less the rank), at the
+/// linearisation `a` whose prior deviation is `deviation`.
+fn covariance(problem: &Problem<'_>, a: &Reduced, deviation: &[f64], dof: usize) -> Vec<f64> {
     let weights = match problem.options.solver {
         Solver::PseudoInverse if problem.prior.is_none() => vec![0.0; problem.parameter_count()],
         _ => super::levenberg::prior_weights(problem),
     };
-    let normal = normal::Normal::new(&solved.a, &weights, &solved.state.deviation);
+    let normal = normal::Normal::new(a, &weights, deviation);
     let Some(inverse) = normal.pseudo_inverse(problem.options.rcond) else { return Vec::new() };
-    let scale = solved.a.residual_sq / dof.max(1) as f64;
+    let scale = a.residual_sq / dof.max(1) as f64;
     let p = inverse.nrows();
     (0..p).flat_map(|i| (0..p).map(move |j| (i, j))).map(|(i, j)| inverse[(i, j)] * scale).collect()
 }
