@@ -51,6 +51,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         for warning in &report.out_of_range {
             eprintln!("warning: {warning}");
         }
+        if let Some(predicted) = &report.geometry_sigma {
+            eprintln!("warning: {predicted}");
+        }
         for warning in &report.beyond_joint_limits {
             eprintln!("warning: {warning}");
         }
@@ -96,6 +99,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     for warning in &report.out_of_range {
         println!("  warning: {warning}");
+    }
+    if let Some(predicted) = &report.geometry_sigma {
+        println!("  warning: {predicted}");
     }
     for warning in &report.beyond_joint_limits {
         println!("  warning: {warning}");

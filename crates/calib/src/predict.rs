@@ -46,6 +46,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     for warning in model.outside_training_range(&data.rows) {
         eprintln!("warning: {warning}");
     }
+    if let Some(predicted) = model.geometry_sigma(&bound)? {
+        eprintln!("warning: {predicted}");
+    }
     for warning in model.beyond_joint_limits(&data.rows) {
         eprintln!("warning: {warning}");
     }

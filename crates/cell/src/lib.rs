@@ -24,6 +24,7 @@
 //!     effects: Vec::new(),
 //!     fallback_kinematics: None,
 //!     effect_uncertainty: None,
+//!     geometry_uncertainty: None,
 //!     residual_gp: None,
 //!     training_range: None,
 //!     joint_limits: Vec::new(),

@@ -41,6 +41,12 @@ pub struct CalibratedModel {
     /// the training rows'. Files written before it was kept have none (no σ, no fallback by it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub effect_uncertainty: Option<crate::EffectUncertainty>,
+    /// The posterior uncertainty of the kinematics (issue 45): for rows that put a joint outside
+    /// the range the model was fitted on, the error the geometry's own uncertainty predicts
+    /// there. Kept by fits under the prior toward the nominal geometry; files written before it
+    /// was kept have none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geometry_uncertainty: Option<crate::GeometryUncertainty>,
     /// The GP on the residual, step 2 (methods `poe-gp`, `poe-gp-load`); `compensation` in the file.
     #[serde(default, skip_serializing_if = "Option::is_none", rename = "compensation")]
     pub residual_gp: Option<crate::ResidualGp>,
@@ -369,6 +375,16 @@ impl CalibratedModel {
     pub fn outside_training_range(&self, rows: &[Measurement]) -> Vec<crate::OutOfRangeWarning> {
         let prismatic: Vec<bool> = self.joint_kinds().iter().map(|k| *k == poe::JointKind::Prismatic).collect();
         self.training_range.as_ref().map_or_else(Vec::new, |range| range.outside(rows, &prismatic))
+    }
+
+    /// What the geometry's own uncertainty predicts on the rows of `data` that put a joint
+    /// outside the range the model was fitted on ([`crate::GeometrySigma`]); `None` where no row
+    /// does, or the model keeps no range or no geometry uncertainty.
+    pub fn geometry_sigma(&self, data: &BoundSet<'_>) -> Result<Option<crate::GeometrySigma>, Error> {
+        let (Some(uncertainty), Some(range)) = (&self.geometry_uncertainty, &self.training_range) else {
+            return Ok(None);
+        };
+        crate::GeometrySigma::of(uncertainty, &self.kinematics, data, |row| !range.contains_joints(row))
     }
 
     /// One warning per joint that some of `rows` put beyond the robot's limits; none for model

@@ -96,16 +96,7 @@ impl EffectUncertainty {
         row: &Measurement,
         tool: usize,
     ) -> Result<Vec<[f64; 6]>, Error> {
-        let columns = kinematics.layout().len();
-        let mut jacobian = vec![0.0; 6 * columns];
-        let pose = kinematics
-            .identification_jacobian(&row.q, tool, RowKind::PointAndRotation, &mut jacobian)
-            .map_err(Error::kinematics)?;
-        let point = pose.translation();
-        let mut changes: Vec<[f64; 6]> = Vec::with_capacity(self.free.len());
-        for &c in &self.free {
-            changes.push(std::array::from_fn(|k| jacobian.get(k * columns + c).copied().unwrap_or(0.0)));
-        }
+        let (mut changes, point) = kinematic_changes(kinematics, &self.free, row, tool)?;
         let mut twists = RowTwists::new(kinematics, &row.q, tool);
         for effect in effects {
             let features = effect.features(row, tool)?;
@@ -134,41 +125,66 @@ impl EffectUncertainty {
         row: &Measurement,
         tool: usize,
     ) -> Result<[f64; 6], Error> {
-        let p = self.parameter_count();
         let changes = self.parameter_changes(kinematics, effects, row, tool)?;
-        if changes.len() != p {
-            return Ok([0.0; 6]);
-        }
-        // (Lᵀ g)_j = Σ_{i ≥ j} L_ij g_i, row i of L starting at i(i+1)/2.
-        let mut u = vec![[0.0; 6]; p];
-        for (i, change) in changes.iter().enumerate() {
-            let start = i * (i + 1) / 2;
-            for (j, uj) in u.iter_mut().enumerate().take(i + 1) {
-                let l = self.factor[start + j];
-                for k in 0..6 {
-                    uj[k] += l * change[k];
-                }
-            }
-        }
-        Ok(std::array::from_fn(|k| u.iter().map(|v| v[k] * v[k]).sum::<f64>().sqrt()))
+        Ok(factor_sigma(&self.factor, &changes))
     }
 }
 
+/// The columns of the identification Jacobian of `kinematics` at `row` (model tool `tool`) for
+/// the parameters `free`, as `(v, ω)` at the tool point, and that point.
+pub(crate) fn kinematic_changes(
+    kinematics: &LocalPoe,
+    free: &[usize],
+    row: &Measurement,
+    tool: usize,
+) -> Result<(Vec<[f64; 6]>, Vector3), Error> {
+    let columns = kinematics.layout().len();
+    let mut jacobian = vec![0.0; 6 * columns];
+    let pose = kinematics
+        .identification_jacobian(&row.q, tool, RowKind::PointAndRotation, &mut jacobian)
+        .map_err(Error::kinematics)?;
+    let changes =
+        free.iter().map(|&c| std::array::from_fn(|k| jacobian.get(k * columns + c).copied().unwrap_or(0.0))).collect();
+    Ok((changes, pose.translation()))
+}
+
+/// Per component of the pose error, `σ_k = ‖Lᵀ g_k‖` for the packed lower factor `factor` of a
+/// covariance and the pose's changes `changes` per parameter; zero when the factor is not of
+/// that many parameters (a model edited by hand; the file check refuses it).
+pub(crate) fn factor_sigma(factor: &[f64], changes: &[[f64; 6]]) -> [f64; 6] {
+    let p = changes.len();
+    if factor.len() != p * (p + 1) / 2 {
+        return [0.0; 6];
+    }
+    // (Lᵀ g)_j = Σ_{i ≥ j} L_ij g_i, row i of L starting at i(i+1)/2.
+    let mut u = vec![[0.0; 6]; p];
+    for (i, change) in changes.iter().enumerate() {
+        let start = i * (i + 1) / 2;
+        for (j, uj) in u.iter_mut().enumerate().take(i + 1) {
+            let l = factor[start + j];
+            for k in 0..6 {
+                uj[k] += l * change[k];
+            }
+        }
+    }
+    std::array::from_fn(|k| u.iter().map(|v| v[k] * v[k]).sum::<f64>().sqrt())
+}
+
 /// A list of numbers as one string, each to seven significant digits.
-mod packed_numbers {
+pub(crate) mod packed_numbers {
     use serde::{Deserialize, Deserializer, Serializer, de::Error};
 
     /// `value` to seven significant digits: what the string keeps.
-    pub(super) fn rounded(value: f64) -> f64 {
+    pub(crate) fn rounded(value: f64) -> f64 {
         format!("{value:.6e}").parse().unwrap_or(value)
     }
 
-    pub(super) fn serialize<S: Serializer>(values: &[f64], serializer: S) -> Result<S::Ok, S::Error> {
+    pub(crate) fn serialize<S: Serializer>(values: &[f64], serializer: S) -> Result<S::Ok, S::Error> {
         let text: Vec<String> = values.iter().map(|v| format!("{v:.6e}")).collect();
         serializer.serialize_str(&text.join(" "))
     }
 
-    pub(super) fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<f64>, D::Error> {
+    pub(crate) fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<f64>, D::Error> {
         let text = String::deserialize(deserializer)?;
         text.split_ascii_whitespace()
             .enumerate()

@@ -50,6 +50,11 @@ pub struct EvalReport {
     /// for every model that records it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub out_of_range: Vec<crate::OutOfRangeWarning>,
+    /// What the geometry's own uncertainty predicts on the rows that put a joint outside the
+    /// range the model was fitted on, for every model that keeps it ([`crate::GeometrySigma`]);
+    /// `None` where no row does.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geometry_sigma: Option<crate::GeometrySigma>,
     /// Joints beyond the robot's limits, for every model that keeps them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub beyond_joint_limits: Vec<crate::BeyondLimitsWarning>,
@@ -126,6 +131,8 @@ impl EvalReport {
                 .then(|| CoverageSplit::of(data, evaluation, covered)),
             warnings: model.extrapolation(&data.rows),
             out_of_range: model.outside_training_range(&data.rows),
+            // The evaluation has walked the same rows with the same kinematics: it cannot fail here.
+            geometry_sigma: model.geometry_sigma(bound).ok().flatten(),
             beyond_joint_limits: model.beyond_joint_limits(&data.rows),
             range_split: model
                 .training_range

@@ -20,6 +20,7 @@
 //!     effects: Vec::new(),
 //!     fallback_kinematics: None,
 //!     effect_uncertainty: None,
+//!     geometry_uncertainty: None,
 //!     residual_gp: None,
 //!     training_range: None,
 //!     joint_limits: Vec::new(),
@@ -40,6 +41,7 @@ mod effect_sigma;
 mod eval_report;
 mod evaluate;
 pub mod geometric;
+mod geometry_sigma;
 mod heldout;
 mod joint_limits;
 mod method;
@@ -60,6 +62,7 @@ pub use predictions::write_predictions;
 pub use calibrated::{CalibratedModel, ExtrapolationWarning, GpFade, PredictedPose, SigmaFallback};
 pub use effect_sigma::EffectUncertainty;
 pub use eval_report::{CoverageSplit, EvalReport, ORIENTATIONS_NOT_EVALUATED};
+pub use geometry_sigma::{GeometrySigma, GeometryUncertainty};
 pub use heldout::{HeldoutEstimate, HeldoutSource};
 pub use joint_limits::{BeyondLimitsWarning, beyond_limits, stored_limits};
 pub use method::{Method, UnknownMethod};

@@ -244,6 +244,10 @@ impl CalibratedModel {
         {
             return Err(at.part("effect_uncertainty", message));
         }
+        if let Some(message) = self.geometry_uncertainty.as_ref().and_then(|u| u.fault(self.kinematics.layout().len()))
+        {
+            return Err(at.part("geometry_uncertainty", message));
+        }
         let (rows, where_) = self.probe_rows();
         // Made here from the model, every row on its first tool.
         let probe = measurements::BoundSet::made_for_model("the model check", rows);

@@ -116,6 +116,7 @@ mod version_1 {
                 effects,
                 fallback_kinematics: None,
                 effect_uncertainty: None,
+                geometry_uncertainty: None,
                 residual_gp: v1.residual_gp,
                 training_range: None,
                 joint_limits: Vec::new(),

@@ -124,6 +124,11 @@ impl std::fmt::Display for OutOfRangeWarning {
 }
 
 impl TrainingRange {
+    /// Whether every joint of `row` lies within the range.
+    pub fn contains_joints(&self, row: &Measurement) -> bool {
+        self.q.iter().zip(&row.q).all(|(&[low, high], &q)| (low..=high).contains(&q))
+    }
+
     /// Whether every input of `row` (joints, payload, and temperature and time where the range
     /// records them) lies within the range.
     pub fn contains(&self, row: &Measurement) -> bool {

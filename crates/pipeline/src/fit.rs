@@ -15,6 +15,7 @@ use model::{
 };
 use poe::identify::{
     IdentificationOptions, IdentificationReport, KinematicPrior, Loss, ParameterMask, Scope, identify_with_prior,
+    posterior_covariance,
 };
 use robot::RobotDescription;
 use serde::Serialize;
@@ -212,6 +213,29 @@ fn effect_uncertainty(
     Ok(Some(uncertainty))
 }
 
+/// The geometry's own uncertainty ([`model::GeometryUncertainty`]) of `kinematics` fitted on
+/// `data`: the kinematic block of the posterior covariance at the fit under the prior of `widths`
+/// (translation m, rotation rad) about the placed nominal `placed`, with the effects' correction
+/// at its fitted parameters where there is one. `None` where the covariance cannot be had.
+#[allow(clippy::too_many_arguments)]
+fn geometry_uncertainty(
+    kinematics: &poe::LocalPoe,
+    placed: &poe::LocalPoe,
+    widths: (f64, f64),
+    mask: &ParameterMask,
+    correction: Option<(&dyn poe::identify::PoseCorrection, &[f64])>,
+    data: &MeasurementSet,
+    bound: &BoundSet<'_>,
+    options: &IdentificationOptions,
+) -> Result<Option<model::GeometryUncertainty>, Error> {
+    let prior = KinematicPrior::on_links(placed.clone(), widths.0, widths.1);
+    let covariance = posterior_covariance(kinematics, &observations(data), mask, correction, &prior, options)
+        .map_err(Error::kinematics)?;
+    let free = mask.free_indices();
+    let dim = free.len() + correction.map_or(0, |(_, theta)| theta.len());
+    model::GeometryUncertainty::of(kinematics, free, &covariance, dim, bound)
+}
+
 /// The effects a list names, built on the training rows.
 fn build_effects(
     specs: &[EffectSpec],
@@ -269,6 +293,7 @@ pub fn fit(
         effects: Vec::new(),
         fallback_kinematics: None,
         effect_uncertainty: None,
+        geometry_uncertainty: None,
         residual_gp: None,
         training_range: model::TrainingRange::of(&data.rows),
         joint_limits: model::stored_limits(&robot.limits()),
@@ -276,6 +301,25 @@ pub fn fit(
         fit_warnings: Some(Vec::new()),
         robot_description: Some(robot.clone()),
     };
+    // The geometry's own uncertainty (issue 45): its posterior under the nominal's tolerance,
+    // whatever strength the held-out clusters chose for the fit (a stronger one says how to fit,
+    // not how far the geometry may be off where the data does not reach). Without a prior the
+    // directions no training pose sees have no variance, and a σ would say nothing.
+    if let Some(widths) = nominal_prior.as_ref().and_then(crate::PriorChoice::posterior) {
+        let mask = ParameterMask::all(model.kinematics.layout());
+        model.geometry_uncertainty = timings::phase("geometry uncertainty", || {
+            geometry_uncertainty(
+                &model.kinematics,
+                &geometry.registered,
+                widths,
+                &mask,
+                None,
+                data,
+                &bound,
+                &options.identification,
+            )
+        })?;
+    }
     let mut identification = geometry.report;
     let mut auto = None;
     let mut effect_report = Vec::new();
@@ -344,6 +388,22 @@ pub fn fit(
         }
         effect_report = effect_reports(&effects, &fitted.report.held_at_prior, &robot.joint_kinds());
         model.fallback_kinematics = Some(std::mem::replace(&mut model.kinematics, fitted.model));
+        if let Some(widths) = nominal_prior.as_ref().and_then(crate::PriorChoice::posterior_with_effects) {
+            // The kinematics' marginal of the fit with the effects: the model's kinematics now.
+            let with = Some((&correction as &dyn poe::identify::PoseCorrection, fitted.correction.as_slice()));
+            model.geometry_uncertainty = timings::phase("geometry uncertainty", || {
+                geometry_uncertainty(
+                    &model.kinematics,
+                    &geometry.registered,
+                    widths,
+                    &mask,
+                    with,
+                    data,
+                    &bound,
+                    &id_options,
+                )
+            })?;
+        }
         model.effect_uncertainty = timings::phase("effects uncertainty", || {
             effect_uncertainty(
                 &model.kinematics,

@@ -255,6 +255,24 @@ impl PriorChoice {
         }
     }
 
+    /// The posterior's widths, translation (m) and rotation (rad): the nominal's tolerance
+    /// weighed against the residual the geometry alone leaves, whatever strength was chosen;
+    /// `None` where there is no prior (what the geometry's own uncertainty is reported under,
+    /// `model::GeometryUncertainty`).
+    pub fn posterior(&self) -> Option<(f64, f64)> {
+        self.chosen()?;
+        let scale = self.residual_scale?;
+        Some((self.tolerance.0 / scale, self.tolerance.1 / scale))
+    }
+
+    /// [`PriorChoice::posterior`] of the fit with effects: the tolerance weighed against the
+    /// residual the geometry with its effects leaves ([`EffectsPrior::residual_scale`]).
+    pub fn posterior_with_effects(&self) -> Option<(f64, f64)> {
+        self.chosen()?;
+        let scale = self.with_effects?.residual_scale;
+        Some((self.tolerance.0 / scale, self.tolerance.1 / scale))
+    }
+
     /// The prior of the fit with effects, given the report of that fit without a prior
     /// (`plain`), and records it ([`EffectsPrior`]): the chosen σ times the geometry's residual
     /// scale over the effects' one. `None` where there is no prior.

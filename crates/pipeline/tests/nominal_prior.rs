@@ -102,6 +102,13 @@ fn fitted_on_one_wrist_configuration_every_method_is_at_most_the_nominals_error_
                 "seed {seed}: {method} {effects} {error:.4} mm RMS on the flipped wrist, nominal {nominal:.4} mm"
             );
             assert!(error <= nominal, "seed {seed}: {method} {effects} {error} mm against the nominal's {nominal} mm");
+            // Beside the warning, the error the geometry's own uncertainty predicts there: its
+            // posterior under the nominal's tolerance (1 mm against this arm's 0.1 mm, and the
+            // gear error), never the held-out choice's far tighter prior (0.01–0.03 mm per link:
+            // a σ of 0.04–0.1 mm where the error is 0.7 mm).
+            let predicted = eval.geometry_sigma.as_ref().expect("the geometry's predicted error");
+            eprintln!("seed {seed}: {method} {effects} {predicted}");
+            assert!(predicted.rms_mm >= error && predicted.rows == test.rows.len(), "{predicted}: {error} mm");
             assert!(
                 eval.out_of_range.iter().any(|w| w.input == "joint 5" && w.rows_outside == test.rows.len()),
                 "{:?}",
@@ -195,4 +202,50 @@ fn a_column_arms_clusters_are_its_branches_and_the_halves_of_its_column() {
     let fixed = simulate(&simulated_cell(&robot, &geometry, 4).unwrap(), &effects, &held, &config, false).unwrap();
     let (_, report) = pipeline::fit(&robot, &fixed, Method::Poe, &FitOptions::default()).unwrap();
     assert!(report.nominal_prior.unwrap().height_splits.is_empty());
+}
+
+/// The posterior keeps what the training poses cannot determine at about the nominal's
+/// tolerance, and says so where it matters (issue 45): a 7-axis arm fitted with only joints 1 and
+/// 2 moving (the others within 2 mrad of zero) cannot know its outer links' errors, and on poses
+/// that move every joint `eval` gives, beside the warning, the error the geometry's own
+/// uncertainty predicts there: of the size of the error it makes (a σ of the tolerance against an
+/// arm off by up to that much), far above its training rows'. Without a prior, the directions no
+/// training pose sees have no variance, and the model keeps no geometry uncertainty at all.
+#[test]
+fn outside_the_fitted_joints_eval_gives_the_error_the_geometrys_uncertainty_predicts() {
+    let robot = testkit::robot("iiwa7.ron");
+    let cell = simulated_cell(&robot, &Perturbation::default(), 7).unwrap();
+    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+    let turn = |lower_rad: f64, upper_rad: f64| JointRange { lower_rad, upper_rad };
+    let outer = turn(-1.0, 1.0);
+    let ranges = [turn(-2.0, 2.0), turn(-1.5, 1.5), outer, outer, outer, outer, outer];
+    // Trained as issue 11's campaign: joints 1 and 2 moving, the others at 0 within 2 mrad.
+    let config = GeneratorConfig {
+        sample_count: 200,
+        seed: 7,
+        moving_joints: vec![0, 1],
+        fixed_jitter_rad: 2e-3,
+        ..Default::default()
+    };
+    let train = simulate(&cell, &effects, &ranges, &config, true).unwrap();
+    let config = GeneratorConfig { sample_count: 60, seed: 8, ..Default::default() };
+    let test = simulate(&cell, &effects, &ranges, &config, true).unwrap();
+    let (model, report) = pipeline::fit(&robot, &train, Method::Poe, &FitOptions::default()).unwrap();
+    eprintln!("{}", report.nominal_prior.as_ref().unwrap());
+    let bound = model.bind(&test).unwrap();
+    let evaluation = model::evaluate(&model, &bound).unwrap();
+    let eval = EvalReport::new(&model, &bound, &evaluation);
+    let outside = eval.range_split.expect("rows outside the fitted range").outside;
+    let predicted = eval.geometry_sigma.clone().expect("the geometry's predicted error beside the warning");
+    eprintln!("{predicted}; the error there: {:.4} mm RMS", outside.rms_position_error_mm);
+    assert_eq!((predicted.rows, predicted.of_rows), (outside.n, test.rows.len()));
+    let ratio = predicted.rms_mm / outside.rms_position_error_mm;
+    assert!((0.5..=4.0).contains(&ratio), "{predicted}: {ratio} times the error {outside:?}");
+    assert!(predicted.rms_mm > 10.0 * predicted.training_rms_mm, "{predicted}");
+    let json = serde_json::to_string(&eval).unwrap();
+    assert!(json.contains("\"geometry_sigma\":{\"rows\":"), "{json}");
+    let mut off = FitOptions::default();
+    off.nominal_prior.choose = false;
+    let (plain, _) = pipeline::fit(&robot, &train, Method::Poe, &off).unwrap();
+    assert!(plain.geometry_uncertainty.is_none());
 }

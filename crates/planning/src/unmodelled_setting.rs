@@ -132,6 +132,7 @@ mod tests {
             effects: Vec::new(),
             fallback_kinematics: None,
             effect_uncertainty: None,
+            geometry_uncertainty: None,
             residual_gp: None,
             training_range: None,
             joint_limits: Vec::new(),
