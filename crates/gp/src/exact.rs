@@ -12,9 +12,7 @@ use crate::gram::training_covariance;
 use crate::kernel::KernelChoice;
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::lml::check_finite_outputs;
-use crate::optimise::{
-    OptimisationReport, finish, fit_hyperparameters, fit_hyperparameters_from, refine, warm_stage, warm_stage_from,
-};
+use crate::optimise::{OptimisationReport, finish, fit_hyperparameters_from, refine, warm_stage_from};
 use crate::points::Points;
 use crate::scaling::{InputStandardiser, OutputNormaliser};
 
@@ -201,7 +199,15 @@ impl ExactGp {
         let search = |start: &Kernel, yg: MatRef<'_, f64>| -> Result<(Kernel, OptimisationReport), Error> {
             start.validate(xs.dim())?;
             let bounds = config.bounds.clone().unwrap_or_else(|| start.default_bounds());
-            let o = fit_hyperparameters(start, &bounds, &xs, yg, &config.optimiser, config.parallelism)?;
+            let o = fit_hyperparameters_from(
+                start,
+                &start.nested_starts(),
+                &bounds,
+                &xs,
+                yg,
+                &config.optimiser,
+                config.parallelism,
+            )?;
             Ok((o.kernel, o.report))
         };
         let build = |kernel: Kernel, cols: &Vec<usize>, yg: MatRef<'_, f64>, optimisation| {
@@ -354,7 +360,15 @@ impl ExactGp {
                 report.isotropic_choice = Some(choice);
                 (component, report)
             };
-            let stage = warm_stage(&start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism)?;
+            let stage = warm_stage_from(
+                &start,
+                &start.nested_starts(),
+                &bounds,
+                &xs,
+                yg.as_ref(),
+                &config.optimiser,
+                config.parallelism,
+            )?;
             if let Some(stage) = &stage {
                 // Screened on the subset first, each kernel's leave-one-out over the subset's own
                 // rows: the isotropic kernel at its subset optimum, fitted to those rows, against

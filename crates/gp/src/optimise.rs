@@ -221,20 +221,8 @@ fn refining(settings: Settings, config: &OptimiserConfig) -> Settings {
 }
 
 /// Every start searched on the warm-start subset (`None` when the configuration has no subset or
-/// the data are no larger than it).
-pub(crate) fn warm_stage(
-    start: &Kernel,
-    bounds: &Bounds,
-    x: &Points,
-    y: MatRef<'_, f64>,
-    config: &OptimiserConfig,
-    parallelism: Parallelism,
-) -> Result<Option<WarmStage>, Error> {
-    warm_stage_from(start, &start.nested_starts(), bounds, x, y, config, parallelism)
-}
-
-/// [`warm_stage`] with `nested` as the deterministic starts after `start` itself, instead of
-/// [`Kernel::nested_starts`]; `start` and every one of `nested` are of one family.
+/// the data are no larger than it): `start` itself, then `nested` (usually
+/// [`Kernel::nested_starts`]), all of one family, then the configured random restarts.
 pub(crate) fn warm_stage_from(
     start: &Kernel,
     nested: &[Kernel],
@@ -261,20 +249,9 @@ pub(crate) fn warm_stage_from(
     Ok(Some(WarmStage { results, rows: idx.len(), indices: idx, evaluations, best }))
 }
 
-/// Maximises the log marginal likelihood of `y` (n × m, all columns sharing the kernel).
-pub(crate) fn fit_hyperparameters(
-    start: &Kernel,
-    bounds: &Bounds,
-    x: &Points,
-    y: MatRef<'_, f64>,
-    config: &OptimiserConfig,
-    parallelism: Parallelism,
-) -> Result<Optimised, Error> {
-    fit_hyperparameters_from(start, &start.nested_starts(), bounds, x, y, config, parallelism)
-}
-
-/// [`fit_hyperparameters`] with `nested` as the deterministic starts after `start` itself,
-/// instead of [`Kernel::nested_starts`].
+/// Maximises the log marginal likelihood of `y` (n × m, all columns sharing the kernel) from
+/// `start` and `nested` (usually [`Kernel::nested_starts`]) as [`warm_stage_from`] and
+/// [`finish`] search.
 pub(crate) fn fit_hyperparameters_from(
     start: &Kernel,
     nested: &[Kernel],
