@@ -147,7 +147,6 @@ pub(crate) struct WarmStage {
     results: Vec<Option<lbfgsb::Minimum>>,
     /// The subset's rows, in the order the searches saw them.
     indices: Vec<usize>,
-    rows: usize,
     evaluations: usize,
     best: usize,
 }
@@ -160,7 +159,7 @@ impl WarmStage {
 
     /// Rows of the subset.
     pub(crate) fn rows(&self) -> usize {
-        self.rows
+        self.indices.len()
     }
 
     /// The subset's rows.
@@ -174,13 +173,7 @@ impl WarmStage {
         let mut results = self.results;
         results.extend(other.results);
         let best = best(&results).map_or(0, |(i, _)| i);
-        WarmStage {
-            results,
-            indices: self.indices,
-            rows: self.rows,
-            evaluations: self.evaluations + other.evaluations,
-            best,
-        }
+        WarmStage { results, indices: self.indices, evaluations: self.evaluations + other.evaluations, best }
     }
 
     /// The subset's best optimum as a kernel of `start`'s family.
@@ -246,12 +239,12 @@ pub(crate) fn warm_stage_from(
         return Err(Error::OptimisationFailed { starts: starts.len() });
     };
     let evaluations = results.iter().flatten().map(|m| m.evaluations).sum();
-    Ok(Some(WarmStage { results, rows: idx.len(), indices: idx, evaluations, best }))
+    Ok(Some(WarmStage { results, indices: idx, evaluations, best }))
 }
 
 /// Maximises the log marginal likelihood of `y` (n × m, all columns sharing the kernel) from
 /// `start` and `nested` (usually [`Kernel::nested_starts`]) as [`warm_stage_from`] and
-/// [`finish`] search.
+/// [`finish_from`] search.
 pub(crate) fn fit_hyperparameters_from(
     start: &Kernel,
     nested: &[Kernel],
@@ -265,24 +258,10 @@ pub(crate) fn fit_hyperparameters_from(
     finish_from(start, nested, bounds, x, y, config, parallelism, warm)
 }
 
-/// The full-data search: from the warm stage's best optimum when there is one, else from every
-/// start.
-pub(crate) fn finish(
-    start: &Kernel,
-    bounds: &Bounds,
-    x: &Points,
-    y: MatRef<'_, f64>,
-    config: &OptimiserConfig,
-    parallelism: Parallelism,
-    warm: Option<WarmStage>,
-) -> Result<Optimised, Error> {
-    finish_from(start, &start.nested_starts(), bounds, x, y, config, parallelism, warm)
-}
-
-/// [`finish`] with `nested` as the deterministic starts after `start` itself where there is no
-/// warm stage.
+/// The full-data search: from the warm stage's best optimum when there is one, else from
+/// `start`, then `nested` (usually [`Kernel::nested_starts`]) and the configured random restarts.
 #[allow(clippy::too_many_arguments)]
-fn finish_from(
+pub(crate) fn finish_from(
     start: &Kernel,
     nested: &[Kernel],
     bounds: &Bounds,
@@ -303,7 +282,7 @@ fn finish_from(
             // Hessian grows about in proportion to them and each gradient change is scaled by
             // n / s. The full search then starts with a quasi-Newton step instead of relearning
             // the curvature down the gradient.
-            let scale = x.len() as f64 / stage.rows.max(1) as f64;
+            let scale = x.len() as f64 / stage.rows().max(1) as f64;
             let pairs: Vec<lbfgsb::Pair> = match (&stage.results[stage.best], config.warm_start_curvature) {
                 (Some(m), true) => m
                     .history
@@ -315,7 +294,7 @@ fn finish_from(
             let mut objective = NegativeLml::new(start, x, y, config, parallelism);
             let settings = refining(settings, config);
             let full = vec![lbfgsb::minimise_with(&mut objective, &from, &lower, &upper, &settings, &pairs)];
-            (stage.results, stage.rows, stage.evaluations, full.into_iter().next().flatten())
+            (stage.results, stage.indices.len(), stage.evaluations, full.into_iter().next().flatten())
         }
         None => {
             let results = search_all(start, &starts, (&lower, &upper), (x, y), &settings, config, parallelism);
