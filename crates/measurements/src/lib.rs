@@ -25,6 +25,7 @@
 mod bound;
 mod column_map;
 mod dialect;
+mod file_lines;
 mod input_files;
 mod layout;
 mod outliers;
@@ -42,6 +43,7 @@ pub use dialect::{Decimal, DecimalFault, Delimiter, Dialect};
 pub use writer::{CsvColumns, MeasurementWriter};
 
 use errors::{Error, ErrorKind};
+use file_lines::LineCounter;
 use layout::{Expectation, Layout, OrientationColumns};
 use lie::{SO3, Vector3};
 use poe::JointKind;
@@ -55,7 +57,8 @@ use std::path::Path;
 /// One measured pose, SI units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measurement {
-    /// 1-based line of the row in its file (0 for rows made in memory).
+    /// The row's line in its file as an editor counts it (0 for rows made in memory): the header
+    /// is line 1, and blank lines and the lines of a quoted field with a line break count.
     pub line: u64,
     /// Joint values, radians (metres for a prismatic joint).
     pub q: Vec<f64>,
@@ -158,6 +161,9 @@ pub struct MeasurementSet {
     pub position_unit: Option<&'static str>,
     /// How the file was written.
     pub format: FileFormat,
+    /// The header's line in the file (1 unless blank lines precede it; 1 for sets made in
+    /// memory): where a refusal of the header is placed.
+    pub header_line: u64,
 }
 
 /// What a measurement file is read against.
@@ -249,12 +255,17 @@ fn parse_keeping<R: Read>(
         .trim(csv::Trim::All)
         .from_reader(body);
     let delimiter = dialect.delimiter;
-    let header = csv.headers().map_err(|e| syntax_error(&e, file, delimiter))?.clone();
+    let header = csv.headers().map_err(|e| syntax_error(&e, file, delimiter, body))?.clone();
     if header.is_empty() || (header.len() == 1 && header[0].is_empty()) {
         return Err(Error::at_line(file.to_owned(), 1, 1, ErrorKind::EmptyFile));
     }
+    // Every row by the line an editor shows it on (module `file_lines`): the header's, 1 unless
+    // blank lines precede it, then each record's from the same counter.
+    let mut lines = LineCounter::new(body);
+    let header_line = header.position().map_or(1, |p| lines.record_line(p.byte()));
     let expect = Expectation {
         file,
+        line: header_line,
         joints: options.joints.as_deref(),
         positions: positions_required,
         columns: &options.columns,
@@ -272,9 +283,9 @@ fn parse_keeping<R: Read>(
         match csv.read_record(&mut record) {
             Ok(true) => {}
             Ok(false) => break,
-            Err(e) => return Err(syntax_error(&e, file, delimiter)),
+            Err(e) => return Err(syntax_error(&e, file, delimiter, body)),
         }
-        let line = record.position().map_or(0, |p| p.line());
+        let line = record.position().map_or(0, |p| lines.record_line(p.byte()));
         let mut row = Row { record: &record, line, file, names: &layout.names, dialect: &mut dialect };
         let q = layout
             .joints
@@ -327,6 +338,7 @@ fn parse_keeping<R: Read>(
         return Err(Error::at_line(file.to_owned(), 1, 1, ErrorKind::EmptyFile));
     }
     Ok(MeasurementSet {
+        header_line,
         source: file.to_owned(),
         joint_count: layout.joints.len(),
         full_pose: layout.orientation.is_some(),
@@ -383,6 +395,7 @@ impl MeasurementSet {
             joint_columns: vec![],
             position_unit: None,
             format: FileFormat::default(),
+            header_line: 1,
         }
     }
 
@@ -403,7 +416,7 @@ impl MeasurementSet {
         }
         Err(Error::at_line(
             self.source.clone(),
-            1,
+            self.header_line,
             1,
             ErrorKind::JointCountMismatch { found: self.joint_count, expected: joints },
         ))
@@ -417,7 +430,7 @@ impl MeasurementSet {
             if column.kind != *kind {
                 return Err(Error::at_line(
                     self.source.clone(),
-                    1,
+                    self.header_line,
                     column.column,
                     ErrorKind::JointUnit { joint: k + 1, kind: layout::error_kind(*kind) },
                 ));
@@ -444,6 +457,7 @@ impl MeasurementSet {
             joint_columns: self.joint_columns.clone(),
             position_unit: self.position_unit,
             format: self.format.clone(),
+            header_line: self.header_line,
         }
     }
 }
