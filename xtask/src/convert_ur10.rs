@@ -102,7 +102,7 @@ pub struct Series {
 
 impl Series {
     /// The tracker placements the rows hold (module `ur10_placements`).
-    pub fn placements(&self) -> Result<Placements, NotPlacements> {
+    pub fn placements(&self) -> Result<Placements, Box<NotPlacements>> {
         let measured: Vec<Vector3> = self.set.rows.iter().map(|r| r.position * 1e3).collect();
         ur10_placements::placements(&self.goals_mm, &measured, &PlacementOptions::default())
     }
@@ -144,7 +144,8 @@ impl Series {
                 );
                 Ok((Placements::Two { first, second, together }, text))
             }
-            Err(NotPlacements { together, best_split }) => {
+            Err(not) => {
+                let NotPlacements { together, best_split } = *not;
                 let split = best_split.map_or(String::new(), |(a, b)| {
                     format!(
                         ", and the best split in two (at line {}) still {:.1} mm",

@@ -71,7 +71,7 @@ pub fn placements(
     goals: &[Vector3],
     measured: &[Vector3],
     options: &PlacementOptions,
-) -> Result<Placements, NotPlacements> {
+) -> Result<Placements, Box<NotPlacements>> {
     let n = goals.len().min(measured.len());
     let together = fit(goals, measured, (0, n));
     if together.max_mm <= options.max_residual_mm {
@@ -92,7 +92,7 @@ pub fn placements(
         {
             Ok(Placements::Two { first, second, together })
         }
-        best_split => Err(NotPlacements { together, best_split }),
+        best_split => Err(Box::new(NotPlacements { together, best_split })),
     }
 }
 
