@@ -208,9 +208,13 @@ fn prepare(start: &Kernel, nested: &[Kernel], bounds: &Bounds, config: &Optimise
 }
 
 /// `settings` for a search from an optimum found elsewhere
-/// ([`OptimiserConfig::refine_function_tolerance`]).
+/// ([`OptimiserConfig::refine_function_tolerance`], [`OptimiserConfig::refine_max_iterations`]).
 fn refining(settings: Settings, config: &OptimiserConfig) -> Settings {
-    Settings { function_tolerance: config.refine_function_tolerance.unwrap_or(settings.function_tolerance), ..settings }
+    Settings {
+        function_tolerance: config.refine_function_tolerance.unwrap_or(settings.function_tolerance),
+        max_iterations: config.refine_max_iterations.unwrap_or(settings.max_iterations),
+        ..settings
+    }
 }
 
 /// Every start searched on the warm-start subset (`None` when the configuration has no subset or
@@ -291,10 +295,21 @@ pub(crate) fn finish_from(
                     .collect(),
                 _ => Vec::new(),
             };
-            let mut objective = NegativeLml::new(start, x, y, config, parallelism);
             let settings = refining(settings, config);
-            let full = vec![lbfgsb::minimise_with(&mut objective, &from, &lower, &upper, &settings, &pairs)];
-            (stage.results, stage.indices.len(), stage.evaluations, full.into_iter().next().flatten())
+            let full = if settings.max_iterations == 0 {
+                // No iteration on all rows: the subset's optimum as it is, converged as its search
+                // did there, and no evaluation on all rows counted.
+                stage.results[stage.best].clone().map(|m| lbfgsb::Minimum {
+                    iterations: 0,
+                    evaluations: 0,
+                    gradients: 0,
+                    ..m
+                })
+            } else {
+                let mut objective = NegativeLml::new(start, x, y, config, parallelism);
+                lbfgsb::minimise_with(&mut objective, &from, &lower, &upper, &settings, &pairs)
+            };
+            (stage.results, stage.indices.len(), stage.evaluations, full)
         }
         None => {
             let results = search_all(start, &starts, (&lower, &upper), (x, y), &settings, config, parallelism);
