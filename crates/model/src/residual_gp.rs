@@ -236,7 +236,6 @@ impl Default for ResidualGpOptions {
             // all of them (its standard error, 1.25 σ / √2000), far inside the rule's margin:
             // the share fades the correction only from half-way between it and 1.
             fade_share_rows: 2000,
-            // FALLBACK_SOURCE
             // The subset's optimum as it is (no iteration on all rows). `calib fit --method poe-gp
             // --effects auto` on the UR10 (docs/results/gp-search-time.md), against the full
             // search: held-out position error C even → odd rows 0.10565 → 0.10560 mm, B even →
