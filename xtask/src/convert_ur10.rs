@@ -132,6 +132,7 @@ pub fn read_series(input: &Path, series: &str, full_pose: bool) -> anyhow::Resul
             temp_c: Some(cell(temperature)?),
             t_s: cells.get(stamp).and_then(|s| seconds(s)),
             torques_nm: None,
+            inputs: measurements::Inputs::default(),
         });
     }
     // A time column only when every stamp survived.

@@ -1,7 +1,6 @@
 //! `calib export`: the calibrated geometry as a URDF for controllers, planners and simulators.
 
 use cell::UrdfTemplate;
-use measurements::ReadOptions;
 use robot::{ChainEnds, NominalTolerance, RobotDescription, UrdfDocument};
 use std::path::PathBuf;
 
@@ -55,7 +54,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let model = model::read_model(&args.model)?;
     let ends = ChainEnds { base_link: args.base_link.clone(), tip_link: args.tip_link.clone() };
     let training = match &args.data {
-        Some(path) => Some(measurements::read_measurements(path, &ReadOptions::for_joints(model.joint_kinds()))?),
+        Some(path) => Some(measurements::read_measurements(path, &model.read_options(Default::default()))?),
         None => None,
     };
     let tolerance = NominalTolerance::default();

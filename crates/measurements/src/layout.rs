@@ -36,6 +36,8 @@ pub(crate) struct Layout {
     pub temp: Option<Column>,
     pub time: Option<Column>,
     pub torques: Vec<Column>,
+    /// The columns of [`Expectation::inputs`], in its order.
+    pub inputs: Vec<Column>,
     /// The names of the columns not used.
     pub ignored: Vec<String>,
     /// Names as the rest of the reader refers to them: the SPEC name of a mapped column.
@@ -50,6 +52,8 @@ pub(crate) struct Expectation<'a> {
     /// Whether the position columns must be there.
     pub positions: bool,
     pub columns: &'a ColumnMap,
+    /// The columns to keep as inputs of a model (`--inputs`), by name.
+    pub inputs: &'a [String],
 }
 
 /// The SPEC name of joint `k`'s column for a joint of `kind`.
@@ -133,6 +137,11 @@ impl Layout {
             }
         }
 
+        let inputs = input_columns(&names, expect, width)?;
+        if !inputs.is_empty() {
+            let taken: HashSet<&str> = expect.inputs.iter().map(String::as_str).collect();
+            ignored.retain(|name| !taken.contains(name.as_str()));
+        }
         let joints = check_joints(joints, expect, width)?;
         let n = joints.len();
         torques.sort_by_key(|(k, _)| *k);
@@ -169,10 +178,59 @@ impl Layout {
             temp,
             time,
             torques: torques.into_iter().map(|(_, c)| c).collect(),
+            inputs,
             ignored,
             names,
         })
     }
+}
+
+/// The columns of the inputs `expect.inputs` names, in its order: each must be in the header, and
+/// be a number that is not already an input or an output of the model. Names are looked up in a
+/// map of the header, not by scanning it.
+fn input_columns(names: &[String], expect: &Expectation<'_>, width: usize) -> Result<Vec<Column>, Error> {
+    if expect.inputs.is_empty() {
+        return Ok(Vec::new());
+    }
+    let file = expect.file;
+    let index: std::collections::HashMap<&str, usize> =
+        names.iter().enumerate().map(|(i, name)| (name.as_str(), i)).collect();
+    let mut seen = HashSet::with_capacity(expect.inputs.len());
+    expect
+        .inputs
+        .iter()
+        .map(|name| {
+            if !seen.insert(name.as_str()) {
+                return Err(Error::at_line("--inputs", 1, 1, ErrorKind::InputList { name: name.clone() }));
+            }
+            let Some(&i) = index.get(name.as_str()) else {
+                return Err(Error::at_line(
+                    file.to_owned(),
+                    1,
+                    width + 1,
+                    ErrorKind::MissingColumn { name: name.clone() },
+                ));
+            };
+            let refused = match quantity(name) {
+                Some(Quantity::Joint { .. }) => Some("a joint, already an input"),
+                Some(Quantity::Position { .. } | Quantity::Quaternion(_) | Quantity::Euler { .. }) => {
+                    Some("the measured pose, what the model predicts")
+                }
+                Some(Quantity::Tool) => Some("the tool, not a number"),
+                Some(Quantity::Payload) => Some("the payload, an input of method poe-gp-load"),
+                _ => None,
+            };
+            match refused {
+                Some(quantity) => Err(Error::at_line(
+                    file.to_owned(),
+                    1,
+                    i + 1,
+                    ErrorKind::NotAnInput { name: name.clone(), quantity },
+                )),
+                None => Ok(Column { index: i, scale: 1.0 }),
+            }
+        })
+        .collect()
 }
 
 /// The joint columns in order, checked: numbered 1…n without gaps, n the robot's joint count

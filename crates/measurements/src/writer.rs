@@ -20,6 +20,9 @@ pub struct CsvColumns {
     pub t_s: bool,
     /// How many `tau{k}_nm` columns are written.
     pub torques: usize,
+    /// The input columns written last, by name (each row's value of the name; blank where a row
+    /// has none).
+    pub inputs: Vec<String>,
 }
 
 /// The measurement CSV written one row at a time (`calib simulate` streams its rows through it).
@@ -59,6 +62,7 @@ impl<W: Write> MeasurementWriter<W> {
             header.push("t_s".into());
         }
         header.extend((1..=columns.torques).map(|k| format!("tau{k}_nm")));
+        header.extend(columns.inputs.iter().cloned());
         out.write_record(&header)?;
         Ok(Self { out, columns, named_tools })
     }
@@ -85,6 +89,14 @@ impl<W: Write> MeasurementWriter<W> {
         if let Some(tau) = &row.torques_nm {
             record.extend(tau.iter().map(|v| format!("{v:?}")));
         }
+        if !columns.inputs.is_empty() {
+            if row.inputs.names() == columns.inputs.as_slice() {
+                record.extend(row.inputs.values().iter().map(|v| format!("{v:?}")));
+            } else {
+                let cell = |name: &String| row.inputs.get(name).map_or(String::new(), |v| format!("{v:?}"));
+                record.extend(columns.inputs.iter().map(cell));
+            }
+        }
         Ok(self.out.write_record(&record)?)
     }
 
@@ -109,6 +121,11 @@ impl MeasurementSet {
             temp_c: has(&|r| r.temp_c.is_some()),
             t_s: has(&|r| r.t_s.is_some()),
             torques: self.rows.first().and_then(|r| r.torques_nm.as_ref()).map_or(0, Vec::len),
+            inputs: if self.inputs.is_empty() {
+                self.rows.first().map_or_else(Vec::new, |r| r.inputs.names().to_vec())
+            } else {
+                self.inputs.iter().map(|c| c.name.clone()).collect()
+            },
         };
         let mut out = MeasurementWriter::new(writer, columns)?;
         for row in &self.rows {
