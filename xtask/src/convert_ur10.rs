@@ -108,6 +108,10 @@ pub fn read_series(input: &Path, series: &str, full_pose: bool) -> anyhow::Resul
     let position = [column("measurement_x")?, column("measurement_y")?, column("measurement_z")?];
     let angles = [column("measurement_rx")?, column("measurement_ry")?, column("measurement_rz")?];
     let temperature = column("measurement_temperature")?;
+    // The tracker's stated standard deviation of every row (issue 46): mm, and degrees of the
+    // three angles, kept as std_x_mm … and std_rx_mrad ….
+    let position_std = [column("measurement_std_x")?, column("measurement_std_y")?, column("measurement_std_z")?];
+    let angle_std = [column("measurement_std_rx")?, column("measurement_std_ry")?, column("measurement_std_rz")?];
     let stamp = column("Timestamp")?;
     let mut rows = Vec::new();
     for (index, raw) in lines.enumerate() {
@@ -133,6 +137,18 @@ pub fn read_series(input: &Path, series: &str, full_pose: bool) -> anyhow::Resul
             t_s: cells.get(stamp).and_then(|s| seconds(s)),
             torques_nm: None,
             inputs: measurements::Inputs::default(),
+            std: Some(measurements::StatedSigma {
+                position_m: Some([
+                    cell(position_std[0])? * 1e-3,
+                    cell(position_std[1])? * 1e-3,
+                    cell(position_std[2])? * 1e-3,
+                ]),
+                rotation_rad: Some([
+                    cell(angle_std[0])?.to_radians(),
+                    cell(angle_std[1])?.to_radians(),
+                    cell(angle_std[2])?.to_radians(),
+                ]),
+            }),
         });
     }
     // A time column only when every stamp survived.

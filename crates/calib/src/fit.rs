@@ -182,6 +182,18 @@ fn summarise(
         "  identifiable: {} of {} free parameters, condition number {:.3e}",
         id.rank, id.free_parameters, id.condition_number
     );
+    if let Some(stated) = &id.stated_noise {
+        let mm = stated.median_position_m.map_or("–".to_owned(), |m| format!("{:.4} mm", m * 1e3));
+        let mrad = stated.median_rotation_rad.map_or(String::new(), |m| format!(", {:.4} mrad", m * 1e3));
+        let excess_mrad = stated.excess_rotation_rad.map_or(String::new(), |t| format!(", {:.4} mrad", t * 1e3));
+        let _ = writeln!(
+            out,
+            "  rows weighted by the tracker's stated uncertainty ({} of {rows} rows state one; median {mm}{mrad}; \
+             residual scatter beyond it {:.4} mm{excess_mrad} per axis)",
+            stated.stated,
+            stated.excess_position_m * 1e3
+        );
+    }
     if let Some(prior) = &report.nominal_prior {
         let _ = writeln!(out, "  {prior}");
     }

@@ -258,6 +258,7 @@ fn measurement(i: usize, s: Sample, used: &[usize], full_pose: bool) -> Measurem
         t_s: Some(s.t_s),
         torques_nm: s.torques_nm,
         inputs: measurements::Inputs::default(),
+        std: None,
     }
 }
 
@@ -326,6 +327,7 @@ pub fn simulate_to_csv<W: std::io::Write>(
         t_s: true,
         torques: if config.torque_sensor.is_some() { cell.robot.joint_count() } else { 0 },
         inputs: Vec::new(),
+        stated_std: [false; 2],
     };
     let io = |source: std::io::Error| Error::io(path.to_owned(), source);
     let mut out = measurements::MeasurementWriter::new(writer, columns).map_err(io)?;

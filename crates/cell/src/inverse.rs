@@ -225,6 +225,7 @@ pub fn solve_targets(
         t_s: None,
         torques_nm: None,
         inputs: targets[i].inputs.clone(),
+        std: None,
     };
     loop {
         // Made here from the targets, each row on its target's model tool.

@@ -150,7 +150,7 @@ pub fn registered_nominal(
         for tool in 0..model.kinematics.tool_count() {
             let pose = model.kinematics.forward(q, tool).map_err(Error::kinematics)?;
             let target = if model.full_pose { Target::Pose(pose) } else { Target::Point(pose.translation()) };
-            observations.push(Observation { q: q.clone(), tool, target });
+            observations.push(Observation { q: q.clone(), tool, target, stated_sigma: None });
         }
     }
     let fitted = poe::identify::calibrate(&nominal, &observations, Scope::BaseTool, &IdentificationOptions::default())

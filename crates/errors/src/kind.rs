@@ -621,6 +621,16 @@ pub enum ErrorKind {
         /// The name at fault (empty for an empty one).
         name: String,
     },
+    /// A stated standard deviation (`std_x_mm` …) that is zero or negative: it would weight its
+    /// row infinitely, or not at all.
+    ///
+    /// At the cell.
+    NotAStandardDeviation {
+        /// The column's name.
+        name: String,
+        /// The value as written.
+        value: f64,
+    },
     /// A row without a value of an input the model takes (`--inputs`): rows made in memory
     /// without it (a file without the column is refused by its header, `MissingColumn`).
     ///
@@ -948,6 +958,9 @@ impl fmt::Display for ErrorKind {
                 write!(f, "an empty name in the list of inputs (NAME[,NAME…])")
             }
             ErrorKind::InputList { name } => write!(f, "the input '{name}' is named twice"),
+            ErrorKind::NotAStandardDeviation { name, value } => {
+                write!(f, "{name} is {value}: a stated standard deviation must be a positive number")
+            }
             ErrorKind::MissingInput { name } => {
                 write!(f, "no value of the input '{name}', which the model takes (the column '{name}')")
             }

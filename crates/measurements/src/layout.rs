@@ -38,6 +38,10 @@ pub(crate) struct Layout {
     pub torques: Vec<Column>,
     /// The columns of [`Expectation::inputs`], in its order.
     pub inputs: Vec<Column>,
+    /// The stated standard deviations of the position, `std_x_mm` … (issue 46): all three or none.
+    pub position_std: Option<[Column; 3]>,
+    /// The stated standard deviations of the orientation, `std_rx_mrad` …: all three or none.
+    pub rotation_std: Option<[Column; 3]>,
     /// The names of the columns not used.
     pub ignored: Vec<String>,
     /// Names as the rest of the reader refers to them: the SPEC name of a mapped column.
@@ -90,6 +94,7 @@ impl Layout {
         let mut quaternion = [None; 4];
         let mut euler = [None; 3];
         let (mut payload, mut tool, mut temp, mut time) = (None, None, None, None);
+        let (mut position_std, mut rotation_std) = ([None; 3], [None; 3]);
         let mut ignored = Vec::new();
         for (index, raw) in header.iter().enumerate() {
             let raw = raw.trim();
@@ -116,6 +121,8 @@ impl Layout {
                 Some(Quantity::Tool) => tool.replace(index).is_none(),
                 Some(Quantity::Temperature) => temp.replace(column(1.0)).is_none(),
                 Some(Quantity::Time) => time.replace(column(1.0)).is_none(),
+                Some(Quantity::PositionStd { axis, scale }) => position_std[axis].replace(column(scale)).is_none(),
+                Some(Quantity::RotationStd { axis, scale }) => rotation_std[axis].replace(column(scale)).is_none(),
                 None => {
                     ignored.push(name.clone());
                     true
@@ -169,6 +176,15 @@ impl Layout {
             _ => None,
         };
         let orientation = orientation(quaternion, euler, &names, file, width)?;
+        // A stated uncertainty of some axes only is refused by the first name missing: a row
+        // weighted on one axis and not on another would be weighted by accident.
+        let all_or_none = |columns: [Option<Column>; 3], names: [&str; 3]| match columns {
+            [Some(x), Some(y), Some(z)] => Ok(Some([x, y, z])),
+            [None, None, None] => Ok(None),
+            _ => Err(at_end(names[columns.iter().position(Option::is_none).unwrap_or(0)].into())),
+        };
+        let position_std = all_or_none(position_std, ["std_x_mm", "std_y_mm", "std_z_mm"])?;
+        let rotation_std = all_or_none(rotation_std, ["std_rx_mrad", "std_ry_mrad", "std_rz_mrad"])?;
         Ok(Self {
             joints,
             position,
@@ -179,6 +195,8 @@ impl Layout {
             time,
             torques: torques.into_iter().map(|(_, c)| c).collect(),
             inputs,
+            position_std,
+            rotation_std,
             ignored,
             names,
         })
@@ -218,6 +236,9 @@ fn input_columns(names: &[String], expect: &Expectation<'_>, width: usize) -> Re
                 }
                 Some(Quantity::Tool) => Some("the tool, not a number"),
                 Some(Quantity::Payload) => Some("the payload, an input of method poe-gp-load"),
+                Some(Quantity::PositionStd { .. } | Quantity::RotationStd { .. }) => {
+                    Some("the tracker's stated uncertainty, which weights its row")
+                }
                 _ => None,
             };
             match refused {

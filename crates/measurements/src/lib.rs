@@ -38,6 +38,8 @@ pub use input_files::InputFiles;
 pub use inputs::{INPUT_UNITS, InputColumn, InputNames, Inputs, input_unit};
 pub use outliers::{OutlierLine, list_lines, without};
 pub use output_file::{FileKind, MAX_SYMLINKS, OutputFile, output_target, write_file};
+/// A row's stated standard deviations (`std_x_mm` …, issue 46), as the identification weighs them.
+pub use poe::identify::StatedSigma;
 
 pub use column_map::{ColumnMap, ColumnMapFault};
 pub use dialect::{Decimal, DecimalFault, Delimiter, Dialect};
@@ -77,6 +79,9 @@ pub struct Measurement {
     pub torques_nm: Option<Vec<f64>>,
     /// The values of the columns read as inputs of a model (`--inputs`), by name, as written.
     pub inputs: Inputs,
+    /// The tracker's stated standard deviations of this row (`std_x_mm` …, `std_rx_mrad` …; SI),
+    /// where the file has them.
+    pub std: Option<StatedSigma>,
 }
 
 impl Measurement {
@@ -96,6 +101,7 @@ impl Measurement {
             t_s: None,
             torques_nm: None,
             inputs: Inputs::default(),
+            std: None,
         }
     }
 }
@@ -333,12 +339,31 @@ fn parse_keeping<R: Read>(
         let t_s = layout.time.map(|c| row.number(c)).transpose()?;
         let torques_nm = if layout.torques.is_empty() { None } else { Some(row.numbers(&layout.torques)?) };
         let inputs = Inputs::new(input_names.clone(), row.numbers(&layout.inputs)?);
+        let std = match (layout.position_std, layout.rotation_std) {
+            (None, None) => None,
+            (p, r) => Some(StatedSigma {
+                position_m: p.map(|c| row.standard_deviations(&c)).transpose()?,
+                rotation_rad: r.map(|c| row.standard_deviations(&c)).transpose()?,
+            }),
+        };
         let tool_name = layout.tool.and_then(|i| record.get(i)).unwrap_or("");
         let tool = *tool_index.entry(tool_name.to_owned()).or_insert_with(|| {
             tools.push(tool_name.to_owned());
             tools.len() - 1
         });
-        rows.push(Measurement { line, q, position, orientation, payload_kg, tool, temp_c, t_s, torques_nm, inputs });
+        rows.push(Measurement {
+            line,
+            q,
+            position,
+            orientation,
+            payload_kg,
+            tool,
+            temp_c,
+            t_s,
+            torques_nm,
+            inputs,
+            std,
+        });
         if let Some(cells) = cells.as_deref_mut() {
             cells.rows.push(record.iter().map(str::to_owned).collect());
         }
@@ -424,6 +449,9 @@ impl MeasurementSet {
                 .map(|c| c.unit.map_or_else(|| c.name.clone(), |unit| format!("{} ({unit})", c.name)))
                 .collect();
             line.push_str(&format!("; inputs: {}", inputs.join(", ")));
+        }
+        if self.rows.iter().any(|r| r.std.is_some()) {
+            line.push_str("; the tracker's stated uncertainty of each row (std_…)");
         }
         if !self.ignored_columns.is_empty() {
             line.push_str(&format!("; ignored columns: {}", self.ignored_columns.join(", ")));

@@ -287,6 +287,7 @@ impl Model {
                 t_s: time.as_ref().map(|t| t[i]),
                 torques_nm: torques.as_ref().map(|t| t.row(i).to_vec()),
                 inputs: measurements::Inputs::new(names.clone(), signal_row),
+                std: None,
             });
         }
         // Angles a turn away from the fitted range are taken into it, as `calib predict` does.
