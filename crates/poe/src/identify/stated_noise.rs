@@ -246,7 +246,8 @@ mod tests {
         let factors = stated.factors([0.0, 0.0]);
         let report = stated.report([0.0, 0.0]);
         let m = report.median_position_m.unwrap();
-        assert!((m - 1.5e-5 * 2f64.sqrt()).abs() < 1e-18, "{m}");
+        // The sixth of eleven: 1.4e-5 m on x and y, twice on z.
+        assert!((m - 1.4e-5 * 2f64.sqrt()).abs() < 1e-18, "{m}");
         assert_eq!((report.stated, report.median_rotation_rad), (11, None));
         // The median observation: its axes relative to it; no orientation: 1.
         let f = factors[5];
@@ -277,7 +278,7 @@ mod tests {
         };
         assert!((spread(0.0) - 5.0).abs() < 1e-12, "{}", spread(0.0));
         assert!(spread(1e-5) > 1.5 && spread(1e-5) < 5.0, "{}", spread(1e-5));
-        assert!((spread(1e-3) - 1.0).abs() < 1e-3, "{}", spread(1e-3));
+        assert!((spread(1e-2) - 1.0).abs() < 1e-4, "{}", spread(1e-2));
     }
 
     /// The scatter beyond the stated noise is found where it is (the residuals' median against
