@@ -26,22 +26,24 @@ def _measurements(
 def fit(
     robot: _calib.Robot,
     data: Union[Measurements, PathLike, Any],
-    method: str = "poe-gp-load",
-    effects: Optional[str] = "auto",
+    method: str,
+    effects: Optional[str] = None,
     gp: Optional[str] = None,
     options: Union[None, PathLike, Mapping[str, Any]] = None,
     force: bool = False,
     inputs: Optional[Sequence[str]] = None,
 ) -> "Model":
-    """Fits a calibrated model, as ``calib fit`` does.
+    """Fits a calibrated model, as ``calib fit`` does, with the CLI's defaults: the same words give
+    the same fit (``calib.fit(robot, data, method="poe")`` is ``calib fit --method poe``).
 
     Args:
         robot: the robot description (:meth:`Robot.load`).
         data: the training measurements (a :class:`Measurements`, a CSV path, a DataFrame).
-        method: ``base-tool``, ``poe``, ``poe-gp`` or ``poe-gp-load``.
-        effects: non-geometric effects identified with the geometry: ``"auto"`` (what the
-            diagnosis selects), ``"none"`` or ``None`` (the geometry alone), or the CLI's list
-            (``"joint_compliance,gear_periodic:1:4"``). Goes over ``options`` as ``--effects`` does.
+        method: ``base-tool``, ``poe``, ``poe-gp`` or ``poe-gp-load`` (required, as ``--method``).
+        effects: non-geometric effects identified with the geometry, only when asked for, as
+            ``--effects``: ``"auto"`` (what the diagnosis selects), ``"none"`` (the geometry
+            alone), or the CLI's list (``"joint_compliance,gear_periodic:1:4"``); ``None`` (not
+            given) keeps what ``options`` says, no effects by default.
         gp: ``exact``, ``sparse`` or ``auto``; ``None`` keeps what ``options`` says (default auto).
         options: the CLI's ``--options``: a RON file, or a mapping of the same fields
             (``{"identification": {"max_iterations": 100}}``).
@@ -66,7 +68,7 @@ def fit(
         robot,
         data._core,
         method,
-        "none" if effects is None else effects,
+        effects,
         gp,
         options_path,
         options_json,

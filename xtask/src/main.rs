@@ -37,6 +37,7 @@ mod reproduce_sim_params;
 mod reproduce_sim_report;
 mod simulation;
 mod ur10;
+mod ur10_placements;
 mod urdf_check;
 
 use clap::{Parser, Subcommand};

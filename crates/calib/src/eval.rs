@@ -45,6 +45,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         if report.orientations_not_evaluated {
             eprintln!("note: {}", model::ORIENTATIONS_NOT_EVALUATED);
         }
+        if let Some(placement) = &report.other_placement {
+            eprintln!("warning: {}", placement_text(placement, args));
+        }
         for warning in &report.warnings {
             eprintln!("warning: {warning}");
         }
@@ -88,6 +91,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     };
     print_split(report.coverage.as_ref(), covered);
     print_split(report.range_split.as_ref(), "the range the model was fitted on");
+    if let Some(placement) = &report.other_placement {
+        println!("  warning: {}", placement_text(placement, args));
+    }
     if let Some(suspects) = &report.suspect_rows {
         println!("  warning: {}", suspect_text(suspects));
     }
@@ -107,6 +113,11 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         println!("  warning: {faded}");
     }
     Ok(())
+}
+
+/// The warning about another tracker placement, with this model's file in the command it names.
+fn placement_text(placement: &model::OtherPlacement, args: &Args) -> String {
+    placement.to_string().replace("--model MODEL", &format!("--model {}", args.model.display()))
 }
 
 /// The warning about rows far beyond the others, with what the others give.

@@ -319,9 +319,10 @@ pub fn write_compensated<W: Write>(writer: W, file: &TargetFile, solved: &[Solve
             .enumerate()
             .map(|(i, name)| if joint_columns.contains(&i) { format!("nominal_{name}") } else { name.clone() }),
     );
-    header.extend(["residual_mm", "residual_mrad", "status"].map(String::from));
+    // Each row's line in the targets file (issue 48), last: version 2's columns keep their places.
+    header.extend(["residual_mm", "residual_mrad", "status", "line"].map(String::from));
     out.write_record(&header)?;
-    for (cells, solved) in file.cells.rows.iter().zip(solved) {
+    for ((cells, solved), row) in file.cells.rows.iter().zip(solved).zip(&file.set.rows) {
         let mut record: Vec<String> = if solved.status.is_ok() {
             solved.q.iter().map(|v| format!("{v:?}")).collect()
         } else {
@@ -331,6 +332,7 @@ pub fn write_compensated<W: Write>(writer: W, file: &TargetFile, solved: &[Solve
         record.push(format!("{:.6}", solved.residual_m * 1e3));
         record.push(solved.residual_rad.map_or(String::new(), |r| format!("{:.6}", r * 1e3)));
         record.push(solved.status.to_string());
+        record.push(row.line.to_string());
         out.write_record(&record)?;
     }
     out.flush()

@@ -51,6 +51,8 @@ pub(crate) struct Layout {
 /// What the header is checked against.
 pub(crate) struct Expectation<'a> {
     pub file: &'a str,
+    /// The header's line (1 unless blank lines precede it): where its refusals are placed.
+    pub line: u64,
     /// The robot's joints, when known.
     pub joints: Option<&'a [JointKind]>,
     /// Whether the position columns must be there.
@@ -80,9 +82,9 @@ impl Layout {
     /// Reads and checks the header. Allocates only in proportion to the header's length: a column
     /// named `q99999999999_rad` is refused, never used as a size.
     pub fn from_header(header: &csv::StringRecord, expect: &Expectation<'_>) -> Result<Self, Error> {
-        let file = expect.file;
+        let (file, line) = (expect.file, expect.line);
         let width = header.len();
-        let at_end = |name: String| Error::at_line(file.to_owned(), 1, width + 1, ErrorKind::MissingColumn { name });
+        let at_end = |name: String| Error::at_line(file.to_owned(), line, width + 1, ErrorKind::MissingColumn { name });
         let mut names: Vec<String> = Vec::with_capacity(width);
         // Sets, not scans of the lists: a header of 400,000 columns took minutes when each name was
         // compared with every earlier one (found by `cargo xtask fuzz`).
@@ -100,7 +102,7 @@ impl Layout {
             let raw = raw.trim();
             let name = expect.columns.target_of(raw).unwrap_or(raw).to_owned();
             let duplicate =
-                || Error::at_line(file.to_owned(), 1, index + 1, ErrorKind::DuplicateColumn { name: name.clone() });
+                || Error::at_line(file.to_owned(), line, index + 1, ErrorKind::DuplicateColumn { name: name.clone() });
             if !seen.insert(name.clone()) {
                 return Err(duplicate());
             }
@@ -137,7 +139,7 @@ impl Layout {
             if !header.iter().any(|h| h.trim() == mapped) {
                 return Err(Error::at_line(
                     file.to_owned(),
-                    1,
+                    line,
                     width + 1,
                     ErrorKind::MappedHeaderMissing { target: target.clone(), header: mapped.clone() },
                 ));
@@ -155,7 +157,7 @@ impl Layout {
         if let Some((k, c)) = torques.iter().find(|(k, _)| *k > n) {
             return Err(Error::at_line(
                 file.to_owned(),
-                1,
+                line,
                 c.index + 1,
                 ErrorKind::ColumnBeyondJoints { name: names[c.index].clone(), index: *k, joints: n },
             ));
@@ -175,7 +177,7 @@ impl Layout {
             }
             _ => None,
         };
-        let orientation = orientation(quaternion, euler, &names, file, width)?;
+        let orientation = orientation(quaternion, euler, &names, (file, line), width)?;
         // A stated uncertainty of some axes only is refused by the first name missing: a row
         // weighted on one axis and not on another would be weighted by accident.
         let all_or_none = |columns: [Option<Column>; 3], names: [&str; 3]| match columns {
@@ -261,7 +263,7 @@ fn check_joints(
     expect: &Expectation<'_>,
     width: usize,
 ) -> Result<Vec<(Column, JointKind)>, Error> {
-    let file = expect.file;
+    let (file, line) = (expect.file, expect.line);
     found.sort_by_key(|(k, _, _)| *k);
     let count = found.len();
     if let Some(kinds) = expect.joints {
@@ -271,7 +273,7 @@ fn check_joints(
             let column = beyond.map_or(width + 1, |(_, c, _)| c.index + 1);
             return Err(Error::at_line(
                 file.to_owned(),
-                1,
+                line,
                 column,
                 ErrorKind::JointCountMismatch { found: count, expected },
             ));
@@ -281,7 +283,7 @@ fn check_joints(
     if count == 0 {
         return Err(Error::at_line(
             file.to_owned(),
-            1,
+            line,
             width + 1,
             ErrorKind::MissingColumn { name: joint_name(1, kind_of(1)) },
         ));
@@ -289,7 +291,7 @@ fn check_joints(
     if let Some(k) = (1..=count).find(|&k| found[k - 1].0 != k) {
         return Err(Error::at_line(
             file.to_owned(),
-            1,
+            line,
             width + 1,
             ErrorKind::MissingColumn { name: joint_name(k, kind_of(k)) },
         ));
@@ -299,7 +301,7 @@ fn check_joints(
             if kind != robot {
                 return Err(Error::at_line(
                     file.to_owned(),
-                    1,
+                    line,
                     column.index + 1,
                     ErrorKind::JointUnit { joint: *k, kind: error_kind(*robot) },
                 ));
@@ -314,11 +316,11 @@ fn orientation(
     quaternion: [Option<Column>; 4],
     euler: [Option<Column>; 3],
     names: &[String],
-    file: &str,
+    (file, line): (&str, u64),
     width: usize,
 ) -> Result<Option<OrientationColumns>, Error> {
     let missing =
-        |name: &str| Error::at_line(file.to_owned(), 1, width + 1, ErrorKind::MissingColumn { name: name.into() });
+        |name: &str| Error::at_line(file.to_owned(), line, width + 1, ErrorKind::MissingColumn { name: name.into() });
     let any_quaternion = quaternion.iter().flatten().next();
     let any_euler = euler.iter().flatten().next();
     if let (Some(q), Some(e)) = (any_quaternion, any_euler) {
@@ -326,7 +328,7 @@ fn orientation(
         let earlier = if e.index > q.index { q } else { e };
         return Err(Error::at_line(
             file.to_owned(),
-            1,
+            line,
             later.index + 1,
             ErrorKind::OrientationTwice { name: names[later.index].clone(), other: names[earlier.index].clone() },
         ));

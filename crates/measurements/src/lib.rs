@@ -25,6 +25,7 @@
 mod bound;
 mod column_map;
 mod dialect;
+mod file_lines;
 mod input_files;
 mod inputs;
 mod layout;
@@ -46,6 +47,7 @@ pub use dialect::{Decimal, DecimalFault, Delimiter, Dialect};
 pub use writer::{CsvColumns, MeasurementWriter};
 
 use errors::{Error, ErrorKind};
+use file_lines::LineCounter;
 use layout::{Expectation, Layout, OrientationColumns};
 use lie::{SO3, Vector3};
 use poe::JointKind;
@@ -59,7 +61,8 @@ use std::path::Path;
 /// One measured pose, SI units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measurement {
-    /// 1-based line of the row in its file (0 for rows made in memory).
+    /// The row's line in its file as an editor counts it (0 for rows made in memory): the header
+    /// is line 1, and blank lines and the lines of a quoted field with a line break count.
     pub line: u64,
     /// Joint values, radians (metres for a prismatic joint).
     pub q: Vec<f64>,
@@ -172,6 +175,9 @@ pub struct MeasurementSet {
     /// The columns read as inputs of a model ([`ReadOptions::inputs`]), in that order (empty for
     /// sets made in memory).
     pub inputs: Vec<InputColumn>,
+    /// The header's line in the file (1 unless blank lines precede it; 1 for sets made in
+    /// memory): where a refusal of the header is placed.
+    pub header_line: u64,
 }
 
 /// What a measurement file is read against.
@@ -272,12 +278,17 @@ fn parse_keeping<R: Read>(
         .trim(csv::Trim::All)
         .from_reader(body);
     let delimiter = dialect.delimiter;
-    let header = csv.headers().map_err(|e| syntax_error(&e, file, delimiter))?.clone();
+    let header = csv.headers().map_err(|e| syntax_error(&e, file, delimiter, body))?.clone();
     if header.is_empty() || (header.len() == 1 && header[0].is_empty()) {
         return Err(Error::at_line(file.to_owned(), 1, 1, ErrorKind::EmptyFile));
     }
+    // Every row by the line an editor shows it on (module `file_lines`): the header's, 1 unless
+    // blank lines precede it, then each record's from the same counter.
+    let mut lines = LineCounter::new(body);
+    let header_line = header.position().map_or(1, |p| lines.record_line(p.byte()));
     let expect = Expectation {
         file,
+        line: header_line,
         joints: options.joints.as_deref(),
         positions: positions_required,
         columns: &options.columns,
@@ -297,9 +308,9 @@ fn parse_keeping<R: Read>(
         match csv.read_record(&mut record) {
             Ok(true) => {}
             Ok(false) => break,
-            Err(e) => return Err(syntax_error(&e, file, delimiter)),
+            Err(e) => return Err(syntax_error(&e, file, delimiter, body)),
         }
-        let line = record.position().map_or(0, |p| p.line());
+        let line = record.position().map_or(0, |p| lines.record_line(p.byte()));
         let mut row = Row { record: &record, line, file, names: &layout.names, dialect: &mut dialect };
         let q = layout
             .joints
@@ -372,6 +383,7 @@ fn parse_keeping<R: Read>(
         return Err(Error::at_line(file.to_owned(), 1, 1, ErrorKind::EmptyFile));
     }
     Ok(MeasurementSet {
+        header_line,
         source: file.to_owned(),
         joint_count: layout.joints.len(),
         full_pose: layout.orientation.is_some(),
@@ -435,6 +447,7 @@ impl MeasurementSet {
             position_unit: None,
             format: FileFormat::default(),
             inputs: Vec::new(),
+            header_line: 1,
         }
     }
 
@@ -466,7 +479,7 @@ impl MeasurementSet {
         }
         Err(Error::at_line(
             self.source.clone(),
-            1,
+            self.header_line,
             1,
             ErrorKind::JointCountMismatch { found: self.joint_count, expected: joints },
         ))
@@ -480,7 +493,7 @@ impl MeasurementSet {
             if column.kind != *kind {
                 return Err(Error::at_line(
                     self.source.clone(),
-                    1,
+                    self.header_line,
                     column.column,
                     ErrorKind::JointUnit { joint: k + 1, kind: layout::error_kind(*kind) },
                 ));
@@ -536,6 +549,7 @@ impl MeasurementSet {
             position_unit: self.position_unit,
             format: self.format.clone(),
             inputs: self.inputs.clone(),
+            header_line: self.header_line,
         }
     }
 }

@@ -35,9 +35,9 @@ pub(super) const JOINT_TRAVEL_RANGE: PhysicalRange =
 pub(super) const JOINT_ANGLE_RANGE: PhysicalRange =
     PhysicalRange { limit: MAX_JOINT_ANGLE_RAD, unit: "rad", quantity: "joint angle" };
 
-/// The CSV layer's refusal as ours, at its line and field.
-pub(super) fn syntax_error(e: &csv::Error, file: &str, delimiter: Delimiter) -> Error {
-    let line = e.position().map_or(1, |p| p.line());
+/// The CSV layer's refusal as ours, at its line (as an editor counts it in `body`) and field.
+pub(super) fn syntax_error(e: &csv::Error, file: &str, delimiter: Delimiter, body: &[u8]) -> Error {
+    let line = super::file_lines::line_of(body, e.position());
     match e.kind() {
         csv::ErrorKind::UnequalLengths { expected_len, len, .. } => Error::at_line(
             file.to_owned(),

@@ -75,6 +75,10 @@ pub struct EvalReport {
     /// where none was (and left out of the JSON).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub wrapped: Vec<crate::WrappedJoint>,
+    /// The data looks measured from another tracker placement than the model's: one rigid motion
+    /// of the predictions explains most of the error ([`crate::OtherPlacement`]); `None` otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub other_placement: Option<crate::OtherPlacement>,
 }
 
 /// The errors inside and outside a model's coverage.
@@ -137,6 +141,12 @@ impl EvalReport {
             // The evaluation has predicted the same rows with the same GP: it cannot fail here.
             gp_fade: model.gp_fade(&data.rows).ok().flatten(),
             wrapped: Vec::new(),
+            other_placement: crate::OtherPlacement::of(
+                &data.rows,
+                &evaluation.poses,
+                data.full_pose && model.full_pose,
+                &crate::OtherPlacementOptions::default(),
+            ),
         }
     }
 }

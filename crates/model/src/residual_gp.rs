@@ -125,6 +125,11 @@ pub struct ResidualGpOptions {
     /// issue 46): columns of the measurement file by name (after `--columns`), in this order. The
     /// GP standardises every input, so each is used in the unit it was measured in.
     pub inputs: Vec<String>,
+    /// The fallback GP's ([`ResidualGp::fallback`]) full-data searches after its warm-start
+    /// subset take at most this many iterations ([`gp::OptimiserConfig::refine_max_iterations`];
+    /// `None`: as the GP's own). The fallback serves only the rows an effect's span fades to the
+    /// geometry alone, where the hyperparameters' last few nats on all rows change little.
+    pub fallback_refine_iterations: Option<usize>,
 }
 
 impl Default for ResidualGpOptions {
@@ -236,6 +241,14 @@ impl Default for ResidualGpOptions {
             // the share fades the correction only from half-way between it and 1.
             fade_share_rows: 2000,
             inputs: Vec::new(),
+            // The subset's optimum as it is (no iteration on all rows). `calib fit --method poe-gp
+            // --effects auto` on the UR10 (docs/results/gp-search-time.md), against the full
+            // search: held-out position error C even → odd rows 0.10565 → 0.10560 mm, B even →
+            // odd 0.2225 → 0.2207, C trained on joint 1's lower 60 % → the rest 0.5719 → 0.5652,
+            // B elbow down → up 0.7928 → 0.7926 (rotation within 0.4 % or better); the arcs'
+            // off-pose error with the fallback on C 0.22528 → 0.22527 mm; the fallback's CPU time on
+            // C 25 → 11 s. One iteration on all rows was no better (0.10575 mm on C).
+            fallback_refine_iterations: Some(0),
         }
     }
 }
@@ -285,6 +298,8 @@ struct OptimiserPatch {
     warm_start_curvature: Option<bool>,
     #[serde(default, deserialize_with = "given")]
     refine_function_tolerance: Option<Option<f64>>,
+    #[serde(default, deserialize_with = "given")]
+    refine_max_iterations: Option<Option<usize>>,
     #[serde(default, deserialize_with = "given")]
     kernel_cache_bytes: Option<usize>,
 }
@@ -357,6 +372,7 @@ fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<
             warm_start_rows,
             warm_start_curvature,
             refine_function_tolerance,
+            refine_max_iterations,
             kernel_cache_bytes,
         } = o;
         let d = &mut gp.optimiser;
@@ -369,6 +385,7 @@ fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<
         d.warm_start_rows = warm_start_rows.unwrap_or(d.warm_start_rows);
         d.warm_start_curvature = warm_start_curvature.unwrap_or(d.warm_start_curvature);
         d.refine_function_tolerance = refine_function_tolerance.unwrap_or(d.refine_function_tolerance);
+        d.refine_max_iterations = refine_max_iterations.unwrap_or(d.refine_max_iterations);
         d.kernel_cache_bytes = kernel_cache_bytes.unwrap_or(d.kernel_cache_bytes);
     }
     Ok(gp)
@@ -921,7 +938,10 @@ impl ResidualGp {
         }
         let ResidualSet { inputs: x, outputs: y } =
             ResidualSet::with_inputs(alone_poses, data, self.with_payload, &self.inputs, self.residual_frame)?;
-        let fallback = GpModel::Exact(timings::phase("search", || exact_fit(&x, &y, data.full_pose, options))?);
+        let mut options = options.clone();
+        options.gp.optimiser.refine_max_iterations =
+            options.fallback_refine_iterations.or(options.gp.optimiser.refine_max_iterations);
+        let fallback = GpModel::Exact(timings::phase("search", || exact_fit(&x, &y, data.full_pose, &options))?);
         if let Some(fade) = &mut self.fade {
             fade.fallback_training_share =
                 Some(timings::phase("fade share", || median_share(&fallback, &x, None, options.fade_share_rows))?);

@@ -79,7 +79,7 @@ fn a_program_taught_on_the_nominal_model_is_rewritten_to_reach_its_poses() {
     assert_eq!(
         lines.next().unwrap(),
         "q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad,nominal_q1_deg,nominal_q2_deg,nominal_q3_deg,nominal_q4_deg,\
-         nominal_q5_deg,nominal_q6_deg,payload_kg,speed,tool,residual_mm,residual_mrad,status"
+         nominal_q5_deg,nominal_q6_deg,payload_kg,speed,tool,residual_mm,residual_mrad,status,line"
     );
     let first: Vec<&str> = lines.next().unwrap().split(',').collect();
     assert_eq!(&first[6..15], ["10", "20", "-10", "30", "40", "50", "0", "v100", ""]);

@@ -183,6 +183,7 @@ impl Model {
         if report.orientations_not_evaluated {
             warnings.push(model::ORIENTATIONS_NOT_EVALUATED.to_owned());
         }
+        warnings.extend(report.other_placement.iter().map(ToString::to_string));
         warnings.extend(report.warnings.iter().map(ToString::to_string));
         warnings.extend(report.out_of_range.iter().map(ToString::to_string));
         warnings.extend(report.beyond_joint_limits.iter().map(ToString::to_string));

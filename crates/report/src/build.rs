@@ -374,7 +374,9 @@ fn gp_view(residual_gp: &model::ResidualGp, model: &CalibratedModel) -> GpView {
 }
 
 fn warnings(model: &CalibratedModel, eval: &EvalReport) -> Vec<String> {
-    let mut out: Vec<String> = eval.warnings.iter().map(ToString::to_string).collect();
+    // Another tracker placement first: it explains the numbers of every other section.
+    let mut out: Vec<String> = eval.other_placement.iter().map(ToString::to_string).collect();
+    out.extend(eval.warnings.iter().map(ToString::to_string));
     out.extend(eval.out_of_range.iter().map(ToString::to_string));
     out.extend(eval.beyond_joint_limits.iter().map(ToString::to_string));
     if eval.orientations_not_evaluated {
