@@ -325,6 +325,8 @@ mod tests {
             temp_c: None,
             t_s: None,
             torques_nm: None,
+            inputs: measurements::Inputs::default(),
+            std: None,
         };
         (vec![pose], MeasurementSet::from_rows("mem", vec![row], vec![]))
     }

@@ -200,6 +200,10 @@ pub fn read_with_goals(input: &Path, series: &str, full_pose: bool) -> anyhow::R
     let position = [column("measurement_x")?, column("measurement_y")?, column("measurement_z")?];
     let angles = [column("measurement_rx")?, column("measurement_ry")?, column("measurement_rz")?];
     let temperature = column("measurement_temperature")?;
+    // The tracker's stated standard deviation of every row (issue 46): mm, and degrees of the
+    // three angles, kept as std_x_mm … and std_rx_mrad ….
+    let position_std = [column("measurement_std_x")?, column("measurement_std_y")?, column("measurement_std_z")?];
+    let angle_std = [column("measurement_std_rx")?, column("measurement_std_ry")?, column("measurement_std_rz")?];
     let stamp = column("Timestamp")?;
     let goal = [column("Goal x")?, column("Goal y")?, column("Goal z")?];
     let mut rows = Vec::new();
@@ -228,6 +232,19 @@ pub fn read_with_goals(input: &Path, series: &str, full_pose: bool) -> anyhow::R
             temp_c: Some(cell(temperature)?),
             t_s: cells.get(stamp).and_then(|s| seconds(s)),
             torques_nm: None,
+            inputs: measurements::Inputs::default(),
+            std: Some(measurements::StatedSigma {
+                position_m: Some([
+                    cell(position_std[0])? * 1e-3,
+                    cell(position_std[1])? * 1e-3,
+                    cell(position_std[2])? * 1e-3,
+                ]),
+                rotation_rad: Some([
+                    cell(angle_std[0])?.to_radians(),
+                    cell(angle_std[1])?.to_radians(),
+                    cell(angle_std[2])?.to_radians(),
+                ]),
+            }),
         });
     }
     // A time column only when every stamp survived.

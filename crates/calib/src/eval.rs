@@ -1,6 +1,6 @@
 //! `calib eval`: the errors of a calibrated model on measurements.
 
-use measurements::{ColumnMap, ReadOptions};
+use measurements::ColumnMap;
 use model::EvalReport;
 use std::path::PathBuf;
 
@@ -23,7 +23,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let model = model::read_model(&args.model)?;
-    let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
+    let options = model.read_options(args.columns.clone().unwrap_or_default());
     let data = measurements::read_measurements(&args.data, &options)?;
     // Angles a turn away from the fitted range are taken into it, as `calib register` does.
     let (rows, wrapped) = model::wrapped(&model, &data.rows);

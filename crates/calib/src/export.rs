@@ -2,7 +2,7 @@
 
 use cell::UrdfTemplate;
 use measurements::ReadOptions;
-use robot::{NominalTolerance, UrdfDocument};
+use robot::{ChainEnds, NominalTolerance, RobotDescription, UrdfDocument};
 use std::path::PathBuf;
 
 /// Write a calibrated model's geometry as a URDF.
@@ -52,7 +52,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         .check_output("--urdf", &args.urdf)?;
     let model = model::read_model(&args.model)?;
     let training = match &args.data {
-        Some(path) => Some(measurements::read_measurements(path, &ReadOptions::for_joints(model.joint_kinds()))?),
+        Some(path) => Some(measurements::read_measurements(path, &model.read_options(Default::default()))?),
         None => None,
     };
     let tolerance = NominalTolerance::default();

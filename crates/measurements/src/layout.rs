@@ -36,6 +36,12 @@ pub(crate) struct Layout {
     pub temp: Option<Column>,
     pub time: Option<Column>,
     pub torques: Vec<Column>,
+    /// The columns of [`Expectation::inputs`], in its order.
+    pub inputs: Vec<Column>,
+    /// The stated standard deviations of the position, `std_x_mm` … (issue 46): all three or none.
+    pub position_std: Option<[Column; 3]>,
+    /// The stated standard deviations of the orientation, `std_rx_mrad` …: all three or none.
+    pub rotation_std: Option<[Column; 3]>,
     /// The names of the columns not used.
     pub ignored: Vec<String>,
     /// Names as the rest of the reader refers to them: the SPEC name of a mapped column.
@@ -52,6 +58,8 @@ pub(crate) struct Expectation<'a> {
     /// Whether the position columns must be there.
     pub positions: bool,
     pub columns: &'a ColumnMap,
+    /// The columns to keep as inputs of a model (`--inputs`), by name.
+    pub inputs: &'a [String],
 }
 
 /// The SPEC name of joint `k`'s column for a joint of `kind`.
@@ -88,6 +96,7 @@ impl Layout {
         let mut quaternion = [None; 4];
         let mut euler = [None; 3];
         let (mut payload, mut tool, mut temp, mut time) = (None, None, None, None);
+        let (mut position_std, mut rotation_std) = ([None; 3], [None; 3]);
         let mut ignored = Vec::new();
         for (index, raw) in header.iter().enumerate() {
             let raw = raw.trim();
@@ -114,6 +123,8 @@ impl Layout {
                 Some(Quantity::Tool) => tool.replace(index).is_none(),
                 Some(Quantity::Temperature) => temp.replace(column(1.0)).is_none(),
                 Some(Quantity::Time) => time.replace(column(1.0)).is_none(),
+                Some(Quantity::PositionStd { axis, scale }) => position_std[axis].replace(column(scale)).is_none(),
+                Some(Quantity::RotationStd { axis, scale }) => rotation_std[axis].replace(column(scale)).is_none(),
                 None => {
                     ignored.push(name.clone());
                     true
@@ -135,6 +146,11 @@ impl Layout {
             }
         }
 
+        let inputs = input_columns(&names, expect, width)?;
+        if !inputs.is_empty() {
+            let taken: HashSet<&str> = expect.inputs.iter().map(String::as_str).collect();
+            ignored.retain(|name| !taken.contains(name.as_str()));
+        }
         let joints = check_joints(joints, expect, width)?;
         let n = joints.len();
         torques.sort_by_key(|(k, _)| *k);
@@ -162,6 +178,15 @@ impl Layout {
             _ => None,
         };
         let orientation = orientation(quaternion, euler, &names, (file, line), width)?;
+        // A stated uncertainty of some axes only is refused by the first name missing: a row
+        // weighted on one axis and not on another would be weighted by accident.
+        let all_or_none = |columns: [Option<Column>; 3], names: [&str; 3]| match columns {
+            [Some(x), Some(y), Some(z)] => Ok(Some([x, y, z])),
+            [None, None, None] => Ok(None),
+            _ => Err(at_end(names[columns.iter().position(Option::is_none).unwrap_or(0)].into())),
+        };
+        let position_std = all_or_none(position_std, ["std_x_mm", "std_y_mm", "std_z_mm"])?;
+        let rotation_std = all_or_none(rotation_std, ["std_rx_mrad", "std_ry_mrad", "std_rz_mrad"])?;
         Ok(Self {
             joints,
             position,
@@ -171,10 +196,64 @@ impl Layout {
             temp,
             time,
             torques: torques.into_iter().map(|(_, c)| c).collect(),
+            inputs,
+            position_std,
+            rotation_std,
             ignored,
             names,
         })
     }
+}
+
+/// The columns of the inputs `expect.inputs` names, in its order: each must be in the header, and
+/// be a number that is not already an input or an output of the model. Names are looked up in a
+/// map of the header, not by scanning it.
+fn input_columns(names: &[String], expect: &Expectation<'_>, width: usize) -> Result<Vec<Column>, Error> {
+    if expect.inputs.is_empty() {
+        return Ok(Vec::new());
+    }
+    let file = expect.file;
+    let index: std::collections::HashMap<&str, usize> =
+        names.iter().enumerate().map(|(i, name)| (name.as_str(), i)).collect();
+    let mut seen = HashSet::with_capacity(expect.inputs.len());
+    expect
+        .inputs
+        .iter()
+        .map(|name| {
+            if !seen.insert(name.as_str()) {
+                return Err(Error::at_line("--inputs", 1, 1, ErrorKind::InputList { name: name.clone() }));
+            }
+            let Some(&i) = index.get(name.as_str()) else {
+                return Err(Error::at_line(
+                    file.to_owned(),
+                    1,
+                    width + 1,
+                    ErrorKind::MissingColumn { name: name.clone() },
+                ));
+            };
+            let refused = match quantity(name) {
+                Some(Quantity::Joint { .. }) => Some("a joint, already an input"),
+                Some(Quantity::Position { .. } | Quantity::Quaternion(_) | Quantity::Euler { .. }) => {
+                    Some("the measured pose, what the model predicts")
+                }
+                Some(Quantity::Tool) => Some("the tool, not a number"),
+                Some(Quantity::Payload) => Some("the payload, an input of method poe-gp-load"),
+                Some(Quantity::PositionStd { .. } | Quantity::RotationStd { .. }) => {
+                    Some("the tracker's stated uncertainty, which weights its row")
+                }
+                _ => None,
+            };
+            match refused {
+                Some(quantity) => Err(Error::at_line(
+                    file.to_owned(),
+                    1,
+                    i + 1,
+                    ErrorKind::NotAnInput { name: name.clone(), quantity },
+                )),
+                None => Ok(Column { index: i, scale: 1.0 }),
+            }
+        })
+        .collect()
 }
 
 /// The joint columns in order, checked: numbered 1…n without gaps, n the robot's joint count

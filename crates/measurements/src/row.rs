@@ -86,6 +86,27 @@ impl Row<'_> {
         columns.iter().map(|&c| self.number(c)).collect()
     }
 
+    /// The cells of three stated standard deviations as SI numbers, each positive: a zero or a
+    /// negative one would weight its row infinitely or not at all.
+    pub fn standard_deviations(&mut self, columns: &[Column; 3]) -> Result<[f64; 3], Error> {
+        let mut out = [0.0; 3];
+        for (slot, &c) in out.iter_mut().zip(columns) {
+            let value = self.number(c)?;
+            if value <= 0.0 {
+                let name = self.names[c.index].clone();
+                let value = value / c.scale;
+                return Err(Error::at_line(
+                    self.file.to_owned(),
+                    self.line,
+                    c.index + 1,
+                    ErrorKind::NotAStandardDeviation { name, value },
+                ));
+            }
+            *slot = value;
+        }
+        Ok(out)
+    }
+
     /// The cells of `columns` as SI numbers, each within `range` in magnitude.
     pub fn bounded_numbers(&mut self, columns: &[Column], range: PhysicalRange) -> Result<Vec<f64>, Error> {
         columns

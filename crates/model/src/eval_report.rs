@@ -208,7 +208,7 @@ mod tests {
     fn a_unit_no_report_writes_is_refused() {
         let text = OLDEST.replace(
             "\"full_pose\":false",
-            "\"full_pose\":false,\"out_of_range\":[{\"input\":\"t_s\",\"unit\":\"h\",\"fitted\":[0,1],\"rows_outside\":1,\"rows\":3,\"first_line\":2}]",
+            "\"full_pose\":false,\"out_of_range\":[{\"input\":\"t_s\",\"unit\":\"furlong\",\"fitted\":[0,1],\"rows_outside\":1,\"rows\":3,\"first_line\":2}]",
         );
         let error = serde_json::from_str::<EvalReport>(&text).unwrap_err();
         assert!(error.to_string().contains("a unit"), "{error}");

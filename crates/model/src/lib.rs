@@ -74,5 +74,5 @@ pub use residual_gp::{
     ResidualSet, UnknownGpChoice, gp_weight,
 };
 pub use suspect_rows::{SuspectRows, suspect_rows};
-pub use training_range::{OutOfRangeWarning, TrainingRange};
+pub use training_range::{InputSpan, OutOfRangeWarning, TrainingRange};
 pub use wrap::{WrappedJoint, wrapped};

@@ -2,7 +2,7 @@
 //! leaves, with the joint values (and the payload) as inputs, placed before the POE model
 //! (Eq. 9): `T = G(q, m) · T_POE(q)`.
 
-use errors::Error;
+use errors::{Error, ErrorKind};
 use faer::Mat;
 use lie::{SE3, Twist, Vector3, Vector6};
 use measurements::{BoundSet, Measurement, MeasurementSet};
@@ -121,6 +121,10 @@ pub struct ResidualGpOptions {
     /// median of all of them took longer than the sparse GP's own search. The exact GP's comes
     /// from its leave-one-out over every row, which the fit computes anyway. At least 1.
     pub fade_share_rows: usize,
+    /// Measured signals taken as inputs beside the joints and the payload (`calib fit --inputs`,
+    /// issue 46): columns of the measurement file by name (after `--columns`), in this order. The
+    /// GP standardises every input, so each is used in the unit it was measured in.
+    pub inputs: Vec<String>,
     /// The fallback GP's ([`ResidualGp::fallback`]) full-data searches after its warm-start
     /// subset take at most this many iterations ([`gp::OptimiserConfig::refine_max_iterations`];
     /// `None`: as the GP's own). The fallback serves only the rows an effect's span fades to the
@@ -236,6 +240,7 @@ impl Default for ResidualGpOptions {
             // all of them (its standard error, 1.25 σ / √2000), far inside the rule's margin:
             // the share fades the correction only from half-way between it and 1.
             fade_share_rows: 2000,
+            inputs: Vec::new(),
             // The subset's optimum as it is (no iteration on all rows). `calib fit --method poe-gp
             // --effects auto` on the UR10 (docs/results/gp-search-time.md), against the full
             // search: held-out position error C even → odd rows 0.10565 → 0.10560 mm, B even →
@@ -259,7 +264,9 @@ impl ResidualGpOptions {
             _ if self.fade_share_rows == 0 => {
                 Err(("fade_share_rows", "residual_gp.fade_share_rows is 0, expected at least 1".to_owned()))
             }
-            _ => Ok(()),
+            _ => measurements::InputNames::new(self.inputs.clone(), "residual_gp.inputs")
+                .map(|_| ())
+                .map_err(|e| ("inputs", format!("residual_gp.inputs: {}", e.kind()))),
         }
     }
 }
@@ -523,6 +530,11 @@ pub struct ResidualGp {
     /// fitted. Absent in older files and where the options turn it off: it never fades there.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fade: Option<GpFadeRule>,
+    /// The measured signals the GP takes after the joints and the payload, by column name
+    /// ([`ResidualGpOptions::inputs`]; their spans are in the model's
+    /// [`crate::TrainingRange::inputs`]). Absent in older files and where it takes none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub inputs: Vec<String>,
 }
 
 /// Where a GP's correction fades: from the share `r` of its prior variance (of the position
@@ -655,6 +667,10 @@ pub struct ResidualGpReport {
     /// The configurations measured more than once.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub repeated_configurations: usize,
+    /// The measured signals the GP took beside the joints (`--inputs`), each with its unit and
+    /// the span it was fitted on; absent where it took none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub inputs: Vec<crate::InputSpan>,
 }
 
 fn is_zero(n: &usize) -> bool {
@@ -675,10 +691,32 @@ fn exact_fit(x: &Mat<f64>, y: &Mat<f64>, full_pose: bool, options: &ResidualGpOp
     gp::ExactGp::fit(x.as_ref(), y.as_ref(), &config).map_err(Error::gp)
 }
 
-fn inputs(rows: &[Measurement], with_payload: bool) -> Mat<f64> {
+/// The GP's inputs of `rows`: the joints, the payload where `with_payload`, then the measured
+/// signals `signals` by name; a row without one of them is refused at its line of `source`
+/// ([`ErrorKind::MissingInput`]: rows a caller made without it; a file without the column was
+/// refused by its reader).
+fn inputs(rows: &[Measurement], with_payload: bool, signals: &[String], source: &str) -> Result<Mat<f64>, Error> {
     let n = rows.first().map_or(0, |r| r.q.len());
-    let d = n + usize::from(with_payload);
-    Mat::from_fn(rows.len(), d, |i, c| if c < n { rows[i].q[c] } else { rows[i].payload_kg })
+    let p = n + usize::from(with_payload);
+    let mut x = Mat::from_fn(rows.len(), p + signals.len(), |i, c| {
+        if c < n {
+            rows[i].q[c]
+        } else if c < p {
+            rows[i].payload_kg
+        } else {
+            0.0
+        }
+    });
+    for (i, row) in rows.iter().enumerate() {
+        for (k, name) in signals.iter().enumerate() {
+            let Some(value) = row.inputs.value(k, name) else {
+                let kind = ErrorKind::MissingInput { name: name.clone() };
+                return Err(Error::at_line(source.to_owned(), row.line, 1, kind));
+            };
+            x[(i, p + k)] = value;
+        }
+    }
+    Ok(x)
 }
 
 /// The error of one row against the model's pose, as the GP's output vector.
@@ -715,6 +753,18 @@ pub struct ResidualSet {
 impl ResidualSet {
     /// The error that the model poses `poses` (one per row) leave on `data`, expressed in `frame`.
     pub fn new(poses: &[SE3], data: &MeasurementSet, with_payload: bool, frame: ResidualFrame) -> Self {
+        Self::with_inputs(poses, data, with_payload, &[], frame).expect("no measured signal to miss")
+    }
+
+    /// [`ResidualSet::new`] with the measured signals `signals` as inputs after the joints and
+    /// the payload; a row without one is refused at its line.
+    pub fn with_inputs(
+        poses: &[SE3],
+        data: &MeasurementSet,
+        with_payload: bool,
+        signals: &[String],
+        frame: ResidualFrame,
+    ) -> Result<Self, Error> {
         let outputs = if data.full_pose { 6 } else { 3 };
         let mut y = Mat::<f64>::zeros(data.rows.len(), outputs);
         for (i, (row, pose)) in data.rows.iter().zip(poses).enumerate() {
@@ -723,7 +773,7 @@ impl ResidualSet {
                 y[(i, c)] = e[c];
             }
         }
-        Self { inputs: inputs(&data.rows, with_payload), outputs: y }
+        Ok(Self { inputs: inputs(&data.rows, with_payload, signals, &data.source)?, outputs: y })
     }
 }
 
@@ -738,7 +788,8 @@ impl ResidualGp {
         options: &ResidualGpOptions,
         repeats: &crate::RepeatGroups,
     ) -> Result<(Self, ResidualGpReport), Error> {
-        let ResidualSet { inputs: x, outputs: y } = ResidualSet::new(poses, data, with_payload, options.residual_frame);
+        let ResidualSet { inputs: x, outputs: y } =
+            ResidualSet::with_inputs(poses, data, with_payload, &options.inputs, options.residual_frame)?;
         let (gp, report, loo, leave_group_out) = match options.choice_for(x.nrows()) {
             GpChoice::Sparse => {
                 let inducing_points = options.sparse.inducing_points.min(x.nrows());
@@ -785,6 +836,7 @@ impl ResidualGp {
             tool_points: Vec::new(),
             fallback: None,
             fade,
+            inputs: options.inputs.clone(),
         };
         let summary = |mean: Mat<f64>| {
             let errors: Vec<crate::PoseError> = poses
@@ -805,14 +857,18 @@ impl ResidualGp {
             leave_group_out: leave_group_out.map(&summary),
             repeated_rows: repeats.repeated_rows(),
             repeated_configurations: repeats.groups.iter().filter(|g| g.len() > 1).count(),
+            inputs: crate::TrainingRange::of(&data.rows)
+                .map(|range| range.inputs.into_iter().filter(|i| options.inputs.contains(&i.name)).collect())
+                .unwrap_or_default(),
         };
         Ok((residual_gp, report))
     }
 
-    /// The GP's inputs for `rows`: `(q_1 … q_n[, m])`, the payload where the GP takes it, as its
-    /// fit and its prediction build them.
-    pub fn inputs_of(&self, rows: &[Measurement]) -> Mat<f64> {
-        inputs(rows, self.with_payload)
+    /// The GP's inputs for `rows`: `(q_1 … q_n[, m], s_1 … s_k)`, the payload where the GP
+    /// takes it and then its measured signals ([`ResidualGp::inputs`]), as its fit and its
+    /// prediction build them; a row without a signal is refused at its line of `source`.
+    pub fn inputs_of(&self, rows: &[Measurement], source: &str) -> Result<Mat<f64>, Error> {
+        inputs(rows, self.with_payload, &self.inputs, source)
     }
 
     /// `G` for the GP's output `g` at a model pose: a translation for position-only data, else the
@@ -881,7 +937,7 @@ impl ResidualGp {
             return Ok(());
         }
         let ResidualSet { inputs: x, outputs: y } =
-            ResidualSet::new(alone_poses, data, self.with_payload, self.residual_frame);
+            ResidualSet::with_inputs(alone_poses, data, self.with_payload, &self.inputs, self.residual_frame)?;
         let mut options = options.clone();
         options.gp.optimiser.refine_max_iterations =
             options.fallback_refine_iterations.or(options.gp.optimiser.refine_max_iterations);
@@ -898,7 +954,7 @@ impl ResidualGp {
     /// of its prior variance the posterior keeps there: of the GP, and with a
     /// [`ResidualGp::fallback`] the smaller of the two weights.
     pub fn weights(&self, rows: &[Measurement]) -> Result<Vec<(f64, f64)>, Error> {
-        let x = inputs(rows, self.with_payload);
+        let x = inputs(rows, self.with_payload, &self.inputs, "the rows")?;
         let mut out = vec![(1.0, 0.0); rows.len()];
         for (gp, fallback) in std::iter::once((&self.gp, false)).chain(self.fallback.iter().map(|f| (f, true))) {
             let prediction = gp.predict(x.as_ref()).map_err(Error::gp)?;
@@ -921,7 +977,8 @@ impl ResidualGp {
         model_poses: &[SE3],
     ) -> Result<Vec<Correction>, Error> {
         let tools = data.tools();
-        let prediction = gp.predict(inputs(data.rows(), self.with_payload).as_ref()).map_err(Error::gp)?;
+        let x = inputs(data.rows(), self.with_payload, &self.inputs, &data.set().source)?;
+        let prediction = gp.predict(x.as_ref()).map_err(Error::gp)?;
         let outputs = prediction.mean.ncols();
         Ok(model_poses
             .iter()
