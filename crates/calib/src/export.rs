@@ -1,8 +1,7 @@
 //! `calib export`: the calibrated geometry as a URDF for controllers, planners and simulators.
 
 use cell::UrdfTemplate;
-use measurements::ReadOptions;
-use robot::{ChainEnds, NominalTolerance, RobotDescription, UrdfDocument};
+use robot::{NominalTolerance, UrdfDocument};
 use std::path::PathBuf;
 
 /// Write a calibrated model's geometry as a URDF.
