@@ -134,37 +134,21 @@ pub struct ResidualGpOptions {
 
 impl Default for ResidualGpOptions {
     fn default() -> Self {
+        // What each default was measured against is in docs/results/gp-defaults.md; here the
+        // reasons.
+        //
         // ARD squared exponential plus a first-order additive term (one one-dimensional squared
-        // exponential per input) rather than the paper's Eq. 5 kernel: on the UR10 data (series
-        // C, 1387 training poses, position only, even rows → odd rows) the paper's kernel left
-        // 0.307 mm held out, SE-ARD 0.205 mm and SE-ARD + additive 0.136 mm; the additive term
-        // learns a joint's periodic gear error from the poses that move that joint, which the
-        // joint ARD term cannot (docs/results/bench-gp.md has the other data sets). The default
-        // start and the kernel's nested start (additive term nearly off), searched on a 500-row
-        // warm-start subset; no random restarts: over the 8 data sets of `bench-gp --kernels`
-        // (24 searches) a random start never reached the best likelihood, and they cost a third
-        // of the search at 300 poses.
+        // exponential per input) rather than the paper's Eq. 5 kernel: the additive term learns a
+        // joint's periodic gear error from the poses that move that joint, which the joint ARD
+        // term cannot. The default start and the kernel's nested start (additive term nearly
+        // off), searched on a 500-row warm-start subset; no random restarts, which never reached
+        // the best likelihood on bench-gp's sets.
         //
         // The search stops when an iteration raises the log marginal likelihood by less than
-        // 1e-5 of itself (≈ 0.005 nats on these data, far below the ~1 nat that separates models
-        // in a likelihood-ratio sense) instead of scipy's 2.2e-9, and keeps 20 curvature pairs
-        // (the default kernel's parameter count on six joints, so nearly full BFGS) instead of
-        // 10. Chosen with `bench-gp --kernels --search-seeds 0,1,2,3,4,5` (8 sets, 6 searches
-        // each, the held-out error's mean ± half its spread; docs/results/gp-kernel.md): against
-        // memory 10 / 1e-6 the fit time summed over the sets fell 18.0 → 10.7 s (UR10 C 10.3 →
-        // 6.4 s), every set's mean held-out error stayed within its seed spread (UR10 C 0.1362 →
-        // 0.1361, B 0.2622 → 0.2600, the simulated sets within 0.0005 mm), and the likelihood
-        // reached fell by 4.3 nats summed over the 24 searches. 1e-5 with memory 10 lost 20 nats
-        // and memory 30 lost 15; 3e-6 with memory 20 took 13.0 s.
-        //
-        // The full-data search after the subset's starts at the subset's optimum and stops at
-        // 1e-4 (`refine_function_tolerance`, ≈ 0.1–0.3 nats per iteration on these data): from
-        // there it climbed a few hundredths of a nat per iteration for half of its iterations,
-        // each an `n³` factorisation on every row. `calib fit --method poe-gp` on UR10 C and B,
-        // even rows → odd rows, subset seeds 0–3 (docs/results/gp-search-time.md): full-data
-        // evaluations summed over the seeds 833 → 488 (C), 915 → 572 (B); the held-out position
-        // error's mean over the seeds +0.5 % (C), +0.2 % (B), the largest single seed +1.6 %,
-        // inside the spread between seeds (2.5 % on C).
+        // 1e-5 of itself (≈ 0.005 nats here, far below the ~1 nat that separates models) and
+        // keeps 20 curvature pairs (the kernel's parameter count on six joints: nearly full
+        // BFGS). The full-data search after the subset starts near its optimum, where an
+        // iteration gains hundredths of a nat for an `n³` factorisation: it stops at 1e-4.
         let optimiser = gp::OptimiserConfig {
             restarts: 0,
             warm_start_rows: 500,
@@ -185,69 +169,44 @@ impl Default for ResidualGpOptions {
                 // The additive term only where the data pay for it: per output, the kernel with
                 // and without it are both searched (on the warm-start subset when there is one,
                 // then only the chosen one on all rows) and the additive term is kept when it
-                // raises the log marginal likelihood by more than the Schwarz penalty ½ · 2d · ln N
-                // (≈ 34 nats for 6 joints and 300 poses). No threshold of ours: BIC's own. On the 8
-                // sets of `bench-gp --kernels` the additive term raised the full-data likelihood
-                // by 229–1634 nats (3 outputs summed) on the UR10 series, where it cuts the
-                // held-out error by a quarter to a third, and by 6–27 nats on the simulated ones,
-                // where SE-ARD alone is as good or better held out on average (iiwa payload runs
-                // seed 1: 0.0454 against 0.0461 mm; docs/results/gp-kernel.md).
+                // raises the log marginal likelihood by more than the Schwarz penalty ½ · 2d · ln N.
+                // No threshold of ours: BIC's own.
                 additive_by_bic: true,
                 // The paper's isotropic Eq. 5 kernel beside it, per output, kept where its
-                // closed-form leave-one-out log predictive probability is higher (issue 25): on
-                // 300 simulated poses with payloads (IRB 4400, soft joints) the ARD kernel's
-                // length scales, fitted by marginal likelihood, overfit and lost up to 11 % held
-                // out to scikit-learn's C·RBF + C + DotProduct + White; on the UR10 series the ARD
-                // kernel wins by half. Decided on the warm-start subset's optimum where there is
-                // one, so the isotropic kernel is searched on all rows only where it wins there.
+                // closed-form leave-one-out log predictive probability is higher: on a few hundred
+                // poses the ARD length scales, fitted by marginal likelihood, can overfit. Decided
+                // on the warm-start subset's optimum where there is one, so the isotropic kernel
+                // is searched on all rows only where it wins there.
                 isotropic_by_loo: true,
                 ..gp::GpConfig::default()
             },
             method: GpChoice::default(),
-            // One exact evaluation with its gradient costs n³ flops: 64 GFLOP at n = 4000, about
-            // 3 s on 2 cores at faer's measured rate (docs/results/bench-gp.md), so a search of
-            // 50 evaluations takes minutes; the sparse GP with 500 inducing points takes seconds
-            // there and is within a few percent of the exact error (bench-gp's sweep).
+            // One exact evaluation with its gradient costs n³ flops (64 GFLOP at n = 4000: a
+            // search takes minutes); the sparse GP with 500 inducing points takes seconds there
+            // and stays within a few percent of the exact error.
             sparse_above_rows: 4000,
             sparse: gp::SparseConfig::default(),
-            // A kernel per output: on 100,000 simulated IRB 4400 poses with payloads (seed 7,
-            // tested on 3000 more) shared hyperparameters left 0.105 mm in 31 s, one kernel per
-            // output 0.073 mm in 52 s (the exact GP on the first 3000 poses: 0.075 mm).
+            // A kernel per output: shared hyperparameters lose accuracy where the outputs' errors
+            // vary on different scales.
             sparse_outputs: gp::OutputMode::Independent,
-            // SE-ARD, not the exact GP's additive kernel: on the same 100,000 poses the additive
-            // term left 0.0730 mm against 0.0729 mm and took 219 s against 84 s (both under load
-            // ≈ 4): its d one-dimensional kernels cost d more exponentials for each of the
-            // n·m entries of every bound evaluation.
+            // SE-ARD, not the exact GP's additive kernel: at the sizes the sparse GP serves the
+            // additive term gained nothing held out, and its d one-dimensional kernels cost d
+            // more exponentials for each of the n·m entries of every bound evaluation.
             sparse_kernel: gp::KernelChoice::SquaredExponentialArd,
             residual_frame: ResidualFrame::default(),
-            // Off: on UR10 series C, full pose, even rows → odd rows (issue 25), the shared
-            // rotation kernel cut the GP's CPU time from 25.9 to 17.5 s but made the held-out
-            // rotation error 22 % worse (0.302 → 0.368 mrad); accuracy first.
+            // Off: a shared rotation kernel is cheaper but cost held-out rotation accuracy on the
+            // UR10; accuracy first.
             rotation_follows_position: false,
             // One half: where the posterior keeps more than half of the prior variance a training
-            // pose leaves, the prediction is more the prior's extrapolation than the data's. On the
-            // UR10 (issue 23, full pose, release; docs/results/splits.md) the GP fitted on all of
-            // series C meets series B with r = 0.5 … 1 on every row but one, and corrected B's rows
-            // to 1.467 mm against the geometry's 1.421. Replayed offline first (`poe-gp`, share
-            // from 0): fading from one half gave 1.428 and cost 0.2–3.6 % on B's own splits, where
-            // the GP's extrapolation past the end of a joint's range helped (elbow − → + 0.794 →
-            // 0.823); from three quarters C → B stayed 1.456 (1.024× the geometry); each output by
-            // its own share cost up to 8 %. As built (share from the training rows' left-out
-            // share): `poe-gp --effects auto` C → B 1.4334, B even → odd 0.2213 → 0.2214, B's
-            // j3-end, elbow and j2-gap splits within 0.3 %.
+            // pose leaves, the prediction is more the prior's extrapolation than the data's.
             fade_above_variance_ratio: Some(0.5),
             // The median of 2,000 rows is within about 3 % of the rows' spread of the median of
             // all of them (its standard error, 1.25 σ / √2000), far inside the rule's margin:
             // the share fades the correction only from half-way between it and 1.
             fade_share_rows: 2000,
             inputs: Vec::new(),
-            // The subset's optimum as it is (no iteration on all rows). `calib fit --method poe-gp
-            // --effects auto` on the UR10 (docs/results/gp-search-time.md), against the full
-            // search: held-out position error C even → odd rows 0.10565 → 0.10560 mm, B even →
-            // odd 0.2225 → 0.2207, C trained on joint 1's lower 60 % → the rest 0.5719 → 0.5652,
-            // B elbow down → up 0.7928 → 0.7926 (rotation within 0.4 % or better); the arcs'
-            // off-pose error with the fallback on C 0.22528 → 0.22527 mm; the fallback's CPU time on
-            // C 25 → 11 s. One iteration on all rows was no better (0.10575 mm on C).
+            // The subset's optimum as it is (no iteration on all rows): the fallback serves only
+            // the rows an effect's span fades, where its held-out error matched the full search's.
             fallback_refine_iterations: Some(0),
         }
     }
