@@ -70,7 +70,7 @@ pub struct PlausibilityOptions {
     /// times the RMS of the nominal robot placed by a rigid transform (`rotation_rms_mm`). The
     /// identification holds that placement as a special case (its base and tool parameters), so at
     /// its optimum it cannot do worse; a fit that does stopped in a wrong minimum (a 7-axis arm's
-    /// identification once ended 200 times above that placement's RMS). 2: a robust fit that leaves
+    /// identification once ended over 200 times above that placement's RMS). 2: a robust fit that leaves
     /// a few gross outliers out may exceed the least-squares placement's RMS over every row
     /// somewhat, never by half again (the check is skipped when rows were left out).
     pub wrong_minimum_ratio: f64,
