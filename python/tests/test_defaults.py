@@ -15,7 +15,14 @@ from conftest import ROBOT, untimed
 
 # Each Python parameter and the CLI flag it stands for.
 FLAGS: Dict[str, Dict[str, str]] = {
-    "fit": {"method": "--method", "effects": "--effects", "gp": "--gp", "options": "--options", "force": "--force"},
+    "fit": {
+        "method": "--method",
+        "effects": "--effects",
+        "gp": "--gp",
+        "options": "--options",
+        "force": "--force",
+        "inputs": "--inputs",
+    },
     "diagnose": {"noise_mm": "--noise-mm", "folds": "--folds", "seed": "--seed", "report": "--report"},
     "simulate": {
         "rows": "--rows",
