@@ -9,7 +9,14 @@ import numpy.typing as npt
 _Path = Union[str, os.PathLike[str]]
 _F64 = npt.NDArray[np.float64]
 
-class CalibError(Exception): ...
+class CalibError(Exception):
+    file: Optional[str]
+    """The file (or command-line option) at fault, where the refusal has one."""
+    line: Optional[int]
+    """Its line as an editor counts it (the header is line 1), where known."""
+    column: Optional[int]
+    """Its 1-based column, where known."""
+
 
 class Robot:
     @staticmethod

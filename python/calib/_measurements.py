@@ -34,7 +34,9 @@ class Measurements:
     refusal names a line and a column: row ``i`` is line ``i + 2`` (line 1 is the header).
 
     ``robot`` (a :class:`Robot` or :class:`Model`) checks the joint columns against its joints
-    when reading, as the CLI does; otherwise they are checked when the set is used.
+    when reading, as the CLI does; otherwise they are checked when the set is used. Read for a
+    :class:`Model` that takes measured signals as inputs, the set requires their columns;
+    ``inputs`` keeps other signal columns by name (``fit(..., inputs=...)``).
     """
 
     __slots__ = ("_core",)
@@ -47,21 +49,24 @@ class Measurements:
         columns: Optional[Mapping[str, str]] = None,
         positions: bool = True,
         name: Optional[str] = None,
+        inputs: Optional[Sequence[str]] = None,
     ) -> None:
+        inputs = None if inputs is None else [str(i) for i in inputs]
         if isinstance(source, _calib.Measurements):
             self._core = source
         elif is_path(source):
             self._core = _calib.Measurements.read(
-                source, _core_of(robot), _pairs(columns), positions
+                source, _core_of(robot), _pairs(columns), positions, inputs
             )
         elif hasattr(source, "columns") and hasattr(source, "to_numpy"):
             self._core = _from_mapping(
                 {str(c): source[c].to_numpy() for c in source.columns},
                 name or "DataFrame",
                 robot,
+                inputs,
             )
         elif isinstance(source, Mapping):
-            self._core = _from_mapping(source, name or "arrays", robot)
+            self._core = _from_mapping(source, name or "arrays", robot, inputs)
         else:
             raise TypeError(
                 "Measurements: expected a CSV path, a mapping of column names to arrays "
@@ -75,10 +80,12 @@ class Measurements:
         robot: Optional[Any] = None,
         columns: Optional[Mapping[str, str]] = None,
         positions: bool = True,
+        inputs: Optional[Sequence[str]] = None,
     ) -> "Measurements":
         """Reads a measurement CSV; ``columns`` maps SPEC names onto other headers
-        (``{"x_mm": "X [mm]"}``, the CLI's ``--columns``)."""
-        return cls(path, robot=robot, columns=columns, positions=positions)
+        (``{"x_mm": "X [mm]"}``, the CLI's ``--columns``); ``inputs`` keeps measured signals
+        by name for ``fit(..., inputs=...)`` (``--inputs``)."""
+        return cls(path, robot=robot, columns=columns, positions=positions, inputs=inputs)
 
     @classmethod
     def from_arrays(
@@ -229,7 +236,12 @@ def _pairs(columns: Optional[Mapping[str, str]]) -> Optional[List[tuple]]:
     return None if columns is None else [(str(k), str(v)) for k, v in columns.items()]
 
 
-def _from_mapping(columns: Mapping[str, Any], name: str, robot: Optional[Any]) -> Any:
+def _from_mapping(
+    columns: Mapping[str, Any],
+    name: str,
+    robot: Optional[Any],
+    inputs: Optional[List[str]] = None,
+) -> Any:
     numeric = []
     text = []
     for key, values in columns.items():
@@ -241,4 +253,4 @@ def _from_mapping(columns: Mapping[str, Any], name: str, robot: Optional[Any]) -
             if array.ndim != 1:
                 raise ValueError(f"{key}: expected one value per row, got shape {array.shape}")
             numeric.append((key, np.ascontiguousarray(array, dtype=np.float64)))
-    return _calib.Measurements.from_columns(numeric, text, name, _core_of(robot))
+    return _calib.Measurements.from_columns(numeric, text, name, _core_of(robot), inputs)

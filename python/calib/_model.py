@@ -15,39 +15,51 @@ from ._measurements import Measurements, _core_of, _pairs
 from ._reports import Compensation, EvalReport, ErrorSummary, FitReport
 
 
-def _measurements(data: Any, robot: Optional[Any] = None) -> Measurements:
-    return data if isinstance(data, Measurements) else Measurements(data, robot=robot)
+def _measurements(
+    data: Any, robot: Optional[Any] = None, inputs: Optional[Sequence[str]] = None
+) -> Measurements:
+    if isinstance(data, Measurements):
+        return data
+    return Measurements(data, robot=robot, inputs=inputs)
 
 
 def fit(
     robot: _calib.Robot,
     data: Union[Measurements, PathLike, Any],
-    method: str = "poe-gp-load",
-    effects: Optional[str] = "auto",
+    method: str,
+    effects: Optional[str] = None,
     gp: Optional[str] = None,
     options: Union[None, PathLike, Mapping[str, Any]] = None,
     force: bool = False,
+    inputs: Optional[Sequence[str]] = None,
 ) -> "Model":
-    """Fits a calibrated model, as ``calib fit`` does.
+    """Fits a calibrated model, as ``calib fit`` does, with the CLI's defaults: the same words give
+    the same fit (``calib.fit(robot, data, method="poe")`` is ``calib fit --method poe``).
 
     Args:
         robot: the robot description (:meth:`Robot.load`).
         data: the training measurements (a :class:`Measurements`, a CSV path, a DataFrame).
-        method: ``base-tool``, ``poe``, ``poe-gp`` or ``poe-gp-load``.
-        effects: non-geometric effects identified with the geometry: ``"auto"`` (what the
-            diagnosis selects), ``"none"`` or ``None`` (the geometry alone), or the CLI's list
-            (``"joint_compliance,gear_periodic:1:4"``). Goes over ``options`` as ``--effects`` does.
+        method: ``base-tool``, ``poe``, ``poe-gp`` or ``poe-gp-load`` (required, as ``--method``).
+        effects: non-geometric effects identified with the geometry, only when asked for, as
+            ``--effects``: ``"auto"`` (what the diagnosis selects), ``"none"`` (the geometry
+            alone), or the CLI's list (``"joint_compliance,gear_periodic:1:4"``); ``None`` (not
+            given) keeps what ``options`` says, no effects by default.
         gp: ``exact``, ``sparse`` or ``auto``; ``None`` keeps what ``options`` says (default auto).
         options: the CLI's ``--options``: a RON file, or a mapping of the same fields
             (``{"identification": {"max_iterations": 100}}``).
         force: fit data that the plausibility checks refuse, with a warning (``--force``).
+        inputs: measured signals the GP takes beside the joints (``--inputs``): column names of
+            ``data`` (``["tilt_x_mrad", "temp_c"]``); a :class:`Measurements` passed as ``data``
+            must have been read with the same ``inputs``. The model then requires those columns
+            in ``eval``, ``predict`` and ``compensate``.
 
     Returns:
         The model; ``model.report`` is the :class:`FitReport` (``calib fit --json``). The model
         is the one its file holds (written and read back, as ``calib fit`` then ``calib eval``
         see it), so that ``eval`` and ``predict`` give the CLI's numbers to the last bit.
     """
-    data = _measurements(data, robot)
+    inputs = None if inputs is None else [str(name) for name in inputs]
+    data = _measurements(data, robot, inputs)
     options_path = options if is_path(options) else None
     options_json = None
     if options is not None and options_path is None:
@@ -56,11 +68,12 @@ def fit(
         robot,
         data._core,
         method,
-        "none" if effects is None else effects,
+        effects,
         gp,
         options_path,
         options_json,
         force,
+        inputs,
     )
     warn_all(warnings)
     return Model(core, FitReport.from_dict(json.loads(report), warnings))
@@ -143,6 +156,7 @@ class Model:
         temp_c: Optional[Any] = None,
         t_s: Optional[Any] = None,
         torques_nm: Optional[Any] = None,
+        inputs: Optional[Mapping[str, Any]] = None,
     ) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         """The compensated tool pose of joint configurations, as ``calib predict`` computes it.
 
@@ -152,6 +166,8 @@ class Model:
             payload: kg, one for all rows or one per row (``poe-gp-load`` models use it).
             tool: the tool identifier, one for all rows or one per row (default: ``""``).
             temp_c, t_s, torques_nm: per row, where the model's effects need them.
+            inputs: the measured signals the model takes (``fit(..., inputs=...)``), by name, one
+                value for all rows or one per row; a model's signal left out is refused by name.
 
         Returns:
             ``(poses, sigma)``. ``poses`` is ``(n, 7)``: ``x_mm, y_mm, z_mm, qw, qx, qy, qz`` in the
@@ -188,6 +204,9 @@ class Model:
             per_row("temp_c", temp_c),
             per_row("t_s", t_s),
             torques,
+            None
+            if inputs is None
+            else [(str(name), per_row(str(name), values)) for name, values in inputs.items()],
         )
         warn_all(warnings)
         return poses, sigma

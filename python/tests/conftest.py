@@ -48,6 +48,21 @@ def cli() -> Cli:
     return Cli(_binary())
 
 
+def untimed(report: dict) -> dict:
+    """A fit report less its `timings`: the wall and CPU seconds of its phases differ between any
+    two runs (and the CLI's add reading and writing files), the rest is equal to the last bit."""
+    assert "timings" in report
+    return {key: value for key, value in report.items() if key != "timings"}
+
+
+@pytest.fixture(scope="session")
+def robot():
+    """The IRB 4400 the campaign is simulated for, as the package loads it."""
+    import calib
+
+    return calib.Robot.load(ROBOT)
+
+
 @pytest.fixture(scope="session")
 def campaign(cli: Cli, tmp_path_factory: pytest.TempPathFactory) -> dict:
     """A full-pose IRB 4400 campaign simulated by the CLI (300 rows, seed 5), split into 200 training

@@ -12,19 +12,7 @@ import numpy as np
 import pytest
 
 import calib
-from conftest import ROBOT
-
-
-@pytest.fixture(scope="module")
-def robot() -> calib.Robot:
-    return calib.Robot.load(ROBOT)
-
-
-def untimed(report: dict) -> dict:
-    """A fit report less its `timings`: the wall and CPU seconds of its phases differ between any
-    two runs (and the CLI's add reading and writing files), the rest is equal to the last bit."""
-    assert "timings" in report
-    return {key: value for key, value in report.items() if key != "timings"}
+from conftest import ROBOT, untimed
 
 
 def test_simulate_writes_the_file_the_cli_writes(cli, robot, tmp_path):

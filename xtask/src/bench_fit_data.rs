@@ -178,6 +178,8 @@ mod tests {
             temp_c: None,
             t_s: None,
             torques_nm: None,
+            inputs: measurements::Inputs::default(),
+            std: None,
         }
     }
 

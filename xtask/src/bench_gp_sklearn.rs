@@ -70,12 +70,14 @@ pub fn fit_predict(
     x_test: &Mat<f64>,
     options: &SklearnOptions,
 ) -> anyhow::Result<Option<SklearnResult>> {
-    fit_predict_with(&python(), x, y, x_test, options)
+    fit_predict_with(&python(), false, x, y, x_test, options)
 }
 
-/// [`fit_predict`] with the interpreter `python`.
+/// [`fit_predict`] with the interpreter `python`; `quiet`: without Python's warnings (scikit-learn's
+/// convergence warnings, one per length scale at its bound).
 pub fn fit_predict_with(
     python: &Path,
+    quiet: bool,
     x: &Mat<f64>,
     y: &Mat<f64>,
     x_test: &Mat<f64>,
@@ -99,7 +101,11 @@ pub fn fit_predict_with(
     let _ = std::fs::remove_file(&response);
     let start = Instant::now();
     // Its own process group, so that a timeout ends the pool's workers with it.
-    let mut child = Command::new(python)
+    let mut command = Command::new(python);
+    if quiet {
+        command.env("PYTHONWARNINGS", "ignore");
+    }
+    let mut child = command
         .process_group(0)
         .arg(&script)
         .arg(&request)

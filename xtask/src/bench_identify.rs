@@ -155,7 +155,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 let dp = Vector3::new(gaussian(&mut rng), gaussian(&mut rng), gaussian(&mut rng)) * SIGMA;
                 let dr = Vector3::new(gaussian(&mut rng), gaussian(&mut rng), gaussian(&mut rng)) * SIGMA;
                 let noisy = SE3::new(lie::SO3::exp(&dr) * pose.rotation(), pose.translation() + dp);
-                Observation { q, tool: 0, target: Target::Pose(noisy) }
+                Observation { q, tool: 0, target: Target::Pose(noisy), stated_sigma: None }
             })
             .collect();
         let start = register(&nominal, &observations)?;

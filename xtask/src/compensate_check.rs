@@ -138,6 +138,7 @@ fn targets(
                 orientation: model.full_pose,
                 payload_kg: *payload_kg,
                 tool: 0,
+                inputs: Default::default(),
             })
         })
         .collect()

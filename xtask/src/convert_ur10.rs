@@ -6,6 +6,7 @@
 //! decimal comma; joints in radians (UR's DH zero), the T-Mac position in millimetres and its
 //! orientation as `rx, ry, rz` in degrees, and the cell temperature.
 
+use crate::ur10_placements::{self, NotPlacements, PlacementOptions, Placements};
 use anyhow::Context;
 use lie::{SO3, Vector3};
 use measurements::{Measurement, MeasurementSet};
@@ -23,6 +24,11 @@ pub struct Dataset {
 }
 
 /// Convert the IPA UR10 dataset (a Leica laser tracker with a T-Mac on a UR10) to SPEC CSV.
+///
+/// The series is checked for the tracker placements it holds first (each row's commanded goal
+/// against its measured point): one placement is written as asked; two are written as
+/// FILE.placement1.csv and FILE.placement2.csv beside --out, with their lines and row counts; rows
+/// neither one nor two placements explain are refused, saying where.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
@@ -85,8 +91,94 @@ fn seconds(stamp: &str) -> Option<f64> {
     Some(part(6, 8)? * 86400.0 + part(8, 10)? * 3600.0 + part(10, 12)? * 60.0 + part(12, 14)?)
 }
 
-/// Reads one series as measurements.
+/// One series as read: its rows, and each row's commanded goal (the planned T-Mac point in the
+/// robot's base frame, mm), which the placement check compares the measured points with.
+pub struct Series {
+    /// The rows.
+    pub set: MeasurementSet,
+    /// Each row's goal, mm.
+    pub goals_mm: Vec<Vector3>,
+}
+
+impl Series {
+    /// The tracker placements the rows hold (module `ur10_placements`).
+    pub fn placements(&self) -> Result<Placements, Box<NotPlacements>> {
+        let measured: Vec<Vector3> = self.set.rows.iter().map(|r| r.position * 1e3).collect();
+        ur10_placements::placements(&self.goals_mm, &measured, &PlacementOptions::default())
+    }
+
+    /// The raw file's line of row `index`.
+    fn line(&self, index: usize) -> u64 {
+        self.set.rows.get(index).map_or(0, |r| r.line)
+    }
+
+    /// What the placement check found, in words; `Err` where it is neither one placement nor two.
+    pub fn placement_text(&self) -> anyhow::Result<(Placements, String)> {
+        let file = &self.set.source;
+        match self.placements() {
+            Ok(Placements::One(fit)) => {
+                let text = format!(
+                    "{file}: one tracker placement: one rigid transform maps the commanded goals onto the measured \
+                     points, RMS {:.2} mm, largest {:.2} mm (line {}); a moved tracker leaves its move, metres",
+                    fit.rms_mm,
+                    fit.max_mm,
+                    self.line(fit.max_row)
+                );
+                Ok((Placements::One(fit), text))
+            }
+            Ok(Placements::Two { first, second, together }) => {
+                let text = format!(
+                    "{file}: two tracker placements: one rigid transform maps the goals onto the measured points only \
+                     to {:.1} mm (line {}); lines {}-{} ({} rows, largest {:.2} mm) and lines {}-{} ({} rows, largest \
+                     {:.2} mm) each by their own",
+                    together.max_mm,
+                    self.line(together.max_row),
+                    self.line(first.rows.0),
+                    self.line(first.rows.1 - 1),
+                    first.rows.1 - first.rows.0,
+                    first.max_mm,
+                    self.line(second.rows.0),
+                    self.line(second.rows.1 - 1),
+                    second.rows.1 - second.rows.0,
+                    second.max_mm
+                );
+                Ok((Placements::Two { first, second, together }, text))
+            }
+            Err(not) => {
+                let NotPlacements { together, best_split } = *not;
+                let split = best_split.map_or(String::new(), |(a, b)| {
+                    format!(
+                        ", and the best split in two (at line {}) still {:.1} mm",
+                        self.line(b.rows.0),
+                        a.max_mm.max(b.max_mm)
+                    )
+                });
+                Err(anyhow::anyhow!(
+                    "{file}: neither one tracker placement nor two: one rigid transform of the commanded goals leaves \
+                     {:.1} mm at line {}{split} (above {} mm): the series needs a look by hand",
+                    together.max_mm,
+                    self.line(together.max_row),
+                    PlacementOptions::default().max_residual_mm
+                ))
+            }
+        }
+    }
+}
+
+/// Reads one series as measurements; a series of more than one tracker placement is refused
+/// (`cargo xtask convert-ur10` writes each placement to its own file).
 pub fn read_series(input: &Path, series: &str, full_pose: bool) -> anyhow::Result<MeasurementSet> {
+    let read = read_with_goals(input, series, full_pose)?;
+    match read.placement_text()? {
+        (Placements::One(_), _) => Ok(read.set),
+        (Placements::Two { .. }, text) => Err(anyhow::anyhow!(
+            "{text}: convert it with `cargo xtask convert-ur10`, which writes each to its own file"
+        )),
+    }
+}
+
+/// Reads one series with each row's commanded goal.
+pub fn read_with_goals(input: &Path, series: &str, full_pose: bool) -> anyhow::Result<Series> {
     let relative = SERIES
         .iter()
         .find(|(name, _)| name.eq_ignore_ascii_case(series))
@@ -108,8 +200,14 @@ pub fn read_series(input: &Path, series: &str, full_pose: bool) -> anyhow::Resul
     let position = [column("measurement_x")?, column("measurement_y")?, column("measurement_z")?];
     let angles = [column("measurement_rx")?, column("measurement_ry")?, column("measurement_rz")?];
     let temperature = column("measurement_temperature")?;
+    // The tracker's stated standard deviation of every row (issue 46): mm, and degrees of the
+    // three angles, kept as std_x_mm … and std_rx_mrad ….
+    let position_std = [column("measurement_std_x")?, column("measurement_std_y")?, column("measurement_std_z")?];
+    let angle_std = [column("measurement_std_rx")?, column("measurement_std_ry")?, column("measurement_std_rz")?];
     let stamp = column("Timestamp")?;
+    let goal = [column("Goal x")?, column("Goal y")?, column("Goal z")?];
     let mut rows = Vec::new();
+    let mut goals_mm = Vec::new();
     for (index, raw) in lines.enumerate() {
         let line = index + 2;
         if raw.trim().is_empty() {
@@ -120,6 +218,8 @@ pub fn read_series(input: &Path, series: &str, full_pose: bool) -> anyhow::Resul
             |c: usize| -> anyhow::Result<f64> { number(cells.get(c).copied().unwrap_or(""), &file, line, c + 1) };
         let q = joints.iter().map(|&c| cell(c)).collect::<Result<Vec<_>, _>>()?;
         let p = Vector3::new(cell(position[0])?, cell(position[1])?, cell(position[2])?) * 1e-3;
+        // The goal in metres, as the planner wrote it.
+        goals_mm.push(Vector3::new(cell(goal[0])?, cell(goal[1])?, cell(goal[2])?) * 1e3);
         let orientation =
             if full_pose { Some(rotation(cell(angles[0])?, cell(angles[1])?, cell(angles[2])?)) } else { None };
         rows.push(Measurement {
@@ -132,6 +232,19 @@ pub fn read_series(input: &Path, series: &str, full_pose: bool) -> anyhow::Resul
             temp_c: Some(cell(temperature)?),
             t_s: cells.get(stamp).and_then(|s| seconds(s)),
             torques_nm: None,
+            inputs: measurements::Inputs::default(),
+            std: Some(measurements::StatedSigma {
+                position_m: Some([
+                    cell(position_std[0])? * 1e-3,
+                    cell(position_std[1])? * 1e-3,
+                    cell(position_std[2])? * 1e-3,
+                ]),
+                rotation_rad: Some([
+                    cell(angle_std[0])?.to_radians(),
+                    cell(angle_std[1])?.to_radians(),
+                    cell(angle_std[2])?.to_radians(),
+                ]),
+            }),
         });
     }
     // A time column only when every stamp survived.
@@ -140,7 +253,7 @@ pub fn read_series(input: &Path, series: &str, full_pose: bool) -> anyhow::Resul
     } else if let Some(t0) = rows.first().and_then(|r| r.t_s) {
         rows.iter_mut().for_each(|r| r.t_s = r.t_s.map(|t| t - t0));
     }
-    Ok(MeasurementSet::from_rows(&file.display().to_string(), rows, vec![]))
+    Ok(Series { set: MeasurementSet::from_rows(&file.display().to_string(), rows, vec![]), goals_mm })
 }
 
 fn write(set: &MeasurementSet, path: &Path) -> anyhow::Result<()> {
@@ -150,8 +263,31 @@ fn write(set: &MeasurementSet, path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// `path` with `.placement{k}` before its extension: `D.csv` → `D.placement1.csv`.
+fn placement_path(path: &Path, k: usize) -> PathBuf {
+    let stem = path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let extension = path.extension().map_or_else(String::new, |e| format!(".{}", e.to_string_lossy()));
+    path.with_file_name(format!("{stem}.placement{k}{extension}"))
+}
+
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let set = read_series(&args.dataset.input, &args.dataset.series, args.full_pose)?;
+    let read = read_with_goals(&args.dataset.input, &args.dataset.series, args.full_pose)?;
+    let (placements, text) = read.placement_text()?;
+    println!("{text}");
+    let set = read.set;
+    if let Placements::Two { first, second, .. } = placements {
+        // Each placement its own file: one set of rows is one tracker frame.
+        let Some(out) = &args.out else {
+            return Err(anyhow::anyhow!(
+                "two tracker placements: --train/--test would mix their frames; give --out FILE (FILE.placement1.csv \
+                 and FILE.placement2.csv are written)"
+            ));
+        };
+        for (k, part) in [first, second].iter().enumerate() {
+            write(&set.subset(&(part.rows.0..part.rows.1).collect::<Vec<_>>()), &placement_path(out, k + 1))?;
+        }
+        return Ok(());
+    }
     match (&args.out, &args.train, &args.test) {
         (Some(out), _, _) => write(&set, out),
         (None, Some(train), Some(test)) => {

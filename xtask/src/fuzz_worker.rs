@@ -124,7 +124,7 @@ impl Bench {
                     Ok(columns) => columns.unwrap_or_default(),
                     Err(e) => return Ok(refused(e.to_string())),
                 };
-                let options = ReadOptions { joints: seed.joints.clone(), columns };
+                let options = ReadOptions { joints: seed.joints.clone(), columns, ..ReadOptions::default() };
                 match measurements::read_measurements(&path, &options) {
                     Err(e) => refused(e.to_string()),
                     Ok(set) => check_rows(&set.rows),

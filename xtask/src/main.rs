@@ -28,6 +28,7 @@ mod fuzz_inputs;
 mod fuzz_seeds;
 mod fuzz_worker;
 mod hostile;
+mod inputs_check;
 mod long_tests;
 mod msrv;
 mod report_browser_check;
@@ -36,6 +37,7 @@ mod reproduce_sim_params;
 mod reproduce_sim_report;
 mod simulation;
 mod ur10;
+mod ur10_placements;
 mod urdf_check;
 
 use clap::{Parser, Subcommand};
@@ -81,6 +83,8 @@ enum Command {
     Deps(deps::Args),
     /// The long tests kept out of CI (`#[ignore]`d, each standing beside a short one): `cargo test --workspace -- --ignored`.
     LongTests(long_tests::Args),
+    /// Issue 46: measured signals (a base's tilt, a temperature) as GP inputs on simulated days; print a table.
+    InputsCheck(inputs_check::Args),
     /// Issue 26: `calib register` and `calib plan` on the real UR10 and simulated truth; print a table.
     CellCheck(cell_check::Args),
     /// Render calibration reports in headless Chromium: a screenshot each, fail on console messages (not in CI).
@@ -106,6 +110,7 @@ fn main() -> ExitCode {
         Command::ConvertUr10(args) => convert_ur10::run(args).map_err(|e| format!("{e:#}")),
         Command::BlindCheck(args) => blind_check::run(args).map_err(|e| format!("{e:#}")),
         Command::Ur10(args) => ur10::run(args).map_err(|e| format!("{e:#}")),
+        Command::InputsCheck(args) => inputs_check::run(args).map_err(|e| format!("{e:#}")),
         Command::CellCheck(args) => cell_check::run(args).map_err(|e| format!("{e:#}")),
         Command::UrdfCheck(args) => urdf_check::run(args).map_err(|e| format!("{e:#}")),
         Command::CompensateCheck(args) => compensate_check::run(args).map_err(|e| format!("{e:#}")),

@@ -1,6 +1,6 @@
 //! `calib eval`: the errors of a calibrated model on measurements.
 
-use measurements::{ColumnMap, ReadOptions};
+use measurements::ColumnMap;
 use model::EvalReport;
 use std::path::PathBuf;
 
@@ -23,7 +23,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let model = model::read_model(&args.model)?;
-    let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
+    let options = model.read_options(args.columns.clone().unwrap_or_default());
     let data = measurements::read_measurements(&args.data, &options)?;
     // Angles a turn away from the fitted range are taken into it, as `calib register` does.
     let (rows, wrapped) = model::wrapped(&model, &data.rows);
@@ -44,6 +44,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         }
         if report.orientations_not_evaluated {
             eprintln!("note: {}", model::ORIENTATIONS_NOT_EVALUATED);
+        }
+        if let Some(placement) = &report.other_placement {
+            eprintln!("warning: {}", placement_text(placement, args));
         }
         for warning in &report.warnings {
             eprintln!("warning: {warning}");
@@ -91,6 +94,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     };
     print_split(report.coverage.as_ref(), covered);
     print_split(report.range_split.as_ref(), "the range the model was fitted on");
+    if let Some(placement) = &report.other_placement {
+        println!("  warning: {}", placement_text(placement, args));
+    }
     if let Some(suspects) = &report.suspect_rows {
         println!("  warning: {}", suspect_text(suspects));
     }
@@ -113,6 +119,11 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         println!("  warning: {faded}");
     }
     Ok(())
+}
+
+/// The warning about another tracker placement, with this model's file in the command it names.
+fn placement_text(placement: &model::OtherPlacement, args: &Args) -> String {
+    placement.to_string().replace("--model MODEL", &format!("--model {}", args.model.display()))
 }
 
 /// The warning about rows far beyond the others, with what the others give.

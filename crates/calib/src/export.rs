@@ -1,8 +1,7 @@
 //! `calib export`: the calibrated geometry as a URDF for controllers, planners and simulators.
 
 use cell::UrdfTemplate;
-use measurements::ReadOptions;
-use robot::{ChainEnds, NominalTolerance, RobotDescription, UrdfDocument};
+use robot::{NominalTolerance, UrdfDocument};
 use std::path::PathBuf;
 
 /// Write a calibrated model's geometry as a URDF.
@@ -10,7 +9,10 @@ use std::path::PathBuf;
 /// The URDF is in the robot's base frame (joint 1 where the nominal description puts it, as
 /// calibrated), with a fixed `tracker` link at the tracker frame and a fixed link per calibrated
 /// tool. What a URDF cannot hold (joint compliance, the GP) is reported with the error the model
-/// makes without it on the training data (--data).
+/// makes without it on the training data (--data). The base frame and the limits come from the
+/// nominal description: --like's URDF, else --robot, else the one the model keeps; a model written
+/// before it kept its robot and given neither has its base at the calibrated joint 1 frame and its
+/// revolute joints written as continuous.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Calibrated model (RON, from `calib fit`).
@@ -20,21 +22,16 @@ pub struct Args {
     #[arg(long)]
     urdf: PathBuf,
     /// Write into this URDF (of the robot the model was fitted with): its links, inertias, visuals
-    /// and limits are kept, the movable joints' origins become the calibrated ones.
+    /// and limits are kept, the movable joints' origins become the calibrated ones (--base-link
+    /// and --tip-link choose its chain).
     #[arg(long, conflicts_with = "robot")]
     like: Option<PathBuf>,
-    /// The nominal robot description the model was fitted with (RON or URDF): places the base
-    /// frame and gives the limits [default: the --like URDF, else the description the model keeps;
-    /// without any, the base is the calibrated joint 1 frame and revolute joints are written as
-    /// continuous].
-    #[arg(long)]
-    robot: Option<PathBuf>,
-    /// URDF only: the chain's base link in --like or --robot.
-    #[arg(long)]
-    base_link: Option<String>,
-    /// URDF only: the chain's tip link in --like or --robot.
-    #[arg(long)]
-    tip_link: Option<String>,
+    // The nominal robot description places the base frame and gives the limits: --like's URDF,
+    // else --robot, else the one the model keeps (the group compensate and report take); without
+    // any (a model written before it kept its robot), the base is the calibrated joint 1 frame and
+    // revolute joints are written as continuous (the command's help says so).
+    #[command(flatten)]
+    robot: crate::robot_args::KeptRobotArgs,
     /// The training data (SPEC CSV): the error with and without what a URDF cannot hold. Required
     /// for a model with joint compliance or a GP.
     #[arg(long)]
@@ -49,20 +46,19 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     measurements::InputFiles::new()
         .with("--model", &args.model)
         .with_optional("--like", args.like.as_deref())
-        .with_optional("--robot", args.robot.as_deref())
+        .with_optional("--robot", args.robot.robot.as_deref())
         .with_optional("--data", args.data.as_deref())
         .check_output("--urdf", &args.urdf)?;
     let model = model::read_model(&args.model)?;
-    let ends = ChainEnds { base_link: args.base_link.clone(), tip_link: args.tip_link.clone() };
     let training = match &args.data {
-        Some(path) => Some(measurements::read_measurements(path, &ReadOptions::for_joints(model.joint_kinds()))?),
+        Some(path) => Some(measurements::read_measurements(path, &model.read_options(Default::default()))?),
         None => None,
     };
     let tolerance = NominalTolerance::default();
-    let export = match (&args.like, &args.robot) {
-        (Some(like), _) => {
+    let export = match &args.like {
+        Some(like) => {
             let document = UrdfDocument::read(like)?;
-            let chain = document.chain(&ends)?;
+            let chain = document.chain(&args.robot.ends())?;
             cell::export_urdf(
                 &model,
                 UrdfTemplate::Like { document: &document, chain: &chain },
@@ -70,21 +66,10 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
                 &tolerance,
             )?
         }
-        (None, Some(robot)) => {
-            let description = RobotDescription::read_with(robot, &ends)?;
-            let file = robot.display().to_string();
-            let template = UrdfTemplate::Plain { nominal: Some((&description, &file)) };
-            cell::export_urdf(&model, template, training.as_ref(), &tolerance)?
-        }
-        (None, None) => {
-            if ends != ChainEnds::default() {
-                return Err(
-                    "--base-link and --tip-link choose the chain of --like or --robot, and neither is given".into()
-                );
-            }
-            let kept = model.robot_description.clone();
-            let file = format!("{} (as the model keeps it)", args.model.display());
-            let nominal = kept.as_ref().map(|description| (description, file.as_str()));
+        // --robot, else the robot the model keeps, as compensate and report take it.
+        None => {
+            let nominal = args.robot.read_or_kept(&model, &args.model)?;
+            let nominal = nominal.as_ref().map(|(description, file)| (description, file.as_str()));
             cell::export_urdf(&model, UrdfTemplate::Plain { nominal }, training.as_ref(), &tolerance)?
         }
     };

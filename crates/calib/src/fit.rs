@@ -21,6 +21,12 @@ pub struct Args {
     /// Calibration method: base-tool, poe, poe-gp or poe-gp-load.
     #[arg(long)]
     method: Method,
+    /// Measured signals the GP takes as inputs beside the joints (and the payload for
+    /// poe-gp-load): numeric columns of --data by name (after --columns), e.g.
+    /// tilt_x_mrad,motor2_temp_c. The model keeps each name, unit (from the name's suffix) and the
+    /// span it was fitted on; eval, predict, compensate and report then require those columns.
+    #[arg(long, value_name = "NAME[,NAME…]")]
+    inputs: Option<measurements::InputNames>,
     /// Where to write the calibrated model (RON).
     #[arg(long)]
     out: PathBuf,
@@ -83,14 +89,20 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
+/// The columns read as inputs: those of `--inputs`.
+fn input_names(args: &Args) -> Vec<String> {
+    args.inputs.as_ref().map(|names| names.names().to_vec()).unwrap_or_default()
+}
+
 type Fitted = (robot::RobotDescription, measurements::MeasurementSet, model::CalibratedModel, FitReport);
 
 /// The command's work, in the phases its report times: reading, the fit, writing the model.
 fn fit_and_write(args: &Args) -> Result<Fitted, Box<dyn std::error::Error>> {
     let (robot, data) = timings::phase("read", || -> Result<_, Box<dyn std::error::Error>> {
         let robot = args.robot.read()?;
-        let options =
-            ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
+        let options = ReadOptions::for_joints(robot.joint_kinds())
+            .with_columns(args.columns.clone().unwrap_or_default())
+            .with_inputs(input_names(args));
         let data = measurements::read_measurements(&args.data, &options)?;
         Ok((robot, data))
     })?;
@@ -110,6 +122,16 @@ fn fit_and_write(args: &Args) -> Result<Fitted, Box<dyn std::error::Error>> {
     }
     if let Some(choice) = args.gp {
         options.residual_gp.method = choice;
+    }
+    if let Some(inputs) = &args.inputs {
+        if !args.method.uses_gp() {
+            return Err(format!(
+                "--inputs: the inputs are the GP's: method {} has no GP (poe-gp, poe-gp-load)",
+                args.method
+            )
+            .into());
+        }
+        options.residual_gp.inputs = inputs.names().to_vec();
     }
     let (model, report) = timings::phase("fit", || pipeline::fit(&robot, &data, args.method, &options))?;
     timings::phase("write", || model::write_model(&args.out, &model))?;
@@ -160,6 +182,18 @@ fn summarise(
         "  identifiable: {} of {} free parameters, condition number {:.3e}",
         id.rank, id.free_parameters, id.condition_number
     );
+    if let Some(stated) = &id.stated_noise {
+        let mm = stated.median_position_m.map_or("–".to_owned(), |m| format!("{:.4} mm", m * 1e3));
+        let mrad = stated.median_rotation_rad.map_or(String::new(), |m| format!(", {:.4} mrad", m * 1e3));
+        let excess_mrad = stated.excess_rotation_rad.map_or(String::new(), |t| format!(", {:.4} mrad", t * 1e3));
+        let _ = writeln!(
+            out,
+            "  rows weighted by the tracker's stated uncertainty ({} of {rows} rows state one; median {mm}{mrad}; \
+             residual scatter beyond it {:.4} mm{excess_mrad} per axis)",
+            stated.stated,
+            stated.excess_position_m * 1e3
+        );
+    }
     if let Some(prior) = &report.nominal_prior {
         let _ = writeln!(out, "  {prior}");
     }
@@ -270,6 +304,10 @@ fn summarise(
             "  GP: {}, {kernels} kernel(s), hyperparameter search met its tolerance for {converged} of {kernels}{additive}{isotropic}",
             residual_gp.gp.choice()
         );
+        if !gp.inputs.is_empty() {
+            let spans: Vec<String> = gp.inputs.iter().map(ToString::to_string).collect();
+            let _ = writeln!(out, "  GP inputs beside the joints, with the spans fitted on: {}", spans.join("; "));
+        }
     }
     for direction in &id.unidentifiable {
         let _ = writeln!(out, "    unidentifiable: {direction}");

@@ -19,7 +19,14 @@ use std::process::ExitCode;
 
 /// Make industrial robots accurate: fit, evaluate and diagnose kinematic calibrations.
 #[derive(Debug, Parser)]
-#[command(name = "calib", version, about, arg_required_else_help = true)]
+#[command(
+    name = "calib",
+    version,
+    about,
+    arg_required_else_help = true,
+    after_help = "The formats (measurement CSV, robot RON and URDF, model file, the CSV and JSON the commands print) \
+                  are those of docs/SPEC.md, version 3."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

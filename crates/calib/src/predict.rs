@@ -20,8 +20,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let model = model::read_model(&args.model)?;
-    let options = measurements::ReadOptions::for_joints(model.joint_kinds())
-        .with_columns(args.columns.clone().unwrap_or_default());
+    let options = model.read_options(args.columns.clone().unwrap_or_default());
     let read = measurements::read_configurations(&args.data, &options)?;
     // Angles a turn away from the fitted range are taken into it, as `calib register` does; the
     // CSV's columns are the same, the note on stderr says which rows.

@@ -1,7 +1,7 @@
 //! `calib register`: a calibrated model carried to a moved tracker or new tools from a few poses
 //! (crate `cell`).
 
-use measurements::{ColumnMap, ReadOptions};
+use measurements::ColumnMap;
 use std::path::PathBuf;
 
 /// Re-fit the tracker-to-base transform and/or the tools from a few poses, everything else held.
@@ -41,7 +41,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         .with("--data", &args.data)
         .check_output("--out", &args.out)?;
     let model = model::read_model(&args.model)?;
-    let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
+    let options = model.read_options(args.columns.clone().unwrap_or_default());
     let data = measurements::read_measurements(&args.data, &options)?;
     let register = cell::RegisterOptions { changed_ratio: args.changed_ratio, ..cell::RegisterOptions::default() };
     let registered = cell::register(&model, &data, args.refit, args.heldout_mm, &register)?;

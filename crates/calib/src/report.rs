@@ -1,7 +1,7 @@
 //! `calib report`: one self-contained HTML page on a calibrated model and test data.
 
 use diagnose::{DiagnoseOptions, diagnose};
-use measurements::{ColumnMap, ReadOptions};
+use measurements::ColumnMap;
 use std::path::PathBuf;
 
 /// Write a calibration report: one HTML file with the errors before and after, ISO 9283 AP/RP,
@@ -45,7 +45,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         )
         .into());
     };
-    let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
+    let options = model.read_options(args.columns.clone().unwrap_or_default());
     let data = measurements::read_measurements(&args.data, &options)?;
     let evaluation = model::evaluate(&model, &model.bind(&data)?)?;
     let finite = |e: &model::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);

@@ -112,14 +112,25 @@ fn register_carries_a_model_to_a_moved_tracker() {
     assert!(stdout.contains("\"verdict\":\"consistent\""), "{stdout}");
     assert!((json_number(&stdout, "angle_deg") - 90.0).abs() < 0.05, "{stdout}");
     let eval = |model: &Path, data: &Path| {
-        let (json, _) = succeeds_with_stderr(&["eval", "--model", &text(model), "--data", &text(data), "--json"]);
-        json_number(&json, "mean_position_error_mm")
+        succeeds_with_stderr(&["eval", "--model", &text(model), "--data", &text(data), "--json"])
     };
-    let before = eval(&model, &original_rest);
-    let after = eval(&out, &rest);
+    let (before_json, _) = eval(&model, &original_rest);
+    let (after_json, _) = eval(&out, &rest);
+    let (before, after) =
+        (json_number(&before_json, "mean_position_error_mm"), json_number(&after_json, "mean_position_error_mm"));
     assert!(after < 1.2 * before, "registered {after} mm against the original's {before} mm");
-    // The model as it was cannot be used on the moved data.
-    assert!(eval(&model, &rest) > 1000.0);
+    // Neither is said to be from another placement.
+    for json in [&before_json, &after_json] {
+        assert!(!json.contains("other_placement"), "{json}");
+    }
+    // The model as it was cannot be used on the moved data, and eval says why (issue 48): one
+    // rigid motion leaves what the model leaves on the unmoved rows, and `calib register` is named.
+    let (moved_json, stderr) = eval(&model, &rest);
+    assert!(json_number(&moved_json, "mean_position_error_mm") > 1000.0);
+    let remaining =
+        json_number(&moved_json[moved_json.find("\"other_placement\"").unwrap()..], "mean_position_error_mm");
+    assert!(remaining < 1.2 * before, "{remaining} mm after the rigid motion, {before} mm unmoved: {moved_json}");
+    assert!(stderr.contains("another tracker placement") && stderr.contains("calib register --model"), "{stderr}");
 }
 
 #[test]

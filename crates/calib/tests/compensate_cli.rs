@@ -76,12 +76,13 @@ fn a_program_comes_out_compensated_with_its_columns_and_residuals() {
         lines.next(),
         Some(
             "q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad,nominal_q1_rad,nominal_q2_rad,nominal_q3_rad,nominal_q4_rad,\
-             nominal_q5_rad,nominal_q6_rad,payload_kg,label,residual_mm,residual_mrad,status"
+             nominal_q5_rad,nominal_q6_rad,payload_kg,label,residual_mm,residual_mrad,status,line"
         )
     );
-    for (line, label) in lines.zip(["p1", "p2"]) {
+    for ((line, label), file_line) in lines.zip(["p1", "p2"]).zip(["2", "3"]) {
         let cells: Vec<&str> = line.split(',').collect();
-        assert_eq!(cells.len(), 17, "{line}");
+        assert_eq!(cells.len(), 18, "{line}");
+        assert_eq!(cells[17], file_line, "{line}");
         assert_eq!((cells[13], cells[16]), (label, "ok"), "{line}");
         assert!(cells[14].parse::<f64>().unwrap() < 1e-6, "{line}");
         assert!(cells[0].parse::<f64>().is_ok(), "{line}");

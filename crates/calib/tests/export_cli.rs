@@ -104,11 +104,25 @@ fn export_refusals_are_one_line() {
     let (_, model) = fitted(dir.path(), "poe");
     let urdf = text(&dir.path().join("out.urdf"));
     let message = fails(&["export", "--model", &text(&model), "--urdf", &urdf, "--base-link", "base"]);
-    assert!(message.contains("neither is given"), "{message}");
+    // The shared robot group's refusal, as compensate and report give it.
+    assert!(message.contains("--base-link and --tip-link need --robot"), "{message}");
     let message = fails(&["export", "--model", &text(&model), "--urdf", &urdf, "--like", &fixture("ur10.urdf")]);
     assert!(message.contains("ur10.urdf: joint"), "{message}");
     let message = fails(&["export", "--model", &text(&model), "--urdf", &urdf, "--robot", &fixture("iiwa7.ron")]);
     assert!(message.contains("the robot has 7 joints, the model 6"), "{message}");
     let help = succeeds(&["export", "--help"]);
     assert!(help.contains("--like"), "{help}");
+    // --robot, --base-link and --tip-link are the group compensate and report take (issue 48).
+    for command in ["compensate", "report"] {
+        let other = succeeds(&[command, "--help"]);
+        for flag in ["--robot <ROBOT>", "--base-link <BASE_LINK>", "--tip-link <TIP_LINK>"] {
+            // The flag's description, whichever layout clap chose for the help.
+            let block = |help: &str| {
+                let after = help.split(flag).nth(1).unwrap_or_default();
+                let lines = after.lines().take_while(|l| !l.trim_start().starts_with('-'));
+                lines.flat_map(str::split_whitespace).collect::<Vec<_>>().join(" ")
+            };
+            assert_eq!(block(&help), block(&other), "{flag} in export and {command}");
+        }
+    }
 }

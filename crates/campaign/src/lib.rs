@@ -257,6 +257,8 @@ fn measurement(i: usize, s: Sample, used: &[usize], full_pose: bool) -> Measurem
         temp_c: Some(s.temp_c),
         t_s: Some(s.t_s),
         torques_nm: s.torques_nm,
+        inputs: measurements::Inputs::default(),
+        std: None,
     }
 }
 
@@ -324,6 +326,8 @@ pub fn simulate_to_csv<W: std::io::Write>(
         temp_c: true,
         t_s: true,
         torques: if config.torque_sensor.is_some() { cell.robot.joint_count() } else { 0 },
+        inputs: Vec::new(),
+        stated_std: [false; 2],
     };
     let io = |source: std::io::Error| Error::io(path.to_owned(), source);
     let mut out = measurements::MeasurementWriter::new(writer, columns).map_err(io)?;

@@ -74,6 +74,9 @@ pub struct PoseTarget {
     pub payload_kg: f64,
     /// The model's tool index.
     pub tool: usize,
+    /// The measured signals the model takes as inputs, as the target's row gives them (empty for
+    /// a model that takes none).
+    pub inputs: measurements::Inputs,
 }
 
 /// Why a row was not compensated.
@@ -221,6 +224,8 @@ pub fn solve_targets(
         temp_c: None,
         t_s: None,
         torques_nm: None,
+        inputs: targets[i].inputs.clone(),
+        std: None,
     };
     loop {
         // Made here from the targets, each row on its target's model tool.

@@ -16,7 +16,7 @@
 use crate::inverse::{InverseOptions, PoseTarget, Solved, TargetStatus, solve_targets};
 use errors::{Error, ErrorKind};
 use lie::{SE3, SO3};
-use measurements::{BoundSet, Cells, ColumnMap, MeasurementSet, ReadOptions};
+use measurements::{BoundSet, Cells, ColumnMap, MeasurementSet};
 use model::CalibratedModel;
 use poe::LocalPoe;
 use poe::identify::{IdentificationOptions, Observation, Scope, Target};
@@ -96,7 +96,7 @@ impl TargetFile {
 /// positions and orientations. An orientation is refused without a position, or where the model
 /// was fitted on positions only (its orientation is not calibrated).
 pub fn read_targets(path: &Path, model: &CalibratedModel, columns: ColumnMap) -> Result<TargetFile, Error> {
-    let options = ReadOptions::for_joints(model.joint_kinds()).with_columns(columns);
+    let options = model.read_options(columns);
     let (set, cells) = measurements::read_configurations_with_cells(path, &options)?;
     if set.full_pose && !(set.positions_measured && model.full_pose) {
         let names = ["qw", "rx_deg", "rx_rad"];
@@ -150,7 +150,7 @@ pub fn registered_nominal(
         for tool in 0..model.kinematics.tool_count() {
             let pose = model.kinematics.forward(q, tool).map_err(Error::kinematics)?;
             let target = if model.full_pose { Target::Pose(pose) } else { Target::Point(pose.translation()) };
-            observations.push(Observation { q: q.clone(), tool, target });
+            observations.push(Observation { q: q.clone(), tool, target, stated_sigma: None });
         }
     }
     let fitted = poe::identify::calibrate(&nominal, &observations, Scope::BaseTool, &IdentificationOptions::default())
@@ -232,6 +232,7 @@ fn targets_of(
                     orientation: model.full_pose,
                     payload_kg: row.payload_kg,
                     tool,
+                    inputs: row.inputs.clone(),
                 })
             })
             .collect::<Result<_, Error>>()?;
@@ -255,6 +256,7 @@ fn targets_of(
             orientation: row.orientation.is_some(),
             payload_kg: row.payload_kg,
             tool,
+            inputs: row.inputs.clone(),
         })
         .collect();
     Ok((targets, None))
@@ -317,9 +319,10 @@ pub fn write_compensated<W: Write>(writer: W, file: &TargetFile, solved: &[Solve
             .enumerate()
             .map(|(i, name)| if joint_columns.contains(&i) { format!("nominal_{name}") } else { name.clone() }),
     );
-    header.extend(["residual_mm", "residual_mrad", "status"].map(String::from));
+    // Each row's line in the targets file (issue 48), last: version 2's columns keep their places.
+    header.extend(["residual_mm", "residual_mrad", "status", "line"].map(String::from));
     out.write_record(&header)?;
-    for (cells, solved) in file.cells.rows.iter().zip(solved) {
+    for ((cells, solved), row) in file.cells.rows.iter().zip(solved).zip(&file.set.rows) {
         let mut record: Vec<String> = if solved.status.is_ok() {
             solved.q.iter().map(|v| format!("{v:?}")).collect()
         } else {
@@ -329,6 +332,7 @@ pub fn write_compensated<W: Write>(writer: W, file: &TargetFile, solved: &[Solve
         record.push(format!("{:.6}", solved.residual_m * 1e3));
         record.push(solved.residual_rad.map_or(String::new(), |r| format!("{:.6}", r * 1e3)));
         record.push(solved.status.to_string());
+        record.push(row.line.to_string());
         out.write_record(&record)?;
     }
     out.flush()

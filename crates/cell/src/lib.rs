@@ -45,6 +45,7 @@
 //!         orientation: true,
 //!         payload_kg: 0.0,
 //!         tool: 0,
+//!         inputs: Default::default(),
 //!     })
 //!     .collect();
 //! let solved = cell::solve_targets(&model, &targets, None, &cell::InverseOptions::default())?;

@@ -26,6 +26,7 @@ use effects::{AngleCoverage, GearOptions, IdentifiedEffect};
 use errors::Error;
 use lie::Vector6;
 use measurements::MeasurementSet;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// The held-out error when arcs of one joint's angles are left out.
@@ -93,75 +94,77 @@ pub(crate) fn arc_checks(
     let kinematic = inputs.design.kinematic.ncols();
     let width: usize = owned.iter().map(|(c, _)| c.len()).sum();
     let all: Vec<usize> = (0..kinematic + width).collect();
-    let mut out = Vec::with_capacity(moving.len());
-    for &joint in moving {
-        let fold = arc_folds(data, joint, inputs.folds);
-        let pool =
-            Pool::single_folds(inputs.design, inputs.kinematic_prior, &blocks, &fold, inputs.folds, inputs.prior);
-        let mut before = Vec::with_capacity(data.rows.len());
-        let mut after = Vec::with_capacity(data.rows.len());
-        let mut folds = Vec::with_capacity(inputs.folds);
-        for f in 0..inputs.folds {
-            let poses = pool.fold_poses(f);
-            if poses.is_empty() {
-                continue;
-            }
-            let base = pool.solve(&[f], &all[..kinematic])?;
-            let full = if width == 0 { base.clone() } else { pool.solve(&[f], &all)? };
-            let betas = [base, full];
-            let residuals = pool.residuals(f, &all, &betas);
-            // Each series' coverage as its fit on this fold's training rows records it.
-            let coverage: Vec<AngleCoverage> = series
-                .iter()
-                .flatten()
-                .map(|&(j, h)| {
-                    let angles: Vec<f64> = (0..data.rows.len())
-                        .filter(|&i| fold[i] != f)
-                        .filter_map(|i| data.rows[i].q.get(j).copied())
-                        .collect();
-                    AngleCoverage::of(j, &(1..=h).collect::<Vec<u32>>(), &angles, inputs.gear)
-                })
-                .collect();
-            // The training rows, blended as this fold's model blends them: each series by the
-            // coverage of its own fit's angles.
-            let mut fold_residuals = vec![Vector6::zeros(); data.rows.len()];
-            let mut alone = vec![(Vector6::zeros(), 1.0); data.rows.len()];
-            for g in (0..inputs.folds).filter(|&g| g != f) {
-                let fitted = pool.residuals(g, &all, &betas);
-                for ((&i, b), a) in pool.fold_poses(g).iter().zip(&fitted[0]).zip(&fitted[1]) {
-                    let w: f64 = coverage.iter().map(|s| s.held_and_weight(data.rows[i].q[s.joint]).1).product();
-                    fold_residuals[i] = a * w + b * (1.0 - w);
+    // Each joint's arcs on their own pool, side by side, collected in the joints' order.
+    moving
+        .par_iter()
+        .map(|&joint| -> Result<(ArcCheck, Vec<FoldResiduals>), Error> {
+            let fold = arc_folds(data, joint, inputs.folds);
+            let pool =
+                Pool::single_folds(inputs.design, inputs.kinematic_prior, &blocks, &fold, inputs.folds, inputs.prior);
+            let mut before = Vec::with_capacity(data.rows.len());
+            let mut after = Vec::with_capacity(data.rows.len());
+            let mut folds = Vec::with_capacity(inputs.folds);
+            for f in 0..inputs.folds {
+                let poses = pool.fold_poses(f);
+                if poses.is_empty() {
+                    continue;
+                }
+                let base = pool.solve(&[f], &all[..kinematic])?;
+                let full = if width == 0 { base.clone() } else { pool.solve(&[f], &all)? };
+                let betas = [base, full];
+                let residuals = pool.residuals(f, &all, &betas);
+                // Each series' coverage as its fit on this fold's training rows records it.
+                let coverage: Vec<AngleCoverage> = series
+                    .iter()
+                    .flatten()
+                    .map(|&(j, h)| {
+                        let angles: Vec<f64> = (0..data.rows.len())
+                            .filter(|&i| fold[i] != f)
+                            .filter_map(|i| data.rows[i].q.get(j).copied())
+                            .collect();
+                        AngleCoverage::of(j, &(1..=h).collect::<Vec<u32>>(), &angles, inputs.gear)
+                    })
+                    .collect();
+                // The training rows, blended as this fold's model blends them: each series by the
+                // coverage of its own fit's angles.
+                let mut fold_residuals = vec![Vector6::zeros(); data.rows.len()];
+                let mut alone = vec![(Vector6::zeros(), 1.0); data.rows.len()];
+                for g in (0..inputs.folds).filter(|&g| g != f) {
+                    let fitted = pool.residuals(g, &all, &betas);
+                    for ((&i, b), a) in pool.fold_poses(g).iter().zip(&fitted[0]).zip(&fitted[1]) {
+                        let w: f64 = coverage.iter().map(|s| s.held_and_weight(data.rows[i].q[s.joint]).1).product();
+                        fold_residuals[i] = a * w + b * (1.0 - w);
+                        alone[i] = (*b, w);
+                    }
+                }
+                for ((&i, b), a) in poses.iter().zip(&residuals[0]).zip(&residuals[1]) {
+                    // A held-out arc of the joint's own angles is where its series knows nothing:
+                    // faded whole, whatever the width of the arc (the model fades it in a gap wider
+                    // than half its shortest period; an arc of a fifth of the rows may be narrower).
+                    let w: f64 = coverage
+                        .iter()
+                        .map(|g| if g.joint == joint { 0.0 } else { g.held_and_weight(data.rows[i].q[g.joint]).1 })
+                        .product();
+                    let blended: Vector6 = a * w + b * (1.0 - w);
+                    before.push(b.fixed_rows::<3>(0).norm());
+                    after.push(blended.fixed_rows::<3>(0).norm());
+                    fold_residuals[i] = blended;
                     alone[i] = (*b, w);
                 }
+                folds.push(FoldResiduals { held_out: poses.to_vec(), residuals: fold_residuals, alone });
             }
-            for ((&i, b), a) in poses.iter().zip(&residuals[0]).zip(&residuals[1]) {
-                // A held-out arc of the joint's own angles is where its series knows nothing:
-                // faded whole, whatever the width of the arc (the model fades it in a gap wider
-                // than half its shortest period; an arc of a fifth of the rows may be narrower).
-                let w: f64 = coverage
-                    .iter()
-                    .map(|g| if g.joint == joint { 0.0 } else { g.held_and_weight(data.rows[i].q[g.joint]).1 })
-                    .product();
-                let blended: Vector6 = a * w + b * (1.0 - w);
-                before.push(b.fixed_rows::<3>(0).norm());
-                after.push(blended.fixed_rows::<3>(0).norm());
-                fold_residuals[i] = blended;
-                alone[i] = (*b, w);
-            }
-            folds.push(FoldResiduals { held_out: poses.to_vec(), residuals: fold_residuals, alone });
-        }
-        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64 * 1e3;
-        let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max) * 1e3;
-        let check = ArcCheck {
-            joint: joint + 1,
-            before_mm: mean(&before),
-            after_mm: mean(&after),
-            before_max_mm: max(&before),
-            after_max_mm: max(&after),
-        };
-        out.push((check, folds));
-    }
-    Ok(out)
+            let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64 * 1e3;
+            let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max) * 1e3;
+            let check = ArcCheck {
+                joint: joint + 1,
+                before_mm: mean(&before),
+                after_mm: mean(&after),
+                before_max_mm: max(&before),
+                after_max_mm: max(&after),
+            };
+            Ok((check, folds))
+        })
+        .collect()
 }
 
 /// The mean of `value` over `arcs`; `None` without any.
@@ -240,25 +243,32 @@ pub(crate) fn order_curves(
             let fold = arc_folds(data, k, inputs.folds);
             let pool =
                 Pool::single_folds(inputs.design, inputs.kinematic_prior, &blocks, &fold, inputs.folds, inputs.prior);
-            for (c, (s, joint, orders)) in curves.iter().enumerate() {
-                if *joint == k {
-                    continue;
+            // Every (series, fold) pair's held-out residuals side by side, then summed in the
+            // serial order, so the curve is the same to the bit.
+            let pairs: Vec<(usize, usize)> = curves
+                .iter()
+                .enumerate()
+                .filter(|(_, (_, joint, _))| *joint != k)
+                .flat_map(|(c, _)| (0..inputs.folds).map(move |f| (c, f)))
+                .filter(|&(_, f)| !pool.fold_poses(f).is_empty())
+                .collect();
+            let residuals = pairs
+                .par_iter()
+                .map(|&(c, f)| {
+                    let (s, _, orders) = &curves[c];
+                    // The kinematics, the other steps at their orders, then this series in full.
+                    let base: Vec<usize> = (0..kinematic)
+                        .chain((0..steps.len()).filter(|&t| t != *s).flat_map(|t| offsets[t]..offsets[t] + at_order[t]))
+                        .collect();
+                    let series: Vec<usize> = (offsets[*s]..offsets[*s] + full[*s].0.len()).collect();
+                    pool.series_residuals(&[f], &[f], &base, &series, orders)
+                })
+                .collect::<Result<Vec<_>, Error>>()?;
+            for (&(c, f), residuals) in pairs.iter().zip(&residuals) {
+                for (total, r) in sums[c].iter_mut().zip(&residuals[0]) {
+                    *total += r.iter().map(|v| v.fixed_rows::<3>(0).norm()).sum::<f64>();
                 }
-                // The kinematics, the other steps at their orders, then this series in full.
-                let base: Vec<usize> = (0..kinematic)
-                    .chain((0..steps.len()).filter(|&t| t != *s).flat_map(|t| offsets[t]..offsets[t] + at_order[t]))
-                    .collect();
-                let series: Vec<usize> = (offsets[*s]..offsets[*s] + full[*s].0.len()).collect();
-                for f in 0..inputs.folds {
-                    if pool.fold_poses(f).is_empty() {
-                        continue;
-                    }
-                    let residuals = pool.series_residuals(&[f], &[f], &base, &series, orders)?;
-                    for (total, r) in sums[c].iter_mut().zip(&residuals[0]) {
-                        *total += r.iter().map(|v| v.fixed_rows::<3>(0).norm()).sum::<f64>();
-                    }
-                    counts[c] += pool.fold_poses(f).len();
-                }
+                counts[c] += pool.fold_poses(f).len();
             }
         }
     }

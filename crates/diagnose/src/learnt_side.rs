@@ -16,6 +16,7 @@ use effects::{Backlash, GearPeriodic, IdentifiedEffect, TorqueSign};
 use errors::Error;
 use measurements::BoundSet;
 use poe::LocalPoe;
+use rayon::prelude::*;
 
 /// Alternations of the side and the classifier (the sides settle in two or three).
 const ALTERNATIONS: usize = 5;
@@ -114,30 +115,39 @@ pub(crate) fn learnt_sides(
     candidate_columns: &[Vec<usize>],
     sources: &[SideSource],
 ) -> Result<Vec<LearntSide>, Error> {
-    let mut out = Vec::new();
-    for source in sources {
-        let compliance = &candidates[source.compliance];
-        let columns = &candidate_columns[source.compliance];
-        // The joint's bare twist: order 0's cosine feature is 1 on every row.
-        let bare = IdentifiedEffect::GearPeriodic(GearPeriodic::new(source.joint, vec![0], data.rows())?);
-        let twist_rows = columns_of(design, &bare, model, data)?.swap_remove(0);
-        // The compliance's features of every row, once for all the folds' alternations.
-        let scalars: Vec<Vec<f64>> =
-            data.iter().map(|(row, tool)| compliance.model.features(row, tool)).collect::<Result<_, _>>()?;
-        let compliance = (scalars.as_slice(), columns.as_slice());
-        let mut per_fold = Vec::with_capacity(pool.folds());
-        for f in 0..pool.folds() {
-            let effect = learn(pool, source, compliance, &twist_rows, data, &[f])?;
-            per_fold.push(columns_of(design, &effect, model, data)?.swap_remove(0));
-        }
-        let effect = learn(pool, source, compliance, &twist_rows, data, &[])?;
-        let all = columns_of(design, &effect, model, data)?.swap_remove(0);
-        let nonzero = |c: &Vec<f64>| c.iter().any(|v| v.abs() > 1e-12);
-        if nonzero(&all) && per_fold.iter().all(nonzero) {
-            out.push(LearntSide { joint: source.joint, per_fold, all, model: effect });
-        }
-    }
-    Ok(out)
+    // Each source, and each fold's side within it, is learnt on its own: side by side on the
+    // rayon pool, collected in order, so the result is the serial one.
+    let learnt = sources
+        .par_iter()
+        .map(|source| -> Result<Option<LearntSide>, Error> {
+            let compliance = &candidates[source.compliance];
+            let columns = &candidate_columns[source.compliance];
+            // The joint's bare twist: order 0's cosine feature is 1 on every row.
+            let bare = IdentifiedEffect::GearPeriodic(GearPeriodic::new(source.joint, vec![0], data.rows())?);
+            let twist_rows = columns_of(design, &bare, model, data)?.swap_remove(0);
+            // The compliance's features of every row, once for all the folds' alternations.
+            let scalars: Vec<Vec<f64>> =
+                data.iter().map(|(row, tool)| compliance.model.features(row, tool)).collect::<Result<_, _>>()?;
+            let compliance = (scalars.as_slice(), columns.as_slice());
+            // Folds 0 … k-1 each held out, then none (k): every row.
+            let mut fits = (0..=pool.folds())
+                .into_par_iter()
+                .map(|f| {
+                    let held = [f];
+                    let held: &[usize] = if f < pool.folds() { &held } else { &[] };
+                    let effect = learn(pool, source, compliance, &twist_rows, data, held)?;
+                    let column = columns_of(design, &effect, model, data)?.swap_remove(0);
+                    Ok::<_, Error>((effect, column))
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            let (effect, all) = fits.pop().expect("the fit on every row");
+            let per_fold: Vec<Vec<f64>> = fits.into_iter().map(|(_, column)| column).collect();
+            let nonzero = |c: &Vec<f64>| c.iter().any(|v| v.abs() > 1e-12);
+            let learnt = nonzero(&all) && per_fold.iter().all(nonzero);
+            Ok(learnt.then_some(LearntSide { joint: source.joint, per_fold, all, model: effect }))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(learnt.into_iter().flatten().collect())
 }
 
 #[cfg(test)]

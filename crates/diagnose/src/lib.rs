@@ -563,10 +563,11 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
         None if selection.steps.is_empty() => explainable.clone(),
         None => None,
     };
-    let noise = match (options.noise_mm, noise::from_repeats(data)) {
-        (Some(sigma), _) => NoiseFloor::from_sigma(sigma, NoiseSource::Given),
-        (None, Some(sigma)) => NoiseFloor::from_sigma(sigma, NoiseSource::Repeats),
-        (None, None) => noise::tracker_default(data, &options.tracker),
+    let noise = match (options.noise_mm, noise::from_repeats(data), noise::stated(data)) {
+        (Some(sigma), _, _) => NoiseFloor::from_sigma(sigma, NoiseSource::Given),
+        (None, Some(sigma), _) => NoiseFloor::from_sigma(sigma, NoiseSource::Repeats),
+        (None, None, Some(sigma)) => NoiseFloor::from_sigma(sigma, NoiseSource::Stated),
+        (None, None, None) => noise::tracker_default(data, &options.tracker),
     };
     let evidence = verdict::Evidence {
         before: &selection.baseline.errors,

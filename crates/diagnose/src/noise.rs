@@ -18,6 +18,8 @@ pub enum NoiseSource {
     Repeats,
     /// Given by the user (`--noise-mm`).
     Given,
+    /// The tracker's own stated standard deviation of every row (`std_x_mm` …, issue 46).
+    Stated,
     /// The default of the instrument class the data come from (a laser tracker), at the measured
     /// distances: see [`NoiseFloor::instrument`].
     TrackerDefault,
@@ -67,6 +69,17 @@ pub(crate) fn tracker_default(data: &MeasurementSet, noise: &TrackerNoise) -> No
         noise.transverse_sigma_per_m * 1e6
     ));
     floor
+}
+
+/// The per-axis σ every row states (`std_x_mm` …), pooled as the tracker default's variances
+/// are, mm; `None` unless every row states its position's.
+pub(crate) fn stated(data: &MeasurementSet) -> Option<f64> {
+    let variances: Vec<f64> = data
+        .rows
+        .iter()
+        .map(|row| row.std.and_then(|s| s.position_m).map(|p| p.iter().map(|v| v * v).sum::<f64>() / 3.0))
+        .collect::<Option<_>>()?;
+    (!variances.is_empty()).then(|| (variances.iter().sum::<f64>() / variances.len() as f64).sqrt() * 1e3)
 }
 
 /// The pooled per-axis scatter of rows that repeat a joint configuration (to 1e-6 rad) with the

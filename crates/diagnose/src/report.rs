@@ -120,6 +120,7 @@ fn noise_source(noise: &super::NoiseFloor) -> String {
     match noise.source {
         NoiseSource::Given => "given".into(),
         NoiseSource::Repeats => "from repeated poses".into(),
+        NoiseSource::Stated => "the tracker's stated uncertainty of each row".into(),
         NoiseSource::TrackerDefault => {
             format!("tracker default: {}", noise.instrument.as_deref().unwrap_or("laser tracker"))
         }

@@ -38,15 +38,15 @@ pub struct CandidateContext<'a> {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CandidateOptions {
-    /// Thermal growth is a candidate only where every row has `temp_c` and it spans more than
-    /// this, K. 0.2 K: the value since the first diagnosis (commit 2f15dff), not fitted to any
-    /// data set. Over 0.2 K steel (11.5e-6 /K) grows a 2 m arm by 4.6 µm, under the tracker's
-    /// 5 µm line-of-sight noise (`loadsim::TrackerNoise`), so a smaller span identifies noise.
+    /// Thermal growth is a candidate only where every row has `temp_c` and it spans more than this,
+    /// K. 0.2 K, not fitted to any data set: over 0.2 K steel (11.5e-6 /K) grows a 2 m arm by
+    /// 4.6 µm, under the tracker's 5 µm line-of-sight noise (`loadsim::TrackerNoise`), so a smaller
+    /// span identifies noise.
     pub thermal_min_span_k: f64,
     /// Drift is a candidate only where every row has `t_s` and some row lies more than this from
-    /// their mean, s. 1 s: the value since the first diagnosis (commit 2f15dff), not fitted to
-    /// any data set; a robot takes seconds to reach and settle at a pose, so rows all within a
-    /// second of their mean are one moment (a constant or rounded stamp), not a session that drifts.
+    /// their mean, s. 1 s, not fitted to any data set: a robot takes seconds to reach and settle at
+    /// a pose, so rows all within a second of their mean are one moment (a constant or rounded
+    /// stamp), not a session that drifts.
     pub drift_min_offset_s: f64,
 }
 

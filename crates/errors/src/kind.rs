@@ -603,6 +603,42 @@ pub enum ErrorKind {
         /// The underlying error.
         source: serde_json::Error,
     },
+    /// A column named as an input of the model (`--inputs`) that cannot be one: a joint (already
+    /// an input), the measured pose (what the model predicts), the tool (not a number) or a
+    /// tracker's stated uncertainty.
+    ///
+    /// At the column in the header.
+    NotAnInput {
+        /// The column's name.
+        name: String,
+        /// What the column is.
+        quantity: &'static str,
+    },
+    /// An `--inputs` list with an empty name or a name given twice.
+    ///
+    /// At `--inputs:1:COLUMN`, the character where the name starts.
+    InputList {
+        /// The name at fault (empty for an empty one).
+        name: String,
+    },
+    /// A stated standard deviation (`std_x_mm` …) that is zero or negative: it would weight its
+    /// row infinitely, or not at all.
+    ///
+    /// At the cell.
+    NotAStandardDeviation {
+        /// The column's name.
+        name: String,
+        /// The value as written.
+        value: f64,
+    },
+    /// A row without a value of an input the model takes (`--inputs`): rows made in memory
+    /// without it (a file without the column is refused by its header, `MissingColumn`).
+    ///
+    /// At the row's line.
+    MissingInput {
+        /// The input's name.
+        name: String,
+    },
 }
 
 impl fmt::Display for ErrorKind {
@@ -914,6 +950,19 @@ impl fmt::Display for ErrorKind {
             ErrorKind::Plot { figure, message } => write!(f, "the chart {figure:?} could not be drawn: {message}"),
             ErrorKind::EvaluationJson { source } => {
                 write!(f, "the evaluation could not be written as JSON: {source}")
+            }
+            ErrorKind::NotAnInput { name, quantity } => {
+                write!(f, "column '{name}' is {quantity}: it cannot be an input of the model (--inputs)")
+            }
+            ErrorKind::InputList { name } if name.is_empty() => {
+                write!(f, "an empty name in the list of inputs (NAME[,NAME…])")
+            }
+            ErrorKind::InputList { name } => write!(f, "the input '{name}' is named twice"),
+            ErrorKind::NotAStandardDeviation { name, value } => {
+                write!(f, "{name} is {value}: a stated standard deviation must be a positive number")
+            }
+            ErrorKind::MissingInput { name } => {
+                write!(f, "no value of the input '{name}', which the model takes (the column '{name}')")
             }
         }
     }

@@ -97,6 +97,14 @@ pub struct OptimiserConfig {
     /// iteration for many iterations, each costing `n³` flops on every row.
     #[serde(default)]
     pub refine_function_tolerance: Option<f64>,
+    /// At most this many iterations of a search that starts from an optimum found elsewhere (as
+    /// [`OptimiserConfig::refine_function_tolerance`]); `Some(0)` keeps that optimum as it is.
+    /// `None`: [`OptimiserConfig::max_iterations`]. A search stopped by this budget reports
+    /// `converged: false`: it was not run to a tolerance, by choice. With `Some(0)` after a
+    /// warm-start subset, the kernel is the subset's optimum and the report is that search's (no
+    /// evaluation on all rows).
+    #[serde(default)]
+    pub refine_max_iterations: Option<usize>,
     /// Bytes of the kernel's exponentials an evaluation of the likelihood may keep from its value
     /// stage for its gradient stage, which otherwise computes every one of them again (the
     /// squared-exponential shapes: `d + 1` per entry of the lower triangle with an additive term
@@ -122,6 +130,7 @@ impl Default for OptimiserConfig {
             warm_start_rows: 0,
             warm_start_curvature: false,
             refine_function_tolerance: None,
+            refine_max_iterations: None,
             // 64 MiB: n = 1,387 rows with six additive inputs (UR10 C's even rows) need 54 MB,
             // small against the two n × n buffers and the GP's own data at that size; at a few
             // thousand rows the exponentials would be hundreds of MB, written and read again

@@ -12,9 +12,7 @@ use crate::gram::training_covariance;
 use crate::kernel::KernelChoice;
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::lml::check_finite_outputs;
-use crate::optimise::{
-    OptimisationReport, finish, fit_hyperparameters, fit_hyperparameters_from, refine, warm_stage, warm_stage_from,
-};
+use crate::optimise::{OptimisationReport, finish_from, fit_hyperparameters_from, refine, warm_stage_from};
 use crate::points::Points;
 use crate::scaling::{InputStandardiser, OutputNormaliser};
 
@@ -198,12 +196,16 @@ impl ExactGp {
             OutputMode::Independent => (0..m).filter(|&j| !follows[j]).map(|j| vec![j]).collect(),
             OutputMode::Shared => vec![(0..m).collect()],
         };
-        let search = |start: &Kernel, yg: MatRef<'_, f64>| -> Result<(Kernel, OptimisationReport), Error> {
-            start.validate(xs.dim())?;
-            let bounds = config.bounds.clone().unwrap_or_else(|| start.default_bounds());
-            let o = fit_hyperparameters(start, &bounds, &xs, yg, &config.optimiser, config.parallelism)?;
-            Ok((o.kernel, o.report))
-        };
+        // `start`, then `nested` (its own nested starts unless a fitted smaller model gives
+        // better ones).
+        let search =
+            |start: &Kernel, nested: &[Kernel], yg: MatRef<'_, f64>| -> Result<(Kernel, OptimisationReport), Error> {
+                start.validate(xs.dim())?;
+                let bounds = config.bounds.clone().unwrap_or_else(|| start.default_bounds());
+                let o =
+                    fit_hyperparameters_from(start, nested, &bounds, &xs, yg, &config.optimiser, config.parallelism)?;
+                Ok((o.kernel, o.report))
+            };
         let build = |kernel: Kernel, cols: &Vec<usize>, yg: MatRef<'_, f64>, optimisation| {
             kernel.validate(xs.dim())?;
             let (component, jitter) =
@@ -230,7 +232,7 @@ impl ExactGp {
             };
             let reduced = if config.additive_by_bic { start.without_additive() } else { None };
             let Some(reduced) = reduced else {
-                let (kernel, report) = search(start, yg.as_ref())?;
+                let (kernel, report) = search(start, &start.nested_starts(), yg.as_ref())?;
                 return build(kernel, cols, yg.as_ref(), Some(report));
             };
             // The Schwarz choice: ½ k ln N for the additive term's k extra hyperparameters over
@@ -281,8 +283,9 @@ impl ExactGp {
                 let choice =
                     AdditiveChoice { with_additive: a, without_additive: b, penalty: penalty(rows), kept, rows };
                 let (chosen, stage) = if kept { (start, with) } else { (&reduced, without) };
-                let o = finish(
+                let o = finish_from(
                     chosen,
+                    &chosen.nested_starts(),
                     &bounds_of(chosen),
                     &xs,
                     yg.as_ref(),
@@ -296,21 +299,9 @@ impl ExactGp {
             }
             // Without a subset, the same nesting on all rows: the smaller kernel first, then the
             // larger one from its default start and from the smaller one's optimum.
-            let (small_kernel, small_report) = search(&reduced, yg.as_ref())?;
+            let (small_kernel, small_report) = search(&reduced, &reduced.nested_starts(), yg.as_ref())?;
             let nested = start.nested_at(&small_kernel).map_or_else(|| start.nested_starts(), |k| vec![k]);
-            let (full_kernel, full_report) = {
-                start.validate(xs.dim())?;
-                let o = fit_hyperparameters_from(
-                    start,
-                    &nested,
-                    &bounds_of(start),
-                    &xs,
-                    yg.as_ref(),
-                    &config.optimiser,
-                    config.parallelism,
-                )?;
-                (o.kernel, o.report)
-            };
+            let (full_kernel, full_report) = search(start, &nested, yg.as_ref())?;
             let with = build(full_kernel, cols, yg.as_ref(), Some(full_report))?;
             let without = build(small_kernel, cols, yg.as_ref(), Some(small_report))?;
             let choice = AdditiveChoice {
@@ -354,7 +345,15 @@ impl ExactGp {
                 report.isotropic_choice = Some(choice);
                 (component, report)
             };
-            let stage = warm_stage(&start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism)?;
+            let stage = warm_stage_from(
+                &start,
+                &start.nested_starts(),
+                &bounds,
+                &xs,
+                yg.as_ref(),
+                &config.optimiser,
+                config.parallelism,
+            )?;
             if let Some(stage) = &stage {
                 // Screened on the subset first, each kernel's leave-one-out over the subset's own
                 // rows: the isotropic kernel at its subset optimum, fitted to those rows, against
@@ -400,7 +399,9 @@ impl ExactGp {
                     return Ok(choose(searched, at_subset, (searched_loo, at_subset_loo), stage.rows()));
                 }
             }
-            let o = finish(&start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism, stage)?;
+            let nested = start.nested_starts();
+            let o =
+                finish_from(&start, &nested, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism, stage)?;
             let isotropic = build(o.kernel, cols, yg.as_ref(), Some(o.report))?;
             let isotropic_loo = loo(&isotropic.0);
             Ok(choose(searched, isotropic, (searched_loo, isotropic_loo), n))

@@ -147,7 +147,6 @@ pub(crate) struct WarmStage {
     results: Vec<Option<lbfgsb::Minimum>>,
     /// The subset's rows, in the order the searches saw them.
     indices: Vec<usize>,
-    rows: usize,
     evaluations: usize,
     best: usize,
 }
@@ -160,7 +159,7 @@ impl WarmStage {
 
     /// Rows of the subset.
     pub(crate) fn rows(&self) -> usize {
-        self.rows
+        self.indices.len()
     }
 
     /// The subset's rows.
@@ -174,13 +173,7 @@ impl WarmStage {
         let mut results = self.results;
         results.extend(other.results);
         let best = best(&results).map_or(0, |(i, _)| i);
-        WarmStage {
-            results,
-            indices: self.indices,
-            rows: self.rows,
-            evaluations: self.evaluations + other.evaluations,
-            best,
-        }
+        WarmStage { results, indices: self.indices, evaluations: self.evaluations + other.evaluations, best }
     }
 
     /// The subset's best optimum as a kernel of `start`'s family.
@@ -215,26 +208,18 @@ fn prepare(start: &Kernel, nested: &[Kernel], bounds: &Bounds, config: &Optimise
 }
 
 /// `settings` for a search from an optimum found elsewhere
-/// ([`OptimiserConfig::refine_function_tolerance`]).
+/// ([`OptimiserConfig::refine_function_tolerance`], [`OptimiserConfig::refine_max_iterations`]).
 fn refining(settings: Settings, config: &OptimiserConfig) -> Settings {
-    Settings { function_tolerance: config.refine_function_tolerance.unwrap_or(settings.function_tolerance), ..settings }
+    Settings {
+        function_tolerance: config.refine_function_tolerance.unwrap_or(settings.function_tolerance),
+        max_iterations: config.refine_max_iterations.unwrap_or(settings.max_iterations),
+        ..settings
+    }
 }
 
 /// Every start searched on the warm-start subset (`None` when the configuration has no subset or
-/// the data are no larger than it).
-pub(crate) fn warm_stage(
-    start: &Kernel,
-    bounds: &Bounds,
-    x: &Points,
-    y: MatRef<'_, f64>,
-    config: &OptimiserConfig,
-    parallelism: Parallelism,
-) -> Result<Option<WarmStage>, Error> {
-    warm_stage_from(start, &start.nested_starts(), bounds, x, y, config, parallelism)
-}
-
-/// [`warm_stage`] with `nested` as the deterministic starts after `start` itself, instead of
-/// [`Kernel::nested_starts`]; `start` and every one of `nested` are of one family.
+/// the data are no larger than it): `start` itself, then `nested` (usually
+/// [`Kernel::nested_starts`]), all of one family, then the configured random restarts.
 pub(crate) fn warm_stage_from(
     start: &Kernel,
     nested: &[Kernel],
@@ -258,23 +243,12 @@ pub(crate) fn warm_stage_from(
         return Err(Error::OptimisationFailed { starts: starts.len() });
     };
     let evaluations = results.iter().flatten().map(|m| m.evaluations).sum();
-    Ok(Some(WarmStage { results, rows: idx.len(), indices: idx, evaluations, best }))
+    Ok(Some(WarmStage { results, indices: idx, evaluations, best }))
 }
 
-/// Maximises the log marginal likelihood of `y` (n × m, all columns sharing the kernel).
-pub(crate) fn fit_hyperparameters(
-    start: &Kernel,
-    bounds: &Bounds,
-    x: &Points,
-    y: MatRef<'_, f64>,
-    config: &OptimiserConfig,
-    parallelism: Parallelism,
-) -> Result<Optimised, Error> {
-    fit_hyperparameters_from(start, &start.nested_starts(), bounds, x, y, config, parallelism)
-}
-
-/// [`fit_hyperparameters`] with `nested` as the deterministic starts after `start` itself,
-/// instead of [`Kernel::nested_starts`].
+/// Maximises the log marginal likelihood of `y` (n × m, all columns sharing the kernel) from
+/// `start` and `nested` (usually [`Kernel::nested_starts`]) as [`warm_stage_from`] and
+/// [`finish_from`] search.
 pub(crate) fn fit_hyperparameters_from(
     start: &Kernel,
     nested: &[Kernel],
@@ -288,24 +262,10 @@ pub(crate) fn fit_hyperparameters_from(
     finish_from(start, nested, bounds, x, y, config, parallelism, warm)
 }
 
-/// The full-data search: from the warm stage's best optimum when there is one, else from every
-/// start.
-pub(crate) fn finish(
-    start: &Kernel,
-    bounds: &Bounds,
-    x: &Points,
-    y: MatRef<'_, f64>,
-    config: &OptimiserConfig,
-    parallelism: Parallelism,
-    warm: Option<WarmStage>,
-) -> Result<Optimised, Error> {
-    finish_from(start, &start.nested_starts(), bounds, x, y, config, parallelism, warm)
-}
-
-/// [`finish`] with `nested` as the deterministic starts after `start` itself where there is no
-/// warm stage.
+/// The full-data search: from the warm stage's best optimum when there is one, else from
+/// `start`, then `nested` (usually [`Kernel::nested_starts`]) and the configured random restarts.
 #[allow(clippy::too_many_arguments)]
-fn finish_from(
+pub(crate) fn finish_from(
     start: &Kernel,
     nested: &[Kernel],
     bounds: &Bounds,
@@ -326,7 +286,7 @@ fn finish_from(
             // Hessian grows about in proportion to them and each gradient change is scaled by
             // n / s. The full search then starts with a quasi-Newton step instead of relearning
             // the curvature down the gradient.
-            let scale = x.len() as f64 / stage.rows.max(1) as f64;
+            let scale = x.len() as f64 / stage.rows().max(1) as f64;
             let pairs: Vec<lbfgsb::Pair> = match (&stage.results[stage.best], config.warm_start_curvature) {
                 (Some(m), true) => m
                     .history
@@ -335,10 +295,21 @@ fn finish_from(
                     .collect(),
                 _ => Vec::new(),
             };
-            let mut objective = NegativeLml::new(start, x, y, config, parallelism);
             let settings = refining(settings, config);
-            let full = vec![lbfgsb::minimise_with(&mut objective, &from, &lower, &upper, &settings, &pairs)];
-            (stage.results, stage.rows, stage.evaluations, full.into_iter().next().flatten())
+            let full = if settings.max_iterations == 0 {
+                // No iteration on all rows: the subset's optimum as it is, converged as its search
+                // did there, and no evaluation on all rows counted.
+                stage.results[stage.best].clone().map(|m| lbfgsb::Minimum {
+                    iterations: 0,
+                    evaluations: 0,
+                    gradients: 0,
+                    ..m
+                })
+            } else {
+                let mut objective = NegativeLml::new(start, x, y, config, parallelism);
+                lbfgsb::minimise_with(&mut objective, &from, &lower, &upper, &settings, &pairs)
+            };
+            (stage.results, stage.indices.len(), stage.evaluations, full)
         }
         None => {
             let results = search_all(start, &starts, (&lower, &upper), (x, y), &settings, config, parallelism);

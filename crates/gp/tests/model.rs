@@ -376,3 +376,36 @@ fn the_additive_term_is_kept_only_where_bic_says_it_pays() {
         ExactGp::fit(x.as_ref(), plain.as_ref(), &GpConfig { additive_by_bic: false, ..config.clone() }).expect("fit");
     assert!(off.report().components[0].additive_choice.is_none());
 }
+
+/// `refine_max_iterations` bounds the full-data search after a warm-start subset: `Some(0)` keeps
+/// the subset's optimum (no evaluation on all rows, the subset stage unchanged), `Some(1)` takes
+/// one iteration, and the unbounded search climbs higher on all rows than either.
+#[test]
+fn refine_budget_bounds_the_full_data_search_after_the_subset() {
+    let (x, y) = data(5, 150, 4, 1);
+    let fit = |budget: Option<usize>| {
+        let optimiser = OptimiserConfig {
+            restarts: 0,
+            warm_start_rows: 60,
+            refine_max_iterations: budget,
+            ..OptimiserConfig::default()
+        };
+        let config = GpConfig {
+            kernel: KernelChoice::SquaredExponentialArd,
+            optimiser,
+            parallelism: Parallelism::Sequential,
+            ..GpConfig::default()
+        };
+        ExactGp::fit(x.as_ref(), y.as_ref(), &config).expect("fit")
+    };
+    let (kept, one, full) = (fit(Some(0)), fit(Some(1)), fit(None));
+    let search = |m: &ExactGp| m.report().components[0].optimisation.clone().expect("optimised");
+    let (k, o, f) = (search(&kept), search(&one), search(&full));
+    assert_eq!((k.iterations, k.evaluations, k.warm_start_rows), (0, 0, 60), "{k:?}");
+    assert_eq!(k.start_log_marginal_likelihoods, f.start_log_marginal_likelihoods, "the subset stage changed");
+    assert_eq!(k.warm_start_evaluations, f.warm_start_evaluations);
+    assert!(o.iterations <= 1 && o.evaluations >= 1, "{o:?}");
+    assert!(f.iterations > 1, "the unbounded search stopped at once: the test cannot tell the budgets apart");
+    let (lk, lo, lf) = (kept.log_marginal_likelihood(), one.log_marginal_likelihood(), full.log_marginal_likelihood());
+    assert!(lk < lo && lo <= lf, "likelihoods on all rows: kept {lk}, one iteration {lo}, unbounded {lf}");
+}

@@ -17,16 +17,27 @@ const SYMMETRIC_BRANCH_ANGLE: f64 = FRAC_PI_2;
 pub const ORTHONORMALITY_TOLERANCE: f64 = 1e-3;
 
 /// A rotation, stored as its orthonormal matrix. Serialised as a unit quaternion `[w, x, y, z]`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 #[serde(into = "[f64; 4]", try_from = "[f64; 4]")]
 pub struct SO3 {
     matrix: Matrix3,
+    /// The quaternion a deserialised rotation was read as, written back as it was: the matrix's
+    /// own quaternion ([`SO3::to_quaternion`]) differs from it in the last digit, so a file written,
+    /// read and written again would not be the same bytes. `None` for every rotation computed; the
+    /// matrix is always the rotation, and equality compares the matrices alone.
+    read_as: Option<[f64; 4]>,
+}
+
+impl PartialEq for SO3 {
+    fn eq(&self, other: &Self) -> bool {
+        self.matrix == other.matrix
+    }
 }
 
 impl SO3 {
     /// The identity rotation.
     pub fn identity() -> Self {
-        Self { matrix: Matrix3::identity() }
+        Self { matrix: Matrix3::identity(), read_as: None }
     }
 
     /// The skew-symmetric matrix `ω^` with `ω^ x = ω × x`.
@@ -43,7 +54,7 @@ impl SO3 {
     pub fn exp(w: &Vector3) -> Self {
         let (a, b) = rodrigues_coefficients(w.norm());
         let k = Self::hat(w);
-        Self { matrix: Matrix3::identity() + k * a + k * k * b }
+        Self { matrix: Matrix3::identity() + k * a + k * k * b, read_as: None }
     }
 
     /// The rotation vector `ω` with `exp(ω^) = R`, `|ω| ≤ π`; at exactly π either of `±π a`.
@@ -83,7 +94,7 @@ impl SO3 {
 
     /// Wraps a matrix the caller knows to be a rotation, without checking.
     pub fn from_matrix_unchecked(matrix: Matrix3) -> Self {
-        Self { matrix }
+        Self { matrix, read_as: None }
     }
 
     /// Re-orthonormalises a nearly-rotation matrix (the nearest rotation in the Frobenius norm,
@@ -96,19 +107,19 @@ impl SO3 {
         }
         let svd = matrix.svd(true, true);
         match (svd.u, svd.v_t) {
-            (Some(u), Some(v_t)) => Ok(Self { matrix: u * v_t }),
+            (Some(u), Some(v_t)) => Ok(Self { matrix: u * v_t, read_as: None }),
             _ => Err(Error::NotARotation { deviation, determinant }),
         }
     }
 
     /// The inverse (transpose).
     pub fn inverse(&self) -> Self {
-        Self { matrix: self.matrix.transpose() }
+        Self { matrix: self.matrix.transpose(), read_as: None }
     }
 
     /// `self · other`.
     pub fn compose(&self, other: &Self) -> Self {
-        Self { matrix: self.matrix * other.matrix }
+        Self { matrix: self.matrix * other.matrix, read_as: None }
     }
 
     /// Rotates a vector.
@@ -146,6 +157,7 @@ impl SO3 {
                 2.0 * (y * z + w * x),
                 1.0 - 2.0 * (x * x + y * y),
             ),
+            read_as: None,
         })
     }
 
@@ -212,16 +224,18 @@ impl Mul for SO3 {
     }
 }
 
+/// The serialised form: the quaternion the rotation was read as, else its matrix's.
 impl From<SO3> for [f64; 4] {
     fn from(r: SO3) -> Self {
-        r.to_quaternion()
+        r.read_as.unwrap_or_else(|| r.to_quaternion())
     }
 }
 
+/// The deserialised form, which keeps the quaternion as read (see `SO3::read_as`).
 impl TryFrom<[f64; 4]> for SO3 {
     type Error = Error;
 
     fn try_from(q: [f64; 4]) -> Result<Self, Error> {
-        SO3::from_quaternion(q[0], q[1], q[2], q[3])
+        Ok(SO3 { read_as: Some(q), ..SO3::from_quaternion(q[0], q[1], q[2], q[3])? })
     }
 }

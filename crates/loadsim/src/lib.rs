@@ -39,6 +39,7 @@
 #![deny(missing_docs)]
 
 mod backlash;
+mod base_tilt;
 mod cell;
 mod compliance;
 mod counterbalance;
@@ -62,6 +63,7 @@ mod torque_sensor;
 mod tracker_noise;
 
 pub use backlash::{Backlash, JointBacklash, backlash_joint_regressor};
+pub use base_tilt::BaseTilt;
 pub use cell::{PoseContext, SimulatedCell};
 pub use compliance::{JointCompliance, MAX_FIXED_POINT_ITERATIONS, compliance_deflection, spring_torque};
 pub use counterbalance::Counterbalance;

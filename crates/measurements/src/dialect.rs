@@ -79,7 +79,9 @@ impl Dialect {
     /// The dialect the header line shows: `;` when it separates more fields than `,` does
     /// (outside double quotes), `,` otherwise. A comma-separated file has the decimal point.
     pub(crate) fn from_header_line(bytes: &[u8]) -> Self {
-        let line = bytes.split(|&b| b == b'\n').next().unwrap_or(&[]);
+        // The first line that is not blank, ended by `\n`, `\r\n` or a lone `\r` (the CSV layer
+        // skips blank lines before the header and ends records at either).
+        let line = bytes.split(|&b| b == b'\n' || b == b'\r').find(|l| !l.is_empty()).unwrap_or(&[]);
         let (mut commas, mut semicolons, mut quoted) = (0usize, 0usize, false);
         for &b in line {
             match b {

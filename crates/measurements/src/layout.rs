@@ -36,6 +36,12 @@ pub(crate) struct Layout {
     pub temp: Option<Column>,
     pub time: Option<Column>,
     pub torques: Vec<Column>,
+    /// The columns of [`Expectation::inputs`], in its order.
+    pub inputs: Vec<Column>,
+    /// The stated standard deviations of the position, `std_x_mm` … (issue 46): all three or none.
+    pub position_std: Option<[Column; 3]>,
+    /// The stated standard deviations of the orientation, `std_rx_mrad` …: all three or none.
+    pub rotation_std: Option<[Column; 3]>,
     /// The names of the columns not used.
     pub ignored: Vec<String>,
     /// Names as the rest of the reader refers to them: the SPEC name of a mapped column.
@@ -45,11 +51,15 @@ pub(crate) struct Layout {
 /// What the header is checked against.
 pub(crate) struct Expectation<'a> {
     pub file: &'a str,
+    /// The header's line (1 unless blank lines precede it): where its refusals are placed.
+    pub line: u64,
     /// The robot's joints, when known.
     pub joints: Option<&'a [JointKind]>,
     /// Whether the position columns must be there.
     pub positions: bool,
     pub columns: &'a ColumnMap,
+    /// The columns to keep as inputs of a model (`--inputs`), by name.
+    pub inputs: &'a [String],
 }
 
 /// The SPEC name of joint `k`'s column for a joint of `kind`.
@@ -72,9 +82,9 @@ impl Layout {
     /// Reads and checks the header. Allocates only in proportion to the header's length: a column
     /// named `q99999999999_rad` is refused, never used as a size.
     pub fn from_header(header: &csv::StringRecord, expect: &Expectation<'_>) -> Result<Self, Error> {
-        let file = expect.file;
+        let (file, line) = (expect.file, expect.line);
         let width = header.len();
-        let at_end = |name: String| Error::at_line(file.to_owned(), 1, width + 1, ErrorKind::MissingColumn { name });
+        let at_end = |name: String| Error::at_line(file.to_owned(), line, width + 1, ErrorKind::MissingColumn { name });
         let mut names: Vec<String> = Vec::with_capacity(width);
         // Sets, not scans of the lists: a header of 400,000 columns took minutes when each name was
         // compared with every earlier one (found by `cargo xtask fuzz`).
@@ -86,12 +96,13 @@ impl Layout {
         let mut quaternion = [None; 4];
         let mut euler = [None; 3];
         let (mut payload, mut tool, mut temp, mut time) = (None, None, None, None);
+        let (mut position_std, mut rotation_std) = ([None; 3], [None; 3]);
         let mut ignored = Vec::new();
         for (index, raw) in header.iter().enumerate() {
             let raw = raw.trim();
             let name = expect.columns.target_of(raw).unwrap_or(raw).to_owned();
             let duplicate =
-                || Error::at_line(file.to_owned(), 1, index + 1, ErrorKind::DuplicateColumn { name: name.clone() });
+                || Error::at_line(file.to_owned(), line, index + 1, ErrorKind::DuplicateColumn { name: name.clone() });
             if !seen.insert(name.clone()) {
                 return Err(duplicate());
             }
@@ -112,6 +123,8 @@ impl Layout {
                 Some(Quantity::Tool) => tool.replace(index).is_none(),
                 Some(Quantity::Temperature) => temp.replace(column(1.0)).is_none(),
                 Some(Quantity::Time) => time.replace(column(1.0)).is_none(),
+                Some(Quantity::PositionStd { axis, scale }) => position_std[axis].replace(column(scale)).is_none(),
+                Some(Quantity::RotationStd { axis, scale }) => rotation_std[axis].replace(column(scale)).is_none(),
                 None => {
                     ignored.push(name.clone());
                     true
@@ -126,20 +139,25 @@ impl Layout {
             if !header.iter().any(|h| h.trim() == mapped) {
                 return Err(Error::at_line(
                     file.to_owned(),
-                    1,
+                    line,
                     width + 1,
                     ErrorKind::MappedHeaderMissing { target: target.clone(), header: mapped.clone() },
                 ));
             }
         }
 
+        let inputs = input_columns(&names, expect, width)?;
+        if !inputs.is_empty() {
+            let taken: HashSet<&str> = expect.inputs.iter().map(String::as_str).collect();
+            ignored.retain(|name| !taken.contains(name.as_str()));
+        }
         let joints = check_joints(joints, expect, width)?;
         let n = joints.len();
         torques.sort_by_key(|(k, _)| *k);
         if let Some((k, c)) = torques.iter().find(|(k, _)| *k > n) {
             return Err(Error::at_line(
                 file.to_owned(),
-                1,
+                line,
                 c.index + 1,
                 ErrorKind::ColumnBeyondJoints { name: names[c.index].clone(), index: *k, joints: n },
             ));
@@ -159,7 +177,16 @@ impl Layout {
             }
             _ => None,
         };
-        let orientation = orientation(quaternion, euler, &names, file, width)?;
+        let orientation = orientation(quaternion, euler, &names, (file, line), width)?;
+        // A stated uncertainty of some axes only is refused by the first name missing: a row
+        // weighted on one axis and not on another would be weighted by accident.
+        let all_or_none = |columns: [Option<Column>; 3], names: [&str; 3]| match columns {
+            [Some(x), Some(y), Some(z)] => Ok(Some([x, y, z])),
+            [None, None, None] => Ok(None),
+            _ => Err(at_end(names[columns.iter().position(Option::is_none).unwrap_or(0)].into())),
+        };
+        let position_std = all_or_none(position_std, ["std_x_mm", "std_y_mm", "std_z_mm"])?;
+        let rotation_std = all_or_none(rotation_std, ["std_rx_mrad", "std_ry_mrad", "std_rz_mrad"])?;
         Ok(Self {
             joints,
             position,
@@ -169,10 +196,64 @@ impl Layout {
             temp,
             time,
             torques: torques.into_iter().map(|(_, c)| c).collect(),
+            inputs,
+            position_std,
+            rotation_std,
             ignored,
             names,
         })
     }
+}
+
+/// The columns of the inputs `expect.inputs` names, in its order: each must be in the header, and
+/// be a number that is not already an input or an output of the model. Names are looked up in a
+/// map of the header, not by scanning it.
+fn input_columns(names: &[String], expect: &Expectation<'_>, width: usize) -> Result<Vec<Column>, Error> {
+    if expect.inputs.is_empty() {
+        return Ok(Vec::new());
+    }
+    let file = expect.file;
+    let index: std::collections::HashMap<&str, usize> =
+        names.iter().enumerate().map(|(i, name)| (name.as_str(), i)).collect();
+    let mut seen = HashSet::with_capacity(expect.inputs.len());
+    expect
+        .inputs
+        .iter()
+        .map(|name| {
+            if !seen.insert(name.as_str()) {
+                return Err(Error::at_line("--inputs", 1, 1, ErrorKind::InputList { name: name.clone() }));
+            }
+            let Some(&i) = index.get(name.as_str()) else {
+                return Err(Error::at_line(
+                    file.to_owned(),
+                    1,
+                    width + 1,
+                    ErrorKind::MissingColumn { name: name.clone() },
+                ));
+            };
+            let refused = match quantity(name) {
+                Some(Quantity::Joint { .. }) => Some("a joint, already an input"),
+                Some(Quantity::Position { .. } | Quantity::Quaternion(_) | Quantity::Euler { .. }) => {
+                    Some("the measured pose, what the model predicts")
+                }
+                Some(Quantity::Tool) => Some("the tool, not a number"),
+                Some(Quantity::Payload) => Some("the payload, an input of method poe-gp-load"),
+                Some(Quantity::PositionStd { .. } | Quantity::RotationStd { .. }) => {
+                    Some("the tracker's stated uncertainty, which weights its row")
+                }
+                _ => None,
+            };
+            match refused {
+                Some(quantity) => Err(Error::at_line(
+                    file.to_owned(),
+                    1,
+                    i + 1,
+                    ErrorKind::NotAnInput { name: name.clone(), quantity },
+                )),
+                None => Ok(Column { index: i, scale: 1.0 }),
+            }
+        })
+        .collect()
 }
 
 /// The joint columns in order, checked: numbered 1…n without gaps, n the robot's joint count
@@ -182,7 +263,7 @@ fn check_joints(
     expect: &Expectation<'_>,
     width: usize,
 ) -> Result<Vec<(Column, JointKind)>, Error> {
-    let file = expect.file;
+    let (file, line) = (expect.file, expect.line);
     found.sort_by_key(|(k, _, _)| *k);
     let count = found.len();
     if let Some(kinds) = expect.joints {
@@ -192,7 +273,7 @@ fn check_joints(
             let column = beyond.map_or(width + 1, |(_, c, _)| c.index + 1);
             return Err(Error::at_line(
                 file.to_owned(),
-                1,
+                line,
                 column,
                 ErrorKind::JointCountMismatch { found: count, expected },
             ));
@@ -202,7 +283,7 @@ fn check_joints(
     if count == 0 {
         return Err(Error::at_line(
             file.to_owned(),
-            1,
+            line,
             width + 1,
             ErrorKind::MissingColumn { name: joint_name(1, kind_of(1)) },
         ));
@@ -210,7 +291,7 @@ fn check_joints(
     if let Some(k) = (1..=count).find(|&k| found[k - 1].0 != k) {
         return Err(Error::at_line(
             file.to_owned(),
-            1,
+            line,
             width + 1,
             ErrorKind::MissingColumn { name: joint_name(k, kind_of(k)) },
         ));
@@ -220,7 +301,7 @@ fn check_joints(
             if kind != robot {
                 return Err(Error::at_line(
                     file.to_owned(),
-                    1,
+                    line,
                     column.index + 1,
                     ErrorKind::JointUnit { joint: *k, kind: error_kind(*robot) },
                 ));
@@ -235,11 +316,11 @@ fn orientation(
     quaternion: [Option<Column>; 4],
     euler: [Option<Column>; 3],
     names: &[String],
-    file: &str,
+    (file, line): (&str, u64),
     width: usize,
 ) -> Result<Option<OrientationColumns>, Error> {
     let missing =
-        |name: &str| Error::at_line(file.to_owned(), 1, width + 1, ErrorKind::MissingColumn { name: name.into() });
+        |name: &str| Error::at_line(file.to_owned(), line, width + 1, ErrorKind::MissingColumn { name: name.into() });
     let any_quaternion = quaternion.iter().flatten().next();
     let any_euler = euler.iter().flatten().next();
     if let (Some(q), Some(e)) = (any_quaternion, any_euler) {
@@ -247,7 +328,7 @@ fn orientation(
         let earlier = if e.index > q.index { q } else { e };
         return Err(Error::at_line(
             file.to_owned(),
-            1,
+            line,
             later.index + 1,
             ErrorKind::OrientationTwice { name: names[later.index].clone(), other: names[earlier.index].clone() },
         ));

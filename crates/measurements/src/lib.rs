@@ -25,7 +25,9 @@
 mod bound;
 mod column_map;
 mod dialect;
+mod file_lines;
 mod input_files;
+mod inputs;
 mod layout;
 mod outliers;
 mod output_file;
@@ -34,14 +36,18 @@ mod row;
 mod writer;
 pub use bound::{BoundSet, model_tool};
 pub use input_files::InputFiles;
+pub use inputs::{INPUT_UNITS, InputColumn, InputNames, Inputs, input_unit};
 pub use outliers::{OutlierLine, list_lines, without};
 pub use output_file::{FileKind, MAX_SYMLINKS, OutputFile, output_target, write_file};
+/// A row's stated standard deviations (`std_x_mm` …, issue 46), as the identification weighs them.
+pub use poe::identify::StatedSigma;
 
 pub use column_map::{ColumnMap, ColumnMapFault};
 pub use dialect::{Decimal, DecimalFault, Delimiter, Dialect};
 pub use writer::{CsvColumns, MeasurementWriter};
 
 use errors::{Error, ErrorKind};
+use file_lines::LineCounter;
 use layout::{Expectation, Layout, OrientationColumns};
 use lie::{SO3, Vector3};
 use poe::JointKind;
@@ -55,7 +61,8 @@ use std::path::Path;
 /// One measured pose, SI units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measurement {
-    /// 1-based line of the row in its file (0 for rows made in memory).
+    /// The row's line in its file as an editor counts it (0 for rows made in memory): the header
+    /// is line 1, and blank lines and the lines of a quoted field with a line break count.
     pub line: u64,
     /// Joint values, radians (metres for a prismatic joint).
     pub q: Vec<f64>,
@@ -73,6 +80,11 @@ pub struct Measurement {
     pub t_s: Option<f64>,
     /// Measured joint torques, N·m.
     pub torques_nm: Option<Vec<f64>>,
+    /// The values of the columns read as inputs of a model (`--inputs`), by name, as written.
+    pub inputs: Inputs,
+    /// The tracker's stated standard deviations of this row (`std_x_mm` …, `std_rx_mrad` …; SI),
+    /// where the file has them.
+    pub std: Option<StatedSigma>,
 }
 
 impl Measurement {
@@ -91,6 +103,8 @@ impl Measurement {
             temp_c: None,
             t_s: None,
             torques_nm: None,
+            inputs: Inputs::default(),
+            std: None,
         }
     }
 }
@@ -158,6 +172,12 @@ pub struct MeasurementSet {
     pub position_unit: Option<&'static str>,
     /// How the file was written.
     pub format: FileFormat,
+    /// The columns read as inputs of a model ([`ReadOptions::inputs`]), in that order (empty for
+    /// sets made in memory).
+    pub inputs: Vec<InputColumn>,
+    /// The header's line in the file (1 unless blank lines precede it; 1 for sets made in
+    /// memory): where a refusal of the header is placed.
+    pub header_line: u64,
 }
 
 /// What a measurement file is read against.
@@ -169,17 +189,26 @@ pub struct ReadOptions {
     pub joints: Option<Vec<JointKind>>,
     /// Other headers mapped onto the SPEC's names (`--columns`).
     pub columns: ColumnMap,
+    /// Columns kept as inputs of a model (`--inputs`, or the inputs a fitted model takes), by
+    /// their name after `columns`: a file without one is refused by its name, and a cell that is
+    /// not a finite number at its line and column.
+    pub inputs: Vec<String>,
 }
 
 impl ReadOptions {
     /// Reading for a robot with these joints.
     pub fn for_joints(joints: Vec<JointKind>) -> Self {
-        Self { joints: Some(joints), columns: ColumnMap::default() }
+        Self { joints: Some(joints), ..Self::default() }
     }
 
     /// The same, with a column map.
     pub fn with_columns(self, columns: ColumnMap) -> Self {
         Self { columns, ..self }
+    }
+
+    /// The same, keeping the columns `inputs` as inputs of a model.
+    pub fn with_inputs(self, inputs: Vec<String>) -> Self {
+        Self { inputs, ..self }
     }
 }
 
@@ -249,20 +278,27 @@ fn parse_keeping<R: Read>(
         .trim(csv::Trim::All)
         .from_reader(body);
     let delimiter = dialect.delimiter;
-    let header = csv.headers().map_err(|e| syntax_error(&e, file, delimiter))?.clone();
+    let header = csv.headers().map_err(|e| syntax_error(&e, file, delimiter, body))?.clone();
     if header.is_empty() || (header.len() == 1 && header[0].is_empty()) {
         return Err(Error::at_line(file.to_owned(), 1, 1, ErrorKind::EmptyFile));
     }
+    // Every row by the line an editor shows it on (module `file_lines`): the header's, 1 unless
+    // blank lines precede it, then each record's from the same counter.
+    let mut lines = LineCounter::new(body);
+    let header_line = header.position().map_or(1, |p| lines.record_line(p.byte()));
     let expect = Expectation {
         file,
+        line: header_line,
         joints: options.joints.as_deref(),
         positions: positions_required,
         columns: &options.columns,
+        inputs: &options.inputs,
     };
     let layout = Layout::from_header(&header, &expect)?;
     if let Some(cells) = cells.as_deref_mut() {
         cells.header = header.iter().map(str::to_owned).collect();
     }
+    let input_names: std::sync::Arc<[String]> = options.inputs.clone().into();
     let mut tools: Vec<String> = Vec::new();
     // Each tool's index by name: a file whose every row names another tool stays linear.
     let mut tool_index: HashMap<String, usize> = HashMap::new();
@@ -272,9 +308,9 @@ fn parse_keeping<R: Read>(
         match csv.read_record(&mut record) {
             Ok(true) => {}
             Ok(false) => break,
-            Err(e) => return Err(syntax_error(&e, file, delimiter)),
+            Err(e) => return Err(syntax_error(&e, file, delimiter, body)),
         }
-        let line = record.position().map_or(0, |p| p.line());
+        let line = record.position().map_or(0, |p| lines.record_line(p.byte()));
         let mut row = Row { record: &record, line, file, names: &layout.names, dialect: &mut dialect };
         let q = layout
             .joints
@@ -313,12 +349,32 @@ fn parse_keeping<R: Read>(
         let temp_c = layout.temp.map(|c| row.number(c)).transpose()?;
         let t_s = layout.time.map(|c| row.number(c)).transpose()?;
         let torques_nm = if layout.torques.is_empty() { None } else { Some(row.numbers(&layout.torques)?) };
+        let inputs = Inputs::new(input_names.clone(), row.numbers(&layout.inputs)?);
+        let std = match (layout.position_std, layout.rotation_std) {
+            (None, None) => None,
+            (p, r) => Some(StatedSigma {
+                position_m: p.map(|c| row.standard_deviations(&c)).transpose()?,
+                rotation_rad: r.map(|c| row.standard_deviations(&c)).transpose()?,
+            }),
+        };
         let tool_name = layout.tool.and_then(|i| record.get(i)).unwrap_or("");
         let tool = *tool_index.entry(tool_name.to_owned()).or_insert_with(|| {
             tools.push(tool_name.to_owned());
             tools.len() - 1
         });
-        rows.push(Measurement { line, q, position, orientation, payload_kg, tool, temp_c, t_s, torques_nm });
+        rows.push(Measurement {
+            line,
+            q,
+            position,
+            orientation,
+            payload_kg,
+            tool,
+            temp_c,
+            t_s,
+            torques_nm,
+            inputs,
+            std,
+        });
         if let Some(cells) = cells.as_deref_mut() {
             cells.rows.push(record.iter().map(str::to_owned).collect());
         }
@@ -327,6 +383,7 @@ fn parse_keeping<R: Read>(
         return Err(Error::at_line(file.to_owned(), 1, 1, ErrorKind::EmptyFile));
     }
     Ok(MeasurementSet {
+        header_line,
         source: file.to_owned(),
         joint_count: layout.joints.len(),
         full_pose: layout.orientation.is_some(),
@@ -341,6 +398,12 @@ fn parse_keeping<R: Read>(
             .map(|(c, kind)| JointColumn { column: c.index + 1, kind: *kind, unit: joint_unit(*kind, c.scale) })
             .collect(),
         position_unit: layout.position.map(|[x, _, _]| if x.scale == 1.0 { "m" } else { "mm" }),
+        inputs: options
+            .inputs
+            .iter()
+            .zip(&layout.inputs)
+            .map(|(name, c)| InputColumn { name: name.clone(), unit: input_unit(name), column: c.index + 1 })
+            .collect(),
         format: FileFormat {
             dialect,
             euler_angles: matches!(layout.orientation, Some(OrientationColumns::Euler(_))),
@@ -383,6 +446,8 @@ impl MeasurementSet {
             joint_columns: vec![],
             position_unit: None,
             format: FileFormat::default(),
+            inputs: Vec::new(),
+            header_line: 1,
         }
     }
 
@@ -390,6 +455,17 @@ impl MeasurementSet {
     /// columns (the CLI prints it).
     pub fn read_summary(&self) -> String {
         let mut line = format!("read {}: {} rows, {}", self.source, self.rows.len(), self.format);
+        if !self.inputs.is_empty() {
+            let inputs: Vec<String> = self
+                .inputs
+                .iter()
+                .map(|c| c.unit.map_or_else(|| c.name.clone(), |unit| format!("{} ({unit})", c.name)))
+                .collect();
+            line.push_str(&format!("; inputs: {}", inputs.join(", ")));
+        }
+        if self.rows.iter().any(|r| r.std.is_some()) {
+            line.push_str("; the tracker's stated uncertainty of each row (std_…)");
+        }
         if !self.ignored_columns.is_empty() {
             line.push_str(&format!("; ignored columns: {}", self.ignored_columns.join(", ")));
         }
@@ -403,7 +479,7 @@ impl MeasurementSet {
         }
         Err(Error::at_line(
             self.source.clone(),
-            1,
+            self.header_line,
             1,
             ErrorKind::JointCountMismatch { found: self.joint_count, expected: joints },
         ))
@@ -417,11 +493,39 @@ impl MeasurementSet {
             if column.kind != *kind {
                 return Err(Error::at_line(
                     self.source.clone(),
-                    1,
+                    self.header_line,
                     column.column,
                     ErrorKind::JointUnit { joint: k + 1, kind: layout::error_kind(*kind) },
                 ));
             }
+        }
+        Ok(())
+    }
+
+    /// Refuses the first row without a value of one of the inputs `names` (a set read from a file
+    /// with them has them all: the reader refused a file without the column): at its line, and
+    /// the input's column where the set has one.
+    pub fn require_inputs(&self, names: &[String]) -> Result<(), Error> {
+        if names.is_empty() {
+            return Ok(());
+        }
+        let mut known: Option<&std::sync::Arc<[String]>> = None;
+        for row in &self.rows {
+            // The rows of a file share one list of names: checked once per list.
+            if known.is_some_and(|k| std::sync::Arc::ptr_eq(k, row.inputs.shared_names())) {
+                continue;
+            }
+            let have: std::collections::HashSet<&str> = row.inputs.names().iter().map(String::as_str).collect();
+            if let Some(name) = names.iter().find(|n| !have.contains(n.as_str())) {
+                let column = self.inputs.iter().find(|c| &c.name == name).map_or(1, |c| c.column);
+                return Err(Error::at_line(
+                    self.source.clone(),
+                    row.line,
+                    column,
+                    ErrorKind::MissingInput { name: name.clone() },
+                ));
+            }
+            known = Some(row.inputs.shared_names());
         }
         Ok(())
     }
@@ -444,6 +548,8 @@ impl MeasurementSet {
             joint_columns: self.joint_columns.clone(),
             position_unit: self.position_unit,
             format: self.format.clone(),
+            inputs: self.inputs.clone(),
+            header_line: self.header_line,
         }
     }
 }

@@ -29,6 +29,18 @@ pub(crate) enum Quantity {
     Time,
     /// `tau<k>_nm`.
     Torque(usize),
+    /// `std_x_mm`, `std_y_m`, …: the tracker's stated standard deviation of position axis 0, 1, 2
+    /// (issue 46).
+    PositionStd {
+        axis: usize,
+        scale: f64,
+    },
+    /// `std_rx_mrad`, `std_ry_deg`, `std_rz_rad`: the stated standard deviation of the orientation
+    /// about axis 0, 1, 2.
+    RotationStd {
+        axis: usize,
+        scale: f64,
+    },
 }
 
 /// `q3_rad` → `Some((3, "rad"))` for the prefix `q`. Digits too many for a `usize` give
@@ -40,6 +52,25 @@ fn indexed_name<'a>(name: &'a str, prefix: &str) -> Option<(usize, &'a str)> {
         return None;
     }
     Some((digits.parse().unwrap_or(usize::MAX), unit))
+}
+
+/// `x_mm` … `rz_mrad` after `std_`: a stated standard deviation of a position or an orientation
+/// axis, with its unit's factor to SI.
+fn stated_std(rest: &str) -> Option<Quantity> {
+    let (axis, unit) = rest.split_once('_')?;
+    let position =
+        |scale| ["x", "y", "z"].iter().position(|a| *a == axis).map(|axis| Quantity::PositionStd { axis, scale });
+    let rotation =
+        |scale| ["rx", "ry", "rz"].iter().position(|a| *a == axis).map(|axis| Quantity::RotationStd { axis, scale });
+    match unit {
+        "mm" => position(1e-3),
+        "m" => position(1.0),
+        "um" => position(1e-6),
+        "mrad" => rotation(1e-3),
+        "rad" => rotation(1.0),
+        "deg" => rotation(1f64.to_radians()),
+        _ => None,
+    }
 }
 
 /// The quantity a SPEC column name stands for; `None` for any other name.
@@ -56,6 +87,7 @@ pub(crate) fn quantity(name: &str) -> Option<Quantity> {
         "tool" => Quantity::Tool,
         "temp_c" => Quantity::Temperature,
         "t_s" => Quantity::Time,
+        _ if name.starts_with("std_") => return stated_std(&name[4..]),
         _ => {
             if let Some((index, unit)) = indexed_name(name, "q") {
                 let (kind, scale) = match unit {

@@ -35,9 +35,9 @@ pub(super) const JOINT_TRAVEL_RANGE: PhysicalRange =
 pub(super) const JOINT_ANGLE_RANGE: PhysicalRange =
     PhysicalRange { limit: MAX_JOINT_ANGLE_RAD, unit: "rad", quantity: "joint angle" };
 
-/// The CSV layer's refusal as ours, at its line and field.
-pub(super) fn syntax_error(e: &csv::Error, file: &str, delimiter: Delimiter) -> Error {
-    let line = e.position().map_or(1, |p| p.line());
+/// The CSV layer's refusal as ours, at its line (as an editor counts it in `body`) and field.
+pub(super) fn syntax_error(e: &csv::Error, file: &str, delimiter: Delimiter, body: &[u8]) -> Error {
+    let line = super::file_lines::line_of(body, e.position());
     match e.kind() {
         csv::ErrorKind::UnequalLengths { expected_len, len, .. } => Error::at_line(
             file.to_owned(),
@@ -84,6 +84,27 @@ impl Row<'_> {
     /// The cells of `columns` as SI numbers.
     pub fn numbers(&mut self, columns: &[Column]) -> Result<Vec<f64>, Error> {
         columns.iter().map(|&c| self.number(c)).collect()
+    }
+
+    /// The cells of three stated standard deviations as SI numbers, each positive: a zero or a
+    /// negative one would weight its row infinitely or not at all.
+    pub fn standard_deviations(&mut self, columns: &[Column; 3]) -> Result<[f64; 3], Error> {
+        let mut out = [0.0; 3];
+        for (slot, &c) in out.iter_mut().zip(columns) {
+            let value = self.number(c)?;
+            if value <= 0.0 {
+                let name = self.names[c.index].clone();
+                let value = value / c.scale;
+                return Err(Error::at_line(
+                    self.file.to_owned(),
+                    self.line,
+                    c.index + 1,
+                    ErrorKind::NotAStandardDeviation { name, value },
+                ));
+            }
+            *slot = value;
+        }
+        Ok(out)
     }
 
     /// The cells of `columns` as SI numbers, each within `range` in magnitude.

@@ -20,6 +20,12 @@ pub struct CsvColumns {
     pub t_s: bool,
     /// How many `tau{k}_nm` columns are written.
     pub torques: usize,
+    /// The input columns written last, by name (each row's value of the name; blank where a row
+    /// has none).
+    pub inputs: Vec<String>,
+    /// Whether the stated standard deviations `std_x_mm, std_y_mm, std_z_mm` are written (blank
+    /// where a row has none), and `std_rx_mrad, std_ry_mrad, std_rz_mrad`.
+    pub stated_std: [bool; 2],
 }
 
 /// The measurement CSV written one row at a time (`calib simulate` streams its rows through it).
@@ -59,6 +65,13 @@ impl<W: Write> MeasurementWriter<W> {
             header.push("t_s".into());
         }
         header.extend((1..=columns.torques).map(|k| format!("tau{k}_nm")));
+        header.extend(columns.inputs.iter().cloned());
+        if columns.stated_std[0] {
+            header.extend(["std_x_mm", "std_y_mm", "std_z_mm"].map(String::from));
+        }
+        if columns.stated_std[1] {
+            header.extend(["std_rx_mrad", "std_ry_mrad", "std_rz_mrad"].map(String::from));
+        }
         out.write_record(&header)?;
         Ok(Self { out, columns, named_tools })
     }
@@ -85,6 +98,23 @@ impl<W: Write> MeasurementWriter<W> {
         if let Some(tau) = &row.torques_nm {
             record.extend(tau.iter().map(|v| format!("{v:?}")));
         }
+        if !columns.inputs.is_empty() {
+            if row.inputs.names() == columns.inputs.as_slice() {
+                record.extend(row.inputs.values().iter().map(|v| format!("{v:?}")));
+            } else {
+                let cell = |name: &String| row.inputs.get(name).map_or(String::new(), |v| format!("{v:?}"));
+                record.extend(columns.inputs.iter().map(cell));
+            }
+        }
+        let stated = [row.std.and_then(|s| s.position_m), row.std.and_then(|s| s.rotation_rad)];
+        for (written, values) in columns.stated_std.iter().zip(stated) {
+            if *written {
+                match values {
+                    Some(v) => record.extend(v.iter().map(|x| format!("{:?}", x * 1e3))),
+                    None => record.extend(std::iter::repeat_n(String::new(), 3)),
+                }
+            }
+        }
         Ok(self.out.write_record(&record)?)
     }
 
@@ -109,6 +139,15 @@ impl MeasurementSet {
             temp_c: has(&|r| r.temp_c.is_some()),
             t_s: has(&|r| r.t_s.is_some()),
             torques: self.rows.first().and_then(|r| r.torques_nm.as_ref()).map_or(0, Vec::len),
+            inputs: if self.inputs.is_empty() {
+                self.rows.first().map_or_else(Vec::new, |r| r.inputs.names().to_vec())
+            } else {
+                self.inputs.iter().map(|c| c.name.clone()).collect()
+            },
+            stated_std: [
+                has(&|r| r.std.is_some_and(|s| s.position_m.is_some())),
+                has(&|r| r.std.is_some_and(|s| s.rotation_rad.is_some())),
+            ],
         };
         let mut out = MeasurementWriter::new(writer, columns)?;
         for row in &self.rows {

@@ -111,6 +111,19 @@ impl CalibratedModel {
         BoundSet::to_model(data, &self.joint_kinds(), &self.tools)
     }
 
+    /// The measured signals the model takes as inputs (`calib fit --inputs`), by column name, in
+    /// the order a file read for it keeps them: the GP's. A file without one of them is refused
+    /// by its name ([`CalibratedModel::read_options`]).
+    pub fn input_names(&self) -> Vec<String> {
+        self.residual_gp.as_ref().map(|gp| gp.inputs.clone()).unwrap_or_default()
+    }
+
+    /// How a measurement file is read for this model: its joints, `columns` (`--columns`), and
+    /// the columns of its inputs ([`CalibratedModel::input_names`]), required by name.
+    pub fn read_options(&self, columns: measurements::ColumnMap) -> measurements::ReadOptions {
+        measurements::ReadOptions::for_joints(self.joint_kinds()).with_columns(columns).with_inputs(self.input_names())
+    }
+
     /// The posterior uncertainty and the effects it is of, where the model keeps it.
     pub(crate) fn uncertainty(&self) -> Option<(&crate::EffectUncertainty, &[IdentifiedEffect])> {
         self.effect_uncertainty.as_ref().map(|u| (u, self.effects.as_slice()))

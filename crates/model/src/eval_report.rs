@@ -80,6 +80,10 @@ pub struct EvalReport {
     /// where none was (and left out of the JSON).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub wrapped: Vec<crate::WrappedJoint>,
+    /// The data looks measured from another tracker placement than the model's: one rigid motion
+    /// of the predictions explains most of the error ([`crate::OtherPlacement`]); `None` otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub other_placement: Option<crate::OtherPlacement>,
 }
 
 /// The errors inside and outside a model's coverage.
@@ -144,6 +148,12 @@ impl EvalReport {
             // The evaluation has predicted the same rows with the same GP: it cannot fail here.
             gp_fade: model.gp_fade(&data.rows).ok().flatten(),
             wrapped: Vec::new(),
+            other_placement: crate::OtherPlacement::of(
+                &data.rows,
+                &evaluation.poses,
+                data.full_pose && model.full_pose,
+                &crate::OtherPlacementOptions::default(),
+            ),
         }
     }
 }
@@ -205,7 +215,7 @@ mod tests {
     fn a_unit_no_report_writes_is_refused() {
         let text = OLDEST.replace(
             "\"full_pose\":false",
-            "\"full_pose\":false,\"out_of_range\":[{\"input\":\"t_s\",\"unit\":\"h\",\"fitted\":[0,1],\"rows_outside\":1,\"rows\":3,\"first_line\":2}]",
+            "\"full_pose\":false,\"out_of_range\":[{\"input\":\"t_s\",\"unit\":\"furlong\",\"fitted\":[0,1],\"rows_outside\":1,\"rows\":3,\"first_line\":2}]",
         );
         let error = serde_json::from_str::<EvalReport>(&text).unwrap_err();
         assert!(error.to_string().contains("a unit"), "{error}");

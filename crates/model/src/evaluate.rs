@@ -2,6 +2,7 @@
 
 use crate::{CalibratedModel, ErrorSummary, PoseError, pose_error};
 use errors::Error;
+use lie::SE3;
 use measurements::BoundSet;
 
 /// Per-row errors and their summary.
@@ -11,6 +12,8 @@ pub struct Evaluation {
     pub errors: Vec<PoseError>,
     /// Their statistics.
     pub summary: ErrorSummary,
+    /// Each row's predicted tool pose (tracker frame), in file order.
+    pub poses: Vec<SE3>,
 }
 
 /// Evaluates a fitted model on measurements bound to it ([`CalibratedModel::bind`]). A model fitted on positions only has no rotation
@@ -27,5 +30,5 @@ pub fn evaluate(model: &CalibratedModel, data: &BoundSet<'_>) -> Result<Evaluati
         })
         .collect();
     let summary = ErrorSummary::from_errors(&errors);
-    Ok(Evaluation { errors, summary })
+    Ok(Evaluation { errors, summary, poses: predictions.iter().map(|p| p.pose).collect() })
 }

@@ -17,6 +17,7 @@ pub fn observations(data: &MeasurementSet) -> Vec<Observation> {
                 Some(rotation) => Target::Pose(SE3::new(rotation, row.position)),
                 None => Target::Point(row.position),
             },
+            stated_sigma: row.std,
         })
         .collect()
 }

@@ -149,8 +149,9 @@ impl std::fmt::Display for GeometrySigma {
         write!(
             f,
             "{} of {} rows (the first at line {}) put a joint outside the range the model was fitted on: there the \
-             geometry's own uncertainty (its posterior under the nominal's tolerance) predicts a position error of \
-             {:.4} mm RMS, up to {:.4} mm ({:.4} mm RMS on its training rows)",
+             geometry's own uncertainty (its posterior under the nominal's tolerance) is σ {:.4} mm RMS, up to {:.4} mm \
+             ({:.4} mm RMS on its training rows); that is the geometry's part alone, a lower bound: what the model \
+             leaves beyond the geometry is not in it, and outside the fitted configurations it can be several times more",
             self.rows, self.of_rows, self.first_line, self.rms_mm, self.max_mm, self.training_rms_mm
         )
     }

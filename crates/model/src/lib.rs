@@ -49,6 +49,7 @@ mod metrics;
 mod model_check;
 mod model_file;
 mod model_parts;
+mod other_placement;
 mod predictions;
 mod repeats;
 mod residual_gp;
@@ -69,11 +70,12 @@ pub use method::{Method, UnknownMethod};
 pub use metrics::{ErrorSummary, PoseError, pose_error};
 pub use model_file::{SCHEMA_VERSION, model_text, parse_model, read_model, write_model};
 pub use model_parts::Part;
+pub use other_placement::{OtherPlacement, OtherPlacementOptions};
 pub use repeats::{HeldoutOptions, RepeatGroups};
 pub use residual_gp::{
     GpChoice, GpFadeRule, GpFitReport, GpModel, ResidualFrame, ResidualGp, ResidualGpOptions, ResidualGpReport,
     ResidualSet, UnknownGpChoice, gp_weight,
 };
 pub use suspect_rows::{SuspectRows, suspect_rows};
-pub use training_range::{OutOfRangeWarning, TrainingRange};
+pub use training_range::{InputSpan, OutOfRangeWarning, TrainingRange};
 pub use wrap::{WrappedJoint, wrapped};

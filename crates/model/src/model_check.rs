@@ -164,7 +164,7 @@ impl CalibratedModel {
                 );
                 return Err(at.part("compensation", message));
             }
-            let inputs = n + usize::from(residual_gp.with_payload);
+            let inputs = n + usize::from(residual_gp.with_payload) + residual_gp.inputs.len();
             if residual_gp.gp.input_dim() != inputs {
                 let found = residual_gp.gp.input_dim();
                 return Err(at.count(("gp", 0), "compensation.gp".into(), "inputs", found, inputs));
@@ -184,7 +184,26 @@ impl CalibratedModel {
                 return Err(at.count(("gp", 0), "compensation.gp".into(), "outputs", found, outputs));
             }
         }
+        self.check_inputs(&at)?;
         self.check_values(&at)
+    }
+
+    /// The measured signals the model takes: named once each, and each with its span in the
+    /// training range where the file keeps one (the check walks the model there, and `eval`
+    /// counts the rows outside it).
+    fn check_inputs(&self, at: &Located<'_>) -> Result<(), Error> {
+        let names = self.input_names();
+        if let Some(k) = (1..names.len()).find(|&k| names[..k].contains(&names[k])) {
+            return Err(at.part("inputs", format!("compensation.inputs: the input '{}' is named twice", names[k])));
+        }
+        if let Some(range) = &self.training_range
+            && let Some(name) = names.iter().find(|name| range.input(name).is_none())
+        {
+            let message =
+                format!("training_range.inputs: no span of the input '{name}', which the model takes (an edited file)");
+            return Err(at.part("training_range", message));
+        }
+        Ok(())
     }
 
     /// The rows the walk probes, and how to say where they are: inside the ranges the model was
@@ -207,7 +226,13 @@ impl CalibratedModel {
             Some(residual_gp) => {
                 let mean = residual_gp.gp.input_mean();
                 let payload = if residual_gp.with_payload { mean.get(n).copied().unwrap_or(0.0) } else { 0.0 };
-                (vec![row(mean[..n.min(mean.len())].to_vec(), payload)], "at the mean of the GP's training inputs")
+                let p = n + usize::from(residual_gp.with_payload);
+                let signals =
+                    residual_gp.inputs.iter().enumerate().map(|(k, _)| mean.get(p + k).copied().unwrap_or(0.0));
+                let names: std::sync::Arc<[String]> = residual_gp.inputs.clone().into();
+                let inputs = measurements::Inputs::new(names, signals.collect());
+                let probe = Measurement { inputs, ..row(mean[..n.min(mean.len())].to_vec(), payload) };
+                (vec![probe], "at the mean of the GP's training inputs")
             }
             None => (vec![row(vec![0.0; n], 0.0), row(vec![1.0; n], 0.0)], "with every joint at 0 or 1"),
         }

@@ -2,7 +2,7 @@
 //! leaves, with the joint values (and the payload) as inputs, placed before the POE model
 //! (Eq. 9): `T = G(q, m) · T_POE(q)`.
 
-use errors::Error;
+use errors::{Error, ErrorKind};
 use faer::Mat;
 use lie::{SE3, Twist, Vector3, Vector6};
 use measurements::{BoundSet, Measurement, MeasurementSet};
@@ -121,41 +121,34 @@ pub struct ResidualGpOptions {
     /// median of all of them took longer than the sparse GP's own search. The exact GP's comes
     /// from its leave-one-out over every row, which the fit computes anyway. At least 1.
     pub fade_share_rows: usize,
+    /// Measured signals taken as inputs beside the joints and the payload (`calib fit --inputs`,
+    /// issue 46): columns of the measurement file by name (after `--columns`), in this order. The
+    /// GP standardises every input, so each is used in the unit it was measured in.
+    pub inputs: Vec<String>,
+    /// The fallback GP's ([`ResidualGp::fallback`]) full-data searches after its warm-start
+    /// subset take at most this many iterations ([`gp::OptimiserConfig::refine_max_iterations`];
+    /// `None`: as the GP's own). The fallback serves only the rows an effect's span fades to the
+    /// geometry alone, where the hyperparameters' last few nats on all rows change little.
+    pub fallback_refine_iterations: Option<usize>,
 }
 
 impl Default for ResidualGpOptions {
     fn default() -> Self {
+        // What each default was measured against is in docs/results/gp-defaults.md; here the
+        // reasons.
+        //
         // ARD squared exponential plus a first-order additive term (one one-dimensional squared
-        // exponential per input) rather than the paper's Eq. 5 kernel: on the UR10 data (series
-        // C, 1387 training poses, position only, even rows → odd rows) the paper's kernel left
-        // 0.307 mm held out, SE-ARD 0.205 mm and SE-ARD + additive 0.136 mm; the additive term
-        // learns a joint's periodic gear error from the poses that move that joint, which the
-        // joint ARD term cannot (docs/results/bench-gp.md has the other data sets). The default
-        // start and the kernel's nested start (additive term nearly off), searched on a 500-row
-        // warm-start subset; no random restarts: over the 8 data sets of `bench-gp --kernels`
-        // (24 searches) a random start never reached the best likelihood, and they cost a third
-        // of the search at 300 poses.
+        // exponential per input) rather than the paper's Eq. 5 kernel: the additive term learns a
+        // joint's periodic gear error from the poses that move that joint, which the joint ARD
+        // term cannot. The default start and the kernel's nested start (additive term nearly
+        // off), searched on a 500-row warm-start subset; no random restarts, which never reached
+        // the best likelihood on bench-gp's sets.
         //
         // The search stops when an iteration raises the log marginal likelihood by less than
-        // 1e-5 of itself (≈ 0.005 nats on these data, far below the ~1 nat that separates models
-        // in a likelihood-ratio sense) instead of scipy's 2.2e-9, and keeps 20 curvature pairs
-        // (the default kernel's parameter count on six joints, so nearly full BFGS) instead of
-        // 10. Chosen with `bench-gp --kernels --search-seeds 0,1,2,3,4,5` (8 sets, 6 searches
-        // each, the held-out error's mean ± half its spread; docs/results/gp-kernel.md): against
-        // memory 10 / 1e-6 the fit time summed over the sets fell 18.0 → 10.7 s (UR10 C 10.3 →
-        // 6.4 s), every set's mean held-out error stayed within its seed spread (UR10 C 0.1362 →
-        // 0.1361, B 0.2622 → 0.2600, the simulated sets within 0.0005 mm), and the likelihood
-        // reached fell by 4.3 nats summed over the 24 searches. 1e-5 with memory 10 lost 20 nats
-        // and memory 30 lost 15; 3e-6 with memory 20 took 13.0 s.
-        //
-        // The full-data search after the subset's starts at the subset's optimum and stops at
-        // 1e-4 (`refine_function_tolerance`, ≈ 0.1–0.3 nats per iteration on these data): from
-        // there it climbed a few hundredths of a nat per iteration for half of its iterations,
-        // each an `n³` factorisation on every row. `calib fit --method poe-gp` on UR10 C and B,
-        // even rows → odd rows, subset seeds 0–3 (docs/results/gp-search-time.md): full-data
-        // evaluations summed over the seeds 833 → 488 (C), 915 → 572 (B); the held-out position
-        // error's mean over the seeds +0.5 % (C), +0.2 % (B), the largest single seed +1.6 %,
-        // inside the spread between seeds (2.5 % on C).
+        // 1e-5 of itself (≈ 0.005 nats here, far below the ~1 nat that separates models) and
+        // keeps 20 curvature pairs (the kernel's parameter count on six joints: nearly full
+        // BFGS). The full-data search after the subset starts near its optimum, where an
+        // iteration gains hundredths of a nat for an `n³` factorisation: it stops at 1e-4.
         let optimiser = gp::OptimiserConfig {
             restarts: 0,
             warm_start_rows: 500,
@@ -176,61 +169,45 @@ impl Default for ResidualGpOptions {
                 // The additive term only where the data pay for it: per output, the kernel with
                 // and without it are both searched (on the warm-start subset when there is one,
                 // then only the chosen one on all rows) and the additive term is kept when it
-                // raises the log marginal likelihood by more than the Schwarz penalty ½ · 2d · ln N
-                // (≈ 34 nats for 6 joints and 300 poses). No threshold of ours: BIC's own. On the 8
-                // sets of `bench-gp --kernels` the additive term raised the full-data likelihood
-                // by 229–1634 nats (3 outputs summed) on the UR10 series, where it cuts the
-                // held-out error by a quarter to a third, and by 6–27 nats on the simulated ones,
-                // where SE-ARD alone is as good or better held out on average (iiwa payload runs
-                // seed 1: 0.0454 against 0.0461 mm; docs/results/gp-kernel.md).
+                // raises the log marginal likelihood by more than the Schwarz penalty ½ · 2d · ln N.
+                // No threshold of ours: BIC's own.
                 additive_by_bic: true,
                 // The paper's isotropic Eq. 5 kernel beside it, per output, kept where its
-                // closed-form leave-one-out log predictive probability is higher (issue 25): on
-                // 300 simulated poses with payloads (IRB 4400, soft joints) the ARD kernel's
-                // length scales, fitted by marginal likelihood, overfit and lost up to 11 % held
-                // out to scikit-learn's C·RBF + C + DotProduct + White; on the UR10 series the ARD
-                // kernel wins by half. Decided on the warm-start subset's optimum where there is
-                // one, so the isotropic kernel is searched on all rows only where it wins there.
+                // closed-form leave-one-out log predictive probability is higher: on a few hundred
+                // poses the ARD length scales, fitted by marginal likelihood, can overfit. Decided
+                // on the warm-start subset's optimum where there is one, so the isotropic kernel
+                // is searched on all rows only where it wins there.
                 isotropic_by_loo: true,
                 ..gp::GpConfig::default()
             },
             method: GpChoice::default(),
-            // One exact evaluation with its gradient costs n³ flops: 64 GFLOP at n = 4000, about
-            // 3 s on 2 cores at faer's measured rate (docs/results/bench-gp.md), so a search of
-            // 50 evaluations takes minutes; the sparse GP with 500 inducing points takes seconds
-            // there and is within a few percent of the exact error (bench-gp's sweep).
+            // One exact evaluation with its gradient costs n³ flops (64 GFLOP at n = 4000: a
+            // search takes minutes); the sparse GP with 500 inducing points takes seconds there
+            // and stays within a few percent of the exact error.
             sparse_above_rows: 4000,
             sparse: gp::SparseConfig::default(),
-            // A kernel per output: on 100,000 simulated IRB 4400 poses with payloads (seed 7,
-            // tested on 3000 more) shared hyperparameters left 0.105 mm in 31 s, one kernel per
-            // output 0.073 mm in 52 s (the exact GP on the first 3000 poses: 0.075 mm).
+            // A kernel per output: shared hyperparameters lose accuracy where the outputs' errors
+            // vary on different scales.
             sparse_outputs: gp::OutputMode::Independent,
-            // SE-ARD, not the exact GP's additive kernel: on the same 100,000 poses the additive
-            // term left 0.0730 mm against 0.0729 mm and took 219 s against 84 s (both under load
-            // ≈ 4): its d one-dimensional kernels cost d more exponentials for each of the
-            // n·m entries of every bound evaluation.
+            // SE-ARD, not the exact GP's additive kernel: at the sizes the sparse GP serves the
+            // additive term gained nothing held out, and its d one-dimensional kernels cost d
+            // more exponentials for each of the n·m entries of every bound evaluation.
             sparse_kernel: gp::KernelChoice::SquaredExponentialArd,
             residual_frame: ResidualFrame::default(),
-            // Off: on UR10 series C, full pose, even rows → odd rows (issue 25), the shared
-            // rotation kernel cut the GP's CPU time from 25.9 to 17.5 s but made the held-out
-            // rotation error 22 % worse (0.302 → 0.368 mrad); accuracy first.
+            // Off: a shared rotation kernel is cheaper but cost held-out rotation accuracy on the
+            // UR10; accuracy first.
             rotation_follows_position: false,
             // One half: where the posterior keeps more than half of the prior variance a training
-            // pose leaves, the prediction is more the prior's extrapolation than the data's. On the
-            // UR10 (issue 23, full pose, release; docs/results/splits.md) the GP fitted on all of
-            // series C meets series B with r = 0.5 … 1 on every row but one, and corrected B's rows
-            // to 1.467 mm against the geometry's 1.421. Replayed offline first (`poe-gp`, share
-            // from 0): fading from one half gave 1.428 and cost 0.2–3.6 % on B's own splits, where
-            // the GP's extrapolation past the end of a joint's range helped (elbow − → + 0.794 →
-            // 0.823); from three quarters C → B stayed 1.456 (1.024× the geometry); each output by
-            // its own share cost up to 8 %. As built (share from the training rows' left-out
-            // share): `poe-gp --effects auto` C → B 1.4334, B even → odd 0.2213 → 0.2214, B's
-            // j3-end, elbow and j2-gap splits within 0.3 %.
+            // pose leaves, the prediction is more the prior's extrapolation than the data's.
             fade_above_variance_ratio: Some(0.5),
             // The median of 2,000 rows is within about 3 % of the rows' spread of the median of
             // all of them (its standard error, 1.25 σ / √2000), far inside the rule's margin:
             // the share fades the correction only from half-way between it and 1.
             fade_share_rows: 2000,
+            inputs: Vec::new(),
+            // The subset's optimum as it is (no iteration on all rows): the fallback serves only
+            // the rows an effect's span fades, where its held-out error matched the full search's.
+            fallback_refine_iterations: Some(0),
         }
     }
 }
@@ -246,7 +223,9 @@ impl ResidualGpOptions {
             _ if self.fade_share_rows == 0 => {
                 Err(("fade_share_rows", "residual_gp.fade_share_rows is 0, expected at least 1".to_owned()))
             }
-            _ => Ok(()),
+            _ => measurements::InputNames::new(self.inputs.clone(), "residual_gp.inputs")
+                .map(|_| ())
+                .map_err(|e| ("inputs", format!("residual_gp.inputs: {}", e.kind()))),
         }
     }
 }
@@ -278,6 +257,8 @@ struct OptimiserPatch {
     warm_start_curvature: Option<bool>,
     #[serde(default, deserialize_with = "given")]
     refine_function_tolerance: Option<Option<f64>>,
+    #[serde(default, deserialize_with = "given")]
+    refine_max_iterations: Option<Option<usize>>,
     #[serde(default, deserialize_with = "given")]
     kernel_cache_bytes: Option<usize>,
 }
@@ -350,6 +331,7 @@ fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<
             warm_start_rows,
             warm_start_curvature,
             refine_function_tolerance,
+            refine_max_iterations,
             kernel_cache_bytes,
         } = o;
         let d = &mut gp.optimiser;
@@ -362,6 +344,7 @@ fn onto_default_gp<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<
         d.warm_start_rows = warm_start_rows.unwrap_or(d.warm_start_rows);
         d.warm_start_curvature = warm_start_curvature.unwrap_or(d.warm_start_curvature);
         d.refine_function_tolerance = refine_function_tolerance.unwrap_or(d.refine_function_tolerance);
+        d.refine_max_iterations = refine_max_iterations.unwrap_or(d.refine_max_iterations);
         d.kernel_cache_bytes = kernel_cache_bytes.unwrap_or(d.kernel_cache_bytes);
     }
     Ok(gp)
@@ -506,6 +489,11 @@ pub struct ResidualGp {
     /// fitted. Absent in older files and where the options turn it off: it never fades there.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fade: Option<GpFadeRule>,
+    /// The measured signals the GP takes after the joints and the payload, by column name
+    /// ([`ResidualGpOptions::inputs`]; their spans are in the model's
+    /// [`crate::TrainingRange::inputs`]). Absent in older files and where it takes none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub inputs: Vec<String>,
 }
 
 /// Where a GP's correction fades: from the share `r` of its prior variance (of the position
@@ -638,6 +626,10 @@ pub struct ResidualGpReport {
     /// The configurations measured more than once.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub repeated_configurations: usize,
+    /// The measured signals the GP took beside the joints (`--inputs`), each with its unit and
+    /// the span it was fitted on; absent where it took none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub inputs: Vec<crate::InputSpan>,
 }
 
 fn is_zero(n: &usize) -> bool {
@@ -658,10 +650,32 @@ fn exact_fit(x: &Mat<f64>, y: &Mat<f64>, full_pose: bool, options: &ResidualGpOp
     gp::ExactGp::fit(x.as_ref(), y.as_ref(), &config).map_err(Error::gp)
 }
 
-fn inputs(rows: &[Measurement], with_payload: bool) -> Mat<f64> {
+/// The GP's inputs of `rows`: the joints, the payload where `with_payload`, then the measured
+/// signals `signals` by name; a row without one of them is refused at its line of `source`
+/// ([`ErrorKind::MissingInput`]: rows a caller made without it; a file without the column was
+/// refused by its reader).
+fn inputs(rows: &[Measurement], with_payload: bool, signals: &[String], source: &str) -> Result<Mat<f64>, Error> {
     let n = rows.first().map_or(0, |r| r.q.len());
-    let d = n + usize::from(with_payload);
-    Mat::from_fn(rows.len(), d, |i, c| if c < n { rows[i].q[c] } else { rows[i].payload_kg })
+    let p = n + usize::from(with_payload);
+    let mut x = Mat::from_fn(rows.len(), p + signals.len(), |i, c| {
+        if c < n {
+            rows[i].q[c]
+        } else if c < p {
+            rows[i].payload_kg
+        } else {
+            0.0
+        }
+    });
+    for (i, row) in rows.iter().enumerate() {
+        for (k, name) in signals.iter().enumerate() {
+            let Some(value) = row.inputs.value(k, name) else {
+                let kind = ErrorKind::MissingInput { name: name.clone() };
+                return Err(Error::at_line(source.to_owned(), row.line, 1, kind));
+            };
+            x[(i, p + k)] = value;
+        }
+    }
+    Ok(x)
 }
 
 /// The error of one row against the model's pose, as the GP's output vector.
@@ -698,6 +712,18 @@ pub struct ResidualSet {
 impl ResidualSet {
     /// The error that the model poses `poses` (one per row) leave on `data`, expressed in `frame`.
     pub fn new(poses: &[SE3], data: &MeasurementSet, with_payload: bool, frame: ResidualFrame) -> Self {
+        Self::with_inputs(poses, data, with_payload, &[], frame).expect("no measured signal to miss")
+    }
+
+    /// [`ResidualSet::new`] with the measured signals `signals` as inputs after the joints and
+    /// the payload; a row without one is refused at its line.
+    pub fn with_inputs(
+        poses: &[SE3],
+        data: &MeasurementSet,
+        with_payload: bool,
+        signals: &[String],
+        frame: ResidualFrame,
+    ) -> Result<Self, Error> {
         let outputs = if data.full_pose { 6 } else { 3 };
         let mut y = Mat::<f64>::zeros(data.rows.len(), outputs);
         for (i, (row, pose)) in data.rows.iter().zip(poses).enumerate() {
@@ -706,7 +732,7 @@ impl ResidualSet {
                 y[(i, c)] = e[c];
             }
         }
-        Self { inputs: inputs(&data.rows, with_payload), outputs: y }
+        Ok(Self { inputs: inputs(&data.rows, with_payload, signals, &data.source)?, outputs: y })
     }
 }
 
@@ -721,7 +747,8 @@ impl ResidualGp {
         options: &ResidualGpOptions,
         repeats: &crate::RepeatGroups,
     ) -> Result<(Self, ResidualGpReport), Error> {
-        let ResidualSet { inputs: x, outputs: y } = ResidualSet::new(poses, data, with_payload, options.residual_frame);
+        let ResidualSet { inputs: x, outputs: y } =
+            ResidualSet::with_inputs(poses, data, with_payload, &options.inputs, options.residual_frame)?;
         let (gp, report, loo, leave_group_out) = match options.choice_for(x.nrows()) {
             GpChoice::Sparse => {
                 let inducing_points = options.sparse.inducing_points.min(x.nrows());
@@ -768,6 +795,7 @@ impl ResidualGp {
             tool_points: Vec::new(),
             fallback: None,
             fade,
+            inputs: options.inputs.clone(),
         };
         let summary = |mean: Mat<f64>| {
             let errors: Vec<crate::PoseError> = poses
@@ -788,14 +816,18 @@ impl ResidualGp {
             leave_group_out: leave_group_out.map(&summary),
             repeated_rows: repeats.repeated_rows(),
             repeated_configurations: repeats.groups.iter().filter(|g| g.len() > 1).count(),
+            inputs: crate::TrainingRange::of(&data.rows)
+                .map(|range| range.inputs.into_iter().filter(|i| options.inputs.contains(&i.name)).collect())
+                .unwrap_or_default(),
         };
         Ok((residual_gp, report))
     }
 
-    /// The GP's inputs for `rows`: `(q_1 … q_n[, m])`, the payload where the GP takes it, as its
-    /// fit and its prediction build them.
-    pub fn inputs_of(&self, rows: &[Measurement]) -> Mat<f64> {
-        inputs(rows, self.with_payload)
+    /// The GP's inputs for `rows`: `(q_1 … q_n[, m], s_1 … s_k)`, the payload where the GP
+    /// takes it and then its measured signals ([`ResidualGp::inputs`]), as its fit and its
+    /// prediction build them; a row without a signal is refused at its line of `source`.
+    pub fn inputs_of(&self, rows: &[Measurement], source: &str) -> Result<Mat<f64>, Error> {
+        inputs(rows, self.with_payload, &self.inputs, source)
     }
 
     /// `G` for the GP's output `g` at a model pose: a translation for position-only data, else the
@@ -864,8 +896,11 @@ impl ResidualGp {
             return Ok(());
         }
         let ResidualSet { inputs: x, outputs: y } =
-            ResidualSet::new(alone_poses, data, self.with_payload, self.residual_frame);
-        let fallback = GpModel::Exact(timings::phase("search", || exact_fit(&x, &y, data.full_pose, options))?);
+            ResidualSet::with_inputs(alone_poses, data, self.with_payload, &self.inputs, self.residual_frame)?;
+        let mut options = options.clone();
+        options.gp.optimiser.refine_max_iterations =
+            options.fallback_refine_iterations.or(options.gp.optimiser.refine_max_iterations);
+        let fallback = GpModel::Exact(timings::phase("search", || exact_fit(&x, &y, data.full_pose, &options))?);
         if let Some(fade) = &mut self.fade {
             fade.fallback_training_share =
                 Some(timings::phase("fade share", || median_share(&fallback, &x, None, options.fade_share_rows))?);
@@ -878,7 +913,7 @@ impl ResidualGp {
     /// of its prior variance the posterior keeps there: of the GP, and with a
     /// [`ResidualGp::fallback`] the smaller of the two weights.
     pub fn weights(&self, rows: &[Measurement]) -> Result<Vec<(f64, f64)>, Error> {
-        let x = inputs(rows, self.with_payload);
+        let x = inputs(rows, self.with_payload, &self.inputs, "the rows")?;
         let mut out = vec![(1.0, 0.0); rows.len()];
         for (gp, fallback) in std::iter::once((&self.gp, false)).chain(self.fallback.iter().map(|f| (f, true))) {
             let prediction = gp.predict(x.as_ref()).map_err(Error::gp)?;
@@ -901,7 +936,8 @@ impl ResidualGp {
         model_poses: &[SE3],
     ) -> Result<Vec<Correction>, Error> {
         let tools = data.tools();
-        let prediction = gp.predict(inputs(data.rows(), self.with_payload).as_ref()).map_err(Error::gp)?;
+        let x = inputs(data.rows(), self.with_payload, &self.inputs, &data.set().source)?;
+        let prediction = gp.predict(x.as_ref()).map_err(Error::gp)?;
         let outputs = prediction.mean.ncols();
         Ok(model_poses
             .iter()

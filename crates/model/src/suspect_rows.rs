@@ -80,12 +80,14 @@ pub(crate) fn suspects_among(
     }
     let mut lines: Vec<OutlierLine> = named
         .iter()
-        .map(|&i| OutlierLine {
-            line: rows[i].line,
-            position_mm: errors[i].position_mm,
-            position_sigmas: sigmas(&errors[i]),
-            rotation_mrad: errors[i].rotation_mrad,
-            rotation_sigmas: errors[i].rotation_mrad.zip(rotation).map(|(a, (m, s))| (a - m) / s),
+        .map(|&i| {
+            OutlierLine::new(
+                rows[i].line,
+                errors[i].position_mm,
+                sigmas(&errors[i]),
+                errors[i].rotation_mrad,
+                errors[i].rotation_mrad.zip(rotation).map(|(a, (m, s))| (a - m) / s),
+            )
         })
         .collect();
     lines.sort_by(|a, b| b.position_sigmas.total_cmp(&a.position_sigmas));

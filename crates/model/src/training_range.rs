@@ -23,6 +23,37 @@ pub struct TrainingRange {
     /// Per joint, `[min, max]` of the measured torque, N·m, where every row had them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub torques_nm: Option<Vec<[f64; 2]>>,
+    /// The measured signals the model takes as inputs (`--inputs`, issue 46), each with its
+    /// unit and `[min, max]` over the training rows, in the order the model takes them. Absent
+    /// in files written before there were inputs, and for models that take none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub inputs: Vec<InputSpan>,
+}
+
+/// A measured signal a model takes as an input, as fitted: `calib eval`, `predict`, `compensate`
+/// and `report` require its column by name and count the rows outside its span.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InputSpan {
+    /// The column's name (after `--columns`).
+    pub name: String,
+    /// The unit its name's suffix states ([`measurements::input_unit`]), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none", deserialize_with = "crate::unit_name::input")]
+    pub unit: Option<crate::unit_name::Unit>,
+    /// Its smallest and largest value on the training rows.
+    pub fitted: [f64; 2],
+}
+
+impl std::fmt::Display for InputSpan {
+    /// `tilt_x_mrad: -1.2 … 3.4 mrad`, the numbers as written (shortest round trip).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let [low, high] = self.fitted;
+        write!(f, "{}: {low} … {high}", self.name)?;
+        match self.unit {
+            Some(unit) => write!(f, " {unit}"),
+            None => Ok(()),
+        }
+    }
 }
 
 fn span(values: impl Iterator<Item = f64>) -> [f64; 2] {
@@ -34,9 +65,22 @@ fn spans<'a>(rows: impl Iterator<Item = &'a [f64]> + Clone, n: usize) -> Vec<[f6
 }
 
 impl TrainingRange {
-    /// The ranges of `rows` (`None` for no rows); optional inputs only where every row has them.
+    /// The ranges of `rows` (`None` for no rows); optional inputs only where every row has them,
+    /// measured signals ([`Measurement::inputs`]) those of the first row that every row has.
     pub fn of(rows: &[Measurement]) -> Option<Self> {
-        let n = rows.first()?.q.len();
+        let first = rows.first()?;
+        let n = first.q.len();
+        let inputs = first
+            .inputs
+            .names()
+            .iter()
+            .enumerate()
+            .filter_map(|(k, name)| {
+                let values: Option<Vec<f64>> = rows.iter().map(|r| r.inputs.value(k, name)).collect();
+                let fitted = span(values?.into_iter());
+                Some(InputSpan { name: name.clone(), unit: measurements::input_unit(name), fitted })
+            })
+            .collect();
         let all = |f: fn(&Measurement) -> Option<f64>| rows.iter().map(f).collect::<Option<Vec<f64>>>();
         let torques: Option<Vec<&[f64]>> =
             rows.iter().map(|r| r.torques_nm.as_deref().filter(|t| t.len() == n)).collect();
@@ -46,7 +90,13 @@ impl TrainingRange {
             temp_c: all(|r| r.temp_c).map(|v| span(v.into_iter())),
             t_s: all(|r| r.t_s).map(|v| span(v.into_iter())),
             torques_nm: torques.map(|t| spans(t.into_iter(), n)),
+            inputs,
         })
+    }
+
+    /// The span of input `name`, if the range records it.
+    pub fn input(&self, name: &str) -> Option<&InputSpan> {
+        self.inputs.iter().find(|i| i.name == name)
     }
 
     /// The first range that is not finite, reversed, of the wrong length, or (for a joint)
@@ -71,13 +121,20 @@ impl TrainingRange {
             }
         }
         let single = [("payload_kg", Some(self.payload_kg)), ("temp_c", self.temp_c), ("t_s", self.t_s)];
-        single.into_iter().find_map(|(name, r)| r.and_then(|r| bad(&r, f64::MAX)).map(|v| (name, 0, v)))
+        if let Some(fault) =
+            single.into_iter().find_map(|(name, r)| r.and_then(|r| bad(&r, f64::MAX)).map(|v| (name, 0, v)))
+        {
+            return Some(fault);
+        }
+        self.inputs.iter().enumerate().find_map(|(k, i)| bad(&i.fitted, f64::MAX).map(|v| ("inputs", k, v)))
     }
 
     /// Rows inside the ranges at which a model is probed: the centre of every range, and the
     /// corners where every input is at its smallest and at its largest (tool 0, no measured pose).
     pub(crate) fn probe_rows(&self) -> Vec<Measurement> {
+        let names: std::sync::Arc<[String]> = self.inputs.iter().map(|i| i.name.clone()).collect();
         let at = |pick: fn(&[f64; 2]) -> f64| Measurement {
+            inputs: measurements::Inputs::new(names.clone(), self.inputs.iter().map(|i| pick(&i.fitted)).collect()),
             payload_kg: pick(&self.payload_kg),
             temp_c: Some(self.temp_c.as_ref().map_or(0.0, pick)),
             t_s: Some(self.t_s.as_ref().map_or(0.0, pick)),
@@ -96,9 +153,10 @@ impl TrainingRange {
 /// fit measured. One per input that some row leaves.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct OutOfRangeWarning {
-    /// The input: `joint 3`, `payload_kg`, `temp_c` or `t_s`.
+    /// The input: `joint 3`, `payload_kg`, `temp_c`, `t_s`, or a measured signal by its name.
     pub input: String,
-    /// Its unit: `rad`, `m` (a prismatic joint), `kg`, `°C`, `s`.
+    /// Its unit: `rad`, `m` (a prismatic joint), `kg`, `°C`, `s`; a signal's as its name states
+    /// it, empty where the name states none.
     #[serde(deserialize_with = "crate::unit_name::deserialize")]
     pub unit: crate::unit_name::Unit,
     /// Its smallest and largest value on the training rows.
@@ -117,8 +175,13 @@ impl std::fmt::Display for OutOfRangeWarning {
         write!(
             f,
             "{} of {} rows (the first at line {}) put {} outside the range the model was fitted on \
-             ({low:.4} … {high:.4} {}): there the model answers for inputs it never saw",
-            self.rows_outside, self.rows, self.first_line, self.input, self.unit
+             ({low:.4} … {high:.4}{}{}): there the model answers for inputs it never saw",
+            self.rows_outside,
+            self.rows,
+            self.first_line,
+            self.input,
+            if self.unit.is_empty() { "" } else { " " },
+            self.unit
         )
     }
 }
@@ -137,6 +200,11 @@ impl TrainingRange {
             && within(row.payload_kg, self.payload_kg)
             && self.temp_c.zip(row.temp_c).is_none_or(|(range, v)| within(v, range))
             && self.t_s.zip(row.t_s).is_none_or(|(range, v)| within(v, range))
+            && self
+                .inputs
+                .iter()
+                .enumerate()
+                .all(|(k, i)| row.inputs.value(k, &i.name).is_none_or(|v| within(v, i.fitted)))
     }
 
     /// One warning per input that some of `rows` put outside its fitted range (`prismatic[j]`:
@@ -163,6 +231,11 @@ impl TrainingRange {
         }
         if let Some(range) = self.t_s {
             inputs.push(("t_s".into(), "s", range, Box::new(|r: &Measurement| r.t_s)));
+        }
+        for (k, input) in self.inputs.iter().enumerate() {
+            let name = input.name.as_str();
+            let pick = Box::new(move |r: &Measurement| r.inputs.value(k, name)) as Pick<'_>;
+            inputs.push((input.name.clone(), input.unit.unwrap_or(""), input.fitted, pick));
         }
         inputs
             .into_iter()

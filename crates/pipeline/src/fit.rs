@@ -133,6 +133,15 @@ pub enum FitWarning {
         /// The effect's label.
         effect: String,
     },
+    /// Rows whose stated uncertainty (`std_x_mm` …) is far above the other rows' (issue 46): a
+    /// lost or half-occluded reflector, or a mistyped σ. They are weighted as if stated at the
+    /// limit, not down to nothing ([`poe::identify::StatedNoise::far_above_median`]).
+    StatedUncertaintyFarAbove {
+        /// The rows, by line, with their stated σ over the median row's, largest first.
+        rows: Vec<(u64, f64)>,
+        /// The limit, times the median.
+        far_above_median: f64,
+    },
     /// The fitted model misses the training positions by more than the nominal robot placed by a
     /// rigid transform ([`crate::PlausibilityOptions::wrong_minimum_ratio`]): the identification
     /// stopped in a wrong minimum, and the model is not to be used.
@@ -173,6 +182,19 @@ impl std::fmt::Display for FitWarning {
                 "effect {effect} has the same value on every training row (a torque or force that never changes \
                  sign): a constant offset the geometry already holds, so its parameters mean nothing; leave it out"
             ),
+            FitWarning::StatedUncertaintyFarAbove { rows, far_above_median } => {
+                let listed: Vec<String> =
+                    rows.iter().take(10).map(|(line, ratio)| format!("line {line} ({ratio:.0}×)")).collect();
+                let more = if rows.len() > 10 { format!(" and {} more", rows.len() - 10) } else { String::new() };
+                write!(
+                    f,
+                    "{} row(s) state an uncertainty more than {far_above_median} times the median row's: {}{more}; \
+                     weighted as if {far_above_median} times, not left out: check them (a lost or half-occluded \
+                     reflector, a mistyped std column)",
+                    rows.len(),
+                    listed.join(", ")
+                )
+            }
             FitWarning::WrongMinimum { rms_mm, rigid_rms_mm } => write!(
                 f,
                 "the fitted model misses the training positions by {rms_mm:.3} mm RMS, more than the nominal robot \
@@ -505,6 +527,13 @@ pub fn fit(
             rows: outliers.clone(),
             threshold_sigmas: identification.robust.outlier_threshold,
             left_out,
+        });
+    }
+    if let Some(stated) = identification.stated_noise.as_ref().filter(|s| !s.far_above.is_empty()) {
+        let rows = stated.far_above.iter().map(|&(i, ratio)| (data.rows.get(i).map_or(0, |r| r.line), ratio));
+        warnings.push(FitWarning::StatedUncertaintyFarAbove {
+            rows: rows.collect(),
+            far_above_median: stated.far_above_median,
         });
     }
     if let Some(report) = &residual_gp {

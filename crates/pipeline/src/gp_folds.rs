@@ -82,7 +82,7 @@ pub(crate) fn predicted_with_gp(
     }
     let n = folds.rows.len();
     let m = exact.output_count();
-    let x = gp.inputs_of(&folds.rows);
+    let x = gp.inputs_of(&folds.rows, "the diagnosis's rows")?;
     let all: Vec<&FoldResiduals> = folds.random.iter().chain(folds.arcs.iter().flat_map(|(_, f)| f)).collect();
     let targets: Vec<Mat<f64>> =
         all.iter().map(|f| Mat::from_fn(n, m, |i, c| f.residuals.get(i).map_or(0.0, |r| r[c]))).collect();

@@ -68,12 +68,11 @@ pub struct PlausibilityOptions {
     pub planar_ratio: f64,
     /// After the fit: warn when the fitted model misses the training positions by more than this
     /// times the RMS of the nominal robot placed by a rigid transform (`rotation_rms_mm`). The
-    /// identification holds that placement as a special case (its base and tool parameters), so
-    /// at its optimum it cannot do worse; a fit that does stopped in a wrong minimum (issue 23's
-    /// 7-axis shape: 855 mm against 4.0 mm before 7eb349d's second registration start). 2: a
-    /// robust fit that leaves a few gross outliers out may exceed the least-squares placement's
-    /// RMS over every row somewhat, never by half again (the check is skipped when rows were left
-    /// out).
+    /// identification holds that placement as a special case (its base and tool parameters), so at
+    /// its optimum it cannot do worse; a fit that does stopped in a wrong minimum (a 7-axis arm's
+    /// identification once ended over 200 times above that placement's RMS). 2: a robust fit that leaves
+    /// a few gross outliers out may exceed the least-squares placement's RMS over every row
+    /// somewhat, never by half again (the check is skipped when rows were left out).
     pub wrong_minimum_ratio: f64,
 }
 

@@ -79,7 +79,7 @@ fn a_program_taught_on_the_nominal_model_is_rewritten_to_reach_its_poses() {
     assert_eq!(
         lines.next().unwrap(),
         "q1_rad,q2_rad,q3_rad,q4_rad,q5_rad,q6_rad,nominal_q1_deg,nominal_q2_deg,nominal_q3_deg,nominal_q4_deg,\
-         nominal_q5_deg,nominal_q6_deg,payload_kg,speed,tool,residual_mm,residual_mrad,status"
+         nominal_q5_deg,nominal_q6_deg,payload_kg,speed,tool,residual_mm,residual_mrad,status,line"
     );
     let first: Vec<&str> = lines.next().unwrap().split(',').collect();
     assert_eq!(&first[6..15], ["10", "20", "-10", "30", "40", "50", "0", "v100", ""]);
@@ -94,8 +94,15 @@ fn pose_targets_from_a_seed_are_reached_on_the_seeds_branch() {
     let pose = predicted(&model, &q, 0.0);
     let seed: Vec<f64> = q.iter().map(|v| v + 0.15).collect();
     let targets = [
-        PoseTarget { seed: seed.clone(), pose, orientation: true, payload_kg: 0.0, tool: 0 },
-        PoseTarget { seed, pose, orientation: false, payload_kg: 0.0, tool: 0 },
+        PoseTarget {
+            seed: seed.clone(),
+            pose,
+            orientation: true,
+            payload_kg: 0.0,
+            tool: 0,
+            inputs: Default::default(),
+        },
+        PoseTarget { seed, pose, orientation: false, payload_kg: 0.0, tool: 0, inputs: Default::default() },
     ];
     let solved = cell::solve_targets(&model, &targets, None, &InverseOptions::default()).unwrap();
     assert!(solved[0].status.is_ok(), "{}", solved[0].status);
@@ -113,7 +120,14 @@ fn a_gp_model_with_payload_is_compensated_through_its_whole_prediction() {
     let pose = predicted(&model, &q, 0.0);
     let targets: Vec<PoseTarget> = [0.0, 10.0]
         .iter()
-        .map(|&payload_kg| PoseTarget { seed: q.clone(), pose, orientation: false, payload_kg, tool: 0 })
+        .map(|&payload_kg| PoseTarget {
+            seed: q.clone(),
+            pose,
+            orientation: false,
+            payload_kg,
+            tool: 0,
+            inputs: Default::default(),
+        })
         .collect();
     let solved = cell::solve_targets(&model, &targets, None, &InverseOptions::default()).unwrap();
     for (s, t) in solved.iter().zip(&targets) {
@@ -132,15 +146,23 @@ fn rows_that_cannot_be_compensated_say_why() {
     let far = SE3::from_translation(Vector3::new(10.0, 0.0, 0.0)) * pose;
     let singular_q = vec![0.3, 0.2, -0.1, 0.8, 0.0, -0.4];
     let targets = [
-        PoseTarget { seed: q.clone(), pose: far, orientation: true, payload_kg: 0.0, tool: 0 },
+        PoseTarget {
+            seed: q.clone(),
+            pose: far,
+            orientation: true,
+            payload_kg: 0.0,
+            tool: 0,
+            inputs: Default::default(),
+        },
         PoseTarget {
             seed: singular_q.clone(),
             pose: predicted(&model, &singular_q, 0.0),
             orientation: true,
             payload_kg: 0.0,
             tool: 0,
+            inputs: Default::default(),
         },
-        PoseTarget { seed: q.clone(), pose, orientation: true, payload_kg: 0.0, tool: 0 },
+        PoseTarget { seed: q.clone(), pose, orientation: true, payload_kg: 0.0, tool: 0, inputs: Default::default() },
     ];
     let mut limits = irb.limits();
     limits[3].1 = 0.5;

@@ -46,7 +46,7 @@ fn data(rows: usize) -> (LocalPoe, Vec<Observation>) {
         .map(|_| {
             let q: Vec<f64> = (0..6).map(|_| next() * 1.5).collect();
             let pose = truth.forward(&q, 0).expect("six joints");
-            Observation { q, tool: 0, target: Target::Pose(pose) }
+            Observation { q, tool: 0, target: Target::Pose(pose), stated_sigma: None }
         })
         .collect();
     (nominal, observations)

@@ -46,7 +46,7 @@ fn with_harmonic(
             moved[joint] += theta[0] * (2.0 * q[joint]).cos() + theta[1] * (2.0 * q[joint]).sin();
             let pose = truth.forward(&moved, 0).unwrap();
             let target = if full_pose { Target::Pose(pose) } else { Target::Point(pose.translation()) };
-            Observation { q, tool: 0, target }
+            Observation { q, tool: 0, target, stated_sigma: None }
         })
         .collect()
 }

@@ -26,7 +26,7 @@ fn wrist_held_still(seed: u64, count: usize) -> (poe::LocalPoe, Vec<Observation>
             let noise = Vector3::new(gaussian(&mut r), gaussian(&mut r), gaussian(&mut r)) * 5e-5;
             let unmodelled = Vector3::new(1.0, -1.0, 0.5) * 3e-4 * (3.0 * q[1]).sin();
             let point = truth.forward(&q, 0).unwrap().translation() + noise + unmodelled;
-            Observation { q, tool: 0, target: Target::Point(point) }
+            Observation { q, tool: 0, target: Target::Point(point), stated_sigma: None }
         })
         .collect();
     (nominal, observations)

@@ -125,7 +125,7 @@ fn each_tool_gets_its_own_transform_and_the_arm_is_shared() {
         let q = common::random_q(&mut rng, &limits);
         let tool = i % 2;
         let p = truth2.forward(&q, tool).unwrap().translation();
-        observations.push(Observation { q, tool, target: Target::Point(p) });
+        observations.push(Observation { q, tool, target: Target::Point(p), stated_sigma: None });
     }
     let fit = calibrate(&nominal, &observations, Scope::Full, &IdentificationOptions::default()).unwrap();
     assert_eq!(fit.model.tool_count(), 2);
@@ -155,7 +155,8 @@ fn a_fixed_block_is_left_untouched() {
 fn identify_refuses_a_mask_of_the_wrong_length() {
     let (nominal, _) = irb4400();
     let mask = ParameterMask::from_flags(vec![true; 5]);
-    let observation = Observation { q: vec![0.0; 6], tool: 0, target: Target::Point(Vector3::zeros()) };
+    let observation =
+        Observation { q: vec![0.0; 6], tool: 0, target: Target::Point(Vector3::zeros()), stated_sigma: None };
     assert_eq!(
         identify(&nominal, &[observation], &mask, &IdentificationOptions::default()).unwrap_err(),
         poe::Error::MaskLength { given: 5, expected: 42 }
@@ -166,8 +167,12 @@ fn identify_refuses_a_mask_of_the_wrong_length() {
 fn registration_refuses_too_few_rows() {
     let (nominal, _) = irb4400();
     let mut rng = rng(700);
-    let observation =
-        Observation { q: vec![0.0; 6], tool: 0, target: Target::Point(Vector3::new(gaussian(&mut rng), 0.0, 0.0)) };
+    let observation = Observation {
+        q: vec![0.0; 6],
+        tool: 0,
+        target: Target::Point(Vector3::new(gaussian(&mut rng), 0.0, 0.0)),
+        stated_sigma: None,
+    };
     assert!(matches!(
         calibrate(&nominal, &[observation], Scope::Full, &IdentificationOptions::default()),
         Err(poe::Error::TooFewForRegistration { observations: 1, needed: 13 })

@@ -39,7 +39,12 @@ fn two_moving_joints_and_four_tools_register_within_the_noise() {
                 let tool = i % 4;
                 let pose = truth.forward(&q, tool).unwrap();
                 let noise = 3e-5 * Vector3::new(gaussian(&mut r), gaussian(&mut r), gaussian(&mut r));
-                Observation { q, tool, target: Target::Pose(SE3::new(pose.rotation(), pose.translation() + noise)) }
+                Observation {
+                    q,
+                    tool,
+                    target: Target::Pose(SE3::new(pose.rotation(), pose.translation() + noise)),
+                    stated_sigma: None,
+                }
             })
             .collect();
         let registered = register(&nominal, &observations).unwrap();

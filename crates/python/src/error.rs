@@ -1,8 +1,8 @@
 //! Errors as Python exceptions: the pipeline's message as it is (it names file, line and column),
 //! `FileNotFoundError` for a missing file, `calib.CalibError` for everything else.
 
-use pyo3::PyErr;
 use pyo3::exceptions::{PyFileNotFoundError, PyValueError};
+use pyo3::prelude::*;
 
 pyo3::create_exception!(
     calib,
@@ -11,14 +11,27 @@ pyo3::create_exception!(
     "A refusal of the calibration pipeline; the message names the file, line and column where it has them."
 );
 
-/// The exception of a pipeline error.
+/// The exception of a pipeline error. A `CalibError` also carries the place as attributes, `file`,
+/// `line` and `column` (`None` where the error has none): the line as an editor counts it, as in
+/// the message.
 pub fn to_py(error: errors::Error) -> PyErr {
     let message = error.to_string();
     match error.kind() {
         errors::ErrorKind::Io { source } if source.kind() == std::io::ErrorKind::NotFound => {
             PyFileNotFoundError::new_err(message)
         }
-        _ => CalibError::new_err(message),
+        _ => {
+            let raised = CalibError::new_err(message);
+            let place = error.place();
+            Python::attach(|py| {
+                let value = raised.value(py);
+                // Setting an attribute on a fresh exception instance cannot fail but for memory.
+                let _ = value.setattr("file", place.map(|p| p.file().to_owned()));
+                let _ = value.setattr("line", place.and_then(errors::Place::line));
+                let _ = value.setattr("column", place.and_then(errors::Place::column));
+            });
+            raised
+        }
     }
 }
 

@@ -14,15 +14,24 @@ use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
-/// The read options for the joints of a robot or a model, or of any robot.
-fn read_options(py: Python<'_>, against: Option<&Bound<'_, PyAny>>, columns: ColumnMap) -> PyResult<ReadOptions> {
+/// The read options for the joints of a robot or a model, or of any robot, keeping the columns
+/// `inputs` as measured signals (`fit(..., inputs=...)`) and, for a model, the inputs it takes.
+fn read_options(
+    py: Python<'_>,
+    against: Option<&Bound<'_, PyAny>>,
+    columns: ColumnMap,
+    inputs: Vec<String>,
+) -> PyResult<ReadOptions> {
     let Some(against) = against.filter(|a| !a.is_none()) else {
-        return Ok(ReadOptions { joints: None, columns });
+        return Ok(ReadOptions { columns, inputs, ..ReadOptions::default() });
     };
     let kinds = if let Ok(robot) = against.cast::<Robot>() {
         robot.get().description.joint_kinds()
     } else if let Ok(model) = against.cast::<Model>() {
-        model.get().model.joint_kinds()
+        let model = &model.get().model;
+        let mut options = model.read_options(columns);
+        options.inputs.extend(inputs.into_iter().filter(|name| !model.input_names().contains(name)));
+        return Ok(options);
     } else {
         let _ = py;
         return Err(argument(
@@ -30,7 +39,14 @@ fn read_options(py: Python<'_>, against: Option<&Bound<'_, PyAny>>, columns: Col
             "expected a calib Robot or Model (whose joints the columns are checked against)",
         ));
     };
-    Ok(ReadOptions::for_joints(kinds).with_columns(columns))
+    Ok(ReadOptions::for_joints(kinds).with_columns(columns).with_inputs(inputs))
+}
+
+/// `inputs=[...]` as `--inputs` checks it: no name empty or given twice.
+fn input_names(inputs: Option<Vec<String>>) -> PyResult<Vec<String>> {
+    let names =
+        measurements::InputNames::new(inputs.unwrap_or_default(), "inputs").map_err(|e| argument("inputs", e))?;
+    Ok(names.names().to_vec())
 }
 
 /// `--columns NAME=HEADER,…` from a mapping, through the CLI's own parser of the option.
@@ -59,15 +75,16 @@ impl Measurements {
     /// onto other headers (`--columns`). With `positions=False` the position columns may be left
     /// out (`calib predict --data`).
     #[staticmethod]
-    #[pyo3(signature = (path, robot=None, columns=None, positions=true))]
+    #[pyo3(signature = (path, robot=None, columns=None, positions=true, inputs=None))]
     fn read(
         py: Python<'_>,
         path: PathBuf,
         robot: Option<&Bound<'_, PyAny>>,
         columns: Option<Vec<(String, String)>>,
         positions: bool,
+        inputs: Option<Vec<String>>,
     ) -> PyResult<Self> {
-        let options = read_options(py, robot, column_map(columns)?)?;
+        let options = read_options(py, robot, column_map(columns)?, input_names(inputs)?)?;
         let set = py
             .detach(|| {
                 if positions {
@@ -85,15 +102,16 @@ impl Measurements {
     /// (the `tool` column) as strings, all of one length. `source` names the set in messages;
     /// row `i` is line `i + 2`.
     #[staticmethod]
-    #[pyo3(signature = (numeric, text, source, robot=None))]
+    #[pyo3(signature = (numeric, text, source, robot=None, inputs=None))]
     fn from_columns(
         py: Python<'_>,
         numeric: Vec<(String, PyReadonlyArray1<'_, f64>)>,
         text: Vec<(String, Vec<String>)>,
         source: String,
         robot: Option<&Bound<'_, PyAny>>,
+        inputs: Option<Vec<String>>,
     ) -> PyResult<Self> {
-        let options = read_options(py, robot, ColumnMap::default())?;
+        let options = read_options(py, robot, ColumnMap::default(), input_names(inputs)?)?;
         let numeric: Vec<(String, Vec<f64>)> =
             numeric.into_iter().map(|(name, values)| (name, values.as_array().to_vec())).collect();
         let rows = numeric.first().map(|(_, v)| v.len()).or_else(|| text.first().map(|(_, v)| v.len())).unwrap_or(0);

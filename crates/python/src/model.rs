@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 /// then `effects`, `force` and `gp` over them, as the CLI's flags go over `--options`. Returns the
 /// model, the fit report as the JSON text `calib fit --json` prints, and its warnings in words.
 #[pyfunction]
-#[pyo3(signature = (robot, data, method, effects=None, gp=None, options_path=None, options_json=None, force=false))]
+#[pyo3(signature = (robot, data, method, effects=None, gp=None, options_path=None, options_json=None, force=false, inputs=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit(
     py: Python<'_>,
@@ -29,6 +29,7 @@ pub fn fit(
     options_path: Option<PathBuf>,
     options_json: Option<&str>,
     force: bool,
+    inputs: Option<Vec<String>>,
 ) -> PyResult<(Model, String, Vec<String>)> {
     let method: Method = method.parse().map_err(|e| argument("method", e))?;
     let mut options = match (&options_path, options_json) {
@@ -48,6 +49,14 @@ pub fn fit(
     }
     if let Some(gp) = gp {
         options.residual_gp.method = gp.parse::<GpChoice>().map_err(|e| argument("gp", e))?;
+    }
+    // As `calib fit --inputs`: the GP's, so refused for a method without one.
+    if let Some(inputs) = inputs.filter(|i| !i.is_empty()) {
+        if !method.uses_gp() {
+            return Err(argument("inputs", format!("the inputs are the GP's: method {method} has no GP")));
+        }
+        let names = measurements::InputNames::new(inputs, "inputs").map_err(|e| argument("inputs", e))?;
+        options.residual_gp.inputs = names.names().to_vec();
     }
     let (robot, data) = (&robot.description, &data.set);
     let ((model, fitted), report) = py
@@ -174,6 +183,7 @@ impl Model {
         if report.orientations_not_evaluated {
             warnings.push(model::ORIENTATIONS_NOT_EVALUATED.to_owned());
         }
+        warnings.extend(report.other_placement.iter().map(ToString::to_string));
         warnings.extend(report.warnings.iter().map(ToString::to_string));
         warnings.extend(report.out_of_range.iter().map(ToString::to_string));
         warnings.extend(report.beyond_joint_limits.iter().map(ToString::to_string));
@@ -194,9 +204,10 @@ impl Model {
     }
 
     /// `calib predict` on arrays: `q` `(n, joints)` rad (m), and per row `payload_kg`, the tool
-    /// identifier, `temp_c`, `t_s` and `torques_nm` `(n, joints)` where the model needs them.
+    /// identifier, `temp_c`, `t_s` and `torques_nm` `(n, joints)` where the model needs them, and
+    /// `inputs`, each measured signal the model takes by name (refused by name where missing).
     /// Row `i` is named line `i + 2` in messages, as in the CSV of the same rows.
-    #[pyo3(signature = (q, payload_kg=None, tools=None, temp_c=None, t_s=None, torques_nm=None))]
+    #[pyo3(signature = (q, payload_kg=None, tools=None, temp_c=None, t_s=None, torques_nm=None, inputs=None))]
     #[allow(clippy::too_many_arguments)]
     fn predict<'py>(
         &self,
@@ -207,6 +218,7 @@ impl Model {
         temp_c: Option<PyReadonlyArray1<'py, f64>>,
         t_s: Option<PyReadonlyArray1<'py, f64>>,
         torques_nm: Option<PyReadonlyArray2<'py, f64>>,
+        inputs: Option<Vec<(String, PyReadonlyArray1<'py, f64>)>>,
     ) -> PyResult<Predicted<'py>> {
         let q = q.as_array();
         let (n, joints) = q.dim();
@@ -221,6 +233,18 @@ impl Model {
             }
             Ok(Some(values))
         };
+        // The model's signals in its order, each found by name among those given.
+        let mut given: std::collections::HashMap<String, PyReadonlyArray1<'py, f64>> =
+            inputs.unwrap_or_default().into_iter().collect();
+        let names = self.model.input_names();
+        let mut signals = Vec::with_capacity(names.len());
+        for name in &names {
+            let values = given.remove(name).ok_or_else(|| {
+                argument("inputs", format!("no values of '{name}', a measured signal the model takes as an input"))
+            })?;
+            signals.push(column(name, Some(values))?.unwrap_or_default());
+        }
+        let names: std::sync::Arc<[String]> = names.into();
         let payload = column("payload_kg", payload_kg)?;
         let temp = column("temp_c", temp_c)?;
         let time = column("t_s", t_s)?;
@@ -243,7 +267,9 @@ impl Model {
             let payload = payload.as_ref().map_or(0.0, |p| p[i]);
             let extra = [payload, temp.as_ref().map_or(0.0, |t| t[i]), time.as_ref().map_or(0.0, |t| t[i])];
             let torque_row = torques.as_ref().map(|t| t.row(i).to_vec()).unwrap_or_default();
-            if let Some(bad) = row_q.iter().chain(&extra).chain(&torque_row).find(|v| !v.is_finite()) {
+            let signal_row: Vec<f64> = signals.iter().map(|s| s[i]).collect();
+            if let Some(bad) = row_q.iter().chain(&extra).chain(&torque_row).chain(&signal_row).find(|v| !v.is_finite())
+            {
                 return Err(argument("q", format!("row {i} has {bad}: every value must be finite")));
             }
             if payload < 0.0 {
@@ -261,6 +287,8 @@ impl Model {
                 temp_c: temp.as_ref().map(|t| t[i]),
                 t_s: time.as_ref().map(|t| t[i]),
                 torques_nm: torques.as_ref().map(|t| t.row(i).to_vec()),
+                inputs: measurements::Inputs::new(names.clone(), signal_row),
+                std: None,
             });
         }
         // Angles a turn away from the fitted range are taken into it, as `calib predict` does.

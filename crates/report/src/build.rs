@@ -118,7 +118,7 @@ impl Report {
                 .iter()
                 .map(|e| effect_view(e, inputs.robot, data, inputs.training, options))
                 .collect(),
-            gp: model.residual_gp.as_ref().map(|c| gp_view(&c.gp, c.with_payload, model.joint_count())),
+            gp: model.residual_gp.as_ref().map(|c| gp_view(c, model)),
             warnings: warnings(model, &eval),
             fit_warnings: model.fit_warnings.clone(),
             eval,
@@ -326,11 +326,25 @@ fn gear_curve(
 /// The GP's kind, its input scales and its kernels with the outputs each serves.
 type GpParts<'a> = (&'static str, &'a [f64], Vec<(&'a [usize], &'a gp::Kernel)>);
 
-fn gp_view(gp: &GpModel, with_payload: bool, joints: usize) -> GpView {
-    let mut inputs: Vec<String> = (1..=joints).map(|j| format!("q{j}")).collect();
-    if with_payload {
+fn gp_view(residual_gp: &model::ResidualGp, model: &CalibratedModel) -> GpView {
+    let gp = &residual_gp.gp;
+    let mut inputs: Vec<String> = (1..=model.joint_count()).map(|j| format!("q{j}")).collect();
+    if residual_gp.with_payload {
         inputs.push("payload".into());
     }
+    inputs.extend(residual_gp.inputs.iter().cloned());
+    let signals = residual_gp
+        .inputs
+        .iter()
+        .map(|name| {
+            let span = model.training_range.as_ref().and_then(|r| r.input(name));
+            span.cloned().unwrap_or(model::InputSpan {
+                name: name.clone(),
+                unit: measurements::input_unit(name),
+                fitted: [f64::NAN; 2],
+            })
+        })
+        .collect();
     let (kind, scale, components): GpParts<'_> = match gp {
         GpModel::Exact(g) => (
             "exact",
@@ -356,11 +370,13 @@ fn gp_view(gp: &GpModel, with_payload: bool, joints: usize) -> GpView {
             KernelScales { outputs: outputs.to_vec(), family: family.to_owned(), length_scales, isotropic }
         })
         .collect();
-    GpView { kind: kind.to_owned(), inputs, input_scale: scale.to_vec(), kernels }
+    GpView { kind: kind.to_owned(), inputs, input_scale: scale.to_vec(), kernels, signals }
 }
 
 fn warnings(model: &CalibratedModel, eval: &EvalReport) -> Vec<String> {
-    let mut out: Vec<String> = eval.warnings.iter().map(ToString::to_string).collect();
+    // Another tracker placement first: it explains the numbers of every other section.
+    let mut out: Vec<String> = eval.other_placement.iter().map(ToString::to_string).collect();
+    out.extend(eval.warnings.iter().map(ToString::to_string));
     out.extend(eval.out_of_range.iter().map(ToString::to_string));
     out.extend(eval.beyond_joint_limits.iter().map(ToString::to_string));
     if eval.orientations_not_evaluated {

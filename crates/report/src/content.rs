@@ -186,13 +186,16 @@ pub struct EffectCurve {
 pub struct GpView {
     /// `exact` or `sparse`.
     pub kind: String,
-    /// Input names (`q1` … `q6`, `payload`).
+    /// Input names (`q1` … `q6`, `payload`, then each measured signal's column name).
     pub inputs: Vec<String>,
-    /// The standard deviation of each input over the training rows (rad, m or kg): a length
-    /// scale of 1 is this much.
+    /// The standard deviation of each input over the training rows (rad, m, kg, or a signal's
+    /// own unit): a length scale of 1 is this much.
     pub input_scale: Vec<f64>,
     /// One entry per kernel.
     pub kernels: Vec<KernelScales>,
+    /// The measured signals among the inputs (`calib fit --inputs`), with their units and the
+    /// spans they were fitted on (unit and span absent where the model file keeps none).
+    pub signals: Vec<model::InputSpan>,
 }
 
 /// The length scales of one kernel.

@@ -440,15 +440,35 @@ fn gp(out: &mut String, r: &Report) {
         out,
         "<p>An {} GP on the inputs {}. Length scales in standard deviations of each input over the training rows (a long length scale: the error barely changes with that input).</p>",
         g.kind,
-        g.inputs.join(", ")
+        escape(&g.inputs.join(", "))
     );
+    if !g.signals.is_empty() {
+        let spans: Vec<String> = g
+            .signals
+            .iter()
+            .map(|s| {
+                let [low, high] = s.fitted;
+                let unit = s.unit.map_or(String::new(), |u| format!(" {u}"));
+                let span = if low.is_finite() { format!("{low} … {high}{unit}") } else { "span not kept".to_owned() };
+                format!("{} (fitted on {span})", escape(&s.name))
+            })
+            .collect();
+        let _ = write!(
+            out,
+            "<p>Measured signals beside the joints: {}. Outside a signal's span the GP extrapolates: <code>calib eval</code> counts those rows, and the correction fades where the GP knows little.</p>",
+            spans.join("; ")
+        );
+    }
     out.push_str("<table><tr><th class=\"l\">outputs</th><th class=\"l\">kernel</th>");
     for input in &g.inputs {
-        let _ = write!(out, "<th>{input}</th>");
+        let _ = write!(out, "<th>{}</th>", escape(input));
     }
     out.push_str("</tr><tr><td class=\"l\" colspan=\"2\">one standard deviation of the input</td>");
+    let joints = g.inputs.len() - g.signals.len();
     for (k, s) in g.input_scale.iter().enumerate() {
-        let unit = if g.inputs.get(k).is_some_and(|i| i == "payload") {
+        let unit = if let Some(signal) = k.checked_sub(joints).and_then(|i| g.signals.get(i)) {
+            format!("{s:.4}{}", signal.unit.map_or(String::new(), |u| format!(" {u}")))
+        } else if g.inputs.get(k).is_some_and(|i| i == "payload") {
             format!("{s:.3} kg")
         } else {
             format!("{:.1}°", s.to_degrees())

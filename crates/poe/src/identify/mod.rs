@@ -13,6 +13,7 @@ mod report;
 mod residual;
 mod robust;
 mod solver;
+mod stated_noise;
 mod termination;
 
 pub use correction::PoseCorrection;
@@ -24,6 +25,7 @@ pub use report::{DampingFallback, IdentificationReport, IterationRecord};
 pub use residual::ResidualStats;
 pub use robust::{KindScale, Loss, OutlierRow, RobustOptions, RobustReport, huber_loss, huber_weight, median};
 pub use solver::{Identification, identify, identify_with_correction, identify_with_prior, posterior_covariance};
+pub use stated_noise::{StatedNoise, StatedNoiseReport, StatedSigma};
 pub use termination::Termination;
 
 use crate::{Error, LocalPoe};
@@ -100,5 +102,6 @@ pub fn calibrate_placed_with_prior(
 
 /// Error statistics of a model on observations (no identification).
 pub fn evaluate(model: &LocalPoe, observations: &[Observation]) -> Result<ResidualStats, Error> {
-    residual::residuals(model, observations, None, &[], &IdentificationOptions::default()).map(|(_, s)| s)
+    let weights = residual::Weights::default();
+    residual::residuals(model, observations, None, weights, &IdentificationOptions::default()).map(|(_, s)| s)
 }

@@ -23,6 +23,10 @@ pub struct Observation {
     pub tool: usize,
     /// What was measured.
     pub target: Target,
+    /// The instrument's stated standard deviations of this observation, where it states them
+    /// (module `stated_noise`): its residual is weighted by them relative to the other
+    /// observations'.
+    pub stated_sigma: Option<super::StatedSigma>,
 }
 
 /// How each iteration's linear least-squares problem is solved.
@@ -84,6 +88,8 @@ pub struct IdentificationOptions {
     /// (`reduced.rs`): memory holds one block of the Jacobian, not all of it. Changes results
     /// only in their rounding.
     pub block_observations: usize,
+    /// How observations that state their own σ are weighted (module `stated_noise`).
+    pub stated_noise: super::StatedNoise,
 }
 
 impl Default for IdentificationOptions {
@@ -116,6 +122,7 @@ impl Default for IdentificationOptions {
             // 1,024 poses: 6,144 rows of at most ~100 columns, under 5 MB, and each fold's QR
             // (of ~6,200 × 100) long enough that the per-block overhead is negligible.
             block_observations: 1024,
+            stated_noise: super::StatedNoise::default(),
         }
     }
 }
@@ -160,6 +167,10 @@ impl IdentificationOptions {
         }
         if !(self.min_damping <= self.initial_damping && self.initial_damping <= self.max_damping) {
             return invalid("initial_damping", self.initial_damping, "between min_damping and max_damping");
+        }
+        let far = self.stated_noise.far_above_median;
+        if !(far.is_finite() && far >= 1.0) {
+            return invalid("stated_noise.far_above_median", far, "a finite number of at least 1");
         }
         self.robust.validate()
     }

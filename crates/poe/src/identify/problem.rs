@@ -20,6 +20,9 @@ pub(super) struct Problem<'a> {
     pub options: &'a IdentificationOptions,
     /// The robust loss's weight of each observation's position and orientation rows (empty: 1).
     pub row_weights: Vec<[f64; 2]>,
+    /// Each observation's stated noise relative to the options' sigmas, per residual component
+    /// (module `stated_noise`; empty: 1).
+    pub noise: Vec<[f64; 6]>,
     /// A prior on the kinematic parameters about its own centre (`prior.rs`); `None`: the
     /// options' prior about the start, if any.
     pub prior: Option<&'a KinematicPrior>,
@@ -59,7 +62,8 @@ impl Problem<'_> {
 
     /// The weighted residual of a state and its errors.
     pub(super) fn residuals(&self, state: &State) -> Result<(Vec<f64>, ResidualStats), Error> {
-        residuals(&state.model, self.observations, self.corrected(&state.theta), &self.row_weights, self.options)
+        let weights = super::residual::Weights { robust: &self.row_weights, noise: &self.noise };
+        residuals(&state.model, self.observations, self.corrected(&state.theta), weights, self.options)
     }
 
     /// The weighted Jacobian (free columns, then the correction's) and residual, reduced to their
@@ -70,7 +74,7 @@ impl Problem<'_> {
             self.observations,
             &self.free,
             self.corrected(&state.theta),
-            &self.row_weights,
+            super::residual::Weights { robust: &self.row_weights, noise: &self.noise },
             self.options,
         )
     }

@@ -53,6 +53,10 @@ pub struct IdentificationReport {
     /// What the robust loss did: the residuals' robust scales, the rows down-weighted, and the
     /// gross outliers named (left out under the Huber loss).
     pub robust: RobustReport,
+    /// How the observations' stated σ weighted them (module `stated_noise`); `None` where none
+    /// states one, or weighting is off.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stated_noise: Option<super::StatedNoiseReport>,
 }
 
 /// Where the pseudo-inverse Gauss–Newton iteration handed over to damped steps.

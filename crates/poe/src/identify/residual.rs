@@ -46,6 +46,26 @@ fn row_kind(observation: &Observation) -> RowKind {
     }
 }
 
+/// How each observation's rows are weighted beyond the options' sigmas: the robust loss's weight
+/// of its position and orientation rows, and its stated noise relative to the sigmas per residual
+/// component (`stated_noise.rs`); an empty slice weighs every observation 1.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Weights<'a> {
+    pub robust: &'a [[f64; 2]],
+    pub noise: &'a [[f64; 6]],
+}
+
+impl Weights<'_> {
+    /// The multiplier of each residual component of observation `index`: `1/σ` of its kind times
+    /// the square root of the robust loss's row weight (module `robust`), so that the squared
+    /// residual counts `w` times, over the observation's relative stated noise.
+    fn of(&self, options: &IdentificationOptions, index: usize) -> [f64; 6] {
+        let [wp, wr] = scaled_weights(options, row_weight(self.robust, index));
+        let noise = self.noise.get(index).copied().unwrap_or([1.0; 6]);
+        std::array::from_fn(|k| if k < 3 { wp } else { wr } / noise[k])
+    }
+}
+
 /// Writes the weighted residual of one observation into `out` and accounts for its errors:
 /// `(p'_i − p_i, log(R'_i R_iᵀ)^∨)` for a pose, `p'_i − p_i` for a point. The decoupled form
 /// ([`RowKind::PointAndRotation`]) carries the same first-order information as the paper's
@@ -53,20 +73,18 @@ fn row_kind(observation: &Observation) -> RowKind {
 fn weighted_residual(
     observation: &Observation,
     model_pose: &SE3,
-    options: &IdentificationOptions,
-    row_weight: [f64; 2],
+    weight: [f64; 6],
     out: &mut [f64],
     acc: &mut Accumulator,
 ) {
-    let [wp, wr] = scaled_weights(options, row_weight);
     acc.rows += 1;
     match observation.target {
         Target::Pose(measured) => {
             let d = measured.translation() - model_pose.translation();
             let w = (measured.rotation() * model_pose.rotation().inverse()).log();
             for k in 0..3 {
-                out[k] = d[k] * wp;
-                out[k + 3] = w[k] * wr;
+                out[k] = d[k] * weight[k];
+                out[k + 3] = w[k] * weight[k + 3];
             }
             acc.position_sq += d.norm_squared();
             acc.rotation_sq += w.norm_squared();
@@ -75,7 +93,7 @@ fn weighted_residual(
         Target::Point(measured) => {
             let d = measured - model_pose.translation();
             for k in 0..3 {
-                out[k] = d[k] * wp;
+                out[k] = d[k] * weight[k];
             }
             acc.position_sq += d.norm_squared();
         }
@@ -135,12 +153,12 @@ pub(crate) fn predict(
 }
 
 /// The weighted residual vector and the error statistics of `model` on `observations`, each
-/// observation's rows also weighted by its robust weight (`row_weights`, empty for none).
+/// observation's rows also weighted by its robust weight and its stated noise (`weights`).
 pub(crate) fn residuals(
     model: &LocalPoe,
     observations: &[Observation],
     correction: Option<Corrected<'_>>,
-    row_weights: &[[f64; 2]],
+    weights: Weights<'_>,
     options: &IdentificationOptions,
 ) -> Result<(Vec<f64>, ResidualStats), Error> {
     let mut y = vec![0.0; row_count(observations)];
@@ -150,8 +168,7 @@ pub(crate) fn residuals(
     for (index, observation) in observations.iter().enumerate() {
         let rows = row_kind(observation).rows();
         let pose = predict(model, observation, index, correction, &mut twists)?;
-        let weight = row_weight(row_weights, index);
-        weighted_residual(observation, &pose, options, weight, &mut y[row..row + rows], &mut acc);
+        weighted_residual(observation, &pose, weights.of(options, index), &mut y[row..row + rows], &mut acc);
         row += rows;
     }
     Ok((y, acc.stats()))
@@ -170,7 +187,7 @@ pub(crate) fn linearise(
     observations: &[Observation],
     free: &[usize],
     correction: Option<Corrected<'_>>,
-    row_weights: &[[f64; 2]],
+    weights: Weights<'_>,
     options: &IdentificationOptions,
 ) -> Result<(Mat<f64>, Vec<f64>, ResidualStats), Error> {
     let extra = correction.map_or(0, |c| c.theta.len());
@@ -179,7 +196,7 @@ pub(crate) fn linearise(
     let mut y = vec![0.0; total_rows];
     let mut acc = Accumulator::default();
     let block = Block { observations, first: 0 };
-    linearise_block(model, block, free, correction, row_weights, options, a.as_mut(), &mut y, &mut acc)?;
+    linearise_block(model, block, free, correction, weights, options, a.as_mut(), &mut y, &mut acc)?;
     Ok((a, y, acc.stats()))
 }
 
@@ -190,7 +207,7 @@ pub(crate) fn linearise_reduced(
     observations: &[Observation],
     free: &[usize],
     correction: Option<Corrected<'_>>,
-    row_weights: &[[f64; 2]],
+    weights: Weights<'_>,
     options: &IdentificationOptions,
 ) -> Result<(Reduced, ResidualStats), Error> {
     let columns = free.len() + correction.map_or(0, |c| c.theta.len());
@@ -202,7 +219,7 @@ pub(crate) fn linearise_reduced(
         let mut a = Mat::<f64>::zeros(rows, columns);
         let mut y = vec![0.0; rows];
         let block = Block { observations: chunk, first: k * size };
-        linearise_block(model, block, free, correction, row_weights, options, a.as_mut(), &mut y, &mut acc)?;
+        linearise_block(model, block, free, correction, weights, options, a.as_mut(), &mut y, &mut acc)?;
         reduced.fold(a.as_ref(), &y);
     }
     Ok((reduced, acc.stats()))
@@ -223,7 +240,7 @@ fn linearise_block(
     block: Block<'_>,
     free: &[usize],
     correction: Option<Corrected<'_>>,
-    row_weights: &[[f64; 2]],
+    weights: Weights<'_>,
     options: &IdentificationOptions,
     mut a: MatMut<'_, f64>,
     y: &mut [f64],
@@ -252,9 +269,9 @@ fn linearise_block(
                 c.apply_with_map(model, index, pose, &mut twists)
             }
         };
-        let [wp, wr] = scaled_weights(options, row_weight(row_weights, index));
-        weighted_residual(observation, &pose, options, row_weight(row_weights, index), &mut y[row..row + rows], acc);
-        let weight = |r: usize| if r < 3 { wp } else { wr };
+        let row_weights = weights.of(options, index);
+        weighted_residual(observation, &pose, row_weights, &mut y[row..row + rows], acc);
+        let weight = |r: usize| row_weights[r];
         // A left twist c moves the tool point by v + ω × p and the orientation by ω.
         let p = pose.translation();
         let rows_of = |twist: &Vector6, out: &mut [f64; 6]| {
@@ -355,8 +372,8 @@ mod tests {
         let nudge = Twist::new(Vector3::new(2e-4, -1e-4, 5e-5), Vector3::new(3e-4, 1e-4, 2e-4)).exp();
         let pose = nudge * model.forward(&[0.4, -0.7], 0).unwrap();
         vec![
-            Observation { q: vec![0.4, -0.7], tool: 0, target: Target::Pose(pose) },
-            Observation { q: vec![-1.0, 0.2], tool: 0, target: Target::Point(pose.translation()) },
+            Observation { q: vec![0.4, -0.7], tool: 0, target: Target::Pose(pose), stated_sigma: None },
+            Observation { q: vec![-1.0, 0.2], tool: 0, target: Target::Point(pose.translation()), stated_sigma: None },
         ]
     }
 
@@ -369,7 +386,7 @@ mod tests {
         let theta = [4e-3, -3e-3, 2e-3];
         let corrected = || Some(Corrected { correction: &OnJoints, theta: &theta });
         let free: Vec<usize> = (0..model.layout().len()).collect();
-        let (a, _, _) = linearise(&model, &observations, &free, corrected(), &[], &options).unwrap();
+        let (a, _, _) = linearise(&model, &observations, &free, corrected(), Weights::default(), &options).unwrap();
         let h = 1e-7;
         for &k in &free {
             let moved = |sign: f64| {
@@ -377,7 +394,7 @@ mod tests {
                 step[k] = sign * h;
                 let mut m = model.clone();
                 m.apply_update(&step);
-                residuals(&m, &observations, corrected(), &[], &options).unwrap().0
+                residuals(&m, &observations, corrected(), Weights::default(), &options).unwrap().0
             };
             let (yp, ym) = (moved(1.0), moved(-1.0));
             for r in 0..yp.len() {
@@ -398,19 +415,29 @@ mod tests {
         let options = IdentificationOptions::default();
         let theta = [2e-3, -1e-3];
         let corrected = Some(Corrected { correction: &Fixed, theta: &theta });
-        let (a, _, _) = linearise(&model, &observations, &[], corrected, &[], &options).unwrap();
+        let (a, _, _) = linearise(&model, &observations, &[], corrected, Weights::default(), &options).unwrap();
         let h = 1e-7;
         for l in 0..2 {
             let mut plus = theta;
             let mut minus = theta;
             plus[l] += h;
             minus[l] -= h;
-            let (yp, _) =
-                residuals(&model, &observations, Some(Corrected { correction: &Fixed, theta: &plus }), &[], &options)
-                    .unwrap();
-            let (ym, _) =
-                residuals(&model, &observations, Some(Corrected { correction: &Fixed, theta: &minus }), &[], &options)
-                    .unwrap();
+            let (yp, _) = residuals(
+                &model,
+                &observations,
+                Some(Corrected { correction: &Fixed, theta: &plus }),
+                Weights::default(),
+                &options,
+            )
+            .unwrap();
+            let (ym, _) = residuals(
+                &model,
+                &observations,
+                Some(Corrected { correction: &Fixed, theta: &minus }),
+                Weights::default(),
+                &options,
+            )
+            .unwrap();
             for r in 0..yp.len() {
                 // The residual is measured − predicted, so its derivative is −A.
                 let numeric = -(yp[r] - ym[r]) / (2.0 * h);
@@ -427,20 +454,26 @@ mod tests {
         }
     }
 
-    /// The robust loss's row weights scale each observation's rows by `√w`: the Jacobian so
-    /// weighted is still the derivative of the residual so weighted.
+    /// The robust loss's row weights scale each observation's rows by `√w`, and its stated noise
+    /// (relative, per component) divides each component: the Jacobian so weighted is still the
+    /// derivative of the residual so weighted.
     #[test]
     fn row_weighted_columns_match_finite_differences_of_the_row_weighted_residual() {
         let model = two_joint_arm();
         let observations = near_prediction(&model);
         let options = IdentificationOptions::default();
-        let weights = [[0.25, 0.64], [0.09, 1.0]];
+        let robust = [[0.25, 0.64], [0.09, 1.0]];
+        let noise = [[2.0, 1.0, 0.5, 1.0, 4.0, 1.0], [1.0, 1.0, 2.0, 1.0, 1.0, 1.0]];
+        let weights = Weights { robust: &robust, noise: &noise };
         let free: Vec<usize> = (0..model.layout().len()).collect();
-        let (a, y, _) = linearise(&model, &observations, &free, None, &weights, &options).unwrap();
-        let (plain_a, plain_y, _) = linearise(&model, &observations, &free, None, &[], &options).unwrap();
+        let (a, y, _) = linearise(&model, &observations, &free, None, weights, &options).unwrap();
+        let (plain_a, plain_y, _) =
+            linearise(&model, &observations, &free, None, Weights::default(), &options).unwrap();
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
-        assert!(close(y[0], plain_y[0] * 0.5) && close(y[3], plain_y[3] * 0.8) && close(y[6], plain_y[6] * 0.3));
-        assert!(close(a[(7, 4)], plain_a[(7, 4)] * 0.3) && close(a[(4, 2)], plain_a[(4, 2)] * 0.8));
+        assert!(close(y[0], plain_y[0] * 0.5 / 2.0) && close(y[3], plain_y[3] * 0.8) && close(y[6], plain_y[6] * 0.3));
+        assert!(close(y[4], plain_y[4] * 0.8 / 4.0) && close(y[8], plain_y[8] * 0.3 / 2.0));
+        assert!(close(a[(7, 4)], plain_a[(7, 4)] * 0.3) && close(a[(4, 2)], plain_a[(4, 2)] * 0.8 / 4.0));
+        assert!(close(a[(2, 3)], plain_a[(2, 3)] * 0.5 / 0.5));
         let h = 1e-7;
         for &k in &free {
             let moved = |sign: f64| {
@@ -448,7 +481,7 @@ mod tests {
                 step[k] = sign * h;
                 let mut m = model.clone();
                 m.apply_update(&step);
-                residuals(&m, &observations, None, &weights, &options).unwrap().0
+                residuals(&m, &observations, None, weights, &options).unwrap().0
             };
             let (yp, ym) = (moved(1.0), moved(-1.0));
             for r in 0..yp.len() {

@@ -194,7 +194,8 @@ pub struct RobustReport {
     pub reweightings: usize,
     /// Whether the weights settled within [`RobustOptions::max_reweightings`].
     pub settled: bool,
-    /// The position residuals' robust scale at the end, metres.
+    /// The position residuals' robust scale at the end, metres (where observations state their
+    /// σ, of residuals taken relative to it: a median observation's, module `stated_noise`).
     pub position: KindScale,
     /// The orientation residuals' robust scale at the end, radians (full-pose data only).
     pub rotation: Option<KindScale>,

@@ -81,8 +81,12 @@ pub fn identify_with_prior(
     if mask.flags().len() != layout.len() {
         return Err(Error::MaskLength { given: mask.flags().len(), expected: layout.len() });
     }
+    let stated = super::stated_noise::Stated::new(observations, &options.stated_noise);
+    // The first solve takes the stated noise alone (no scatter beyond it); the reweighted solves
+    // then estimate that scatter from their residuals.
+    let noise = stated.as_ref().map_or_else(Vec::new, |s| s.factors([0.0, 0.0]));
     let mut problem =
-        Problem { observations, free: mask.free_indices(), correction, options, row_weights: Vec::new(), prior };
+        Problem { observations, free: mask.free_indices(), correction, options, row_weights: Vec::new(), noise, prior };
     let rows = super::residual::row_count(observations);
     let parameters = problem.parameter_count();
     if rows < parameters {
@@ -94,7 +98,8 @@ pub fn identify_with_prior(
         None => vec![0.0; parameters],
     };
     let start = State { model: initial.clone(), theta, deviation };
-    let (solved, robust) = reweighted(&mut problem, start)?;
+    let (solved, robust, excess) = reweighted(&mut problem, stated.as_ref(), start)?;
+    let stated_noise = stated.map(|s| s.report(excess));
     let svd = normal::Decomposition::new(&solved.a, solved.iterations.len())?;
     let smax = svd.singular_values.first().copied().unwrap_or(0.0);
     let kept: Vec<f64> = svd.singular_values.iter().copied().filter(|&s| s > options.rcond * smax && s > 0.0).collect();
@@ -125,6 +130,7 @@ pub fn identify_with_prior(
             held_at_prior: solved.held_at_prior,
             damping_fallback: solved.damping_fallback,
             robust,
+            stated_noise,
         },
     })
 }
@@ -194,6 +200,25 @@ fn covariance(problem: &Problem<'_>, a: &Reduced, deviation: &[f64], dof: usize)
     (0..p).flat_map(|i| (0..p).map(move |j| (i, j))).map(|(i, j)| inverse[(i, j)] * scale).collect()
 }
 
+/// Each row's residual norms over its stated noise relative to the median row's (the root mean
+/// square of its point's and of its orientation's factors; module `stated_noise`): the robust loss
+/// then judges a row by what its own σ lets it miss, and its scales are a median row's. Unchanged
+/// where no row states a σ.
+fn relative_to_stated(errors: &[robust::RowError], noise: &[[f64; 6]]) -> Vec<robust::RowError> {
+    if noise.is_empty() {
+        return errors.to_vec();
+    }
+    let rms = |f: &[f64]| (f.iter().map(|x| x * x).sum::<f64>() / f.len() as f64).sqrt();
+    errors
+        .iter()
+        .zip(noise)
+        .map(|(e, f)| robust::RowError {
+            position_m: e.position_m / rms(&f[..3]),
+            rotation_rad: e.rotation_rad.map(|r| r / rms(&f[3..])),
+        })
+        .collect()
+}
+
 fn solve(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
     match problem.options.solver {
         Solver::PseudoInverse if problem.prior.is_none() => gauss_newton(problem, start),
@@ -211,11 +236,20 @@ fn solve(problem: &Problem<'_>, start: State) -> Result<Solved, Error> {
 /// only those): a row a metre off would otherwise drag the first solve far from the solution,
 /// where Gauss–Newton crawls back for its whole iteration limit. Where no row is beyond the
 /// thresholds, at the start or at the end, this is the plain solve alone.
-fn reweighted(problem: &mut Problem<'_>, start: State) -> Result<(Solved, RobustReport), Error> {
+///
+/// Where observations state their σ (`stated`), each solve also estimates the residuals' scatter
+/// beyond the stated noise, and the solves go on while the stated noise's weights it calls for
+/// change (module `stated_noise`); that scatter is returned (per axis, of the point and of the
+/// orientation).
+fn reweighted(
+    problem: &mut Problem<'_>,
+    stated: Option<&super::stated_noise::Stated>,
+    start: State,
+) -> Result<(Solved, RobustReport, [f64; 2]), Error> {
     let options = &problem.options.robust;
     if options.loss == robust::Loss::Huber {
         let errors = row_errors(&start.model, problem.observations, problem.corrected(&start.theta))?;
-        let at_start = robust::assess(&errors, options);
+        let at_start = robust::assess(&relative_to_stated(&errors, &problem.noise), options);
         if !at_start.report.outliers.is_empty() {
             problem.row_weights =
                 at_start.weights.iter().map(|w| if *w == [0.0, 0.0] { *w } else { [1.0, 1.0] }).collect();
@@ -223,15 +257,36 @@ fn reweighted(problem: &mut Problem<'_>, start: State) -> Result<(Solved, Robust
     }
     let mut solved = solve(problem, start)?;
     let mut reweightings = 0;
+    let mut excess = [0.0; 2];
     loop {
         let errors = row_errors(&solved.state.model, problem.observations, problem.corrected(&solved.state.theta))?;
-        let assessment = robust::assess(&errors, options);
+        let mut assessment = robust::assess(&relative_to_stated(&errors, &problem.noise), options);
+        // The outliers are named with their own residuals, not those relative to their σ.
+        for outlier in &mut assessment.report.outliers {
+            outlier.position_m = errors[outlier.observation].position_m;
+            outlier.rotation_rad = errors[outlier.observation].rotation_rad;
+        }
         let current: &[[f64; 2]] =
             if problem.row_weights.is_empty() { &vec![[1.0, 1.0]; errors.len()] } else { &problem.row_weights };
-        let settled = robust::settled(current, &assessment.weights, options.weight_tolerance);
+        let mut settled = robust::settled(current, &assessment.weights, options.weight_tolerance);
+        if let Some(stated) = stated {
+            let rows = super::residual::row_count(problem.observations) as f64;
+            let inflation = rows / (rows - problem.parameter_count() as f64).max(1.0);
+            excess = stated.excess(&errors, inflation);
+            let noise = stated.factors(excess);
+            // Noise factors are weights' inverse square roots: compare them as the robust
+            // weights are compared, by the weight each implies.
+            let moved = noise.iter().zip(&problem.noise).any(|(a, b)| {
+                a.iter().zip(b).any(|(x, y)| (1.0 / (x * x) - 1.0 / (y * y)).abs() > options.weight_tolerance)
+            });
+            if moved {
+                settled = false;
+                problem.noise = noise;
+            }
+        }
         if settled || reweightings == options.max_reweightings {
             let report = RobustReport { reweightings, settled, ..assessment.report };
-            return Ok((solved, report));
+            return Ok((solved, report, excess));
         }
         reweightings += 1;
         problem.row_weights = assessment.weights;

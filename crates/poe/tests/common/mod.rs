@@ -118,7 +118,7 @@ pub fn observe(
             } else {
                 Target::Point(pose.translation() + dp)
             };
-            Observation { q, tool: 0, target }
+            Observation { q, tool: 0, target, stated_sigma: None }
         })
         .collect()
 }
