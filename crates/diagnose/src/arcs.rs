@@ -234,6 +234,17 @@ pub(crate) fn order_curves(
         .collect();
     let mut sums: Vec<Vec<f64>> = curves.iter().map(|(_, _, orders)| vec![0.0; orders.len()]).collect();
     let mut counts = vec![0usize; curves.len()];
+    // Each series' columns: the kinematics, the other steps at their orders, then this series in
+    // full (the same for every joint's arcs).
+    let columns: Vec<(Vec<usize>, Vec<usize>)> = curves
+        .iter()
+        .map(|&(s, _, _)| {
+            let base = (0..kinematic)
+                .chain((0..steps.len()).filter(|&t| t != s).flat_map(|t| offsets[t]..offsets[t] + at_order[t]))
+                .collect();
+            (base, (offsets[s]..offsets[s] + full[s].0.len()).collect())
+        })
+        .collect();
     if !curves.is_empty() {
         let blocks: Vec<Block<'_>> = full.iter().map(|(c, sd)| (c.as_slice(), *sd)).collect();
         for &k in moving {
@@ -255,13 +266,8 @@ pub(crate) fn order_curves(
             let residuals = pairs
                 .par_iter()
                 .map(|&(c, f)| {
-                    let (s, _, orders) = &curves[c];
-                    // The kinematics, the other steps at their orders, then this series in full.
-                    let base: Vec<usize> = (0..kinematic)
-                        .chain((0..steps.len()).filter(|&t| t != *s).flat_map(|t| offsets[t]..offsets[t] + at_order[t]))
-                        .collect();
-                    let series: Vec<usize> = (offsets[*s]..offsets[*s] + full[*s].0.len()).collect();
-                    pool.series_residuals(&[f], &[f], &base, &series, orders)
+                    let (base, series) = &columns[c];
+                    pool.series_residuals(&[f], &[f], base, series, &curves[c].2)
                 })
                 .collect::<Result<Vec<_>, Error>>()?;
             for (&(c, f), residuals) in pairs.iter().zip(&residuals) {

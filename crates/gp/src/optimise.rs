@@ -278,23 +278,6 @@ pub(crate) fn finish_from(
     let Prepared { lower, upper, starts, settings } = prepare(start, nested, bounds, config)?;
     let (results, warm_rows, warm_evaluations, full) = match warm {
         Some(stage) => {
-            let from = stage.results[stage.best]
-                .as_ref()
-                .map(|m| m.x.clone())
-                .ok_or(Error::OptimisationFailed { starts: starts.len() })?;
-            // The subset's curvature carried over: the likelihood is a sum over rows, so its
-            // Hessian grows about in proportion to them and each gradient change is scaled by
-            // n / s. The full search then starts with a quasi-Newton step instead of relearning
-            // the curvature down the gradient.
-            let scale = x.len() as f64 / stage.rows().max(1) as f64;
-            let pairs: Vec<lbfgsb::Pair> = match (&stage.results[stage.best], config.warm_start_curvature) {
-                (Some(m), true) => m
-                    .history
-                    .iter()
-                    .map(|p| lbfgsb::Pair { s: p.s.clone(), y: p.y.iter().map(|v| v * scale).collect() })
-                    .collect(),
-                _ => Vec::new(),
-            };
             let settings = refining(settings, config);
             let full = if settings.max_iterations == 0 {
                 // No iteration on all rows: the subset's optimum as it is, converged as its search
@@ -306,6 +289,23 @@ pub(crate) fn finish_from(
                     ..m
                 })
             } else {
+                let from = stage.results[stage.best]
+                    .as_ref()
+                    .map(|m| m.x.clone())
+                    .ok_or(Error::OptimisationFailed { starts: starts.len() })?;
+                // The subset's curvature carried over: the likelihood is a sum over rows, so its
+                // Hessian grows about in proportion to them and each gradient change is scaled by
+                // n / s. The full search then starts with a quasi-Newton step instead of
+                // relearning the curvature down the gradient.
+                let scale = x.len() as f64 / stage.rows().max(1) as f64;
+                let pairs: Vec<lbfgsb::Pair> = match (&stage.results[stage.best], config.warm_start_curvature) {
+                    (Some(m), true) => m
+                        .history
+                        .iter()
+                        .map(|p| lbfgsb::Pair { s: p.s.clone(), y: p.y.iter().map(|v| v * scale).collect() })
+                        .collect(),
+                    _ => Vec::new(),
+                };
                 let mut objective = NegativeLml::new(start, x, y, config, parallelism);
                 lbfgsb::minimise_with(&mut objective, &from, &lower, &upper, &settings, &pairs)
             };
