@@ -187,7 +187,7 @@ fn training_costs(seed: u64, mask: u32, extra: u32, options: &FitOptions) -> Tra
     };
     let cell = simulated_cell(&robot, &Perturbation::default(), seed).unwrap();
     let config = GeneratorConfig { sample_count: 80, seed, ..GeneratorConfig::default() };
-    let data = simulate(&cell, &effects, &joint_ranges(&robot), &config, seed % 2 == 0).unwrap();
+    let data = simulate(&cell, &effects, &joint_ranges(&robot), &config, seed.is_multiple_of(2)).unwrap();
     let cost = |list: &str| {
         let options =
             options.clone().with_effects(if list.is_empty() { EffectSelection::None } else { list.parse().unwrap() });
