@@ -457,11 +457,11 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
     let learnt = timings::phase("learnt backlash sides", || {
         learnt_side::learnt_sides(&pool, &design, &model, bound, &candidates, &candidate_columns, &sides)
     })?;
-    for side in learnt {
-        let mut columns = side.per_fold;
-        side_columns.push(side.all.clone());
-        columns.push(side.all);
-        let range = pool.extend(&columns, None, &options.prior);
+    let sets: Vec<Vec<Vec<f64>>> =
+        learnt.iter().map(|side| side.per_fold.iter().chain(std::iter::once(&side.all)).cloned().collect()).collect();
+    let ranges = pool.extend_sets(&sets, None, &options.prior);
+    for (side, range) in learnt.into_iter().zip(ranges) {
+        side_columns.push(side.all);
         let indices: Vec<usize> = range.collect();
         let all = indices[indices.len() - 1];
         terms.push(Term {

@@ -327,68 +327,94 @@ impl Pool {
         vec![]
     }
 
-    /// Appends `columns` (weighted rows of every pose) whose parameters have the prior standard
-    /// deviation `sd` (`None`: [`PriorOptions::effect_m`] of tool displacement); returns their
-    /// indices.
-    pub(crate) fn extend(
+    /// Appends each set of `sets` of columns (weighted rows of every pose) in turn, their
+    /// parameters with the prior standard deviation `sd` (`None`: [`PriorOptions::effect_m`] of
+    /// tool displacement); returns each set's indices. Every Gram matrix is grown once (set by
+    /// set, each would be copied at every size between).
+    pub(crate) fn extend_sets(
         &mut self,
-        columns: &[Vec<f64>],
+        sets: &[Vec<Vec<f64>>],
         sd: Option<f64>,
         prior: &PriorOptions,
-    ) -> std::ops::Range<usize> {
+    ) -> Vec<std::ops::Range<usize>> {
         let k = self.k;
-        let old = self.x.first().map_or(0, |x| x.ncols());
-        let m = columns.len();
-        let total = old + m;
-        let mut cross = Vec::with_capacity(self.folds());
-        let mut cross_y = Vec::with_capacity(self.folds());
+        let first = self.x.first().map_or(0, |x| x.ncols());
+        let mut ranges = Vec::with_capacity(sets.len());
+        let mut end = first;
+        for set in sets {
+            ranges.push(end..end + set.len());
+            end += set.len();
+        }
+        let total = end;
+        // Per set and fold: the products of its new columns with every column up to them (what
+        // `extend` of that set alone would multiply), and with the targets.
+        let mut cross: Vec<Vec<Mat<f64>>> = vec![Vec::with_capacity(self.folds()); sets.len()];
+        let mut cross_y: Vec<Vec<Vec<f64>>> = vec![Vec::with_capacity(self.folds()); sets.len()];
         for f in 0..self.folds() {
             let poses = &self.fold_poses[f];
             let rows = poses.len() * k;
             let mut xf = Mat::<f64>::zeros(rows, total);
-            for c in 0..old {
+            for c in 0..first {
                 xf.col_as_slice_mut(c).copy_from_slice(self.x[f].col_as_slice(c));
             }
-            for (l, column) in columns.iter().enumerate() {
-                for (r, v) in xf.col_as_slice_mut(old + l).iter_mut().enumerate() {
-                    *v = column[poses[r / k] * k + r % k];
+            for (set, range) in sets.iter().zip(&ranges) {
+                for (l, column) in set.iter().enumerate() {
+                    for (r, v) in xf.col_as_slice_mut(range.start + l).iter_mut().enumerate() {
+                        *v = column[poses[r / k] * k + r % k];
+                    }
                 }
             }
-            let fresh = xf.as_ref().subcols(old, m);
-            let mut block = Mat::<f64>::zeros(total, m);
-            matmul(block.as_mut(), Accum::Replace, xf.transpose(), fresh, 1.0, Par::Seq);
-            let by: Vec<f64> = (0..m).map(|l| fresh.col(l).iter().zip(&self.y[f]).map(|(a, b)| a * b).sum()).collect();
-            cross.push(block);
-            cross_y.push(by);
+            for (s, range) in ranges.iter().enumerate() {
+                let m = range.len();
+                let fresh = xf.as_ref().subcols(range.start, m);
+                let mut block = Mat::<f64>::zeros(range.end, m);
+                matmul(
+                    block.as_mut(),
+                    Accum::Replace,
+                    xf.as_ref().subcols(0, range.end).transpose(),
+                    fresh,
+                    1.0,
+                    Par::Seq,
+                );
+                let by: Vec<f64> =
+                    (0..m).map(|l| fresh.col(l).iter().zip(&self.y[f]).map(|(a, b)| a * b).sum()).collect();
+                cross[s].push(block);
+                cross_y[s].push(by);
+            }
             self.x[f] = xf;
         }
         for index in 0..self.gram.len() {
             let left_out = self.left_out_of(index);
             let mut g = Mat::<f64>::zeros(total, total);
-            for c in 0..old {
-                g.col_as_slice_mut(c)[..old].copy_from_slice(&self.gram[index].col_as_slice(c)[..old]);
+            for c in 0..first {
+                g.col_as_slice_mut(c)[..first].copy_from_slice(&self.gram[index].col_as_slice(c)[..first]);
             }
-            let mut added_y = vec![0.0; m];
-            for f in (0..self.folds()).filter(|f| !left_out.contains(f)) {
-                for l in 0..m {
-                    for r in 0..total {
-                        let v = cross[f][(r, l)];
-                        g[(r, old + l)] += v;
-                        if r < old {
-                            g[(old + l, r)] += v;
+            // Each set writes its own columns (rows up to its end) and, mirrored, its own rows
+            // left of it: no entry is written by two sets.
+            for (s, range) in ranges.iter().enumerate() {
+                let (old, m) = (range.start, range.len());
+                let mut added_y = vec![0.0; m];
+                for f in (0..self.folds()).filter(|f| !left_out.contains(f)) {
+                    for l in 0..m {
+                        for r in 0..range.end {
+                            let v = cross[s][f][(r, l)];
+                            g[(r, old + l)] += v;
+                            if r < old {
+                                g[(old + l, r)] += v;
+                            }
                         }
+                        added_y[l] += cross_y[s][f][l];
                     }
-                    added_y[l] += cross_y[f][l];
                 }
+                self.xty[index].extend(added_y);
             }
-            self.xty[index].extend(added_y);
             self.gram[index] = g;
         }
-        for column in columns {
+        for column in sets.iter().flatten() {
             self.precision.push(effect_precision(column, sd, k, self.weights.position_m, prior));
             self.prior_mean.push(0.0);
         }
-        old..total
+        ranges
     }
 
     /// The weighted residual rows `y − X β` of the poses of fold `fold` (in their order).

@@ -97,6 +97,40 @@ impl Factor {
         &self.l
     }
 
+    /// `L⁻¹`, lower triangular (the strict upper triangle 0), in `n³/3` flops.
+    pub(crate) fn inverse_lower(&self, par: Par) -> Mat<f64> {
+        let n = self.l.nrows();
+        let mut inverse = Mat::<f64>::zeros(n, n);
+        faer::linalg::triangular_inverse::invert_lower_triangular(inverse.as_mut(), self.l.as_ref(), par);
+        inverse
+    }
+
+    /// `K⁻¹ = L⁻ᵀ L⁻¹` in full (both triangles): `2n³/3` flops, the lower triangle by one
+    /// triangular product, then mirrored.
+    pub(crate) fn inverse(&self, par: Par) -> Mat<f64> {
+        use faer::linalg::matmul::triangular::{self, BlockStructure};
+        let n = self.l.nrows();
+        let lower = self.inverse_lower(par);
+        let mut inverse = Mat::<f64>::zeros(n, n);
+        triangular::matmul(
+            inverse.as_mut(),
+            BlockStructure::TriangularLower,
+            faer::Accum::Replace,
+            lower.transpose(),
+            BlockStructure::TriangularUpper,
+            lower.as_ref(),
+            BlockStructure::TriangularLower,
+            1.0,
+            par,
+        );
+        for j in 1..n {
+            for i in 0..j {
+                inverse[(i, j)] = inverse[(j, i)];
+            }
+        }
+        inverse
+    }
+
     /// `rhs ← L⁻¹ rhs`.
     pub(crate) fn solve_lower_in_place(&self, rhs: MatMut<'_, f64>, par: Par) {
         solve_lower(self.l.as_ref(), rhs, par);

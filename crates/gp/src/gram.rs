@@ -205,8 +205,20 @@ fn covariance(kernel: &Evaluator, x: &Prepared, z: &Prepared, same: bool, par: P
         x.additive.as_ref().zip(z.additive.as_ref()).map(|(ax, az)| (additive::columns(ax), additive::columns(az)));
     for_each_column(k.as_mut(), par, |j, col| {
         let col = slice_mut(col);
-        for (i, v) in col.iter_mut().enumerate() {
-            *v = shape.value(signal, squared_distance(sx[i], sz[j], *v, same && i == j)) + constant;
+        match shape {
+            // The training matrix's vectorised loop, so that a prediction's cross covariances
+            // use the exponential the fit's own matrices were built with.
+            StationaryShape::SquaredExponential => {
+                stationary::fill_column(col, &sx, sz[j], signal, constant);
+                if same {
+                    col[j] = shape.value(signal, 0.0) + constant;
+                }
+            }
+            StationaryShape::Matern52 => {
+                for (i, v) in col.iter_mut().enumerate() {
+                    *v = shape.value(signal, squared_distance(sx[i], sz[j], *v, same && i == j)) + constant;
+                }
+            }
         }
         if let Some((ax, az)) = &additive {
             let term = additive::Additive { shape, variances: &kernel.additive_variances, columns: ax, query: az };

@@ -7,6 +7,7 @@ use super::{IdentificationOptions, Observation, Target};
 use crate::{Error, LocalPoe, RowKind};
 use faer::{Mat, MatMut};
 use lie::{SE3, SO3, Vector6};
+use rayon::prelude::*;
 
 /// Root-mean-square errors of a model on a set of observations.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,7 +26,26 @@ struct Accumulator {
     pose_rows: usize,
 }
 
+/// What one observation adds to the error statistics. Blocks of observations linearised side by
+/// side hand these back, and they are added in observation order: the sums are then the same
+/// bits on any number of threads.
+#[derive(Debug, Clone, Copy)]
+struct ObservationError {
+    position_sq: f64,
+    /// `None` for a point.
+    rotation_sq: Option<f64>,
+}
+
 impl Accumulator {
+    fn add(&mut self, error: ObservationError) {
+        self.rows += 1;
+        self.position_sq += error.position_sq;
+        if let Some(rotation_sq) = error.rotation_sq {
+            self.rotation_sq += rotation_sq;
+            self.pose_rows += 1;
+        }
+    }
+
     fn stats(&self) -> ResidualStats {
         ResidualStats {
             rms_position_m: (self.position_sq / self.rows.max(1) as f64).sqrt(),
@@ -66,7 +86,7 @@ impl Weights<'_> {
     }
 }
 
-/// Writes the weighted residual of one observation into `out` and accounts for its errors:
+/// Writes the weighted residual of one observation into `out` and returns its errors:
 /// `(p'_i − p_i, log(R'_i R_iᵀ)^∨)` for a pose, `p'_i − p_i` for a point. The decoupled form
 /// ([`RowKind::PointAndRotation`]) carries the same first-order information as the paper's
 /// `log(T'_i T_i⁻¹)^∨` but lets position and orientation noise be weighted each in its own unit.
@@ -75,9 +95,7 @@ fn weighted_residual(
     model_pose: &SE3,
     weight: [f64; 6],
     out: &mut [f64],
-    acc: &mut Accumulator,
-) {
-    acc.rows += 1;
+) -> ObservationError {
     match observation.target {
         Target::Pose(measured) => {
             let d = measured.translation() - model_pose.translation();
@@ -86,16 +104,14 @@ fn weighted_residual(
                 out[k] = d[k] * weight[k];
                 out[k + 3] = w[k] * weight[k + 3];
             }
-            acc.position_sq += d.norm_squared();
-            acc.rotation_sq += w.norm_squared();
-            acc.pose_rows += 1;
+            ObservationError { position_sq: d.norm_squared(), rotation_sq: Some(w.norm_squared()) }
         }
         Target::Point(measured) => {
             let d = measured - model_pose.translation();
             for k in 0..3 {
                 out[k] = d[k] * weight[k];
             }
-            acc.position_sq += d.norm_squared();
+            ObservationError { position_sq: d.norm_squared(), rotation_sq: None }
         }
     }
 }
@@ -161,15 +177,30 @@ pub(crate) fn residuals(
     weights: Weights<'_>,
     options: &IdentificationOptions,
 ) -> Result<(Vec<f64>, ResidualStats), Error> {
-    let mut y = vec![0.0; row_count(observations)];
+    // Blocks of observations side by side, their rows and errors then taken in observation order
+    // (as `linearise_reduced` does): the same bits on any number of threads.
+    let size = options.block_observations.max(1);
+    let block = |(k, chunk): (usize, &[Observation])| -> Result<(Vec<f64>, Vec<ObservationError>), Error> {
+        let mut y = vec![0.0; row_count(chunk)];
+        let mut errors = Vec::with_capacity(chunk.len());
+        let mut twists = Vec::new();
+        let mut row = 0;
+        for (offset, observation) in chunk.iter().enumerate() {
+            let index = k * size + offset;
+            let rows = row_kind(observation).rows();
+            let pose = predict(model, observation, index, correction, &mut twists)?;
+            errors.push(weighted_residual(observation, &pose, weights.of(options, index), &mut y[row..row + rows]));
+            row += rows;
+        }
+        Ok((y, errors))
+    };
+    let blocks: Vec<_> = observations.par_chunks(size).enumerate().map(block).collect();
+    let mut y = Vec::with_capacity(row_count(observations));
     let mut acc = Accumulator::default();
-    let mut twists = Vec::new();
-    let mut row = 0;
-    for (index, observation) in observations.iter().enumerate() {
-        let rows = row_kind(observation).rows();
-        let pose = predict(model, observation, index, correction, &mut twists)?;
-        weighted_residual(observation, &pose, weights.of(options, index), &mut y[row..row + rows], &mut acc);
-        row += rows;
+    for result in blocks {
+        let (rows, errors) = result?;
+        y.extend(rows);
+        errors.into_iter().for_each(|e| acc.add(e));
     }
     Ok((y, acc.stats()))
 }
@@ -196,7 +227,7 @@ pub(crate) fn linearise(
     let mut y = vec![0.0; total_rows];
     let mut acc = Accumulator::default();
     let block = Block { observations, first: 0 };
-    linearise_block(model, block, free, correction, weights, options, a.as_mut(), &mut y, &mut acc)?;
+    linearise_block(model, block, free, correction, weights, options, a.as_mut(), &mut y, &mut |e| acc.add(e))?;
     Ok((a, y, acc.stats()))
 }
 
@@ -214,13 +245,31 @@ pub(crate) fn linearise_reduced(
     let mut reduced = Reduced::new(columns);
     let mut acc = Accumulator::default();
     let size = options.block_observations.max(1);
-    for (k, chunk) in observations.chunks(size).enumerate() {
-        let rows = row_count(chunk);
+    let blocks: Vec<Block<'_>> = observations
+        .chunks(size)
+        .enumerate()
+        .map(|(k, chunk)| Block { observations: chunk, first: k * size })
+        .collect();
+    // As many blocks linearised side by side as there are threads (memory: that many blocks),
+    // then folded and counted in block order, so that the triangle and the statistics are the
+    // same bits on any number of threads.
+    let linearised = |block: &Block<'_>| -> Result<(Mat<f64>, Vec<f64>, Vec<ObservationError>), Error> {
+        let rows = row_count(block.observations);
         let mut a = Mat::<f64>::zeros(rows, columns);
         let mut y = vec![0.0; rows];
-        let block = Block { observations: chunk, first: k * size };
-        linearise_block(model, block, free, correction, weights, options, a.as_mut(), &mut y, &mut acc)?;
-        reduced.fold(a.as_ref(), &y);
+        let mut errors = Vec::with_capacity(block.observations.len());
+        linearise_block(model, *block, free, correction, weights, options, a.as_mut(), &mut y, &mut |e| {
+            errors.push(e)
+        })?;
+        Ok((a, y, errors))
+    };
+    for group in blocks.chunks(rayon::current_num_threads().max(1)) {
+        let done: Vec<_> = group.par_iter().map(linearised).collect();
+        for result in done {
+            let (a, y, errors) = result?;
+            reduced.fold(a.as_ref(), &y);
+            errors.into_iter().for_each(|e| acc.add(e));
+        }
     }
     Ok((reduced, acc.stats()))
 }
@@ -233,7 +282,7 @@ struct Block<'a> {
     first: usize,
 }
 
-/// The rows of one [`Block`] written into `a` and `y`, its errors into `acc`.
+/// The rows of one [`Block`] written into `a` and `y`, each observation's errors handed to `count`.
 #[allow(clippy::too_many_arguments)]
 fn linearise_block(
     model: &LocalPoe,
@@ -244,7 +293,7 @@ fn linearise_block(
     options: &IdentificationOptions,
     mut a: MatMut<'_, f64>,
     y: &mut [f64],
-    acc: &mut Accumulator,
+    count: &mut dyn FnMut(ObservationError),
 ) -> Result<(), Error> {
     let columns = model.layout().len();
     let joint_columns = 6 * model.joint_count();
@@ -270,7 +319,7 @@ fn linearise_block(
             }
         };
         let row_weights = weights.of(options, index);
-        weighted_residual(observation, &pose, row_weights, &mut y[row..row + rows], acc);
+        count(weighted_residual(observation, &pose, row_weights, &mut y[row..row + rows]));
         let weight = |r: usize| row_weights[r];
         // A left twist c moves the tool point by v + ω × p and the orientation by ω.
         let p = pose.translation();
@@ -375,6 +424,48 @@ mod tests {
             Observation { q: vec![0.4, -0.7], tool: 0, target: Target::Pose(pose), stated_sigma: None },
             Observation { q: vec![-1.0, 0.2], tool: 0, target: Target::Point(pose.translation()), stated_sigma: None },
         ]
+    }
+
+    #[test]
+    fn blocks_linearised_or_evaluated_side_by_side_give_the_same_bits_as_one_thread() {
+        let model = two_joint_arm();
+        let base = near_prediction(&model);
+        // 37 observations in blocks of 4: ten blocks, the last one short.
+        let observations: Vec<Observation> = (0..37)
+            .map(|i| {
+                let mut o = base[i % 2].clone();
+                o.q = vec![0.4 - 0.05 * i as f64, -0.7 + 0.03 * i as f64];
+                o
+            })
+            .collect();
+        let options = IdentificationOptions { block_observations: 4, ..IdentificationOptions::default() };
+        let free: Vec<usize> = (0..model.layout().len()).collect();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let (reduced, stats) = pool
+                .install(|| linearise_reduced(&model, &observations, &free, None, Weights::default(), &options))
+                .unwrap();
+            let r: Vec<u64> = (0..reduced.r.nrows())
+                .flat_map(|i| (0..reduced.r.ncols()).map(move |j| (i, j)))
+                .map(|(i, j)| reduced.r[(i, j)].to_bits())
+                .collect();
+            let z: Vec<u64> = reduced.z.iter().map(|v| v.to_bits()).collect();
+            let stats = (stats.rms_position_m.to_bits(), stats.rms_rotation_rad.map(f64::to_bits));
+            (r, z, reduced.residual_sq.to_bits(), stats)
+        };
+        let one = run(1);
+        assert!(!one.0.is_empty() && one.3.1.is_some());
+        assert_eq!(one, run(3));
+        let residual = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let (y, stats) =
+                pool.install(|| residuals(&model, &observations, None, Weights::default(), &options)).unwrap();
+            let y: Vec<u64> = y.iter().map(|v| v.to_bits()).collect();
+            (y, stats.rms_position_m.to_bits(), stats.rms_rotation_rad.map(f64::to_bits))
+        };
+        let serial = residual(1);
+        assert_eq!(serial.0.len(), row_count(&observations));
+        assert_eq!(serial, residual(3));
     }
 
     #[test]
