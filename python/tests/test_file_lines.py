@@ -78,7 +78,8 @@ def test_rows_outliers_and_warnings_are_named_by_their_lines(robot, campaign, tm
     train_lines = _quirky(train_path, header, train)
     data = calib.Measurements.read(train_path)
     assert list(data.lines) == train_lines
-    model = calib.fit(robot, data, method="poe", effects=None)
+    with pytest.warns(calib.CalibWarning, match=f"gross outliers.*line {train_lines[9]} "):
+        model = calib.fit(robot, data, method="poe", effects=None)
     assert model.report.as_dict()["outliers"][0]["line"] == train_lines[9]
     assert _at(train_path, train_lines[9]).startswith(train[9].split(",")[0])
     test[9] = _with(header, test[9], "y_mm", str(float(test[9].split(",")[header.split(",").index("y_mm")]) + 40))

@@ -281,10 +281,14 @@ fn simulate_refuses_an_absurd_row_count_without_panicking() {
     }
 }
 
-/// Kill -9 while `simulate` writes: the output holds either the old file or the complete new one,
-/// never a part (a temporary file may be left next to it, as nothing can clean up after a kill).
+/// Kill -9 while `simulate` writes: the output holds the old file, never a part (a temporary file
+/// may be left next to it, as nothing can clean up after a kill). The kill must land while rows
+/// are being written: `simulate` writes each row as it draws it, so with 100,000 rows (seconds
+/// of drawing in debug) it is still running when the first buffer of rows reaches the temporary
+/// file, and the exit status must say it was killed.
 #[test]
-fn a_killed_simulate_leaves_the_old_file_or_the_whole_new_one() {
+fn a_simulate_killed_while_writing_leaves_the_old_file() {
+    use std::os::unix::process::ExitStatusExt;
     let dir = tempfile::tempdir().unwrap();
     let out_path = dir.path().join("sim.csv");
     let old = b"the previous measurements\n".to_vec();
@@ -296,26 +300,34 @@ fn a_killed_simulate_leaves_the_old_file_or_the_whole_new_one() {
         .stdout(std::process::Stdio::null())
         .spawn()
         .unwrap();
-    // Kill as soon as writing has begun: a temporary file appears, or the output changes.
+    // Kill once rows have reached the disk: a file next to the output that is not empty, or the
+    // output itself changed (where the writer wrote in place).
     let started = std::time::Instant::now();
-    let killed = loop {
-        let writing = names(dir.path()).len() > 1 || std::fs::read(&out_path).map(|b| b != old).unwrap_or(true);
-        if writing {
-            child.kill().unwrap();
-            break true;
-        }
-        if child.try_wait().unwrap().is_some() || started.elapsed().as_secs() > 120 {
-            break false;
-        }
-        std::thread::sleep(std::time::Duration::from_micros(200));
+    let writing = || {
+        let others = names(dir.path()).into_iter().filter(|n| n != "sim.csv");
+        others.into_iter().any(|n| std::fs::metadata(dir.path().join(n)).is_ok_and(|m| m.len() > 0))
+            || std::fs::read(&out_path).map(|b| b != old).unwrap_or(true)
     };
-    let status = child.wait().unwrap();
-    let content = std::fs::read(&out_path).unwrap();
-    if content != old {
-        let text = String::from_utf8(content).unwrap();
-        assert_eq!(text.lines().count(), rows + 1, "killed: {killed}, {status}: a partial file under the final name");
-        assert!(text.ends_with('\n'));
+    loop {
+        if writing() {
+            child.kill().unwrap();
+            break;
+        }
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("simulate ended ({status}) before it was seen writing: the kill would not land");
+        }
+        assert!(started.elapsed().as_secs() < 60, "simulate wrote nothing in 60 s");
+        std::thread::sleep(std::time::Duration::from_micros(200));
     }
+    let status = child.wait().unwrap();
+    assert_eq!(status.signal(), Some(9), "simulate was not killed but ended: {status}");
+    let content = std::fs::read(&out_path).unwrap();
+    assert!(
+        content == old,
+        "killed while writing, the output is no longer the old file: {} bytes, {} lines",
+        content.len(),
+        String::from_utf8_lossy(&content).lines().count()
+    );
 }
 
 #[test]

@@ -516,3 +516,65 @@ fn the_effects_items_are_the_parsers() {
         filled.parse::<effects::EffectSelection>().unwrap_or_else(|e| panic!("{filled}: {e}"));
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// `fit --json` warning kinds
+
+/// One warning of each kind the fit gives (`pipeline::FitWarning`), `forced` carrying a
+/// plausibility check's refusal.
+fn every_fit_warning() -> Vec<pipeline::FitWarning> {
+    use pipeline::FitWarning;
+    let outlier = measurements::OutlierLine {
+        line: 7,
+        position_mm: 1000.0,
+        position_sigmas: 400.0,
+        rotation_mrad: None,
+        rotation_sigmas: None,
+    };
+    let warnings = vec![
+        FitWarning::Forced { refusal: "a refusal".to_owned() },
+        FitWarning::LowRedundancy { residual_rows: 30, identifiable: 24, redundancy: 1.25, min_redundancy: 3.0 },
+        FitWarning::GpSearchNotConverged { outputs: vec![0], iterations: 200 },
+        FitWarning::GrossOutliers { rows: vec![outlier], threshold_sigmas: 10.0, left_out: true },
+        FitWarning::ConstantEffect { effect: "backlash:1".to_owned() },
+        FitWarning::StatedUncertaintyFarAbove { rows: vec![(7, 12.0)], far_above_median: 10.0 },
+        FitWarning::WrongMinimum { rms_mm: 9.0, rigid_rms_mm: 3.0 },
+    ];
+    // No wildcard: a kind added to the code does not compile here until it is added above, and
+    // then it must be in docs/SPEC.md's list for the test below to pass.
+    for warning in &warnings {
+        match warning {
+            FitWarning::Forced { .. }
+            | FitWarning::LowRedundancy { .. }
+            | FitWarning::GpSearchNotConverged { .. }
+            | FitWarning::GrossOutliers { .. }
+            | FitWarning::ConstantEffect { .. }
+            | FitWarning::StatedUncertaintyFarAbove { .. }
+            | FitWarning::WrongMinimum { .. } => {}
+        }
+    }
+    warnings
+}
+
+#[test]
+fn the_fit_warning_kinds_are_the_specs() {
+    let spec = spec_text();
+    let tables = tables(&spec);
+    let table = table(&tables, "`calib fit --json`", "key");
+    let row = |key: &str| {
+        table.rows.iter().find(|r| r[0] == format!("`{key}`")).unwrap_or_else(|| panic!("docs/SPEC.md lacks {key}"))
+    };
+    let listed: BTreeSet<String> = ticked(&row("warnings[].kind")[3]).into_iter().collect();
+    let mut kinds = BTreeSet::new();
+    for warning in every_fit_warning() {
+        let value = serde_json::to_value(&warning).unwrap();
+        let kind = value["kind"].as_str().unwrap_or_else(|| panic!("no kind: {value}")).to_owned();
+        // Each field the kind prints is a `warnings[].…` row of the SPEC that names the kind.
+        for field in value.as_object().unwrap().keys().filter(|k| *k != "kind") {
+            let cells = row(&format!("warnings[].{field}"));
+            assert!(ticked(&cells[3]).contains(&kind), "docs/SPEC.md's warnings[].{field} does not name {kind}");
+        }
+        kinds.insert(kind);
+    }
+    assert_eq!(listed, kinds, "docs/SPEC.md's fit warning kinds against pipeline::FitWarning's");
+}

@@ -168,53 +168,110 @@ fn a_seven_axis_campaign_with_two_moving_joints_reaches_the_noise_with_joint_com
     }
 }
 
+/// The training costs a fit with the effects `mask` and one with `mask | extra` end at, and the
+/// geometry's alone, on 80 simulated poses of the IRB 4400 (a gear error of joint 2 and the
+/// tracker's noise) drawn with `seed`; with the convergence of the two effect fits.
+fn training_costs(seed: u64, mask: u32, extra: u32, options: &FitOptions) -> TrainingCosts {
+    const ITEMS: [&str; 5] = ["gear_periodic:2:2", "gear_periodic:3:1", "backlash:3", "thermal", "time_drift"];
+    let pick = |bits: u32| -> String {
+        ITEMS.iter().enumerate().filter(|(k, _)| bits & (1 << k) != 0).map(|(_, s)| *s).collect::<Vec<_>>().join(",")
+    };
+    let (subset, superset) = (pick(mask), pick(mask | extra));
+    let robot = testkit::robot("irb4400.ron");
+    let effects = Effects {
+        periodic: Some(PeriodicError {
+            harmonics: vec![Harmonic { joint_index: 1, order: 3.0, amplitude_rad: 2e-4, phase_rad: 0.5 }],
+        }),
+        tracker_noise: Some(TrackerNoise::default()),
+        ..Effects::default()
+    };
+    let cell = simulated_cell(&robot, &Perturbation::default(), seed).unwrap();
+    let config = GeneratorConfig { sample_count: 80, seed, ..GeneratorConfig::default() };
+    let data = simulate(&cell, &effects, &joint_ranges(&robot), &config, seed.is_multiple_of(2)).unwrap();
+    let cost = |list: &str| {
+        let options =
+            options.clone().with_effects(if list.is_empty() { EffectSelection::None } else { list.parse().unwrap() });
+        let (_, report) = pipeline::fit(&robot, &data, Method::Poe, &options).unwrap();
+        let id = &report.identification;
+        (id.final_cost, (!id.converged).then(|| format!("{list}: {} after {}", id.termination, id.iteration_count())))
+    };
+    let (geometry, _) = cost("");
+    let ((small, small_stop), (large, large_stop)) = (cost(&subset), cost(&superset));
+    TrainingCosts { subset, superset, geometry, small, large, not_converged: small_stop.or(large_stop) }
+}
+
+struct TrainingCosts {
+    subset: String,
+    superset: String,
+    geometry: f64,
+    small: f64,
+    large: f64,
+    not_converged: Option<String>,
+}
+
+impl TrainingCosts {
+    /// What the fit promises: each effect fit ends at or below the geometry's cost, where it
+    /// starts, and converged; the superset at or below the subset.
+    fn check(&self) -> Result<(), String> {
+        let TrainingCosts { subset, superset, geometry, small, large, .. } = self;
+        if let Some(stop) = &self.not_converged {
+            return Err(format!("not converged: {stop}"));
+        }
+        if *small > geometry * (1.0 + 1e-12) {
+            return Err(format!("{subset}: {small} above the geometry's {geometry}"));
+        }
+        if *large > geometry * (1.0 + 1e-12) {
+            return Err(format!("{superset}: {large} above the geometry's {geometry}"));
+        }
+        if *large > small * (1.0 + 1e-6) {
+            return Err(format!("{superset}: {large} above {subset}: {small} ({:.2e} relative)", large / small - 1.0));
+        }
+        Ok(())
+    }
+}
+
+/// One objective for every selection: plain least squares and no prior toward the nominal, the
+/// claim below being of one cost minimised with more freedom. The defaults make the objective
+/// depend on the fit: the Huber loss reweights each fit's rows by its own residuals, and the
+/// prior toward the nominal in a fit with effects is scaled by that fit's own residual
+/// (`EffectsPrior::residual_scale` in pipeline's `fit_prior.rs`), so the subset's solution is no point of the
+/// superset's problem and a superset can end above its subset without any solver fault.
+fn one_objective() -> FitOptions {
+    let mut options = FitOptions::default();
+    options.identification.robust.loss = poe::identify::Loss::Squared;
+    options.nominal_prior.choose = false;
+    options
+}
+
+/// The counterexample an unseeded run of the property below drew under the default options
+/// (seed 8, mask 23, extra 8: gear_periodic:2:2, gear_periodic:3:1, backlash:3 and time_drift,
+/// then thermal too; 4.5e-6 above under the Huber loss, the same with every tolerance a
+/// thousand times tighter), kept as a case of its own: it was found before the regressions file
+/// recorded it. The other, seed 155, mask 4, extra 8 (backlash:3, then thermal: 4.6e-4 above
+/// under the squared loss with the prior, the same with tighter tolerances, rcond 1e-14 or
+/// Levenberg-Marquardt), is in effects.proptest-regressions.
+#[test]
+fn more_effects_never_end_at_a_higher_training_cost_seed_8_mask_23_extra_8() {
+    let costs = training_costs(8, 23, 8, &one_objective());
+    if let Err(failure) = costs.check() {
+        panic!("{failure}");
+    }
+}
+
 proptest::proptest! {
-    // A fixed seed: the same eight cases every run. Seed 8, mask 23, extra 8 (drawn by an unseeded
-    // run) ends the superset 6e-5 (relative) above the subset, and that is not a false
-    // convergence: both fits stop where the gradient's cosine is 2e-10 and 3e-9 (stationary), the
-    // same with rcond 1e-13 for 1e-9; the superset's path from the geometry reaches another
-    // stationary point of the thermal/time_drift valley. The claim holds for the cases drawn here.
     #![proptest_config(proptest::prelude::ProptestConfig {
         cases: 8,
-        rng_seed: proptest::test_runner::RngSeed::Fixed(20261126),
         ..proptest::prelude::ProptestConfig::default()
     })]
 
-    /// The training cost a fit minimises (data and prior) with a superset of effects ends at or
-    /// below the cost with a subset: the subset's solution is a point of the superset's problem
-    /// (its extra parameters at zero), and every effect fit starts from the geometry's solution.
+    /// The training cost a fit minimises (plain least squares, no prior: [`one_objective`])
+    /// with a superset of effects ends at or below the cost with a subset: the subset's solution
+    /// is a point of the superset's problem (its extra parameters at zero), and every effect fit
+    /// starts from the geometry's solution.
     #[test]
     fn more_effects_never_end_at_a_higher_training_cost(seed in 0_u64..500, mask in 1_u32..32, extra in 1_u32..32) {
-        const ITEMS: [&str; 5] = ["gear_periodic:2:2", "gear_periodic:3:1", "backlash:3", "thermal", "time_drift"];
-        let pick = |bits: u32| -> String {
-            ITEMS.iter().enumerate().filter(|(k, _)| bits & (1 << k) != 0).map(|(_, s)| *s).collect::<Vec<_>>().join(",")
-        };
-        let (subset, superset) = (pick(mask), pick(mask | extra));
-        let robot = testkit::robot("irb4400.ron");
-        let effects = Effects {
-            periodic: Some(PeriodicError { harmonics: vec![Harmonic { joint_index: 1, order: 3.0, amplitude_rad: 2e-4, phase_rad: 0.5 }] }),
-            ..Effects::default()
-        };
-        let cell = simulated_cell(&robot, &Perturbation::default(), seed).unwrap();
-        let config = GeneratorConfig { sample_count: 80, seed, ..GeneratorConfig::default() };
-        let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..effects };
-        let data = simulate(&cell, &effects, &joint_ranges(&robot), &config, seed % 2 == 0).unwrap();
-        let cost = |list: &str| {
-            let options = FitOptions::default().with_effects(list.parse().unwrap());
-            let (_, report) = pipeline::fit(&robot, &data, Method::Poe, &options).unwrap();
-            let id = &report.identification;
-            (id.final_cost, id.converged.then_some(()).ok_or_else(|| format!("{list}: {} after {}", id.termination, id.iteration_count())))
-        };
-        let (geometry, _) = {
-            let (_, report) = pipeline::fit(&robot, &data, Method::Poe, &FitOptions::default()).unwrap();
-            (report.identification.final_cost, ())
-        };
-        let (small, small_converged) = cost(&subset);
-        let (large, large_converged) = cost(&superset);
-        proptest::prop_assert!(small <= geometry * (1.0 + 1e-12), "{subset}: {small} above the geometry's {geometry}");
-        proptest::prop_assert!(large <= geometry * (1.0 + 1e-12), "{superset}: {large} above the geometry's {geometry}");
-        proptest::prop_assert!(small_converged.is_ok() && large_converged.is_ok(), "{small_converged:?} / {large_converged:?}");
-        proptest::prop_assert!(large <= small * (1.0 + 1e-6), "{superset}: {large} above {subset}: {small}");
+        let costs = training_costs(seed, mask, extra, &one_objective());
+        proptest::prop_assert!(costs.check().is_ok(), "{}", costs.check().unwrap_err());
     }
 }
 

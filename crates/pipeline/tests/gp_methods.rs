@@ -220,3 +220,52 @@ fn where_the_gp_knows_nothing_its_correction_fades_to_the_geometry() {
     }
     assert!(moved > 1e-7, "without the fade the GP moves the far poses: {moved} m (the test is not vacuous)");
 }
+
+/// The fade's training share ([`model::GpFadeRule::training_share`]) is what its rule says: the
+/// median, over the GP's training rows, of the share of the prior variance of the position
+/// outputs (pooled) that the posterior keeps at each row left out of it, the noise taken off
+/// (R&W Eq. 5.12). Recomputed here from the GP's own leave-one-out, so that a share taken at the
+/// row with it in, with the noise, over all six outputs, or a mean for the median, fails.
+#[test]
+fn the_fades_training_share_is_the_median_share_the_left_out_training_rows_keep() {
+    let robot = testkit::robot("irb4400.ron");
+    // An odd count: the median is one row's share, whichever way it is taken.
+    let all = loaded_data(&robot, 61, true, 23);
+    let (model, _) = pipeline::fit(&robot, &all, Method::PoeGp, &FitOptions::default()).unwrap();
+    let gp = model.residual_gp.as_ref().unwrap();
+    let fade = gp.fade.expect("the default options fade");
+    let model::GpModel::Exact(exact) = &gp.gp else { panic!("61 rows: the exact GP") };
+    assert!(gp.fallback.is_none() && gp.inputs.is_empty());
+    let joints = all.rows[0].q.len();
+    let x = faer::Mat::from_fn(all.rows.len(), exact.input_dim(), |i, c| {
+        if c < joints { all.rows[i].q[c] } else { all.rows[i].payload_kg }
+    });
+    let loo = exact.leave_one_out().unwrap();
+    let prior = exact.prior_variance(x.as_ref()).unwrap();
+    let scale = &exact.output_normaliser().scale;
+    let mut noise = vec![0.0; exact.output_count()];
+    for component in &exact.report().components {
+        for &out in &component.outputs {
+            noise[out] = component.kernel.noise_variance() * scale[out] * scale[out];
+        }
+    }
+    let mut shares: Vec<f64> = (0..all.rows.len())
+        .map(|i| {
+            let kept: f64 = (0..3).map(|c| (loo.variance[(i, c)] - noise[c]).max(0.0)).sum();
+            let whole: f64 = (0..3).map(|c| prior[(i, c)]).sum();
+            (kept / whole).min(1.0)
+        })
+        .collect();
+    shares.sort_by(f64::total_cmp);
+    let median = shares[shares.len() / 2];
+    eprintln!(
+        "training share {} against the median {median} (from {} to {})",
+        fade.training_share, shares[0], shares[60]
+    );
+    assert!(shares[0] < shares[60], "the shares differ between rows: {shares:?}");
+    assert!(
+        (fade.training_share - median).abs() <= 1e-9 * median.max(1e-12),
+        "{} against {median}",
+        fade.training_share
+    );
+}
