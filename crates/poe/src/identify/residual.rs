@@ -253,7 +253,7 @@ pub(crate) fn linearise_reduced(
     // As many blocks linearised side by side as there are threads (memory: that many blocks),
     // then folded and counted in block order, so that the triangle and the statistics are the
     // same bits on any number of threads.
-    let linearised = |block: &Block<'_>| -> Result<(Mat<f64>, Vec<f64>, Vec<ObservationError>), Error> {
+    let linearised = |block: &Block<'_>| -> Result<Linearised, Error> {
         let rows = row_count(block.observations);
         let mut a = Mat::<f64>::zeros(rows, columns);
         let mut y = vec![0.0; rows];
@@ -261,17 +261,24 @@ pub(crate) fn linearise_reduced(
         linearise_block(model, *block, free, correction, weights, options, a.as_mut(), &mut y, &mut |e| {
             errors.push(e)
         })?;
-        Ok((a, y, errors))
+        Ok(Linearised { a, y, errors })
     };
     for group in blocks.chunks(rayon::current_num_threads().max(1)) {
         let done: Vec<_> = group.par_iter().map(linearised).collect();
         for result in done {
-            let (a, y, errors) = result?;
+            let Linearised { a, y, errors } = result?;
             reduced.fold(a.as_ref(), &y);
             errors.into_iter().for_each(|e| acc.add(e));
         }
     }
     Ok((reduced, acc.stats()))
+}
+
+/// One block's weighted rows, residuals and errors, before they are folded in.
+struct Linearised {
+    a: Mat<f64>,
+    y: Vec<f64>,
+    errors: Vec<ObservationError>,
 }
 
 /// Consecutive observations and the index of the first among all of them (the correction's
