@@ -5,19 +5,7 @@
 
 mod common;
 
-use common::{calib, fixture, text};
-use std::path::Path;
-
-fn run(args: &[&str]) -> (String, String) {
-    let out = calib(args);
-    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
-    (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
-}
-
-fn eval_json(model: &Path, data: &Path) -> serde_json::Value {
-    let (stdout, _) = run(&["eval", "--model", &text(model), "--data", &text(data), "--json"]);
-    serde_json::from_str(&stdout).expect("eval prints JSON")
-}
+use common::{eval_json, fixture, succeeds_with_stderr as run, text};
 
 #[test]
 fn eval_reports_the_gp_fade_where_the_training_rows_say_nothing_and_not_on_them() {

@@ -26,6 +26,13 @@ pub fn succeeds_with_stderr(args: &[&str]) -> (String, String) {
     (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
 }
 
+/// `calib eval --json` of `model` on `data`, which must succeed, parsed.
+#[allow(dead_code)] // not every test file that shares this module uses it
+pub fn eval_json(model: &Path, data: &Path) -> serde_json::Value {
+    let (stdout, _) = succeeds_with_stderr(&["eval", "--model", &text(model), "--data", &text(data), "--json"]);
+    serde_json::from_str(&stdout).expect("eval prints JSON")
+}
+
 /// Runs a command that must fail and returns its stderr, checked to be exactly one line.
 #[allow(dead_code)] // not every test file that shares this module uses it
 pub fn fails(args: &[&str]) -> String {
