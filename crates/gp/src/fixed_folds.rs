@@ -20,7 +20,7 @@ use rayon::prelude::*;
 
 use crate::Error;
 use crate::cholesky::Factor;
-use crate::config::GpConfig;
+use crate::config::{GpConfig, Parallelism};
 use crate::exact::ExactGp;
 use crate::gram::training_covariance;
 
@@ -93,30 +93,30 @@ impl ExactGp {
             }
             let mut weighted = Mat::<f64>::zeros(n, targets.ncols());
             product(weighted.as_mut(), Accum::Replace, p.as_ref(), targets.as_ref(), 1.0, par);
-            let solved: Vec<Result<Vec<Vec<f64>>, Error>> = folds
-                .par_iter()
-                .enumerate()
-                .map(|(f, fold)| {
-                    let held = fold.held_out;
-                    let h = held.len();
-                    if h == 0 {
-                        return Ok(Vec::new());
-                    }
-                    let block = Mat::from_fn(h, h, |a, b| p[(held[a], held[b])]);
-                    let llt = block.llt(Side::Lower).map_err(|_| Error::LeaveOneOutFailed {
-                        size: n,
-                        row: held[0],
-                        value: block[(0, 0)],
-                    })?;
-                    Ok((0..served)
-                        .map(|k| {
-                            let rhs = Mat::from_fn(h, 1, |a, _| weighted[(held[a], f * served + k)]);
-                            let shift = llt.solve(rhs);
-                            (0..h).map(|a| shift[(a, 0)]).collect()
-                        })
-                        .collect())
-                })
-                .collect();
+            let solve = |(f, fold): (usize, &FoldTargets<'_>)| -> Result<Vec<Vec<f64>>, Error> {
+                let held = fold.held_out;
+                let h = held.len();
+                if h == 0 {
+                    return Ok(Vec::new());
+                }
+                let block = Mat::from_fn(h, h, |a, b| p[(held[a], held[b])]);
+                let llt = block.llt(Side::Lower).map_err(|_| Error::LeaveOneOutFailed {
+                    size: n,
+                    row: held[0],
+                    value: block[(0, 0)],
+                })?;
+                Ok((0..served)
+                    .map(|k| {
+                        let rhs = Mat::from_fn(h, 1, |a, _| weighted[(held[a], f * served + k)]);
+                        let shift = llt.solve(rhs);
+                        (0..h).map(|a| shift[(a, 0)]).collect()
+                    })
+                    .collect())
+            };
+            let solved: Vec<Result<Vec<Vec<f64>>, Error>> = match self.parallelism {
+                Parallelism::Sequential => folds.iter().enumerate().map(solve).collect(),
+                Parallelism::Rayon => folds.par_iter().enumerate().map(solve).collect(),
+            };
             for ((mean, shifts), fold) in out.iter_mut().zip(solved).zip(folds) {
                 for (k, shift) in shifts?.into_iter().enumerate() {
                     let out = c.outputs[k];
