@@ -9,6 +9,7 @@
 
 mod cholesky;
 mod exp;
+pub mod nearest;
 pub mod one_input;
 mod products;
 pub mod stationary;
