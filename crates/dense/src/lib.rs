@@ -1,7 +1,8 @@
 //! The dense numerics the Gaussian process is made of, below any notion of a kernel or a
 //! hyperparameter: the Cholesky factorisation by halves, products and triangular solves whose
 //! results do not depend on the thread count, and the vectorised loops of the squared exponential
-//! (a branch-free exponential, `pulp`'s run-time dispatch, fixed-order partial sums).
+//! (a branch-free exponential, `pulp`'s run-time dispatch, fixed-order partial sums), and
+//! k-means' nearest-centre assignment.
 //!
 //! Invariant: every function gives the same bits whatever the number of threads it is given or
 //! runs on (on one machine; a processor without AVX2 + FMA rounds differently in the last bits).
