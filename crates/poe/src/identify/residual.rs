@@ -185,8 +185,7 @@ pub(crate) fn residuals(
         let mut errors = Vec::with_capacity(chunk.len());
         let mut twists = Vec::new();
         let mut row = 0;
-        for (offset, observation) in chunk.iter().enumerate() {
-            let index = k * size + offset;
+        for (index, observation) in (k * size..).zip(chunk) {
             let rows = row_kind(observation).rows();
             let pose = predict(model, observation, index, correction, &mut twists)?;
             errors.push(weighted_residual(observation, &pose, weights.of(options, index), &mut y[row..row + rows]));
@@ -227,7 +226,9 @@ pub(crate) fn linearise(
     let mut y = vec![0.0; total_rows];
     let mut acc = Accumulator::default();
     let block = Block { observations, first: 0 };
-    linearise_block(model, block, free, correction, weights, options, a.as_mut(), &mut y, &mut |e| acc.add(e))?;
+    let mut errors = Vec::new();
+    linearise_block(model, block, free, correction, weights, options, a.as_mut(), &mut y, &mut errors)?;
+    errors.into_iter().for_each(|e| acc.add(e));
     Ok((a, y, acc.stats()))
 }
 
@@ -258,9 +259,7 @@ pub(crate) fn linearise_reduced(
         let mut a = Mat::<f64>::zeros(rows, columns);
         let mut y = vec![0.0; rows];
         let mut errors = Vec::with_capacity(block.observations.len());
-        linearise_block(model, *block, free, correction, weights, options, a.as_mut(), &mut y, &mut |e| {
-            errors.push(e)
-        })?;
+        linearise_block(model, *block, free, correction, weights, options, a.as_mut(), &mut y, &mut errors)?;
         Ok(Linearised { a, y, errors })
     };
     for group in blocks.chunks(rayon::current_num_threads().max(1)) {
@@ -289,7 +288,7 @@ struct Block<'a> {
     first: usize,
 }
 
-/// The rows of one [`Block`] written into `a` and `y`, each observation's errors handed to `count`.
+/// The rows of one [`Block`] written into `a` and `y`, each observation's errors pushed to `errors`.
 #[allow(clippy::too_many_arguments)]
 fn linearise_block(
     model: &LocalPoe,
@@ -300,7 +299,7 @@ fn linearise_block(
     options: &IdentificationOptions,
     mut a: MatMut<'_, f64>,
     y: &mut [f64],
-    count: &mut dyn FnMut(ObservationError),
+    errors: &mut Vec<ObservationError>,
 ) -> Result<(), Error> {
     let columns = model.layout().len();
     let joint_columns = 6 * model.joint_count();
@@ -326,7 +325,7 @@ fn linearise_block(
             }
         };
         let row_weights = weights.of(options, index);
-        count(weighted_residual(observation, &pose, row_weights, &mut y[row..row + rows]));
+        errors.push(weighted_residual(observation, &pose, row_weights, &mut y[row..row + rows]));
         let weight = |r: usize| row_weights[r];
         // A left twist c moves the tool point by v + ω × p and the orientation by ω.
         let p = pose.translation();
