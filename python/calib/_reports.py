@@ -46,7 +46,7 @@ class FitReport:
     after: ErrorSummary
     identification: Dict[str, Any]
     effects: List[Dict[str, Any]]
-    compensation: Optional[Dict[str, Any]]
+    residual_gp: Optional[Dict[str, Any]]
     auto: Optional[Dict[str, Any]]
     plausibility: Optional[Dict[str, Any]]
     outliers: List[Dict[str, Any]]
@@ -63,13 +63,19 @@ class FitReport:
             after=ErrorSummary.from_dict(d["after"]),
             identification=d["identification"],
             effects=d["effects"],
-            compensation=d.get("compensation"),
+            residual_gp=d.get("compensation"),
             auto=d.get("auto"),
             plausibility=d.get("plausibility"),
             outliers=d["outliers"],
             warnings=list(warnings),
             raw=d,
         )
+
+    @property
+    def compensation(self) -> Optional[Dict[str, Any]]:
+        """The old name of :attr:`residual_gp` (the JSON key keeps it), still read; "compensation"
+        now means :meth:`Model.compensate`'s joint targets alone."""
+        return self.residual_gp
 
     def as_dict(self) -> Dict[str, Any]:
         """The JSON object of ``calib fit --json``."""

@@ -28,9 +28,9 @@ use anyhow::{Context, Result, bail};
 use campaign::{Perturbation, Remount, campaign_cell, payload_run_campaign};
 use diagnose::{DiagnoseOptions, Effect, StructureOptions, diagnose};
 use loadsim::{
-    Backlash, BaseDrift, BentLink, CouplingFactor, CouplingTerm, Effects, GeneratorConfig, Harmonic, JointBacklash,
-    JointCompliance, JointCoupling, LinkDeflection, PeriodicError, RobotDynamics, SimulatedCell, ThermalGrowth,
-    TrackerNoise,
+    BacklashModel, BentLink, CouplingFactor, CouplingModel, CouplingTerm, Effects, GearPeriodicModel, GeneratorConfig,
+    Harmonic, JointBacklash, JointComplianceModel, LinkDeflectionModel, RobotDynamics, SimulatedCell, ThermalModel,
+    TimeDriftModel, TrackerNoiseModel,
 };
 use measurements::MeasurementSet;
 use model::Method;
@@ -157,16 +157,16 @@ impl Hidden {
                         *k = if joints.contains(&j) { *k / scale } else { 1e15 };
                     }
                 }
-                effects.compliance = Some(JointCompliance::default());
+                effects.compliance = Some(JointComplianceModel::default());
             }
             Hidden::ComplianceAll => {
                 if let Some(d) = dynamics.as_mut() {
                     d.stiffness_nm_per_rad.iter_mut().for_each(|k| *k /= scale);
                 }
-                effects.compliance = Some(JointCompliance::default());
+                effects.compliance = Some(JointComplianceModel::default());
             }
             Hidden::Backlash(joints) => {
-                effects.backlash = Some(Backlash {
+                effects.backlash = Some(BacklashModel {
                     joints: joints
                         .iter()
                         .map(|&joint_index| JointBacklash { joint_index, half_band_rad: 1e-4 * scale })
@@ -174,7 +174,7 @@ impl Hidden {
                 });
             }
             Hidden::Gear(joint, harmonics) => {
-                effects.periodic = Some(PeriodicError {
+                effects.periodic = Some(GearPeriodicModel {
                     harmonics: harmonics
                         .iter()
                         .map(|&(order, weight, phase_rad)| Harmonic {
@@ -187,16 +187,16 @@ impl Hidden {
                 });
             }
             Hidden::Thermal => {
-                effects.thermal = Some(ThermalGrowth { expansion_per_k: 12e-6 * scale, ..ThermalGrowth::default() })
+                effects.thermal = Some(ThermalModel { expansion_per_k: 12e-6 * scale, ..ThermalModel::default() })
             }
             Hidden::Drift => {
                 let per_hour = scale * 1e-4 / 3600.0;
-                effects.drift = Some(BaseDrift {
+                effects.drift = Some(TimeDriftModel {
                     twist_per_s: [per_hour, -0.5 * per_hour, 0.7 * per_hour, 0.0, 0.0, 0.3 * per_hour],
                 });
             }
             Hidden::Coupling(joint, factors) => {
-                effects.coupling = Some(JointCoupling {
+                effects.coupling = Some(CouplingModel {
                     terms: vec![CouplingTerm {
                         joint_index: *joint,
                         amplitude_rad: 1e-4 * scale,
@@ -212,7 +212,7 @@ impl Hidden {
                 });
             }
             Hidden::Deflection(joint, weights) => {
-                effects.deflection = Some(LinkDeflection {
+                effects.deflection = Some(LinkDeflectionModel {
                     links: vec![BentLink {
                         joint_index: *joint,
                         flexibility_per_nm2: weights.map(|w| 1e-7 * w * scale),
@@ -398,7 +398,8 @@ pub fn run_case(robots: &Robots, index: usize, seed: u64, rows: usize, dump: Opt
     let sim = |cell: &SimulatedCell, effects: &Effects, full_pose: bool| -> Result<MeasurementSet> {
         simulate(cell, effects, &ranges, &config, full_pose)
     };
-    let with_noise = |effects: &Effects| Effects { tracker_noise: Some(TrackerNoise::default()), ..effects.clone() };
+    let with_noise =
+        |effects: &Effects| Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..effects.clone() };
     let clean_none = sim(&cell, &Effects::default(), full_pose)?;
     let noisy_none = sim(&cell, &with_noise(&Effects::default()), full_pose)?;
     let floor_mm = mean_distance_mm(&clean_none, &noisy_none);

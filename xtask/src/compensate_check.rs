@@ -10,7 +10,7 @@
 //! `compensate.md` into `--out`.
 
 use anyhow::Context;
-use campaign::{Effects, GeneratorConfig, Perturbation, SimulatedCell, TrackerNoise};
+use campaign::{Effects, GeneratorConfig, Perturbation, SimulatedCell, TrackerNoiseModel};
 use cell::{CompensateOptions, InverseOptions, PoseTarget};
 use indicatif::{ProgressBar, ProgressStyle};
 use lie::{Matrix4, SE3};
@@ -74,7 +74,7 @@ struct Outcome {
 }
 
 fn cases() -> Vec<Case> {
-    let noise = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+    let noise = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
     let paper = campaign::paper_effects();
     let payloads = GeneratorConfig::default().payloads_kg;
     vec![

@@ -131,6 +131,7 @@ fn words(reader: Reader) -> &'static [&'static str] {
             "PoeGpLoad",
             "PoeGp",
             "BaseTool",
+            "residual_gp",
             "compensation",
             "joint_compliance",
             "terms",

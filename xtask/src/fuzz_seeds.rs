@@ -4,7 +4,7 @@
 //! model files written by `calib fit`'s writer for every kind of part, and effects files.
 
 use anyhow::{Context, Result};
-use campaign::{Effects, GeneratorConfig, JointCoupling, Perturbation, Remount};
+use campaign::{CouplingModel, Effects, GeneratorConfig, Perturbation, Remount};
 use effects::{EffectKind, EffectSelection, EffectSpec};
 use measurements::MeasurementSet;
 use model::Method;
@@ -221,7 +221,7 @@ fn model_seeds(folder: &Path) -> Result<Vec<Seed>> {
 
 fn effects_seeds() -> Result<Vec<Seed>> {
     let mut typical = Effects::typical(6);
-    typical.coupling = Some(JointCoupling {
+    typical.coupling = Some(CouplingModel {
         terms: vec![campaign::CouplingTerm {
             joint_index: 2,
             amplitude_rad: 1e-3,

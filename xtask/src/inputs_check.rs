@@ -2,7 +2,7 @@
 //! whose error follows them. A base that tilts with the arm's gravity moment and with the floor
 //! under it (each day's placement tilts it anew), read by an inclinometer with its own noise
 //! (`loadsim::BaseTilt`), and thermal growth of the links with a temperature that drifts through
-//! each day (`loadsim::ThermalGrowth`, `temp_c`), beside the tracker's noise. `poe-gp` sees only
+//! each day (`loadsim::ThermalModel`, `temp_c`), beside the tracker's noise. `poe-gp` sees only
 //! the joints; `poe-gp --inputs tilt_x_mrad,tilt_y_mrad,temp_c` sees the signals too; the
 //! same residuals go to scikit-learn's ARD GP with the same inputs. Held out: every other row
 //! (even → odd) and the last day (trained on the others). The noise floor is the mean distance of
@@ -11,9 +11,9 @@
 use crate::bench_gp_residuals::heldout_mm;
 use crate::bench_gp_sklearn::{self, SklearnOptions};
 use anyhow::Context;
-use campaign::{Effects, GeneratorConfig, Perturbation, SimulatedCell, TrackerNoise};
+use campaign::{Effects, GeneratorConfig, Perturbation, SimulatedCell, TrackerNoiseModel};
 use lie::{SE3, Vector3};
-use loadsim::{BaseTilt, Payload, ThermalGrowth};
+use loadsim::{BaseTilt, Payload, ThermalModel};
 use measurements::{Inputs, MeasurementSet};
 use model::{CalibratedModel, Method, ResidualFrame, ResidualSet};
 use pipeline::FitOptions;
@@ -75,9 +75,9 @@ struct Days {
 fn simulate_days(robot: &RobotDescription, args: &Args, tilt: &BaseTilt) -> anyhow::Result<Days> {
     let cell: SimulatedCell = campaign::simulated_cell(robot, &Perturbation::default(), args.seed)?;
     let dynamics = cell.dynamics.clone().context("the robot file has no masses: the base tilt needs them")?;
-    let thermal = Some(ThermalGrowth::default());
+    let thermal = Some(ThermalModel::default());
     let noisy =
-        Effects { tracker_noise: Some(TrackerNoise::default()), thermal: thermal.clone(), ..Effects::default() };
+        Effects { tracker_noise: Some(TrackerNoiseModel::default()), thermal: thermal.clone(), ..Effects::default() };
     let quiet = Effects { thermal, ..Effects::default() };
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     let names: Arc<[String]> = SIGNALS.iter().map(|s| (*s).to_owned()).collect();

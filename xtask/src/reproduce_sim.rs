@@ -17,7 +17,7 @@ use campaign::{Perturbation, joint_ranges, simulate, simulated_cell};
 use effects::EffectSelection;
 use gp::{KernelChoice, OutputMode, Parallelism};
 use indicatif::{ProgressBar, ProgressStyle};
-use loadsim::{Effects, GeneratorConfig, JointCompliance, RobotDynamics, SimulatedCell};
+use loadsim::{Effects, GeneratorConfig, JointComplianceModel, RobotDynamics, SimulatedCell};
 use measurements::MeasurementSet;
 use model::{Method, ResidualFrame, ResidualGpOptions};
 use pipeline::FitOptions;
@@ -150,7 +150,7 @@ fn magnitudes(
     let run = |effects: &Effects| simulate(cell, effects, ranges, config, full_pose).map_err(anyhow::Error::from);
     let rigid = run(&Effects::default())?;
     let bent = run(&Effects { compliance: effects.compliance, ..Effects::default() })?;
-    let payload_only = JointCompliance { payload_only: true, ..JointCompliance::default() };
+    let payload_only = JointComplianceModel { payload_only: true, ..JointComplianceModel::default() };
     let payload = run(&Effects { compliance: Some(payload_only), ..Effects::default() })?;
     let noisy = run(&Effects { tracker_noise: effects.tracker_noise, ..Effects::default() })?;
     Ok(Magnitudes {

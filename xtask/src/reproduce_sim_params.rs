@@ -3,7 +3,7 @@
 
 use anyhow::Context;
 use campaign::{Perturbation, paper_effects};
-use loadsim::{Effects, GeneratorConfig, JointCompliance, RobotDynamics, SimulatedCell};
+use loadsim::{Effects, GeneratorConfig, JointComplianceModel, RobotDynamics, SimulatedCell};
 use model::Method;
 use pipeline::FitOptions;
 use robot::RobotDescription;
@@ -269,7 +269,7 @@ payloads\"; the arm's own weight on joints this soft would leave POE 5 mm)"
                 n.transverse_sigma_per_m * 1e6,
                 n.orientation_sigma_rad.to_degrees()
             ),
-            "loadsim `TrackerNoise` docs: Leica AT901 MPE ±(15 µm + 6 µm/m), ADM ±10 µm, T-Mac ≈ 0.01°; σ = MPE/2 \
+            "loadsim `TrackerNoiseModel` docs: Leica AT901 MPE ±(15 µm + 6 µm/m), ADM ±10 µm, T-Mac ≈ 0.01°; σ = MPE/2 \
 (Leica: typical errors are half the MPE)",
         );
     }
@@ -410,7 +410,10 @@ impl Preset {
     /// The simulated effects: compliance (under everything, or the payload alone) and tracker noise.
     pub fn effects(self) -> Effects {
         let payload_only = self == Preset::PaperLike;
-        Effects { compliance: Some(JointCompliance { payload_only, ..JointCompliance::default() }), ..paper_effects() }
+        Effects {
+            compliance: Some(JointComplianceModel { payload_only, ..JointComplianceModel::default() }),
+            ..paper_effects()
+        }
     }
 }
 

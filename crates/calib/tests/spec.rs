@@ -334,7 +334,7 @@ fn every_json_key_is_the_specs() {
     let missing: Vec<&String> =
         listed.iter().filter(|(f, p)| **p == Presence::Always && !fields.contains(*f)).map(|(f, _)| f).collect();
     assert!(missing.is_empty(), "the model file lacks fields docs/SPEC.md says are always there: {missing:?}");
-    for field in ["effects", "compensation", "training_range", "heldout", "robot_description"] {
+    for field in ["effects", "residual_gp", "training_range", "heldout", "robot_description"] {
         assert!(fields.contains(field), "{field} not written");
     }
 }

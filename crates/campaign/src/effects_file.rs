@@ -116,13 +116,16 @@ pub fn check_effects(effects: &Effects, robot: &RobotDescription, text: &str, fi
 #[cfg(test)]
 mod tests {
     use super::*;
-    use loadsim::{JointCompliance, TrackerNoise};
+    use loadsim::{JointComplianceModel, TrackerNoiseModel};
 
     #[test]
     fn an_effects_file_with_a_typo_is_refused_at_its_line() {
         let good = parse_effects("(compliance: (payload_only: true), tracker_noise: ())", "e.ron").unwrap();
-        assert_eq!(good.compliance, Some(JointCompliance { payload_only: true, ..JointCompliance::default() }));
-        assert_eq!(good.tracker_noise, Some(TrackerNoise::default()));
+        assert_eq!(
+            good.compliance,
+            Some(JointComplianceModel { payload_only: true, ..JointComplianceModel::default() })
+        );
+        assert_eq!(good.tracker_noise, Some(TrackerNoiseModel::default()));
         let coupled = parse_effects(
             "(coupling: (terms: [(joint_index: 2, amplitude_rad: 1e-3, factors: [(source_joint_index: 1, order: 2.0, phase_rad: 0.0)])]))",
             "e.ron",

@@ -45,8 +45,8 @@ pub use effects_file::{
     MAX_SCREW_ERROR_M, MAX_TEMPERATURE_C, check_effects, parse_effects, read_effects,
 };
 pub use loadsim::{
-    CouplingFactor, CouplingTerm, EffectKind, Effects, GeneratorConfig, JointCompliance, JointCoupling, JointRange,
-    Sample, SimulatedCell, TorqueSensorNoise, TrackerNoise,
+    CouplingFactor, CouplingModel, CouplingTerm, EffectKind, Effects, GeneratorConfig, JointComplianceModel,
+    JointRange, Sample, SimulatedCell, TorqueSensorNoise, TrackerNoiseModel,
 };
 
 /// How far the true robot is from its nominal model: every constant transform of the local POE
@@ -225,8 +225,8 @@ pub fn joint_ranges(robot: &RobotDescription) -> Vec<JointRange> {
 /// compliance under the arm's weight and the payload) and tracker noise (Leica AT901 with T-Mac).
 pub fn paper_effects() -> Effects {
     Effects {
-        compliance: Some(JointCompliance::default()),
-        tracker_noise: Some(TrackerNoise::default()),
+        compliance: Some(JointComplianceModel::default()),
+        tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     }
 }
@@ -394,7 +394,7 @@ mod tests {
         let robot = testkit::robot("irb4400.ron");
         let cell = simulated_cell(&robot, &Perturbation::default(), 1).unwrap();
         let config = GeneratorConfig { sample_count: 3, ..GeneratorConfig::default() };
-        let noise = TrackerNoise { transverse_sigma_per_m: 1e308, ..TrackerNoise::default() };
+        let noise = TrackerNoiseModel { transverse_sigma_per_m: 1e308, ..TrackerNoiseModel::default() };
         let effects = Effects { tracker_noise: Some(noise), ..Effects::default() };
         let result = simulate(&cell, &effects, &joint_ranges(&robot), &config, true);
         assert!(
@@ -475,7 +475,7 @@ mod tests {
         let robot = testkit::robot("irb4400.ron");
         let cell = simulated_cell(&robot, &Perturbation::default(), 1).unwrap();
         let config = GeneratorConfig { sample_count: 3, ..GeneratorConfig::default() };
-        let noise = TrackerNoise { transverse_sigma_per_m: 1e308, ..TrackerNoise::default() };
+        let noise = TrackerNoiseModel { transverse_sigma_per_m: 1e308, ..TrackerNoiseModel::default() };
         let effects = Effects { tracker_noise: Some(noise), ..Effects::default() };
         let result = simulate_to_csv(&cell, &effects, &joint_ranges(&robot), &config, true, Vec::new(), "mem");
         assert!(

@@ -51,21 +51,13 @@ pub(crate) fn check_joint_kinds(document: &UrdfDocument, chain: &UrdfChain, mode
                 ErrorKind::UrdfJointKind {
                     joint: step.joint.clone(),
                     index: k + 1,
-                    urdf: error_kind(urdf_kind),
-                    model: error_kind(model_kind),
+                    urdf: urdf_kind.name(),
+                    model: model_kind.name(),
                 },
             ));
         }
     }
     Ok(())
-}
-
-/// A joint's kind as an error names it (the errors know no kinematics crate).
-fn error_kind(kind: JointKind) -> errors::JointKind {
-    match kind {
-        JointKind::Revolute => errors::JointKind::Revolute,
-        JointKind::Prismatic => errors::JointKind::Prismatic,
-    }
 }
 
 pub(crate) fn write_like(

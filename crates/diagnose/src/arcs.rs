@@ -9,7 +9,7 @@
 //! of the held-out joint's own angle is faded whole there (the model fades it in any gap wider
 //! than half its shortest period, and a prediction for poses off the training poses must not
 //! count on a gap being narrow), another joint's series is applied with the coverage weight
-//! [`effects::GearPeriodic::held_and_weight`] computed from that fit's own training angles, and the pose
+//! [`effects::GearPeriodicTerm::held_and_weight`] computed from that fit's own training angles, and the pose
 //! is blended to the geometry fitted alone by the product of those weights (the model's
 //! `fallback` part). So the arcs measure how the geometry and the other effects carry into
 //! angles the fit never saw.

@@ -12,8 +12,8 @@
 
 use super::design::Design;
 use effects::{
-    CandidateContext, CandidateModel, ComplianceTerm, ComplianceTorque, EffectContext, EffectKind, IdentifiedEffect,
-    LoadFrame, has_torques, stand_in_dynamics,
+    CandidateContext, CandidateModel, ComplianceParameter, ComplianceTorque, EffectContext, EffectKind,
+    IdentifiedEffect, LoadFrame, has_torques, stand_in_dynamics,
 };
 use errors::Error;
 use measurements::BoundSet;
@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 /// Generates [`Effect`] from the identified kinds of `loadsim::effect_kinds!`, and `None` and
 /// `Unknown`.
 macro_rules! verdict_effect {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident $(=> $field:ident: $sim:ty)?, )* }
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident: $sim:ty)?, )* }
      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// An effect a verdict can name (the SPEC's `verdict.effect`): every kind the fit
         /// identifies, in the list's order, then `None` and `Unknown`.
@@ -109,7 +109,7 @@ pub(crate) struct SideSource {
     /// Index of the joint's gravity-regressor compliance candidate.
     pub compliance: usize,
     /// Its terms (the regressors whose combination is the learnt torque).
-    pub terms: Vec<ComplianceTerm>,
+    pub terms: Vec<ComplianceParameter>,
     /// The gravity frame, for the learnt torque's definition.
     pub load: LoadFrame,
 }
@@ -210,7 +210,7 @@ pub(crate) fn build_candidates(
         // sign no mass model changes (a balancer of the robot file is in the stated force), so a
         // learnt side would only follow the noise or the payload (issue 30: a vertical column).
         let constant_force =
-            robot.joints[j].kind == robot::JointType::Prismatic && !built.iter().any(|c| c.effect == Effect::Backlash);
+            robot.joints[j].kind == poe::JointKind::Prismatic && !built.iter().any(|c| c.effect == Effect::Backlash);
         let side = built.iter().position(|c| {
             matches!(&c.model, IdentifiedEffect::JointCompliance(jc)
                 if matches!(jc.torque, ComplianceTorque::GravityRegressor(_)))

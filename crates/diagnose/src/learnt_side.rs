@@ -12,7 +12,7 @@
 use super::candidates::{Candidate, SideSource, columns_of};
 use super::design::Design;
 use super::pool::Pool;
-use effects::{Backlash, GearPeriodic, IdentifiedEffect, TorqueSign};
+use effects::{BacklashTerm, GearPeriodicTerm, IdentifiedEffect, TorqueSign};
 use errors::Error;
 use measurements::BoundSet;
 use poe::LocalPoe;
@@ -102,7 +102,7 @@ fn learn(
         columns: source.terms.iter().map(|t| t.column).collect(),
         coefficients: pi.iter().zip(&source.terms).map(|(c, t)| c / t.scale).collect(),
     };
-    Ok(IdentifiedEffect::Backlash(Backlash::new(source.joint, learnt, data)?))
+    Ok(IdentifiedEffect::Backlash(BacklashTerm::new(source.joint, learnt, data)?))
 }
 
 /// The learnt side of every source joint: per fold, and on every row.
@@ -123,7 +123,7 @@ pub(crate) fn learnt_sides(
             let compliance = &candidates[source.compliance];
             let columns = &candidate_columns[source.compliance];
             // The joint's bare twist: order 0's cosine feature is 1 on every row.
-            let bare = IdentifiedEffect::GearPeriodic(GearPeriodic::new(source.joint, vec![0], data.rows())?);
+            let bare = IdentifiedEffect::GearPeriodic(GearPeriodicTerm::new(source.joint, vec![0], data.rows())?);
             let twist_rows = columns_of(design, &bare, model, data)?.swap_remove(0);
             // The compliance's features of every row, once for all the folds' alternations.
             let scalars: Vec<Vec<f64>> =
@@ -157,7 +157,7 @@ mod tests {
     use super::super::pool::{KinematicPrior, PriorOptions};
     use super::super::{fold_assignment, terms_of};
     use super::*;
-    use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell};
+    use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel, joint_ranges, simulate, simulated_cell};
     use robot::RobotDescription;
 
     #[test]
@@ -165,8 +165,8 @@ mod tests {
         let robot = testkit::robot("irb4400.ron");
         let cell = simulated_cell(&robot, &Perturbation::default(), 41).unwrap();
         let effects = Effects {
-            backlash: Some(loadsim::Backlash::uniform(6, 3e-4)),
-            tracker_noise: Some(TrackerNoise::default()),
+            backlash: Some(loadsim::BacklashModel::uniform(6, 3e-4)),
+            tracker_noise: Some(TrackerNoiseModel::default()),
             ..Effects::default()
         };
         let config = GeneratorConfig { sample_count: 120, seed: 41, ..GeneratorConfig::default() };

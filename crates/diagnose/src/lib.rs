@@ -85,7 +85,7 @@ pub struct DiagnoseOptions {
     /// instrument default `tracker`.
     pub noise_mm: Option<f64>,
     /// The instrument class assumed when neither `noise_mm` nor repeated poses give the noise.
-    pub tracker: loadsim::TrackerNoise,
+    pub tracker: loadsim::TrackerNoiseModel,
     /// A joint counts as moving when its angles span more than this, rad. 0.05 rad (3°): the
     /// 7-axis campaign of issue 11 holds its still joints within ±2 mrad, and over a few degrees
     /// a function of the angle is a straight line the kinematic model already holds.
@@ -119,7 +119,7 @@ impl Default for DiagnoseOptions {
             folds: 5,
             seed: 0,
             noise_mm: None,
-            tracker: loadsim::TrackerNoise::default(),
+            tracker: loadsim::TrackerNoiseModel::default(),
             moving_min_range_rad: 0.05,
             arc_folds: 10,
             prior: PriorOptions::default(),
@@ -658,7 +658,7 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
         })
         .collect();
     let prismatic: Vec<usize> = (0..robot.joint_count())
-        .filter(|&j| robot.joints[j].kind == robot::JointType::Prismatic)
+        .filter(|&j| robot.joints[j].kind == poe::JointKind::Prismatic)
         .map(|j| j + 1)
         .collect();
     let regions = regions::regions(&poses, &moving, &prismatic);

@@ -3,7 +3,7 @@
 //! (a GP's leftover holds every structure the GP missed, and called 0.27 mm "the floor" on a UR10
 //! whose tracker is ten times better).
 
-use loadsim::TrackerNoise;
+use loadsim::TrackerNoiseModel;
 use measurements::MeasurementSet;
 use serde::{Deserialize, Serialize};
 
@@ -47,10 +47,10 @@ impl NoiseFloor {
 }
 
 /// The floor of a laser tracker of the class `noise` describes (default: Leica AT901 with a
-/// T-Mac, σ = MPE/2, module `loadsim::TrackerNoise`), the tracker at the origin of the measurement
+/// T-Mac, σ = MPE/2, module `loadsim::TrackerNoiseModel`), the tracker at the origin of the measurement
 /// frame: per pose the radial and the two transverse variances at the measured distance, pooled
 /// into one per-axis σ.
-pub(crate) fn tracker_default(data: &MeasurementSet, noise: &TrackerNoise) -> NoiseFloor {
+pub(crate) fn tracker_default(data: &MeasurementSet, noise: &TrackerNoiseModel) -> NoiseFloor {
     let variance: f64 = data
         .rows
         .iter()
@@ -123,7 +123,7 @@ mod tests {
 
     #[test]
     fn the_tracker_default_grows_with_distance_and_names_its_instrument() {
-        let noise = TrackerNoise::default();
+        let noise = TrackerNoiseModel::default();
         let near = MeasurementSet::from_rows("t", vec![row(0.0, 1.0)], vec![String::new()]);
         let far = MeasurementSet::from_rows("t", vec![row(0.0, 10.0)], vec![String::new()]);
         let (a, b) = (tracker_default(&near, &noise), tracker_default(&far, &noise));

@@ -662,7 +662,7 @@ mod tests {
         let fold = super::super::fold_assignment(200, 5, 3);
         let blocks = [(std::slice::from_ref(&effect), None)];
         let loose = Pool::new(&design, &prior(1e6), &blocks, &fold, 5, &PriorOptions::default());
-        let model = effects::IdentifiedEffect::Thermal(effects::Thermal {
+        let model = effects::IdentifiedEffect::Thermal(effects::ThermalTerm {
             reference_c: 20.0,
             scale: vec![1.0],
             theta: vec![0.0],

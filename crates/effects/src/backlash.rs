@@ -42,7 +42,7 @@ pub enum TorqueSign {
 
 /// Backlash of one joint.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Backlash {
+pub struct BacklashTerm {
     /// 0-based joint.
     pub joint: usize,
     /// The torque whose sign selects the side.
@@ -57,7 +57,7 @@ fn sign(x: f64) -> f64 {
     loadsim::backlash_joint_regressor(&[x])[0]
 }
 
-impl Backlash {
+impl BacklashTerm {
     /// Backlash of `joint` (1-based) whose side is set by `sign`, scaled on the training rows.
     pub fn new(joint: usize, sign: TorqueSign, data: &BoundSet<'_>) -> Result<Self, Error> {
         let mut model = Self { joint, sign, scale: vec![1.0], theta: vec![0.0] };
@@ -94,7 +94,7 @@ impl Backlash {
     }
 }
 
-impl Regressor for Backlash {
+impl Regressor for BacklashTerm {
     fn directions(&self) -> Vec<Direction> {
         vec![Direction::Joint(self.joint)]
     }
@@ -116,7 +116,7 @@ impl Regressor for Backlash {
     }
 }
 
-impl EffectTerm for Backlash {
+impl EffectTerm for BacklashTerm {
     fn label(&self) -> String {
         let source = match self.sign {
             TorqueSign::Measured => "measured torque",
@@ -175,7 +175,7 @@ impl EffectTerm for Backlash {
     }
 }
 
-impl NewEffect for Backlash {
+impl NewEffect for BacklashTerm {
     const ARGUMENTS: &'static [Argument] = &[Argument::Joint];
 
     /// The sign of the measured torque where every row has one, of the robot's static torque
@@ -188,7 +188,7 @@ impl NewEffect for Backlash {
             let dynamics = context.robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(context.robot));
             TorqueSign::Stated { load: context.load_frame(data)?, dynamics }
         };
-        Backlash::new(joint, sign, data)
+        BacklashTerm::new(joint, sign, data)
     }
 
     /// `δq_j = b_j sign(τ_j)`: the sign of the stated (or stand-in) static torque, first among the
@@ -202,10 +202,10 @@ impl NewEffect for Backlash {
         let stated = TorqueSign::Stated { load: context.load.clone(), dynamics: context.dynamics.clone() };
         let mut out = vec![CandidateModel {
             only_if_nonzero: true,
-            ..CandidateModel::plain(IdentifiedEffect::Backlash(Backlash::new(joint, stated, context.data)?), 0)
+            ..CandidateModel::plain(IdentifiedEffect::Backlash(BacklashTerm::new(joint, stated, context.data)?), 0)
         }];
         if context.measured {
-            let measured = Backlash::new(joint, TorqueSign::Measured, context.data)?;
+            let measured = BacklashTerm::new(joint, TorqueSign::Measured, context.data)?;
             out.push(CandidateModel {
                 only_if_nonzero: true,
                 ..CandidateModel::plain(IdentifiedEffect::Backlash(measured), 3)

@@ -161,7 +161,7 @@ mod tests {
         let q = [-0.7, 0.5, 2.0];
         let h = 1e-7;
         // Every link but the tracker-to-base placement (link 0) grows by the strain h.
-        let growth = loadsim::ThermalGrowth {
+        let growth = loadsim::ThermalModel {
             reference_temp_c: 0.0,
             expansion_per_k: 1.0,
             link_expansion_per_k: vec![0.0, 1.0, 1.0, 1.0],

@@ -7,7 +7,7 @@
 //! of millimetres within a few degrees (issue 23: UR10 series B, 20 mm). So the series is fitted
 //! and applied *held and faded*: at an angle outside the fitted angles (past either end, or in a
 //! gap wider than half the shortest period) it is evaluated at the nearest fitted angle and
-//! multiplied by a raised-cosine taper that reaches zero [`GearPeriodic::taper_rad`] away, where
+//! multiplied by a raised-cosine taper that reaches zero [`GearPeriodicTerm::taper_rad`] away, where
 //! the model is the geometry alone. Each feature has its mean over the training angles removed, so
 //! that a constant joint offset stays with the geometry, which holds it everywhere, rather than
 //! with the series, which fades.
@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 
 /// A periodic error of one joint in its own angle.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct GearPeriodic {
+pub struct GearPeriodicTerm {
     /// 0-based joint.
     pub joint: usize,
     /// The harmonic orders, each with a cosine then a sine parameter.
@@ -117,14 +117,14 @@ impl GearOptions {
     }
 }
 
-impl GearPeriodic {
+impl GearPeriodicTerm {
     /// The gear series of `joint` (1-based) with `orders`, scaled on the training rows, with the
     /// default [`GearOptions`].
     pub fn new(joint: usize, orders: Vec<u32>, rows: &[Measurement]) -> Result<Self, Error> {
         Self::with_options(joint, orders, rows, &GearOptions::default())
     }
 
-    /// [`GearPeriodic::new`] with the taper of `options`.
+    /// [`GearPeriodicTerm::new`] with the taper of `options`.
     pub fn with_options(
         joint: usize,
         orders: Vec<u32>,
@@ -136,7 +136,7 @@ impl GearPeriodic {
     }
 
     /// The series of `joint` fitted on the angles `angles` (rad; for a screw, its phases,
-    /// `crate::ScrewPeriodic`), with the taper of `options`.
+    /// `crate::ScrewPeriodicTerm`), with the taper of `options`.
     pub(crate) fn from_angles(joint: usize, orders: Vec<u32>, angles: &[f64], options: &GearOptions) -> Self {
         let fitted_range = angles.iter().fold(None, |range: Option<[f64; 2]>, &q| {
             Some(range.map_or([q, q], |[low, high]| [low.min(q), high.max(q)]))
@@ -172,7 +172,7 @@ impl GearPeriodic {
     }
 }
 
-impl GearPeriodic {
+impl GearPeriodicTerm {
     /// Whether the series was fitted on poses near the angle `q` (inside the fitted range and
     /// outside its gaps); true for model files that do not record the range.
     pub fn covers(&self, q: f64) -> bool {
@@ -204,13 +204,13 @@ impl GearPeriodic {
             .collect()
     }
 
-    /// Records [`GearPeriodic::fitted_rms_rad`] over the training rows, after the fit.
+    /// Records [`GearPeriodicTerm::fitted_rms_rad`] over the training rows, after the fit.
     pub fn record_rms(&mut self, rows: &[Measurement]) {
         let angles: Vec<f64> = rows.iter().filter_map(|r| r.q.get(self.joint).copied()).collect();
         self.record_rms_at(&angles);
     }
 
-    /// Records [`GearPeriodic::fitted_rms_rad`] over the training angles `angles`.
+    /// Records [`GearPeriodicTerm::fitted_rms_rad`] over the training angles `angles`.
     pub(crate) fn record_rms_at(&mut self, angles: &[f64]) {
         let values: Vec<f64> = angles.iter().map(|&q| self.joint_error(q)).collect();
         let rms = (values.iter().map(|v| v * v).sum::<f64>() / values.len().max(1) as f64).sqrt();
@@ -238,14 +238,14 @@ impl GearPeriodic {
 
     /// The angle the series is evaluated at for `q` (the nearest fitted angle where `q` lies
     /// outside them) and the weight it is applied with there (1 on the fitted angles, fading to
-    /// 0 over [`GearPeriodic::taper_rad`]). Older files without a taper: `(q, 1)` everywhere.
+    /// 0 over [`GearPeriodicTerm::taper_rad`]). Older files without a taper: `(q, 1)` everywhere.
     pub fn held_and_weight(&self, q: f64) -> (f64, f64) {
         held_and_weight(&self.turn_gaps, self.taper_rad, q)
     }
 }
 
 /// Where a joint's series of the orders up to the highest fitted was fitted on the turn of its
-/// angles, and how it fades beyond: what [`GearPeriodic::held_and_weight`] reads, without the
+/// angles, and how it fades beyond: what [`GearPeriodicTerm::held_and_weight`] reads, without the
 /// series' features (their means and scales over the angles cost a sine and cosine per order
 /// and angle). For a caller that needs only the coverage of a fit on some angles (the
 /// diagnosis's arcs, once per fold).
@@ -259,7 +259,7 @@ pub struct AngleCoverage {
 
 impl AngleCoverage {
     /// The coverage of a series of `joint` with `orders` fitted on `angles` (rad), as
-    /// [`GearPeriodic`] records it with `options`.
+    /// [`GearPeriodicTerm`] records it with `options`.
     pub fn of(joint: usize, orders: &[u32], angles: &[f64], options: &GearOptions) -> Self {
         let mut turn: Vec<f64> = angles.iter().map(|q| q.rem_euclid(std::f64::consts::TAU)).collect();
         turn.sort_by(f64::total_cmp);
@@ -276,14 +276,14 @@ impl AngleCoverage {
         Self { joint, turn_gaps, taper_rad }
     }
 
-    /// [`GearPeriodic::held_and_weight`] of the series this coverage describes.
+    /// [`GearPeriodicTerm::held_and_weight`] of the series this coverage describes.
     pub fn held_and_weight(&self, q: f64) -> (f64, f64) {
         held_and_weight(&self.turn_gaps, self.taper_rad, q)
     }
 }
 
 /// The held angle and the weight at `q` of a series whose turn has the gaps `turn_gaps` and fades
-/// over `taper_rad` ([`GearPeriodic::held_and_weight`]).
+/// over `taper_rad` ([`GearPeriodicTerm::held_and_weight`]).
 fn held_and_weight(turn_gaps: &[[f64; 2]], taper_rad: Option<f64>, q: f64) -> (f64, f64) {
     let Some(width) = taper_rad else { return (q, 1.0) };
     let Some((t, [a, b])) = turn_gap(turn_gaps, q) else { return (q, 1.0) };
@@ -302,7 +302,7 @@ fn turn_gap(turn_gaps: &[[f64; 2]], q: f64) -> Option<(f64, [f64; 2])> {
         .find_map(|&[a, b]| [t, t + std::f64::consts::TAU].into_iter().find(|&x| a < x && x < b).map(|x| (x, [a, b])))
 }
 
-impl Regressor for GearPeriodic {
+impl Regressor for GearPeriodicTerm {
     fn directions(&self) -> Vec<Direction> {
         vec![Direction::Joint(self.joint); 2 * self.orders.len()]
     }
@@ -329,7 +329,7 @@ impl Regressor for GearPeriodic {
     }
 }
 
-impl EffectTerm for GearPeriodic {
+impl EffectTerm for GearPeriodicTerm {
     fn after_fit(&mut self, rows: &[Measurement]) {
         self.record_rms(rows);
     }
@@ -413,12 +413,12 @@ impl EffectTerm for GearPeriodic {
     }
 
     /// 1 on the joint angles it was fitted on, fading to 0 outside them
-    /// ([`GearPeriodic::held_and_weight`]).
+    /// ([`GearPeriodicTerm::held_and_weight`]).
     fn coverage_weight(&self, row: &Measurement) -> f64 {
         row.q.get(self.joint).map_or(1.0, |&q| self.held_and_weight(q).1)
     }
 
-    /// [`GearPeriodic::faded_sigma`] along the joint's twist.
+    /// [`GearPeriodicTerm::faded_sigma`] along the joint's twist.
     fn uncovered(&self, row: &Measurement) -> Option<(Direction, f64)> {
         row.q.get(self.joint).map(|&q| (Direction::Joint(self.joint), self.faded_sigma(q)))
     }
@@ -428,31 +428,31 @@ impl EffectTerm for GearPeriodic {
     }
 
     fn prior_scale(&self) -> Vec<f64> {
-        GearPeriodic::prior_scale(self)
+        GearPeriodicTerm::prior_scale(self)
     }
 }
 
-impl NewEffect for GearPeriodic {
+impl NewEffect for GearPeriodicTerm {
     const ARGUMENTS: &'static [Argument] = &[Argument::Joint, Argument::Harmonics];
 
     /// Harmonics `1..=harmonics` of a revolute joint (on a linear axis the period of a screw or
     /// rack is a length, which this series has no parameter for), faded as `context.gear` says.
     fn build(spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
         let joint = spec.joint_index()?;
-        if context.robot.joints[joint].kind == robot::JointType::Prismatic {
+        if context.robot.joints[joint].kind == poe::JointKind::Prismatic {
             return Err(Error::new(ErrorKind::EffectJointKind { effect: "gear_periodic", joint: joint + 1 }));
         }
         let harmonics = spec.required_harmonics()?;
-        GearPeriodic::with_options(joint, (1..=harmonics).collect(), data.rows(), &context.gear)
+        GearPeriodicTerm::with_options(joint, (1..=harmonics).collect(), data.rows(), &context.gear)
     }
 
     /// A series of the joint's own angle up to the diagnosis's longest order, for a revolute
     /// joint that moves; last among the joint's candidates.
     fn joint_candidates(context: &CandidateContext<'_>, joint: usize) -> Result<Vec<CandidateModel>, Error> {
-        if !context.moving.contains(&joint) || context.robot.joints[joint].kind != robot::JointType::Revolute {
+        if !context.moving.contains(&joint) || context.robot.joints[joint].kind != poe::JointKind::Revolute {
             return Ok(Vec::new());
         }
-        let gear = GearPeriodic::new(joint, (1..=context.longest_order).collect(), context.data.rows())?;
+        let gear = GearPeriodicTerm::new(joint, (1..=context.longest_order).collect(), context.data.rows())?;
         Ok(vec![CandidateModel { series: true, ..CandidateModel::plain(IdentifiedEffect::GearPeriodic(gear), 4) }])
     }
 }
@@ -473,7 +473,7 @@ mod tests {
 
     #[test]
     fn inside_the_fitted_angles_the_series_is_applied_whole_and_past_the_end_it_fades_to_zero() {
-        let gear = GearPeriodic::new(0, (1..=12).collect(), &rows(&spread(-1.0, 0.5, 200))).unwrap();
+        let gear = GearPeriodicTerm::new(0, (1..=12).collect(), &rows(&spread(-1.0, 0.5, 200))).unwrap();
         let width = gear.taper_rad.unwrap();
         assert!((width - 0.25 * TAU / 12.0).abs() < 1e-15, "{width}");
         for q in [-1.0, -0.3, 0.0, 0.5] {
@@ -504,7 +504,7 @@ mod tests {
         let mut angles = spread(-1.0, -0.2, 100);
         angles.extend(spread(0.2, 1.0, 100)); // a 0.4 rad gap, wider than π/12 = 0.26
         angles.extend(spread(1.0 + 0.9 * spacing, 1.5, 50)); // a gap just under the spacing
-        let gear = GearPeriodic::new(0, (1..=order).collect(), &rows(&angles)).unwrap();
+        let gear = GearPeriodicTerm::new(0, (1..=order).collect(), &rows(&angles)).unwrap();
         assert_eq!(gear.held_and_weight(0.0).1, 0.0);
         let (held, weight) = gear.held_and_weight(-0.19);
         assert!((held + 0.2).abs() < 1e-12 && weight > 0.9, "{held} {weight}");
@@ -514,13 +514,13 @@ mod tests {
     #[test]
     fn the_fitted_angles_wrap_with_the_turn_so_a_wrist_fitted_over_more_than_a_turn_has_no_gap() {
         // -4 … 2.5 rad is more than a turn: every angle of the circle was seen, once or twice.
-        let gear = GearPeriodic::new(0, (1..=24).collect(), &rows(&spread(-4.0, 2.5, 2000))).unwrap();
+        let gear = GearPeriodicTerm::new(0, (1..=24).collect(), &rows(&spread(-4.0, 2.5, 2000))).unwrap();
         assert!(gear.turn_gaps.is_empty(), "{:?}", gear.turn_gaps);
         for q in [-10.0, -4.5, 3.0, 7.0] {
             assert_eq!(gear.held_and_weight(q), (q, 1.0), "{q}");
         }
         // The same angles one turn away count as fitted: 0.3 + 2π lies where 0.3 was seen.
-        let gear = GearPeriodic::new(0, (1..=24).collect(), &rows(&spread(0.0, 1.0, 300))).unwrap();
+        let gear = GearPeriodicTerm::new(0, (1..=24).collect(), &rows(&spread(0.0, 1.0, 300))).unwrap();
         assert_eq!(gear.held_and_weight(0.3 + TAU).1, 1.0);
         assert_eq!(gear.held_and_weight(3.0).1, 0.0);
     }
@@ -528,7 +528,7 @@ mod tests {
     #[test]
     fn the_features_have_no_mean_over_the_training_angles_so_a_constant_offset_stays_with_the_geometry() {
         let training = rows(&spread(-0.4, 0.9, 300));
-        let gear = GearPeriodic::new(0, (1..=6).collect(), &training).unwrap();
+        let gear = GearPeriodicTerm::new(0, (1..=6).collect(), &training).unwrap();
         let features: Vec<Vec<f64>> = training.iter().map(|r| gear.features(r, 0).unwrap()).collect();
         for l in 0..12 {
             let mean = features.iter().map(|f| f[l]).sum::<f64>() / features.len() as f64;
@@ -540,13 +540,13 @@ mod tests {
 
     #[test]
     fn order_zero_is_the_bare_twist_and_keeps_its_constant_feature() {
-        let gear = GearPeriodic::new(0, vec![0], &rows(&spread(-0.4, 0.9, 30))).unwrap();
+        let gear = GearPeriodicTerm::new(0, vec![0], &rows(&spread(-0.4, 0.9, 30))).unwrap();
         assert_eq!(gear.features(&rows(&[0.3])[0], 0).unwrap(), vec![1.0, 0.0]);
     }
 
     #[test]
     fn a_model_file_without_the_taper_applies_its_series_everywhere_as_it_did() {
-        let mut gear = GearPeriodic::new(0, vec![1, 2], &rows(&spread(0.0, 0.5, 50))).unwrap();
+        let mut gear = GearPeriodicTerm::new(0, vec![1, 2], &rows(&spread(0.0, 0.5, 50))).unwrap();
         gear.taper_rad = None;
         gear.mean.clear();
         assert_eq!(gear.held_and_weight(3.0), (3.0, 1.0));

@@ -91,7 +91,7 @@ impl TorqueFit {
 
 /// One parameter: one joint's deflection per unit of one torque regressor.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct ComplianceTerm {
+pub struct ComplianceParameter {
     /// 0-based joint whose deflection the term drives.
     pub joint: usize,
     /// Column of the gravity regressor `Y` (4 per link), or `4n` for the payload torque; 0 for a
@@ -104,11 +104,11 @@ pub struct ComplianceTerm {
 
 /// Joint compliance, identified with the geometry.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct JointCompliance {
+pub struct JointComplianceTerm {
     /// The torque that drives the deflection.
     pub torque: ComplianceTorque,
     /// The parameters' meaning.
-    pub terms: Vec<ComplianceTerm>,
+    pub terms: Vec<ComplianceParameter>,
     /// Their values: radians of deflection per unit of the scaled regressor.
     pub theta: Vec<f64>,
     /// The payloads (and measured torques) of the training rows and the rule beyond them
@@ -118,7 +118,7 @@ pub struct JointCompliance {
     pub payload_span: Option<PayloadSpan>,
 }
 
-impl JointCompliance {
+impl JointComplianceTerm {
     /// The terms of `joints` (0-based) seen on the rows of `data` driven by `torque`: every
     /// regressor that is not zero on every row.
     pub fn new(torque: ComplianceTorque, joints: &[usize], data: &BoundSet<'_>) -> Result<Self, Error> {
@@ -134,7 +134,7 @@ impl JointCompliance {
                 // throughout) carry nothing.
                 if values.iter().any(|v| v[0].abs() > 1e-12) {
                     let scale = rms_scales(&values)[0];
-                    model.terms.push(ComplianceTerm { joint, column, scale });
+                    model.terms.push(ComplianceParameter { joint, column, scale });
                 }
             }
         }
@@ -185,7 +185,7 @@ impl JointCompliance {
     }
 }
 
-impl Regressor for JointCompliance {
+impl Regressor for JointComplianceTerm {
     fn directions(&self) -> Vec<Direction> {
         self.terms.iter().map(|t| Direction::Joint(t.joint)).collect()
     }
@@ -241,7 +241,7 @@ impl Regressor for JointCompliance {
     }
 }
 
-impl EffectTerm for JointCompliance {
+impl EffectTerm for JointComplianceTerm {
     fn label(&self) -> String {
         match self.torque {
             ComplianceTorque::Measured => "joint_compliance (measured torques)".into(),
@@ -253,7 +253,7 @@ impl EffectTerm for JointCompliance {
     }
 
     fn joints(&self) -> Vec<usize> {
-        JointCompliance::joints(self).into_iter().map(|j| j + 1).collect()
+        JointComplianceTerm::joints(self).into_iter().map(|j| j + 1).collect()
     }
 
     fn check(&self, cursor: &Cursor<'_>, n: usize, tools: usize) -> Result<(), EffectFault> {
@@ -333,7 +333,7 @@ impl EffectTerm for JointCompliance {
     }
 }
 
-impl NewEffect for JointCompliance {
+impl NewEffect for JointComplianceTerm {
     const ARGUMENTS: &'static [Argument] = &[];
 
     /// Every joint, through measured torques where every row has them, the gravity-torque
@@ -342,9 +342,9 @@ impl NewEffect for JointCompliance {
         let joints: Vec<usize> = (0..context.robot.joint_count()).collect();
         let load = context.load_frame(data)?;
         if has_torques(data.rows()) {
-            JointCompliance::modelled(load, &joints, data)
+            JointComplianceTerm::modelled(load, &joints, data)
         } else {
-            JointCompliance::new(ComplianceTorque::GravityRegressor(load), &joints, data)
+            JointComplianceTerm::new(ComplianceTorque::GravityRegressor(load), &joints, data)
         }
     }
 
@@ -355,11 +355,11 @@ impl NewEffect for JointCompliance {
     fn joint_candidates(context: &CandidateContext<'_>, joint: usize) -> Result<Vec<CandidateModel>, Error> {
         let gravity = ComplianceTorque::GravityRegressor(context.load.clone());
         let mut out = vec![CandidateModel::plain(
-            IdentifiedEffect::JointCompliance(JointCompliance::new(gravity, &[joint], context.data)?),
+            IdentifiedEffect::JointCompliance(JointComplianceTerm::new(gravity, &[joint], context.data)?),
             1,
         )];
         if context.measured {
-            let modelled = JointCompliance::modelled(context.load.clone(), &[joint], context.data)?;
+            let modelled = JointComplianceTerm::modelled(context.load.clone(), &[joint], context.data)?;
             if !modelled.terms.is_empty() {
                 out.push(CandidateModel::plain(IdentifiedEffect::JointCompliance(modelled), 2));
             }

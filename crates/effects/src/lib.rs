@@ -46,7 +46,7 @@ pub use backlash::TorqueSign;
 pub use beyond_span::BeyondSpan;
 pub use direction::Direction;
 pub use gear_periodic::{AngleCoverage, GearOptions};
-pub use joint_compliance::{ComplianceTerm, ComplianceTorque, TorqueFit};
+pub use joint_compliance::{ComplianceParameter, ComplianceTorque, TorqueFit};
 pub use load_frame::LoadFrame;
 pub use loadsim::EffectKind;
 pub use payload_span::PayloadSpan;
@@ -125,30 +125,30 @@ pub fn has_torques(rows: &[Measurement]) -> bool {
 pub const CONSTANT_FEATURES: f64 = 1e-9;
 
 /// Declares each identified kind's module, named as its SPEC name (`joint_compliance.rs`, …), and
-/// re-exports the type of the kind's name from it: an effect's file is declared by its line in
-/// `loadsim::effect_kinds!`, nowhere else.
+/// re-exports the kind's term type (`JointComplianceTerm`, …) from it: an effect's file is declared
+/// by its line in `loadsim::effect_kinds!`, nowhere else.
 macro_rules! effect_modules {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident $(=> $field:ident: $sim:ty)?, )* }
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident: $sim:ty)?, )* }
      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
-        $( mod $name; pub use $name::$kind; )*
+        $( mod $name; pub use $name::$term; )*
     };
 }
 
 loadsim::effect_kinds!(effect_modules);
 
 /// Generates [`IdentifiedEffect`] from the identified kinds of `loadsim::effect_kinds!`: a variant
-/// per kind holding the type of the same name, every method delegated to its `EffectTerm` /
-/// `NewEffect` (module `term`).
+/// per kind holding the kind's term type (`GearPeriodic(GearPeriodicTerm)`), every method
+/// delegated to its `EffectTerm` / `NewEffect` (module `term`).
 macro_rules! identified_effect {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident $(=> $field:ident: $sim:ty)?, )* }
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident: $sim:ty)?, )* }
      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// An effect of a calibrated model, with its identified parameters: one variant per
-        /// identified kind of `loadsim::effect_kinds!`, holding the type of the same name,
-        /// written in model files under the kind's SPEC name.
+        /// identified kind of `loadsim::effect_kinds!`, holding the kind's term type, written in
+        /// model files under the kind's SPEC name.
         #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
         #[serde(rename_all = "snake_case")]
         pub enum IdentifiedEffect {
-            $( $(#[$doc])* $kind($kind), )*
+            $( $(#[$doc])* $kind($term), )*
         }
 
         impl IdentifiedEffect {
@@ -175,7 +175,7 @@ macro_rules! identified_effect {
             /// does not identify).
             pub fn arguments(kind: EffectKind) -> &'static [Argument] {
                 match kind {
-                    $( EffectKind::$kind => <$kind as NewEffect>::ARGUMENTS, )*
+                    $( EffectKind::$kind => <$term as NewEffect>::ARGUMENTS, )*
                     _ => &[],
                 }
             }
@@ -183,7 +183,7 @@ macro_rules! identified_effect {
             fn build(spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
                 match spec.kind {
                     $( EffectKind::$kind => {
-                        <$kind as NewEffect>::build(spec, context, data).map(IdentifiedEffect::$kind)
+                        <$term as NewEffect>::build(spec, context, data).map(IdentifiedEffect::$kind)
                     } )*
                     _ => Err(Error::at_line("--effects", 1, 1, ErrorKind::EffectList { text: spec.to_string(), fault: EffectListFault::UnknownEffect { items: spec::effect_items() } })),
                 }
@@ -196,7 +196,7 @@ macro_rules! identified_effect {
                 joint: usize,
             ) -> Result<Vec<CandidateModel>, Error> {
                 let mut all = Vec::new();
-                $( all.extend(<$kind as NewEffect>::joint_candidates(context, joint)?); )*
+                $( all.extend(<$term as NewEffect>::joint_candidates(context, joint)?); )*
                 all.sort_by_key(|c| c.order);
                 Ok(all)
             }
@@ -205,7 +205,7 @@ macro_rules! identified_effect {
             /// [`CandidateModel::order`] (the list's order among equals).
             pub fn global_candidates(context: &CandidateContext<'_>) -> Result<Vec<CandidateModel>, Error> {
                 let mut all = Vec::new();
-                $( all.extend(<$kind as NewEffect>::global_candidates(context)?); )*
+                $( all.extend(<$term as NewEffect>::global_candidates(context)?); )*
                 all.sort_by_key(|c| c.order);
                 Ok(all)
             }
@@ -258,8 +258,8 @@ impl IdentifiedEffect {
     }
 
     /// The gear series of an effect known only near the angles it was fitted on (see
-    /// [`GearPeriodic::covers`]); `None` for other effects.
-    pub fn angle_coverage(&self) -> Option<&GearPeriodic> {
+    /// [`GearPeriodicTerm::covers`]); `None` for other effects.
+    pub fn angle_coverage(&self) -> Option<&GearPeriodicTerm> {
         match self {
             IdentifiedEffect::GearPeriodic(e) if e.fitted_range.is_some() => Some(e),
             _ => None,
@@ -267,14 +267,14 @@ impl IdentifiedEffect {
     }
 
     /// How fully the effect applies at `row`: 1 on the joint angles it was fitted on, fading to 0
-    /// outside them (a gear series, [`GearPeriodic::held_and_weight`]); 1 for every other effect.
+    /// outside them (a gear series, [`GearPeriodicTerm::held_and_weight`]); 1 for every other effect.
     pub fn coverage_weight(&self, row: &Measurement) -> f64 {
         self.term().coverage_weight(row)
     }
 
     /// The standard deviation of what the effect leaves uncorrected at `row`, per component of
     /// the pose error `(v, ω)` at the tool point `point` (m, rad): a gear series faded out of its
-    /// fitted angles leaves a joint error of [`GearPeriodic::faded_sigma`] along the joint's
+    /// fitted angles leaves a joint error of [`GearPeriodicTerm::faded_sigma`] along the joint's
     /// twist; zero elsewhere and for every other effect.
     pub fn sigma(
         &self,
@@ -368,7 +368,7 @@ impl IdentifiedEffect {
     }
 
     /// Each parameter's prior standard deviation relative to the effects' common one (1 but for
-    /// a gear series' higher harmonics, [`GearPeriodic::prior_scale`]).
+    /// a gear series' higher harmonics, [`GearPeriodicTerm::prior_scale`]).
     pub fn prior_scale(&self) -> Vec<f64> {
         self.term().prior_scale()
     }
@@ -479,7 +479,7 @@ mod tests {
 
     #[test]
     fn model_files_name_each_effect_by_its_kind() {
-        let thermal = IdentifiedEffect::Thermal(Thermal {
+        let thermal = IdentifiedEffect::Thermal(ThermalTerm {
             reference_c: 20.0,
             scale: vec![1.0],
             theta: vec![0.0],

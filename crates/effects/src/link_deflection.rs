@@ -22,7 +22,7 @@ use crate::{
 use errors::Error;
 use loadsim::{Payload, RobotDynamics};
 use measurements::{BoundSet, Measurement};
-use robot::JointType;
+use poe::JointKind;
 use serde::{Deserialize, Serialize};
 
 /// A bending axis is kept where its feature's RMS over the training rows exceeds this, N·m²:
@@ -37,7 +37,7 @@ const CANDIDATE_ORDER: u8 = 5;
 
 /// The bending of one joint's link, identified with the geometry.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct LinkDeflection {
+pub struct LinkDeflectionTerm {
     /// 0-based joint whose link bends.
     pub joint: usize,
     /// Gravity and the nominal arm (the moment is computed in the robot's base frame).
@@ -57,7 +57,7 @@ pub struct LinkDeflection {
     pub payload_span: Option<PayloadSpan>,
 }
 
-impl LinkDeflection {
+impl LinkDeflectionTerm {
     /// The bending of `joint`'s link (0-based) with the moment of `dynamics`, its axes those that
     /// carry a moment on the rows of `data`, scaled there, its parameters at zero.
     pub fn new(joint: usize, load: LoadFrame, dynamics: RobotDynamics, data: &BoundSet<'_>) -> Result<Self, Error> {
@@ -83,7 +83,7 @@ impl LinkDeflection {
     }
 }
 
-impl Regressor for LinkDeflection {
+impl Regressor for LinkDeflectionTerm {
     fn directions(&self) -> Vec<Direction> {
         self.axes.iter().map(|&axis| Direction::LinkBend { joint: self.joint, axis }).collect()
     }
@@ -114,7 +114,7 @@ impl Regressor for LinkDeflection {
     }
 }
 
-impl EffectTerm for LinkDeflection {
+impl EffectTerm for LinkDeflectionTerm {
     fn label(&self) -> String {
         format!("link_deflection:{} (gravity moment of the mass model)", self.joint + 1)
     }
@@ -166,24 +166,24 @@ impl EffectTerm for LinkDeflection {
     }
 }
 
-impl NewEffect for LinkDeflection {
+impl NewEffect for LinkDeflectionTerm {
     const ARGUMENTS: &'static [Argument] = &[Argument::Joint];
 
     /// The link of the item's joint, with the robot's mass model or a stand-in.
     fn build(spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
         let joint = spec.joint_index()?;
         let dynamics = context.robot.dynamics.clone().unwrap_or_else(|| stand_in_dynamics(context.robot));
-        LinkDeflection::new(joint, context.load_frame(data)?, dynamics, data)
+        LinkDeflectionTerm::new(joint, context.load_frame(data)?, dynamics, data)
     }
 
     /// One candidate per prismatic joint (module doc), after every joint's compliance.
     fn global_candidates(context: &CandidateContext<'_>) -> Result<Vec<CandidateModel>, Error> {
         let mut out = Vec::new();
         for (joint, description) in context.robot.joints.iter().enumerate() {
-            if description.kind != JointType::Prismatic {
+            if description.kind != JointKind::Prismatic {
                 continue;
             }
-            let bend = LinkDeflection::new(joint, context.load.clone(), context.dynamics.clone(), context.data)?;
+            let bend = LinkDeflectionTerm::new(joint, context.load.clone(), context.dynamics.clone(), context.data)?;
             if !bend.axes.is_empty() {
                 out.push(CandidateModel {
                     only_if_nonzero: true,

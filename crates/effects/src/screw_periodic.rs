@@ -1,7 +1,7 @@
 //! A linear axis's periodic error per screw (or rack) pitch: the carriage of a ball-screw or
 //! rack-and-pinion axis errs periodically in its own position, with the screw's lead (the
-//! pinion's circumference) as period `p` (`loadsim::ScrewError`). It is a gear series
-//! ([`GearPeriodic`]) in the screw's phase `φ = 2π q / p`: `δq = Σ_h a_h cos(h φ) + b_h sin(h φ)`,
+//! pinion's circumference) as period `p` (`loadsim::ScrewPeriodicModel`). It is a gear series
+//! ([`GearPeriodicTerm`]) in the screw's phase `φ = 2π q / p`: `δq = Σ_h a_h cos(h φ) + b_h sin(h φ)`,
 //! metres along the joint's axis (its spatial twist per metre), held and faded outside the phases
 //! it was fitted on exactly as a gear series is outside its angles, and centred so that a constant
 //! offset stays with the geometry.
@@ -15,7 +15,7 @@ use super::Regressor;
 use crate::check::{Cursor, EffectFault};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{
-    Argument, CandidateContext, CandidateModel, Direction, EffectContext, EffectSpec, GearPeriodic, IdentifiedEffect,
+    Argument, CandidateContext, CandidateModel, Direction, EffectContext, EffectSpec, GearPeriodicTerm, IdentifiedEffect,
 };
 use errors::{Error, ErrorKind};
 use measurements::{BoundSet, Measurement};
@@ -24,16 +24,16 @@ use std::f64::consts::TAU;
 
 /// A periodic error of one linear axis in its own position, per screw or rack pitch.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ScrewPeriodic {
+pub struct ScrewPeriodicTerm {
     /// The screw's lead (or the pinion's circumference), m.
     pub pitch_m: f64,
     /// The series in the screw's phase `2π q / pitch_m`: its `joint` is the axis; its angles
     /// (`fitted_range`, `turn_gaps`, `taper_rad`) are phases, rad; its `theta` and
     /// `fitted_rms_rad` are metres along the axis.
-    pub series: GearPeriodic,
+    pub series: GearPeriodicTerm,
 }
 
-impl ScrewPeriodic {
+impl ScrewPeriodicTerm {
     /// The screw series of 0-based `joint` with pitch `pitch_m` and `orders`, scaled on the
     /// training rows, faded as `options` says.
     pub fn new(
@@ -44,7 +44,7 @@ impl ScrewPeriodic {
         options: &crate::GearOptions,
     ) -> Self {
         let phases: Vec<f64> = rows.iter().filter_map(|r| r.q.get(joint)).map(|&q| TAU * q / pitch_m).collect();
-        Self { pitch_m, series: GearPeriodic::from_angles(joint, orders, &phases, options) }
+        Self { pitch_m, series: GearPeriodicTerm::from_angles(joint, orders, &phases, options) }
     }
 
     /// The screw's phase at the axis position `q`, m: `2π q / pitch`.
@@ -63,7 +63,7 @@ impl ScrewPeriodic {
     }
 
     /// Records the series' RMS over the training rows, after the fit (see
-    /// [`GearPeriodic::record_rms`]).
+    /// [`GearPeriodicTerm::record_rms`]).
     pub fn record_rms(&mut self, rows: &[Measurement]) {
         let phases: Vec<f64> = rows.iter().filter_map(|r| r.q.get(self.series.joint)).map(|&q| self.phase(q)).collect();
         self.series.record_rms_at(&phases);
@@ -78,7 +78,7 @@ impl ScrewPeriodic {
     }
 }
 
-impl Regressor for ScrewPeriodic {
+impl Regressor for ScrewPeriodicTerm {
     fn directions(&self) -> Vec<Direction> {
         self.series.directions()
     }
@@ -105,7 +105,7 @@ impl Regressor for ScrewPeriodic {
     }
 }
 
-impl EffectTerm for ScrewPeriodic {
+impl EffectTerm for ScrewPeriodicTerm {
     fn after_fit(&mut self, rows: &[Measurement]) {
         self.record_rms(rows);
     }
@@ -160,7 +160,7 @@ impl EffectTerm for ScrewPeriodic {
     }
 }
 
-impl NewEffect for ScrewPeriodic {
+impl NewEffect for ScrewPeriodicTerm {
     const ARGUMENTS: &'static [Argument] = &[Argument::Joint, Argument::Pitch, Argument::Harmonics];
 
     /// Harmonics `1..=harmonics` of a prismatic joint's screw phase, with the item's pitch (or,
@@ -168,12 +168,12 @@ impl NewEffect for ScrewPeriodic {
     fn build(spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
         let joint = spec.joint_index()?;
         let description = &context.robot.joints[joint];
-        if description.kind != robot::JointType::Prismatic {
+        if description.kind != poe::JointKind::Prismatic {
             return Err(Error::new(ErrorKind::EffectNeedsPrismatic { effect: "screw_periodic", joint: joint + 1 }));
         }
         let pitch_m = spec.required_pitch_m(description.pitch_mm)?;
         let harmonics = spec.required_harmonics()?;
-        Ok(ScrewPeriodic::new(joint, pitch_m, (1..=harmonics).collect(), data.rows(), &context.gear))
+        Ok(ScrewPeriodicTerm::new(joint, pitch_m, (1..=harmonics).collect(), data.rows(), &context.gear))
     }
 
     /// A series of the screw's phase up to the diagnosis's longest order, on a prismatic joint
@@ -182,12 +182,12 @@ impl NewEffect for ScrewPeriodic {
     fn joint_candidates(context: &CandidateContext<'_>, joint: usize) -> Result<Vec<CandidateModel>, Error> {
         let description = &context.robot.joints[joint];
         let Some(pitch_mm) = description.pitch_mm else { return Ok(Vec::new()) };
-        if !context.moving.contains(&joint) || description.kind != robot::JointType::Prismatic {
+        if !context.moving.contains(&joint) || description.kind != poe::JointKind::Prismatic {
             return Ok(Vec::new());
         }
         let orders = (1..=context.longest_order).collect();
         let screw =
-            ScrewPeriodic::new(joint, pitch_mm * 1e-3, orders, context.data.rows(), &crate::GearOptions::default());
+            ScrewPeriodicTerm::new(joint, pitch_mm * 1e-3, orders, context.data.rows(), &crate::GearOptions::default());
         Ok(vec![CandidateModel { series: true, ..CandidateModel::plain(IdentifiedEffect::ScrewPeriodic(screw), 5) }])
     }
 }
@@ -204,7 +204,7 @@ mod tests {
     fn the_features_repeat_every_pitch_and_fade_outside_the_fitted_travel() {
         // 0.2 … 0.6 m of travel on a 10 mm screw: 40 turns, every phase seen.
         let travel: Vec<f64> = (0..400).map(|i| 0.2 + 0.4 * f64::from(i) / 399.0).collect();
-        let screw = ScrewPeriodic::new(0, 0.01, vec![1, 2], &rows(&travel), &crate::GearOptions::default());
+        let screw = ScrewPeriodicTerm::new(0, 0.01, vec![1, 2], &rows(&travel), &crate::GearOptions::default());
         let at = |q: f64| screw.features(&rows(&[q])[0], 0).unwrap();
         let (a, b) = (at(0.3333), at(0.3333 + 0.01));
         for (x, y) in a.iter().zip(&b) {
@@ -217,7 +217,7 @@ mod tests {
         // A quarter of a turn of travel seen (2.5 mm): outside it the series fades within a
         // quarter of the shortest period.
         let short: Vec<f64> = (0..50).map(|i| 0.3 + 0.0025 * f64::from(i) / 49.0).collect();
-        let screw = ScrewPeriodic::new(0, 0.01, vec![1, 2], &rows(&short), &crate::GearOptions::default());
+        let screw = ScrewPeriodicTerm::new(0, 0.01, vec![1, 2], &rows(&short), &crate::GearOptions::default());
         let weight = |q: f64| screw.coverage_weight(&rows(&[q])[0]);
         assert_eq!(weight(0.301), 1.0);
         assert_eq!(weight(0.3025 + 0.01 * 0.25 / 2.0 * 1.01), 0.0);

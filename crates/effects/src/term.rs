@@ -40,7 +40,7 @@ pub struct CandidateContext<'a> {
 pub struct CandidateOptions {
     /// Thermal growth is a candidate only where every row has `temp_c` and it spans more than this,
     /// K. 0.2 K, not fitted to any data set: over 0.2 K steel (11.5e-6 /K) grows a 2 m arm by
-    /// 4.6 µm, under the tracker's 5 µm line-of-sight noise (`loadsim::TrackerNoise`), so a smaller
+    /// 4.6 µm, under the tracker's 5 µm line-of-sight noise (`loadsim::TrackerNoiseModel`), so a smaller
     /// span identifies noise.
     pub thermal_min_span_k: f64,
     /// Drift is a candidate only where every row has `t_s` and some row lies more than this from

@@ -1,5 +1,5 @@
 //! Thermal growth: every link but the base placement grows by `α ΔT` with the temperature
-//! (`loadsim::ThermalGrowth`, one coefficient for the whole arm, `loadsim::thermal_regressor`).
+//! (`loadsim::ThermalModel`, one coefficient for the whole arm, `loadsim::thermal_regressor`).
 
 use super::{Regressor, check_column_varies, rms_scales};
 use crate::check::{Cursor, EffectFault};
@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 
 /// Thermal growth of the arm with `temp_c`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Thermal {
+pub struct ThermalTerm {
     /// The temperature at which the geometry holds (the training rows' mean), °C.
     pub reference_c: f64,
     /// `ΔT` is divided by this (its RMS on the training poses), K.
@@ -31,7 +31,7 @@ pub struct Thermal {
     pub beyond_span: BeyondSpan,
 }
 
-impl Thermal {
+impl ThermalTerm {
     /// A growth linear in `temp_c`, scaled on the training rows, held beyond `hold_beyond_span` of
     /// their temperature span past either end.
     pub fn new(rows: &[Measurement], hold_beyond_span: f64) -> Result<Self, Error> {
@@ -58,7 +58,7 @@ impl Thermal {
     }
 }
 
-impl Regressor for Thermal {
+impl Regressor for ThermalTerm {
     fn directions(&self) -> Vec<Direction> {
         vec![Direction::LinkGrowth]
     }
@@ -86,7 +86,7 @@ impl Regressor for Thermal {
     }
 }
 
-impl EffectTerm for Thermal {
+impl EffectTerm for ThermalTerm {
     fn label(&self) -> String {
         "thermal".into()
     }
@@ -116,11 +116,11 @@ impl EffectTerm for Thermal {
     }
 }
 
-impl NewEffect for Thermal {
+impl NewEffect for ThermalTerm {
     const ARGUMENTS: &'static [Argument] = &[];
 
     fn build(_spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
-        Thermal::new(data.rows(), context.hold_beyond_span)
+        ThermalTerm::new(data.rows(), context.hold_beyond_span)
     }
 
     /// One expansion coefficient for the whole arm (every link but the tracker-to-base placement
@@ -134,7 +134,7 @@ impl NewEffect for Thermal {
         if high - low <= context.options.thermal_min_span_k {
             return Ok(Vec::new());
         }
-        let thermal = Thermal::new(context.data.rows(), crate::HOLD_BEYOND_SPAN)?;
+        let thermal = ThermalTerm::new(context.data.rows(), crate::HOLD_BEYOND_SPAN)?;
         Ok(vec![CandidateModel::plain(IdentifiedEffect::Thermal(thermal), 0)])
     }
 }

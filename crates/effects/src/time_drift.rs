@@ -1,5 +1,5 @@
 //! Drift: the robot's placement in the tracker frame moves at a constant twist rate, `exp(t ξ̂) T`
-//! (`loadsim::BaseDrift`, `loadsim::drift_regressor`): six parameters, `(v, ω)`.
+//! (`loadsim::TimeDriftModel`, `loadsim::drift_regressor`): six parameters, `(v, ω)`.
 
 use super::{Regressor, check_column_varies, rms_scales};
 use crate::check::{Cursor, EffectFault};
@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 
 /// Linear drift of the placement with `t_s`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TimeDrift {
+pub struct TimeDriftTerm {
     /// The time at which the geometry holds (the training rows' mean), s.
     pub reference_s: f64,
     /// `Δt` is divided by this (its RMS on the training poses), s; six equal entries.
@@ -32,7 +32,7 @@ pub struct TimeDrift {
     pub beyond_span: BeyondSpan,
 }
 
-impl TimeDrift {
+impl TimeDriftTerm {
     /// A drift linear in `t_s`, scaled on the training rows, applied up to `hold_beyond_span` of
     /// their time span beyond either end.
     pub fn new(rows: &[Measurement], hold_beyond_span: f64) -> Result<Self, Error> {
@@ -59,7 +59,7 @@ impl TimeDrift {
     }
 }
 
-impl Regressor for TimeDrift {
+impl Regressor for TimeDriftTerm {
     fn directions(&self) -> Vec<Direction> {
         (0..6).map(Direction::Component).collect()
     }
@@ -90,7 +90,7 @@ impl Regressor for TimeDrift {
     }
 }
 
-impl EffectTerm for TimeDrift {
+impl EffectTerm for TimeDriftTerm {
     fn label(&self) -> String {
         "time_drift".into()
     }
@@ -120,11 +120,11 @@ impl EffectTerm for TimeDrift {
     }
 }
 
-impl NewEffect for TimeDrift {
+impl NewEffect for TimeDriftTerm {
     const ARGUMENTS: &'static [Argument] = &[];
 
     fn build(_spec: &EffectSpec, context: &EffectContext<'_>, data: &BoundSet<'_>) -> Result<Self, Error> {
-        TimeDrift::new(data.rows(), context.hold_beyond_span)
+        TimeDriftTerm::new(data.rows(), context.hold_beyond_span)
     }
 
     /// Where every row has `t_s` and some row lies more than `CandidateOptions::drift_min_offset_s`
@@ -137,7 +137,7 @@ impl NewEffect for TimeDrift {
         if !times.iter().any(|t| (t - mean).abs() > context.options.drift_min_offset_s) {
             return Ok(Vec::new());
         }
-        let drift = TimeDrift::new(context.data.rows(), crate::HOLD_BEYOND_SPAN)?;
+        let drift = TimeDriftTerm::new(context.data.rows(), crate::HOLD_BEYOND_SPAN)?;
         Ok(vec![CandidateModel::plain(IdentifiedEffect::TimeDrift(drift), 0)])
     }
 }
@@ -145,7 +145,7 @@ impl NewEffect for TimeDrift {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Thermal;
+    use crate::ThermalTerm;
 
     fn row(t_s: f64, temp_c: f64) -> Measurement {
         Measurement { temp_c: Some(temp_c), t_s: Some(t_s), ..Measurement::at(vec![0.0], lie::Vector3::zeros()) }
@@ -156,8 +156,8 @@ mod tests {
     #[test]
     fn a_drift_and_a_thermal_growth_are_held_at_the_ends_of_the_span_they_were_fitted_on() {
         let session: Vec<Measurement> = (0..50).map(|i| row(f64::from(i) * 88.0, 20.0 + f64::from(i) * 0.05)).collect();
-        let drift = TimeDrift::new(&session, 0.0).unwrap();
-        let thermal = Thermal::new(&session, 0.0).unwrap();
+        let drift = TimeDriftTerm::new(&session, 0.0).unwrap();
+        let thermal = ThermalTerm::new(&session, 0.0).unwrap();
         assert_eq!(drift.fitted_span, Some([0.0, 49.0 * 88.0]));
         let end = session.last().unwrap();
         let week_later = row(8.0 * 86_400.0, 9.0);
@@ -170,13 +170,13 @@ mod tests {
         assert_eq!(drift.features(&inside, 0).unwrap()[0], raw);
         // With a margin of one span, half a span past the end is still the line; two spans past
         // it, nothing.
-        let margin = TimeDrift::new(&session, 1.0).unwrap();
+        let margin = TimeDriftTerm::new(&session, 1.0).unwrap();
         let width = 49.0 * 88.0;
         let at = |t: f64| margin.features(&row(t, 20.0), 0).unwrap()[0];
         assert_eq!(at(1.5 * width), (1.5 * width - margin.reference_s) / margin.scale[0]);
         assert_eq!(at(3.0 * width), 0.0);
         // A model file written before the span was recorded applies the line as it did.
-        let old = TimeDrift { fitted_span: None, ..drift.clone() };
+        let old = TimeDriftTerm { fitted_span: None, ..drift.clone() };
         assert!(old.features(&week_later, 0).unwrap()[0] > 100.0);
     }
 
@@ -185,8 +185,8 @@ mod tests {
     #[test]
     fn a_drift_may_be_held_and_a_growth_zeroed_beyond_the_span_and_the_default_rule_is_not_written() {
         let session: Vec<Measurement> = (0..50).map(|i| row(f64::from(i) * 88.0, 20.0 + f64::from(i) * 0.05)).collect();
-        let mut drift = TimeDrift::new(&session, 0.0).unwrap();
-        let mut thermal = Thermal::new(&session, 0.0).unwrap();
+        let mut drift = TimeDriftTerm::new(&session, 0.0).unwrap();
+        let mut thermal = ThermalTerm::new(&session, 0.0).unwrap();
         let week_later = row(8.0 * 86_400.0, 9.0);
         let (end, first) = (session.last().unwrap(), &session[0]);
         let drift_text = ron::to_string(&drift).unwrap();
@@ -199,8 +199,8 @@ mod tests {
         assert_ne!(thermal.features(first, 0).unwrap(), vec![0.0], "inside the span the growth is applied");
         let text = ron::to_string(&drift).unwrap();
         assert!(text.contains("beyond_span:hold"), "{text}");
-        assert_eq!(ron::from_str::<TimeDrift>(&text).unwrap(), drift);
-        assert_eq!(ron::from_str::<TimeDrift>(&drift_text).unwrap().beyond_span, BeyondSpan::Zero);
-        assert_eq!(ron::from_str::<Thermal>(&thermal_text).unwrap().beyond_span, BeyondSpan::Hold);
+        assert_eq!(ron::from_str::<TimeDriftTerm>(&text).unwrap(), drift);
+        assert_eq!(ron::from_str::<TimeDriftTerm>(&drift_text).unwrap().beyond_span, BeyondSpan::Zero);
+        assert_eq!(ron::from_str::<ThermalTerm>(&thermal_text).unwrap().beyond_span, BeyondSpan::Hold);
     }
 }

@@ -1,7 +1,7 @@
 //! What went wrong, apart from where: [`ErrorKind`] holds the numbers that explain a refusal, and
 //! [`Error`](crate::Error) adds the [`Place`](crate::Place) that its message starts with.
 
-use crate::{ColumnMapFault, DecimalFault, EffectListFault, FileKind, JointKind};
+use crate::{ColumnMapFault, DecimalFault, EffectListFault, FileKind};
 use std::fmt;
 
 /// What can go wrong reading inputs, fitting or evaluating: the kind of an [`Error`](crate::Error), without its
@@ -61,8 +61,8 @@ pub enum ErrorKind {
     JointUnit {
         /// 1-based joint.
         joint: usize,
-        /// The robot's kind of that joint.
-        kind: JointKind,
+        /// The robot's kind of that joint, as `poe::JointKind::name` gives it (`revolute`, `prismatic`).
+        kind: &'static str,
     },
     /// A per-joint column (`tau<k>_nm`) for a joint the data does not have.
     ///
@@ -219,10 +219,10 @@ pub enum ErrorKind {
         joint: String,
         /// The joint's 1-based place among the chain's movable joints.
         index: usize,
-        /// Its kind in the URDF.
-        urdf: JointKind,
-        /// The model's kind of that joint.
-        model: JointKind,
+        /// Its kind in the URDF, as `poe::JointKind::name` gives it.
+        urdf: &'static str,
+        /// The model's kind of that joint, as `poe::JointKind::name` gives it.
+        model: &'static str,
     },
     /// A nominal robot description whose joints are not where a calibrated model has them, once
     /// its base is placed by joint 1: not the description the model was fitted with.
@@ -487,8 +487,9 @@ pub enum ErrorKind {
     JointBeyondLimits {
         /// 1-based joint.
         joint: usize,
-        /// Revolute (value and limits in radians) or prismatic (metres).
-        kind: JointKind,
+        /// `revolute` (value and limits in radians) or `prismatic` (metres), as `poe::JointKind::name`
+        /// gives it.
+        kind: &'static str,
         /// The value, SI.
         value: f64,
         /// The robot's limits, SI.
@@ -664,11 +665,11 @@ impl fmt::Display for ErrorKind {
             ErrorKind::NegativePayload { value } => {
                 write!(f, "column 'payload_kg': {value} kg, a payload cannot be negative")
             }
-            ErrorKind::JointUnit { joint, kind } => match kind {
-                JointKind::Prismatic => {
+            ErrorKind::JointUnit { joint, kind } => match *kind {
+                "prismatic" => {
                     write!(f, "joint {joint} is prismatic: its column is q{joint}_m or q{joint}_mm, not an angle")
                 }
-                JointKind::Revolute => {
+                _ => {
                     write!(f, "joint {joint} is revolute: its column is q{joint}_rad or q{joint}_deg, not a length")
                 }
             },
@@ -714,8 +715,7 @@ impl fmt::Display for ErrorKind {
                 f,
                 "joint '{joint}' (movable joint {index}) is {} in the URDF but {} in the \
                  model: refusing to write the calibration into a joint of another kind",
-                urdf.name(),
-                model.name()
+                urdf, model
             ),
             ErrorKind::JointCountMismatch { found, expected } => {
                 write!(f, "{found} joint columns, the robot has {expected} joints")
@@ -879,8 +879,8 @@ impl fmt::Display for ErrorKind {
                 write!(f, "more than {links} symbolic links in a row (a loop?): refusing to write there")
             }
             ErrorKind::JointBeyondLimits { joint, kind, value, limits: (lo, hi), margin, degrees_under_rad } => {
-                match kind {
-                    JointKind::Revolute => write!(
+                match *kind {
+                    "revolute" => write!(
                         f,
                         "joint {joint} is at {value} rad ({:.1}°), beyond its limits {:.1}° to {:.1}° by more than {:.1}°",
                         value.to_degrees(),
@@ -888,7 +888,7 @@ impl fmt::Display for ErrorKind {
                         hi.to_degrees(),
                         margin.to_degrees()
                     )?,
-                    JointKind::Prismatic => write!(
+                    _ => write!(
                         f,
                         "joint {joint} is at {value} m, beyond its limits {lo} m to {hi} m by more than {margin} m"
                     )?,

@@ -27,6 +27,6 @@ mod place;
 pub mod ron_position;
 
 pub use error::Error;
-pub use faults::{ColumnMapFault, DecimalFault, EffectListFault, FileKind, JointKind, MAX_HARMONICS, PITCH_BOUNDS_MM};
+pub use faults::{ColumnMapFault, DecimalFault, EffectListFault, FileKind, MAX_HARMONICS, PITCH_BOUNDS_MM};
 pub use kind::ErrorKind;
 pub use place::Place;

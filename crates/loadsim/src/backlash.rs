@@ -20,12 +20,12 @@ pub struct JointBacklash {
 /// Backlash on some joints. Default: none listed.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default)]
-pub struct Backlash {
+pub struct BacklashModel {
     /// The joints with play; a joint not listed has none.
     pub joints: Vec<JointBacklash>,
 }
 
-impl Backlash {
+impl BacklashModel {
     /// The same half-band on every joint of an `joint_count`-joint robot.
     pub fn uniform(joint_count: usize, half_band_rad: f64) -> Self {
         Self { joints: (0..joint_count).map(|joint_index| JointBacklash { joint_index, half_band_rad }).collect() }
@@ -72,10 +72,10 @@ pub fn backlash_joint_regressor(torque: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-impl SimulatedEffect for Backlash {
+impl SimulatedEffect for BacklashModel {
     fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
         let n = cell.robot.joint_count();
-        Backlash::validate(self, n)?;
+        BacklashModel::validate(self, n)?;
         cell.dynamics_for("backlash")?.validate(n)
     }
 
@@ -85,8 +85,8 @@ impl SimulatedEffect for Backlash {
 
     fn check_entries(&self, robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
         for (k, joint) in self.joints.iter().enumerate() {
-            let alone = Backlash { joints: vec![*joint] };
-            let fault = Backlash::validate(&alone, robot.joints.len())
+            let alone = BacklashModel { joints: vec![*joint] };
+            let fault = BacklashModel::validate(&alone, robot.joints.len())
                 .err()
                 .map(|e| e.to_string())
                 .or_else(|| beyond(&[("half_band_rad", joint.half_band_rad, MAX_JOINT_ERROR_RAD)]));

@@ -8,7 +8,7 @@
 //! reads `θ`'s two horizontal components plus its own white noise.
 //!
 //! Not an effect of [`crate::Effects`]: its part of the forward model is a motion of the base like
-//! [`crate::BaseDrift`]'s, but the signal it is read by is a column of the data set, which the
+//! [`crate::TimeDriftModel`]'s, but the signal it is read by is a column of the data set, which the
 //! generator's samples do not carry; `cargo xtask inputs-check` adds both to simulated data.
 
 use crate::gravity::{link_centres_of_mass, payload_centre_of_mass};

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 /// [`RobotDynamics`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default)]
-pub struct JointCompliance {
+pub struct JointComplianceModel {
     /// Deflect under the payload's weight only, leaving out the arm's own weight and its balancer
     /// (the paper's load effect in isolation). Default: false, everything.
     pub payload_only: bool,
@@ -30,7 +30,7 @@ pub fn spring_torque(
     q: &[f64],
     tool: usize,
     payload: &Payload,
-    settings: &JointCompliance,
+    settings: &JointComplianceModel,
 ) -> Result<Vec<f64>, Error> {
     if settings.payload_only {
         dynamics.validate(model.joint_count())?;
@@ -47,7 +47,7 @@ pub fn compliance_deflection(
     q: &[f64],
     tool: usize,
     payload: &Payload,
-    settings: &JointCompliance,
+    settings: &JointComplianceModel,
 ) -> Result<Vec<f64>, Error> {
     dynamics.validate(model.joint_count())?;
     let stiffness = dynamics.stiffness("joint compliance")?;
@@ -61,11 +61,11 @@ pub fn compliance_deflection(
 }
 
 /// Most fixed-point steps of the compliance equilibrium an effects file may ask for. Each step
-/// shrinks the error by the factor `C·∂τ/∂q`, below 1e-2 for industrial arms ([`JointCompliance`]),
+/// shrinks the error by the factor `C·∂τ/∂q`, below 1e-2 for industrial arms ([`JointComplianceModel`]),
 /// so 100 steps are far past double precision; more is a typo or a hostile file.
 pub const MAX_FIXED_POINT_ITERATIONS: usize = 100;
 
-impl SimulatedEffect for JointCompliance {
+impl SimulatedEffect for JointComplianceModel {
     fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
         let dynamics = cell.dynamics_for("joint compliance")?;
         dynamics.validate(cell.robot.joint_count())?;

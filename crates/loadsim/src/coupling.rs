@@ -40,12 +40,12 @@ pub struct CouplingTerm {
 /// Coupled joint errors. Default: no term.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default)]
-pub struct JointCoupling {
+pub struct CouplingModel {
     /// The terms, any number per joint.
     pub terms: Vec<CouplingTerm>,
 }
 
-impl JointCoupling {
+impl CouplingModel {
     /// Checks indices and values against a robot with `joint_count` joints: every index inside
     /// the robot, every term with at least one factor and none on its own joint, values finite.
     pub fn validate(&self, joint_count: usize) -> Result<(), Error> {
@@ -92,17 +92,17 @@ impl JointCoupling {
     }
 }
 
-impl SimulatedEffect for JointCoupling {
+impl SimulatedEffect for CouplingModel {
     fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
-        JointCoupling::validate(self, cell.robot.joint_count())
+        CouplingModel::validate(self, cell.robot.joint_count())
     }
 
     fn check_entries(&self, robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
         for (k, term) in self.terms.iter().enumerate() {
-            let alone = JointCoupling { terms: vec![term.clone()] };
+            let alone = CouplingModel { terms: vec![term.clone()] };
             let mut bounds = vec![("amplitude_rad", term.amplitude_rad, MAX_JOINT_ERROR_RAD)];
             bounds.extend(term.factors.iter().map(|f| ("order", f.order, MAX_ORDER)));
-            let fault = JointCoupling::validate(&alone, robot.joints.len())
+            let fault = CouplingModel::validate(&alone, robot.joints.len())
                 .err()
                 .map(|e| e.to_string())
                 .or_else(|| beyond(&bounds));

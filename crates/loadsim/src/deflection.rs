@@ -42,7 +42,7 @@ pub struct BentLink {
 /// Link deflection of some links (module doc).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default)]
-pub struct LinkDeflection {
+pub struct LinkDeflectionModel {
     /// The links that bend.
     pub links: Vec<BentLink>,
 }
@@ -127,7 +127,7 @@ pub fn link_deflection_features(
     Ok(bend.axes.map(|e| bend.length_m * e.dot(&moment)))
 }
 
-impl LinkDeflection {
+impl LinkDeflectionModel {
     /// Checks the links against a robot with `joint_count` joints: indices inside it,
     /// flexibilities finite and not negative.
     pub fn validate(&self, joint_count: usize) -> Result<(), Error> {
@@ -168,10 +168,10 @@ impl LinkDeflection {
 /// column or boom has `EI` of 1e5 to 1e7 N·m². Beyond the bound the bend is no longer small.
 pub const MAX_FLEXIBILITY_PER_NM2: f64 = 1e-2;
 
-impl SimulatedEffect for LinkDeflection {
+impl SimulatedEffect for LinkDeflectionModel {
     fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
         let n = cell.robot.joint_count();
-        LinkDeflection::validate(self, n)?;
+        LinkDeflectionModel::validate(self, n)?;
         cell.dynamics_for("link deflection")?.validate(n)
     }
 
@@ -181,10 +181,10 @@ impl SimulatedEffect for LinkDeflection {
 
     fn check_entries(&self, robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
         for (k, link) in self.links.iter().enumerate() {
-            let alone = LinkDeflection { links: vec![*link] };
+            let alone = LinkDeflectionModel { links: vec![*link] };
             let bounds: Vec<_> =
                 link.flexibility_per_nm2.iter().map(|&f| ("flexibility_per_nm2", f, MAX_FLEXIBILITY_PER_NM2)).collect();
-            let fault = LinkDeflection::validate(&alone, robot.joints.len())
+            let fault = LinkDeflectionModel::validate(&alone, robot.joints.len())
                 .err()
                 .map(|e| e.to_string())
                 .or_else(|| beyond(&bounds));
@@ -246,7 +246,8 @@ mod tests {
         assert!((high.midpoint - Vector3::new(0.0, 0.0, 1.25)).norm() < 1e-12);
         // The load hangs out along +x: the moment about the column is about +y, and a positive
         // rotation about y turns the column's top towards +x, the load's side.
-        let deflection = LinkDeflection { links: vec![BentLink { joint_index: 0, flexibility_per_nm2: [2e-7, 2e-7] }] };
+        let deflection =
+            LinkDeflectionModel { links: vec![BentLink { joint_index: 0, flexibility_per_nm2: [2e-7, 2e-7] }] };
         let cell = SimulatedCell::new(model.clone(), Some(dynamics.clone()));
         let effects = Effects { deflection: Some(deflection), ..Effects::default() };
         let context = PoseContext { payload, ..PoseContext::default() };
@@ -308,7 +309,7 @@ mod tests {
             let mut flexibility = [0.0; 2];
             flexibility[a] = h;
             let effects = Effects {
-                deflection: Some(LinkDeflection {
+                deflection: Some(LinkDeflectionModel {
                     links: vec![BentLink { joint_index: 0, flexibility_per_nm2: flexibility }],
                 }),
                 ..Effects::default()
@@ -322,11 +323,13 @@ mod tests {
 
     #[test]
     fn a_link_beyond_the_robot_or_a_negative_flexibility_is_refused() {
-        let bad_joint = LinkDeflection { links: vec![BentLink { joint_index: 3, flexibility_per_nm2: [0.0; 2] }] };
+        let bad_joint = LinkDeflectionModel { links: vec![BentLink { joint_index: 3, flexibility_per_nm2: [0.0; 2] }] };
         assert!(matches!(bad_joint.validate(3), Err(Error::UnknownJoint { joint_index: 3, .. })));
-        let negative = LinkDeflection { links: vec![BentLink { joint_index: 0, flexibility_per_nm2: [1e-7, -1.0] }] };
+        let negative =
+            LinkDeflectionModel { links: vec![BentLink { joint_index: 0, flexibility_per_nm2: [1e-7, -1.0] }] };
         assert!(matches!(negative.validate(3), Err(Error::InvalidParameter { .. })));
-        let nan = LinkDeflection { links: vec![BentLink { joint_index: 0, flexibility_per_nm2: [f64::NAN, 0.0] }] };
+        let nan =
+            LinkDeflectionModel { links: vec![BentLink { joint_index: 0, flexibility_per_nm2: [f64::NAN, 0.0] }] };
         assert!(nan.validate(3).is_err());
         let (model, _) = column();
         assert!(link_bend(&model, &[0.0; 3], 0, 3).is_err());

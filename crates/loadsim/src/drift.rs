@@ -12,20 +12,20 @@ use serde::{Deserialize, Serialize};
 /// A constant-rate drift of the base placement in the tracker frame.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
-pub struct BaseDrift {
+pub struct TimeDriftModel {
     /// Drift twist per second, tracker frame, `(v m/s, ω rad/s)`. Default: 10 µm/h along x,
     /// −5 µm/h along z and 5 µrad/h about z, an engineering estimate of a settling cell.
     pub twist_per_s: [f64; 6],
 }
 
-impl Default for BaseDrift {
+impl Default for TimeDriftModel {
     fn default() -> Self {
         let per_hour = 1.0 / 3600.0;
         Self { twist_per_s: [10e-6 * per_hour, 0.0, -5e-6 * per_hour, 0.0, 0.0, 5e-6 * per_hour] }
     }
 }
 
-impl BaseDrift {
+impl TimeDriftModel {
     /// Checks that every component is finite.
     pub fn validate(&self) -> Result<(), Error> {
         match self.twist_per_s.iter().find(|x| !x.is_finite()) {
@@ -49,13 +49,13 @@ impl BaseDrift {
 /// drifts by micrometres per hour; a base moving a metre per second is not drifting.
 pub const MAX_DRIFT_PER_S: f64 = 1.0;
 
-impl SimulatedEffect for BaseDrift {
+impl SimulatedEffect for TimeDriftModel {
     fn validate(&self, _cell: &SimulatedCell) -> Result<(), Error> {
-        BaseDrift::validate(self)
+        TimeDriftModel::validate(self)
     }
 
     fn check_entries(&self, _robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
-        BaseDrift::validate(self).map_err(|e| EntryFault::of_section(&e))?;
+        TimeDriftModel::validate(self).map_err(|e| EntryFault::of_section(&e))?;
         let bounds: Vec<_> = self.twist_per_s.iter().map(|&v| ("twist_per_s", v, MAX_DRIFT_PER_S)).collect();
         match beyond(&bounds) {
             Some(message) => Err(EntryFault { field: "twist_per_s".into(), index: 0, message }),

@@ -4,16 +4,16 @@
 //! on through [`SimulatedEffect`], in the list's order.
 
 use crate::{
-    Backlash, EffectKind, Error, JointBacklash, JointCompliance, PeriodicError, PoseContext, PoseInput, SimulatedCell,
-    SimulatedEffect, ThermalGrowth, TrackerNoise, gravity::static_torque, periodic::Harmonic,
+    BacklashModel, EffectKind, Error, GearPeriodicModel, JointBacklash, JointComplianceModel, PoseContext, PoseInput,
+    SimulatedCell, SimulatedEffect, ThermalModel, TrackerNoiseModel, gravity::static_torque, periodic::Harmonic,
 };
-use crate::{BaseDrift, effect_kinds};
+use crate::{TimeDriftModel, effect_kinds};
 use lie::SE3;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 macro_rules! effects_struct {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident $(=> $field:ident: $sim:ty)?, )* }
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident: $sim:ty)?, )* }
      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// Which effects act and with which parameters, a field per kind of
         /// [`effect_kinds!`](crate::effect_kinds) that the simulator models (named as its line
@@ -110,16 +110,16 @@ impl Effects {
             })
             .collect();
         Self {
-            compliance: Some(JointCompliance::default()),
-            backlash: Some(Backlash {
+            compliance: Some(JointComplianceModel::default()),
+            backlash: Some(BacklashModel {
                 joints: (0..joint_count)
                     .map(|joint_index| JointBacklash { joint_index, half_band_rad: half_band })
                     .collect(),
             }),
-            periodic: Some(PeriodicError { harmonics }),
-            thermal: Some(ThermalGrowth::default()),
-            drift: Some(BaseDrift::default()),
-            tracker_noise: Some(TrackerNoise::default()),
+            periodic: Some(GearPeriodicModel { harmonics }),
+            thermal: Some(ThermalModel::default()),
+            drift: Some(TimeDriftModel::default()),
+            tracker_noise: Some(TrackerNoiseModel::default()),
             ..Effects::default()
         }
     }

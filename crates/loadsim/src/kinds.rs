@@ -8,24 +8,26 @@
 /// Calls the macro `$callback` with the list of effect kinds, in a fixed order:
 ///
 /// ```text
-/// identified { $( #[doc] Kind spec_name $( => simulated_field: SimulatedType )?, )* }
-/// simulated { $( #[doc] Kind spec_name => simulated_field: SimulatedType, )* }
+/// identified { $( #[doc] Kind spec_name: KindTerm $( => simulated_field: KindModel )?, )* }
+/// simulated { $( #[doc] Kind spec_name => simulated_field: KindModel, )* }
 /// ```
 ///
-/// `identified` kinds have a regressor in the `effects` crate: a type named `Kind` in its module
+/// `identified` kinds have a regressor in the `effects` crate: the type `KindTerm` in its module
 /// `spec_name` (the file `crates/effects/src/spec_name.rs`, declared from this list), implementing
-/// its `EffectTerm`; each is an item of `--effects` and a candidate the diagnosis can name.
+/// its `EffectTerm`; each is an item of `--effects` and a candidate the diagnosis can name. The
+/// names keep the two sides apart: `effects::GearPeriodicTerm` is what the fit identifies and a
+/// model file holds, `loadsim::GearPeriodicModel` the simulator's ground truth.
 /// `simulated` kinds exist only in the simulator. `spec_name` is the SPEC's name (serde, the
 /// `--effects` item, the diagnosis JSON). Where a kind is simulated, `simulated_field` is the field
 /// of [`crate::Effects`] (and of the effects file of `calib simulate`) that switches it on, and
-/// `SimulatedType` the type it holds there, which implements [`crate::SimulatedEffect`] (the
-/// effect's simulation: its checks and its place in the forward model). An identified kind may
-/// have no simulation: it is then fitted, diagnosed and read from model files, and
+/// `KindModel` the type it holds there, which implements [`crate::SimulatedEffect`] (the effect's
+/// simulation: its checks and its place in the forward model). An identified kind may have no
+/// simulation: it is then fitted, diagnosed and read from model files, and
 /// [`EffectKind::simulated_field`] is `None`.
 ///
 /// ```
 /// macro_rules! names {
-///     (identified { $( $(#[$doc:meta])* $kind:ident $name:ident $(=> $field:ident: $sim:ty)?, )* }
+///     (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident: $sim:ty)?, )* }
 ///      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
 ///         [$(stringify!($name)),*]
 ///     };
@@ -39,32 +41,32 @@ macro_rules! effect_kinds {
         $callback! {
             identified {
                 /// Joint compliance under gravity and payload.
-                JointCompliance joint_compliance => compliance: $crate::JointCompliance,
+                JointCompliance joint_compliance: JointComplianceTerm => compliance: $crate::JointComplianceModel,
                 /// Backlash following the sign of the static torque.
-                Backlash backlash => backlash: $crate::Backlash,
+                Backlash backlash: BacklashTerm => backlash: $crate::BacklashModel,
                 /// A periodic error of a joint in its own angle (gear or encoder).
-                GearPeriodic gear_periodic => periodic: $crate::PeriodicError,
+                GearPeriodic gear_periodic: GearPeriodicTerm => periodic: $crate::GearPeriodicModel,
                 /// Thermal growth of the links with `temp_c`.
-                Thermal thermal => thermal: $crate::ThermalGrowth,
+                Thermal thermal: ThermalTerm => thermal: $crate::ThermalModel,
                 /// Drift of the robot's placement with `t_s`.
-                TimeDrift time_drift => drift: $crate::BaseDrift,
+                TimeDrift time_drift: TimeDriftTerm => drift: $crate::TimeDriftModel,
                 /// A link bending under the gravity moment of everything beyond it.
-                LinkDeflection link_deflection => deflection: $crate::LinkDeflection,
+                LinkDeflection link_deflection: LinkDeflectionTerm => deflection: $crate::LinkDeflectionModel,
                 /// A periodic error of a linear axis in its own position, per screw or rack pitch.
-                ScrewPeriodic screw_periodic => screw: $crate::ScrewError,
+                ScrewPeriodic screw_periodic: ScrewPeriodicTerm => screw: $crate::ScrewPeriodicModel,
             }
             simulated {
                 /// Tracker measurement noise.
-                TrackerNoise tracker_noise => tracker_noise: $crate::TrackerNoise,
+                TrackerNoise tracker_noise => tracker_noise: $crate::TrackerNoiseModel,
                 /// A joint error driven by other joints' angles; no candidate of the diagnosis models it.
-                Coupling coupling => coupling: $crate::JointCoupling,
+                Coupling coupling => coupling: $crate::CouplingModel,
             }
         }
     };
 }
 
 macro_rules! effect_kind_enum {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident $(=> $field:ident: $sim:ty)?, )* }
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident: $sim:ty)?, )* }
      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// The kinds of effect, named as in the SPEC (`--effects`, the model file, the `calib
         /// diagnose` JSON), generated from [`effect_kinds!`](crate::effect_kinds).

@@ -17,7 +17,7 @@
 //!
 //! ```
 //! use lie::{SE3, SO3, Vector3};
-//! use loadsim::{Effects, JointCompliance, LinkInertia, Payload, PoseContext, RobotDynamics, SimulatedCell};
+//! use loadsim::{Effects, JointComplianceModel, LinkInertia, Payload, PoseContext, RobotDynamics, SimulatedCell};
 //! use poe::{JointAxis, JointKind, LocalPoe};
 //!
 //! // A one-joint arm: a horizontal axis, the tool 1 m out along x.
@@ -30,7 +30,7 @@
 //!     gravity_m_per_s2: loadsim::FLOOR_GRAVITY_M_PER_S2,
 //! };
 //! let cell = SimulatedCell::new(arm, Some(dynamics));
-//! let effects = Effects { compliance: Some(JointCompliance::default()), ..Effects::default() };
+//! let effects = Effects { compliance: Some(JointComplianceModel::default()), ..Effects::default() };
 //! let context = PoseContext { payload: Payload::at_tool(10.0), ..PoseContext::default() };
 //! let pose = effects.true_pose(&cell, &[0.0], &context).unwrap();
 //! // 10 kg at 1 m: 98.1 N·m, 0.981 mrad, the tool sags by 0.981 mm.
@@ -62,16 +62,17 @@ mod thermal;
 mod torque_sensor;
 mod tracker_noise;
 
-pub use backlash::{Backlash, JointBacklash, backlash_joint_regressor};
+pub use backlash::{BacklashModel, JointBacklash, backlash_joint_regressor};
 pub use base_tilt::BaseTilt;
 pub use cell::{PoseContext, SimulatedCell};
-pub use compliance::{JointCompliance, MAX_FIXED_POINT_ITERATIONS, compliance_deflection, spring_torque};
+pub use compliance::{JointComplianceModel, MAX_FIXED_POINT_ITERATIONS, compliance_deflection, spring_torque};
 pub use counterbalance::Counterbalance;
-pub use coupling::{CouplingFactor, CouplingTerm, JointCoupling};
+pub use coupling::{CouplingFactor, CouplingModel, CouplingTerm};
 pub use deflection::{
-    BentLink, LinkBend, LinkDeflection, MAX_FLEXIBILITY_PER_NM2, link_bend, link_deflection_features, moment_beyond,
+    BentLink, LinkBend, LinkDeflectionModel, MAX_FLEXIBILITY_PER_NM2, link_bend, link_deflection_features,
+    moment_beyond,
 };
-pub use drift::{BaseDrift, MAX_DRIFT_PER_S};
+pub use drift::{MAX_DRIFT_PER_S, TimeDriftModel};
 pub use dynamics::{FLOOR_GRAVITY_M_PER_S2, LinkInertia, RobotDynamics, tilted_base_gravity};
 pub use effects::{Effects, JointOffsets};
 pub use error::Error;
@@ -84,16 +85,16 @@ pub use gravity::{
 };
 pub use gravity_regressor::gravity_regressor;
 pub use kinds::EffectKind;
-pub use periodic::{Harmonic, PeriodicError, periodic_joint_regressor};
+pub use periodic::{GearPeriodicModel, Harmonic, periodic_joint_regressor};
 pub use regressor::{
     EffectParameter, RegressorColumn, backlash_regressor, compliance_regressor, drift_regressor, periodic_regressor,
     thermal_regressor,
 };
-pub use screw::{MAX_SCREW_ERROR_M, ScrewError, ScrewHarmonic};
+pub use screw::{MAX_SCREW_ERROR_M, ScrewHarmonic, ScrewPeriodicModel};
 pub use simulated::{
     DynamicsNeed, EntryFault, MAX_JOINT_ERROR_RAD, MAX_ORDER, PoseInput, RobotFacts, SimulatedEffect, beyond, short,
 };
 pub use singularity::{smallest_singular_value, smallest_singular_value_of_joints, tool_point_jacobian};
-pub use thermal::{MAX_EXPANSION_PER_K, MAX_TEMPERATURE_C, ThermalGrowth};
+pub use thermal::{MAX_EXPANSION_PER_K, MAX_TEMPERATURE_C, ThermalModel};
 pub use torque_sensor::TorqueSensorNoise;
-pub use tracker_noise::{MAX_NOISE, TrackerNoise};
+pub use tracker_noise::{MAX_NOISE, TrackerNoiseModel};

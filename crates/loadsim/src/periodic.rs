@@ -35,12 +35,12 @@ impl Harmonic {
 /// Transmission error on some joints. Default: no harmonic.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default)]
-pub struct PeriodicError {
+pub struct GearPeriodicModel {
     /// The harmonics, any number per joint.
     pub harmonics: Vec<Harmonic>,
 }
 
-impl PeriodicError {
+impl GearPeriodicModel {
     /// Checks indices and values against a robot with `joint_count` joints.
     pub fn validate(&self, joint_count: usize) -> Result<(), Error> {
         for h in &self.harmonics {
@@ -77,16 +77,16 @@ pub fn periodic_joint_regressor(joint_value: f64, order: f64) -> [f64; 2] {
     [c, s]
 }
 
-impl SimulatedEffect for PeriodicError {
+impl SimulatedEffect for GearPeriodicModel {
     fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
-        PeriodicError::validate(self, cell.robot.joint_count())
+        GearPeriodicModel::validate(self, cell.robot.joint_count())
     }
 
     fn check_entries(&self, robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
         for (k, h) in self.harmonics.iter().enumerate() {
-            let alone = PeriodicError { harmonics: vec![*h] };
+            let alone = GearPeriodicModel { harmonics: vec![*h] };
             let fault =
-                PeriodicError::validate(&alone, robot.joints.len()).err().map(|e| e.to_string()).or_else(|| {
+                GearPeriodicModel::validate(&alone, robot.joints.len()).err().map(|e| e.to_string()).or_else(|| {
                     beyond(&[("amplitude_rad", h.amplitude_rad, MAX_JOINT_ERROR_RAD), ("order", h.order, MAX_ORDER)])
                 });
             if let Some(fault) = fault {

@@ -135,7 +135,7 @@ pub fn periodic_regressor(
 
 /// Thermal columns, one per constant transform (n joints, then the tool): growing transform `i` by
 /// the strain `α_i ΔT` moves the pose by `α_i ΔT (R_{i-1}(q) t_i, 0)` exactly (module
-/// [`crate::ThermalGrowth`]). With a tracker-frame model, column 0 grows the tracker-to-base
+/// [`crate::ThermalModel`]). With a tracker-frame model, column 0 grows the tracker-to-base
 /// distance, which is not a robot link: leave it out there.
 pub fn thermal_regressor(
     model: &LocalPoe,

@@ -4,7 +4,7 @@
 //! `δq_j = Σ_h A_h cos(2π h q_j / p + φ_h)`, metres (ISO 230-2's periodic deviation of a
 //! ball-screw axis; the once-per-turn harmonic from the screw's run-out and the nut's
 //! eccentricity, higher ones from the balls' circulation). The same series as a gear's
-//! ([`crate::PeriodicError`]) in the phase `2π q_j / p` of the screw.
+//! ([`crate::GearPeriodicModel`]) in the phase `2π q_j / p` of the screw.
 
 use crate::Error;
 use crate::{EntryFault, MAX_ORDER, PoseInput, RobotFacts, SimulatedCell, SimulatedEffect, beyond, short};
@@ -28,12 +28,12 @@ pub struct ScrewHarmonic {
 /// Screw (or rack) errors on some linear axes. Default: no harmonic.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default)]
-pub struct ScrewError {
+pub struct ScrewPeriodicModel {
     /// The harmonics, any number per joint.
     pub harmonics: Vec<ScrewHarmonic>,
 }
 
-impl ScrewError {
+impl ScrewPeriodicModel {
     /// Checks indices, joint kinds and values against a robot whose joints are `prismatic`.
     pub fn validate(&self, prismatic: &[bool]) -> Result<(), Error> {
         for h in &self.harmonics {
@@ -73,18 +73,18 @@ impl ScrewError {
 /// screws and racks by tens of µm; a millimetre per turn is a broken drive.
 pub const MAX_SCREW_ERROR_M: f64 = 1e-3;
 
-impl SimulatedEffect for ScrewError {
+impl SimulatedEffect for ScrewPeriodicModel {
     fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
         let prismatic: Vec<bool> = cell.robot.joints().iter().map(|j| j.kind == poe::JointKind::Prismatic).collect();
-        ScrewError::validate(self, &prismatic)
+        ScrewPeriodicModel::validate(self, &prismatic)
     }
 
     fn check_entries(&self, robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
         let prismatic: Vec<bool> = robot.joints.iter().map(|&kind| kind == poe::JointKind::Prismatic).collect();
         let (low, high) = robot.pitch_bounds_mm;
         for (k, h) in self.harmonics.iter().enumerate() {
-            let alone = ScrewError { harmonics: vec![*h] };
-            let fault = ScrewError::validate(&alone, &prismatic).err().map(|e| e.to_string()).or_else(|| {
+            let alone = ScrewPeriodicModel { harmonics: vec![*h] };
+            let fault = ScrewPeriodicModel::validate(&alone, &prismatic).err().map(|e| e.to_string()).or_else(|| {
                 beyond(&[("amplitude_m", h.amplitude_m, MAX_SCREW_ERROR_M), ("order", h.order, MAX_ORDER)])
             });
             let pitch_mm = h.pitch_m * 1e3;
@@ -110,7 +110,7 @@ mod tests {
 
     #[test]
     fn the_error_repeats_with_every_pitch_of_travel_and_is_refused_on_a_revolute_joint() {
-        let screw = ScrewError {
+        let screw = ScrewPeriodicModel {
             harmonics: vec![ScrewHarmonic {
                 joint_index: 0,
                 pitch_m: 0.01,

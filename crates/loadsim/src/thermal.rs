@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 /// Thermal growth of the link lengths.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
-pub struct ThermalGrowth {
+pub struct ThermalModel {
     /// Temperature at which the model's lengths hold, °C. Default 20 (ISO 1).
     pub reference_temp_c: f64,
     /// Linear expansion coefficient of every link, 1/K. Default 12e-6, steel and cast iron
@@ -28,13 +28,13 @@ pub struct ThermalGrowth {
     pub link_expansion_per_k: Vec<f64>,
 }
 
-impl Default for ThermalGrowth {
+impl Default for ThermalModel {
     fn default() -> Self {
         Self { reference_temp_c: 20.0, expansion_per_k: 12e-6, link_expansion_per_k: Vec::new() }
     }
 }
 
-impl ThermalGrowth {
+impl ThermalModel {
     /// Checks the values against a robot with `joint_count` joints.
     pub fn validate(&self, joint_count: usize) -> Result<(), Error> {
         if !self.reference_temp_c.is_finite() {
@@ -89,13 +89,13 @@ pub const MAX_EXPANSION_PER_K: f64 = 1e-3;
 /// Largest magnitude of a reference temperature an effects file may give, °C.
 pub const MAX_TEMPERATURE_C: f64 = 1e4;
 
-impl SimulatedEffect for ThermalGrowth {
+impl SimulatedEffect for ThermalModel {
     fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
-        ThermalGrowth::validate(self, cell.robot.joint_count())
+        ThermalModel::validate(self, cell.robot.joint_count())
     }
 
     fn check_entries(&self, robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
-        ThermalGrowth::validate(self, robot.joints.len()).map_err(|e| EntryFault::of_section(&e))?;
+        ThermalModel::validate(self, robot.joints.len()).map_err(|e| EntryFault::of_section(&e))?;
         let mut bounds = vec![
             ("reference_temp_c", self.reference_temp_c, MAX_TEMPERATURE_C),
             ("expansion_per_k", self.expansion_per_k, MAX_EXPANSION_PER_K),

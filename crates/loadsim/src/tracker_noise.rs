@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 /// Gaussian tracker noise, radial and transverse in position, isotropic in orientation.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
-pub struct TrackerNoise {
+pub struct TrackerNoiseModel {
     /// Standard deviation along the line of sight, m. Default 5 µm (AT901 ADM, MPE 10 µm).
     pub radial_sigma_m: f64,
     /// Standard deviation across the line of sight at zero distance, m. Default 7.5 µm.
@@ -27,7 +27,7 @@ pub struct TrackerNoise {
     pub orientation_sigma_rad: f64,
 }
 
-impl Default for TrackerNoise {
+impl Default for TrackerNoiseModel {
     fn default() -> Self {
         Self {
             radial_sigma_m: 5e-6,
@@ -38,7 +38,7 @@ impl Default for TrackerNoise {
     }
 }
 
-impl TrackerNoise {
+impl TrackerNoiseModel {
     /// Checks that every standard deviation is finite and non-negative.
     pub fn validate(&self) -> Result<(), Error> {
         for (field, value) in [
@@ -94,13 +94,13 @@ impl TrackerNoise {
 pub const MAX_NOISE: f64 = 1.0;
 
 /// The noise acts where the tracker measures (`Effects::measured_pose`), not on the robot.
-impl SimulatedEffect for TrackerNoise {
+impl SimulatedEffect for TrackerNoiseModel {
     fn validate(&self, _cell: &SimulatedCell) -> Result<(), Error> {
-        TrackerNoise::validate(self)
+        TrackerNoiseModel::validate(self)
     }
 
     fn check_entries(&self, _robot: &RobotFacts<'_>) -> Result<(), EntryFault> {
-        TrackerNoise::validate(self).map_err(|e| EntryFault::of_section(&e))?;
+        TrackerNoiseModel::validate(self).map_err(|e| EntryFault::of_section(&e))?;
         let bounds = [
             ("radial_sigma_m", self.radial_sigma_m, MAX_NOISE),
             ("transverse_sigma_m", self.transverse_sigma_m, MAX_NOISE),

@@ -63,14 +63,6 @@ pub(crate) struct Expectation<'a> {
 }
 
 /// The SPEC name of joint `k`'s column for a joint of `kind`.
-/// A joint's kind as an error names it (the errors know no kinematics crate).
-pub(crate) fn error_kind(kind: JointKind) -> errors::JointKind {
-    match kind {
-        JointKind::Revolute => errors::JointKind::Revolute,
-        JointKind::Prismatic => errors::JointKind::Prismatic,
-    }
-}
-
 fn joint_name(k: usize, kind: JointKind) -> String {
     match kind {
         JointKind::Revolute => format!("q{k}_rad"),
@@ -303,7 +295,7 @@ fn check_joints(
                     file.to_owned(),
                     line,
                     column.index + 1,
-                    ErrorKind::JointUnit { joint: *k, kind: error_kind(*robot) },
+                    ErrorKind::JointUnit { joint: *k, kind: robot.name() },
                 ));
             }
         }

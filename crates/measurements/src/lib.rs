@@ -495,7 +495,7 @@ impl MeasurementSet {
                     self.source.clone(),
                     self.header_line,
                     column.column,
-                    ErrorKind::JointUnit { joint: k + 1, kind: layout::error_kind(*kind) },
+                    ErrorKind::JointUnit { joint: k + 1, kind: kind.name() },
                 ));
             }
         }

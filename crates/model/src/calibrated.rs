@@ -47,8 +47,10 @@ pub struct CalibratedModel {
     /// was kept have none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub geometry_uncertainty: Option<crate::GeometryUncertainty>,
-    /// The GP on the residual, step 2 (methods `poe-gp`, `poe-gp-load`); `compensation` in the file.
-    #[serde(default, skip_serializing_if = "Option::is_none", rename = "compensation")]
+    /// The GP on the residual, step 2 (methods `poe-gp`, `poe-gp-load`). Written `residual_gp`;
+    /// files written before SPEC version 4 call it `compensation`, which still reads (the name
+    /// now belongs to `calib compensate`'s correction of joint targets alone).
+    #[serde(default, skip_serializing_if = "Option::is_none", alias = "compensation")]
     pub residual_gp: Option<crate::ResidualGp>,
     /// The range of every input the model was fitted on: the check on reading probes the model
     /// inside it. Files written before it existed have none.

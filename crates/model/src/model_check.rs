@@ -68,6 +68,16 @@ fn occurrences_before(text: &str, field: &str, part: &str) -> usize {
         .count()
 }
 
+/// The residual GP's field as `text` spells it: `residual_gp`, or `compensation` in a file written
+/// before SPEC version 4, so that a refusal names the field the file has.
+fn residual_gp_field(text: &str) -> &'static str {
+    if field_position(text, "residual_gp", 0) == (1, 1) && field_position(text, "compensation", 0) != (1, 1) {
+        "compensation"
+    } else {
+        "residual_gp"
+    }
+}
+
 /// The widest a GP hyperparameter of a model file may be, as a factor either way of 1: the GP
 /// works on standardised inputs and normalised outputs, and its search box is far narrower (gp's
 /// default bounds span 1e-9 to 1e3). Like [`robot::MAX_TRANSLATION_M`] a sanity bound on a file, not a
@@ -141,7 +151,7 @@ impl CalibratedModel {
         }
         if self.method.uses_gp() != self.residual_gp.is_some() {
             let has = if self.residual_gp.is_some() { "has a" } else { "has no" };
-            return Err(at.part("method", format!("method {} but the model {has} GP compensation", self.method)));
+            return Err(at.part("method", format!("method {} but the model {has} residual GP", self.method)));
         }
         if let Some(robot) = &self.robot_description {
             check_robot(robot, self, &at)?;
@@ -152,28 +162,29 @@ impl CalibratedModel {
         })
         .map_err(|fault| fault.into_error(file))?;
         if let Some(residual_gp) = &self.residual_gp {
+            let gp_field = residual_gp_field(text);
             if residual_gp.with_payload != (self.method == Method::PoeGpLoad) {
                 let message =
-                    format!("compensation.with_payload is {} for method {}", residual_gp.with_payload, self.method);
+                    format!("{gp_field}.with_payload is {} for method {}", residual_gp.with_payload, self.method);
                 return Err(at.part("with_payload", message));
             }
             if residual_gp.full_pose != self.full_pose {
                 let message = format!(
-                    "compensation.full_pose is {}, the model's full_pose {}",
+                    "{gp_field}.full_pose is {}, the model's full_pose {}",
                     residual_gp.full_pose, self.full_pose
                 );
-                return Err(at.part("compensation", message));
+                return Err(at.part(gp_field, message));
             }
             let inputs = n + usize::from(residual_gp.with_payload) + residual_gp.inputs.len();
             if residual_gp.gp.input_dim() != inputs {
                 let found = residual_gp.gp.input_dim();
-                return Err(at.count(("gp", 0), "compensation.gp".into(), "inputs", found, inputs));
+                return Err(at.count(("gp", 0), format!("{gp_field}.gp"), "inputs", found, inputs));
             }
             let bound = 10f64.powf(MAX_HYPERPARAMETER_DECADES);
             let hyperparameters = residual_gp.gp.kernels().into_iter().flat_map(|k| k.parameters());
             if let Some(value) = hyperparameters.into_iter().find(|p| !(p.abs() <= bound && p.abs() >= 1.0 / bound)) {
                 let message = format!(
-                    "compensation.gp: a kernel hyperparameter is {value:e}, outside 1e-{MAX_HYPERPARAMETER_DECADES} to \
+                    "{gp_field}.gp: a kernel hyperparameter is {value:e}, outside 1e-{MAX_HYPERPARAMETER_DECADES} to \
                      1e{MAX_HYPERPARAMETER_DECADES} (the GP works on standardised data; an edited or corrupt file)"
                 );
                 return Err(at.part("kernel", message));
@@ -181,7 +192,7 @@ impl CalibratedModel {
             let outputs = if self.full_pose { 6 } else { 3 };
             if residual_gp.gp.output_count() != outputs {
                 let found = residual_gp.gp.output_count();
-                return Err(at.count(("gp", 0), "compensation.gp".into(), "outputs", found, outputs));
+                return Err(at.count(("gp", 0), format!("{gp_field}.gp"), "outputs", found, outputs));
             }
         }
         self.check_inputs(&at)?;
@@ -194,7 +205,8 @@ impl CalibratedModel {
     fn check_inputs(&self, at: &Located<'_>) -> Result<(), Error> {
         let names = self.input_names();
         if let Some(k) = (1..names.len()).find(|&k| names[..k].contains(&names[k])) {
-            return Err(at.part("inputs", format!("compensation.inputs: the input '{}' is named twice", names[k])));
+            let gp_field = residual_gp_field(at.text);
+            return Err(at.part("inputs", format!("{gp_field}.inputs: the input '{}' is named twice", names[k])));
         }
         if let Some(range) = &self.training_range
             && let Some(name) = names.iter().find(|name| range.input(name).is_none())
@@ -286,7 +298,7 @@ impl CalibratedModel {
                 Part::Geometry(_) => "kinematics",
                 Part::Effect(_) => "effects",
                 Part::Fallback(_) => "fallback_kinematics",
-                Part::GaussianProcess(_) => "compensation",
+                Part::GaussianProcess(_) => residual_gp_field(at.text),
             };
             let why = applied
                 .err()

@@ -64,7 +64,7 @@ pub fn parse_model(text: &str, file: &str) -> Result<CalibratedModel, Error> {
 /// The version-1 layout: the same model with joint compliance as its only possible effect.
 mod version_1 {
     use crate::{CalibratedModel, Method, ResidualGp, SCHEMA_VERSION};
-    use effects::{ComplianceTerm, ComplianceTorque, IdentifiedEffect, JointCompliance, LoadFrame};
+    use effects::{ComplianceParameter, ComplianceTorque, IdentifiedEffect, JointComplianceTerm, LoadFrame};
     use poe::LocalPoe;
     use serde::Deserialize;
 
@@ -72,7 +72,7 @@ mod version_1 {
     pub(super) struct Compliance {
         base_model: LocalPoe,
         gravity_m_per_s2: [f64; 3],
-        terms: Vec<ComplianceTerm>,
+        terms: Vec<ComplianceParameter>,
         theta: Vec<f64>,
     }
 
@@ -97,7 +97,7 @@ mod version_1 {
                 .joint_compliance
                 .map(|c| {
                     let load = LoadFrame { base_model: c.base_model, gravity_m_per_s2: c.gravity_m_per_s2 };
-                    IdentifiedEffect::JointCompliance(JointCompliance {
+                    IdentifiedEffect::JointCompliance(JointComplianceTerm {
                         torque: ComplianceTorque::GravityRegressor(load),
                         terms: c.terms,
                         theta: c.theta,

@@ -272,17 +272,13 @@ fn joint_limits(robot: &RobotDescription, data: &MeasurementSet, options: &Plaus
             // Degrees written under `_rad`: every value of the column, read as degrees, fits.
             let degrees_under_rad = column.is_some_and(|c| c.unit == "rad")
                 && data.rows.iter().all(|r| r.q.get(k).is_none_or(|&v| within(k, v.to_radians())));
-            let kind = match kinds[k] {
-                JointKind::Revolute => errors::JointKind::Revolute,
-                JointKind::Prismatic => errors::JointKind::Prismatic,
-            };
             return Some(Error::at_line(
                 data.source.clone(),
                 row.line,
                 column.map_or(k + 1, |c| c.column),
                 ErrorKind::JointBeyondLimits {
                     joint: k + 1,
-                    kind,
+                    kind: kinds[k].name(),
                     value,
                     limits: limits[k],
                     margin: margin(k),

@@ -4,23 +4,23 @@
 //! holds. The diagnosis does not offer it (nor `--effects auto` pick it), while a shoulder whose
 //! torque changes sign keeps its backlash candidate.
 
-use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell};
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel, joint_ranges, simulate, simulated_cell};
 use diagnose::{DiagnoseOptions, Effect, diagnose};
-use loadsim::{Backlash, JointBacklash, Payload};
+use loadsim::{BacklashModel, JointBacklash, Payload};
 
 #[test]
 fn a_vertical_column_whose_force_never_changes_sign_is_offered_no_backlash() {
     let robot = testkit::robot("column_arm.urdf");
     // A backlash of the shoulder (joint 3, the UR10's joint 2) and of the column: the column's
     // band is a constant offset in the data, since its force keeps its sign.
-    let backlash = Backlash {
+    let backlash = BacklashModel {
         joints: vec![
             JointBacklash { joint_index: 0, half_band_rad: 2e-4 },
             JointBacklash { joint_index: 2, half_band_rad: 1e-4 },
         ],
     };
     let effects =
-        Effects { backlash: Some(backlash), tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+        Effects { backlash: Some(backlash), tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
     let cell = simulated_cell(&robot, &Perturbation::default(), 47).unwrap();
     let config = GeneratorConfig { sample_count: 250, seed: 47, ..GeneratorConfig::default() };
     let data = simulate(&cell, &effects, &joint_ranges(&robot), &config, false).unwrap();
@@ -87,7 +87,7 @@ fn a_vertical_column_whose_force_never_changes_sign_is_offered_no_backlash() {
 #[test]
 fn a_column_carrying_one_payload_is_offered_no_compliance() {
     let robot = testkit::robot("column_arm.urdf");
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
     let cell = simulated_cell(&robot, &Perturbation::default(), 48).unwrap();
     let config = GeneratorConfig { sample_count: 150, seed: 48, payloads_kg: vec![5.0], ..GeneratorConfig::default() };
     let data = simulate(&cell, &effects, &joint_ranges(&robot), &config, false).unwrap();

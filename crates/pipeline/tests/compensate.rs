@@ -2,7 +2,7 @@
 //! reaches what each row means; every refusal says why, and the targets file's refusals name the
 //! file, line and column.
 
-use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise};
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel};
 use cell::{CompensateOptions, InverseOptions, PoseTarget, TargetFrame, TargetStatus};
 use errors::Error;
 use lie::{SE3, Vector3};
@@ -27,7 +27,7 @@ fn fitted(
 }
 
 fn noise_only() -> Effects {
-    Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() }
+    Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() }
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {

@@ -1,19 +1,19 @@
 //! `diagnose` on simulated data whose hidden effect it is not told.
 
 use campaign::{
-    Effects, GeneratorConfig, Perturbation, Remount, TrackerNoise, joint_ranges, payload_run_campaign, simulate,
+    Effects, GeneratorConfig, Perturbation, Remount, TrackerNoiseModel, joint_ranges, payload_run_campaign, simulate,
     simulate_campaign, simulated_cell,
 };
 use diagnose::{DiagnoseOptions, Effect, NoiseSource, StructureOptions, diagnose};
 use effects::CandidateOptions;
-use loadsim::{CouplingFactor, CouplingTerm, Harmonic, JointCoupling, PeriodicError};
+use loadsim::{CouplingFactor, CouplingModel, CouplingTerm, GearPeriodicModel, Harmonic};
 use measurements::MeasurementSet;
 use robot::RobotDescription;
 
 fn simulated(robot: &RobotDescription, effects: &Effects, full_pose: bool, seed: u64) -> MeasurementSet {
     let cell = simulated_cell(robot, &Perturbation::default(), seed).unwrap();
     let config = GeneratorConfig { sample_count: 250, seed, ..GeneratorConfig::default() };
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..effects.clone() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..effects.clone() };
     simulate(&cell, &effects, &joint_ranges(robot), &config, full_pose).unwrap()
 }
 
@@ -26,7 +26,7 @@ fn blind(robot: &RobotDescription) -> RobotDescription {
 fn a_second_harmonic_on_joint_three_is_named_and_removed_position_only_and_full_pose() {
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
-        periodic: Some(PeriodicError {
+        periodic: Some(GearPeriodicModel {
             harmonics: vec![Harmonic { joint_index: 2, order: 2.0, amplitude_rad: 2e-4, phase_rad: 0.4 }],
         }),
         ..Effects::default()
@@ -59,7 +59,7 @@ fn a_second_harmonic_on_joint_three_is_named_and_removed_position_only_and_full_
 #[test]
 fn compliance_is_found_without_the_masses() {
     let robot = testkit::robot("irb4400.ron");
-    let effects = Effects { compliance: Some(loadsim::JointCompliance::default()), ..Effects::default() };
+    let effects = Effects { compliance: Some(loadsim::JointComplianceModel::default()), ..Effects::default() };
     let data = simulated(&robot, &effects, false, 23);
     let d = diagnose(&blind(&robot), &data, &DiagnoseOptions::default()).unwrap();
     assert_eq!(d.verdict.effect, Effect::JointCompliance, "{}", d.summary());
@@ -123,8 +123,8 @@ fn the_seven_axis_two_moving_joint_campaign_names_compliance_on_joint_two() {
         }
     }
     let effects = Effects {
-        compliance: Some(loadsim::JointCompliance::default()),
-        tracker_noise: Some(TrackerNoise::default()),
+        compliance: Some(loadsim::JointComplianceModel::default()),
+        tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     };
     for seed in [31, 32] {
@@ -151,7 +151,7 @@ fn the_seven_axis_two_moving_joint_campaign_names_compliance_on_joint_two() {
 fn a_coupling_between_joints_is_unknown_with_the_joints_it_depends_on() {
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
-        coupling: Some(JointCoupling {
+        coupling: Some(CouplingModel {
             terms: vec![CouplingTerm {
                 joint_index: 2,
                 amplitude_rad: 1e-3,
@@ -179,9 +179,10 @@ fn a_coupling_between_joints_is_unknown_with_the_joints_it_depends_on() {
 #[test]
 fn a_lifting_column_is_reported_in_millimetres_and_offered_no_series_of_its_angle() {
     let robot = testkit::robot("column_ur10.ron");
-    assert_eq!(robot.joints[0].kind, robot::JointType::Prismatic);
-    let periodic =
-        PeriodicError { harmonics: vec![Harmonic { joint_index: 2, order: 3.0, amplitude_rad: 4e-4, phase_rad: 0.3 }] };
+    assert_eq!(robot.joints[0].kind, poe::JointKind::Prismatic);
+    let periodic = GearPeriodicModel {
+        harmonics: vec![Harmonic { joint_index: 2, order: 3.0, amplitude_rad: 4e-4, phase_rad: 0.3 }],
+    };
     let data = simulated(&robot, &Effects { periodic: Some(periodic), ..Effects::default() }, false, 5);
     let diagnosis = diagnose(&robot, &data, &DiagnoseOptions::default()).unwrap();
     assert_eq!(diagnosis.prismatic_joints, vec![1]);

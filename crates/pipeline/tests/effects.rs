@@ -2,9 +2,9 @@
 //! that effect hidden, takes the held-out error down to the tracker noise; the model file keeps
 //! them and an older file (schema 1) still reads.
 
-use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell};
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel, joint_ranges, simulate, simulated_cell};
 use effects::{EffectSelection, IdentifiedEffect};
-use loadsim::{BaseDrift, Harmonic, JointBacklash, PeriodicError, ThermalGrowth};
+use loadsim::{GearPeriodicModel, Harmonic, JointBacklash, ThermalModel, TimeDriftModel};
 use measurements::MeasurementSet;
 use model::Method;
 use pipeline::FitOptions;
@@ -15,7 +15,7 @@ use robot::RobotDescription;
 fn split(robot: &RobotDescription, effects: &Effects, seed: u64) -> (MeasurementSet, MeasurementSet) {
     let cell = simulated_cell(robot, &Perturbation::default(), seed).unwrap();
     let config = GeneratorConfig { sample_count: 400, seed, ..GeneratorConfig::default() };
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..effects.clone() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..effects.clone() };
     let all = simulate(&cell, &effects, &joint_ranges(robot), &config, false).unwrap();
     (all.subset(&(0..250).collect::<Vec<_>>()), all.subset(&(250..400).collect::<Vec<_>>()))
 }
@@ -35,10 +35,12 @@ fn noise_floor(robot: &RobotDescription, seed: u64) -> f64 {
 }
 
 /// A gear error of orders 1, 7 and 12 on joint 2, 0.1–0.2 mrad each.
-fn joint_2_gear_error() -> PeriodicError {
+fn joint_2_gear_error() -> GearPeriodicModel {
     let harmonic =
         |order: f64, amplitude_rad: f64, phase_rad: f64| Harmonic { joint_index: 1, order, amplitude_rad, phase_rad };
-    PeriodicError { harmonics: vec![harmonic(1.0, 1e-4, 0.3), harmonic(7.0, 2e-4, -1.0), harmonic(12.0, 1e-4, 2.0)] }
+    GearPeriodicModel {
+        harmonics: vec![harmonic(1.0, 1e-4, 0.3), harmonic(7.0, 2e-4, -1.0), harmonic(12.0, 1e-4, 2.0)],
+    }
 }
 
 #[test]
@@ -62,7 +64,7 @@ fn backlash_thermal_growth_and_drift_are_each_identified_down_to_the_noise() {
         (
             "backlash:3",
             Effects {
-                backlash: Some(loadsim::Backlash {
+                backlash: Some(loadsim::BacklashModel {
                     joints: vec![JointBacklash { joint_index: 2, half_band_rad: 3e-4 }],
                 }),
                 ..Effects::default()
@@ -71,14 +73,14 @@ fn backlash_thermal_growth_and_drift_are_each_identified_down_to_the_noise() {
         (
             "thermal",
             Effects {
-                thermal: Some(ThermalGrowth { expansion_per_k: 1e-4, ..ThermalGrowth::default() }),
+                thermal: Some(ThermalModel { expansion_per_k: 1e-4, ..ThermalModel::default() }),
                 ..Effects::default()
             },
         ),
         (
             "time_drift",
             Effects {
-                drift: Some(BaseDrift { twist_per_s: [4e-8, -3e-8, 2e-8, 0.0, 1e-8, 0.0] }),
+                drift: Some(TimeDriftModel { twist_per_s: [4e-8, -3e-8, 2e-8, 0.0, 1e-8, 0.0] }),
                 ..Effects::default()
             },
         ),
@@ -136,7 +138,7 @@ fn a_model_with_every_effect_reads_back_and_predicts_the_same() {
 fn campaign(effects: &Effects, seed: u64) -> (MeasurementSet, MeasurementSet) {
     let robot = testkit::robot("iiwa7.ron");
     let config = campaign::payload_run_campaign(400, seed);
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..effects.clone() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..effects.clone() };
     let remount = campaign::Remount::default();
     let (_, all) =
         campaign::simulate_campaign(&robot, &effects, &Perturbation::default(), &remount, &config, true).unwrap();
@@ -179,10 +181,10 @@ fn training_costs(seed: u64, mask: u32, extra: u32, options: &FitOptions) -> Tra
     let (subset, superset) = (pick(mask), pick(mask | extra));
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
-        periodic: Some(PeriodicError {
+        periodic: Some(GearPeriodicModel {
             harmonics: vec![Harmonic { joint_index: 1, order: 3.0, amplitude_rad: 2e-4, phase_rad: 0.5 }],
         }),
-        tracker_noise: Some(TrackerNoise::default()),
+        tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     };
     let cell = simulated_cell(&robot, &Perturbation::default(), seed).unwrap();
@@ -279,10 +281,10 @@ proptest::proptest! {
 fn a_model_is_its_parts_applied_in_order_and_export_reports_each_one() {
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
-        periodic: Some(PeriodicError {
+        periodic: Some(GearPeriodicModel {
             harmonics: vec![Harmonic { joint_index: 2, order: 2.0, amplitude_rad: 3e-4, phase_rad: 0.1 }],
         }),
-        backlash: Some(loadsim::Backlash { joints: vec![JointBacklash { joint_index: 1, half_band_rad: 3e-4 }] }),
+        backlash: Some(loadsim::BacklashModel { joints: vec![JointBacklash { joint_index: 1, half_band_rad: 3e-4 }] }),
         ..Effects::default()
     };
     let (train, test) = split(&robot, &effects, 36);
@@ -370,7 +372,7 @@ fn joint_2_gear_campaign(seed: u64) -> (RobotDescription, MeasurementSet) {
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
         periodic: Some(joint_2_gear_error()),
-        tracker_noise: Some(TrackerNoise::default()),
+        tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     };
     let cell = simulated_cell(&robot, &Perturbation::default(), seed).unwrap();
@@ -465,7 +467,7 @@ fn where_the_effects_fade_the_gp_falls_back_with_the_geometry() {
     periodic.harmonics.push(Harmonic { joint_index: 2, order: 1.0, amplitude_rad: 4e-4, phase_rad: 0.7 });
     periodic.harmonics.push(Harmonic { joint_index: 2, order: 2.0, amplitude_rad: 2e-4, phase_rad: -0.4 });
     let effects =
-        Effects { periodic: Some(periodic), tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+        Effects { periodic: Some(periodic), tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
     let cell = simulated_cell(&robot, &Perturbation::default(), 59).unwrap();
     let config = GeneratorConfig { sample_count: 1000, seed: 59, ..GeneratorConfig::default() };
     let all = simulate(&cell, &effects, &joint_ranges(&robot), &config, false).unwrap();
@@ -552,8 +554,8 @@ fn the_diagnosis_predicts_the_error_in_a_gap_and_past_the_end_from_arcs_of_the_j
 fn a_drift_fitted_in_one_session_is_not_carried_into_another_days_later() {
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
-        drift: Some(BaseDrift { twist_per_s: [4e-8, -3e-8, 2e-8, 0.0, 1e-8, 0.0] }),
-        tracker_noise: Some(TrackerNoise::default()),
+        drift: Some(TimeDriftModel { twist_per_s: [4e-8, -3e-8, 2e-8, 0.0, 1e-8, 0.0] }),
+        tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     };
     let cell = simulated_cell(&robot, &Perturbation::default(), 61).unwrap();
@@ -597,7 +599,7 @@ fn a_drift_fitted_in_one_session_is_not_carried_into_another_days_later() {
 fn rows_that_excite_what_no_training_row_did_have_a_large_sigma_and_fall_back_to_the_geometry() {
     let robot = testkit::robot("irb4400.ron");
     for seed in [61, 62] {
-        let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+        let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
         let cell = simulated_cell(&robot, &Perturbation::default(), seed).unwrap();
         let config = GeneratorConfig { sample_count: 3000, seed, ..GeneratorConfig::default() };
         let all = simulate(&cell, &effects, &joint_ranges(&robot), &config, false).unwrap();
@@ -656,7 +658,7 @@ fn the_sigmas_columns_are_the_derivatives_of_the_prediction() {
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
         periodic: Some(joint_2_gear_error()),
-        tracker_noise: Some(TrackerNoise::default()),
+        tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     };
     let (train, test) = split(&robot, &effects, 5);

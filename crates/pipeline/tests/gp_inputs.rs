@@ -1,7 +1,7 @@
 //! Measured signals as inputs of the GP (issue 46, `calib fit --inputs`): learnt beside the
 //! joints, kept in the model with their spans, required by name wherever the model is used.
 
-use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell};
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel, joint_ranges, simulate, simulated_cell};
 use errors::ErrorKind;
 use lie::{SE3, SO3, Vector3};
 use measurements::{Inputs, MeasurementSet, parse_measurements};
@@ -18,7 +18,7 @@ const SIGNAL: &str = "tilt_x_mrad";
 fn tilted(rows: usize, seed: u64) -> MeasurementSet {
     let robot = testkit::robot("irb4400.ron");
     let cell = simulated_cell(&robot, &Perturbation::default(), seed).unwrap();
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
     let config = GeneratorConfig { sample_count: rows, seed, payloads_kg: vec![0.0], ..GeneratorConfig::default() };
     let mut data = simulate(&cell, &effects, &joint_ranges(&robot), &config, false).unwrap();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);

@@ -3,11 +3,11 @@
 //! hyperparameters are chosen: each fold's GP is conditioned on its training rows' residuals alone.
 
 use campaign::{
-    CouplingFactor, CouplingTerm, Effects, GeneratorConfig, JointCoupling, Perturbation, TrackerNoise, joint_ranges,
-    simulate, simulated_cell,
+    CouplingFactor, CouplingModel, CouplingTerm, Effects, GeneratorConfig, Perturbation, TrackerNoiseModel,
+    joint_ranges, simulate, simulated_cell,
 };
 use effects::EffectSelection;
-use loadsim::{Harmonic, PeriodicError};
+use loadsim::{GearPeriodicModel, Harmonic};
 use measurements::MeasurementSet;
 use model::Method;
 use pipeline::FitOptions;
@@ -25,10 +25,10 @@ fn coupled_campaign(seed: u64) -> (RobotDescription, MeasurementSet) {
     let robot = testkit::robot("irb4400.ron");
     let harmonic =
         |order: f64, amplitude_rad: f64, phase_rad: f64| Harmonic { joint_index: 1, order, amplitude_rad, phase_rad };
-    let periodic = PeriodicError {
+    let periodic = GearPeriodicModel {
         harmonics: vec![harmonic(1.0, 1e-4, 0.3), harmonic(7.0, 2e-4, -1.0), harmonic(12.0, 1e-4, 2.0)],
     };
-    let coupling = JointCoupling {
+    let coupling = CouplingModel {
         terms: vec![CouplingTerm {
             joint_index: 2,
             amplitude_rad: 3e-4,
@@ -41,7 +41,7 @@ fn coupled_campaign(seed: u64) -> (RobotDescription, MeasurementSet) {
     let effects = Effects {
         periodic: Some(periodic),
         coupling: Some(coupling),
-        tracker_noise: Some(TrackerNoise::default()),
+        tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     };
     let cell = simulated_cell(&robot, &Perturbation::default(), seed).unwrap();

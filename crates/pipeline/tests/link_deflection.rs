@@ -5,10 +5,10 @@
 //! file reads back, and the diagnosis names it beside a backlash, so that `--effects auto` reaches
 //! the noise too.
 
-use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell};
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel, joint_ranges, simulate, simulated_cell};
 use diagnose::{DiagnoseOptions, Effect, diagnose};
 use effects::{EffectSelection, IdentifiedEffect};
-use loadsim::{Backlash, BentLink, JointBacklash, LinkDeflection};
+use loadsim::{BacklashModel, BentLink, JointBacklash, LinkDeflectionModel};
 use measurements::MeasurementSet;
 use model::Method;
 use pipeline::FitOptions;
@@ -26,8 +26,8 @@ fn column_arm() -> RobotDescription {
 /// `EI ≈ 8e5 N·m²` and a stiffer direction. Under the UR10's 29 kg of the URDF this bends about
 /// as much as the 2.5 times stiffer column did under the heavier stand-in masses the test used
 /// before the URDF's masses were read (poe 0.24 mm held out against 0.09 mm at `EI ≈ 2e6`).
-fn column_bending() -> LinkDeflection {
-    LinkDeflection { links: vec![BentLink { joint_index: 0, flexibility_per_nm2: [1.25e-6, 7.5e-7] }] }
+fn column_bending() -> LinkDeflectionModel {
+    LinkDeflectionModel { links: vec![BentLink { joint_index: 0, flexibility_per_nm2: [1.25e-6, 7.5e-7] }] }
 }
 
 /// 400 poses with `effects` and the tracker's noise, position only: the first 250 to train on,
@@ -35,7 +35,7 @@ fn column_bending() -> LinkDeflection {
 fn split(robot: &RobotDescription, effects: &Effects, seed: u64) -> (MeasurementSet, MeasurementSet) {
     let cell = simulated_cell(robot, &Perturbation::default(), seed).unwrap();
     let config = GeneratorConfig { sample_count: 400, seed, ..GeneratorConfig::default() };
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..effects.clone() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..effects.clone() };
     let all = simulate(&cell, &effects, &joint_ranges(robot), &config, false).unwrap();
     (all.subset(&(0..250).collect::<Vec<_>>()), all.subset(&(250..400).collect::<Vec<_>>()))
 }
@@ -107,7 +107,7 @@ fn a_column_deflection_is_identified_down_to_the_noise_and_its_model_file_reads_
 fn the_diagnosis_names_the_column_deflection_beside_a_backlash_and_auto_reaches_the_noise() {
     let robot = column_arm();
     // A backlash of the shoulder (joint 3: the UR10's joint 2) of 0.1 mrad half band.
-    let backlash = Backlash { joints: vec![JointBacklash { joint_index: 2, half_band_rad: 1e-4 }] };
+    let backlash = BacklashModel { joints: vec![JointBacklash { joint_index: 2, half_band_rad: 1e-4 }] };
     let effects = Effects { deflection: Some(column_bending()), backlash: Some(backlash), ..Effects::default() };
     let (train, test) = split(&robot, &effects, 43);
     let floor = noise_floor(&robot, 43);

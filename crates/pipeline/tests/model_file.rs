@@ -104,7 +104,7 @@ fn a_gp_method_without_a_gp_is_refused() {
     let (mut model, _) = fitted(false);
     model.residual_gp = None;
     let (_, message) = refused(&text_of(&model));
-    assert!(message.contains("method poe-gp-load but the model has no GP compensation"), "{message}");
+    assert!(message.contains("method poe-gp-load but the model has no residual GP"), "{message}");
 }
 
 /// A fitted model's file with the first coordinate of its first translation set to `value`.
@@ -139,7 +139,7 @@ struct Version1 {
 struct Version1Compliance {
     base_model: poe::LocalPoe,
     gravity_m_per_s2: [f64; 3],
-    terms: Vec<effects::ComplianceTerm>,
+    terms: Vec<effects::ComplianceParameter>,
     theta: Vec<f64>,
 }
 
@@ -265,7 +265,24 @@ fn gp_training_data_that_overflow_its_weights_are_refused() {
     let end = first + text[first..].find(',').unwrap();
     let edited = format!("{}1e308{}", &text[..first], &text[end..]);
     let (_, message) = refused(&edited);
-    assert!(message.contains("compensation: part") && message.contains("gaussian_process"), "{message}");
+    assert!(message.contains("residual_gp: part") && message.contains("gaussian_process"), "{message}");
+}
+
+/// Files written before SPEC version 4 call the residual GP `compensation` (the word now means
+/// `calib compensate`'s joint targets alone): such a file reads as the same model, written back
+/// under the new name, and a refusal names the field as the file spells it.
+#[test]
+fn a_file_that_calls_the_residual_gp_compensation_reads_as_the_same_model() {
+    let (model, text) = fitted(false);
+    assert!(model.residual_gp.is_some() && text.contains("\n    residual_gp: ("), "{text}");
+    assert!(!text.contains("compensation"), "the old name is written again");
+    let old = text.replacen("\n    residual_gp: (", "\n    compensation: (", 1);
+    let read = model::parse_model(&old, "old.ron").unwrap();
+    assert_eq!(text_of(&read), text);
+    let (_, message) = refused(&old.replacen("with_payload: true", "with_payload: false", 1));
+    assert!(message.contains("compensation.with_payload is false for method poe-gp-load"), "{message}");
+    let (_, message) = refused(&text.replacen("with_payload: true", "with_payload: false", 1));
+    assert!(message.contains("residual_gp.with_payload is false for method poe-gp-load"), "{message}");
 }
 
 #[test]

@@ -4,8 +4,8 @@
 //! model written by `write_model` reads back with `read_model` and predicts the same poses.
 
 use campaign::{
-    Effects, GeneratorConfig, Perturbation, Remount, TrackerNoise, joint_ranges, paper_effects, payload_run_campaign,
-    simulate, simulate_campaign, simulated_cell,
+    Effects, GeneratorConfig, Perturbation, Remount, TrackerNoiseModel, joint_ranges, paper_effects,
+    payload_run_campaign, simulate, simulate_campaign, simulated_cell,
 };
 use effects::EffectSelection;
 use measurements::MeasurementSet;
@@ -24,7 +24,7 @@ struct Shape {
 const ROWS: usize = 100;
 
 fn shapes() -> Vec<Shape> {
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..paper_effects() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..paper_effects() };
     let iiwa = testkit::robot("iiwa7.ron");
     // The campaign of the issue: joints 1–2 moving, the others within 2 mrad of 0, four payload
     // runs with a tool each, measured torques; full pose and position only.
@@ -124,7 +124,7 @@ fn assert_rewritten_as_read(path: &std::path::Path, read: &model::CalibratedMode
 fn every_fixture_s_model_is_written_again_as_it_was_read() {
     let dir = tempfile::tempdir().unwrap();
     // Not every fixture has the stiffnesses the paper's compliance needs: noise alone.
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
     let mut fixtures: Vec<String> = std::fs::read_dir(testkit::robot_path(""))
         .unwrap()
         .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())

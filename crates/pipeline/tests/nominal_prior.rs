@@ -3,9 +3,9 @@
 //! (at its fitted base and tool placement), and `eval` says the rows lie outside the fitted range.
 //! The prior is never weaker than the nominal's tolerance against the residual a plain fit leaves.
 
-use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, simulate, simulated_cell};
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel, simulate, simulated_cell};
 use effects::EffectSelection;
-use loadsim::{Harmonic, JointRange, PeriodicError};
+use loadsim::{GearPeriodicModel, Harmonic, JointRange};
 use measurements::MeasurementSet;
 use model::{EvalReport, Method};
 use pipeline::FitOptions;
@@ -22,14 +22,14 @@ fn ur10() -> RobotDescription {
 /// geometry cannot hold. On one side of the wrist's singular angle the joint-5 term looks like an
 /// offset of that joint, which a plain fit takes into its links and carries, with the wrong sign,
 /// to the other side.
-fn gear_error() -> PeriodicError {
+fn gear_error() -> GearPeriodicModel {
     let harmonic = |joint_index: usize, order: f64, amplitude_rad: f64, phase_rad: f64| Harmonic {
         joint_index,
         order,
         amplitude_rad,
         phase_rad,
     };
-    PeriodicError {
+    GearPeriodicModel {
         harmonics: vec![harmonic(1, 2.0, 1e-3, 0.4), harmonic(2, 3.0, 6e-4, -1.2), harmonic(4, 1.0, 1e-3, 0.0)],
     }
 }
@@ -45,8 +45,11 @@ fn wrist(seed: u64, count: usize, flipped: bool) -> MeasurementSet {
     let turn = |lower_rad: f64, upper_rad: f64| JointRange { lower_rad, upper_rad };
     let wrist = if flipped { turn(-PI + 0.2, -0.2) } else { turn(0.2, PI - 0.2) };
     let ranges = [turn(-PI, PI), turn(-PI, 0.0), turn(-PI + 0.2, PI - 0.2), turn(-PI, PI), wrist, turn(-PI, PI)];
-    let effects =
-        Effects { periodic: Some(gear_error()), tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+    let effects = Effects {
+        periodic: Some(gear_error()),
+        tracker_noise: Some(TrackerNoiseModel::default()),
+        ..Effects::default()
+    };
     // Separate pose streams for the two sides; the cell (geometry, tool) is the seed's.
     let config = GeneratorConfig { sample_count: count, seed: seed + u64::from(flipped) * 1000, ..Default::default() };
     let mut set =
@@ -187,7 +190,7 @@ fn eval_splits_the_error_at_the_fitted_range_and_names_a_glitch_inside_it() {
 fn a_column_arms_clusters_are_its_branches_and_the_halves_of_its_column() {
     let robot = testkit::robot("column_arm.urdf");
     let geometry = Perturbation { translation_m: 1e-4, rotation_rad: 1e-4, ..Perturbation::default() };
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
     let ranges = campaign::joint_ranges(&robot);
     let config = GeneratorConfig { sample_count: 300, seed: 4, ..Default::default() };
     let data = simulate(&simulated_cell(&robot, &geometry, 4).unwrap(), &effects, &ranges, &config, false).unwrap();
@@ -218,7 +221,7 @@ fn a_column_arms_clusters_are_its_branches_and_the_halves_of_its_column() {
 fn outside_the_fitted_joints_eval_gives_the_error_the_geometrys_uncertainty_predicts() {
     let robot = testkit::robot("iiwa7.ron");
     let cell = simulated_cell(&robot, &Perturbation::default(), 7).unwrap();
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
     let turn = |lower_rad: f64, upper_rad: f64| JointRange { lower_rad, upper_rad };
     let outer = turn(-1.0, 1.0);
     let ranges = [turn(-2.0, 2.0), turn(-1.5, 1.5), outer, outer, outer, outer, outer];

@@ -2,9 +2,9 @@
 //! a half band in mm and its compliance is along the axis under the force, where a revolute
 //! joint's are in rad under a torque; the model file keeps SI units either way.
 
-use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell};
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel, joint_ranges, simulate, simulated_cell};
 use effects::IdentifiedEffect;
-use loadsim::{Backlash, JointBacklash};
+use loadsim::{BacklashModel, JointBacklash};
 use model::Method;
 use pipeline::FitOptions;
 
@@ -12,9 +12,9 @@ use pipeline::FitOptions;
 fn a_prismatic_joints_backlash_and_compliance_are_reported_in_mm_under_a_force() {
     // column_arm.urdf: joint 1 is the lifting column (prismatic), joint 3 the UR10's shoulder.
     let robot = testkit::robot("column_arm.urdf");
-    let backlash = Backlash { joints: vec![JointBacklash { joint_index: 2, half_band_rad: 1e-4 }] };
+    let backlash = BacklashModel { joints: vec![JointBacklash { joint_index: 2, half_band_rad: 1e-4 }] };
     let effects =
-        Effects { backlash: Some(backlash), tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+        Effects { backlash: Some(backlash), tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
     let cell = simulated_cell(&robot, &Perturbation::default(), 8).unwrap();
     let config = GeneratorConfig { sample_count: 200, seed: 8, ..GeneratorConfig::default() };
     let data = simulate(&cell, &effects, &joint_ranges(&robot), &config, false).unwrap();

@@ -4,10 +4,10 @@
 //! geometry alone cannot, its parameters are reported in mm, its model file reads back, a bad item
 //! is refused, and the diagnosis offers it only where the robot file states the pitch.
 
-use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell};
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel, joint_ranges, simulate, simulated_cell};
 use diagnose::{DiagnoseOptions, Effect, diagnose};
 use effects::{EffectSelection, IdentifiedEffect};
-use loadsim::{ScrewError, ScrewHarmonic};
+use loadsim::{ScrewHarmonic, ScrewPeriodicModel};
 use measurements::MeasurementSet;
 use model::Method;
 use pipeline::FitOptions;
@@ -15,7 +15,7 @@ use robot::RobotDescription;
 
 /// The column's screw: a 10 mm lead, 50 µm once per turn and 20 µm twice (a rolled screw's
 /// periodic deviation; ISO 3408-3 allows a ground class-10 screw 40 µm per turn).
-fn screw() -> ScrewError {
+fn screw() -> ScrewPeriodicModel {
     let harmonic = |order: f64, amplitude_m: f64, phase_rad: f64| ScrewHarmonic {
         joint_index: 0,
         pitch_m: 0.010,
@@ -23,14 +23,14 @@ fn screw() -> ScrewError {
         amplitude_m,
         phase_rad,
     };
-    ScrewError { harmonics: vec![harmonic(1.0, 50e-6, 0.4), harmonic(2.0, 20e-6, -1.1)] }
+    ScrewPeriodicModel { harmonics: vec![harmonic(1.0, 50e-6, 0.4), harmonic(2.0, 20e-6, -1.1)] }
 }
 
 /// 500 poses with `effects` and the tracker's noise, position only: 300 to train on, 200 held out.
 fn split(robot: &RobotDescription, effects: &Effects, seed: u64) -> (MeasurementSet, MeasurementSet) {
     let cell = simulated_cell(robot, &Perturbation::default(), seed).unwrap();
     let config = GeneratorConfig { sample_count: 500, seed, ..GeneratorConfig::default() };
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..effects.clone() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..effects.clone() };
     let all = simulate(&cell, &effects, &joint_ranges(robot), &config, false).unwrap();
     (all.subset(&(0..300).collect::<Vec<_>>()), all.subset(&(300..500).collect::<Vec<_>>()))
 }

@@ -7,9 +7,9 @@
 //! the span is nearer, and the hold is chosen. Either way the choice beats the other rule on the
 //! later session and `time_drift` (and `--effects auto`) is no worse than without it.
 
-use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell};
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel, joint_ranges, simulate, simulated_cell};
 use effects::{BeyondSpan, EffectSelection, IdentifiedEffect};
-use loadsim::BaseDrift;
+use loadsim::TimeDriftModel;
 use measurements::MeasurementSet;
 use model::Method;
 use pipeline::FitOptions;
@@ -22,8 +22,8 @@ const DAYS: [f64; 4] = [0.0, 1.0, 3.0, 8.0];
 /// session `k`: the first three joined to train on, the last to evaluate.
 fn campaign(robot: &RobotDescription, offsets_mm: [[f64; 3]; 4], seed: u64) -> (MeasurementSet, MeasurementSet) {
     let effects = Effects {
-        drift: Some(BaseDrift { twist_per_s: [2e-8, -1.5e-8, 1e-8, 0.0, 0.0, 0.0] }),
-        tracker_noise: Some(TrackerNoise::default()),
+        drift: Some(TimeDriftModel { twist_per_s: [2e-8, -1.5e-8, 1e-8, 0.0, 0.0, 0.0] }),
+        tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     };
     let cell = simulated_cell(robot, &Perturbation::default(), seed).unwrap();

@@ -2,7 +2,7 @@
 //! kept by the writer, weighting the identification, naming a row stated far above the rest, and
 //! setting the diagnosis's noise floor.
 
-use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell};
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel, joint_ranges, simulate, simulated_cell};
 use errors::ErrorKind;
 use measurements::{MeasurementSet, ReadOptions, StatedSigma, parse_measurements};
 use model::Method;
@@ -54,7 +54,7 @@ fn mixed_noise(rows: usize, noisy: usize, seed: u64) -> MeasurementSet {
     let cell = simulated_cell(&robot, &Perturbation::default(), seed).unwrap();
     let config = GeneratorConfig { sample_count: rows, seed, payloads_kg: vec![0.0], ..GeneratorConfig::default() };
     let quiet = Effects {
-        tracker_noise: Some(TrackerNoise {
+        tracker_noise: Some(TrackerNoiseModel {
             radial_sigma_m: 0.0,
             transverse_sigma_m: 0.0,
             transverse_sigma_per_m: 0.0,

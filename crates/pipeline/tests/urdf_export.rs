@@ -2,7 +2,7 @@
 //! 1e-9 m in the tracker and in the base frame; written like an existing URDF it keeps that file's
 //! links and their meaning; what it cannot hold is measured or refused.
 
-use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise};
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel};
 use cell::{UrdfTemplate, export_urdf};
 use errors::ErrorKind;
 use lie::{SE3, Vector3};
@@ -15,7 +15,7 @@ use robot::{ChainEnds, NominalTolerance, RobotDescription, UrdfDocument, in_base
 /// Tracker data of a perturbed `robot` (noise only, so every method fits).
 fn data(robot: &RobotDescription, rows: usize, full_pose: bool, seed: u64) -> MeasurementSet {
     let cell = campaign::simulated_cell(robot, &Perturbation::default(), seed).unwrap();
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
     let config = GeneratorConfig { sample_count: rows, seed, payloads_kg: vec![0.0], ..GeneratorConfig::default() };
     campaign::simulate(&cell, &effects, &campaign::joint_ranges(robot), &config, full_pose).unwrap()
 }

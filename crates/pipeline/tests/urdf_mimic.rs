@@ -7,20 +7,21 @@ mod mimic_common;
 use errors::ErrorKind;
 use lie::Vector3;
 use mimic_common::{assert_refused, chain, joint_by_joint, largest_difference, mimic_position, random_q, refusal};
+use poe::JointKind;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robot::{ChainEnds, JointType, RobotDescription, UrdfDocument};
+use robot::{ChainEnds, RobotDescription, UrdfDocument};
 
 #[test]
 fn the_column_arm_folds_its_three_column_stages_into_one_joint_of_scale_three() {
     let robot = testkit::robot("column_arm.urdf");
     assert_eq!(robot.joint_count(), 7);
     let column = &robot.joints[0];
-    assert_eq!(column.kind, JointType::Prismatic);
+    assert_eq!(column.kind, JointKind::Prismatic);
     assert!((column.scale - 3.0).abs() < 1e-12, "scale {}", column.scale);
     assert!((Vector3::from(column.axis) - Vector3::z()).norm() < 1e-12);
     assert_eq!(column.limits_m, Some((0.0, 0.8333333333333334)));
-    assert!(robot.joints[1..].iter().all(|j| j.kind == JointType::Revolute && j.scale == 1.0));
+    assert!(robot.joints[1..].iter().all(|j| j.kind == JointKind::Revolute && j.scale == 1.0));
     assert_eq!(robot.folded.len(), 1);
     let folded = &robot.folded[0];
     assert_eq!((folded.joint, folded.actuated.as_str()), (1, "lift"));
@@ -216,7 +217,7 @@ fn a_mimic_before_the_joint_it_follows_is_refused() {
 
 mod export {
     use super::*;
-    use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise};
+    use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel};
     use cell::{UrdfTemplate, export_urdf};
     use model::Method;
     use pipeline::FitOptions;
@@ -228,7 +229,7 @@ mod export {
         let text = std::fs::read_to_string(testkit::robot_path("column_arm.urdf")).unwrap();
         let robot = chain(&text, &ChainEnds::default()).description();
         let cell = campaign::simulated_cell(&robot, &Perturbation::default(), 7).unwrap();
-        let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+        let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
         let config =
             GeneratorConfig { sample_count: 150, seed: 7, payloads_kg: vec![0.0], ..GeneratorConfig::default() };
         let set = campaign::simulate(&cell, &effects, &campaign::joint_ranges(&robot), &config, true).unwrap();

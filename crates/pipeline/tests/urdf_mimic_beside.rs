@@ -6,7 +6,7 @@
 
 mod mimic_common;
 
-use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise};
+use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel};
 use cell::{UrdfTemplate, export_urdf};
 use errors::ErrorKind;
 use lie::Vector3;
@@ -14,10 +14,10 @@ use measurements::MeasurementSet;
 use mimic_common::{assert_refused, chain, joint_by_joint, largest_difference, random_q};
 use model::Method;
 use pipeline::FitOptions;
-use poe::LocalPoe;
+use poe::{JointKind, LocalPoe};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robot::{ChainEnds, JointType, NominalTolerance, RobotDescription, UrdfDocument};
+use robot::{ChainEnds, NominalTolerance, RobotDescription, UrdfDocument};
 
 fn shipped_text() -> String {
     std::fs::read_to_string(testkit::robot_path("column_arm_shipped.urdf")).unwrap()
@@ -64,7 +64,7 @@ fn the_shipped_column_folds_its_two_stages_into_one_joint_of_the_motor_beside_th
     let robot = testkit::robot("column_arm_shipped.urdf");
     assert_eq!(robot.joint_count(), 7);
     let column = &robot.joints[0];
-    assert_eq!(column.kind, JointType::Prismatic);
+    assert_eq!(column.kind, JointKind::Prismatic);
     // 0.5 + 0.5 per metre of the motor, along the column; the motor's limits.
     assert!((column.scale - 1.0).abs() < 1e-12, "scale {}", column.scale);
     assert!((Vector3::from(column.axis) - Vector3::z()).norm() < 1e-12);
@@ -101,7 +101,7 @@ fn the_shipped_column_arm_is_the_same_chain_folded_by_hand() {
 /// 50 to test.
 fn simulated(robot: &RobotDescription) -> (MeasurementSet, MeasurementSet) {
     let cell = campaign::simulated_cell(robot, &Perturbation::default(), 11).unwrap();
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
     let config = GeneratorConfig { sample_count: 200, seed: 11, payloads_kg: vec![0.0], ..GeneratorConfig::default() };
     let set = campaign::simulate(&cell, &effects, &campaign::joint_ranges(robot), &config, true).unwrap();
     let (train, test) = set.rows.split_at(150);

@@ -23,6 +23,14 @@ impl JointKind {
             JointKind::Prismatic => Twist::new(Vector3::z(), Vector3::zeros()),
         }
     }
+
+    /// The kind as a URDF names it (`revolute`, `prismatic`), and as a refusal names it.
+    pub fn name(self) -> &'static str {
+        match self {
+            JointKind::Revolute => "revolute",
+            JointKind::Prismatic => "prismatic",
+        }
+    }
 }
 
 /// A joint: the constant transform from the previous frame to this joint's frame at zero joint value,

@@ -9,10 +9,11 @@ use crate::content::{
 use crate::{Iso9283, RepeatOptions};
 use cell::CompensateOptions;
 use diagnose::Diagnosis;
-use effects::{GearPeriodic, IdentifiedEffect};
+use effects::{GearPeriodicTerm, IdentifiedEffect};
 use measurements::{BoundSet, MeasurementSet};
 use model::{CalibratedModel, ErrorSummary, EvalReport, Evaluation, GpModel, PoseError};
-use robot::{JointType, RobotDescription};
+use poe::JointKind;
+use robot::RobotDescription;
 use serde::Serialize;
 
 /// What the report is made of.
@@ -231,7 +232,7 @@ fn tools(data: &MeasurementSet) -> Vec<(String, usize)> {
 }
 
 fn is_prismatic(robot: &RobotDescription, joint: usize) -> bool {
-    robot.joints.get(joint).is_some_and(|j| j.kind == JointType::Prismatic)
+    robot.joints.get(joint).is_some_and(|j| j.kind == JointKind::Prismatic)
 }
 
 /// A joint value in the unit reports use: degrees, or mm for a prismatic joint.
@@ -247,7 +248,7 @@ fn robot_summary(robot: &RobotDescription, file: &str) -> RobotSummary {
             .joints
             .iter()
             .map(|j| match j.kind {
-                JointType::Prismatic => {
+                JointKind::Prismatic => {
                     JointSummary { kind: "prismatic", limits: j.limits_m.map(|(a, b)| [a * 1e3, b * 1e3]), unit: "mm" }
                 }
                 _ => JointSummary { kind: "revolute", limits: j.limits_deg.map(|(a, b)| [a, b]), unit: "deg" },
@@ -292,7 +293,7 @@ fn effect_view(
 }
 
 fn gear_curve(
-    gear: &GearPeriodic,
+    gear: &GearPeriodicTerm,
     data: &MeasurementSet,
     training: Option<&MeasurementSet>,
     options: &ReportOptions,

@@ -4,7 +4,7 @@
 use campaign::{Perturbation, Remount, campaign_cell, joint_ranges, payload_run_campaign, simulate};
 use diagnose::{DiagnoseOptions, diagnose};
 use effects::{EffectSelection, EffectSpec};
-use loadsim::{Effects, Harmonic, PeriodicError};
+use loadsim::{Effects, GearPeriodicModel, Harmonic};
 use measurements::MeasurementSet;
 use model::{EvalReport, Method};
 use pipeline::FitOptions;
@@ -25,7 +25,7 @@ fn rendered() -> &'static Rendered {
     RENDERED.get_or_init(|| {
         let robot = testkit::robot("irb4400.ron");
         let effects = Effects {
-            periodic: Some(PeriodicError {
+            periodic: Some(GearPeriodicModel {
                 harmonics: vec![
                     Harmonic { joint_index: 1, order: 1.0, amplitude_rad: 2e-4, phase_rad: 0.3 },
                     Harmonic { joint_index: 1, order: 2.0, amplitude_rad: 1e-4, phase_rad: -1.0 },

@@ -2,7 +2,7 @@
 //! `calib eval` does, and gives the numbers it gives for the same rows a turn back.
 
 use campaign::{GeneratorConfig, Perturbation, joint_ranges, simulate, simulated_cell};
-use loadsim::{Effects, TrackerNoise};
+use loadsim::{Effects, TrackerNoiseModel};
 use measurements::MeasurementSet;
 use model::Method;
 use pipeline::FitOptions;
@@ -15,7 +15,7 @@ fn rows_a_turn_away_are_reported_at_the_wrapped_angles() {
     // Joint 1 within ±170°: a turn on, every angle lies outside, within the ±360° limits.
     ranges[0].lower_rad = -170f64.to_radians();
     ranges[0].upper_rad = 170f64.to_radians();
-    let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..Effects::default() };
+    let effects = Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
     let config = GeneratorConfig { sample_count: 160, seed: 4, ..GeneratorConfig::default() };
     let all = simulate(&cell, &effects, &ranges, &config, true).unwrap();
     let train = all.subset(&(0..110).collect::<Vec<_>>());

@@ -7,21 +7,12 @@ use lie::{Matrix3, SE3, SO3, Vector3};
 use poe::{JointAxis, JointKind, LocalPoe};
 use serde::{Deserialize, Serialize};
 
-/// Whether a joint turns or slides, as written in the file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum JointType {
-    /// Rotation about the axis; limits in degrees.
-    Revolute,
-    /// Translation along the axis; limits in metres.
-    Prismatic,
-}
-
 /// One joint at the zero configuration, base frame.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct JointDescription {
-    /// Revolute or prismatic.
-    pub kind: JointType,
+    /// Revolute or prismatic, written `Revolute` or `Prismatic` in the file.
+    pub kind: JointKind,
     /// Unit direction of the axis.
     pub axis: [f64; 3],
     /// A point on the axis, metres.
@@ -150,10 +141,10 @@ pub struct RobotDescription {
 pub(crate) const MAX_LIMIT: [f64; 2] = [1e6, 1e3];
 
 /// The limit bound of a joint kind, SI, and its unit.
-pub(crate) fn limit_bound(kind: JointType) -> (f64, &'static str) {
+pub(crate) fn limit_bound(kind: JointKind) -> (f64, &'static str) {
     match kind {
-        JointType::Revolute => (MAX_LIMIT[0], "rad"),
-        JointType::Prismatic => (MAX_LIMIT[1], "m"),
+        JointKind::Revolute => (MAX_LIMIT[0], "rad"),
+        JointKind::Prismatic => (MAX_LIMIT[1], "m"),
     }
 }
 
@@ -173,8 +164,8 @@ impl RobotDescription {
         self.joints
             .iter()
             .map(|j| match (j.kind, j.limits_deg, j.limits_m) {
-                (JointType::Revolute, Some((lo, hi)), _) => (lo.to_radians(), hi.to_radians()),
-                (JointType::Prismatic, _, Some(limits)) => limits,
+                (JointKind::Revolute, Some((lo, hi)), _) => (lo.to_radians(), hi.to_radians()),
+                (JointKind::Prismatic, _, Some(limits)) => limits,
                 _ => (f64::NEG_INFINITY, f64::INFINITY),
             })
             .collect()
@@ -193,10 +184,7 @@ impl RobotDescription {
         self.joints
             .iter()
             .map(|joint| JointAxis {
-                kind: match joint.kind {
-                    JointType::Revolute => JointKind::Revolute,
-                    JointType::Prismatic => JointKind::Prismatic,
-                },
+                kind: joint.kind,
                 direction: Vector3::from(joint.axis).normalize(),
                 point: Vector3::from(joint.point),
             })

@@ -34,8 +34,7 @@ pub use bounds::{MAX_TRANSLATION_M, bad_translation};
 
 pub use base_frame::{NominalTolerance, axis_changes, check_nominal, in_base_frame, tracker_from_base};
 pub use description::{
-    FlangeDescription, FoldedJoint, JointDescription, JointType, MimicStage, RobotDescription, SCALE_BOUNDS,
-    scale_in_bounds,
+    FlangeDescription, FoldedJoint, JointDescription, MimicStage, RobotDescription, SCALE_BOUNDS, scale_in_bounds,
 };
 pub use robot_dh::{DhTable, DhTableRow};
 pub use urdf_chain::{ChainEnds, UrdfChain, UrdfDocument};

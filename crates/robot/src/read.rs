@@ -4,10 +4,11 @@
 use crate::description::limit_bound;
 use crate::robot_dh::DhTable;
 use crate::urdf_chain::{ChainEnds, UrdfDocument};
-use crate::{FlangeDescription, JointDescription, JointType, RobotDescription, SCALE_BOUNDS, scale_in_bounds};
+use crate::{FlangeDescription, JointDescription, RobotDescription, SCALE_BOUNDS, scale_in_bounds};
 use errors::ron_position::{field_position, ron_options};
 use errors::{Error, ErrorKind};
 use lie::Vector3;
+use poe::JointKind;
 use serde::Deserialize;
 use std::path::Path;
 
@@ -136,7 +137,7 @@ impl RobotDescription {
             if let Some(pitch) = joint.pitch_mm {
                 let before = self.joints[..i].iter().filter(|j| j.pitch_mm.is_some()).count();
                 let (lo, hi) = errors::PITCH_BOUNDS_MM;
-                if joint.kind != JointType::Prismatic {
+                if joint.kind != JointKind::Prismatic {
                     let message = format!(
                         "joint {}: pitch_mm is a linear axis's screw lead, and joint {} is {:?}",
                         i + 1,
@@ -160,12 +161,12 @@ impl RobotDescription {
                 return Err(at("point", i, message));
             }
             let (limits, field, index) = match joint.kind {
-                JointType::Revolute => (joint.limits_deg, "limits_deg", &mut deg_index),
-                JointType::Prismatic => (joint.limits_m, "limits_m", &mut m_index),
+                JointKind::Revolute => (joint.limits_deg, "limits_deg", &mut deg_index),
+                JointKind::Prismatic => (joint.limits_m, "limits_m", &mut m_index),
             };
             let other = match joint.kind {
-                JointType::Revolute => joint.limits_m.map(|_| "limits_m"),
-                JointType::Prismatic => joint.limits_deg.map(|_| "limits_deg"),
+                JointKind::Revolute => joint.limits_m.map(|_| "limits_m"),
+                JointKind::Prismatic => joint.limits_deg.map(|_| "limits_deg"),
             };
             if let Some(other) = other {
                 return Err(at("kind", i, format!("joint {}: {other} does not fit a {:?} joint", i + 1, joint.kind)));
@@ -181,7 +182,7 @@ impl RobotDescription {
                 }
                 Some((lo, hi)) => {
                     let (bound, unit) = limit_bound(joint.kind);
-                    let si = if joint.kind == JointType::Revolute { 1f64.to_radians() } else { 1.0 };
+                    let si = if joint.kind == JointKind::Revolute { 1f64.to_radians() } else { 1.0 };
                     if lo.abs().max(hi.abs()) * si > bound {
                         return Err(at(
                             field,

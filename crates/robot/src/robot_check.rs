@@ -78,18 +78,18 @@ const SAME_LINE_TOLERANCE: [f64; 2] = [1e-9, 1e-9];
 /// the other, so their columns of the identification Jacobian are equal at every pose and their
 /// values cannot be told apart (issue 31: "the singularity threshold is too strict"). 1-based.
 pub(crate) fn repeated_axis(robot: &RobotDescription) -> Option<(usize, usize)> {
-    use crate::description::JointType;
     use lie::Vector3;
+    use poe::JointKind;
     let [angle, distance] = SAME_LINE_TOLERANCE;
     robot.joints.windows(2).enumerate().find_map(|(i, pair)| {
         let (a, b) = (&pair[0], &pair[1]);
         let (da, db) = (Vector3::from(a.axis).normalize(), Vector3::from(b.axis).normalize());
         let parallel = da.cross(&db).norm() <= angle;
         let same = match (a.kind, b.kind) {
-            (JointType::Revolute, JointType::Revolute) => {
+            (JointKind::Revolute, JointKind::Revolute) => {
                 parallel && (Vector3::from(b.point) - Vector3::from(a.point)).cross(&da).norm() <= distance
             }
-            (JointType::Prismatic, JointType::Prismatic) => parallel,
+            (JointKind::Prismatic, JointKind::Prismatic) => parallel,
             _ => false,
         };
         same.then_some((i + 1, i + 2))
@@ -100,10 +100,10 @@ pub(crate) fn repeated_axis(robot: &RobotDescription) -> Option<(usize, usize)> 
 /// joint across it, so the tool point moves in a plane and 3-D positions cannot be drawn (a
 /// simulation) or its out-of-plane placement identified. `None` for a spatial chain.
 pub(crate) fn planar_direction(robot: &RobotDescription) -> Option<[f64; 3]> {
-    use crate::description::JointType;
     use lie::Vector3;
+    use poe::JointKind;
     let [angle, _] = SAME_LINE_TOLERANCE;
-    let first = robot.joints.iter().find(|j| j.kind == JointType::Revolute)?;
+    let first = robot.joints.iter().find(|j| j.kind == JointKind::Revolute)?;
     let d = Vector3::from(first.axis).normalize();
     robot
         .joints
@@ -111,8 +111,8 @@ pub(crate) fn planar_direction(robot: &RobotDescription) -> Option<[f64; 3]> {
         .all(|j| {
             let axis = Vector3::from(j.axis).normalize();
             match j.kind {
-                JointType::Revolute => axis.cross(&d).norm() <= angle,
-                JointType::Prismatic => axis.dot(&d).abs() <= angle,
+                JointKind::Revolute => axis.cross(&d).norm() <= angle,
+                JointKind::Prismatic => axis.dot(&d).abs() <= angle,
             }
         })
         .then_some([d.x, d.y, d.z])
@@ -132,7 +132,7 @@ pub(crate) fn check_chain(robot: &RobotDescription, text: Option<&str>, file: &s
         ErrorKind::RepeatedJointAxis {
             first,
             second,
-            revolute: joint.kind == crate::description::JointType::Revolute,
+            revolute: joint.kind == poe::JointKind::Revolute,
             axis: joint.axis,
             point: joint.point,
         },

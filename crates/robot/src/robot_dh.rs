@@ -4,7 +4,7 @@
 //! standard DH, frame `i` in modified DH) and passes through that frame's origin; the flange, unless
 //! the file gives one, is the last DH frame.
 
-use crate::description::{FlangeDescription, JointDescription, JointType};
+use crate::description::{FlangeDescription, JointDescription};
 use errors::ron_position::field_position;
 use errors::{Error, ErrorKind};
 use poe::{DhConvention, DhRow, JointKind, LocalPoe};
@@ -27,7 +27,7 @@ pub struct DhTable {
 #[serde(deny_unknown_fields)]
 pub struct DhTableRow {
     /// Revolute or prismatic.
-    pub kind: JointType,
+    pub kind: JointKind,
     /// Link length `a`, metres.
     pub a_m: f64,
     /// Link twist `α`, degrees (or give `alpha_rad`).
@@ -93,11 +93,7 @@ impl DhTable {
                 if ![row.a_m, row.d_m, alpha, theta].iter().all(|v| v.is_finite()) {
                     return Err(at(i, "a_m, d_m, alpha and theta must be finite".into()));
                 }
-                let kind = match row.kind {
-                    JointType::Revolute => JointKind::Revolute,
-                    JointType::Prismatic => JointKind::Prismatic,
-                };
-                Ok(DhRow { kind, a: row.a_m, alpha, d: row.d_m, theta })
+                Ok(DhRow { kind: row.kind, a: row.a_m, alpha, d: row.d_m, theta })
             })
             .collect()
     }

@@ -15,9 +15,10 @@ use crate::urdf_mimic::{ChainJoint, OffChain, fold, folded_joint};
 use crate::urdf_model::{UrdfJoint, UrdfJointType, UrdfRobot, read_robot};
 use crate::urdf_steps::{ChainStep, StepMimic, StepMotion};
 use crate::xml_outline::{Element, Position, outline};
-use crate::{FlangeDescription, JointDescription, JointType, RobotDescription};
+use crate::{FlangeDescription, JointDescription, RobotDescription};
 use errors::{Error, ErrorKind};
 use lie::{SE3, SO3, Vector3};
+use poe::JointKind;
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
@@ -419,11 +420,8 @@ impl UrdfDocument {
             if !(lower.is_finite() && upper.is_finite() && lower < upper) {
                 return Err(format!("limits lower {lower} upper {upper} must be finite and increasing"));
             }
-            let kind = if joint.joint_type == UrdfJointType::Prismatic {
-                crate::JointType::Prismatic
-            } else {
-                crate::JointType::Revolute
-            };
+            let kind =
+                if joint.joint_type == UrdfJointType::Prismatic { JointKind::Prismatic } else { JointKind::Revolute };
             let (bound, unit) = crate::description::limit_bound(kind);
             if lower.abs().max(upper.abs()) > bound {
                 return Err(format!(
@@ -554,9 +552,9 @@ impl UrdfChain {
             let (kind, limits_deg, limits_m) = match step.motion {
                 StepMotion::Fixed => continue,
                 StepMotion::Revolute { limits_rad } => {
-                    (JointType::Revolute, limits_rad.map(|(lo, hi)| (lo.to_degrees(), hi.to_degrees())), None)
+                    (JointKind::Revolute, limits_rad.map(|(lo, hi)| (lo.to_degrees(), hi.to_degrees())), None)
                 }
-                StepMotion::Prismatic { limits_m } => (JointType::Prismatic, None, Some(limits_m)),
+                StepMotion::Prismatic { limits_m } => (JointKind::Prismatic, None, Some(limits_m)),
             };
             joints.push(JointDescription {
                 kind,

@@ -4,8 +4,8 @@
 use crate::robot::{iiwa7, irb4400, with_tool};
 use lie::{SE3, Vector3};
 use loadsim::{
-    Effects, Error, GeneratorConfig, JointCompliance, JointRange, Payload, SimulatedCell, TorqueSensorNoise, generate,
-    static_torque,
+    Effects, Error, GeneratorConfig, JointComplianceModel, JointRange, Payload, SimulatedCell, TorqueSensorNoise,
+    generate, static_torque,
 };
 
 /// The iiwa 7 with four tools: the probe remounted 1 mm further out along the flange z each time.
@@ -98,7 +98,7 @@ fn measured_torques_are_the_drive_torques_holding_the_static_torque_within_the_s
         torque_sensor: Some(TorqueSensorNoise { sigma_nm: 0.0, ..Default::default() }),
         ..two_joint_runs()
     };
-    let effects = Effects { compliance: Some(JointCompliance::default()), ..Effects::default() };
+    let effects = Effects { compliance: Some(JointComplianceModel::default()), ..Effects::default() };
     let samples = generate(&cell, &effects, &ranges, &exact).unwrap();
     let dynamics = cell.dynamics.clone().unwrap();
     for s in &samples {

@@ -3,15 +3,15 @@
 
 use crate::robot::{iiwa7, irb4400, random_q, with_tool};
 use loadsim::{
-    CouplingFactor, CouplingTerm, EffectKind, Effects, Error, Harmonic, JointCoupling, Payload, PeriodicError,
+    CouplingFactor, CouplingModel, CouplingTerm, EffectKind, Effects, Error, GearPeriodicModel, Harmonic, Payload,
     PoseContext, RobotDynamics, SimulatedCell, gravity_torque, periodic_joint_regressor, tilted_base_gravity,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// Joint 3's error driven by q2 and q4 (0-based 2 by 1 and 3).
-fn joint3_by_q2_q4(amplitude_rad: f64) -> JointCoupling {
-    JointCoupling {
+fn joint3_by_q2_q4(amplitude_rad: f64) -> CouplingModel {
+    CouplingModel {
         terms: vec![CouplingTerm {
             joint_index: 2,
             amplitude_rad,
@@ -99,7 +99,7 @@ fn a_gear_error_of_order_forty_with_any_phase_on_joint_1_is_its_cos_sin_regresso
             phase_rad: rng.random_range(0.0..std::f64::consts::TAU),
         })
         .collect();
-    let effects = Effects { periodic: Some(PeriodicError { harmonics: harmonics.clone() }), ..Effects::default() };
+    let effects = Effects { periodic: Some(GearPeriodicModel { harmonics: harmonics.clone() }), ..Effects::default() };
     for _ in 0..20 {
         let q = random_q(&robot.ranges, &mut rng);
         let offsets = effects.joint_offsets(&cell, &q, &PoseContext::default()).unwrap();

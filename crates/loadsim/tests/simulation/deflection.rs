@@ -3,7 +3,7 @@
 
 use crate::robot::{irb4400, massless, random_q, with_tool};
 use lie::Vector3;
-use loadsim::{Effects, JointCompliance, Payload, PoseContext, SimulatedCell, compliance_deflection};
+use loadsim::{Effects, JointComplianceModel, Payload, PoseContext, SimulatedCell, compliance_deflection};
 use poe::LocalPoe;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -13,7 +13,7 @@ use rand_chacha::ChaCha8Rng;
 const STIFFNESS: [f64; 6] = [3e5, 3e5, 3e5, 1e5, 1e5, 1e5];
 const PAYLOAD_KG: f64 = 7.5;
 
-fn tool_displacement(cell: &SimulatedCell, q: &[f64], settings: JointCompliance) -> Vector3 {
+fn tool_displacement(cell: &SimulatedCell, q: &[f64], settings: JointComplianceModel) -> Vector3 {
     let effects = Effects { compliance: Some(settings), ..Effects::default() };
     let context = PoseContext { payload: Payload::at_tool(PAYLOAD_KG), ..PoseContext::default() };
     effects.true_pose(cell, q, &context).unwrap().translation() - cell.robot.forward(q, 0).unwrap().translation()
@@ -32,7 +32,8 @@ fn zero_configuration_sag_matches_the_hand_lever_arm_calculation() {
     let d3 = w * 1.22 / 3e5;
     let d5 = w * 0.34 / 1e5;
     let by_hand = Vector3::new(d2 * 1.04 + d3 * 0.15, 0.0, -(d2 * 1.22 + d3 * 1.22 + d5 * 0.34));
-    let computed = tool_displacement(&cell, &[0.0; 6], JointCompliance { payload_only: true, ..Default::default() });
+    let computed =
+        tool_displacement(&cell, &[0.0; 6], JointComplianceModel { payload_only: true, ..Default::default() });
     println!("zero-configuration sag: by hand {:.4} mm, model {:.4} mm", by_hand.norm() * 1e3, computed.norm() * 1e3);
     // Second-order terms (δ² · l ≈ 1e-7 m) are all that separates them.
     assert!((computed - by_hand).norm() < 5e-7, "{computed:?} vs {by_hand:?}");
@@ -72,7 +73,8 @@ fn mean_payload_deflection_over_random_poses_is_half_a_millimetre_and_matches_en
     let (mut sum_model, mut sum_energy, mut worst_relative) = (0.0, 0.0, 0.0_f64);
     for _ in 0..poses {
         let q = random_q(&robot.ranges, &mut rng);
-        let first_order = tool_displacement(&cell, &q, JointCompliance { payload_only: true, ..Default::default() });
+        let first_order =
+            tool_displacement(&cell, &q, JointComplianceModel { payload_only: true, ..Default::default() });
         let theta = energy_minimum(&model, &q);
         let energy = model.forward(&theta, 0).unwrap().translation() - model.forward(&q, 0).unwrap().translation();
         worst_relative = worst_relative.max((first_order - energy).norm() / energy.norm());
@@ -97,7 +99,7 @@ fn fixed_point_iterations_reach_the_energy_minimum() {
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     for _ in 0..10 {
         let q = random_q(&robot.ranges, &mut rng);
-        let settings = JointCompliance { payload_only: true, fixed_point_iterations: 5 };
+        let settings = JointComplianceModel { payload_only: true, fixed_point_iterations: 5 };
         let dq = compliance_deflection(&model, &dynamics, &q, 0, &Payload::at_tool(PAYLOAD_KG), &settings).unwrap();
         let theta = energy_minimum(&model, &q);
         for j in 0..6 {
@@ -111,7 +113,7 @@ fn deflection_is_proportional_to_payload_and_inverse_to_stiffness() {
     let robot = irb4400();
     let model = with_tool(&robot.model, 0.2);
     let q = [0.4, 0.3, -0.2, 0.8, 0.9, 0.1];
-    let settings = JointCompliance { payload_only: true, ..Default::default() };
+    let settings = JointComplianceModel { payload_only: true, ..Default::default() };
     let soft = massless(STIFFNESS.to_vec());
     let stiff = massless(STIFFNESS.iter().map(|k| 2.0 * k).collect());
     let base = compliance_deflection(&model, &soft, &q, 0, &Payload::at_tool(5.0), &settings).unwrap();

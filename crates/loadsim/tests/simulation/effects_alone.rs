@@ -3,7 +3,8 @@
 use crate::robot::{irb4400, pose_error, random_q, with_tool};
 use lie::{SE3, SO3, Vector3};
 use loadsim::{
-    Backlash, EffectKind, Effects, Payload, PoseContext, SimulatedCell, ThermalGrowth, TrackerNoise, static_torque,
+    BacklashModel, EffectKind, Effects, Payload, PoseContext, SimulatedCell, ThermalModel, TrackerNoiseModel,
+    static_torque,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -28,7 +29,7 @@ fn thermal_growth_alone_scales_the_tool_position_about_the_base_by_one_plus_alph
     let cell = fixture_cell();
     let alpha = 12e-6;
     let effects =
-        Effects { thermal: Some(ThermalGrowth { expansion_per_k: alpha, ..Default::default() }), ..Default::default() };
+        Effects { thermal: Some(ThermalModel { expansion_per_k: alpha, ..Default::default() }), ..Default::default() };
     let mut rng = ChaCha8Rng::seed_from_u64(30);
     for _ in 0..10 {
         let q = random_q(&irb4400().ranges, &mut rng);
@@ -48,7 +49,7 @@ fn backlash_alone_flips_with_the_sign_of_the_joint_torque() {
     let cell = fixture_cell();
     let dynamics = cell.dynamics.clone().unwrap();
     let b = 1e-4;
-    let effects = Effects { backlash: Some(Backlash::uniform(6, b)), ..Default::default() };
+    let effects = Effects { backlash: Some(BacklashModel::uniform(6, b)), ..Default::default() };
     let context = PoseContext::default();
     let mut rng = ChaCha8Rng::seed_from_u64(31);
     let (mut positive, mut negative) = (0, 0);
@@ -104,7 +105,7 @@ fn tracker_noise_alone_has_the_stated_radial_transverse_and_angular_spread() {
     let mut cell = fixture_cell();
     // Tracker 3 m in front of the robot, looking back at it.
     cell.tracker_from_base = SE3::new(SO3::from_rpy(0.0, 0.0, std::f64::consts::PI), Vector3::new(3.0, 0.0, -0.5));
-    let noise = TrackerNoise::default();
+    let noise = TrackerNoiseModel::default();
     let effects = Effects { tracker_noise: Some(noise), ..Default::default() };
     let q = [0.0, 0.3, -0.2, 0.0, 0.5, 0.0];
     let truth = effects.true_pose(&cell, &q, &PoseContext::default()).unwrap();

@@ -2,7 +2,7 @@
 //! claim.
 
 use crate::robot::{iiwa7, irb4400, random_q, with_tool};
-use loadsim::{Effects, JointCompliance, Payload, PoseContext, RobotDynamics, SimulatedCell, gravity_torque};
+use loadsim::{Effects, JointComplianceModel, Payload, PoseContext, RobotDynamics, SimulatedCell, gravity_torque};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -36,7 +36,7 @@ fn iiwa7_joint_2_deflection_under_five_kilograms_is_reported() {
         }
     }
     let cell = SimulatedCell::new(with_tool(&robot.model, 0.1), Some(dynamics));
-    let effects = Effects { compliance: Some(JointCompliance::default()), ..Effects::default() };
+    let effects = Effects { compliance: Some(JointComplianceModel::default()), ..Effects::default() };
     let context = PoseContext { payload: Payload::at_tool(5.0), ..PoseContext::default() };
     let q = [0.0, std::f64::consts::FRAC_PI_2, 0.0, 0.0, 0.0, 0.0, 0.0];
     let moved = effects.true_pose(&cell, &q, &context).unwrap().translation();
@@ -78,8 +78,8 @@ fn irb4400_compliance_deflection_magnitudes_are_reported() {
         let q = random_q(&robot.ranges, &mut rng);
         let nominal = cell.robot.forward(&q, 0).unwrap().translation();
         for (settings, sum) in [
-            (JointCompliance { payload_only: true, ..Default::default() }, &mut payload_only),
-            (JointCompliance::default(), &mut everything),
+            (JointComplianceModel { payload_only: true, ..Default::default() }, &mut payload_only),
+            (JointComplianceModel::default(), &mut everything),
         ] {
             let effects = Effects { compliance: Some(settings), ..Effects::default() };
             *sum += (effects.true_pose(&cell, &q, &context).unwrap().translation() - nominal).norm();

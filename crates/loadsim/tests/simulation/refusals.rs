@@ -2,8 +2,8 @@
 
 use crate::robot::{irb4400, massless};
 use loadsim::{
-    Backlash, Counterbalance, Effects, Error, GeneratorConfig, JointCompliance, JointRange, Payload, PoseContext,
-    SimulatedCell, ThermalGrowth, gravity_torque, sample_configurations,
+    BacklashModel, Counterbalance, Effects, Error, GeneratorConfig, JointComplianceModel, JointRange, Payload,
+    PoseContext, SimulatedCell, ThermalModel, gravity_torque, sample_configurations,
 };
 
 #[test]
@@ -34,7 +34,7 @@ fn negative_payload_is_refused() {
 fn backlash_on_a_joint_the_robot_lacks_is_refused() {
     let robot = irb4400();
     let cell = SimulatedCell::new(robot.model, Some(robot.dynamics));
-    let mut backlash = Backlash::uniform(6, 1e-5);
+    let mut backlash = BacklashModel::uniform(6, 1e-5);
     backlash.joints[2].joint_index = 6;
     let effects = Effects { backlash: Some(backlash), ..Effects::default() };
     let refused = effects.true_pose(&cell, &[0.0; 6], &PoseContext::default()).unwrap_err();
@@ -44,7 +44,7 @@ fn backlash_on_a_joint_the_robot_lacks_is_refused() {
 #[test]
 fn compliance_without_dynamics_is_refused() {
     let cell = SimulatedCell::new(irb4400().model, None);
-    let effects = Effects { compliance: Some(JointCompliance::default()), ..Effects::default() };
+    let effects = Effects { compliance: Some(JointComplianceModel::default()), ..Effects::default() };
     let refused = effects.true_pose(&cell, &[0.0; 6], &PoseContext::default()).unwrap_err();
     assert_eq!(refused, Error::MissingDynamics { effect: "joint compliance" });
 }
@@ -54,12 +54,12 @@ fn compliance_on_masses_without_stiffness_is_refused_and_what_needs_masses_alone
     let robot = irb4400();
     let dynamics = loadsim::RobotDynamics { stiffness_nm_per_rad: Vec::new(), ..robot.dynamics.clone() };
     let cell = SimulatedCell::new(robot.model, Some(dynamics));
-    let effects = Effects { compliance: Some(JointCompliance::default()), ..Effects::default() };
+    let effects = Effects { compliance: Some(JointComplianceModel::default()), ..Effects::default() };
     let q = [0.1, 0.3, -0.2, 0.0, 0.4, 0.0];
     let refused = effects.true_pose(&cell, &q, &PoseContext::default()).unwrap_err();
     assert_eq!(refused, Error::MissingStiffness { effect: "joint compliance" });
     assert!(refused.to_string().contains("stiffness_nm_per_rad"), "{refused}");
-    let backlash = Effects { backlash: Some(Backlash::uniform(6, 1e-4)), ..Effects::default() };
+    let backlash = Effects { backlash: Some(BacklashModel::uniform(6, 1e-4)), ..Effects::default() };
     let moved = backlash.true_pose(&cell, &q, &PoseContext::default()).unwrap();
     let still = Effects::default().true_pose(&cell, &q, &PoseContext::default()).unwrap();
     assert!((moved.translation() - still.translation()).norm() > 1e-5, "the backlash did not act");
@@ -75,7 +75,7 @@ fn wrong_joint_count_is_refused() {
 #[test]
 fn thermal_coefficients_of_the_wrong_length_are_refused() {
     let cell = SimulatedCell::new(irb4400().model, None);
-    let thermal = ThermalGrowth { link_expansion_per_k: vec![1e-5; 6], ..Default::default() };
+    let thermal = ThermalModel { link_expansion_per_k: vec![1e-5; 6], ..Default::default() };
     let effects = Effects { thermal: Some(thermal), ..Effects::default() };
     let refused = effects.true_pose(&cell, &[0.0; 6], &PoseContext::default()).unwrap_err();
     assert_eq!(refused, Error::LengthMismatch { field: "thermal.link_expansion_per_k", given: 6, expected: 7 });

@@ -5,9 +5,9 @@
 use crate::robot::{irb4400, pose_error, random_q, with_tool};
 use lie::{SE3, SO3, Twist, Vector3, Vector6};
 use loadsim::{
-    Backlash, BaseDrift, Effects, Harmonic, JointCompliance, Payload, PeriodicError, PoseContext, RegressorColumn,
-    RobotDynamics, SimulatedCell, ThermalGrowth, backlash_regressor, compliance_regressor, drift_regressor,
-    periodic_regressor, static_torque, thermal_regressor,
+    BacklashModel, Effects, GearPeriodicModel, Harmonic, JointComplianceModel, Payload, PoseContext, RegressorColumn,
+    RobotDynamics, SimulatedCell, ThermalModel, TimeDriftModel, backlash_regressor, compliance_regressor,
+    drift_regressor, periodic_regressor, static_torque, thermal_regressor,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -36,7 +36,7 @@ fn compliance_regressor_predicts_the_compliance_pose_error() {
     // 100× stiffer than the fixture so that the second-order remainder is 1e-5 of the effect.
     let dynamics = stiff(&robot.dynamics, 100.0);
     let cell = SimulatedCell::new(model.clone(), Some(dynamics.clone()));
-    let effects = Effects { compliance: Some(JointCompliance::default()), ..Effects::default() };
+    let effects = Effects { compliance: Some(JointComplianceModel::default()), ..Effects::default() };
     let mut rng = ChaCha8Rng::seed_from_u64(20);
     for _ in 0..20 {
         let q = random_q(&robot.ranges, &mut rng);
@@ -55,7 +55,7 @@ fn backlash_regressor_predicts_the_backlash_pose_error() {
     let robot = irb4400();
     let cell = SimulatedCell::new(robot.model.clone(), Some(robot.dynamics.clone()));
     let half_bands = [3e-6, 5e-6, 4e-6, 8e-6, 6e-6, 7e-6];
-    let backlash = Backlash {
+    let backlash = BacklashModel {
         joints: half_bands
             .iter()
             .enumerate()
@@ -83,7 +83,7 @@ fn periodic_regressor_predicts_the_gear_error_pose_error_per_harmonic() {
         Harmonic { joint_index: 1, order: 3.0, amplitude_rad: 1e-5, phase_rad: -1.1 },
         Harmonic { joint_index: 4, order: 2.0, amplitude_rad: 3e-5, phase_rad: 2.0 },
     ];
-    let effects = Effects { periodic: Some(PeriodicError { harmonics: harmonics.clone() }), ..Effects::default() };
+    let effects = Effects { periodic: Some(GearPeriodicModel { harmonics: harmonics.clone() }), ..Effects::default() };
     let mut rng = ChaCha8Rng::seed_from_u64(22);
     for _ in 0..20 {
         let q = random_q(&robot.ranges, &mut rng);
@@ -103,7 +103,7 @@ fn thermal_regressor_is_exact_per_link() {
     let model = with_tool(&robot.model, 0.2);
     let cell = SimulatedCell::new(model.clone(), None);
     let alphas = vec![11e-6, 12e-6, 23e-6, 13e-6, 17e-6, 9e-6, 20e-6];
-    let thermal = ThermalGrowth { reference_temp_c: 20.0, expansion_per_k: 0.0, link_expansion_per_k: alphas.clone() };
+    let thermal = ThermalModel { reference_temp_c: 20.0, expansion_per_k: 0.0, link_expansion_per_k: alphas.clone() };
     let effects = Effects { thermal: Some(thermal), ..Effects::default() };
     let mut rng = ChaCha8Rng::seed_from_u64(23);
     for _ in 0..20 {
@@ -124,7 +124,7 @@ fn drift_regressor_is_exact_in_the_tracker_frame() {
     let robot = irb4400();
     let mut cell = SimulatedCell::new(robot.model.clone(), None);
     cell.tracker_from_base = SE3::new(SO3::from_rpy(0.1, -0.2, 2.5), Vector3::new(3.0, -1.0, 0.4));
-    let drift = BaseDrift { twist_per_s: [3e-9, -1e-9, 2e-9, 1e-9, -2e-9, 4e-9] };
+    let drift = TimeDriftModel { twist_per_s: [3e-9, -1e-9, 2e-9, 1e-9, -2e-9, 4e-9] };
     let effects = Effects { drift: Some(drift), ..Effects::default() };
     let q = [0.2, 0.3, -0.1, 0.5, 0.6, -0.7];
     for t_s in [0.0, 600.0, 7200.0, 36000.0] {
