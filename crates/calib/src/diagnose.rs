@@ -1,5 +1,6 @@
 //! `calib diagnose`: where the geometric model misses, which effect explains it, how far it shrinks.
 
+use crate::args::{DataArgs, JsonFlag};
 use diagnose::{DiagnoseOptions, diagnose};
 use measurements::ReadOptions;
 use std::path::PathBuf;
@@ -9,15 +10,10 @@ use std::path::PathBuf;
 pub struct Args {
     #[command(flatten)]
     robot: crate::robot_args::RobotArgs,
-    /// Measurements (SPEC CSV; `;` and decimal commas are detected).
-    #[arg(long)]
-    data: PathBuf,
-    /// Other headers mapped onto the SPEC's column names: NAME=HEADER,… (e.g. x_mm="X [mm]",qw=Q0).
-    #[arg(long)]
-    columns: Option<measurements::ColumnMap>,
-    /// Print one JSON object on stdout instead of the summary.
-    #[arg(long)]
-    json: bool,
+    #[command(flatten)]
+    data: DataArgs,
+    #[command(flatten)]
+    json: JsonFlag,
     /// The instrument's noise per axis, mm, if known (otherwise from repeated poses, or a laser
     /// tracker's default, as the report says).
     #[arg(long)]
@@ -39,10 +35,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     {
         return Err(format!("--noise-mm must be a positive number of millimetres, got {noise}").into());
     }
-    let inputs = measurements::InputFiles::new().with("--robot", &args.robot.robot).with("--data", &args.data);
+    let inputs = measurements::InputFiles::new().with("--robot", &args.robot.robot).with("--data", &args.data.data);
     let robot = args.robot.read()?;
-    let read = ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
-    let data = measurements::read_measurements(&args.data, &read)?;
+    let data = args.data.read(ReadOptions::for_joints(robot.joint_kinds()))?;
     let options =
         DiagnoseOptions { folds: args.folds, seed: args.seed, noise_mm: args.noise_mm, ..DiagnoseOptions::default() };
     let diagnosis = diagnose(&robot, &data, &options)?;
@@ -51,7 +46,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         .as_deref()
         .map(|folder| ::report::write_diagnosis_report(&diagnosis, folder, "--report", &inputs))
         .transpose()?;
-    if args.json {
+    if args.json.json {
         println!("{}", diagnosis.to_json()?);
         eprintln!("{}", data.read_summary());
     } else {
