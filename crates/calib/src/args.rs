@@ -1,10 +1,14 @@
 //! The argument groups the subcommands share, each with one help text and the one call that reads
-//! what it names: `--data` with `--columns` (every subcommand that reads measurements), `--columns`
+//! what it names: `--data` with `--columns` (every subcommand that reads measurements), with
+//! `--robot` before it (`fit`, `diagnose`) or `--model` (`eval`, `predict`, `register`), `--columns`
 //! alone (where the file has another flag: `compensate --targets`, `plan --candidates`), `--model`
 //! and `--json`. `--robot` and its chain's ends are in `robot_args`.
 
+use crate::robot_args::RobotArgs;
 use errors::Error;
 use measurements::{ColumnMap, MeasurementSet, ReadOptions};
+use model::CalibratedModel;
+use robot::RobotDescription;
 use std::path::{Path, PathBuf};
 
 /// `--columns`: the column map every reader of a measurement CSV takes.
@@ -66,8 +70,69 @@ pub struct ModelArg {
 
 impl ModelArg {
     /// Reads and checks the model file.
-    pub fn read(&self) -> Result<model::CalibratedModel, Error> {
+    pub fn read(&self) -> Result<CalibratedModel, Error> {
         model::read_model(&self.model)
+    }
+}
+
+/// `--robot` (with its chain's ends), `--data` and `--columns`: measurements of a robot, read
+/// against its joints.
+#[derive(Debug, clap::Args)]
+pub struct RobotDataArgs {
+    #[command(flatten)]
+    pub robot: RobotArgs,
+    #[command(flatten)]
+    pub data: DataArgs,
+}
+
+impl RobotDataArgs {
+    /// Reads the robot, then the measurements against its joints, keeping the columns `inputs`
+    /// as measured signals.
+    pub fn read(&self, inputs: Vec<String>) -> Result<(RobotDescription, MeasurementSet), Error> {
+        let robot = self.robot.read()?;
+        let data = self.data.read(ReadOptions::for_joints(robot.joint_kinds()).with_inputs(inputs))?;
+        Ok((robot, data))
+    }
+
+    /// The path of `--data`, for messages.
+    pub fn display(&self) -> std::path::Display<'_> {
+        self.data.display()
+    }
+}
+
+/// `--model`, `--data` and `--columns`: measurements a model is applied to, read against its
+/// joints and the inputs it takes.
+#[derive(Debug, clap::Args)]
+pub struct ModelDataArgs {
+    #[command(flatten)]
+    pub model: ModelArg,
+    #[command(flatten)]
+    pub data: DataArgs,
+}
+
+impl ModelDataArgs {
+    /// Reads the model, then the measurements.
+    pub fn read(&self) -> Result<(CalibratedModel, MeasurementSet), Error> {
+        let model = self.model.read()?;
+        let data = self.data.read(model.read_options(ColumnMap::default()))?;
+        Ok((model, data))
+    }
+
+    /// Reads the model, then the joint configurations (the position columns may be left out).
+    pub fn read_configurations(&self) -> Result<(CalibratedModel, MeasurementSet), Error> {
+        let model = self.model.read()?;
+        let data = self.data.read_configurations(model.read_options(ColumnMap::default()))?;
+        Ok((model, data))
+    }
+
+    /// The path of `--data`, for messages.
+    pub fn display(&self) -> std::path::Display<'_> {
+        self.data.display()
+    }
+
+    /// The path of `--model`.
+    pub fn model_file(&self) -> &Path {
+        &self.model.model
     }
 }
 

@@ -1,17 +1,14 @@
 //! `calib diagnose`: where the geometric model misses, which effect explains it, how far it shrinks.
 
-use crate::args::{DataArgs, JsonFlag};
+use crate::args::{JsonFlag, RobotDataArgs};
 use diagnose::{DiagnoseOptions, diagnose};
-use measurements::ReadOptions;
 use std::path::PathBuf;
 
 /// Diagnose what a geometric calibration leaves: where, which effect, how far it shrinks.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    robot: crate::robot_args::RobotArgs,
-    #[command(flatten)]
-    data: DataArgs,
+    data: RobotDataArgs,
     #[command(flatten)]
     json: JsonFlag,
     /// The instrument's noise per axis, mm, if known (otherwise from repeated poses, or a laser
@@ -35,9 +32,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     {
         return Err(format!("--noise-mm must be a positive number of millimetres, got {noise}").into());
     }
-    let inputs = measurements::InputFiles::new().with("--robot", &args.robot.robot).with("--data", &args.data.data);
-    let robot = args.robot.read()?;
-    let data = args.data.read(ReadOptions::for_joints(robot.joint_kinds()))?;
+    let inputs =
+        measurements::InputFiles::new().with("--robot", &args.data.robot.robot).with("--data", &args.data.data.data);
+    let (robot, data) = args.data.read(Vec::new())?;
     let options =
         DiagnoseOptions { folds: args.folds, seed: args.seed, noise_mm: args.noise_mm, ..DiagnoseOptions::default() };
     let diagnosis = diagnose(&robot, &data, &options)?;

@@ -1,23 +1,21 @@
 //! `calib eval`: the errors of a calibrated model on measurements.
 
-use crate::args::{DataArgs, JsonFlag, ModelArg};
+use crate::args::{JsonFlag, ModelDataArgs};
 
 /// Evaluate a calibrated model on measurements.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    model: ModelArg,
-    #[command(flatten)]
-    data: DataArgs,
+    data: ModelDataArgs,
     #[command(flatten)]
     json: JsonFlag,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let model = args.model.read()?;
-    let data = args.data.read(model.read_options(Default::default()))?;
+    let (model, data) = args.data.read()?;
     // Angles a turn away from the fitted range taken into it, the one binding, the evaluation.
-    let calib::flow::Evaluated { data, evaluation, report } = calib::flow::evaluate(&model, &args.model.model, data)?;
+    let calib::flow::Evaluated { data, evaluation, report } =
+        calib::flow::evaluate(&model, args.data.model_file(), data)?;
     if args.json.json {
         println!("{}", serde_json::to_string(&report)?);
         eprintln!("{}", data.read_summary());
@@ -105,7 +103,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
 
 /// The warning about another tracker placement, with this model's file in the command it names.
 fn placement_text(placement: &model::OtherPlacement, args: &Args) -> String {
-    placement.to_string().replace("--model MODEL", &format!("--model {}", args.model.model.display()))
+    placement.to_string().replace("--model MODEL", &format!("--model {}", args.data.model_file().display()))
 }
 
 /// The warning about rows far beyond the others, with what the others give.

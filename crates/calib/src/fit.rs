@@ -1,9 +1,8 @@
 //! `calib fit`: fit a calibration method to measurements and write the model.
 
-use crate::args::{DataArgs, JsonFlag};
+use crate::args::{JsonFlag, RobotDataArgs};
 use calib::flow::FitOverrides;
 use effects::{EffectKind, EffectSelection, EffectSpec};
-use measurements::ReadOptions;
 use model::{ErrorSummary, Method};
 use pipeline::{FitOptions, FitReport};
 use std::fmt::Write;
@@ -13,9 +12,7 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    robot: crate::robot_args::RobotArgs,
-    #[command(flatten)]
-    data: DataArgs,
+    data: RobotDataArgs,
     /// Calibration method: base-tool, poe, poe-gp or poe-gp-load.
     #[arg(long)]
     method: Method,
@@ -63,8 +60,8 @@ fn effects_help() -> String {
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     // Refused before any work: the model must not replace a file this fit reads.
     measurements::InputFiles::new()
-        .with("--robot", &args.robot.robot)
-        .with("--data", &args.data.data)
+        .with("--robot", &args.data.robot.robot)
+        .with("--data", &args.data.data.data)
         .with_optional("--options", args.options.as_deref())
         .check_output("--out", &args.out)?;
     let progress = crate::progress::Progress::on_terminal("fit");
@@ -95,11 +92,8 @@ type Fitted = (robot::RobotDescription, measurements::MeasurementSet, model::Cal
 
 /// The command's work, in the phases its report times: reading, the fit, writing the model.
 fn fit_and_write(args: &Args) -> Result<Fitted, Box<dyn std::error::Error>> {
-    let (robot, data) = timings::phase("read", || -> Result<_, Box<dyn std::error::Error>> {
-        let robot = args.robot.read()?;
-        let data = args.data.read(ReadOptions::for_joints(robot.joint_kinds()).with_inputs(input_names(args)))?;
-        Ok((robot, data))
-    })?;
+    let (robot, data) =
+        timings::phase("read", || -> Result<_, Box<dyn std::error::Error>> { Ok(args.data.read(input_names(args))?) })?;
     let mut options = match &args.options {
         Some(path) => FitOptions::read(path)?,
         None => FitOptions::default(),

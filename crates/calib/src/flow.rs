@@ -1,12 +1,13 @@
-//! The flows of `fit`, `eval`, `predict` and `compensate`, run by the `calib` binary and by the
+//! The flows of `fit`, `eval`, `predict`, `compensate` and `simulate`, run by the `calib` binary and by the
 //! Python package (`crates/python`) alike: the same library calls in the same order, so that a
 //! number in Python equals the CLI's to the last bit. Each front end reads its inputs its own way
 //! (flags and files, or keyword arguments and arrays) and prints or returns what these give; the
 //! refusals here are the library's, each front end names its own flags in its own.
 
+use campaign::{GeneratorConfig, Perturbation, Remount, TorqueSensorNoise};
 use cell::{CompensateOptions, CompensationSummary, Solved, TargetFile, TargetFrame};
 use effects::EffectSelection;
-use errors::Error;
+use errors::{Error, ErrorKind};
 use measurements::{BoundSet, MeasurementSet};
 use model::{CalibratedModel, EvalReport, Evaluation, GpChoice, Method, PoseError, PredictedPose, WrappedJoint};
 use pipeline::{FitOptions, FitReport};
@@ -203,4 +204,107 @@ pub fn compensate(
     warnings.extend(model.outside_training_range(rows).iter().map(ToString::to_string));
     warnings.extend(model.beyond_joint_limits(rows).iter().map(ToString::to_string));
     Ok(CompensatedTargets { file, solved, summary, warnings })
+}
+
+/// `simulate`'s campaign shape, as its flags (the Python `simulate`'s keyword arguments) give it.
+#[derive(Debug, Default)]
+pub struct CampaignShape {
+    /// Payloads, kg, one drawn per pose [default: the generator's].
+    pub payloads: Option<Vec<f64>>,
+    /// The joints that move, 1-based; the others sit at 0.
+    pub moving_joints: Option<Vec<usize>>,
+    /// The joints that do not move are drawn within ± this of 0, mrad.
+    pub fixed_jitter_mrad: Option<f64>,
+    /// The poses split into consecutive runs, one per payload.
+    pub runs: bool,
+    /// A run per payload with the probe remounted for each (implies `runs`).
+    pub tool_per_payload: bool,
+    /// Measured joint torques written.
+    pub torques: bool,
+    /// Standard deviation of the measured torques, N·m (with `torques`).
+    pub torque_sigma_nm: Option<f64>,
+}
+
+/// A campaign shape refused; each front end names its own flags in the message.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ShapeFault {
+    /// A moving joint numbered 0: they are numbered from 1.
+    JointZero,
+    /// A jitter of the joints that do not move, without moving joints.
+    JitterWithoutMovingJoints,
+    /// A jitter that is not a non-negative number.
+    Jitter(f64),
+    /// A torque sigma without torques.
+    SigmaWithoutTorques,
+    /// A torque sigma that is not a non-negative number.
+    Sigma(f64),
+}
+
+impl CampaignShape {
+    /// The generator's configuration for `rows` poses drawn from `seed`.
+    pub fn config(self, rows: usize, seed: u64) -> Result<GeneratorConfig, ShapeFault> {
+        let defaults = GeneratorConfig::default();
+        let payloads_kg = self.payloads.unwrap_or_else(|| defaults.payloads_kg.clone());
+        let mut moving_joints = Vec::new();
+        for joint in self.moving_joints.into_iter().flatten() {
+            if joint == 0 {
+                return Err(ShapeFault::JointZero);
+            }
+            moving_joints.push(joint - 1);
+        }
+        moving_joints.sort_unstable();
+        moving_joints.dedup();
+        if self.fixed_jitter_mrad.is_some() && moving_joints.is_empty() {
+            return Err(ShapeFault::JitterWithoutMovingJoints);
+        }
+        let jitter = self.fixed_jitter_mrad.unwrap_or(0.0);
+        if !(jitter.is_finite() && jitter >= 0.0) {
+            return Err(ShapeFault::Jitter(jitter));
+        }
+        if self.torque_sigma_nm.is_some() && !self.torques {
+            return Err(ShapeFault::SigmaWithoutTorques);
+        }
+        if let Some(sigma) = self.torque_sigma_nm.filter(|s| !(s.is_finite() && *s >= 0.0)) {
+            return Err(ShapeFault::Sigma(sigma));
+        }
+        let torque_sensor = self.torques.then(|| match self.torque_sigma_nm {
+            Some(sigma_nm) => TorqueSensorNoise { sigma_nm, ..TorqueSensorNoise::default() },
+            None => TorqueSensorNoise::default(),
+        });
+        Ok(GeneratorConfig {
+            sample_count: rows,
+            seed,
+            payloads_kg,
+            moving_joints,
+            fixed_jitter_rad: jitter * 1e-3,
+            payload_runs: self.runs || self.tool_per_payload,
+            tool_per_run: self.tool_per_payload,
+            torque_sensor,
+            ..defaults
+        })
+    }
+}
+
+/// `simulate`: the campaign `config` describes on `robot` (read from `robot_file`) with `effects`,
+/// written row by row as measurement CSV to `out` (`out_name` in messages); the number of rows.
+/// A planar chain is refused where every joint moves: the generator draws poses where the tool
+/// point moves in all three directions, which a planar chain has not, and would refuse them only
+/// after a million draws as "too strict a threshold".
+pub fn simulate(
+    robot: &RobotDescription,
+    robot_file: &str,
+    effects: &campaign::Effects,
+    config: &GeneratorConfig,
+    full_pose: bool,
+    out: impl std::io::Write,
+    out_name: &str,
+) -> Result<usize, Error> {
+    if config.moving_joints.is_empty()
+        && let Some(direction) = robot.planar_direction()
+    {
+        let joints = robot.joint_count();
+        return Err(Error::in_file(robot_file.to_owned(), ErrorKind::PlanarChain { direction, joints }));
+    }
+    let cell = campaign::campaign_cell(robot, &Perturbation::default(), &Remount::default(), config)?;
+    campaign::simulate_to_csv(&cell, effects, &campaign::joint_ranges(robot), config, full_pose, out, out_name)
 }

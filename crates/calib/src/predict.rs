@@ -1,7 +1,7 @@
 //! `calib predict`: the compensated pose of every row of a joint file, with the GP's standard
 //! deviation where the model has a GP.
 
-use crate::args::{DataArgs, ModelArg};
+use crate::args::ModelDataArgs;
 use std::io::Write;
 
 /// Predict the tool pose (tracker frame) for the joint configurations of --data (its position
@@ -9,20 +9,17 @@ use std::io::Write;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    model: ModelArg,
-    #[command(flatten)]
-    data: DataArgs,
+    data: ModelDataArgs,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let model = args.model.read()?;
-    let read = args.data.read_configurations(model.read_options(Default::default()))?;
+    let (model, read) = args.data.read_configurations()?;
     // Angles a turn away from the fitted range are taken into it, as `calib register` does; the
     // CSV's columns are the same, the note on stderr says which rows.
     let (data, wrapped) = calib::flow::wrapped(&model, read);
     // The one binding of `predict`: joints checked, tools mapped.
     let bound = model.bind(&data)?;
-    let predicted = calib::flow::predict(&model, &args.model.model, &bound, &wrapped)?;
+    let predicted = calib::flow::predict(&model, args.data.model_file(), &bound, &wrapped)?;
     for joint in &predicted.notes {
         eprintln!("note: {joint}");
     }

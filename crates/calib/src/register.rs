@@ -1,7 +1,7 @@
 //! `calib register`: a calibrated model carried to a moved tracker or new tools from a few poses
 //! (crate `cell`).
 
-use crate::args::{DataArgs, JsonFlag, ModelArg};
+use crate::args::{JsonFlag, ModelDataArgs};
 use std::path::PathBuf;
 
 /// Re-fit the tracker-to-base transform and/or the tools from a few poses (--data, full-pose or
@@ -9,9 +9,7 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    model: ModelArg,
-    #[command(flatten)]
-    data: DataArgs,
+    data: ModelDataArgs,
     /// The registered model (RON); never one of the inputs.
     #[arg(long)]
     out: PathBuf,
@@ -32,11 +30,10 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     measurements::InputFiles::new()
-        .with("--model", &args.model.model)
-        .with("--data", &args.data.data)
+        .with("--model", args.data.model_file())
+        .with("--data", &args.data.data.data)
         .check_output("--out", &args.out)?;
-    let model = args.model.read()?;
-    let data = args.data.read(model.read_options(Default::default()))?;
+    let (model, data) = args.data.read()?;
     let register = cell::RegisterOptions { changed_ratio: args.changed_ratio, ..cell::RegisterOptions::default() };
     let registered = cell::register(&model, &data, args.refit, args.heldout_mm, &register)?;
     let text = cell::checked_model_text(&registered.model, &args.out.display().to_string())?;

@@ -1,5 +1,5 @@
-//! `Model` and `fit`: what `calib fit`, `eval`, `predict` and `compensate` do, on the same
-//! pipeline calls in the same order as `crates/calib/src/{fit,eval,predict,compensate}.rs`.
+//! `Model` and `fit`: what `calib fit`, `eval`, `predict` and `compensate` do, through the flows
+//! those commands run (`calib::flow`).
 
 use crate::error::{argument, to_py};
 use crate::robot::Robot;
