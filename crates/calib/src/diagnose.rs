@@ -1,7 +1,7 @@
 //! `calib diagnose`: where the geometric model misses, which effect explains it, how far it shrinks.
 
 use crate::args::{JsonFlag, RobotDataArgs};
-use diagnose::{DiagnoseOptions, diagnose};
+use diagnose::DiagnoseOptions;
 use std::path::PathBuf;
 
 /// Diagnose what a geometric calibration leaves: where, which effect, how far it shrinks.
@@ -37,12 +37,8 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let (robot, data) = args.data.read(Vec::new())?;
     let options =
         DiagnoseOptions { folds: args.folds, seed: args.seed, noise_mm: args.noise_mm, ..DiagnoseOptions::default() };
-    let diagnosis = diagnose(&robot, &data, &options)?;
-    let report = args
-        .report
-        .as_deref()
-        .map(|folder| ::report::write_diagnosis_report(&diagnosis, folder, "--report", &inputs))
-        .transpose()?;
+    let report = args.report.as_deref().map(|folder| (folder, "--report", &inputs));
+    let (diagnosis, report) = calib::flow::diagnose(&robot, &data, &options, report)?;
     if args.json.json {
         println!("{}", diagnosis.to_json()?);
         eprintln!("{}", data.read_summary());

@@ -1,18 +1,19 @@
-//! The flows of `fit`, `eval`, `predict`, `compensate` and `simulate`, run by the `calib` binary and by the
-//! Python package (`crates/python`) alike: the same library calls in the same order, so that a
-//! number in Python equals the CLI's to the last bit. Each front end reads its inputs its own way
-//! (flags and files, or keyword arguments and arrays) and prints or returns what these give; the
-//! refusals here are the library's, each front end names its own flags in its own.
+//! The flows of `fit`, `eval`, `predict`, `compensate`, `simulate` and `diagnose`, run by the `calib` binary
+//! and by the Python package (`crates/python`) alike: the same library calls in the same order, so
+//! that a number in Python equals the CLI's to the last bit. Each front end reads its inputs its
+//! own way (flags and files, or keyword arguments and arrays) and prints or returns what these
+//! give; the refusals here are the library's, and each front end names its own flags in its own.
 
 use campaign::{GeneratorConfig, Perturbation, Remount, TorqueSensorNoise};
 use cell::{CompensateOptions, CompensationSummary, Solved, TargetFile, TargetFrame};
+use diagnose::{DiagnoseOptions, Diagnosis};
 use effects::EffectSelection;
 use errors::{Error, ErrorKind};
-use measurements::{BoundSet, MeasurementSet};
+use measurements::{BoundSet, InputFiles, MeasurementSet};
 use model::{CalibratedModel, EvalReport, Evaluation, GpChoice, Method, PoseError, PredictedPose, WrappedJoint};
 use pipeline::{FitOptions, FitReport};
 use robot::RobotDescription;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// What `calib fit`'s flags (the Python `fit`'s keyword arguments) set over the fit options, as
 /// they go over `--options`.
@@ -307,4 +308,20 @@ pub fn simulate(
     }
     let cell = campaign::campaign_cell(robot, &Perturbation::default(), &Remount::default(), config)?;
     campaign::simulate_to_csv(&cell, effects, &campaign::joint_ranges(robot), config, full_pose, out, out_name)
+}
+
+/// `diagnose`: the diagnosis of `data` for `robot` and, where `report` names a folder, the
+/// markdown report with its plots written there (with the option that names the folder in
+/// refusals, and the command's input files, which it never replaces); the report's path.
+pub fn diagnose(
+    robot: &RobotDescription,
+    data: &MeasurementSet,
+    options: &DiagnoseOptions,
+    report: Option<(&Path, &'static str, &InputFiles)>,
+) -> Result<(Diagnosis, Option<PathBuf>), Error> {
+    let diagnosis = diagnose::diagnose(robot, data, options)?;
+    let written = report
+        .map(|(folder, option, inputs)| report::write_diagnosis_report(&diagnosis, folder, option, inputs))
+        .transpose()?;
+    Ok((diagnosis, written))
 }

@@ -30,27 +30,22 @@ pub fn diagnose(
     }
     let options = DiagnoseOptions { folds, seed, noise_mm, ..DiagnoseOptions::default() };
     let (description, set) = (&robot.description, &data.set);
-    // As the CLI, which reads the data against the robot's joints: bound once, here.
-    let bound = measurements::BoundSet::to_robot(set, &description.joint_kinds()).map_err(to_py)?;
     let robot_path = PathBuf::from(&robot.path);
     let data_path = PathBuf::from(&set.source);
     py.detach(|| {
-        let diagnosis = ::diagnose::diagnose_bound(description, &bound, &options)?;
         let inputs = measurements::InputFiles::new().with("robot", &robot_path).with("data", &data_path);
         // The folder `calib diagnose --report` writes, through the report crate's one writer.
-        let written = report
-            .as_deref()
-            .map(|folder| {
-                report::write_diagnosis_report(&diagnosis, folder, "report", &inputs).map_err(|e| match e.kind() {
-                    // A chart or the embedded JSON: named by the folder they were for, as before the
-                    // report crate had an error type of its own.
-                    errors::ErrorKind::Plot { .. } | errors::ErrorKind::EvaluationJson { .. } => {
-                        errors::Error::io(folder.display().to_string(), std::io::Error::other(e.to_string()))
-                    }
-                    _ => e,
-                })
-            })
-            .transpose()?;
+        let folder = report.as_deref().map(|folder| (folder, "report", &inputs));
+        let (diagnosis, written) = calib::flow::diagnose(description, set, &options, folder).map_err(|e| {
+            match (e.kind(), &report) {
+                // A chart or the embedded JSON (only the report's writer raises them): named by
+                // the folder they were for, as before the report crate had an error type of its own.
+                (errors::ErrorKind::Plot { .. } | errors::ErrorKind::EvaluationJson { .. }, Some(folder)) => {
+                    errors::Error::io(folder.display().to_string(), std::io::Error::other(e.to_string()))
+                }
+                _ => e,
+            }
+        })?;
         Ok((diagnosis.to_json()?, diagnosis.summary(), written.map(|p| p.display().to_string())))
     })
     .map_err(to_py)
