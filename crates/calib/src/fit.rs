@@ -111,6 +111,9 @@ fn fit_and_write(args: &Args) -> Result<Fitted, Box<dyn std::error::Error>> {
     Ok((robot, data, model, report))
 }
 
+/// The fit's summary, in the order a reader checks it: the errors, the identification and its
+/// priors, the effects (chosen, beyond their spans, identified), the GP, what cannot be
+/// identified, the solver, the plausibility, the warnings and the slow phases.
 fn summarise(
     out: &mut String,
     args: &Args,
@@ -129,26 +132,7 @@ fn summarise(
         args.method,
         args.data.display()
     );
-    errors(out, "training error before (nominal, registered)", &report.before);
-    errors(out, "training error after", &report.after);
-    // Beside the training error, which a GP that interpolates its poses drives to nothing: the
-    // same rows, each corrected by the GP fitted without it (closed form, issue 25).
-    if let Some(gp) = &report.residual_gp {
-        // Where rows repeat a configuration, a row left out alone keeps its twin, whose value the
-        // GP returns: the grouped error is the one to read, and is what the model keeps (issue 26).
-        match (&gp.leave_one_out, &gp.leave_group_out) {
-            (Some(loo), Some(grouped)) => {
-                errors(out, "GP leave-one-out error (each row predicted without it, its repeats kept)", loo);
-                let label = format!(
-                    "GP leave-group-out error ({} rows repeat {} configurations, each left out whole)",
-                    gp.repeated_rows, gp.repeated_configurations
-                );
-                errors(out, &label, grouped);
-            }
-            (Some(loo), None) => errors(out, "GP leave-one-out error (each row predicted without it)", loo),
-            _ => {}
-        }
-    }
+    summarise_errors(out, report);
     let id = &report.identification;
     let _ = writeln!(
         out,
@@ -171,55 +155,102 @@ fn summarise(
         let _ = writeln!(out, "  {prior}");
     }
     if let Some(auto) = &report.auto {
-        let chosen: Vec<String> = auto.chosen.iter().map(ToString::to_string).collect();
+        summarise_auto(out, auto);
+    }
+    summarise_effects(out, report);
+    if let (Some(residual_gp), Some(gp)) = (&model.residual_gp, &report.residual_gp) {
+        summarise_gp(out, residual_gp, gp);
+    }
+    summarise_solver(out, report);
+    for warning in &report.warnings {
+        let _ = writeln!(out, "  warning: {warning}");
+    }
+    summarise_slow_phases(out, &report.timings);
+    let _ = writeln!(out, "  wrote {}", args.out.display());
+}
+
+/// The training errors before and after, and beside them the GP's errors on the same rows, each
+/// predicted without it (closed form): a GP that interpolates its poses drives the training error
+/// to nothing.
+fn summarise_errors(out: &mut String, report: &FitReport) {
+    errors(out, "training error before (nominal, registered)", &report.before);
+    errors(out, "training error after", &report.after);
+    let Some(gp) = &report.residual_gp else { return };
+    // Where rows repeat a configuration, a row left out alone keeps its twin, whose value the GP
+    // returns: the grouped error is the one to read, and is what the model keeps.
+    match (&gp.leave_one_out, &gp.leave_group_out) {
+        (Some(loo), Some(grouped)) => {
+            errors(out, "GP leave-one-out error (each row predicted without it, its repeats kept)", loo);
+            let label = format!(
+                "GP leave-group-out error ({} rows repeat {} configurations, each left out whole)",
+                gp.repeated_rows, gp.repeated_configurations
+            );
+            errors(out, &label, grouped);
+        }
+        (Some(loo), None) => errors(out, "GP leave-one-out error (each row predicted without it)", loo),
+        _ => {}
+    }
+}
+
+/// What `--effects auto` chose, its held-out predictions and the effects it selected.
+fn summarise_auto(out: &mut String, auto: &pipeline::AutoChoice) {
+    let chosen: Vec<String> = auto.chosen.iter().map(ToString::to_string).collect();
+    let _ = writeln!(
+        out,
+        "  effects auto: the diagnosis of the training data (verdict {}; held-out {:.4} mm with the geometry alone) selected {}",
+        auto.verdict.effect.name(),
+        auto.heldout_before_mm,
+        if chosen.is_empty() { "nothing".to_owned() } else { chosen.join(", ") }
+    );
+    if let Some([before, after]) = auto.off_poses_mm {
         let _ = writeln!(
             out,
-            "  effects auto: the diagnosis of the training data (verdict {}; held-out {:.4} mm with the geometry alone) selected {}",
-            auto.verdict.effect.name(),
-            auto.heldout_before_mm,
-            if chosen.is_empty() { "nothing".to_owned() } else { chosen.join(", ") }
+            "    predicted held out: {:.4} -> {:.4} mm on poses like these (random folds); {before:.4} -> {after:.4} mm off them (arcs of each moving joint's angles held out)",
+            auto.heldout_before_mm, auto.heldout_after_mm
         );
-        if let Some([before, after]) = auto.off_poses_mm {
-            let _ = writeln!(
-                out,
-                "    predicted held out: {:.4} -> {:.4} mm on poses like these (random folds); {before:.4} -> {after:.4} mm off them (arcs of each moving joint's angles held out)",
-                auto.heldout_before_mm, auto.heldout_after_mm
-            );
-        }
-        if let Some(with_gp) = &auto.predicted_with_gp {
-            let off = with_gp.off_poses_mm.map_or(String::new(), |off| format!("; {off:.4} mm off them"));
-            let _ = writeln!(
-                out,
-                "    predicted held out with the GP on top: {:.4} mm on poses like these{off} (the same folds, each fold's GP conditioned on the residuals its geometry and effects leave on its training rows, the final GP's hyperparameters held fixed: a standard approximation, searching them again in every fold would be too slow)",
-                with_gp.on_poses_mm
-            );
-            if let Some(choice) = &with_gp.fallback_gp {
-                let mm = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.4} mm"));
-                let _ = writeln!(
-                    out,
-                    "    where the effects fade: {} (arcs off the poses: {} with a GP of what the geometry alone leaves, {} with the GP of what the effects leave)",
-                    if choice.kept {
-                        "the GP falls back with the geometry to one fitted on what the geometry alone leaves"
-                    } else {
-                        "the GP of what the effects leave stays (it predicted the arcs better)"
-                    },
-                    mm(choice.off_poses_with_mm),
-                    mm(choice.off_poses_without_mm)
-                );
-            }
-        }
-        for s in &auto.selected {
-            let joints: Vec<String> = s.joints.iter().map(ToString::to_string).collect();
-            let harmonic = s.harmonic.map_or(String::new(), |h| format!(", harmonics 1 to {h}"));
-            let _ = writeln!(
-                out,
-                "    {} on joint(s) {}{harmonic}: cross-validated {:.4} mm with it and those above",
-                s.effect.name(),
-                joints.join(","),
-                s.heldout_after_mm
-            );
-        }
     }
+    if let Some(with_gp) = &auto.predicted_with_gp {
+        summarise_predicted_with_gp(out, with_gp);
+    }
+    for s in &auto.selected {
+        let joints: Vec<String> = s.joints.iter().map(ToString::to_string).collect();
+        let harmonic = s.harmonic.map_or(String::new(), |h| format!(", harmonics 1 to {h}"));
+        let _ = writeln!(
+            out,
+            "    {} on joint(s) {}{harmonic}: cross-validated {:.4} mm with it and those above",
+            s.effect.name(),
+            joints.join(","),
+            s.heldout_after_mm
+        );
+    }
+}
+
+/// `--effects auto`'s held-out prediction with the GP on top, and the fallback GP's choice.
+fn summarise_predicted_with_gp(out: &mut String, with_gp: &pipeline::PredictedWithGp) {
+    let off = with_gp.off_poses_mm.map_or(String::new(), |off| format!("; {off:.4} mm off them"));
+    let _ = writeln!(
+        out,
+        "    predicted held out with the GP on top: {:.4} mm on poses like these{off} (the same folds, each fold's GP conditioned on the residuals its geometry and effects leave on its training rows, the final GP's hyperparameters held fixed: a standard approximation, searching them again in every fold would be too slow)",
+        with_gp.on_poses_mm
+    );
+    if let Some(choice) = &with_gp.fallback_gp {
+        let mm = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v:.4} mm"));
+        let _ = writeln!(
+            out,
+            "    where the effects fade: {} (arcs off the poses: {} with a GP of what the geometry alone leaves, {} with the GP of what the effects leave)",
+            if choice.kept {
+                "the GP falls back with the geometry to one fitted on what the geometry alone leaves"
+            } else {
+                "the GP of what the effects leave stays (it predicted the arcs better)"
+            },
+            mm(choice.off_poses_with_mm),
+            mm(choice.off_poses_without_mm)
+        );
+    }
+}
+
+/// The effects: what each is beyond the spans and payloads it was fitted on, and its parameters.
+fn summarise_effects(out: &mut String, report: &FitReport) {
     for choice in &report.beyond_span {
         let _ = writeln!(out, "  {choice}");
     }
@@ -238,50 +269,50 @@ fn summarise(
             let _ = writeln!(out, "    held at the prior, the data barely sees them: {}", held.join(", "));
         }
     }
-    if let (Some(residual_gp), Some(gp)) = (&model.residual_gp, &report.residual_gp) {
-        let kernels = match &gp.gp {
-            model::GpFitReport::Exact(r) => r.components.len(),
-            model::GpFitReport::Sparse(r) => r.components.len(),
-        };
-        let converged = kernels - gp.gp.unconverged().len();
-        // Where the additive term was weighed (BIC), how often it paid for itself.
-        let additive = match &gp.gp {
-            model::GpFitReport::Exact(r) => {
-                let choices: Vec<bool> =
-                    r.components.iter().filter_map(|c| c.additive_choice.as_ref().map(|a| a.kept)).collect();
-                let kept = choices.iter().filter(|k| **k).count();
-                if choices.is_empty() {
-                    String::new()
-                } else {
-                    format!("; additive term kept (BIC) for {kept} of {}", choices.len())
-                }
-            }
-            model::GpFitReport::Sparse(_) => String::new(),
-        };
-        // Where the paper's isotropic kernel was weighed (leave-one-out), how often it won.
-        let isotropic = match &gp.gp {
-            model::GpFitReport::Exact(r) => {
-                let choices: Vec<bool> =
-                    r.components.iter().filter_map(|c| c.isotropic_choice.as_ref().map(|a| a.kept_isotropic)).collect();
-                let kept = choices.iter().filter(|k| **k).count();
-                if choices.is_empty() {
-                    String::new()
-                } else {
-                    format!("; the paper's isotropic Eq. 5 kernel kept (leave-one-out) for {kept} of {}", choices.len())
-                }
-            }
-            model::GpFitReport::Sparse(_) => String::new(),
-        };
-        let _ = writeln!(
-            out,
-            "  GP: {}, {kernels} kernel(s), hyperparameter search met its tolerance for {converged} of {kernels}{additive}{isotropic}",
-            residual_gp.gp.choice()
-        );
-        if !gp.inputs.is_empty() {
-            let spans: Vec<String> = gp.inputs.iter().map(ToString::to_string).collect();
-            let _ = writeln!(out, "  GP inputs beside the joints, with the spans fitted on: {}", spans.join("; "));
-        }
+}
+
+/// The GP: its kernels, how many searches converged, the kernel choices and its extra inputs.
+fn summarise_gp(out: &mut String, residual_gp: &model::ResidualGp, gp: &model::ResidualGpReport) {
+    let kernels = match &gp.gp {
+        model::GpFitReport::Exact(r) => r.components.len(),
+        model::GpFitReport::Sparse(r) => r.components.len(),
+    };
+    let converged = kernels - gp.gp.unconverged().len();
+    let (additive, isotropic) = match &gp.gp {
+        model::GpFitReport::Exact(r) => (
+            // Where the additive term was weighed (BIC), how often it paid for itself.
+            kernel_choices(&r.components, |c| c.additive_choice.as_ref().map(|a| a.kept), "additive term kept (BIC)"),
+            // Where the paper's isotropic kernel was weighed (leave-one-out), how often it won.
+            kernel_choices(
+                &r.components,
+                |c| c.isotropic_choice.as_ref().map(|a| a.kept_isotropic),
+                "the paper's isotropic Eq. 5 kernel kept (leave-one-out)",
+            ),
+        ),
+        model::GpFitReport::Sparse(_) => (String::new(), String::new()),
+    };
+    let _ = writeln!(
+        out,
+        "  GP: {}, {kernels} kernel(s), hyperparameter search met its tolerance for {converged} of {kernels}{additive}{isotropic}",
+        residual_gp.gp.choice()
+    );
+    if !gp.inputs.is_empty() {
+        let spans: Vec<String> = gp.inputs.iter().map(ToString::to_string).collect();
+        let _ = writeln!(out, "  GP inputs beside the joints, with the spans fitted on: {}", spans.join("; "));
     }
+}
+
+/// `"; {what} for {kept} of {weighed}"` over the exact GP's kernels, `kept` saying whether a
+/// kernel's choice was made and which way; empty where none was made.
+fn kernel_choices<C>(components: &[C], kept: impl Fn(&C) -> Option<bool>, what: &str) -> String {
+    let choices: Vec<bool> = components.iter().filter_map(kept).collect();
+    let kept = choices.iter().filter(|k| **k).count();
+    if choices.is_empty() { String::new() } else { format!("; {what} for {kept} of {}", choices.len()) }
+}
+
+/// What the data cannot identify, how the solver stopped, and the plausibility checks' numbers.
+fn summarise_solver(out: &mut String, report: &FitReport) {
+    let id = &report.identification;
     for direction in &id.unidentifiable {
         let _ = writeln!(out, "    unidentifiable: {direction}");
     }
@@ -307,12 +338,11 @@ fn summarise(
             check.measured_spread_mm, check.robot_spread_mm, check.rotation_rms_mm, check.reflection_rms_mm
         );
     }
-    for warning in &report.warnings {
-        let _ = writeln!(out, "  warning: {warning}");
-    }
-    // Where a fit of more than a second spent it (every phase is in --json's `timings`).
-    let slow: Vec<String> = report
-        .timings
+}
+
+/// Where a fit of more than a second spent it (every phase is in --json's `timings`).
+fn summarise_slow_phases(out: &mut String, timings: &[timings::PhaseTime]) {
+    let slow: Vec<String> = timings
         .iter()
         .filter(|p| p.wall_s >= 1.0)
         .map(|p| {
@@ -323,7 +353,6 @@ fn summarise(
     if !slow.is_empty() {
         let _ = writeln!(out, "  time (phases of a second or more):\n{}", slow.join("\n"));
     }
-    let _ = writeln!(out, "  wrote {}", args.out.display());
 }
 
 fn errors(out: &mut String, label: &str, summary: &ErrorSummary) {

@@ -65,6 +65,7 @@ use errors::{Error, ErrorKind};
 use lie::Vector3;
 use measurements::{BoundSet, MeasurementSet};
 use model::geometric::{fit_geometry, observations};
+use poe::LocalPoe;
 use poe::identify::{IdentificationOptions, Scope};
 use pool::Pool;
 use rand::SeedableRng;
@@ -86,18 +87,17 @@ pub struct DiagnoseOptions {
     pub noise_mm: Option<f64>,
     /// The instrument class assumed when neither `noise_mm` nor repeated poses give the noise.
     pub tracker: loadsim::TrackerNoiseModel,
-    /// A joint counts as moving when its angles span more than this, rad. 0.05 rad (3°): the
-    /// 7-axis campaign of issue 11 holds its still joints within ±2 mrad, and over a few degrees
-    /// a function of the angle is a straight line the kinematic model already holds.
+    /// A joint counts as moving when its angles span more than this, rad. 0.05 rad (3°): well
+    /// above the few mrad a joint held still jitters by, and over a few degrees a function of the
+    /// angle is a straight line the kinematic model already holds.
     pub moving_min_range_rad: f64,
     /// Arcs each moving joint's angles are cut into for the prediction off the training poses
     /// (module `arcs`). 10, the usual choice of k-fold cross-validation beside 5 (Hastie,
     /// Tibshirani and Friedman, ESL §7.10): each fold's geometry is fitted on nine tenths of the
     /// joint's range. Where the series fade, the fitted model is the geometry fitted on all of it,
-    /// and fewer arcs take away more of the range and over-predict: with 5 (the random folds'
-    /// count) the simulated 40° gap of issue 23 was predicted 11–35 % above the fitted error over
-    /// five seeds and UR10 B's odd rows 29 % above; with 10, 4–13 % and 16 %. More arcs approach the
-    /// geometry's error at the training poses (15 fell below the fitted error on one seed).
+    /// and fewer arcs take away more of the range and over-predict; more arcs approach the
+    /// geometry's error at the training poses and under-predict (the comparison of 5, 10 and 15 on
+    /// simulated gaps and the UR10: `docs/results/off-training.md`).
     pub arc_folds: usize,
     /// The prior that keeps each fold's fit from moving where its rows see nothing.
     pub prior: PriorOptions,
@@ -416,11 +416,12 @@ pub fn diagnose_bound(
     diagnosis(robot, bound, options)
 }
 
-/// The diagnosis of `bound`, its options validated.
+/// The diagnosis of `bound`, its options validated: the outlier screen, the geometry, the
+/// candidates' pooled problem, the selection and its orders, the arcs, the structure GP, the
+/// noise floor and the verdict, each a phase below, in this order.
 fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseOptions) -> Result<Diagnosis, Error> {
     let data = bound.set();
-    let folds = options.folds;
-    let needed = folds * 10;
+    let needed = options.folds * 10;
     if data.rows.len() < needed {
         return Err(Error::in_file(data.source.clone(), ErrorKind::TooFewRows { rows: data.rows.len(), needed }));
     }
@@ -428,69 +429,167 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
     let screened = timings::phase("outlier screen", || outliers::screen(&nominal, bound, &options.outliers))?;
     let bound = screened.data.as_ref();
     let data = bound.set();
-    let geometry =
-        timings::phase("geometry", || fit_geometry(&nominal, data, Scope::Full, &IdentificationOptions::default()))?;
-    let model = geometry.model;
-    let stats = poe::identify::evaluate(&model, &observations(data)).map_err(Error::kinematics)?;
-    // Weight each kind of row by its own residual scale, so that neither swamps the other.
-    let weights = Weights {
-        position_m: (stats.rms_position_m / 3f64.sqrt()).max(1e-9),
-        rotation_rad: stats.rms_rotation_rad.map_or(1.0, |r| (r / 3f64.sqrt()).max(1e-12)),
-    };
-    let design = Design::new(&model, data, weights)?;
-    let moving = moving_joints(data, options.moving_min_range_rad);
-    let settings = candidates::Settings {
-        moving: &moving,
-        orders: &options.selection.series_orders,
-        series_sd: options.prior.series_rad,
-        inputs: options.candidates,
-    };
-    let (candidates, sides) =
-        timings::phase("candidates", || candidates::build_candidates(robot, &model, bound, &design, &settings))?;
-    let (mut terms, blocks) = terms_of(&candidates, design.kinematic.ncols());
-    let fold = fold_assignment(data.rows.len(), folds, options.seed);
-    let kinematic_prior = pool::KinematicPrior::new(&nominal, &model, &options.prior);
-    let mut pool = Pool::new(&design, &kinematic_prior, &blocks, &fold, folds, &options.prior);
-    // Backlash sides learnt inside each fold: a column per fold and one on every row.
-    let candidate_columns: Vec<Vec<usize>> = terms.iter().map(|t| t.columns.clone()).collect();
-    let mut side_columns: Vec<Vec<f64>> = Vec::new();
-    let learnt = timings::phase("learnt backlash sides", || {
-        learnt_side::learnt_sides(&pool, &design, &model, bound, &candidates, &candidate_columns, &sides)
-    })?;
-    let sets: Vec<Vec<Vec<f64>>> =
-        learnt.iter().map(|side| side.per_fold.iter().chain(std::iter::once(&side.all)).cloned().collect()).collect();
-    let ranges = pool.extend_sets(&sets, None, &options.prior);
-    for (side, range) in learnt.into_iter().zip(ranges) {
-        side_columns.push(side.all);
-        let indices: Vec<usize> = range.collect();
-        let all = indices[indices.len() - 1];
-        terms.push(Term {
-            effect: Effect::Backlash,
-            joints: vec![side.joint + 1],
-            columns: vec![all],
-            per_fold: Some(indices[..indices.len() - 1].iter().map(|&c| vec![c]).collect()),
-            orders: None,
-            model: side.model,
-        });
-    }
-    let mut selection = timings::phase("selection", || selection::select(&pool, &terms, &options.selection))?;
+    let geometry = Geometry::fit(&nominal, data, options)?;
+    let pooled = Pooled::new(robot, &nominal, &geometry, bound, options)?;
+    let (pool, terms) = (&pooled.pool, &pooled.terms);
+    let mut selection = timings::phase("selection", || selection::select(pool, terms, &options.selection))?;
     let arc_inputs = arcs::ArcInputs {
-        design: &design,
-        kinematic_prior: &kinematic_prior,
+        design: &geometry.design,
+        kinematic_prior: &pooled.kinematic_prior,
         prior: &options.prior,
         gear: &effects::GearOptions::default(),
         folds: options.arc_folds,
     };
-    let columns_of = |t: usize| match candidates.get(t) {
-        Some(c) => (c.columns.clone(), c.prior_sd),
-        None => (vec![side_columns[t - candidates.len()].clone()], None),
-    };
-    // Each selected series' order: its random folds' curve and its curve over the other joints'
-    // arcs, weighed (`SelectionOptions::arc_order_weight`).
+    let order_curves = choose_series_orders(&arc_inputs, data, &geometry.moving, &pooled, &mut selection, options)?;
+    let (arcs, heldout_folds) = arc_checks(&arc_inputs, data, &geometry.moving, &pooled, &selection)?;
+    let all_selected = selection.last();
+    let checks = StructureChecks::run(&geometry, data, &pooled.fold, &selection, options)?;
+    let noise = noise_floor(data, options);
+    let (decision, verdict, verdict_result) = name_verdict(&pooled, &selection, &checks, &noise, options)?;
+    let gross_outliers = screened.judged(&all_selected.errors);
+    let (verdict, verdict_result) = gross_outliers.verdict(verdict, verdict_result);
+    let shapes = series_shapes(pool, terms, &selection, data)?;
+    let poses = pose_diagnoses(robot, &nominal, &geometry, data, &selection)?;
+    let prismatic = prismatic_joints(robot);
+    let regions = regions::regions(&poses, &geometry.moving, &prismatic);
+    let before_mm = selection.baseline.mean_error() * 1e3;
+    Ok(Diagnosis {
+        robot: robot.name.clone(),
+        n: data.rows.len(),
+        full_pose: data.full_pose,
+        moving_joints: geometry.moving.iter().map(|j| j + 1).collect(),
+        prismatic_joints: prismatic,
+        verdict,
+        heldout_before_mm: before_mm,
+        heldout_after_mm: verdict_result.map_or(before_mm, |m| m * 1e3),
+        heldout_after_selected_mm: all_selected.mean_error() * 1e3,
+        explained_fraction: decision.explained_fraction,
+        candidates: candidate_scores(terms, &selection),
+        selected: selected_effects(terms, &selection, shapes, order_curves),
+        critical_z: selection.critical_z,
+        explainable: checks.explainable,
+        remaining: checks.remaining,
+        noise,
+        regions,
+        off_poses_before_mm: arcs::mean_of(&arcs, |a| a.before_mm),
+        off_poses_after_mm: arcs::mean_of(&arcs, |a| a.after_mm),
+        arcs,
+        poses,
+        gross_outliers,
+        folds: heldout_folds,
+    })
+}
+
+/// The geometric model fitted to every (screened) row, and the linear problem around it.
+struct Geometry {
+    model: LocalPoe,
+    design: Design,
+    /// 0-based joints whose angles span more than `moving_min_range_rad`.
+    moving: Vec<usize>,
+}
+
+impl Geometry {
+    fn fit(nominal: &LocalPoe, data: &MeasurementSet, options: &DiagnoseOptions) -> Result<Self, Error> {
+        let geometry =
+            timings::phase("geometry", || fit_geometry(nominal, data, Scope::Full, &IdentificationOptions::default()))?;
+        let model = geometry.model;
+        let stats = poe::identify::evaluate(&model, &observations(data)).map_err(Error::kinematics)?;
+        // Weight each kind of row by its own residual scale, so that neither swamps the other.
+        let weights = Weights {
+            position_m: (stats.rms_position_m / 3f64.sqrt()).max(1e-9),
+            rotation_rad: stats.rms_rotation_rad.map_or(1.0, |r| (r / 3f64.sqrt()).max(1e-12)),
+        };
+        let design = Design::new(&model, data, weights)?;
+        let moving = moving_joints(data, options.moving_min_range_rad);
+        Ok(Self { model, design, moving })
+    }
+}
+
+/// Every candidate effect as columns of one pooled problem: the candidates built from the data,
+/// then the backlash sides learnt inside each fold.
+struct Pooled {
+    candidates: Vec<candidates::Candidate>,
+    /// The candidates' terms, then one per learnt side.
+    terms: Vec<Term>,
+    /// Each learnt side's column on every row, in the order of its term.
+    side_columns: Vec<Vec<f64>>,
+    /// Each row's random fold.
+    fold: Vec<usize>,
+    kinematic_prior: pool::KinematicPrior,
+    pool: Pool,
+}
+
+impl Pooled {
+    fn new(
+        robot: &RobotDescription,
+        nominal: &LocalPoe,
+        geometry: &Geometry,
+        bound: &BoundSet<'_>,
+        options: &DiagnoseOptions,
+    ) -> Result<Self, Error> {
+        let (model, design, data, folds) = (&geometry.model, &geometry.design, bound.set(), options.folds);
+        let settings = candidates::Settings {
+            moving: &geometry.moving,
+            orders: &options.selection.series_orders,
+            series_sd: options.prior.series_rad,
+            inputs: options.candidates,
+        };
+        let (candidates, sides) =
+            timings::phase("candidates", || candidates::build_candidates(robot, model, bound, design, &settings))?;
+        let (mut terms, blocks) = terms_of(&candidates, design.kinematic.ncols());
+        let fold = fold_assignment(data.rows.len(), folds, options.seed);
+        let kinematic_prior = pool::KinematicPrior::new(nominal, model, &options.prior);
+        let mut pool = Pool::new(design, &kinematic_prior, &blocks, &fold, folds, &options.prior);
+        // Backlash sides learnt inside each fold: a column per fold and one on every row.
+        let candidate_columns: Vec<Vec<usize>> = terms.iter().map(|t| t.columns.clone()).collect();
+        let mut side_columns: Vec<Vec<f64>> = Vec::new();
+        let learnt = timings::phase("learnt backlash sides", || {
+            learnt_side::learnt_sides(&pool, design, model, bound, &candidates, &candidate_columns, &sides)
+        })?;
+        let sets: Vec<Vec<Vec<f64>>> = learnt
+            .iter()
+            .map(|side| side.per_fold.iter().chain(std::iter::once(&side.all)).cloned().collect())
+            .collect();
+        let ranges = pool.extend_sets(&sets, None, &options.prior);
+        for (side, range) in learnt.into_iter().zip(ranges) {
+            side_columns.push(side.all);
+            let indices: Vec<usize> = range.collect();
+            let all = indices[indices.len() - 1];
+            terms.push(Term {
+                effect: Effect::Backlash,
+                joints: vec![side.joint + 1],
+                columns: vec![all],
+                per_fold: Some(indices[..indices.len() - 1].iter().map(|&c| vec![c]).collect()),
+                orders: None,
+                model: side.model,
+            });
+        }
+        Ok(Self { candidates, terms, side_columns, fold, kinematic_prior, pool })
+    }
+
+    /// Term `t`'s columns on every row and their prior, for the fits over the arcs.
+    fn columns_of(&self, t: usize) -> (Vec<Vec<f64>>, Option<f64>) {
+        match self.candidates.get(t) {
+            Some(c) => (c.columns.clone(), c.prior_sd),
+            None => (vec![self.side_columns[t - self.candidates.len()].clone()], None),
+        }
+    }
+}
+
+/// Each selected series' order: its random folds' curve and its curve over the other joints'
+/// arcs, weighed (`SelectionOptions::arc_order_weight`). Returns every selected step's curve.
+fn choose_series_orders(
+    arc_inputs: &arcs::ArcInputs<'_>,
+    data: &MeasurementSet,
+    moving: &[usize],
+    pooled: &Pooled,
+    selection: &mut Selection,
+    options: &DiagnoseOptions,
+) -> Result<Vec<Vec<OrderScore>>, Error> {
     let weight = options.selection.arc_order_weight;
     let arc_curves = if weight > 0.0 {
         timings::phase("arc order curves", || {
-            arcs::order_curves(&arc_inputs, data, &moving, &terms, &selection, &columns_of)
+            arcs::order_curves(arc_inputs, data, moving, &pooled.terms, selection, &|t| pooled.columns_of(t))
         })?
     } else {
         vec![None; selection.steps.len()]
@@ -518,93 +617,152 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
         }
         order_curves.push(scores);
     }
-    let (arcs, arc_folds): (Vec<ArcCheck>, Vec<(usize, Vec<FoldResiduals>)>) =
-        timings::phase("arcs", || arcs::arc_checks(&arc_inputs, data, &moving, &terms, &selection, &columns_of))?
-            .into_iter()
-            .map(|(check, folds)| {
-                let joint = check.joint;
-                (check, (joint, folds))
-            })
-            .unzip();
-    let all_selected = selection.last();
+    Ok(order_curves)
+}
+
+/// Folds that see gaps: per moving joint, the held-out error when contiguous arcs of its angles
+/// are left out; and the random folds and the arcs fold by fold, for a stage fitted on top.
+fn arc_checks(
+    arc_inputs: &arcs::ArcInputs<'_>,
+    data: &MeasurementSet,
+    moving: &[usize],
+    pooled: &Pooled,
+    selection: &Selection,
+) -> Result<(Vec<ArcCheck>, HeldoutFolds), Error> {
+    let (arcs, arc_folds): (Vec<ArcCheck>, Vec<(usize, Vec<FoldResiduals>)>) = timings::phase("arcs", || {
+        arcs::arc_checks(arc_inputs, data, moving, &pooled.terms, selection, &|t| pooled.columns_of(t))
+    })?
+    .into_iter()
+    .map(|(check, folds)| {
+        let joint = check.joint;
+        (check, (joint, folds))
+    })
+    .unzip();
     let heldout_folds = HeldoutFolds {
         rows: data.rows.clone(),
-        random: fold_residuals::random_folds(&pool, &all_selected.fold_columns)?,
+        random: fold_residuals::random_folds(&pooled.pool, &selection.last().fold_columns)?,
         arcs: arc_folds,
     };
+    Ok((arcs, heldout_folds))
+}
 
-    // What any smooth function of the joint angles explains, before and after the effects.
-    let single_critical = statistics::normal_quantile(1.0 - options.selection.significance);
-    let link1: Vec<lie::SO3> = data
-        .rows
-        .iter()
-        .map(|row| Ok(model.frames(&row.q).map_err(Error::kinematics)?[0].rotation()))
-        .collect::<Result<_, Error>>()?;
-    let structure = |residuals: &[lie::Vector6]| {
-        structure::residual_structure(residuals, &link1, data, &moving, &fold, folds, &options.structure)
-    };
-    let (gp_before, gp_after) = if options.structure.enabled {
-        // The two are independent (each deterministic): run side by side, so that their ten fold
-        // fits share the threads.
-        let (before, after) = timings::phase("structure GP", || {
-            rayon::join(
-                || structure(&selection.baseline.residuals),
-                || (!selection.steps.is_empty()).then(|| structure(&all_selected.residuals)).transpose(),
-            )
-        });
-        (Some(before?), after?)
-    } else {
-        (None, None)
-    };
-    let explainable =
-        gp_before.as_ref().map(|s| GpCheck::new(&selection.baseline.errors, s, single_critical, &options.verdict));
-    let remaining = match &gp_after {
-        Some(s) => Some(GpCheck::new(&all_selected.errors, s, single_critical, &options.verdict)),
-        None if selection.steps.is_empty() => explainable.clone(),
-        None => None,
-    };
-    let noise = match (options.noise_mm, noise::from_repeats(data), noise::stated(data)) {
+/// 1-based prismatic joints.
+fn prismatic_joints(robot: &RobotDescription) -> Vec<usize> {
+    (0..robot.joint_count()).filter(|&j| robot.joints[j].kind == poe::JointKind::Prismatic).map(|j| j + 1).collect()
+}
+
+/// What any smooth function of the joint angles explains, before and after the effects.
+struct StructureChecks {
+    gp_before: Option<structure::Structure>,
+    gp_after: Option<structure::Structure>,
+    explainable: Option<GpCheck>,
+    remaining: Option<GpCheck>,
+}
+
+impl StructureChecks {
+    fn run(
+        geometry: &Geometry,
+        data: &MeasurementSet,
+        fold: &[usize],
+        selection: &Selection,
+        options: &DiagnoseOptions,
+    ) -> Result<Self, Error> {
+        let all_selected = selection.last();
+        let single_critical = statistics::normal_quantile(1.0 - options.selection.significance);
+        let link1: Vec<lie::SO3> = data
+            .rows
+            .iter()
+            .map(|row| Ok(geometry.model.frames(&row.q).map_err(Error::kinematics)?[0].rotation()))
+            .collect::<Result<_, Error>>()?;
+        let structure = |residuals: &[lie::Vector6]| {
+            let (moving, folds) = (&geometry.moving, options.folds);
+            structure::residual_structure(residuals, &link1, data, moving, fold, folds, &options.structure)
+        };
+        let (gp_before, gp_after) = if options.structure.enabled {
+            // The two are independent (each deterministic): run side by side, so that their ten fold
+            // fits share the threads.
+            let (before, after) = timings::phase("structure GP", || {
+                rayon::join(
+                    || structure(&selection.baseline.residuals),
+                    || (!selection.steps.is_empty()).then(|| structure(&all_selected.residuals)).transpose(),
+                )
+            });
+            (Some(before?), after?)
+        } else {
+            (None, None)
+        };
+        let explainable =
+            gp_before.as_ref().map(|s| GpCheck::new(&selection.baseline.errors, s, single_critical, &options.verdict));
+        let remaining = match &gp_after {
+            Some(s) => Some(GpCheck::new(&all_selected.errors, s, single_critical, &options.verdict)),
+            None if selection.steps.is_empty() => explainable.clone(),
+            None => None,
+        };
+        Ok(Self { gp_before, gp_after, explainable, remaining })
+    }
+
+    /// The 1-based joints of a GP that found significant structure (after the effects if it did
+    /// there), for an `unknown` verdict; an insignificant GP's length scales point nowhere.
+    fn telling_joints(&self, short_length_scale: f64) -> Vec<usize> {
+        let significant = |check: &Option<GpCheck>| check.as_ref().is_some_and(|c| c.significant);
+        let telling = if significant(&self.remaining) && self.gp_after.is_some() {
+            self.gp_after.as_ref()
+        } else if significant(&self.explainable) {
+            self.gp_before.as_ref()
+        } else {
+            None
+        };
+        telling.map_or(vec![], |s| {
+            let mut joints: Vec<usize> = s
+                .relevant(short_length_scale)
+                .into_iter()
+                .filter_map(|(input, _)| match input {
+                    GpInput::Joint(j) => Some(j),
+                    _ => None,
+                })
+                .collect();
+            joints.sort_unstable();
+            joints
+        })
+    }
+}
+
+/// The noise floor: given, from repeated poses, stated by the data, or the instrument's default.
+fn noise_floor(data: &MeasurementSet, options: &DiagnoseOptions) -> NoiseFloor {
+    match (options.noise_mm, noise::from_repeats(data), noise::stated(data)) {
         (Some(sigma), _, _) => NoiseFloor::from_sigma(sigma, NoiseSource::Given),
         (None, Some(sigma), _) => NoiseFloor::from_sigma(sigma, NoiseSource::Repeats),
         (None, None, Some(sigma)) => NoiseFloor::from_sigma(sigma, NoiseSource::Stated),
         (None, None, None) => noise::tracker_default(data, &options.tracker),
-    };
+    }
+}
+
+/// The verdict (before the gross outliers have their say) and the mean held-out error, m, with
+/// its effect alone where that differs from every selected effect.
+fn name_verdict(
+    pooled: &Pooled,
+    selection: &Selection,
+    checks: &StructureChecks,
+    noise: &NoiseFloor,
+    options: &DiagnoseOptions,
+) -> Result<(verdict::Decision, Verdict, Option<f64>), Error> {
+    let (terms, all_selected) = (&pooled.terms, selection.last());
     let evidence = verdict::Evidence {
         before: &selection.baseline.errors,
         selected: &all_selected.errors,
-        gp_before: gp_before
+        gp_before: checks
+            .gp_before
             .as_ref()
-            .map(|s| (s.errors.as_slice(), explainable.as_ref().is_some_and(|c| c.significant))),
-        gp_after: gp_after.as_ref().map(|s| s.errors.as_slice()),
+            .map(|s| (s.errors.as_slice(), checks.explainable.as_ref().is_some_and(|c| c.significant))),
+        gp_after: checks.gp_after.as_ref().map(|s| s.errors.as_slice()),
         floor: noise.floor_mm * 1e-3,
     };
     let decision = verdict::decide(&evidence, !selection.steps.is_empty(), &options.verdict);
     let (verdict, verdict_result) = match selection.steps.first() {
-        _ if decision.unknown => {
-            // The joints of a GP that found significant structure (after the effects if it did
-            // there); an insignificant GP's length scales point nowhere.
-            let significant = |check: &Option<GpCheck>| check.as_ref().is_some_and(|c| c.significant);
-            let telling = if significant(&remaining) && gp_after.is_some() {
-                gp_after.as_ref()
-            } else if significant(&explainable) {
-                gp_before.as_ref()
-            } else {
-                None
-            };
-            let relevant = telling.map_or(vec![], |s| {
-                let mut joints: Vec<usize> = s
-                    .relevant(options.structure.short_length_scale)
-                    .into_iter()
-                    .filter_map(|(input, _)| match input {
-                        GpInput::Joint(j) => Some(j),
-                        _ => None,
-                    })
-                    .collect();
-                joints.sort_unstable();
-                joints
-            });
-            (Verdict { effect: Effect::Unknown, joints: relevant }, None)
-        }
+        _ if decision.unknown => (
+            Verdict { effect: Effect::Unknown, joints: checks.telling_joints(options.structure.short_length_scale) },
+            None,
+        ),
         None => (Verdict { effect: Effect::None, joints: vec![] }, None),
         Some(first) => {
             let effect = terms[first.term].effect;
@@ -617,30 +775,38 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
             let result = if keep.len() == selection.steps.len() {
                 None
             } else {
-                Some(selection::with_steps(&pool, &terms, &selection, &keep)?)
+                Some(selection::with_steps(&pooled.pool, terms, selection, &keep)?)
             };
             (Verdict { effect, joints }, Some(result.map_or(all_selected.mean_error(), |r| r.mean_error())))
         }
     };
-    let gross_outliers = screened.judged(&all_selected.errors);
-    let (verdict, verdict_result) = gross_outliers.verdict(verdict, verdict_result);
-    let shapes = series_shapes(&pool, &terms, &selection, data)?;
+    Ok((decision, verdict, verdict_result))
+}
 
+/// Every pose's residuals before and after the selected effects, in the robot's base frame.
+fn pose_diagnoses(
+    robot: &RobotDescription,
+    nominal: &LocalPoe,
+    geometry: &Geometry,
+    data: &MeasurementSet,
+    selection: &Selection,
+) -> Result<Vec<PoseDiagnosis>, Error> {
+    let all_selected = selection.last();
     // Base-frame axes for the breakdown: tracker_from_base = calibrated · nominal⁻¹ at q = 0.
     let zero = vec![0.0; robot.joint_count()];
-    let tracker_from_base = model.frames(&zero).map_err(Error::kinematics)?[0]
+    let tracker_from_base = geometry.model.frames(&zero).map_err(Error::kinematics)?[0]
         * nominal.frames(&zero).map_err(Error::kinematics)?[0].inverse();
     let base_from_tracker = tracker_from_base.inverse();
     let to_base = |v: &lie::Vector6| -> [f64; 3] {
         let r = base_from_tracker.rotation().act(&Vector3::new(v[0], v[1], v[2])) * 1e3;
         [r.x, r.y, r.z]
     };
-    let poses: Vec<PoseDiagnosis> = data
+    Ok(data
         .rows
         .iter()
         .enumerate()
         .map(|(i, row)| {
-            let p = base_from_tracker.transform_point(&design.points[i]);
+            let p = base_from_tracker.transform_point(&geometry.design.points[i]);
             let (b, a) = (&selection.baseline.residuals[i], &all_selected.residuals[i]);
             let rotation = |v: &lie::Vector6| Vector3::new(v[3], v[4], v[5]).norm() * 1e3;
             PoseDiagnosis {
@@ -656,12 +822,11 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
                 rotation_mrad: data.full_pose.then(|| [rotation(b), rotation(a)]),
             }
         })
-        .collect();
-    let prismatic: Vec<usize> = (0..robot.joint_count())
-        .filter(|&j| robot.joints[j].kind == poe::JointKind::Prismatic)
-        .map(|j| j + 1)
-        .collect();
-    let regions = regions::regions(&poses, &moving, &prismatic);
+        .collect())
+}
+
+/// Every candidate tried alone on top of the geometric model, best first.
+fn candidate_scores(terms: &[Term], selection: &Selection) -> Vec<CandidateScore> {
     let mut scores: Vec<CandidateScore> = terms
         .iter()
         .zip(&selection.single)
@@ -674,7 +839,17 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
         })
         .collect();
     scores.sort_by(|a, b| a.heldout_after_mm.total_cmp(&b.heldout_after_mm));
-    let selected: Vec<SelectedEffect> = selection
+    scores
+}
+
+/// The effects kept, in the order they were selected, with their shapes and order curves.
+fn selected_effects(
+    terms: &[Term],
+    selection: &Selection,
+    shapes: Vec<Option<SeriesShape>>,
+    order_curves: Vec<Vec<OrderScore>>,
+) -> Vec<SelectedEffect> {
+    selection
         .steps
         .iter()
         .zip(shapes)
@@ -689,31 +864,5 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
             heldout_after_mm: s.scored.result.mean_error() * 1e3,
             z: s.z,
         })
-        .collect();
-    let before_mm = selection.baseline.mean_error() * 1e3;
-    Ok(Diagnosis {
-        robot: robot.name.clone(),
-        n: data.rows.len(),
-        full_pose: data.full_pose,
-        moving_joints: moving.iter().map(|j| j + 1).collect(),
-        prismatic_joints: prismatic,
-        verdict,
-        heldout_before_mm: before_mm,
-        heldout_after_mm: verdict_result.map_or(before_mm, |m| m * 1e3),
-        heldout_after_selected_mm: all_selected.mean_error() * 1e3,
-        explained_fraction: decision.explained_fraction,
-        candidates: scores,
-        selected,
-        critical_z: selection.critical_z,
-        explainable,
-        remaining,
-        noise,
-        regions,
-        off_poses_before_mm: arcs::mean_of(&arcs, |a| a.before_mm),
-        off_poses_after_mm: arcs::mean_of(&arcs, |a| a.after_mm),
-        arcs,
-        poses,
-        gross_outliers,
-        folds: heldout_folds,
-    })
+        .collect()
 }

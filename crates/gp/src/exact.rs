@@ -9,10 +9,10 @@ use crate::Error;
 use crate::cholesky::{Factor, JitterOutcome};
 use crate::config::{GpConfig, OutputMode, Parallelism};
 use crate::gram::training_covariance;
-use crate::kernel::KernelChoice;
+use crate::kernel::{Bounds, KernelChoice};
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::lml::check_finite_outputs;
-use crate::optimise::{OptimisationReport, finish_from, fit_hyperparameters_from, refine, warm_stage_from};
+use crate::optimise::{OptimisationReport, WarmStage, finish_from, fit_hyperparameters_from, refine, warm_stage_from};
 use crate::points::Points;
 use crate::scaling::{InputStandardiser, OutputNormaliser};
 
@@ -130,6 +130,319 @@ enum Hyperparameters<'a> {
     Fixed(&'a [Kernel]),
 }
 
+/// A kernel with its factorisation, and what its fit did.
+type Fitted = (Component, ComponentReport);
+
+/// The output groups searched (one per output, or one for all), and the follower groups that are
+/// fitted from the searched kernel that explains them best (searched hyperparameters and
+/// independent outputs only).
+fn output_groups(how: &Hyperparameters<'_>, config: &GpConfig, m: usize) -> Result<[Vec<Vec<usize>>; 2], Error> {
+    let followers: Vec<Vec<usize>> =
+        if matches!(how, Hyperparameters::Optimise(_)) && config.outputs == OutputMode::Independent {
+            config.follower_groups.clone()
+        } else {
+            Vec::new()
+        };
+    let mut follows = vec![false; m];
+    for &j in followers.iter().flatten() {
+        if j >= m || follows[j] {
+            return Err(Error::InvalidConfig { field: "follower_groups", value: j as f64 });
+        }
+        follows[j] = true;
+    }
+    if followers.iter().any(Vec::is_empty) || (!followers.is_empty() && follows.iter().all(|f| *f)) {
+        return Err(Error::InvalidConfig { field: "follower_groups", value: followers.len() as f64 });
+    }
+    let groups: Vec<Vec<usize>> = match config.outputs {
+        OutputMode::Independent => (0..m).filter(|&j| !follows[j]).map(|j| vec![j]).collect(),
+        OutputMode::Shared => vec![(0..m).collect()],
+    };
+    Ok([groups, followers])
+}
+
+/// What every output group's fit reads: the scaled training data, the config, and whether the
+/// hyperparameters are searched or given.
+struct GroupFits<'a> {
+    xs: &'a Points,
+    /// Normalised outputs, `n × m`.
+    yn: &'a Mat<f64>,
+    config: &'a GpConfig,
+    how: &'a Hyperparameters<'a>,
+}
+
+/// One group of outputs: their columns and their normalised values, `n × cols.len()`.
+#[derive(Clone, Copy)]
+struct Group<'g> {
+    cols: &'g [usize],
+    y: MatRef<'g, f64>,
+}
+
+impl GroupFits<'_> {
+    /// The normalised outputs `cols`, `n × cols.len()`.
+    fn outputs(&self, cols: &[usize]) -> Mat<f64> {
+        Mat::from_fn(self.yn.nrows(), cols.len(), |i, c| self.yn[(i, cols[c])])
+    }
+
+    /// The configured search box, or `kernel`'s default one.
+    fn bounds_of(&self, kernel: &Kernel) -> Bounds {
+        self.config.bounds.clone().unwrap_or_else(|| kernel.default_bounds())
+    }
+
+    /// `start`, then `nested` (its own nested starts unless a fitted smaller model gives better ones).
+    fn search(&self, start: &Kernel, nested: &[Kernel], g: Group<'_>) -> Result<(Kernel, OptimisationReport), Error> {
+        start.validate(self.xs.dim())?;
+        let (bounds, config) = (self.bounds_of(start), self.config);
+        let o = fit_hyperparameters_from(start, nested, &bounds, self.xs, g.y, &config.optimiser, config.parallelism)?;
+        Ok((o.kernel, o.report))
+    }
+
+    /// `kernel` factorised on group `g`, with its report.
+    fn build(&self, kernel: Kernel, g: Group<'_>, optimisation: Option<OptimisationReport>) -> Result<Fitted, Error> {
+        kernel.validate(self.xs.dim())?;
+        let config = self.config;
+        let (component, jitter) =
+            Component::build(kernel.clone(), g.cols.to_vec(), self.xs, g.y, None, config, config.parallelism)?;
+        let lml = component.log_marginal_likelihood(g.y);
+        let report = ComponentReport {
+            outputs: g.cols.to_vec(),
+            kernel,
+            log_marginal_likelihood: lml,
+            jitter,
+            optimisation,
+            additive_choice: None,
+            isotropic_choice: None,
+        };
+        Ok((component, report))
+    }
+
+    /// Group `index` (outputs `cols`) at its given hyperparameters, or searched, with the Schwarz
+    /// choice of the additive term where the config asks for it.
+    fn fit_searched(&self, index: usize, cols: &[usize]) -> Result<Fitted, Error> {
+        let y = self.outputs(cols);
+        let g = Group { cols, y: y.as_ref() };
+        let start = match self.how {
+            Hyperparameters::Fixed(kernels) => {
+                return self.build(kernels[index.min(kernels.len() - 1)].clone(), g, None);
+            }
+            Hyperparameters::Optimise(start) => *start,
+        };
+        let reduced = if self.config.additive_by_bic { start.without_additive() } else { None };
+        let Some(reduced) = reduced else {
+            let (kernel, report) = self.search(start, &start.nested_starts(), g)?;
+            return self.build(kernel, g, Some(report));
+        };
+        match self.additive_on_subset(start, &reduced, g)? {
+            Some(fitted) => Ok(fitted),
+            None => self.additive_on_all_rows(start, &reduced, g),
+        }
+    }
+
+    /// The Schwarz choice: ½ k ln N for the additive term's k extra hyperparameters (`start`'s
+    /// over `reduced`'s) over the N = rows · (outputs served) values the two likelihoods are
+    /// computed on.
+    fn penalty(start: &Kernel, reduced: &Kernel, served: usize, rows: usize) -> f64 {
+        let k = (start.parameter_count() - reduced.parameter_count()) as f64;
+        0.5 * k * ((rows * served) as f64).ln()
+    }
+
+    /// With a warm-start subset, both kernels are searched there and the choice is made on the
+    /// subset's likelihoods; only the chosen kernel is searched on all rows. `None` without a
+    /// subset.
+    ///
+    /// The larger kernel's nested start is the smaller one's subset optimum with the additive term
+    /// nearly off ([`Kernel::nested_at`]), searched after it beside the default start: the same
+    /// nesting as [`Kernel::nested_starts`] without walking the smaller model's path a second time.
+    fn additive_on_subset(&self, start: &Kernel, reduced: &Kernel, g: Group<'_>) -> Result<Option<Fitted>, Error> {
+        let (config, xs) = (self.config, self.xs);
+        let warm_from = |k: &Kernel, nested: &[Kernel], optimiser: &crate::OptimiserConfig| {
+            k.validate(xs.dim())?;
+            warm_stage_from(k, nested, &self.bounds_of(k), xs, g.y, optimiser, config.parallelism)
+        };
+        // Random restarts, when configured, belong to the default start's stage alone.
+        let once = crate::OptimiserConfig { restarts: 0, ..config.optimiser.clone() };
+        let warm = both(
+            config.parallelism,
+            || Ok((warm_from(start, &[], &config.optimiser)?, None)),
+            || {
+                let without = warm_from(reduced, &[], &config.optimiser)?;
+                let nested = match &without {
+                    Some(stage) => start
+                        .nested_at(&stage.best_kernel(reduced)?)
+                        .or_else(|| start.nested_starts().into_iter().next()),
+                    None => None,
+                };
+                let nested = match nested {
+                    Some(nested) => warm_from(&nested, &[], &once)?,
+                    None => None,
+                };
+                Ok::<_, Error>((without, nested))
+            },
+        );
+        let ((with, _), (without, nested)) = (warm.0?, warm.1?);
+        let with = match (with, nested) {
+            (Some(with), Some(nested)) => Some(with.join(nested)),
+            (with, _) => with,
+        };
+        let (Some(with), Some(without)) = (with, without) else { return Ok(None) };
+        let rows = with.rows();
+        let (a, b) = (with.best_log_marginal_likelihood(), without.best_log_marginal_likelihood());
+        let penalty = Self::penalty(start, reduced, g.cols.len(), rows);
+        let kept = a - b > penalty;
+        let choice = AdditiveChoice { with_additive: a, without_additive: b, penalty, kept, rows };
+        let (chosen, stage) = if kept { (start, with) } else { (reduced, without) };
+        let (bounds, nested) = (self.bounds_of(chosen), chosen.nested_starts());
+        let o = finish_from(chosen, &nested, &bounds, xs, g.y, &config.optimiser, config.parallelism, Some(stage))?;
+        let (component, mut report) = self.build(o.kernel, g, Some(o.report))?;
+        report.additive_choice = Some(choice);
+        Ok(Some((component, report)))
+    }
+
+    /// Without a subset, the same nesting on all rows: the smaller kernel first, then the larger
+    /// one from its default start and from the smaller one's optimum.
+    fn additive_on_all_rows(&self, start: &Kernel, reduced: &Kernel, g: Group<'_>) -> Result<Fitted, Error> {
+        let n = g.y.nrows();
+        let (small_kernel, small_report) = self.search(reduced, &reduced.nested_starts(), g)?;
+        let nested = start.nested_at(&small_kernel).map_or_else(|| start.nested_starts(), |k| vec![k]);
+        let (full_kernel, full_report) = self.search(start, &nested, g)?;
+        let with = self.build(full_kernel, g, Some(full_report))?;
+        let without = self.build(small_kernel, g, Some(small_report))?;
+        let penalty = Self::penalty(start, reduced, g.cols.len(), n);
+        let choice = AdditiveChoice {
+            with_additive: with.1.log_marginal_likelihood,
+            without_additive: without.1.log_marginal_likelihood,
+            penalty,
+            kept: with.1.log_marginal_likelihood - without.1.log_marginal_likelihood > penalty,
+            rows: n,
+        };
+        let (component, mut report) = if choice.kept { with } else { without };
+        report.additive_choice = Some(choice);
+        Ok((component, report))
+    }
+
+    /// Leave-one-out log predictive probability (R&W Eq. 5.11), summed over rows and outputs.
+    fn loo(&self, c: &Component) -> f64 {
+        c.log_predictive(&c.inverse_diagonal(self.config.parallelism.faer())).iter().sum()
+    }
+
+    /// The paper's Eq. 5 beside the searched kernel, kept where it predicts the rows it has not
+    /// seen better (leave-one-out, R&W Eq. 5.11).
+    fn with_isotropic(&self, searched: Fitted, cols: &[usize]) -> Result<Fitted, Error> {
+        let (config, xs) = (self.config, self.xs);
+        let optimised = matches!(self.how, Hyperparameters::Optimise(_));
+        if !config.isotropic_by_loo || !optimised || matches!(searched.1.kernel, Kernel::Quadratic(_)) {
+            return Ok(searched);
+        }
+        let y = self.outputs(cols);
+        let g = Group { cols, y: y.as_ref() };
+        let start = Kernel::start(KernelChoice::Quadratic, xs.dim());
+        let (bounds, nested) = (start.default_bounds(), start.nested_starts());
+        let (optimiser, parallelism) = (&config.optimiser, config.parallelism);
+        let stage = warm_stage_from(&start, &nested, &bounds, xs, g.y, optimiser, parallelism)?;
+        let screened = match &stage {
+            Some(stage) => self.isotropic_screen(&searched, stage, &start, g)?,
+            None => None,
+        };
+        if let Some(choice) = screened {
+            let (component, mut report) = searched;
+            report.isotropic_choice = Some(choice);
+            return Ok((component, report));
+        }
+        let searched_loo = self.loo(&searched.0);
+        if let Some(stage) = &stage {
+            // The subset's optimum compared on all rows first: a full search only when the
+            // isotropic kernel already predicts better from there.
+            let at_subset = self.build(stage.best_kernel(&start)?, g, None)?;
+            let at_subset_loo = self.loo(&at_subset.0);
+            if at_subset_loo <= searched_loo {
+                return Ok(choose_isotropic(searched, at_subset, (searched_loo, at_subset_loo), stage.rows()));
+            }
+        }
+        let o = finish_from(&start, &nested, &bounds, xs, g.y, optimiser, parallelism, stage)?;
+        let isotropic = self.build(o.kernel, g, Some(o.report))?;
+        let isotropic_loo = self.loo(&isotropic.0);
+        Ok(choose_isotropic(searched, isotropic, (searched_loo, isotropic_loo), g.y.nrows()))
+    }
+
+    /// Screened on the subset first, each kernel's leave-one-out over the subset's own rows: the
+    /// isotropic kernel at its subset optimum, fitted to those rows, against the searched kernel
+    /// at its all-rows optimum. Where the isotropic kernel predicts the rows it was fitted to no
+    /// better, it is not compared on all rows (two factorisations and an inverse of the full
+    /// covariance saved): the choice to report, else `None`.
+    fn isotropic_screen(
+        &self,
+        searched: &Fitted,
+        stage: &WarmStage,
+        start: &Kernel,
+        g: Group<'_>,
+    ) -> Result<Option<IsotropicChoice>, Error> {
+        let (config, idx) = (self.config, stage.indices());
+        let sub_x = self.xs.select(idx);
+        let sub_y = Mat::from_fn(idx.len(), g.cols.len(), |i, c| g.y[(idx[i], c)]);
+        let on_subset = |kernel: Kernel| -> Result<f64, Error> {
+            let (c, _) =
+                Component::build(kernel, g.cols.to_vec(), &sub_x, sub_y.as_ref(), None, config, config.parallelism)?;
+            Ok(self.loo(&c))
+        };
+        let (sub_searched, sub_isotropic) =
+            (on_subset(searched.1.kernel.clone())?, on_subset(stage.best_kernel(start)?)?);
+        Ok((sub_isotropic <= sub_searched).then(|| IsotropicChoice {
+            searched: sub_searched,
+            isotropic: sub_isotropic,
+            kept_isotropic: false,
+            isotropic_search_rows: stage.rows(),
+            compared_rows: Some(stage.rows()),
+        }))
+    }
+
+    /// A follower group (outputs `cols`) from the fitted kernel among `leaders` that explains it
+    /// best, refined on all rows.
+    fn follow(&self, leaders: &[Kernel], cols: &[usize]) -> Result<Fitted, Error> {
+        let config = self.config;
+        let y = self.outputs(cols);
+        let g = Group { cols, y: y.as_ref() };
+        let mut best: Option<(f64, &Kernel)> = None;
+        for kernel in leaders {
+            let (component, _) =
+                Component::build(kernel.clone(), cols.to_vec(), self.xs, g.y, None, config, config.parallelism)?;
+            let lml = component.log_marginal_likelihood(g.y);
+            if best.is_none_or(|(b, _)| lml > b) {
+                best = Some((lml, kernel));
+            }
+        }
+        let start = best.map(|(_, k)| k).ok_or(Error::OptimisationFailed { starts: 0 })?;
+        // The configured box where it is the chosen kernel's (its family may differ: the
+        // isotropic kernel or the form without the additive term).
+        let bounds = config
+            .bounds
+            .clone()
+            .filter(|b| b.lower.len() == start.parameter_count())
+            .unwrap_or_else(|| start.default_bounds());
+        let o = refine(start, &bounds, self.xs, g.y, &config.optimiser, config.parallelism)?;
+        self.with_isotropic(self.build(o.kernel, g, Some(o.report))?, cols)
+    }
+}
+
+/// The searched or the isotropic kernel, whichever has the larger leave-one-out sum
+/// (`(searched, isotropic)`), with the choice in its report; `rows` the isotropic search's.
+fn choose_isotropic(
+    searched: Fitted,
+    isotropic: Fitted,
+    (searched_loo, isotropic_loo): (f64, f64),
+    rows: usize,
+) -> Fitted {
+    let kept_isotropic = isotropic_loo > searched_loo;
+    let choice = IsotropicChoice {
+        searched: searched_loo,
+        isotropic: isotropic_loo,
+        kept_isotropic,
+        isotropic_search_rows: rows,
+        compared_rows: None,
+    };
+    let (component, mut report) = if kept_isotropic { isotropic } else { searched };
+    report.isotropic_choice = Some(choice);
+    (component, report)
+}
+
 impl ExactGp {
     /// Fits the model: inputs `x` (n × d), outputs `y` (n × m), hyperparameters found by maximising
     /// the log marginal likelihood from the default start of `config.kernel`.
@@ -167,7 +480,7 @@ impl ExactGp {
     ) -> Result<Self, Error> {
         config.validate()?;
         let raw = validate_training_data(x, y)?;
-        let (n, m) = (y.nrows(), y.ncols());
+        let m = y.ncols();
         let inputs = if config.standardise_inputs {
             InputStandardiser::fit(&raw)
         } else {
@@ -176,237 +489,9 @@ impl ExactGp {
         let outputs = if config.normalise_outputs { OutputNormaliser::fit(y) } else { OutputNormaliser::identity(m) };
         let xs = inputs.apply_points(&raw);
         let yn = outputs.normalise(y);
-        let followers: Vec<Vec<usize>> =
-            if matches!(how, Hyperparameters::Optimise(_)) && config.outputs == OutputMode::Independent {
-                config.follower_groups.clone()
-            } else {
-                Vec::new()
-            };
-        let mut follows = vec![false; m];
-        for &j in followers.iter().flatten() {
-            if j >= m || follows[j] {
-                return Err(Error::InvalidConfig { field: "follower_groups", value: j as f64 });
-            }
-            follows[j] = true;
-        }
-        if followers.iter().any(Vec::is_empty) || (!followers.is_empty() && follows.iter().all(|f| *f)) {
-            return Err(Error::InvalidConfig { field: "follower_groups", value: followers.len() as f64 });
-        }
-        let groups: Vec<Vec<usize>> = match config.outputs {
-            OutputMode::Independent => (0..m).filter(|&j| !follows[j]).map(|j| vec![j]).collect(),
-            OutputMode::Shared => vec![(0..m).collect()],
-        };
-        // `start`, then `nested` (its own nested starts unless a fitted smaller model gives
-        // better ones).
-        let search =
-            |start: &Kernel, nested: &[Kernel], yg: MatRef<'_, f64>| -> Result<(Kernel, OptimisationReport), Error> {
-                start.validate(xs.dim())?;
-                let bounds = config.bounds.clone().unwrap_or_else(|| start.default_bounds());
-                let o =
-                    fit_hyperparameters_from(start, nested, &bounds, &xs, yg, &config.optimiser, config.parallelism)?;
-                Ok((o.kernel, o.report))
-            };
-        let build = |kernel: Kernel, cols: &Vec<usize>, yg: MatRef<'_, f64>, optimisation| {
-            kernel.validate(xs.dim())?;
-            let (component, jitter) =
-                Component::build(kernel.clone(), cols.clone(), &xs, yg, None, config, config.parallelism)?;
-            let lml = component.log_marginal_likelihood(yg);
-            let report = ComponentReport {
-                outputs: cols.clone(),
-                kernel,
-                log_marginal_likelihood: lml,
-                jitter,
-                optimisation,
-                additive_choice: None,
-                isotropic_choice: None,
-            };
-            Ok::<_, Error>((component, report))
-        };
-        let fit_searched = |(g, cols): (usize, &Vec<usize>)| -> Result<(Component, ComponentReport), Error> {
-            let yg = Mat::from_fn(n, cols.len(), |i, c| yn[(i, cols[c])]);
-            let start = match &how {
-                Hyperparameters::Fixed(kernels) => {
-                    return build(kernels[g.min(kernels.len() - 1)].clone(), cols, yg.as_ref(), None);
-                }
-                Hyperparameters::Optimise(start) => *start,
-            };
-            let reduced = if config.additive_by_bic { start.without_additive() } else { None };
-            let Some(reduced) = reduced else {
-                let (kernel, report) = search(start, &start.nested_starts(), yg.as_ref())?;
-                return build(kernel, cols, yg.as_ref(), Some(report));
-            };
-            // The Schwarz choice: ½ k ln N for the additive term's k extra hyperparameters over
-            // the N = rows · (outputs served) values the two likelihoods are computed on.
-            let k = (start.parameter_count() - reduced.parameter_count()) as f64;
-            let penalty = |rows: usize| 0.5 * k * ((rows * cols.len()) as f64).ln();
-            let bounds_of = |k: &Kernel| config.bounds.clone().unwrap_or_else(|| k.default_bounds());
-            // With a warm-start subset, both kernels are searched there and the choice is made
-            // on the subset's likelihoods; only the chosen kernel is searched on all rows.
-            //
-            // The larger kernel's nested start is the smaller one's subset optimum with the
-            // additive term nearly off ([`Kernel::nested_at`]), searched after it beside the
-            // default start: the same nesting as [`Kernel::nested_starts`] without walking the
-            // smaller model's path a second time.
-            let warm_from = |k: &Kernel, nested: &[Kernel], optimiser: &crate::OptimiserConfig| {
-                k.validate(xs.dim())?;
-                warm_stage_from(k, nested, &bounds_of(k), &xs, yg.as_ref(), optimiser, config.parallelism)
-            };
-            // Random restarts, when configured, belong to the default start's stage alone.
-            let once = crate::OptimiserConfig { restarts: 0, ..config.optimiser.clone() };
-            let warm = both(
-                config.parallelism,
-                || Ok((warm_from(start, &[], &config.optimiser)?, None)),
-                || {
-                    let without = warm_from(&reduced, &[], &config.optimiser)?;
-                    let nested = match &without {
-                        Some(stage) => start
-                            .nested_at(&stage.best_kernel(&reduced)?)
-                            .or_else(|| start.nested_starts().into_iter().next()),
-                        None => None,
-                    };
-                    let nested = match nested {
-                        Some(nested) => warm_from(&nested, &[], &once)?,
-                        None => None,
-                    };
-                    Ok::<_, Error>((without, nested))
-                },
-            );
-            let ((with, _), (without, nested)) = (warm.0?, warm.1?);
-            let with = match (with, nested) {
-                (Some(with), Some(nested)) => Some(with.join(nested)),
-                (with, _) => with,
-            };
-            if let (Some(with), Some(without)) = (with, without) {
-                let rows = with.rows();
-                let (a, b) = (with.best_log_marginal_likelihood(), without.best_log_marginal_likelihood());
-                let kept = a - b > penalty(rows);
-                let choice =
-                    AdditiveChoice { with_additive: a, without_additive: b, penalty: penalty(rows), kept, rows };
-                let (chosen, stage) = if kept { (start, with) } else { (&reduced, without) };
-                let o = finish_from(
-                    chosen,
-                    &chosen.nested_starts(),
-                    &bounds_of(chosen),
-                    &xs,
-                    yg.as_ref(),
-                    &config.optimiser,
-                    config.parallelism,
-                    Some(stage),
-                )?;
-                let (component, mut report) = build(o.kernel, cols, yg.as_ref(), Some(o.report))?;
-                report.additive_choice = Some(choice);
-                return Ok((component, report));
-            }
-            // Without a subset, the same nesting on all rows: the smaller kernel first, then the
-            // larger one from its default start and from the smaller one's optimum.
-            let (small_kernel, small_report) = search(&reduced, &reduced.nested_starts(), yg.as_ref())?;
-            let nested = start.nested_at(&small_kernel).map_or_else(|| start.nested_starts(), |k| vec![k]);
-            let (full_kernel, full_report) = search(start, &nested, yg.as_ref())?;
-            let with = build(full_kernel, cols, yg.as_ref(), Some(full_report))?;
-            let without = build(small_kernel, cols, yg.as_ref(), Some(small_report))?;
-            let choice = AdditiveChoice {
-                with_additive: with.1.log_marginal_likelihood,
-                without_additive: without.1.log_marginal_likelihood,
-                penalty: penalty(n),
-                kept: with.1.log_marginal_likelihood - without.1.log_marginal_likelihood > penalty(n),
-                rows: n,
-            };
-            let (component, mut report) = if choice.kept { with } else { without };
-            report.additive_choice = Some(choice);
-            Ok((component, report))
-        };
-        // The paper's Eq. 5 beside the searched kernel, kept where it predicts the rows it has not
-        // seen better (leave-one-out, R&W Eq. 5.11).
-        let loo =
-            |c: &Component| -> f64 { c.log_predictive(&c.inverse_diagonal(config.parallelism.faer())).iter().sum() };
-        let with_isotropic = |searched: (Component, ComponentReport),
-                              cols: &Vec<usize>|
-         -> Result<(Component, ComponentReport), Error> {
-            let optimised = matches!(how, Hyperparameters::Optimise(_));
-            if !config.isotropic_by_loo || !optimised || matches!(searched.1.kernel, Kernel::Quadratic(_)) {
-                return Ok(searched);
-            }
-            let yg = Mat::from_fn(n, cols.len(), |i, c| yn[(i, cols[c])]);
-            let start = Kernel::start(KernelChoice::Quadratic, xs.dim());
-            let bounds = start.default_bounds();
-            let choose = |searched: (Component, ComponentReport),
-                          isotropic: (Component, ComponentReport),
-                          (searched_loo, isotropic_loo): (f64, f64),
-                          rows| {
-                let kept_isotropic = isotropic_loo > searched_loo;
-                let choice = IsotropicChoice {
-                    searched: searched_loo,
-                    isotropic: isotropic_loo,
-                    kept_isotropic,
-                    isotropic_search_rows: rows,
-                    compared_rows: None,
-                };
-                let (component, mut report) = if kept_isotropic { isotropic } else { searched };
-                report.isotropic_choice = Some(choice);
-                (component, report)
-            };
-            let stage = warm_stage_from(
-                &start,
-                &start.nested_starts(),
-                &bounds,
-                &xs,
-                yg.as_ref(),
-                &config.optimiser,
-                config.parallelism,
-            )?;
-            if let Some(stage) = &stage {
-                // Screened on the subset first, each kernel's leave-one-out over the subset's own
-                // rows: the isotropic kernel at its subset optimum, fitted to those rows, against
-                // the searched kernel at its all-rows optimum. Where the isotropic kernel predicts
-                // the rows it was fitted to no better, it is not compared on all rows (two
-                // factorisations and an inverse of the full covariance saved).
-                let idx = stage.indices();
-                let sub_x = xs.select(idx);
-                let sub_y = Mat::from_fn(idx.len(), cols.len(), |i, c| yg[(idx[i], c)]);
-                let on_subset = |kernel: Kernel| -> Result<f64, Error> {
-                    let (c, _) = Component::build(
-                        kernel,
-                        cols.clone(),
-                        &sub_x,
-                        sub_y.as_ref(),
-                        None,
-                        config,
-                        config.parallelism,
-                    )?;
-                    Ok(loo(&c))
-                };
-                let (sub_searched, sub_isotropic) =
-                    (on_subset(searched.1.kernel.clone())?, on_subset(stage.best_kernel(&start)?)?);
-                if sub_isotropic <= sub_searched {
-                    let (component, mut report) = searched;
-                    report.isotropic_choice = Some(IsotropicChoice {
-                        searched: sub_searched,
-                        isotropic: sub_isotropic,
-                        kept_isotropic: false,
-                        isotropic_search_rows: stage.rows(),
-                        compared_rows: Some(stage.rows()),
-                    });
-                    return Ok((component, report));
-                }
-            }
-            let searched_loo = loo(&searched.0);
-            if let Some(stage) = &stage {
-                // The subset's optimum compared on all rows first: a full search only when the
-                // isotropic kernel already predicts better from there.
-                let at_subset = build(stage.best_kernel(&start)?, cols, yg.as_ref(), None)?;
-                let at_subset_loo = loo(&at_subset.0);
-                if at_subset_loo <= searched_loo {
-                    return Ok(choose(searched, at_subset, (searched_loo, at_subset_loo), stage.rows()));
-                }
-            }
-            let nested = start.nested_starts();
-            let o =
-                finish_from(&start, &nested, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism, stage)?;
-            let isotropic = build(o.kernel, cols, yg.as_ref(), Some(o.report))?;
-            let isotropic_loo = loo(&isotropic.0);
-            Ok(choose(searched, isotropic, (searched_loo, isotropic_loo), n))
-        };
-        let fit_group = |(g, cols): (usize, &Vec<usize>)| with_isotropic(fit_searched((g, cols))?, cols);
+        let [groups, followers] = output_groups(&how, config, m)?;
+        let fits = GroupFits { xs: &xs, yn: &yn, config, how: &how };
+        let fit_group = |(g, cols): (usize, &Vec<usize>)| fits.with_isotropic(fits.fit_searched(g, cols)?, cols);
         let fitted: Vec<_> = match config.parallelism {
             Parallelism::Sequential => groups.iter().enumerate().map(fit_group).collect(),
             Parallelism::Rayon => groups.par_iter().enumerate().map(fit_group).collect(),
@@ -414,28 +499,7 @@ impl ExactGp {
         let mut fitted = fitted.into_iter().collect::<Result<Vec<_>, _>>()?;
         // Each follower group from the fitted kernel that explains it best, refined on all rows.
         let leaders: Vec<Kernel> = fitted.iter().map(|(_, r)| r.kernel.clone()).collect();
-        let follow = |cols: &Vec<usize>| -> Result<(Component, ComponentReport), Error> {
-            let yg = Mat::from_fn(n, cols.len(), |i, c| yn[(i, cols[c])]);
-            let mut best: Option<(f64, &Kernel)> = None;
-            for kernel in &leaders {
-                let (component, _) =
-                    Component::build(kernel.clone(), cols.clone(), &xs, yg.as_ref(), None, config, config.parallelism)?;
-                let lml = component.log_marginal_likelihood(yg.as_ref());
-                if best.is_none_or(|(b, _)| lml > b) {
-                    best = Some((lml, kernel));
-                }
-            }
-            let start = best.map(|(_, k)| k).ok_or(Error::OptimisationFailed { starts: 0 })?;
-            // The configured box where it is the chosen kernel's (its family may differ: the
-            // isotropic kernel or the form without the additive term).
-            let bounds = config
-                .bounds
-                .clone()
-                .filter(|b| b.lower.len() == start.parameter_count())
-                .unwrap_or_else(|| start.default_bounds());
-            let o = refine(start, &bounds, &xs, yg.as_ref(), &config.optimiser, config.parallelism)?;
-            with_isotropic(build(o.kernel, cols, yg.as_ref(), Some(o.report))?, cols)
-        };
+        let follow = |cols: &Vec<usize>| fits.follow(&leaders, cols);
         let followed: Vec<_> = match config.parallelism {
             Parallelism::Sequential => followers.iter().map(follow).collect(),
             Parallelism::Rayon => followers.par_iter().map(follow).collect(),
@@ -512,34 +576,42 @@ pub(crate) fn validate_training_data(x: MatRef<'_, f64>, y: MatRef<'_, f64>) -> 
     Points::from_rows(x)
 }
 
+/// Every output of `0..m` served by exactly one kernel (`outputs`, per kernel), or prediction
+/// would leave it empty.
+pub(crate) fn check_served<'a>(outputs: impl Iterator<Item = &'a Vec<usize>>, m: usize) -> Result<(), Error> {
+    let mut served = vec![0usize; m];
+    for &j in outputs.flatten() {
+        if j >= m {
+            return Err(Error::InputDimensionMismatch { expected: m, found: j + 1 });
+        }
+        served[j] += 1;
+    }
+    match served.iter().position(|&k| k != 1) {
+        Some(j) => Err(Error::InvalidConfig { field: "report.components.outputs", value: j as f64 }),
+        None => Ok(()),
+    }
+}
+
 impl Component {
     /// `[K⁻¹]ᵢᵢ` for every row: the squared column norms of `L⁻¹`.
     pub(crate) fn inverse_diagonal(&self, par: faer::Par) -> Vec<f64> {
-        let inverse = self.inverse_factor(par);
+        let inverse = self.factor.inverse_lower(par);
         let n = inverse.nrows();
         // L⁻¹ is lower triangular: column i has entries from row i down.
         (0..n).map(|i| (i..n).map(|k| inverse[(k, i)] * inverse[(k, i)]).sum()).collect()
     }
 
-    /// `L⁻¹`, lower triangular: `[K⁻¹]ᵢⱼ = Σ_{k ≥ max(i, j)} L⁻¹ₖᵢ L⁻¹ₖⱼ`.
-    /// Inverted as a triangle (`n³/3` flops; a solve against the identity would take `n³`); the
-    /// strict upper triangle is 0.
-    pub(crate) fn inverse_factor(&self, par: faer::Par) -> Mat<f64> {
-        self.factor.inverse_lower(par)
-    }
-
     /// Per served output, the log predictive probability of Eq. 5.11 summed over rows, for the
     /// normalised outputs the component was built on.
     pub(crate) fn log_predictive(&self, diagonal: &[f64]) -> Vec<f64> {
-        let component = self;
         let ln_2pi = (2.0 * std::f64::consts::PI).ln();
-        (0..component.alpha.ncols())
+        (0..self.alpha.ncols())
             .map(|c| {
                 diagonal
                     .iter()
                     .enumerate()
                     .map(|(i, &kii)| {
-                        let residual = component.alpha[(i, c)] / kii;
+                        let residual = self.alpha[(i, c)] / kii;
                         0.5 * kii.ln() - 0.5 * residual * residual * kii - 0.5 * ln_2pi
                     })
                     .sum()
@@ -623,19 +695,7 @@ impl TryFrom<StoredExactGp> for ExactGp {
         s.inputs.check(d)?;
         s.outputs.check(m)?;
         let points = validate_training_data(x.as_ref(), y.as_ref())?;
-        // Every output must be served by exactly one kernel, or prediction would leave it empty.
-        let mut served = vec![0usize; m];
-        for c in &s.report.components {
-            for &j in &c.outputs {
-                if j >= m {
-                    return Err(Error::InputDimensionMismatch { expected: m, found: j + 1 });
-                }
-                served[j] += 1;
-            }
-        }
-        if let Some(j) = served.iter().position(|&k| k != 1) {
-            return Err(Error::InvalidConfig { field: "report.components.outputs", value: j as f64 });
-        }
+        check_served(s.report.components.iter().map(|c| &c.outputs), m)?;
         let config = GpConfig::default();
         let mut components = Vec::with_capacity(s.report.components.len());
         for c in &s.report.components {

@@ -78,7 +78,7 @@ impl ExactGp {
         let mut log_predictive_all = vec![0.0; m];
         let half_ln_2pi = 0.5 * (2.0 * std::f64::consts::PI).ln();
         for c in &self.components {
-            let inverse = c.inverse_factor(par);
+            let inverse = c.factor.inverse_lower(par);
             // [K⁻¹]ᵢⱼ from the columns of L⁻¹ (lower triangular).
             let entry = |i: usize, j: usize| (i.max(j)..n).map(|k| inverse[(k, i)] * inverse[(k, j)]).sum::<f64>();
             let mut lp = vec![0.0; c.outputs.len()];

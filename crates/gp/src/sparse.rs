@@ -20,7 +20,7 @@ use crate::Error;
 use crate::cholesky::{Factor, JitterOutcome};
 use crate::config::{GpConfig, OutputMode, Parallelism};
 use crate::elbo::{CHUNK_ROWS, Posterior, evidence_lower_bound};
-use crate::exact::{ComponentReport, ExactGp, validate_training_data};
+use crate::exact::{ComponentReport, ExactGp, check_served, validate_training_data};
 use crate::gram::{cross_covariance, full_covariance, prior_variances, training_covariance};
 use crate::inducing::{InducingSelection, random_indices, select_inducing};
 use crate::kernel::Kernel;
@@ -452,18 +452,7 @@ impl TryFrom<StoredSparseGp> for SparseGp {
         }
         let zm = Mat::from_fn(nu, d, |i, j| s.inducing_inputs[i][j]);
         let inducing = Points::from_rows(zm.as_ref())?;
-        let mut served = vec![0usize; m];
-        for c in &s.report.components {
-            for &j in &c.outputs {
-                if j >= m {
-                    return Err(Error::InputDimensionMismatch { expected: m, found: j + 1 });
-                }
-                served[j] += 1;
-            }
-        }
-        if let Some(j) = served.iter().position(|&k| k != 1) {
-            return Err(Error::InvalidConfig { field: "report.components.outputs", value: j as f64 });
-        }
+        check_served(s.report.components.iter().map(|c| &c.outputs), m)?;
         if s.posteriors.len() != s.report.components.len() {
             return Err(Error::InvalidConfig { field: "posteriors", value: s.posteriors.len() as f64 });
         }

@@ -52,110 +52,122 @@ impl<'a> Part<'a> {
     /// Applies the part to the state of a walk over `rows`.
     pub(crate) fn apply(&self, walk: &mut Walk<'a>) -> Result<(), Error> {
         match *self {
-            Part::Geometry(kinematics) => {
-                walk.kinematics = Some(kinematics);
-                walk.poses = walk
-                    .data
-                    .iter()
-                    .map(|(row, tool)| kinematics.forward(&row.q, tool))
-                    .collect::<Result<_, _>>()
-                    .map_err(Error::kinematics)?;
-                walk.pending = vec![Vector6::zeros(); walk.data.len()];
-                walk.coverage = vec![1.0; walk.data.len()];
-                walk.posterior_variance = None;
-                walk.faded = None;
-            }
-            Part::Effect(effect) => {
-                let kinematics = walk.kinematics.ok_or(Error::new(ErrorKind::PartOrder { part: "effect" }))?;
-                for (((pending, coverage), row), &tool) in
-                    walk.pending.iter_mut().zip(&mut walk.coverage).zip(walk.data.rows()).zip(walk.data.tools())
-                {
-                    *pending += effect.twist(kinematics, row, tool)?;
-                    *coverage *= effect.coverage_weight(row);
+            Part::Geometry(kinematics) => walk.set_geometry(kinematics),
+            Part::Effect(effect) => walk.add_effect(effect),
+            Part::Fallback(fallback) => walk.fall_back(fallback),
+            Part::GaussianProcess(residual_gp) => walk.correct_with_gp(residual_gp),
+        }
+    }
+}
+
+/// What each part does to the self's state ([`Part::apply`]).
+impl<'a> Walk<'a> {
+    /// The geometry's poses, nothing pending, every row covered.
+    fn set_geometry(&mut self, kinematics: &'a LocalPoe) -> Result<(), Error> {
+        self.kinematics = Some(kinematics);
+        self.poses = self
+            .data
+            .iter()
+            .map(|(row, tool)| kinematics.forward(&row.q, tool))
+            .collect::<Result<_, _>>()
+            .map_err(Error::kinematics)?;
+        self.pending = vec![Vector6::zeros(); self.data.len()];
+        self.coverage = vec![1.0; self.data.len()];
+        self.posterior_variance = None;
+        self.faded = None;
+        Ok(())
+    }
+
+    /// The effect's twist added to each row's pending twist, its coverage and σ to the rows'.
+    fn add_effect(&mut self, effect: &'a IdentifiedEffect) -> Result<(), Error> {
+        let kinematics = self.kinematics.ok_or(Error::new(ErrorKind::PartOrder { part: "effect" }))?;
+        for (((pending, coverage), row), &tool) in
+            self.pending.iter_mut().zip(&mut self.coverage).zip(self.data.rows()).zip(self.data.tools())
+        {
+            *pending += effect.twist(kinematics, row, tool)?;
+            *coverage *= effect.coverage_weight(row);
+        }
+        if effect.has_sigma() {
+            let variance = self.effect_variance.get_or_insert_with(|| vec![[0.0; 6]; self.data.len()]);
+            for (((variance, pose), row), &tool) in
+                variance.iter_mut().zip(&self.poses).zip(self.data.rows()).zip(self.data.tools())
+            {
+                let sigma = effect.sigma(kinematics, row, tool, &pose.translation())?;
+                for (v, s) in variance.iter_mut().zip(sigma.iter()) {
+                    *v += s * s;
                 }
-                if effect.has_sigma() {
-                    let variance = walk.effect_variance.get_or_insert_with(|| vec![[0.0; 6]; walk.data.len()]);
-                    for (((variance, pose), row), &tool) in
-                        variance.iter_mut().zip(&walk.poses).zip(walk.data.rows()).zip(walk.data.tools())
-                    {
-                        let sigma = effect.sigma(kinematics, row, tool, &pose.translation())?;
-                        for (v, s) in variance.iter_mut().zip(sigma.iter()) {
-                            *v += s * s;
-                        }
-                    }
-                }
-            }
-            Part::Fallback(fallback) => {
-                walk.flush();
-                // Where the effects' own σ says they were fitted on nothing like the row, the
-                // model falls back to the geometry fitted alone, as outside a gear series' angles;
-                // the σ of what is still applied shrinks with it.
-                if let Some((uncertainty, effects)) = walk.uncertainty {
-                    let kinematics = walk.kinematics.ok_or(Error::new(ErrorKind::PartOrder { part: "fallback" }))?;
-                    let mut variances = Vec::with_capacity(walk.data.len());
-                    for ((coverage, row), &tool) in
-                        walk.coverage.iter_mut().zip(walk.data.rows()).zip(walk.data.tools())
-                    {
-                        let sigma = uncertainty.sigma(kinematics, effects, row, tool)?;
-                        *coverage *= uncertainty.weight(EffectUncertainty::position(&sigma));
-                        variances.push(sigma.map(|s| s * s * *coverage * *coverage));
-                    }
-                    walk.posterior_variance = Some(variances);
-                }
-                if walk.coverage.iter().all(|&w| w >= 1.0) {
-                    return Ok(());
-                }
-                let mut faded = FadedPoses { unblended: walk.poses.clone(), alone: walk.poses.clone() };
-                for ((((pose, alone_pose), coverage), row), &tool) in walk
-                    .poses
-                    .iter_mut()
-                    .zip(&mut faded.alone)
-                    .zip(&walk.coverage)
-                    .zip(walk.data.rows())
-                    .zip(walk.data.tools())
-                {
-                    if *coverage < 1.0 {
-                        // T = exp(w · log(T_e T_g⁻¹)) T_g: the geometry alone at w = 0.
-                        let alone = fallback.forward(&row.q, tool).map_err(Error::kinematics)?;
-                        *pose = blend(pose, &alone, *coverage);
-                        *alone_pose = alone;
-                    }
-                }
-                walk.faded = Some(faded);
-            }
-            Part::GaussianProcess(residual_gp) => {
-                walk.flush();
-                let fallback = match &walk.faded {
-                    Some(faded) => residual_gp.predict_fallback(walk.data, &faded.alone).transpose()?,
-                    None => None,
-                };
-                let mut std = Vec::with_capacity(walk.poses.len());
-                match (fallback, &walk.faded) {
-                    (Some(fallback), Some(faded)) => {
-                        // Where the effects fade, the pose blends from the effects' pose with
-                        // this GP's correction to the geometry alone with the fallback GP's.
-                        let corrections = residual_gp.predict(walk.data, &faded.unblended)?;
-                        for (i, ((g, s), (g0, s0))) in corrections.into_iter().zip(fallback).enumerate() {
-                            let w = walk.coverage[i];
-                            walk.poses[i] = if w < 1.0 {
-                                blend(&(g * faded.unblended[i]), &(g0 * faded.alone[i]), w)
-                            } else {
-                                g * faded.unblended[i]
-                            };
-                            std.push(std::array::from_fn(|k| (w * s[k] * s[k] + (1.0 - w) * s0[k] * s0[k]).sqrt()));
-                        }
-                    }
-                    _ => {
-                        let corrections = residual_gp.predict(walk.data, &walk.poses)?;
-                        for (pose, (g, s)) in walk.poses.iter_mut().zip(corrections) {
-                            *pose = g * *pose;
-                            std.push(s);
-                        }
-                    }
-                }
-                walk.std = Some(std);
             }
         }
+        Ok(())
+    }
+
+    /// The pending twists applied; where the effects fade, the poses blend to `fallback`'s.
+    fn fall_back(&mut self, fallback: &'a LocalPoe) -> Result<(), Error> {
+        self.flush();
+        // Where the effects' own σ says they were fitted on nothing like the row, the
+        // model falls back to the geometry fitted alone, as outside a gear series' angles;
+        // the σ of what is still applied shrinks with it.
+        if let Some((uncertainty, effects)) = self.uncertainty {
+            let kinematics = self.kinematics.ok_or(Error::new(ErrorKind::PartOrder { part: "fallback" }))?;
+            let mut variances = Vec::with_capacity(self.data.len());
+            for ((coverage, row), &tool) in self.coverage.iter_mut().zip(self.data.rows()).zip(self.data.tools()) {
+                let sigma = uncertainty.sigma(kinematics, effects, row, tool)?;
+                *coverage *= uncertainty.weight(EffectUncertainty::position(&sigma));
+                variances.push(sigma.map(|s| s * s * *coverage * *coverage));
+            }
+            self.posterior_variance = Some(variances);
+        }
+        if self.coverage.iter().all(|&w| w >= 1.0) {
+            return Ok(());
+        }
+        let mut faded = FadedPoses { unblended: self.poses.clone(), alone: self.poses.clone() };
+        for ((((pose, alone_pose), coverage), row), &tool) in
+            self.poses.iter_mut().zip(&mut faded.alone).zip(&self.coverage).zip(self.data.rows()).zip(self.data.tools())
+        {
+            if *coverage < 1.0 {
+                // T = exp(w · log(T_e T_g⁻¹)) T_g: the geometry alone at w = 0.
+                let alone = fallback.forward(&row.q, tool).map_err(Error::kinematics)?;
+                *pose = blend(pose, &alone, *coverage);
+                *alone_pose = alone;
+            }
+        }
+        self.faded = Some(faded);
+        Ok(())
+    }
+
+    /// The pending twists applied, then the GP's correction (blended with the fallback GP's where
+    /// the effects fade) and its σ.
+    fn correct_with_gp(&mut self, residual_gp: &'a ResidualGp) -> Result<(), Error> {
+        self.flush();
+        let fallback = match &self.faded {
+            Some(faded) => residual_gp.predict_fallback(self.data, &faded.alone).transpose()?,
+            None => None,
+        };
+        let mut std = Vec::with_capacity(self.poses.len());
+        match (fallback, &self.faded) {
+            (Some(fallback), Some(faded)) => {
+                // Where the effects fade, the pose blends from the effects' pose with
+                // this GP's correction to the geometry alone with the fallback GP's.
+                let corrections = residual_gp.predict(self.data, &faded.unblended)?;
+                for (i, ((g, s), (g0, s0))) in corrections.into_iter().zip(fallback).enumerate() {
+                    let w = self.coverage[i];
+                    self.poses[i] = if w < 1.0 {
+                        blend(&(g * faded.unblended[i]), &(g0 * faded.alone[i]), w)
+                    } else {
+                        g * faded.unblended[i]
+                    };
+                    std.push(std::array::from_fn(|k| (w * s[k] * s[k] + (1.0 - w) * s0[k] * s0[k]).sqrt()));
+                }
+            }
+            _ => {
+                let corrections = residual_gp.predict(self.data, &self.poses)?;
+                for (pose, (g, s)) in self.poses.iter_mut().zip(corrections) {
+                    *pose = g * *pose;
+                    std.push(s);
+                }
+            }
+        }
+        self.std = Some(std);
         Ok(())
     }
 }

@@ -372,62 +372,138 @@ pub fn choose(
         );
         return Ok(PriorChoice::without(Vec::new(), Vec::new(), prior, reason));
     }
-    let scan = ScanOptions {
-        steps: prior.scan_steps,
-        probes: prior.scan_probes,
-        tolerance_rad: prior.scan_tolerance_rad,
-        min_height_span_m: prior.min_height_span_m,
-    };
-    let branch_joints = clusters::branch_joints(nominal, &data.rows, scan)?;
-    let height_splits = clusters::height_splits(nominal, &data.rows, scan);
-    let found = clusters::clusters(&branch_joints, &height_splits, &data.rows);
-    // The posterior: the tolerance weighed against the residual a plain fit leaves. Below the
-    // stated noise the likelihood is the stated noise's: the prior is never weaker than the
-    // tolerance.
-    let (_, plain) = calibrate_placed_with_prior(nominal, &observations(data), Scope::Full, None, identification)
-        .map_err(Error::kinematics)?;
-    let scale = residual_scale(&plain.report);
-    let posterior = (prior.tolerance_translation_m / scale, prior.tolerance_rotation_rad / scale);
-    let tolerance = format!(
-        "the nominal's tolerance {:.3} mm / {:.3} mrad against a residual {scale:.2} times the stated noise",
-        prior.tolerance_translation_m * 1e3,
-        prior.tolerance_rotation_rad * 1e3
-    );
-    let without = |reason: String| {
-        let mut choice =
-            PriorChoice::without(branch_joints.clone(), found.clone(), prior, format!("{tolerance}; {reason}"));
-        choice.height_splits = height_splits.clone();
-        choice.residual_scale = Some(scale);
-        (choice.translation_m, choice.rotation_rad) = (Some(posterior.0), Some(posterior.1));
-        choice
-    };
-    if branch_joints.is_empty() && height_splits.is_empty() {
-        let revolute = nominal.joints().iter().filter(|j| j.kind == poe::JointKind::Revolute).count();
-        let reason = if revolute == 6 {
-            "no joint's singular angles separate branches of the arm: one configuration cluster".to_owned()
-        } else if revolute == nominal.joint_count() {
-            format!("{} joints, not 6: the branches are not found, one configuration cluster", nominal.joint_count())
-        } else {
-            format!(
-                "{revolute} revolute joints, not 6, and no prismatic joint spans nominal_prior.min_height_span_m: \
-                 one configuration cluster"
-            )
-        };
-        return Ok(without(reason));
+    let base = Posterior::new(nominal, data, identification, prior)?;
+    if base.branch_joints.is_empty() && base.height_splits.is_empty() {
+        return Ok(base.without(one_cluster_reason(nominal), prior));
     }
     let least = (prior.min_cluster_share * data.rows.len() as f64).ceil() as usize;
-    let folds: Vec<&Cluster> = found.iter().filter(|c| c.n >= least).collect();
+    let folds: Vec<&Cluster> = base.found.iter().filter(|c| c.n >= least).collect();
     if folds.len() < 2 {
         let reason = format!(
             "one configuration cluster of at least {:.0} % of the rows ({}): nothing to hold out, the posterior",
             100.0 * prior.min_cluster_share,
-            found.first().map_or("no rows".into(), |c| c.label.clone())
+            base.found.first().map_or("no rows".into(), |c| c.label.clone())
         );
-        return Ok(without(reason));
+        return Ok(base.without(reason, prior));
     }
-    // Each fold trains on every other row; a fold whose rows carry a tool no other row carries
-    // cannot be predicted and is not held out.
-    let splits: Vec<(String, MeasurementSet, MeasurementSet)> = folds
+    let splits = cluster_splits(&folds, data);
+    // The posterior first (the weakest, which the one-standard-error rule prefers), then the
+    // stronger candidates.
+    let posterior = base.posterior;
+    let stronger = prior.translations_m.iter().filter(|&&t| t.is_finite() && t < posterior.0);
+    let sigmas: Vec<Option<(f64, f64)>> =
+        std::iter::once(Some(posterior)).chain(stronger.map(|&t| Some((t, t / prior.length_m)))).collect();
+    let (usable, rows) = held_out_rows(nominal, &splits, &sigmas, identification);
+    if usable.is_empty() {
+        let reason =
+            "no configuration cluster could be held out (a tool only it carries, or too few rows without it): \
+                      the posterior"
+                .to_owned();
+        return Ok(base.without(reason, prior));
+    }
+    let (candidates, chosen) = one_standard_error(&sigmas, &rows);
+    let held_out: Vec<String> = usable.iter().map(|&s| splits[s].0.clone()).collect();
+    let reason = format!(
+        "{}; {} configuration clusters held out in turn: held-out RMS {:.4} mm, {:.4} mm at the tolerance",
+        base.tolerance,
+        held_out.len(),
+        candidates[chosen].heldout_rms_position_mm,
+        candidates[0].heldout_rms_position_mm
+    );
+    Ok(PriorChoice {
+        branch_joints: base.branch_joints,
+        height_splits: base.height_splits,
+        clusters: base.found,
+        tolerance: (prior.tolerance_translation_m, prior.tolerance_rotation_rad),
+        residual_scale: Some(base.scale),
+        held_out,
+        translation_m: candidates[chosen].translation_m,
+        rotation_rad: candidates[chosen].rotation_rad,
+        candidates,
+        reason,
+        with_effects: None,
+    })
+}
+
+/// The data's configuration clusters and the posterior of the nominal's tolerance, what every
+/// choice reports.
+struct Posterior {
+    branch_joints: Vec<BranchJoint>,
+    height_splits: Vec<HeightSplit>,
+    found: Vec<Cluster>,
+    /// The residual a plain fit leaves, times the stated noise.
+    scale: f64,
+    /// The posterior's widths, translation m and rotation rad.
+    posterior: (f64, f64),
+    /// The tolerance and the scale in words.
+    tolerance: String,
+}
+
+impl Posterior {
+    fn new(
+        nominal: &LocalPoe,
+        data: &MeasurementSet,
+        identification: &IdentificationOptions,
+        prior: &NominalPriorOptions,
+    ) -> Result<Self, Error> {
+        let scan = ScanOptions {
+            steps: prior.scan_steps,
+            probes: prior.scan_probes,
+            tolerance_rad: prior.scan_tolerance_rad,
+            min_height_span_m: prior.min_height_span_m,
+        };
+        let branch_joints = clusters::branch_joints(nominal, &data.rows, scan)?;
+        let height_splits = clusters::height_splits(nominal, &data.rows, scan);
+        let found = clusters::clusters(&branch_joints, &height_splits, &data.rows);
+        // The posterior: the tolerance weighed against the residual a plain fit leaves. Below the
+        // stated noise the likelihood is the stated noise's: the prior is never weaker than the
+        // tolerance.
+        let (_, plain) = calibrate_placed_with_prior(nominal, &observations(data), Scope::Full, None, identification)
+            .map_err(Error::kinematics)?;
+        let scale = residual_scale(&plain.report);
+        let posterior = (prior.tolerance_translation_m / scale, prior.tolerance_rotation_rad / scale);
+        let tolerance = format!(
+            "the nominal's tolerance {:.3} mm / {:.3} mrad against a residual {scale:.2} times the stated noise",
+            prior.tolerance_translation_m * 1e3,
+            prior.tolerance_rotation_rad * 1e3
+        );
+        Ok(Self { branch_joints, height_splits, found, scale, posterior, tolerance })
+    }
+
+    /// The fit under the posterior, for `reason`: nothing held out chose otherwise.
+    fn without(&self, reason: String, prior: &NominalPriorOptions) -> PriorChoice {
+        let mut choice = PriorChoice::without(
+            self.branch_joints.clone(),
+            self.found.clone(),
+            prior,
+            format!("{}; {reason}", self.tolerance),
+        );
+        choice.height_splits = self.height_splits.clone();
+        choice.residual_scale = Some(self.scale);
+        (choice.translation_m, choice.rotation_rad) = (Some(self.posterior.0), Some(self.posterior.1));
+        choice
+    }
+}
+
+/// Why a robot without branch joints or height splits has one configuration cluster.
+fn one_cluster_reason(nominal: &LocalPoe) -> String {
+    let revolute = nominal.joints().iter().filter(|j| j.kind == poe::JointKind::Revolute).count();
+    if revolute == 6 {
+        "no joint's singular angles separate branches of the arm: one configuration cluster".to_owned()
+    } else if revolute == nominal.joint_count() {
+        format!("{} joints, not 6: the branches are not found, one configuration cluster", nominal.joint_count())
+    } else {
+        format!(
+            "{revolute} revolute joints, not 6, and no prismatic joint spans nominal_prior.min_height_span_m: \
+             one configuration cluster"
+        )
+    }
+}
+
+/// Each fold trains on every other row; a fold whose rows carry a tool no other row carries
+/// cannot be predicted and is not held out. Per fold: its label, its training and its held-out rows.
+fn cluster_splits(folds: &[&Cluster], data: &MeasurementSet) -> Vec<(String, MeasurementSet, MeasurementSet)> {
+    folds
         .iter()
         .filter_map(|cluster| {
             let held: std::collections::BTreeSet<usize> = cluster.rows.iter().copied().collect();
@@ -436,12 +512,18 @@ pub fn choose(
                 cluster.rows.iter().all(|&i| train.iter().any(|&t| data.rows[t].tool == data.rows[i].tool));
             tools_known.then(|| (cluster.label.clone(), data.subset(&train), data.subset(&cluster.rows)))
         })
-        .collect();
-    // The posterior first (the weakest, which the one-standard-error rule prefers), then the
-    // stronger candidates.
-    let stronger = prior.translations_m.iter().filter(|&&t| t.is_finite() && t < posterior.0);
-    let sigmas: Vec<Option<(f64, f64)>> =
-        std::iter::once(Some(posterior)).chain(stronger.map(|&t| Some((t, t / prior.length_m)))).collect();
+        .collect()
+}
+
+/// Every candidate (`sigmas`) fitted on every split's training rows and judged on its held-out
+/// rows: the usable splits, and per candidate every held-out row of them (criterion, squared
+/// position error mm²), in the same order.
+fn held_out_rows(
+    nominal: &LocalPoe,
+    splits: &[(String, MeasurementSet, MeasurementSet)],
+    sigmas: &[Option<(f64, f64)>],
+    identification: &IdentificationOptions,
+) -> (Vec<usize>, Vec<Vec<(f64, f64)>>) {
     let work: Vec<(usize, usize)> = (0..splits.len()).flat_map(|s| (0..sigmas.len()).map(move |c| (s, c))).collect();
     let results: Vec<Option<Vec<(f64, f64)>>> = work
         .par_iter()
@@ -456,21 +538,20 @@ pub fn choose(
     // every candidate, so that all are judged on the same rows.
     let usable: Vec<usize> =
         (0..splits.len()).filter(|&s| (0..sigmas.len()).all(|c| results[s * sigmas.len() + c].is_some())).collect();
-    if usable.is_empty() {
-        let reason =
-            "no configuration cluster could be held out (a tool only it carries, or too few rows without it): \
-                      the posterior"
-                .to_owned();
-        return Ok(without(reason));
-    }
     // Every held-out row of every usable fold, per candidate, in the same order.
     let rows: Vec<Vec<(f64, f64)>> = (0..sigmas.len())
         .map(|c| usable.iter().flat_map(|&s| results[s * sigmas.len() + c].clone().unwrap_or_default()).collect())
         .collect();
+    (usable, rows)
+}
+
+/// The candidates with their held-out scores, and the one chosen: the first whose mean criterion
+/// is within one standard error of the best's.
+fn one_standard_error(sigmas: &[Option<(f64, f64)>], rows: &[Vec<(f64, f64)>]) -> (Vec<PriorCandidate>, usize) {
     let n = rows[0].len().max(1) as f64;
     let candidates: Vec<PriorCandidate> = sigmas
         .iter()
-        .zip(&rows)
+        .zip(rows)
         .map(|(sigma, rows)| PriorCandidate {
             translation_m: sigma.map(|s| s.0),
             rotation_rad: sigma.map(|s| s.1),
@@ -488,26 +569,7 @@ pub fn choose(
         mean <= (variance / n).sqrt()
     };
     let chosen = (0..candidates.len()).find(|&c| within_one_error(c)).unwrap_or(best);
-    let held_out: Vec<String> = usable.iter().map(|&s| splits[s].0.clone()).collect();
-    let reason = format!(
-        "{tolerance}; {} configuration clusters held out in turn: held-out RMS {:.4} mm, {:.4} mm at the tolerance",
-        held_out.len(),
-        candidates[chosen].heldout_rms_position_mm,
-        candidates[0].heldout_rms_position_mm
-    );
-    Ok(PriorChoice {
-        branch_joints,
-        height_splits,
-        clusters: found,
-        tolerance: (prior.tolerance_translation_m, prior.tolerance_rotation_rad),
-        residual_scale: Some(scale),
-        held_out,
-        translation_m: candidates[chosen].translation_m,
-        rotation_rad: candidates[chosen].rotation_rad,
-        candidates,
-        reason,
-        with_effects: None,
-    })
+    (candidates, chosen)
 }
 
 #[cfg(test)]
