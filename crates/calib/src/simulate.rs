@@ -1,8 +1,9 @@
 //! `calib simulate`: a simulated tracker campaign written as SPEC measurement CSV, to try the other
 //! subcommands without a robot, or to test a calibration on data whose truth is known.
 
+use campaign::ErrorKind;
 use campaign::{GeneratorConfig, Perturbation, Remount, TorqueSensorNoise};
-use errors::{Error, ErrorKind};
+use errors::Error;
 use std::path::PathBuf;
 
 /// Simulate tracker measurements of a robot whose kinematics are off its nominal.

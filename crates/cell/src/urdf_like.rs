@@ -17,8 +17,9 @@
 //! goes on the origin of its first stage on the chain, before that stage's offset: the shipped
 //! shape is written back, the motor, its pseudo link and every `<mimic>` as they were.
 
+use crate::ErrorKind;
 use crate::urdf_text::{Written, escape, fixed_joint, origin_element};
-use errors::{Error, ErrorKind};
+use errors::Error;
 use lie::SE3;
 use poe::{JointKind, LocalPoe};
 use robot::{StepMotion, UrdfChain, UrdfDocument};

@@ -3,7 +3,8 @@
 
 use super::ColumnMap;
 use super::quantity::{Quantity, quantity};
-use errors::{Error, ErrorKind};
+use crate::ErrorKind;
+use errors::Error;
 use poe::JointKind;
 use std::collections::HashSet;
 

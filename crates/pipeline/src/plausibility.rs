@@ -11,7 +11,8 @@
 //! matrix of `R_i t` is `n I`, so the bounded solution is the unbounded one brought into the
 //! ball). The two steps alternate; each lowers the sum of squares.
 
-use errors::{Error, ErrorKind};
+use crate::ErrorKind;
+use errors::Error;
 use lie::{Matrix3, Vector3};
 use measurements::{BoundSet, MeasurementSet};
 use poe::JointKind;

@@ -5,9 +5,10 @@ use crate::robot::Robot;
 use crate::types::Measurements;
 use ::diagnose::DiagnoseOptions;
 use campaign::{GeneratorConfig, Perturbation, Remount, TorqueSensorNoise};
-use errors::{Error, ErrorKind};
+use errors::Error;
 use measurements::ReadOptions;
 use pyo3::prelude::*;
+use report::ErrorKind;
 use std::path::PathBuf;
 
 /// `calib diagnose --json`: the diagnosis's JSON text, the summary the CLI prints, and the path of
@@ -41,13 +42,15 @@ pub fn diagnose(
         let written = report
             .as_deref()
             .map(|folder| {
-                report::write_diagnosis_report(&diagnosis, folder, "report", &inputs).map_err(|e| match e.kind() {
-                    // A chart or the embedded JSON: named by the folder they were for, as before the
-                    // report crate had an error type of its own.
-                    errors::ErrorKind::Plot { .. } | errors::ErrorKind::EvaluationJson { .. } => {
-                        errors::Error::io(folder.display().to_string(), std::io::Error::other(e.to_string()))
+                report::write_diagnosis_report(&diagnosis, folder, "report", &inputs).map_err(|e| {
+                    match e.kind::<ErrorKind>() {
+                        // A chart or the embedded JSON: named by the folder they were for, as before the
+                        // report crate had an error type of its own.
+                        Some(ErrorKind::Plot { .. } | ErrorKind::EvaluationJson { .. }) => {
+                            errors::Error::io(folder.display().to_string(), std::io::Error::other(e.to_string()))
+                        }
+                        _ => e,
                     }
-                    _ => e,
                 })
             })
             .transpose()?;
@@ -81,7 +84,10 @@ pub fn simulate(
     out: Option<PathBuf>,
 ) -> PyResult<Measurements> {
     if rows > campaign::MAX_ROWS {
-        return Err(argument("rows", Error::new(ErrorKind::TooManySimulatedRows { rows, max: campaign::MAX_ROWS })));
+        return Err(argument(
+            "rows",
+            Error::new(campaign::ErrorKind::TooManySimulatedRows { rows, max: campaign::MAX_ROWS }),
+        ));
     }
     if rows == 0 {
         return Err(argument("rows", "at least one pose is needed"));
@@ -99,7 +105,7 @@ pub fn simulate(
         let file = robot.path.clone();
         return Err(to_py(Error::in_file(
             file,
-            ErrorKind::PlanarChain { direction, joints: description.joint_count() },
+            campaign::ErrorKind::PlanarChain { direction, joints: description.joint_count() },
         )));
     }
     let source = out.as_ref().map_or_else(|| "simulated".to_owned(), |p| p.display().to_string());
