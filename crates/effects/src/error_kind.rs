@@ -1,7 +1,6 @@
 //! The refusals of the effects: the kinds of [`errors::Error`] this crate raises, with their messages
 //! (the error adds the place a message starts with).
 
-use crate::spec::MAX_HARMONICS;
 use robot::PITCH_BOUNDS_MM;
 use std::fmt;
 
@@ -102,6 +101,11 @@ impl fmt::Display for ErrorKind {
 impl std::error::Error for ErrorKind {}
 
 impl errors::Kind for ErrorKind {}
+
+/// The most harmonics a `gear_periodic` item may ask for: two parameters each, and a series of a
+/// joint's own angle beyond a few dozen orders follows the noise of any campaign we know of (the
+/// UR10 analysis of issue #11 found 24–32 enough). It also bounds the work a typo can ask for.
+pub const MAX_HARMONICS: u32 = 256;
 
 /// What is wrong with one item of an `--effects` list.
 #[non_exhaustive]

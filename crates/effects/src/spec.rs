@@ -13,13 +13,8 @@ use loadsim::EffectKind;
 use std::fmt;
 use std::str::FromStr;
 
-pub use crate::error_kind::EffectListFault;
+pub use crate::error_kind::{EffectListFault, MAX_HARMONICS};
 pub use robot::PITCH_BOUNDS_MM;
-
-/// The most harmonics a `gear_periodic` item may ask for: two parameters each, and a series of a
-/// joint's own angle beyond a few dozen orders follows the noise of any campaign we know of (the
-/// UR10 analysis of issue #11 found 24–32 enough). It also bounds the work a typo can ask for.
-pub const MAX_HARMONICS: u32 = 256;
 
 /// What an `--effects` item takes after its name, in order (`gear_periodic:JOINT:HARMONICS`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
