@@ -4,7 +4,7 @@
 //! module `blind_check_cases`. Cases run in parallel; each is seeded on its own, so the table does
 //! not depend on the order they finish in.
 
-use crate::blind_check_cases::{Case, Class, Robots, run_case};
+use super::blind_check_cases::{Case, Class, Robots, run_case};
 use anyhow::{Context, Result, bail};
 use diagnose::Effect;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -40,7 +40,7 @@ pub struct Args {
     dump: Option<PathBuf>,
 }
 
-/// A relative shrink error counts as right within this fraction of the true shrink (issue 11).
+/// A relative shrink error counts as right within this fraction of the true shrink.
 const SHRINK_TOLERANCE: f64 = 0.2;
 
 fn percent(a: usize, b: usize) -> String {
@@ -215,7 +215,7 @@ pub fn run(args: &Args) -> Result<()> {
         let body = format!(
             "# Blind check\n\n`cargo xtask blind-check --cases {} --seed {} --rows {}`: simulated data sets with hidden \
              effects, diagnosed by `calib diagnose` without the truth (the robot file without masses and stiffness). \
-             Classes and how each is drawn: `xtask/src/blind_check_cases.rs`. \"Size\" is what a geometric calibration \
+             Classes and how each is drawn: `xtask/src/checks/blind_check_cases.rs`. \"Size\" is what a geometric calibration \
              leaves of the hidden effect on noise-free positions; \"true after\" the geometric model's held-out error on \
              the same poses and noise without any effect; \"after\" the diagnosis's held-out error with the effects it \
              selected.\n\n{text}",

@@ -12,7 +12,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use model::ResidualGpOptions;
 use robot::RobotDescription;
 
-use crate::bench_gp_residuals::{Residuals, heldout_mm, real, simulated, simulated_payload_runs};
+use super::bench_gp_residuals::{Residuals, heldout_mm, real, simulated, simulated_payload_runs};
 
 /// Where the data are.
 #[derive(Debug, Clone, clap::Args)]

@@ -1,5 +1,5 @@
 //! `cargo xtask bench-gp --paper`: the GP stage against scikit-learn on the paper's own setting
-//! and on the real UR10, same residuals, same run (issue 25).
+//! and on the real UR10, same residuals, same run.
 //!
 //! - Simulated campaigns of the paper's shape (`calib simulate --robot irb4400.ron --rows 600
 //!   --seed S [--full-pose]`: joint compliance under the arm's weight and the payload, payloads
@@ -28,10 +28,10 @@ use robot::RobotDescription;
 
 use campaign::paper_effects;
 
-use crate::bench_gp_residuals::{Residuals, heldout_mm, real, simulated_campaign};
-use crate::bench_gp_sklearn::{SklearnOptions, available, fit_predict};
-use crate::reproduce_sim::robot_for;
-use crate::reproduce_sim_params::Preset;
+use super::bench_gp_residuals::{Residuals, heldout_mm, real, simulated_campaign};
+use super::bench_gp_sklearn::{SklearnOptions, available, fit_predict};
+use super::reproduce_sim::robot_for;
+use super::reproduce_sim_params::Preset;
 
 /// Arguments of `--paper`.
 #[derive(Debug, Clone, clap::Args)]
@@ -102,7 +102,7 @@ pub fn run(args: &PaperArgs, ur10_data: &std::path::Path) -> anyhow::Result<Stri
     if !with_sklearn {
         eprintln!(
             "scikit-learn is not importable by {}: its columns stay empty",
-            crate::bench_gp_sklearn::python().display()
+            super::bench_gp_sklearn::python().display()
         );
     }
     let timeout = Duration::from_secs_f64(args.paper_sklearn_timeout_s);

@@ -1,4 +1,4 @@
-//! `cargo xtask bench-fit`: how long a person waits for `calib`, against issue 49's budgets and
+//! `cargo xtask bench-fit`: how long a person waits for `calib`, against its time budgets and
 //! beside what a user would run instead, on the same rows in the same run. Prints a markdown
 //! table.
 //!
@@ -17,13 +17,13 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
 
-use crate::bench_fit_data::{Files, even_odd, position_only, simulate, spread, ur10_series, write_pair};
-use crate::bench_fit_run::{heldout_of_eval, measure, phases_of_fit};
-use crate::bench_fit_sklearn::{PipelineOptions, SklearnKernel, SklearnSide, python_env, sklearn_pipeline};
-use crate::bench_fit_table::{Budget, Measured, Outcome, Row, Run, RunResult, Side, table};
+use super::bench_fit_data::{Files, even_odd, position_only, simulate, spread, ur10_series, write_pair};
+use super::bench_fit_run::{heldout_of_eval, measure, phases_of_fit};
+use super::bench_fit_sklearn::{PipelineOptions, SklearnKernel, SklearnSide, python_env, sklearn_pipeline};
+use super::bench_fit_table::{Budget, Measured, Outcome, Row, Run, RunResult, Side, table};
 
-/// Time `calib fit` and `calib diagnose` on the UR10 and simulated data against issue 49's
-/// budgets, beside scikit-learn; print a markdown table.
+/// Time `calib fit` and `calib diagnose` on the UR10 and simulated data against the
+/// time budgets, beside scikit-learn; print a markdown table.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
     /// Only these rows, comma separated [default: all].
@@ -145,7 +145,7 @@ impl RowKey {
         }
     }
 
-    /// Issue 49's budget for the row, on the 2-core machine.
+    /// The time budget for the row, on the 2-core machine.
     pub fn budget(self) -> Option<Budget> {
         match self {
             RowKey::CPoeGp | RowKey::CPoeGpPosition => Some(Budget::SpeedupAtLeast(40.0)),
@@ -219,7 +219,7 @@ struct Inputs<'a> {
 impl Inputs<'_> {
     fn robot_path(&self, key: RowKey) -> PathBuf {
         let file = if matches!(key.data(), Data::Simulated { .. }) { "irb4400.ron" } else { "ur10.ron" };
-        crate::reproduce_sim::workspace_root().join("fixtures/robots").join(file)
+        crate::workspace_root().join("fixtures/robots").join(file)
     }
 
     fn robot(&self, key: RowKey) -> &RobotDescription {
@@ -427,8 +427,8 @@ fn calib_binary(args: &Args) -> anyhow::Result<(PathBuf, String)> {
         return Ok((path.clone(), path.display().to_string()));
     }
     eprintln!("bench-fit: cargo build --release -p calib …");
-    let path = crate::bench_memory::calib_binary(true)?;
-    let root = crate::reproduce_sim::workspace_root();
+    let path = crate::calib_runs::calib_binary(true)?;
+    let root = crate::workspace_root();
     let git = |args: &[&str]| {
         Command::new("git")
             .args(args)
@@ -454,7 +454,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let work = std::env::temp_dir().join(format!("calib-bench-fit-{}", std::process::id()));
     std::fs::create_dir_all(&work).with_context(|| work.display().to_string())?;
     let read = |file: &str| {
-        let path = crate::reproduce_sim::workspace_root().join("fixtures/robots").join(file);
+        let path = crate::workspace_root().join("fixtures/robots").join(file);
         RobotDescription::read(&path).with_context(|| path.display().to_string())
     };
     let (ur10, irb) = (read("ur10.ron")?, read("irb4400.ron")?);
@@ -487,7 +487,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let run = Run {
         machine: format!(
             "{}, {} cores visible",
-            crate::bench_gp::cpu_model(),
+            super::bench_gp::cpu_model(),
             std::thread::available_parallelism().map_or(1, |n| n.get())
         ),
         load_start,
@@ -495,7 +495,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         calib: calib_text,
         base: args.calib_base.as_ref().map(|b| b.display().to_string()),
         python: match &python {
-            Ok(p) => crate::bench_fit_sklearn::versions(p),
+            Ok(p) => super::bench_fit_sklearn::versions(p),
             Err(why) => format!("not run ({why})"),
         },
         quick: args.quick,
@@ -541,7 +541,7 @@ mod tests {
     }
 
     #[test]
-    fn defaults_are_the_issues_setting() {
+    fn defaults_are_the_budgets_setting() {
         let args = parse(&[]).unwrap();
         assert_eq!(args.data, PathBuf::from("../shared/data/ipa-ur10"));
         assert_eq!((args.runs, args.paper_seed, args.skip_sklearn, args.quick), (3, 1, false, false));
@@ -550,7 +550,7 @@ mod tests {
     }
 
     #[test]
-    fn every_budget_of_issue_49_is_on_its_row() {
+    fn every_time_budget_is_on_its_row() {
         let budgets: Vec<(RowKey, Budget)> = RowKey::all().iter().filter_map(|k| Some((*k, k.budget()?))).collect();
         assert_eq!(
             budgets,

@@ -28,7 +28,7 @@ pub struct Files {
 /// order). `None` when `dir` has neither.
 pub fn ur10_series(dir: &Path, robot: &RobotDescription, series: &str) -> anyhow::Result<Option<MeasurementSet>> {
     if dir.join(format!("Series_{series}")).is_dir() {
-        return crate::convert_ur10::read_series(dir, series, true).map(Some);
+        return super::convert_ur10::read_series(dir, series, true).map(Some);
     }
     let options = ReadOptions::for_joints(robot.joint_kinds());
     let read = |p: &Path| measurements::read_measurements(p, &options).with_context(|| p.display().to_string());

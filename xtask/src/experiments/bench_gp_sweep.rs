@@ -19,8 +19,8 @@ use std::time::{Duration, Instant};
 use diagnose::chart::{Canvas, escape};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::bench_gp_residuals::{heldout_mm, residuals};
-use crate::bench_gp_sklearn::{SklearnOptions, available, fit_predict};
+use super::bench_gp_residuals::{heldout_mm, residuals};
+use super::bench_gp_sklearn::{SklearnOptions, available, fit_predict};
 
 /// Options of the sweep.
 #[derive(Debug, Clone, clap::Args)]

@@ -1,4 +1,4 @@
-//! `cargo xtask cell-check`: issue 26's "must show" table for `calib register` and `calib plan`
+//! `cargo xtask cell-check`: the table for `calib register` and `calib plan`
 //! (crate `cell`), in process, printed as markdown.
 //!
 //! - The real UR10 (Landgraf et al., CASE 2021, converted to SPEC CSV, not in this repository):
@@ -29,7 +29,7 @@ use std::fmt::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Issue 26's table: registration and planning on the real UR10 and on simulated truth.
+/// Registration and planning on the real UR10 and on simulated truth.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Folder with the UR10 series as SPEC CSV (`ur10_C_full.csv`, `ur10_C_full_even.csv`, …,
@@ -104,8 +104,7 @@ fn fit_and_test(
 }
 
 pub fn run(args: &Args) -> Result<()> {
-    let mut md =
-        String::from("# Issue 26: re-registration and planned poses\n\nProduced by `cargo xtask cell-check`.\n");
+    let mut md = String::from("# Re-registration and planned poses\n\nProduced by `cargo xtask cell-check`.\n");
     let wanted = |name: &str| {
         if args.only.is_empty() { name != "effects" || args.effects } else { args.only.iter().any(|o| o == name) }
     };
@@ -148,7 +147,7 @@ fn scipy_reference(
     std::fs::write(&file, text)?;
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/register_scipy.py");
     let lines: Vec<String> = picked.iter().map(ToString::to_string).collect();
-    let out = std::process::Command::new(crate::bench_gp_sklearn::python())
+    let out = std::process::Command::new(super::bench_gp_sklearn::python())
         .arg(&script)
         .arg(&file)
         .arg(path)
@@ -406,14 +405,14 @@ fn plan_timing(args: &Args, md: &mut String) -> Result<()> {
         for full_pose in [false, true] {
             for criterion in [planning::Criterion::I, planning::Criterion::D] {
                 let options = planning::PlanOptions { criterion, ..plan_options(args)? };
-                let (start, cpu) = (Instant::now(), crate::ur10::process_cpu_seconds());
+                let (start, cpu) = (Instant::now(), super::ur10::process_cpu_seconds());
                 planning::plan(&set.model, &set.candidates, 100, full_pose, &options)?;
                 let _ = writeln!(
                     md,
                     "| {name} | {} | {criterion:?} | {:.2} | {:.2} |",
                     if full_pose { "full pose" } else { "position" },
                     start.elapsed().as_secs_f64(),
-                    crate::ur10::process_cpu_seconds() - cpu
+                    super::ur10::process_cpu_seconds() - cpu
                 );
             }
         }

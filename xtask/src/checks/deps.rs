@@ -1,7 +1,8 @@
-//! `cargo xtask deps`: the workspace's crate graph with the lines of each crate, and the checks
-//! issue 24 asks to keep true: no crate above a line budget, no circle between crates, and no
-//! module of a crate (or of xtask) that imports a module importing it back. And one of issue 49:
-//! the crates CI builds alone share the tests' build (`deps_features`).
+//! `cargo xtask deps`: the workspace's crate graph with the lines of each crate, and the structure
+//! it keeps true: no crate above a line budget, no circle between crates, and no module of a crate
+//! (or of xtask) that imports a module importing it back; in xtask, no check that imports an
+//! experiment or the reverse. And the crates CI builds alone share the tests' build
+//! (`deps_features`), so that CI compiles the workspace once.
 //!
 //! A module's imports are its `crate::…` and `super::…` paths outside `#[cfg(test)]` blocks and
 //! comments, resolved to the longest module prefix; a name the crate root re-exports
@@ -15,8 +16,8 @@ use std::path::{Path, PathBuf};
 /// Print the crate graph with lines per crate; fail on a module or crate circle or an oversized crate.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The most lines of Rust a crate's `src/` may hold. 5,000: issue 24's bound, where `pipeline`
-    /// had grown to 12,200 lines holding six concerns.
+    /// The most lines of Rust a crate's `src/` may hold. 5,000: a crate a newcomer can read
+    /// whole, and the size above which one crate had come to hold several concerns.
     #[arg(long, default_value_t = 5000)]
     max_lines: usize,
 }
@@ -31,7 +32,7 @@ struct Crate {
 }
 
 pub fn run(args: &Args) -> Result<()> {
-    let root = crate::reproduce_sim::workspace_root();
+    let root = crate::workspace_root();
     let crates = workspace_crates(&root)?;
     let names: BTreeSet<String> = crates.iter().map(|c| c.name.clone()).collect();
     let mut failures = Vec::new();
@@ -55,11 +56,17 @@ pub fn run(args: &Args) -> Result<()> {
     }
     for c in &crates {
         let modules = read_modules(&c.src)?;
-        for circle in circles(&module_graph(&modules)) {
+        let graph = module_graph(&modules);
+        for circle in circles(&graph) {
             failures.push(format!("{}: modules import each other: {}", c.name, circle.join(" <-> ")));
         }
+        if c.name == "xtask" {
+            for (from, to) in across(&graph, SEPARATE_HALVES) {
+                failures.push(format!("xtask: {from} imports {to} (checks and experiments share only the crate root)"));
+            }
+        }
     }
-    failures.extend(crate::deps_features::drift(&root)?);
+    failures.extend(super::deps_features::drift(&root)?);
     if failures.is_empty() {
         println!("\nno crate above {} lines; no circle between crates or between the modules of one", args.max_lines);
         println!(
@@ -241,6 +248,21 @@ fn dependencies(section: &str) -> Vec<&str> {
         .collect()
 }
 
+/// xtask's two halves: a check must not change because an experiment did, nor an experiment
+/// because a check did; what both need sits at the crate root.
+const SEPARATE_HALVES: [&str; 2] = ["checks", "experiments"];
+
+/// Each import from a module under one of `halves` to a module under another, as (from, to).
+fn across(graph: &BTreeMap<String, BTreeSet<String>>, halves: [&str; 2]) -> Vec<(String, String)> {
+    let half = |module: &str| halves.iter().position(|h| module == *h || module.starts_with(&format!("{h}::")));
+    graph
+        .iter()
+        .flat_map(|(from, targets)| targets.iter().map(move |to| (from, to)))
+        .filter(|(from, to)| matches!((half(from), half(to)), (Some(a), Some(b)) if a != b))
+        .map(|(from, to)| (from.clone(), to.clone()))
+        .collect()
+}
+
 /// Which module imports which.
 fn module_graph(modules: &BTreeMap<String, String>) -> BTreeMap<String, BTreeSet<String>> {
     // Names the crate root re-exports, and the module each comes from.
@@ -388,6 +410,21 @@ mod tests {
             ("p::y", "use super::x::X;"),
         ]);
         assert_eq!(circles(&module_graph(&m)), vec![vec!["p::x".to_owned(), "p::y".to_owned()]]);
+    }
+
+    #[test]
+    fn a_check_importing_an_experiment_is_found_and_the_shared_root_modules_are_not() {
+        let m = modules(&[
+            ("", "mod checks; mod experiments; mod simulation;"),
+            ("simulation", "pub fn cell() {}"),
+            ("checks", "pub mod a;"),
+            ("checks::a", "use crate::simulation::cell; use crate::experiments::b::run;"),
+            ("experiments", "pub mod b;"),
+            ("experiments::b", "use crate::simulation::cell; pub fn run() {}"),
+        ]);
+        let graph = module_graph(&m);
+        assert!(circles(&graph).is_empty());
+        assert_eq!(across(&graph, SEPARATE_HALVES), [("checks::a".to_owned(), "experiments::b".to_owned())]);
     }
 }
 

@@ -4,7 +4,7 @@
 //! another separator or decimal mark. Each input is drawn from the run's seed, the reader and
 //! the case number alone, so that any case can be made again on its own (`--dump`).
 
-use crate::fuzz_seeds::{Reader, Seed};
+use super::fuzz_seeds::{Reader, Seed};
 use rand::seq::IndexedRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

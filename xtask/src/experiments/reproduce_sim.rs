@@ -8,9 +8,9 @@
 //! 10 folds (Fig. 1); then each is fitted on all 300 and tested on three independent sets of 100
 //! poses (Table I). The report and the box plot go to `--out`, the numbers to `--json`.
 
-use crate::box_plot::{BoxGroup, box_plot};
-use crate::reproduce_sim_params::{Params, Preset, Seeds, Setup, Sizes, Variant};
-use crate::reproduce_sim_report::{Magnitudes, Outcome, VariantResult, json, markdown};
+use super::box_plot::{BoxGroup, box_plot};
+use super::reproduce_sim_params::{Params, Preset, Seeds, Setup, Sizes, Variant};
+use super::reproduce_sim_report::{Magnitudes, Outcome, VariantResult, json, markdown};
 use crate::simulation::mean_distance_mm;
 use anyhow::Context;
 use campaign::{Perturbation, joint_ranges, simulate, simulated_cell};
@@ -110,11 +110,6 @@ fn variants(sizes: &Sizes) -> Vec<Variant> {
     ]
 }
 
-/// The workspace root, so that the defaults work from any directory.
-pub(crate) fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf)
-}
-
 /// The robot with the preset's stiffness.
 pub(crate) fn robot_for(robot: &RobotDescription, preset: Preset, file: &Path) -> anyhow::Result<RobotDescription> {
     let mut dynamics: RobotDynamics = robot.dynamics.clone().ok_or_else(|| {
@@ -187,7 +182,7 @@ fn fit_and_test(
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let started = Instant::now();
-    let root = workspace_root();
+    let root = crate::workspace_root();
     let robot_file = args.robot.clone().unwrap_or_else(|| root.join("fixtures/robots/irb4400.ron"));
     let out_dir = args.out.clone().unwrap_or_else(|| root.join("docs/results"));
     let nominal = RobotDescription::read(&robot_file)?;
@@ -299,7 +294,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if let Some(path) = &args.json {
         write(path.clone(), &json(&params, &outcome))?;
     }
-    println!("{}", crate::reproduce_sim_report::summary(&params, &outcome));
+    println!("{}", super::reproduce_sim_report::summary(&params, &outcome));
     println!("wrote {} and {}", out_dir.join(format!("{stem}.md")).display(), out_dir.join(&svg_name).display());
     Ok(())
 }

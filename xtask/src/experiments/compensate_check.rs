@@ -227,7 +227,7 @@ fn scipy(model: &CalibratedModel, targets: &[PoseTarget]) -> anyhow::Result<Opti
     };
     let path = std::env::temp_dir().join("calib-compensate-scipy.json");
     std::fs::write(&path, serde_json::to_string(&problem)?)?;
-    let script = crate::reproduce_sim::workspace_root().join("xtask/scripts/compensate_scipy.py");
+    let script = crate::workspace_root().join("xtask/scripts/compensate_scipy.py");
     let output = Command::new("python3").arg(&script).arg(&path).output().context("running python3")?;
     if !output.status.success() {
         anyhow::bail!("{}: {}", script.display(), String::from_utf8_lossy(&output.stderr));

@@ -110,7 +110,7 @@ pub fn scipy_identify(
     };
     let path = std::env::temp_dir().join(format!("calib-identify-{}-{}.json", std::process::id(), observations.len()));
     std::fs::write(&path, serde_json::to_string(&problem)?).with_context(|| path.display().to_string())?;
-    let script = crate::reproduce_sim::workspace_root().join("xtask/scripts/identify_scipy.py");
+    let script = crate::workspace_root().join("xtask/scripts/identify_scipy.py");
     let output = Command::new(python)
         .arg(&script)
         .arg(&path)

@@ -9,7 +9,7 @@
 //! `ur10.md` into `--out` (with `--diagnosis-only`, only its section from `## Diagnosis` on is
 //! replaced, the methods table kept) and the report folder `ur10-diagnosis/` (the first series).
 
-use crate::convert_ur10::{Dataset, read_series};
+use super::convert_ur10::{Dataset, read_series};
 use anyhow::{Context, Result};
 use diagnose::{DiagnoseOptions, Diagnosis, diagnose};
 use effects::EffectSelection;

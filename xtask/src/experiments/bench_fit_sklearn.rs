@@ -14,7 +14,7 @@ use measurements::MeasurementSet;
 use model::{ErrorSummary, PoseError, pose_error};
 use robot::RobotDescription;
 
-use crate::bench_gp_sklearn::{SklearnOptions, fit_predict_with};
+use super::bench_gp_sklearn::{SklearnOptions, fit_predict_with};
 
 /// SciPy's identification beside ours (`--scipy-identify`).
 #[derive(Debug, Clone, PartialEq)]
@@ -143,7 +143,7 @@ fn imports(python: &Path) -> bool {
 }
 
 /// The interpreter the scikit-learn side runs: `given` (`--python`), else the comparisons' usual
-/// one ([`crate::bench_gp_sklearn::python`]: `$CALIB_PYTHON`, `target/pyenv`, `python3`) where it
+/// one ([`super::bench_gp_sklearn::python`]: `$CALIB_PYTHON`, `target/pyenv`, `python3`) where it
 /// imports scikit-learn, else `target/pyenv` made for it with pip from
 /// `xtask/scripts/requirements.txt`. `Err` says why there is none.
 pub fn python_env(given: Option<&Path>) -> Result<PathBuf, String> {
@@ -154,11 +154,11 @@ pub fn python_env(given: Option<&Path>) -> Result<PathBuf, String> {
             Err(format!("--python {}: does not import NumPy, SciPy and scikit-learn", python.display()))
         };
     }
-    let usual = crate::bench_gp_sklearn::python();
+    let usual = super::bench_gp_sklearn::python();
     if imports(&usual) {
         return Ok(usual);
     }
-    let root = crate::reproduce_sim::workspace_root();
+    let root = crate::workspace_root();
     let venv = root.join("target/pyenv");
     let python = venv.join("bin/python3");
     eprintln!("bench-fit: making {} with pip (xtask/scripts/requirements.txt) …", venv.display());
@@ -258,13 +258,13 @@ pub fn sklearn_pipeline(
     test: &MeasurementSet,
     options: &PipelineOptions,
 ) -> anyhow::Result<SklearnSide> {
-    let set = crate::bench_gp_residuals::residuals(String::new(), robot, train, test, options.with_payload)?;
+    let set = super::bench_gp_residuals::residuals(String::new(), robot, train, test, options.with_payload)?;
     let y = &set.train.outputs;
     let scipy = if options.scipy_identify {
         let observations = model::geometric::observations(train);
         let start = poe::identify::register(&robot.nominal_model()?, &observations)?;
         let weights = pipeline::FitOptions::default().identification;
-        let scipy = crate::bench_identify::scipy_identify(
+        let scipy = super::bench_identify::scipy_identify(
             &options.python,
             &start,
             &observations,

@@ -7,8 +7,8 @@
 //! Deterministic for a seed: the same inputs in the same order; the counts are the same on every
 //! machine that has the time and memory the limits allow.
 
-use crate::fuzz_inputs::{generate, regressions};
-use crate::fuzz_seeds::{Reader, seeds};
+use super::fuzz_inputs::{generate, regressions};
+use super::fuzz_seeds::{Reader, seeds};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::{BufRead, BufReader};

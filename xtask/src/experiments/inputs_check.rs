@@ -1,4 +1,4 @@
-//! `cargo xtask inputs-check` (issue 46): measured signals as inputs of the GP, on simulated days
+//! `cargo xtask inputs-check`: measured signals as inputs of the GP, on simulated days
 //! whose error follows them. A base that tilts with the arm's gravity moment and with the floor
 //! under it (each day's placement tilts it anew), read by an inclinometer with its own noise
 //! (`loadsim::BaseTilt`), and thermal growth of the links with a temperature that drifts through
@@ -8,8 +8,8 @@
 //! (even → odd) and the last day (trained on the others). The noise floor is the mean distance of
 //! the measured test positions from the same poses simulated without tracker noise.
 
-use crate::bench_gp_residuals::heldout_mm;
-use crate::bench_gp_sklearn::{self, SklearnOptions};
+use super::bench_gp_residuals::heldout_mm;
+use super::bench_gp_sklearn::{self, SklearnOptions};
 use anyhow::Context;
 use campaign::{Effects, GeneratorConfig, Perturbation, SimulatedCell, TrackerNoise};
 use lie::{SE3, Vector3};

@@ -6,7 +6,7 @@
 //! decimal comma; joints in radians (UR's DH zero), the T-Mac position in millimetres and its
 //! orientation as `rx, ry, rz` in degrees, and the cell temperature.
 
-use crate::ur10_placements::{self, NotPlacements, PlacementOptions, Placements};
+use super::ur10_placements::{self, NotPlacements, PlacementOptions, Placements};
 use anyhow::Context;
 use lie::{SO3, Vector3};
 use measurements::{Measurement, MeasurementSet};
@@ -200,7 +200,7 @@ pub fn read_with_goals(input: &Path, series: &str, full_pose: bool) -> anyhow::R
     let position = [column("measurement_x")?, column("measurement_y")?, column("measurement_z")?];
     let angles = [column("measurement_rx")?, column("measurement_ry")?, column("measurement_rz")?];
     let temperature = column("measurement_temperature")?;
-    // The tracker's stated standard deviation of every row (issue 46): mm, and degrees of the
+    // The tracker's stated standard deviation of every row: mm, and degrees of the
     // three angles, kept as std_x_mm … and std_rx_mrad ….
     let position_std = [column("measurement_std_x")?, column("measurement_std_y")?, column("measurement_std_z")?];
     let angle_std = [column("measurement_std_rx")?, column("measurement_std_ry")?, column("measurement_std_rz")?];

@@ -3,7 +3,7 @@
 //! calibrated URDF exported like `ur10.urdf` reads back to the calibrated model within 1e-9 m.
 //! Writes `urdf.md` into `--out`.
 
-use crate::convert_ur10::{Dataset, read_series};
+use super::convert_ur10::{Dataset, read_series};
 use anyhow::Context;
 use cell::UrdfTemplate;
 use lie::{SE3, Vector3};

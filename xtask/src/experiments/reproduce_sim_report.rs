@@ -1,9 +1,9 @@
 //! What `cargo xtask reproduce-sim` writes: the markdown report beside the paper's Table I, the
 //! SPEC JSON, and the console summary.
 
-use crate::box_plot::BoxStatistics;
-use crate::reproduce_sim_params::Params;
-use crate::reproduce_sim_params::{PAPER_LIKE_SOFTENING, Preset, list};
+use super::box_plot::BoxStatistics;
+use super::reproduce_sim_params::Params;
+use super::reproduce_sim_params::{PAPER_LIKE_SOFTENING, Preset, list};
 use serde::Serialize;
 use std::fmt::Write;
 
@@ -241,7 +241,7 @@ Table I implies, and says so.\n"
             "**Paper-like preset, not a physical robot: every joint is {PAPER_LIKE_SOFTENING}× softer than the fixture's \
 estimate, and only the payload's weight bends it.** With the fixture's stiffness the payload moves the tool by \
 about 0.1 mm, too little for the paper's gains; see `reproduce-sim.md` for the physical preset and \
-`PAPER_LIKE_SOFTENING` in `xtask/src/reproduce_sim.rs` for why this factor.\n"
+`PAPER_LIKE_SOFTENING` in `xtask/src/experiments/reproduce_sim.rs` for why this factor.\n"
         );
     }
     let _ = writeln!(out, "## Table I: test sets (mm)\n");
@@ -297,7 +297,7 @@ be learnt with the payload as an input.\n",
     );
     out.push_str(&reading(params, outcome));
     out.push_str(&beyond_reading(outcome));
-    out.push_str(&crate::reproduce_sim_params::parameters_section(params));
+    out.push_str(&super::reproduce_sim_params::parameters_section(params));
     out
 }
 

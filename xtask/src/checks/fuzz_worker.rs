@@ -7,8 +7,8 @@
 //! poses predicted, effects simulated), so that a reader that lets through what breaks its users
 //! shows up as "accepted, then failed".
 
-use crate::fuzz_inputs::{Case, generate, regressions};
-use crate::fuzz_seeds::{Reader, Seed, fixture_robot, seeds};
+use super::fuzz_inputs::{Case, generate, regressions};
+use super::fuzz_seeds::{Reader, Seed, fixture_robot, seeds};
 use anyhow::{Context, Result};
 use campaign::{GeneratorConfig, SimulatedCell};
 use effects::EffectSelection;

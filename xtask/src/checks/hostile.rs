@@ -1,5 +1,5 @@
-//! `cargo xtask hostile`: every row of issue 31's table ("Nothing lost, and no fit that looks
-//! right and is not") run against the release `calib` in a temporary folder, each asserting the
+//! `cargo xtask hostile`: every row of the hostile-input table (nothing lost, and no fit that
+//! looks right and is not) run against the release `calib` in a temporary folder, each asserting the
 //! exit status and the message; one line per row, a non-zero exit if any row fails. The same rows
 //! are tests of the suite (`crates/calib/tests/{nothing_lost_cli,plausibility_cli,sanity_cli,
 //! hostile_cli}.rs`); this runs them on the binary a user runs. The 68 MB memory row runs with
@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::Instant;
 
-/// Issue 31's table against the built binary.
+/// The hostile-input table against the built binary.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Also run the 68 MB memory row (about a minute; with the dev profile's binary unless
@@ -126,11 +126,11 @@ fn rows() -> Vec<Row> {
 
 pub fn run(args: &Args) -> Result<()> {
     let started = Instant::now();
-    let calib = crate::bench_memory::calib_binary(args.release)?;
+    let calib = crate::calib_runs::calib_binary(args.release)?;
     println!("{}", calib.display());
     let dir = std::env::temp_dir().join(format!("calib-hostile-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
-    let robot = crate::reproduce_sim::workspace_root().join("fixtures/robots/irb4400.ron").display().to_string();
+    let robot = crate::workspace_root().join("fixtures/robots/irb4400.ron").display().to_string();
     let bench = Bench { calib, dir: dir.clone(), robot };
     let mut failures = 0;
     let mut table: Vec<Row> = rows();
@@ -387,7 +387,7 @@ fn export_like(b: &Bench) -> Result<Outcome> {
     let (data, model, like, out) = (b.path("e.csv"), b.path("e.ron"), b.path("arm.urdf"), b.path("out.urdf"));
     b.simulate(&data, 60, &[])?;
     ensure!(b.fit(&data, &model, &[])?.status.success(), "fit failed");
-    let urdf = crate::reproduce_sim::workspace_root().join("fixtures/robots/irb4400.urdf");
+    let urdf = crate::workspace_root().join("fixtures/robots/irb4400.urdf");
     let changed = std::fs::read_to_string(urdf)?
         .replace("<joint name=\"joint_3\" type=\"revolute\">", "<joint name=\"joint_3\" type=\"prismatic\">");
     std::fs::write(&like, changed)?;
@@ -410,7 +410,7 @@ fn constant_time(b: &Bench) -> Result<Outcome> {
 }
 
 fn memory(b: &Bench) -> Result<Outcome> {
-    let (simulate, fit, size_mb) = crate::bench_memory::simulate_and_fit(&b.calib, &b.dir, 242_000)?;
+    let (simulate, fit, size_mb) = crate::calib_runs::simulate_and_fit(&b.calib, &b.dir, 242_000)?;
     ensure!(fit.peak_mb <= 400.0, "calib fit peaked at {:.0} MB on {size_mb:.1} MB", fit.peak_mb);
     Ok(Outcome::Passed(format!(
         "{size_mb:.1} MB: fit peak {:.0} MB ({:.1} s), simulate peak {:.0} MB",

@@ -9,12 +9,12 @@
 //! `none`; `gear` (1–4 harmonics of orders 1–40, random phases and weights, any joint, joint 1
 //! included); `compliance` (one or two of joints 2–6); `coupling` (joint 2–5's error a product of
 //! harmonics of two *other* joints' angles: no candidate models it, the truth is `unknown`);
-//! `seven_axis` (the iiwa 7 campaign of issue 11: joints 1 and 2 moving, four payload runs with a
+//! `seven_axis` (a real iiwa 7 campaign's shape: joints 1 and 2 moving, four payload runs with a
 //! remounted probe each, measured torques, every joint compliant, full pose); `two_effects` (two
 //! of compliance, backlash, gear at once); `backlash` (one or two of joints 2–6); `joint_one`
 //! (compliance or backlash on joint 1 of a base tilted 30–90°, so that gravity loads joint 1; the
-//! diagnosis is told the mounting, not the masses); `thermal`; `drift`; `deflection` (issue 30:
-//! `column_ur10.ron`, a UR10 on a 2.5 m lifting column, whose column bends under the arm's
+//! diagnosis is told the mounting, not the masses); `thermal`; `drift`; `deflection`
+//! (`column_ur10.ron`, a UR10 on a 2.5 m lifting column, whose column bends under the arm's
 //! gravity moment by `1/EI` of 1e-7 1/(N·m²) times weights 0.3–1 about its two horizontal axes,
 //! the masses 50 kg per metre of link times 0.5–1.5 link by link; the diagnosis gets the robot
 //! without masses, so its stand-in masses are not the truth).

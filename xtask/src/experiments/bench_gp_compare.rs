@@ -9,9 +9,9 @@ use std::time::{Duration, Instant};
 use gp::ExactGp;
 use model::ResidualGpOptions;
 
-use crate::bench_gp_kernels::{KernelArgs, data_sets};
-use crate::bench_gp_residuals::heldout_mm;
-use crate::bench_gp_sklearn::{SklearnOptions, available, fit_predict};
+use super::bench_gp_kernels::{KernelArgs, data_sets};
+use super::bench_gp_residuals::heldout_mm;
+use super::bench_gp_sklearn::{SklearnOptions, available, fit_predict};
 
 /// Runs the comparison and returns the markdown table.
 pub fn run(args: &KernelArgs, timeout: Duration) -> anyhow::Result<String> {

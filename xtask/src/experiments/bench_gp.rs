@@ -53,7 +53,7 @@ pub struct Args {
     #[arg(long)]
     paper: bool,
     #[command(flatten)]
-    paper_args: crate::bench_gp_paper::PaperArgs,
+    paper_args: super::bench_gp_paper::PaperArgs,
     /// Write the residual sets of `--kernels`/`--compare` to this folder as CSV (`NAME.train.csv`,
     /// `NAME.test.csv`: inputs, then outputs) instead, for other tools to read.
     #[arg(long)]
@@ -63,13 +63,13 @@ pub struct Args {
     #[arg(long)]
     lml_floor: Option<usize>,
     #[command(flatten)]
-    kernel_args: crate::bench_gp_kernels::KernelArgs,
+    kernel_args: super::bench_gp_kernels::KernelArgs,
     /// The older table instead of the sweep: exact GP fit and predict on synthetic robot-like data
     /// (Eq. 5 kernel, shared outputs), n = 100 … 3000, beside scikit-learn.
     #[arg(long)]
     synthetic: bool,
     #[command(flatten)]
-    sweep: crate::bench_gp_sweep::SweepArgs,
+    sweep: super::bench_gp_sweep::SweepArgs,
 }
 
 /// One LML + gradient evaluation at `n` against the time faer's own n × n matrix product takes for
@@ -290,7 +290,7 @@ fn ours(d: &Data, n: usize, restarts: usize) -> anyhow::Result<OurRow> {
 }
 
 fn sklearn_available() -> bool {
-    Command::new(crate::bench_gp_sklearn::python())
+    Command::new(super::bench_gp_sklearn::python())
         .args(["-c", "import sklearn"])
         .output()
         .map(|o| o.status.success())
@@ -317,7 +317,7 @@ fn sklearn(d: &Data, sizes: &[usize], restarts: usize) -> anyhow::Result<Vec<Skl
         "upper": bounds.upper,
     });
     std::fs::write(&request, body.to_string()).with_context(|| request.display().to_string())?;
-    let status = Command::new(crate::bench_gp_sklearn::python())
+    let status = Command::new(super::bench_gp_sklearn::python())
         .arg(&script)
         .arg(&request)
         .arg(&response)
@@ -357,7 +357,7 @@ fn fmt_opt(v: Option<f64>, f: impl Fn(f64) -> String) -> String {
 /// Runs the benchmark and prints the markdown table.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.paper {
-        let md = crate::bench_gp_paper::run(&args.paper_args, &args.kernel_args.ur10_data)?;
+        let md = super::bench_gp_paper::run(&args.paper_args, &args.kernel_args.ur10_data)?;
         println!("{md}");
         if let Some(path) = &args.out {
             std::fs::write(path, &md).with_context(|| path.display().to_string())?;
@@ -365,19 +365,19 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         return Ok(());
     }
     if args.compare {
-        let md = crate::bench_gp_compare::run(&args.kernel_args, std::time::Duration::from_secs(300))?;
+        let md = super::bench_gp_compare::run(&args.kernel_args, std::time::Duration::from_secs(300))?;
         println!("{md}");
         return Ok(());
     }
     if let Some(dir) = &args.dump_residuals {
-        return crate::bench_gp_residuals::dump(&crate::bench_gp_kernels::data_sets(&args.kernel_args)?, dir);
+        return super::bench_gp_residuals::dump(&super::bench_gp_kernels::data_sets(&args.kernel_args)?, dir);
     }
     if let Some(n) = args.lml_floor {
         println!("{}", lml_floor(n)?);
         return Ok(());
     }
     if args.kernels {
-        let md = crate::bench_gp_kernels::run(&args.kernel_args)?;
+        let md = super::bench_gp_kernels::run(&args.kernel_args)?;
         println!("{md}");
         return Ok(());
     }
@@ -387,7 +387,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             sweep.sizes = vec![300, 1000];
         }
         let svg = args.out.as_ref().map(|p| p.with_extension("svg"));
-        let md = crate::bench_gp_sweep::run(&sweep, svg.as_deref())?;
+        let md = super::bench_gp_sweep::run(&sweep, svg.as_deref())?;
         println!("{md}");
         if let Some(path) = &args.out {
             std::fs::write(path, &md).with_context(|| path.display().to_string())?;

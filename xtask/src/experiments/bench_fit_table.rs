@@ -1,12 +1,12 @@
 //! The table `cargo xtask bench-fit` prints: one line per row (the `calib` binary's median time,
 //! CPU, peak memory and held-out errors, the base binary's beside it, scikit-learn's pipeline and
-//! the ratio), each of issue 49's budgets with its verdict, and what the run was measured on.
+//! the ratio), each of the time budgets with its verdict, and what the run was measured on.
 
 use std::fmt::Write;
 
-use crate::bench_fit_sklearn::SklearnSide;
+use super::bench_fit_sklearn::SklearnSide;
 
-/// Issue 49's budget of a row.
+/// The time budget of a row: how long a person may wait for it on the 2-core machine.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Budget {
     /// The fit's wall time at most this, s.
@@ -34,7 +34,7 @@ impl Budget {
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunResult {
     /// Wall, CPU and peak memory of the command.
-    pub cost: crate::bench_fit_run::Cost,
+    pub cost: super::bench_fit_run::Cost,
     /// Mean held-out position error (mm) and rotation error (mrad, full pose); `None` for the
     /// diagnosis, which predicts nothing.
     pub heldout: Option<(f64, Option<f64>)>,
@@ -134,7 +134,7 @@ pub enum Outcome {
 pub struct Row {
     /// The name.
     pub label: &'static str,
-    /// Issue 49's budget, if it has one.
+    /// The row's time budget, if it has one.
     pub budget: Option<Budget>,
     /// What happened.
     pub outcome: Outcome,
@@ -204,8 +204,8 @@ fn speedup(budget: Budget, side: &Side, sklearn: &SklearnSide) -> Option<(f64, b
 }
 
 /// Whether `side` meets `budget`: `met`, `missed`, or why it is not known. A speed-up counts only
-/// at no worse held-out error (position, and rotation where both have it): the issue asks for it
-/// at equal accuracy.
+/// at no worse held-out error (position, and rotation where both have it): a faster answer that is
+/// less accurate is not the same answer.
 pub fn verdict(budget: Budget, side: &Side, sklearn: Option<&SklearnSide>) -> String {
     let target = match budget {
         Budget::WallAtMost(limit) => return (if side.wall_s <= limit { "met" } else { "missed" }).to_owned(),
@@ -313,7 +313,7 @@ pub fn table(run: &Run, rows: &[Row]) -> String {
         let _ = writeln!(
             md,
             "\n**--quick**: every set cut to a few hundred rows (10⁵ poses to a few thousand), one run, scikit-learn \
-             without restarts: a smoke run, not issue 49's measurement; the budgets are not judged."
+             without restarts: a smoke run, not the budgets' measurement; the budgets are not judged."
         );
     }
     let mut head =
@@ -417,8 +417,8 @@ A speed-up budget counts only at no worse held-out error.
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bench_fit_run::Cost;
-    use crate::bench_fit_sklearn::Identification;
+    use crate::experiments::bench_fit_run::Cost;
+    use crate::experiments::bench_fit_sklearn::Identification;
 
     fn run(wall_s: f64, heldout: (f64, Option<f64>), gp_s: Option<f64>) -> RunResult {
         let mut phases = vec![timings::PhaseTime { phase: "fit".into(), calls: 1, wall_s, cpu_s: wall_s }];

@@ -1,5 +1,5 @@
 //! `cargo xtask long-tests`: the tests kept out of CI (`#[ignore = "long …: cargo xtask long-tests"]`), each of which
-//! proves at full size what a short test of the suite proves in seconds (issue 49: CI within 20
+//! proves at full size what a short test of the suite proves in seconds (CI within 20
 //! minutes on the 2-core machine). A person runs them before a change that touches what they
 //! guard; `docs/results/ci-time.md` lists them with the short test that stands for each.
 
@@ -19,7 +19,7 @@ pub struct Args {
 pub fn run(args: &Args) -> Result<()> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
     let mut command = Command::new(&cargo);
-    command.current_dir(crate::reproduce_sim::workspace_root()).args(["test", "--workspace"]);
+    command.current_dir(crate::workspace_root()).args(["test", "--workspace"]);
     if args.release {
         command.arg("--release");
     }

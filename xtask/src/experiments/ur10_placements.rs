@@ -1,4 +1,4 @@
-//! How many tracker placements one series of the IPA UR10 dataset holds (issue 48). Every row
+//! How many tracker placements one series of the IPA UR10 dataset holds. Every row
 //! has the commanded goal (the T-Mac's point in the robot's base frame, planned) beside the
 //! measured point (tracker frame): within one placement a single rigid transform maps the goals
 //! onto the measured points to the robot's uncalibrated accuracy (millimetres); a tracker moved
