@@ -4,11 +4,12 @@
 //! own way (flags and files, or keyword arguments and arrays) and prints or returns what these
 //! give; the refusals here are the library's, and each front end names its own flags in its own.
 
+use campaign::ErrorKind;
 use campaign::{GeneratorConfig, Perturbation, Remount, TorqueSensorNoise};
 use cell::{CompensateOptions, CompensationSummary, Solved, TargetFile, TargetFrame};
 use diagnose::{DiagnoseOptions, Diagnosis};
 use effects::EffectSelection;
-use errors::{Error, ErrorKind};
+use errors::Error;
 use measurements::{BoundSet, InputFiles, MeasurementSet};
 use model::{CalibratedModel, EvalReport, Evaluation, GpChoice, Method, PoseError, PredictedPose, WrappedJoint};
 use pipeline::{FitOptions, FitReport};

@@ -2,8 +2,9 @@
 //! subcommands without a robot, or to test a calibration on data whose truth is known.
 
 use calib::flow::{CampaignShape, ShapeFault};
+use campaign::ErrorKind;
 use campaign::GeneratorConfig;
-use errors::{Error, ErrorKind};
+use errors::Error;
 use std::path::PathBuf;
 
 /// Simulate tracker measurements of a robot whose kinematics are off its nominal.

@@ -3,7 +3,7 @@
 //! without a file to point at; a hostile count (`fixed_point_iterations: 1e18`) it would run for ever.
 
 use errors::ron_position::{field_position, field_position_in, ron_options};
-use errors::{Error, ErrorKind};
+use errors::{CommonKind, Error};
 use loadsim::{DynamicsNeed, Effects, RobotFacts};
 use robot::RobotDescription;
 use ron::Value;
@@ -30,7 +30,7 @@ pub fn read_effects(path: &Path, robot: &RobotDescription) -> Result<Effects, Er
 /// refused at its line: serde would skip it, and a misspelt effect would silently stay off.
 pub fn parse_effects(text: &str, file: &str) -> Result<Effects, Error> {
     let at = |line: usize, column: usize, message: String| {
-        Error::at_line(file.to_owned(), line as u64, column, ErrorKind::RonFormat { message })
+        Error::at_line(file.to_owned(), line as u64, column, CommonKind::RonFormat { message })
     };
     let syntax = |e: ron::error::SpannedError| at(e.span.start.line, e.span.start.col, e.code.to_string());
     let effects: Effects = ron_options().from_str(text).map_err(syntax)?;
@@ -82,7 +82,7 @@ pub fn check_effects(effects: &Effects, robot: &RobotDescription, text: &str, fi
             file.to_owned(),
             line as u64,
             column,
-            ErrorKind::RonFormat { message: format!("{section}: {message}") },
+            CommonKind::RonFormat { message: format!("{section}: {message}") },
         )
     };
     let active = effects.active();
@@ -105,7 +105,7 @@ pub fn check_effects(effects: &Effects, robot: &RobotDescription, text: &str, fi
     }
     let joints = robot.joint_kinds();
     let facts =
-        RobotFacts { joints: &joints, dynamics: robot.dynamics.as_ref(), pitch_bounds_mm: errors::PITCH_BOUNDS_MM };
+        RobotFacts { joints: &joints, dynamics: robot.dynamics.as_ref(), pitch_bounds_mm: robot::PITCH_BOUNDS_MM };
     for (kind, effect) in &active {
         let section = kind.simulated_field().unwrap_or(kind.name());
         effect.check_entries(&facts).map_err(|f| at(section, &f.field, f.index, f.message))?;
@@ -142,7 +142,7 @@ mod tests {
             ),
         ] {
             let e = parse_effects(text, "e.ron").expect_err(text);
-            assert!(matches!(e.kind(), ErrorKind::RonFormat { .. }), "{text}: {e:?}");
+            assert!(matches!(e.kind::<CommonKind>(), Some(CommonKind::RonFormat { .. })), "{text}: {e:?}");
             let place = e.place().expect("a RON error has a place");
             assert_eq!((place.file(), place.line()), ("e.ron", Some(line)), "{text}");
         }
@@ -224,7 +224,7 @@ mod tests {
             ),
         ] {
             let e = check(text).expect_err(text);
-            let ErrorKind::RonFormat { message } = e.kind() else { panic!("{text}: {e:?}") };
+            let Some(CommonKind::RonFormat { message }) = e.kind::<CommonKind>() else { panic!("{text}: {e:?}") };
             let place = e.place().expect("a RON error has a place");
             assert_eq!((place.file(), place.position()), ("e.ron", Some(position)), "{text}: {message}");
             assert!(message.contains(words), "{message}");

@@ -30,8 +30,9 @@
 #![deny(missing_docs)]
 
 mod effects_file;
+mod error_kind;
 
-use errors::{Error, ErrorKind};
+use errors::Error;
 use lie::{SE3, SO3, Twist, Vector3};
 use measurements::{Measurement, MeasurementSet};
 use poe::LocalPoe;
@@ -44,6 +45,7 @@ pub use effects_file::{
     MAX_DRIFT_PER_S, MAX_EXPANSION_PER_K, MAX_FIXED_POINT_ITERATIONS, MAX_JOINT_ERROR_RAD, MAX_NOISE, MAX_ORDER,
     MAX_SCREW_ERROR_M, MAX_TEMPERATURE_C, check_effects, parse_effects, read_effects,
 };
+pub use error_kind::ErrorKind;
 pub use loadsim::{
     CouplingFactor, CouplingModel, CouplingTerm, EffectKind, Effects, GeneratorConfig, JointComplianceModel,
     JointRange, Sample, SimulatedCell, TorqueSensorNoise, TrackerNoiseModel,
@@ -398,7 +400,10 @@ mod tests {
         let effects = Effects { tracker_noise: Some(noise), ..Effects::default() };
         let result = simulate(&cell, &effects, &joint_ranges(&robot), &config, true);
         assert!(
-            matches!(result.as_ref().map_err(Error::kind), Err(ErrorKind::NonFiniteSimulation { row: 1 })),
+            matches!(
+                result.as_ref().map_err(Error::kind::<ErrorKind>),
+                Err(Some(ErrorKind::NonFiniteSimulation { row: 1 }))
+            ),
             "{result:?}"
         );
     }
@@ -479,13 +484,19 @@ mod tests {
         let effects = Effects { tracker_noise: Some(noise), ..Effects::default() };
         let result = simulate_to_csv(&cell, &effects, &joint_ranges(&robot), &config, true, Vec::new(), "mem");
         assert!(
-            matches!(result.as_ref().map_err(Error::kind), Err(ErrorKind::NonFiniteSimulation { row: 1 })),
+            matches!(
+                result.as_ref().map_err(Error::kind::<ErrorKind>),
+                Err(Some(ErrorKind::NonFiniteSimulation { row: 1 }))
+            ),
             "{result:?}"
         );
         let many = GeneratorConfig { sample_count: MAX_ROWS + 1, ..GeneratorConfig::default() };
         let result = simulate_to_csv(&cell, &effects, &joint_ranges(&robot), &many, true, Vec::new(), "mem");
         assert!(
-            matches!(result.as_ref().map_err(Error::kind), Err(ErrorKind::TooManySimulatedRows { .. })),
+            matches!(
+                result.as_ref().map_err(Error::kind::<ErrorKind>),
+                Err(Some(ErrorKind::TooManySimulatedRows { .. }))
+            ),
             "{result:?}"
         );
     }

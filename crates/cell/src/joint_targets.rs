@@ -13,8 +13,9 @@
 //! compensation removes what no placement of base and tool can, and the program's error before
 //! compensation is the error a user with a registered cell would see.
 
+use crate::ErrorKind;
 use crate::inverse::{InverseOptions, PoseTarget, Solved, TargetStatus, solve_targets};
-use errors::{Error, ErrorKind};
+use errors::Error;
 use lie::{SE3, SO3};
 use measurements::{BoundSet, Cells, ColumnMap, MeasurementSet};
 use model::CalibratedModel;
@@ -135,7 +136,7 @@ pub fn registered_nominal(
     if nominal.joint_count() != model.joint_count() {
         return Err(Error::in_file(
             file.to_owned(),
-            ErrorKind::RobotJointCount { robot: nominal.joint_count(), model: model.joint_count() },
+            robot::ErrorKind::RobotJointCount { robot: nominal.joint_count(), model: model.joint_count() },
         ));
     }
     let config = loadsim::GeneratorConfig {

@@ -3,8 +3,8 @@
 //! geometry exported as a URDF.
 //!
 //! Every function returns `errors::Error`, the one error of the calibration crates (its message
-//! names the file, line and column where there is one); the refusals only registration
-//! raises are kinds of it (`errors::ErrorKind::TooFewPoses`, `PosesUndetermined`, …).
+//! names the file, line and column where there is one); the refusals this crate raises are its
+//! own [`ErrorKind`] (`ErrorKind::TooFewPoses`, `PosesUndetermined`, …).
 //!
 //! ```
 //! # let fixture = |name: &str| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/robots").join(name);
@@ -83,6 +83,7 @@
 //! ```
 #![deny(missing_docs)]
 
+mod error_kind;
 mod inverse;
 mod joint_targets;
 mod model_text;
@@ -94,6 +95,7 @@ mod urdf_export;
 mod urdf_like;
 mod urdf_text;
 
+pub use error_kind::ErrorKind;
 pub use inverse::{InverseOptions, PoseTarget, Solved, TargetStatus, solve_targets};
 pub use joint_targets::{
     CompensateOptions, CompensationSummary, RegisteredNominal, TargetFile, TargetFrame, compensate, pose_targets,

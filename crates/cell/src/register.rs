@@ -8,10 +8,11 @@
 //! are carried by [`model::ResidualGp::moved_by`]. A tool becomes `T_{n,n+1} · D_t` of the
 //! model tool it was measured against (a new tool: the model's first tool).
 
+use crate::ErrorKind;
 use crate::register_options::{Refit, RegisterOptions};
 use crate::registration::{Registration, RegistrationRow, Unknowns, register_rows};
 use crate::report::{Fitted, Heldout, HeldoutFrom, RegisterReport, RegisterWarning, RegisteredTool, Verdict};
-use errors::{Error, ErrorKind};
+use errors::Error;
 use lie::{SE3, Vector3};
 use measurements::{BoundSet, Measurement, MeasurementSet};
 use model::CalibratedModel;
@@ -415,7 +416,10 @@ mod tests {
         let err = register(&model, &few.subset(&[0, 1, 2, 3, 4, 5, 6, 7]), refit, None, &RegisterOptions::default())
             .unwrap_err();
         assert!(
-            matches!(err.kind(), ErrorKind::TooFewPoses { poses: 8, needed_poses: 9, rows: 24, parameters: 9, .. }),
+            matches!(
+                err.kind::<ErrorKind>(),
+                Some(ErrorKind::TooFewPoses { poses: 8, needed_poses: 9, rows: 24, parameters: 9, .. })
+            ),
             "{err}"
         );
     }

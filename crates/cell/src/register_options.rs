@@ -1,7 +1,7 @@
 //! What `calib register` re-fits and how it is tuned.
 
 use crate::registration::RegistrationOptions;
-use errors::{Error, ErrorKind};
+use errors::{Error, OptionOutOfRange};
 use serde::{Deserialize, Serialize};
 
 /// What `register` re-fits.
@@ -72,13 +72,7 @@ impl RegisterOptions {
     pub fn validate(&self) -> Result<(), Error> {
         self.registration.validate()?;
         for (field, value) in [("min_redundancy", self.min_redundancy), ("changed_ratio", self.changed_ratio)] {
-            if !(value.is_finite() && value >= 1.0) {
-                return Err(Error::new(ErrorKind::OptionOutOfRange {
-                    field,
-                    value,
-                    expected: "a finite number of at least 1",
-                }));
-            }
+            OptionOutOfRange::check(field, value, value.is_finite() && value >= 1.0, "a finite number of at least 1")?;
         }
         Ok(())
     }

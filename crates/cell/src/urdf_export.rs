@@ -9,9 +9,10 @@
 //! compliance, the GP) is named, and the error the model makes without it measured on the training
 //! data.
 
+use crate::ErrorKind;
 use crate::urdf_like::{check_joint_kinds, write_like};
 use crate::urdf_text::{Written, escape, fixed_joint, origin_element};
-use errors::{Error, ErrorKind};
+use errors::Error;
 use lie::SE3;
 use measurements::MeasurementSet;
 use model::{CalibratedModel, ErrorSummary};

@@ -17,8 +17,9 @@
 //! goes on the origin of its first stage on the chain, before that stage's offset: the shipped
 //! shape is written back, the motor, its pseudo link and every `<mimic>` as they were.
 
+use crate::ErrorKind;
 use crate::urdf_text::{Written, escape, fixed_joint, origin_element};
-use errors::{Error, ErrorKind};
+use errors::Error;
 use lie::SE3;
 use poe::{JointKind, LocalPoe};
 use robot::{StepMotion, UrdfChain, UrdfDocument};
@@ -51,8 +52,8 @@ pub(crate) fn check_joint_kinds(document: &UrdfDocument, chain: &UrdfChain, mode
                 ErrorKind::UrdfJointKind {
                     joint: step.joint.clone(),
                     index: k + 1,
-                    urdf: urdf_kind.name(),
-                    model: model_kind.name(),
+                    urdf: urdf_kind,
+                    model: model_kind,
                 },
             ));
         }

@@ -34,6 +34,7 @@ mod arcs;
 mod candidates;
 pub mod chart;
 mod design;
+mod error_kind;
 mod fold_residuals;
 mod learnt_side;
 mod noise;
@@ -49,6 +50,7 @@ mod verdict;
 
 pub use arcs::ArcCheck;
 pub use candidates::Effect;
+pub use error_kind::ErrorKind;
 pub use fold_residuals::{FoldResiduals, HeldoutFolds};
 pub use noise::{NoiseFloor, NoiseSource};
 pub use outliers::{GrossOutliers, OutlierOptions};
@@ -61,7 +63,7 @@ pub use verdict::{GpCheck, InputScale, Verdict, VerdictOptions};
 
 use design::{Design, Weights};
 use effects::IdentifiedEffect;
-use errors::{Error, ErrorKind};
+use errors::{Error, OptionOutOfRange, option};
 use lie::Vector3;
 use measurements::{BoundSet, MeasurementSet};
 use model::geometric::{fit_geometry, observations};
@@ -148,9 +150,7 @@ impl DiagnoseOptions {
             ("structure.max_training_rows", self.structure.max_training_rows as f64),
         ];
         for (field, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(Error::new(ErrorKind::DiagnoseOption { field, value }));
-            }
+            option::positive(field, value)?;
         }
         let fractions: [(&'static str, f64); 5] = [
             ("outliers.max_left_out_fraction", self.outliers.max_left_out_fraction),
@@ -160,33 +160,28 @@ impl DiagnoseOptions {
             ("verdict.min_explained_fraction", self.verdict.min_explained_fraction),
         ];
         for (field, value) in fractions {
-            if !(0.0..1.0).contains(&value) {
-                return Err(Error::new(ErrorKind::DiagnoseOption { field, value }));
-            }
+            OptionOutOfRange::check(field, value, (0.0..1.0).contains(&value), "a number in [0, 1)")?;
         }
         let at_least_zero: [(&'static str, f64); 2] = [
             ("candidates.thermal_min_span_k", self.candidates.thermal_min_span_k),
             ("candidates.drift_min_offset_s", self.candidates.drift_min_offset_s),
         ];
         for (field, value) in at_least_zero {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(Error::new(ErrorKind::DiagnoseOption { field, value }));
-            }
+            option::non_negative(field, value)?;
         }
         let weight = self.selection.arc_order_weight;
-        if !(0.0..=1.0).contains(&weight) {
-            return Err(Error::new(ErrorKind::DiagnoseOption { field: "selection.arc_order_weight", value: weight }));
-        }
-        if self.arc_folds < 2 {
-            return Err(Error::new(ErrorKind::DiagnoseOption { field: "arc_folds", value: self.arc_folds as f64 }));
-        }
-        if self.folds < 3 {
-            // Inner cross-validation inside a fold needs two folds left.
-            return Err(Error::new(ErrorKind::DiagnoseOption { field: "folds", value: self.folds as f64 }));
-        }
-        if self.selection.series_orders.is_empty() || self.selection.series_orders.contains(&0) {
-            return Err(Error::new(ErrorKind::DiagnoseOption { field: "selection.series_orders", value: 0.0 }));
-        }
+        OptionOutOfRange::check(
+            "selection.arc_order_weight",
+            weight,
+            (0.0..=1.0).contains(&weight),
+            "a number in [0, 1]",
+        )?;
+        OptionOutOfRange::check("arc_folds", self.arc_folds as f64, self.arc_folds >= 2, "at least 2")?;
+        // Inner cross-validation inside a fold needs two folds left.
+        OptionOutOfRange::check("folds", self.folds as f64, self.folds >= 3, "at least 3")?;
+        let orders = &self.selection.series_orders;
+        let accepted = !orders.is_empty() && !orders.contains(&0);
+        OptionOutOfRange::check("selection.series_orders", 0.0, accepted, "orders of at least 1, and at least one")?;
         Ok(())
     }
 }

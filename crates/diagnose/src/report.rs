@@ -5,7 +5,8 @@ use super::candidates::Effect;
 use super::noise::NoiseSource;
 use super::regions::{PoseDiagnosis, Region};
 use super::{Diagnosis, svg};
-use errors::{Error, ErrorKind};
+use crate::ErrorKind;
+use errors::Error;
 use serde::{Deserialize, Serialize};
 
 /// One candidate tried alone on top of the geometric model.

@@ -9,7 +9,8 @@ use crate::{
     Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect, has_torques,
     stand_in_dynamics,
 };
-use errors::{Error, ErrorKind};
+use errors::Error;
+use crate::ErrorKind;
 use loadsim::{Payload, RobotDynamics};
 use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};

@@ -4,7 +4,7 @@
 //! (`EffectTerm::check`, in its file) through a [`Cursor`]; this module places the faults.
 
 use super::{IdentifiedEffect, LoadFrame};
-use errors::{Error, ErrorKind};
+use errors::{CommonKind, Error};
 
 /// What is wrong, where.
 #[derive(Debug)]
@@ -41,22 +41,22 @@ impl EffectFault {
         let field = self.path;
         match self.kind {
             FaultKind::Count { what, found, expected } => {
-                Error::at_line(file, line as u64, column, ErrorKind::ModelCount { field, what, found, expected })
+                Error::at_line(file, line as u64, column, CommonKind::ModelCount { field, what, found, expected })
             }
             FaultKind::Index { index, limit } => {
-                Error::at_line(file, line as u64, column, ErrorKind::ModelIndex { field, index, limit })
+                Error::at_line(file, line as u64, column, CommonKind::ModelIndex { field, index, limit })
             }
             FaultKind::NotFinite { value } => {
-                Error::at_line(file, line as u64, column, ErrorKind::NotFinite { field, value })
+                Error::at_line(file, line as u64, column, CommonKind::NotFinite { field, value })
             }
             FaultKind::Value { value, limit } => {
-                Error::at_line(file, line as u64, column, ErrorKind::ModelValue { field, value, limit })
+                Error::at_line(file, line as u64, column, CommonKind::ModelValue { field, value, limit })
             }
             FaultKind::Order { low, high } => Error::at_line(
                 file,
                 line as u64,
                 column,
-                ErrorKind::RonFormat {
+                CommonKind::RonFormat {
                     message: format!("{field} is [{low}, {high}]: its first value must not exceed its second"),
                 },
             ),

@@ -1,7 +1,8 @@
 //! Where one effect parameter moves the pose: the left twist that a unit of its scaled feature
 //! adds, in the model's reference frame (the tracker for a calibrated model).
 
-use errors::{Error, ErrorKind};
+use crate::ErrorKind;
+use errors::Error;
 use lie::{Twist, Vector6};
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};

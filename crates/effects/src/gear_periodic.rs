@@ -17,7 +17,8 @@ use crate::Direction;
 use crate::check::{Cursor, EffectFault, FaultKind};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect, MAX_HARMONICS};
-use errors::{Error, ErrorKind};
+use errors::{Error, OptionOutOfRange};
+use crate::ErrorKind;
 use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};
 
@@ -97,23 +98,13 @@ impl Default for GearOptions {
 
 impl GearOptions {
     /// Refuses a taper fraction outside (0, 0.25]: a wider taper would not reach zero inside a
-    /// gap. The field at fault and why, for the options file's error.
-    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+    /// gap.
+    pub fn validate(&self) -> Result<(), OptionOutOfRange> {
         let f = self.taper_fraction_of_period;
-        if !(f.is_finite() && f > 0.0 && f <= 0.25) {
-            return Err((
-                "taper_fraction_of_period",
-                format!("effects.gear.taper_fraction_of_period is {f}, expected a number in (0, 0.25]"),
-            ));
-        }
+        let taper = f.is_finite() && f > 0.0 && f <= 0.25;
+        OptionOutOfRange::check("taper_fraction_of_period", f, taper, "a number in (0, 0.25]")?;
         let r = self.roughness_order;
-        if !(r.is_finite() && (0.0..=4.0).contains(&r)) {
-            return Err((
-                "roughness_order",
-                format!("effects.gear.roughness_order is {r}, expected a number in [0, 4]"),
-            ));
-        }
-        Ok(())
+        OptionOutOfRange::check("roughness_order", r, r.is_finite() && (0.0..=4.0).contains(&r), "a number in [0, 4]")
     }
 }
 
@@ -558,11 +549,11 @@ mod tests {
         assert!(GearOptions::default().validate().is_ok());
         for taper in [0.0, -0.1, 0.3, f64::NAN] {
             let options = GearOptions { taper_fraction_of_period: taper, ..GearOptions::default() };
-            assert_eq!(options.validate().unwrap_err().0, "taper_fraction_of_period", "{taper}");
+            assert_eq!(options.validate().unwrap_err().field, "taper_fraction_of_period", "{taper}");
         }
         for roughness in [-1.0, 5.0, f64::INFINITY] {
             let options = GearOptions { roughness_order: roughness, ..GearOptions::default() };
-            assert_eq!(options.validate().unwrap_err().0, "roughness_order", "{roughness}");
+            assert_eq!(options.validate().unwrap_err().field, "roughness_order", "{roughness}");
         }
     }
 }

@@ -11,7 +11,8 @@ use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect, has_torques};
 
 use crate::{BeyondSpan, Direction, PayloadSpan};
-use errors::{Error, ErrorKind};
+use errors::Error;
+use crate::ErrorKind;
 use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};
 

@@ -17,7 +17,8 @@ use crate::term::{EffectTerm, NewEffect};
 use crate::{
     Argument, CandidateContext, CandidateModel, Direction, EffectContext, EffectSpec, GearPeriodicTerm, IdentifiedEffect,
 };
-use errors::{Error, ErrorKind};
+use errors::Error;
+use crate::ErrorKind;
 use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
@@ -124,7 +125,7 @@ impl EffectTerm for ScrewPeriodicTerm {
     }
 
     fn check(&self, cursor: &Cursor<'_>, n: usize, tools: usize) -> Result<(), EffectFault> {
-        let (low, high) = errors::PITCH_BOUNDS_MM;
+        let (low, high) = robot::PITCH_BOUNDS_MM;
         cursor.finite("pitch_m", &[self.pitch_m], true)?;
         if !(low * 1e-3..=high * 1e-3).contains(&self.pitch_m) {
             let kind = crate::FaultKind::Value { value: self.pitch_m, limit: high * 1e-3 };

@@ -6,13 +6,15 @@
 //! [`EffectKind::IDENTIFIED`] and each kind's arguments its `NewEffect::ARGUMENTS` (module `term`),
 //! so a new effect is parsed and printed without a change here.
 
+use crate::ErrorKind;
 use crate::IdentifiedEffect;
-use errors::{Error, ErrorKind};
+use errors::Error;
 use loadsim::EffectKind;
 use std::fmt;
 use std::str::FromStr;
 
-pub use errors::{EffectListFault, MAX_HARMONICS, PITCH_BOUNDS_MM};
+pub use crate::error_kind::{EffectListFault, MAX_HARMONICS};
+pub use robot::PITCH_BOUNDS_MM;
 
 /// What an `--effects` item takes after its name, in order (`gear_periodic:JOINT:HARMONICS`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -262,8 +264,8 @@ mod tests {
 
     fn fault_of(text: &str) -> (usize, String, EffectListFault) {
         let e = text.parse::<EffectSelection>().expect_err(text);
-        match (e.place(), e.kind()) {
-            (Some(place), ErrorKind::EffectList { text, fault }) if place.file() == "--effects" => {
+        match (e.place(), e.kind::<ErrorKind>()) {
+            (Some(place), Some(ErrorKind::EffectList { text, fault })) if place.file() == "--effects" => {
                 (place.column().expect("a column"), text.clone(), *fault)
             }
             _ => panic!("{text}: {e:?}"),

@@ -6,7 +6,8 @@ use crate::check::{Cursor, EffectFault};
 use crate::term::{EffectTerm, NewEffect};
 use crate::{Argument, CandidateContext, CandidateModel, EffectContext, EffectSpec, IdentifiedEffect};
 use crate::{BeyondSpan, Direction};
-use errors::{Error, ErrorKind};
+use errors::Error;
+use crate::ErrorKind;
 use measurements::{BoundSet, Measurement};
 use serde::{Deserialize, Serialize};
 

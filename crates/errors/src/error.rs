@@ -1,8 +1,14 @@
-//! The error of the calibration crates: a [`Place`] (where, if anywhere) and an [`ErrorKind`]
-//! (what), kept apart as ripgrep's globset keeps a glob apart from its error's kind.
+//! The error of the calibration crates: a [`Place`] (where, if anywhere) and a [`Kind`] (what),
+//! kept apart as ripgrep's globset keeps a glob apart from its error's kind. The kind is the
+//! raising crate's own enum, so that a new refusal is written (and rebuilds) where it is raised.
 
-use crate::{ErrorKind, Place};
+use crate::{CommonKind, Place};
 use std::fmt;
+
+/// What went wrong, without where: each crate's `ErrorKind` enum (and this crate's [`CommonKind`]
+/// and [`OptionOutOfRange`](crate::OptionOutOfRange)). Its `Display` is the message after the
+/// place, its `source()` the error it wraps, if any.
+pub trait Kind: std::error::Error + Send + Sync + 'static {}
 
 /// What went wrong ([`kind`](Error::kind)) and where ([`place`](Error::place)): its message is the
 /// place's `file:line:column: ` (or `file: `) followed by the kind's.
@@ -14,27 +20,27 @@ pub struct Error(Box<Inner>);
 #[derive(Debug)]
 struct Inner {
     place: Option<Place>,
-    kind: ErrorKind,
+    kind: Box<dyn Kind>,
 }
 
 impl Error {
     /// An error without a place (about an argument, a fit, a simulation).
-    pub fn new(kind: ErrorKind) -> Error {
-        Error(Box::new(Inner { place: None, kind }))
+    pub fn new(kind: impl Kind) -> Error {
+        Error(Box::new(Inner { place: None, kind: Box::new(kind) }))
     }
 
     /// An error at a place.
-    pub fn at(place: Place, kind: ErrorKind) -> Error {
-        Error(Box::new(Inner { place: Some(place), kind }))
+    pub fn at(place: Place, kind: impl Kind) -> Error {
+        Error(Box::new(Inner { place: Some(place), kind: Box::new(kind) }))
     }
 
     /// An error about a whole file (or a path): its message starts with `file: `.
-    pub fn in_file(file: impl Into<String>, kind: ErrorKind) -> Error {
+    pub fn in_file(file: impl Into<String>, kind: impl Kind) -> Error {
         Error::at(Place::in_file(file), kind)
     }
 
     /// An error at a line and column of a file: its message starts with `file:line:column: `.
-    pub fn at_line(file: impl Into<String>, line: u64, column: usize, kind: ErrorKind) -> Error {
+    pub fn at_line(file: impl Into<String>, line: u64, column: usize, kind: impl Kind) -> Error {
         Error::at(Place::new(file, line, column), kind)
     }
 
@@ -44,34 +50,34 @@ impl Error {
             file,
             e.span.start.line as u64,
             e.span.start.col,
-            ErrorKind::RonFormat { message: e.code.to_string() },
+            CommonKind::RonFormat { message: e.code.to_string() },
         )
     }
 
     /// A file that could not be read or written.
     pub fn io(path: impl Into<String>, source: std::io::Error) -> Error {
-        Error::in_file(path, ErrorKind::Io { source })
+        Error::in_file(path, CommonKind::Io { source })
     }
 
     /// The kinematic model or its identification failed (a `poe::Error`, say).
     pub fn kinematics(source: impl std::error::Error + Send + Sync + 'static) -> Error {
-        Error::new(ErrorKind::Kinematics { source: Box::new(source) })
+        Error::new(CommonKind::Kinematics { source: Box::new(source) })
     }
 
     /// The load and effect models refused their input (a `loadsim::Error`, say).
     pub fn load(source: impl std::error::Error + Send + Sync + 'static) -> Error {
-        Error::new(ErrorKind::Load { source: Box::new(source) })
+        Error::new(CommonKind::Load { source: Box::new(source) })
     }
 
     /// The pose generator refused its input while drawing candidates (a `loadsim::Error`, say);
     /// the message is the generator's own.
     pub fn generator(source: impl std::error::Error + Send + Sync + 'static) -> Error {
-        Error::new(ErrorKind::Generator { source: Box::new(source) })
+        Error::new(CommonKind::Generator { source: Box::new(source) })
     }
 
     /// The Gaussian process failed (a `gp::Error`, say).
     pub fn gp(source: impl std::error::Error + Send + Sync + 'static) -> Error {
-        Error::new(ErrorKind::Gp { source: Box::new(source) })
+        Error::new(CommonKind::Gp { source: Box::new(source) })
     }
 
     /// Where the error is: a file (or a command-line option's argument), and a line and column
@@ -80,14 +86,16 @@ impl Error {
         self.0.place.as_ref()
     }
 
-    /// What went wrong.
-    pub fn kind(&self) -> &ErrorKind {
-        &self.0.kind
+    /// What went wrong, as the kind `K` (a crate's `ErrorKind`, [`CommonKind`]), or `None`
+    /// where the kind is another crate's: `error.kind::<measurements::ErrorKind>()`.
+    pub fn kind<K: Kind>(&self) -> Option<&K> {
+        let kind: &(dyn std::error::Error + 'static) = &*self.0.kind;
+        kind.downcast_ref::<K>()
     }
 
-    /// The kind, the place dropped.
-    pub fn into_kind(self) -> ErrorKind {
-        self.0.kind
+    /// What went wrong, whatever crate's kind it is: its `Display` is the message without the place.
+    pub fn dyn_kind(&self) -> &dyn Kind {
+        &*self.0.kind
     }
 
     /// The 1-based line and column of the place, where it has them.
@@ -96,8 +104,8 @@ impl Error {
     }
 }
 
-impl From<ErrorKind> for Error {
-    fn from(kind: ErrorKind) -> Self {
+impl<K: Kind> From<K> for Error {
+    fn from(kind: K) -> Self {
         Error::new(kind)
     }
 }
@@ -119,22 +127,50 @@ impl std::error::Error for Error {
 
 #[cfg(test)]
 mod tests {
-    use super::Error;
-    use crate::{ErrorKind, Place};
+    use super::{Error, Kind};
+    use crate::{CommonKind, OptionOutOfRange, Place};
+    use std::fmt;
+
+    /// A crate's own kind, as the crates above this one define theirs.
+    #[derive(Debug)]
+    enum ReadKind {
+        MissingColumn { name: String },
+    }
+
+    impl fmt::Display for ReadKind {
+        fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            match self {
+                ReadKind::MissingColumn { name } => write!(f, "missing required column '{name}'"),
+            }
+        }
+    }
+
+    impl std::error::Error for ReadKind {}
+    impl Kind for ReadKind {}
 
     #[test]
     fn a_message_is_the_place_then_the_kind() {
-        let kind = || ErrorKind::MissingColumn { name: "y_mm".into() };
+        let kind = || ReadKind::MissingColumn { name: "y_mm".into() };
         let error = Error::at_line("poses.csv", 1, 5, kind());
         assert_eq!(error.to_string(), "poses.csv:1:5: missing required column 'y_mm'");
         assert_eq!(error.position(), Some((1, 5)));
         assert_eq!(error.place().map(Place::file), Some("poses.csv"));
-        let error = Error::in_file("poses.csv", ErrorKind::TooFewRows { rows: 3, needed: 50 });
-        assert_eq!(error.to_string(), "poses.csv: 3 measurement rows, at least 50 needed");
+        let error = Error::in_file("poses.csv", CommonKind::NotFinite { field: "x".into(), value: f64::NAN });
+        assert_eq!(error.to_string(), "poses.csv: x is NaN, a finite number is needed");
         assert_eq!(error.position(), None);
-        let error = Error::new(ErrorKind::PartOrder { part: "effect" });
-        assert_eq!(error.to_string(), "a model's effect comes before its geometry");
+        let error = Error::new(OptionOutOfRange { field: "ridge", value: -1.0, expected: "a positive finite number" });
+        assert_eq!(error.to_string(), "option ridge = -1: expected a positive finite number");
         assert!(error.place().is_none());
+    }
+
+    #[test]
+    fn a_kind_is_found_by_its_type_and_only_by_it() {
+        let error = Error::at_line("poses.csv", 1, 5, ReadKind::MissingColumn { name: "y_mm".into() });
+        assert!(matches!(error.kind::<ReadKind>(), Some(ReadKind::MissingColumn { name }) if name == "y_mm"));
+        assert!(error.kind::<CommonKind>().is_none());
+        let error: Error = CommonKind::RonFormat { message: "expected ')'".into() }.into();
+        assert!(matches!(error.kind::<CommonKind>(), Some(CommonKind::RonFormat { .. })));
+        assert!(error.kind::<ReadKind>().is_none());
     }
 
     #[test]
@@ -143,52 +179,11 @@ mod tests {
         assert_eq!(error.to_string(), "Gaussian process: not positive definite");
         let source = std::error::Error::source(&error).map(ToString::to_string);
         assert_eq!(source.as_deref(), Some("not positive definite"));
-        assert!(matches!(error.kind(), ErrorKind::Gp { .. }));
-    }
-
-    #[test]
-    fn the_registration_and_report_kinds_keep_the_messages_of_their_former_enums() {
-        // The texts `cell::Error` and `report::Error` wrote before they were folded in here.
-        let error = Error::at_line("d.csv", 7, 3, ErrorKind::NewToolWithoutRefit { tool: "probe".into() });
-        assert_eq!(
-            error.to_string(),
-            "d.csv:7:3: tool 'probe' is not in the model; re-fit tools to add it (--refit tools or --refit base,tools)"
-        );
-        let kind = ErrorKind::TooFewPoses {
-            what: "the registration".into(),
-            poses: 8,
-            needed_poses: 9,
-            rows: 24,
-            parameters: 9,
-        };
-        assert_eq!(
-            kind.to_string(),
-            "too few poses for the registration: 8 poses (24 residual rows) for 9 re-fitted parameters; at least 9 poses are needed"
-        );
-        let kind = ErrorKind::PosesUndetermined { rank: 5, parameters: 6, condition: 1234.5 };
-        assert_eq!(
-            kind.to_string(),
-            "the poses determine only 5 of the 6 re-fitted parameters (condition number 1.234e3): measure poses with more varied joint angles and flange orientations"
-        );
-        let kind = ErrorKind::RegistrationNotConverged { iterations: 50, rms_m: 0.000_123_4 };
-        assert_eq!(kind.to_string(), "the registration did not converge in 50 iterations (RMS residual 0.1234 mm)");
-        let kind = ErrorKind::OptionOutOfRange { field: "ridge", value: -1.0, expected: "a positive finite number" };
-        assert_eq!(kind.to_string(), "option ridge = -1: expected a positive finite number");
-        assert_eq!(
-            ErrorKind::TooFewCandidates { candidates: 5, poses: 6 }.to_string(),
-            "6 poses asked for but only 5 candidates given"
-        );
-        assert_eq!(
-            ErrorKind::NoIdentifiableDirection { candidates: 4 }.to_string(),
-            "the 4 candidates determine no direction of the identification"
-        );
+        assert!(matches!(error.kind::<CommonKind>(), Some(CommonKind::Gp { .. })));
         let error = Error::generator(std::io::Error::other("joint 2 has no range"));
         assert_eq!(error.to_string(), "joint 2 has no range");
-        let kind = ErrorKind::Plot { figure: "histogram".into(), message: "no room".into() };
-        assert_eq!(kind.to_string(), "the chart \"histogram\" could not be drawn: no room");
-        let source = serde_json::from_str::<f64>("x").unwrap_err();
-        let expected = format!("the evaluation could not be written as JSON: {source}");
-        assert_eq!(ErrorKind::EvaluationJson { source }.to_string(), expected);
+        let error = Error::load(std::io::Error::other("no mass"));
+        assert_eq!(error.to_string(), "load model: no mass");
     }
 
     #[test]

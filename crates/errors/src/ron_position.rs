@@ -16,7 +16,7 @@ pub fn text_of(bytes: Vec<u8>, file: &str) -> Result<String, crate::Error> {
         let valid = std::str::from_utf8(valid).unwrap_or_default();
         let line = valid.matches('\n').count() as u64 + 1;
         let column = valid.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-        crate::Error::at_line(file, line, column, crate::ErrorKind::InvalidUtf8)
+        crate::Error::at_line(file, line, column, crate::CommonKind::InvalidUtf8)
     })
 }
 

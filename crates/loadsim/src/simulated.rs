@@ -60,7 +60,7 @@ pub struct RobotFacts<'a> {
     pub joints: &'a [JointKind],
     /// The robot's dynamics, if its file gives them.
     pub dynamics: Option<&'a RobotDynamics>,
-    /// The range of a screw's pitch an `--effects` item takes, mm (`errors::PITCH_BOUNDS_MM`),
+    /// The range of a screw's pitch an `--effects` item takes, mm (`robot::PITCH_BOUNDS_MM`),
     /// which an effects file's pitch must respect too.
     pub pitch_bounds_mm: (f64, f64),
 }

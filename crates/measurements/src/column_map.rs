@@ -2,8 +2,9 @@
 //! that a tracker export is read as it comes. Units stay explicit: the target names carry them.
 
 use super::quantity::quantity;
-pub use errors::ColumnMapFault;
-use errors::{Error, ErrorKind};
+use crate::ErrorKind;
+pub use crate::error_kind::ColumnMapFault;
+use errors::Error;
 use std::fmt;
 use std::str::FromStr;
 

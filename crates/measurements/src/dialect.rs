@@ -3,7 +3,7 @@
 //! them (SPEC v2). The separator is read off the header, the decimal mark off the first numbers
 //! that have one; every later number must agree.
 
-pub use errors::DecimalFault;
+pub use crate::error_kind::DecimalFault;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 

@@ -4,8 +4,9 @@
 //! Two paths are the same file when their canonical paths are equal (`./run.csv`, `a/../run.csv`,
 //! a symbolic link) or, on Unix, when they have the same device and inode (a hard link).
 
+use crate::ErrorKind;
 use crate::output_file::output_target;
-use errors::{Error, ErrorKind};
+use errors::Error;
 use std::path::{Path, PathBuf};
 
 /// One input: the option that named it, the path as given, and what identifies the file.
@@ -108,7 +109,7 @@ mod tests {
 
     fn refused(inputs: &InputFiles, output: &Path) -> String {
         match inputs.check_output("--out", output) {
-            Err(e) if matches!(e.kind(), ErrorKind::OutputIsInput { .. }) => e.to_string(),
+            Err(e) if matches!(e.kind::<ErrorKind>(), Some(ErrorKind::OutputIsInput { .. })) => e.to_string(),
             other => panic!("{} should be refused as an input, got {other:?}", output.display()),
         }
     }

@@ -3,7 +3,8 @@
 //! by name and in the unit the column's name states, as written (no conversion: a model learns
 //! from them in whatever unit they were measured in, and records that unit).
 
-use errors::{Error, ErrorKind};
+use crate::ErrorKind;
+use errors::Error;
 use std::fmt;
 use std::str::FromStr;
 use std::sync::Arc;

@@ -3,7 +3,8 @@
 
 use super::ColumnMap;
 use super::quantity::{Quantity, quantity};
-use errors::{Error, ErrorKind};
+use crate::ErrorKind;
+use errors::Error;
 use poe::JointKind;
 use std::collections::HashSet;
 
@@ -295,7 +296,7 @@ fn check_joints(
                     file.to_owned(),
                     line,
                     column.index + 1,
-                    ErrorKind::JointUnit { joint: *k, kind: robot.name() },
+                    ErrorKind::JointUnit { joint: *k, kind: *robot },
                 ));
             }
         }

@@ -25,6 +25,7 @@
 mod bound;
 mod column_map;
 mod dialect;
+mod error_kind;
 mod file_lines;
 mod input_files;
 mod inputs;
@@ -35,6 +36,7 @@ mod quantity;
 mod row;
 mod writer;
 pub use bound::{BoundSet, model_tool};
+pub use error_kind::ErrorKind;
 pub use input_files::InputFiles;
 pub use inputs::{INPUT_UNITS, InputColumn, InputNames, Inputs, input_unit};
 pub use outliers::{OutlierLine, list_lines, without};
@@ -46,7 +48,7 @@ pub use column_map::{ColumnMap, ColumnMapFault};
 pub use dialect::{Decimal, DecimalFault, Delimiter, Dialect};
 pub use writer::{CsvColumns, MeasurementWriter};
 
-use errors::{Error, ErrorKind};
+use errors::Error;
 use file_lines::LineCounter;
 use layout::{Expectation, Layout, OrientationColumns};
 use lie::{SO3, Vector3};
@@ -495,7 +497,7 @@ impl MeasurementSet {
                     self.source.clone(),
                     self.header_line,
                     column.column,
-                    ErrorKind::JointUnit { joint: k + 1, kind: kind.name() },
+                    ErrorKind::JointUnit { joint: k + 1, kind: *kind },
                 ));
             }
         }

@@ -7,8 +7,9 @@
 //! FIFO, a socket, a device node such as `/dev/null`) is refused rather than replaced by a
 //! regular file.
 
-pub use errors::FileKind;
-use errors::{Error, ErrorKind};
+use crate::ErrorKind;
+pub use crate::error_kind::FileKind;
+use errors::Error;
 use std::fs::{File, OpenOptions};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -253,8 +254,8 @@ mod tests {
         std::os::unix::fs::symlink(&b, &a).unwrap();
         std::os::unix::fs::symlink(&a, &b).unwrap();
         assert!(matches!(
-            write_file(&a, b"x").unwrap_err().kind(),
-            ErrorKind::OutputSymlinkChain { links: MAX_SYMLINKS }
+            write_file(&a, b"x").unwrap_err().kind::<ErrorKind>(),
+            Some(ErrorKind::OutputSymlinkChain { links: MAX_SYMLINKS })
         ));
     }
 
@@ -264,7 +265,13 @@ mod tests {
         let folder = dir.path().join("folder");
         std::fs::create_dir(&folder).unwrap();
         let error = write_file(&folder, b"x").unwrap_err();
-        assert!(matches!(error.kind(), ErrorKind::OutputNotRegularFile { kind: FileKind::Directory, .. }), "{error:?}");
+        assert!(
+            matches!(
+                error.kind::<ErrorKind>(),
+                Some(ErrorKind::OutputNotRegularFile { kind: FileKind::Directory, .. })
+            ),
+            "{error:?}"
+        );
         assert!(error.to_string().contains("is a directory"), "{error}");
         assert!(folder.is_dir());
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary file made");
@@ -277,8 +284,8 @@ mod tests {
         let link = dir.path().join("link");
         std::os::unix::fs::symlink(dir.path(), &link).unwrap();
         assert!(matches!(
-            write_file(&link, b"x").unwrap_err().kind(),
-            ErrorKind::OutputNotRegularFile { kind: FileKind::Directory }
+            write_file(&link, b"x").unwrap_err().kind::<ErrorKind>(),
+            Some(ErrorKind::OutputNotRegularFile { kind: FileKind::Directory })
         ));
     }
 
@@ -287,7 +294,10 @@ mod tests {
     fn a_character_device_is_refused() {
         let error = output_target(Path::new("/dev/null")).unwrap_err();
         assert!(
-            matches!(error.kind(), ErrorKind::OutputNotRegularFile { kind: FileKind::CharacterDevice, .. }),
+            matches!(
+                error.kind::<ErrorKind>(),
+                Some(ErrorKind::OutputNotRegularFile { kind: FileKind::CharacterDevice, .. })
+            ),
             "{error:?}"
         );
     }

@@ -3,7 +3,8 @@
 
 use super::dialect::{Delimiter, Dialect};
 use super::layout::{Column, OrientationColumns};
-use errors::{Error, ErrorKind};
+use crate::ErrorKind;
+use errors::Error;
 use lie::{SO3, Vector3};
 
 /// The largest magnitude a column's value can have, in SI units: beyond it the cell is a unit or
@@ -46,7 +47,7 @@ pub(super) fn syntax_error(e: &csv::Error, file: &str, delimiter: Delimiter, bod
             ErrorKind::FieldCount { found: *len, expected: *expected_len, delimiter: delimiter.byte() as char },
         ),
         csv::ErrorKind::Utf8 { err, .. } => {
-            Error::at_line(file.to_owned(), line, err.field() + 1, ErrorKind::InvalidUtf8)
+            Error::at_line(file.to_owned(), line, err.field() + 1, errors::CommonKind::InvalidUtf8)
         }
         _ => Error::at_line(file.to_owned(), line, 1, ErrorKind::CsvSyntax { message: e.to_string() }),
     }

@@ -38,6 +38,7 @@
 
 mod calibrated;
 mod effect_sigma;
+mod error_kind;
 mod eval_report;
 mod evaluate;
 pub mod geometric;
@@ -57,6 +58,7 @@ mod suspect_rows;
 mod training_range;
 mod unit_name;
 mod wrap;
+pub use error_kind::ErrorKind;
 pub use evaluate::{Evaluation, evaluate};
 pub use predictions::write_predictions;
 

@@ -6,7 +6,7 @@
 use crate::model_parts::{Part, Walk};
 use crate::{CalibratedModel, Method};
 use errors::ron_position::field_position;
-use errors::{Error, ErrorKind};
+use errors::{CommonKind, Error};
 use measurements::Measurement;
 use robot::{MAX_TRANSLATION_M, bad_translation};
 
@@ -27,13 +27,13 @@ impl Located<'_> {
             self.file.to_owned(),
             line as u64,
             column,
-            ErrorKind::ModelCount { field, what, found, expected },
+            CommonKind::ModelCount { field, what, found, expected },
         )
     }
 
     fn not_finite(&self, at: (&str, usize), field: String, value: f64) -> Error {
         let (line, column) = self.at(at.0, at.1);
-        Error::at_line(self.file.to_owned(), line as u64, column, ErrorKind::NotFinite { field, value })
+        Error::at_line(self.file.to_owned(), line as u64, column, CommonKind::NotFinite { field, value })
     }
 
     /// A value that is not finite, or finite and beyond [`robot::MAX_TRANSLATION_M`].
@@ -46,13 +46,13 @@ impl Located<'_> {
             self.file.to_owned(),
             line as u64,
             column,
-            ErrorKind::ModelValue { field, value, limit: MAX_TRANSLATION_M },
+            CommonKind::ModelValue { field, value, limit: MAX_TRANSLATION_M },
         )
     }
 
     fn part(&self, field: &str, message: String) -> Error {
         let (line, column) = self.at(field, 0);
-        Error::at_line(self.file.to_owned(), line as u64, column, ErrorKind::RonFormat { message })
+        Error::at_line(self.file.to_owned(), line as u64, column, CommonKind::RonFormat { message })
     }
 }
 
@@ -95,12 +95,12 @@ fn check_robot(robot: &robot::RobotDescription, model: &CalibratedModel, at: &Lo
     match robot.check_kept(&at.text[start.min(at.text.len())..], at.file) {
         Ok(()) => {}
         Err(e) => {
-            if let (ErrorKind::RonFormat { message }, Some(place)) = (e.kind(), e.place())
+            if let (Some(CommonKind::RonFormat { message }), Some(place)) = (e.kind::<CommonKind>(), e.place())
                 && let Some((relative, column)) = place.position()
             {
                 let message = format!("robot_description is not a valid robot: {message}");
                 let line = line as u64 + relative - 1;
-                return Err(Error::at_line(place.file(), line, column, ErrorKind::RonFormat { message }));
+                return Err(Error::at_line(place.file(), line, column, CommonKind::RonFormat { message }));
             }
             return Err(at.part(field, format!("robot_description is not a valid robot: {e}")));
         }
@@ -141,7 +141,7 @@ impl CalibratedModel {
             let (lo, hi) = robot::SCALE_BOUNDS;
             let (line, column) = at.at("scale", k);
             let message = format!("a joint's scale is {scale:e}, expected a finite number from {lo:e} to {hi:e}");
-            return Err(Error::at_line(file.to_owned(), line as u64, column, ErrorKind::RonFormat { message }));
+            return Err(Error::at_line(file.to_owned(), line as u64, column, CommonKind::RonFormat { message }));
         }
         if self.tools.len() != tool_count {
             return Err(at.count(("tools", 0), "tools".into(), "tool names", self.tools.len(), tool_count));

@@ -1,7 +1,8 @@
 //! The calibrated model as a file: RON with a schema version, written atomically.
 
 use crate::CalibratedModel;
-use errors::{Error, ErrorKind};
+use crate::ErrorKind;
+use errors::{CommonKind, Error};
 use std::path::Path;
 
 /// The schema version this build writes. Version 2 holds the non-geometric effects as a list
@@ -19,7 +20,7 @@ pub fn write_model(path: &Path, model: &CalibratedModel) -> Result<(), Error> {
 /// The text [`write_model`] writes; `file` names it in errors.
 pub fn model_text(model: &CalibratedModel, file: &str) -> Result<String, Error> {
     ron::ser::to_string_pretty(model, ron::ser::PrettyConfig::default().depth_limit(6))
-        .map_err(|e| Error::at_line(file.to_owned(), 1, 1, ErrorKind::RonFormat { message: e.to_string() }))
+        .map_err(|e| Error::at_line(file.to_owned(), 1, 1, CommonKind::RonFormat { message: e.to_string() }))
 }
 
 /// Reads a calibrated model, refusing a file of another schema version.
@@ -41,7 +42,7 @@ pub fn parse_model(text: &str, file: &str) -> Result<CalibratedModel, Error> {
     let options = errors::ron_position::ron_options();
     let version: Version = match options.from_str::<ron::Value>(text) {
         Ok(value) => value.into_rust().map_err(|e| {
-            Error::at_line(file.to_owned(), 1, 1, ErrorKind::RonFormat { message: format!("no schema_version: {e}") })
+            Error::at_line(file.to_owned(), 1, 1, CommonKind::RonFormat { message: format!("no schema_version: {e}") })
         })?,
         Err(e) => return Err(position_error(e)),
     };

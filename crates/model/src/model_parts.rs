@@ -8,10 +8,11 @@
 //! rows' pending twist, and the pending twist is applied before the GP reads the poses and at the
 //! end.
 
+use crate::ErrorKind;
 use crate::ResidualGp;
 use crate::effect_sigma::EffectUncertainty;
 use effects::IdentifiedEffect;
-use errors::{Error, ErrorKind};
+use errors::Error;
 use lie::{SE3, Twist, Vector6};
 use measurements::BoundSet;
 use poe::LocalPoe;

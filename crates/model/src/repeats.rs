@@ -30,15 +30,9 @@ impl Default for HeldoutOptions {
 
 impl HeldoutOptions {
     /// The tolerance is finite and not negative (0: only identical joint vectors repeat).
-    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+    pub fn validate(&self) -> Result<(), errors::OptionOutOfRange> {
         let t = self.repeat_tolerance;
-        if !(t.is_finite() && t >= 0.0) {
-            return Err((
-                "repeat_tolerance",
-                format!("heldout.repeat_tolerance is {t}, expected a number of at least 0"),
-            ));
-        }
-        Ok(())
+        errors::OptionOutOfRange::check("repeat_tolerance", t, t.is_finite() && t >= 0.0, "a number of at least 0")
     }
 }
 
@@ -191,7 +185,7 @@ mod tests {
     fn a_negative_or_infinite_tolerance_is_refused() {
         for t in [-1e-3, f64::NAN, f64::INFINITY] {
             let options = HeldoutOptions { repeat_tolerance: t };
-            assert_eq!(options.validate().unwrap_err().0, "repeat_tolerance");
+            assert_eq!(options.validate().unwrap_err().field, "repeat_tolerance");
         }
         assert!(HeldoutOptions::default().validate().is_ok());
     }

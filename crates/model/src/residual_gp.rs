@@ -2,7 +2,7 @@
 //! leaves, with the joint values (and the payload) as inputs, placed before the POE model
 //! (Eq. 9): `T = G(q, m) · T_POE(q)`.
 
-use errors::{Error, ErrorKind};
+use errors::Error;
 use faer::Mat;
 use lie::{SE3, Twist, Vector3, Vector6};
 use measurements::{BoundSet, Measurement, MeasurementSet};
@@ -225,7 +225,7 @@ impl ResidualGpOptions {
             }
             _ => measurements::InputNames::new(self.inputs.clone(), "residual_gp.inputs")
                 .map(|_| ())
-                .map_err(|e| ("inputs", format!("residual_gp.inputs: {}", e.kind()))),
+                .map_err(|e| ("inputs", format!("residual_gp.inputs: {}", e.dyn_kind()))),
         }
     }
 }
@@ -652,7 +652,7 @@ fn exact_fit(x: &Mat<f64>, y: &Mat<f64>, full_pose: bool, options: &ResidualGpOp
 
 /// The GP's inputs of `rows`: the joints, the payload where `with_payload`, then the measured
 /// signals `signals` by name; a row without one of them is refused at its line of `source`
-/// ([`ErrorKind::MissingInput`]: rows a caller made without it; a file without the column was
+/// ([`measurements::ErrorKind::MissingInput`]: rows a caller made without it; a file without the column was
 /// refused by its reader).
 fn inputs(rows: &[Measurement], with_payload: bool, signals: &[String], source: &str) -> Result<Mat<f64>, Error> {
     let n = rows.first().map_or(0, |r| r.q.len());
@@ -669,7 +669,7 @@ fn inputs(rows: &[Measurement], with_payload: bool, signals: &[String], source: 
     for (i, row) in rows.iter().enumerate() {
         for (k, name) in signals.iter().enumerate() {
             let Some(value) = row.inputs.value(k, name) else {
-                let kind = ErrorKind::MissingInput { name: name.clone() };
+                let kind = measurements::ErrorKind::MissingInput { name: name.clone() };
                 return Err(Error::at_line(source.to_owned(), row.line, 1, kind));
             };
             x[(i, p + k)] = value;

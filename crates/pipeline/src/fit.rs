@@ -1,11 +1,12 @@
 //! The fit of a method on a measurement set, and the evaluation of a fitted model.
 
+use crate::ErrorKind;
 use crate::auto::AutoChoice;
 use crate::fit_options::FitOptions;
 use effects::{
     EffectContext, EffectCorrection, EffectReport, EffectSelection, EffectSpec, IdentifiedEffect, effect_reports,
 };
-use errors::{Error, ErrorKind};
+use errors::Error;
 use measurements::MeasurementSet;
 use measurements::{BoundSet, OutlierLine, list_lines};
 use model::geometric::{GeometricFit, fit_geometry_with_prior, observations};

@@ -3,7 +3,7 @@
 
 use diagnose::DiagnoseOptions;
 use effects::EffectSelection;
-use errors::{Error, ErrorKind};
+use errors::{CommonKind, Error, OptionOutOfRange, option};
 use model::ResidualGpOptions;
 use poe::identify::{IdentificationOptions, Solver};
 use serde::{Deserialize, Serialize};
@@ -168,7 +168,7 @@ impl FitOptions {
             errors::ron_position::ron_options().from_str(text).map_err(|e| Error::ron(file, &e))?;
         options.validate().map_err(|(field, message)| {
             let (line, column) = errors::ron_position::field_position(text, field, 0);
-            Error::at_line(file.to_owned(), line as u64, column, ErrorKind::RonFormat { message })
+            Error::at_line(file.to_owned(), line as u64, column, CommonKind::RonFormat { message })
         })?;
         Ok(options)
     }
@@ -178,16 +178,11 @@ impl FitOptions {
         if let Err(poe::Error::InvalidOption { name, value, expected }) = self.identification.validate() {
             return Err((name, format!("identification.{name} is {value}, expected {expected}")));
         }
-        if self.effects.max_iterations == 0 {
-            return Err(("max_iterations", "effects.max_iterations is 0, expected at least 1".into()));
-        }
-        if !(self.min_redundancy.is_finite() && self.min_redundancy >= 1.0) {
-            let value = self.min_redundancy;
-            return Err((
-                "min_redundancy",
-                format!("min_redundancy is {value}, expected a finite number of at least 1"),
-            ));
-        }
+        option::at_least_one("max_iterations", self.effects.max_iterations).map_err(|e| e.in_file("effects"))?;
+        let redundancy = self.min_redundancy;
+        let accepted = redundancy.is_finite() && redundancy >= 1.0;
+        OptionOutOfRange::check("min_redundancy", redundancy, accepted, "a finite number of at least 1")
+            .map_err(|e| e.in_file(""))?;
         self.residual_gp.validate_fade()?;
         if let Err(gp::Error::InvalidConfig { field, value }) = self.residual_gp.gp.validate() {
             // The field's own name, where the file gives it (`function_tolerance:` for
@@ -201,33 +196,28 @@ impl FitOptions {
             };
             return Err((last, format!("compensation.gp.{field} is {value}, expected {expected}")));
         }
-        self.effects.gear.validate()?;
+        self.effects.gear.validate().map_err(|e| e.in_file("effects.gear"))?;
         let hold = self.effects.hold_beyond_span;
-        if !(hold.is_finite() && hold >= 0.0) {
-            return Err((
-                "hold_beyond_span",
-                format!("effects.hold_beyond_span is {hold}, expected a number of at least 0"),
-            ));
-        }
-        self.effects.sessions.validate()?;
-        self.effects.payloads.validate()?;
+        let accepted = hold.is_finite() && hold >= 0.0;
+        OptionOutOfRange::check("hold_beyond_span", hold, accepted, "a number of at least 0")
+            .map_err(|e| e.in_file("effects"))?;
+        self.effects.sessions.validate().map_err(|e| e.in_file("effects.sessions"))?;
+        self.effects.payloads.validate().map_err(|e| e.in_file("effects.payloads"))?;
         let ratio = self.effects.fallback_sigma_ratio;
-        if ratio.is_nan() || ratio < 1.0 {
-            return Err((
-                "fallback_sigma_ratio",
-                format!("effects.fallback_sigma_ratio is {ratio}, expected a number of at least 1 (inf for never)"),
-            ));
-        }
+        let accepted = !ratio.is_nan() && ratio >= 1.0;
+        OptionOutOfRange::check("fallback_sigma_ratio", ratio, accepted, "a number of at least 1 (inf for never)")
+            .map_err(|e| e.in_file("effects"))?;
         self.plausibility.validate()?;
         self.nominal_prior.validate()?;
-        self.heldout.validate()?;
+        self.heldout.validate().map_err(|e| e.in_file("heldout"))?;
         let prior = self.effects.prior_sigma;
-        if prior.is_nan() || prior <= 0.0 {
-            return Err((
-                "prior_sigma",
-                format!("effects.prior_sigma is {prior}, expected a number above 0 (inf for none)"),
-            ));
-        }
+        OptionOutOfRange::check(
+            "prior_sigma",
+            prior,
+            !prior.is_nan() && prior > 0.0,
+            "a number above 0 (inf for none)",
+        )
+        .map_err(|e| e.in_file("effects"))?;
         Ok(())
     }
 }
@@ -256,14 +246,10 @@ impl Default for SessionOptions {
 }
 
 impl SessionOptions {
-    /// Refuses a ratio that is not a finite number above 1 (every gap would split). The field at
-    /// fault and why, for the options file's error.
-    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+    /// Refuses a ratio that is not a finite number above 1 (every gap would split).
+    pub fn validate(&self) -> Result<(), OptionOutOfRange> {
         let r = self.gap_ratio;
-        if !(r.is_finite() && r > 1.0) {
-            return Err(("gap_ratio", format!("effects.sessions.gap_ratio is {r}, expected a finite number above 1")));
-        }
-        Ok(())
+        OptionOutOfRange::check("gap_ratio", r, r.is_finite() && r > 1.0, "a finite number above 1")
     }
 }
 
@@ -290,14 +276,10 @@ impl Default for PayloadOptions {
 }
 
 impl PayloadOptions {
-    /// Refuses fewer than 2 groups (a fold would leave nothing to fit on). The field at fault and
-    /// why, for the options file's error.
-    pub fn validate(&self) -> Result<(), (&'static str, String)> {
-        if self.min_groups < 2 {
-            let n = self.min_groups;
-            return Err(("min_groups", format!("effects.payloads.min_groups is {n}, expected at least 2")));
-        }
-        Ok(())
+    /// Refuses fewer than 2 groups (a fold would leave nothing to fit on).
+    pub fn validate(&self) -> Result<(), OptionOutOfRange> {
+        let n = self.min_groups;
+        OptionOutOfRange::check("min_groups", n as f64, n >= 2, "at least 2")
     }
 }
 

@@ -36,6 +36,7 @@
 
 mod auto;
 mod clusters;
+mod error_kind;
 mod fit;
 mod fit_options;
 mod fit_prior;
@@ -47,6 +48,7 @@ mod sessions;
 
 pub use auto::{AutoChoice, choose as choose_effects, effects_of};
 pub use clusters::{BranchJoint, Cluster, HeightSplit};
+pub use error_kind::ErrorKind;
 pub use fit::{FitReport, FitWarning, fit};
 pub use fit_options::{EffectOptions, FitOptions};
 pub use fit_options::{PayloadOptions, SessionOptions};

@@ -209,7 +209,7 @@ mod tests {
         assert!(PayloadOptions::default().validate().is_ok());
         for n in [0, 1] {
             assert_eq!(
-                PayloadOptions { min_groups: n, ..PayloadOptions::default() }.validate().unwrap_err().0,
+                PayloadOptions { min_groups: n, ..PayloadOptions::default() }.validate().unwrap_err().field,
                 "min_groups"
             );
         }

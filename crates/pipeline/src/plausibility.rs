@@ -11,7 +11,8 @@
 //! matrix of `R_i t` is `n I`, so the bounded solution is the unbounded one brought into the
 //! ball). The two steps alternate; each lowers the sum of squares.
 
-use errors::{Error, ErrorKind};
+use crate::ErrorKind;
+use errors::Error;
 use lie::{Matrix3, Vector3};
 use measurements::{BoundSet, MeasurementSet};
 use poe::JointKind;
@@ -278,7 +279,7 @@ fn joint_limits(robot: &RobotDescription, data: &MeasurementSet, options: &Plaus
                 column.map_or(k + 1, |c| c.column),
                 ErrorKind::JointBeyondLimits {
                     joint: k + 1,
-                    kind: kinds[k].name(),
+                    kind: kinds[k],
                     value,
                     limits: limits[k],
                     margin: margin(k),

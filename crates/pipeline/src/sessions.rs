@@ -211,7 +211,7 @@ mod tests {
         assert!(SessionOptions::default().validate().is_ok());
         for ratio in [1.0, 0.5, f64::NAN, f64::INFINITY] {
             assert_eq!(
-                SessionOptions { gap_ratio: ratio, ..SessionOptions::default() }.validate().unwrap_err().0,
+                SessionOptions { gap_ratio: ratio, ..SessionOptions::default() }.validate().unwrap_err().field,
                 "gap_ratio"
             );
         }

@@ -1,6 +1,7 @@
 //! Every bad measurement file the SPEC lists is refused with its file, line and column.
 
-use errors::{Error, ErrorKind};
+use errors::Error;
+use measurements::ErrorKind;
 use measurements::{ReadOptions, parse_measurements};
 use poe::JointKind;
 
@@ -24,21 +25,21 @@ const HEADER2: &str = "q1_rad,q2_rad,x_mm,y_mm,z_mm";
 #[test]
 fn an_empty_file_is_refused() {
     let (error, message) = refuse("", None);
-    assert!(matches!(error.kind(), ErrorKind::EmptyFile), "{message}");
+    assert!(matches!(error.kind::<ErrorKind>(), Some(ErrorKind::EmptyFile)), "{message}");
     assert_eq!(message, "cell.csv:1:1: the file has no header or no data row");
 }
 
 #[test]
 fn a_header_without_rows_is_refused() {
     let (error, message) = refuse(&format!("{HEADER2}\n"), Some(2));
-    assert!(matches!(error.kind(), ErrorKind::EmptyFile), "{message}");
+    assert!(matches!(error.kind::<ErrorKind>(), Some(ErrorKind::EmptyFile)), "{message}");
 }
 
 #[test]
 fn a_missing_position_column_is_refused_at_the_end_of_the_header() {
     let (error, message) = refuse("q1_rad,q2_rad,x_mm,z_mm\n0,0,1,2\n", Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::MissingColumn { name, .. } if name == "y_mm")
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::MissingColumn { name, .. }) if name == "y_mm")
             && matches!(error.position(), Some((1, 5))),
         "{message}"
     );
@@ -48,20 +49,27 @@ fn a_missing_position_column_is_refused_at_the_end_of_the_header() {
 #[test]
 fn a_gap_in_the_joint_columns_is_refused() {
     let (error, message) = refuse("q1_rad,q3_rad,x_mm,y_mm,z_mm\n0,0,1,2,3\n", None);
-    assert!(matches!(error.kind(), ErrorKind::MissingColumn { name, .. } if name == "q2_rad"), "{message}");
+    assert!(
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::MissingColumn { name, .. }) if name == "q2_rad"),
+        "{message}"
+    );
 }
 
 #[test]
 fn a_partial_quaternion_is_refused() {
     let (error, message) = refuse(&format!("{HEADER2},qw,qx,qy\n0,0,1,2,3,1,0,0\n"), Some(2));
-    assert!(matches!(error.kind(), ErrorKind::MissingColumn { name, .. } if name == "qz"), "{message}");
+    assert!(
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::MissingColumn { name, .. }) if name == "qz"),
+        "{message}"
+    );
 }
 
 #[test]
 fn a_duplicate_header_is_refused_at_its_second_occurrence() {
     let (error, message) = refuse("q1_rad,q2_rad,x_mm,y_mm,z_mm,y_mm\n0,0,1,2,3,4\n", Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::DuplicateColumn { .. }) && matches!(error.position(), Some((1, 6))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::DuplicateColumn { .. }))
+            && matches!(error.position(), Some((1, 6))),
         "{message}"
     );
     assert_eq!(message, "cell.csv:1:6: column 'y_mm' appears more than once");
@@ -71,12 +79,14 @@ fn a_duplicate_header_is_refused_at_its_second_occurrence() {
 fn one_quantity_in_two_units_is_a_duplicate() {
     let (error, message) = refuse("q1_rad,q1_deg,x_mm,y_mm,z_mm\n0,0,1,2,3\n", None);
     assert!(
-        matches!(error.kind(), ErrorKind::DuplicateColumn { .. }) && matches!(error.position(), Some((_, 2))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::DuplicateColumn { .. }))
+            && matches!(error.position(), Some((_, 2))),
         "{message}"
     );
     let (error, message) = refuse("q1_rad,x_mm,x_m,y_mm,z_mm\n0,0,1,2,3\n", None);
     assert!(
-        matches!(error.kind(), ErrorKind::DuplicateColumn { .. }) && matches!(error.position(), Some((_, 3))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::DuplicateColumn { .. }))
+            && matches!(error.position(), Some((_, 3))),
         "{message}"
     );
 }
@@ -85,7 +95,8 @@ fn one_quantity_in_two_units_is_a_duplicate() {
 fn a_non_number_is_refused_at_its_cell() {
     let (error, message) = refuse(&format!("{HEADER2}\n0,0,1,2,3\n0,0.5,1,abc,3\n"), Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::NotANumber { .. }) && matches!(error.position(), Some((3, 4))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::NotANumber { .. }))
+            && matches!(error.position(), Some((3, 4))),
         "{message}"
     );
     assert_eq!(message, "cell.csv:3:4: column 'y_mm': 'abc' is not a finite number");
@@ -96,7 +107,8 @@ fn nan_and_infinity_are_refused() {
     for bad in ["NaN", "nan", "inf", "-Infinity", ""] {
         let (error, message) = refuse(&format!("{HEADER2}\n0,{bad},1,2,3\n"), Some(2));
         assert!(
-            matches!(error.kind(), ErrorKind::NotANumber { .. }) && matches!(error.position(), Some((2, 2))),
+            matches!(error.kind::<ErrorKind>(), Some(ErrorKind::NotANumber { .. }))
+                && matches!(error.position(), Some((2, 2))),
             "{bad}: {message}"
         );
     }
@@ -106,7 +118,8 @@ fn nan_and_infinity_are_refused() {
 fn a_bad_optional_column_is_refused_too() {
     let (error, message) = refuse(&format!("{HEADER2},payload_kg,temp_c\n0,0,1,2,3,five,20\n"), Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::NotANumber { .. }) && matches!(error.position(), Some((_, 6))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::NotANumber { .. }))
+            && matches!(error.position(), Some((_, 6))),
         "{message}"
     );
 }
@@ -115,14 +128,15 @@ fn a_bad_optional_column_is_refused_too() {
 fn a_joint_count_that_does_not_match_the_robot_is_refused() {
     let (error, message) = refuse(&format!("{HEADER2}\n0,0,1,2,3\n"), Some(6));
     assert!(
-        matches!(error.kind(), ErrorKind::JointCountMismatch { found: 2, expected: 6, .. })
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::JointCountMismatch { found: 2, expected: 6, .. }))
             && matches!(error.position(), Some((1, _))),
         "{message}"
     );
     assert_eq!(message, "cell.csv:1:6: 2 joint columns, the robot has 6 joints");
     let (error, message) = refuse("q1_rad,q2_rad,q3_rad,x_mm,y_mm,z_mm\n0,0,0,1,2,3\n", Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::JointCountMismatch { .. }) && matches!(error.position(), Some((_, 3))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::JointCountMismatch { .. }))
+            && matches!(error.position(), Some((_, 3))),
         "{message}"
     );
 }
@@ -132,7 +146,8 @@ fn a_quaternion_off_unit_norm_is_refused() {
     let (error, message) =
         refuse(&format!("{HEADER2},qw,qx,qy,qz\n0,0,1,2,3,1,0,0,0\n0,0,1,2,3,1.01,0,0,0\n"), Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::QuaternionNorm { .. }) && matches!(error.position(), Some((3, 6))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::QuaternionNorm { .. }))
+            && matches!(error.position(), Some((3, 6))),
         "{message}"
     );
     assert!(message.starts_with("cell.csv:3:6: quaternion"), "{message}");
@@ -142,7 +157,7 @@ fn a_quaternion_off_unit_norm_is_refused() {
 fn a_row_with_a_missing_field_is_refused_at_its_line() {
     let (error, message) = refuse(&format!("{HEADER2}\n0,0,1,2,3\n0,0,1,2\n"), Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::FieldCount { found: 4, expected: 5, .. })
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::FieldCount { found: 4, expected: 5, .. }))
             && matches!(error.position(), Some((3, 5))),
         "{message}"
     );
@@ -194,14 +209,16 @@ fn an_angle_unit_on_a_prismatic_joint_is_refused_at_its_column() {
     for name in ["q2_deg", "q2_rad"] {
         let (error, message) = refuse_with(&format!("q1_rad,{name},x_mm,y_mm,z_mm\n0,0,1,2,3\n"), &options);
         assert!(
-            matches!(error.kind(), ErrorKind::JointUnit { joint: 2, .. }) && matches!(error.position(), Some((1, 2))),
+            matches!(error.kind::<ErrorKind>(), Some(ErrorKind::JointUnit { joint: 2, .. }))
+                && matches!(error.position(), Some((1, 2))),
             "{message}"
         );
         assert_eq!(message, "cell.csv:1:2: joint 2 is prismatic: its column is q2_m or q2_mm, not an angle");
     }
     let (error, message) = refuse_with("q1_mm,q2_m,x_mm,y_mm,z_mm\n0,0,1,2,3\n", &options);
     assert!(
-        matches!(error.kind(), ErrorKind::JointUnit { joint: 1, .. }) && matches!(error.position(), Some((_, 1))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::JointUnit { joint: 1, .. }))
+            && matches!(error.position(), Some((_, 1))),
         "{message}"
     );
     assert_eq!(message, "cell.csv:1:1: joint 1 is revolute: its column is q1_rad or q1_deg, not a length");
@@ -220,7 +237,8 @@ fn a_prismatic_joint_in_millimetres_is_read_in_metres() {
 fn a_negative_payload_is_refused_at_its_cell() {
     let (error, message) = refuse(&format!("{HEADER2},payload_kg\n0,0,1,2,3,0\n0,0,1,2,3,-2\n"), Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::NegativePayload { .. }) && matches!(error.position(), Some((3, 6))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::NegativePayload { .. }))
+            && matches!(error.position(), Some((3, 6))),
         "{message}"
     );
     assert_eq!(message, "cell.csv:3:6: column 'payload_kg': -2 kg, a payload cannot be negative");
@@ -234,20 +252,20 @@ fn a_huge_joint_number_in_a_header_is_refused_without_allocating_for_it() {
         let text = format!("q1_rad,q2_rad,{name},x_mm,y_mm,z_mm\n0,0,0,1,2,3\n");
         let (error, message) = refuse(&text, Some(2));
         assert!(
-            matches!(error.kind(), ErrorKind::JointCountMismatch { found: 3, expected: 2, .. })
+            matches!(error.kind::<ErrorKind>(), Some(ErrorKind::JointCountMismatch { found: 3, expected: 2, .. }))
                 && matches!(error.position(), Some((_, 3))),
             "{message}"
         );
         let (error, message) = refuse(&text, None);
         assert!(
-            matches!(error.kind(), ErrorKind::MissingColumn { name, .. } if name == "q3_rad")
+            matches!(error.kind::<ErrorKind>(), Some(ErrorKind::MissingColumn { name, .. }) if name == "q3_rad")
                 && matches!(error.position(), Some((_, 7))),
             "{message}"
         );
     }
     let (error, message) = refuse(&format!("{HEADER2},tau1_nm,tau99999999999_nm\n0,0,1,2,3,0,0\n"), Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::ColumnBeyondJoints { index: 99999999999, joints: 2, .. })
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::ColumnBeyondJoints { index: 99999999999, joints: 2, .. }))
             && matches!(error.position(), Some((_, 7))),
         "{message}"
     );
@@ -258,7 +276,7 @@ fn a_huge_joint_number_in_a_header_is_refused_without_allocating_for_it() {
 fn torque_columns_must_cover_every_joint() {
     let (error, message) = refuse(&format!("{HEADER2},tau2_nm\n0,0,1,2,3,0\n"), Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::MissingColumn { name, .. } if name == "tau1_nm")
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::MissingColumn { name, .. }) if name == "tau1_nm")
             && matches!(error.position(), Some((_, 7))),
         "{message}"
     );
@@ -269,7 +287,11 @@ fn invalid_utf8_is_refused_at_its_line_and_field() {
     let mut bytes = format!("{HEADER2},tool\n0,0,1,2,3,A\n0,0,1,2,3,").into_bytes();
     bytes.extend([0xff, 0xfe, b'\n']);
     let error = parse_measurements(bytes.as_slice(), "cell.csv", &revolute(Some(2))).unwrap_err();
-    assert!(matches!(error.kind(), ErrorKind::InvalidUtf8) && matches!(error.position(), Some((3, 6))), "{error}");
+    assert!(
+        matches!(error.kind::<errors::CommonKind>(), Some(errors::CommonKind::InvalidUtf8))
+            && matches!(error.position(), Some((3, 6))),
+        "{error}"
+    );
     assert_eq!(error.to_string(), "cell.csv:3:6: the text is not UTF-8");
 }
 
@@ -280,7 +302,7 @@ fn a_position_beyond_a_kilometre_is_refused_at_its_cell() {
     assert!(parse_measurements(at_bound.as_bytes(), "cell.csv", &revolute(Some(2))).is_ok());
     let (error, message) = refuse(&format!("{HEADER2}\n0,0,1,2,3\n0,0,1,-1.5e6,3\n"), Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::BeyondPhysicalRange { name, .. } if name == "y_mm")
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::BeyondPhysicalRange { name, .. }) if name == "y_mm")
             && matches!(error.position(), Some((3, 4))),
         "{message}"
     );
@@ -291,7 +313,8 @@ fn a_position_beyond_a_kilometre_is_refused_at_its_cell() {
     );
     let (error, _) = refuse("q1_rad,q2_rad,x_m,y_m,z_m\n0,0,0,0,2000\n", Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::BeyondPhysicalRange { .. }) && matches!(error.position(), Some((2, 5))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::BeyondPhysicalRange { .. }))
+            && matches!(error.position(), Some((2, 5))),
         "{error}"
     );
 }
@@ -305,7 +328,7 @@ fn a_joint_angle_beyond_a_thousand_radians_is_refused_after_unit_conversion() {
     );
     let (error, message) = refuse(&format!("{header}\n0,58000,1,2,3\n"), Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::BeyondPhysicalRange { name, .. } if name == "q2_deg")
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::BeyondPhysicalRange { name, .. }) if name == "q2_deg")
             && matches!(error.position(), Some((2, 2))),
         "{message}"
     );
@@ -316,7 +339,8 @@ fn a_joint_angle_beyond_a_thousand_radians_is_refused_after_unit_conversion() {
     );
     let (error, message) = refuse(&format!("{header}\n-1000.5,0,1,2,3\n"), Some(2));
     assert!(
-        matches!(error.kind(), ErrorKind::BeyondPhysicalRange { .. }) && matches!(error.position(), Some((2, 1))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::BeyondPhysicalRange { .. }))
+            && matches!(error.position(), Some((2, 1))),
         "{message}"
     );
 }

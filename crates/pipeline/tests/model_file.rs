@@ -4,7 +4,7 @@
 
 use campaign::{GeneratorConfig, Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
 use effects::IdentifiedEffect;
-use errors::{Error, ErrorKind};
+use errors::{CommonKind, Error};
 use model::{CalibratedModel, Method};
 use pipeline::FitOptions;
 
@@ -47,10 +47,10 @@ fn a_written_model_reads_back_and_passes_its_check() {
 fn a_compliance_term_of_a_joint_the_robot_lacks_is_refused() {
     let (_, text) = fitted(false);
     let (error, message) = refused(&text.replacen("joint: 1,", "joint: 9,", 1));
-    assert!(matches!(error.kind(), ErrorKind::ModelIndex { index: 9, limit: 6, .. }), "{message}");
+    assert!(matches!(error.kind::<CommonKind>(), Some(CommonKind::ModelIndex { index: 9, limit: 6, .. })), "{message}");
     assert!(message.contains("effects[0].terms[") && message.contains("].joint is 9, it must be below 6"), "{message}");
     let (error, message) = refused(&text.replacen("column: ", "column: 9999", 1));
-    assert!(matches!(error.kind(), ErrorKind::ModelIndex { limit: 25, .. }), "{message}");
+    assert!(matches!(error.kind::<CommonKind>(), Some(CommonKind::ModelIndex { limit: 25, .. })), "{message}");
 }
 
 #[test]
@@ -63,7 +63,7 @@ fn compliance_values_that_do_not_match_their_terms_are_refused() {
     let terms = compliance.terms.len();
     let (error, message) = refused(&text_of(&model));
     assert!(
-        matches!(error.kind(), ErrorKind::ModelCount { found, expected, .. } if *found == terms - 1 && *expected == terms),
+        matches!(error.kind::<CommonKind>(), Some(CommonKind::ModelCount { found, expected, .. }) if *found == terms - 1 && *expected == terms),
         "{message}"
     );
     assert!(message.contains("effects[0].theta has"), "{message}");
@@ -74,7 +74,10 @@ fn tool_names_that_do_not_match_the_kinematics_are_refused() {
     let (mut model, _) = fitted(false);
     model.tools.push("second".into());
     let (error, message) = refused(&text_of(&model));
-    assert!(matches!(error.kind(), ErrorKind::ModelCount { found: 2, expected: 1, .. }), "{message}");
+    assert!(
+        matches!(error.kind::<CommonKind>(), Some(CommonKind::ModelCount { found: 2, expected: 1, .. })),
+        "{message}"
+    );
     assert!(message.contains("tools has 2 tool names, the rest of the model needs 1"), "{message}");
 }
 
@@ -86,7 +89,13 @@ fn a_gp_of_the_wrong_dimensions_is_refused() {
     full_pose.residual_gp = position_only.residual_gp.clone();
     full_pose.residual_gp.as_mut().unwrap().full_pose = true;
     let (error, message) = refused(&text_of(&full_pose));
-    assert!(matches!(error.kind(), ErrorKind::ModelCount { what: "outputs", found: 3, expected: 6, .. }), "{message}");
+    assert!(
+        matches!(
+            error.kind::<CommonKind>(),
+            Some(CommonKind::ModelCount { what: "outputs", found: 3, expected: 6, .. })
+        ),
+        "{message}"
+    );
     // The payload input dropped from the method but not from the GP.
     let mut model = position_only.clone();
     model.method = Method::PoeGp;
@@ -96,7 +105,13 @@ fn a_gp_of_the_wrong_dimensions_is_refused() {
     model.residual_gp.as_mut().unwrap().with_payload = false;
     model.method = Method::PoeGp;
     let (error, message) = refused(&text_of(&model));
-    assert!(matches!(error.kind(), ErrorKind::ModelCount { what: "inputs", found: 7, expected: 6, .. }), "{message}");
+    assert!(
+        matches!(
+            error.kind::<CommonKind>(),
+            Some(CommonKind::ModelCount { what: "inputs", found: 7, expected: 6, .. })
+        ),
+        "{message}"
+    );
 }
 
 #[test]
@@ -118,7 +133,10 @@ fn first_translation_set_to(value: &str) -> String {
 #[test]
 fn a_non_finite_transform_is_refused_at_its_translation() {
     let (error, message) = refused(&first_translation_set_to("NaN"));
-    assert!(matches!(error.kind(), ErrorKind::NotFinite { field, .. } if field == "kinematics.joints[0]"), "{message}");
+    assert!(
+        matches!(error.kind::<CommonKind>(), Some(CommonKind::NotFinite { field, .. }) if field == "kinematics.joints[0]"),
+        "{message}"
+    );
 }
 
 /// The layout of a version-1 model file, whose only effect was joint compliance.
@@ -209,7 +227,7 @@ fn an_effect_on_a_joint_the_robot_lacks_is_refused_at_its_field() {
     let Some(IdentifiedEffect::GearPeriodic(gear)) = model.effects.first_mut() else { panic!("no gear effect") };
     gear.joint = 8;
     let (error, message) = refused(&text_of(&model));
-    assert!(matches!(error.kind(), ErrorKind::ModelIndex { index: 8, limit: 6, .. }), "{message}");
+    assert!(matches!(error.kind::<CommonKind>(), Some(CommonKind::ModelIndex { index: 8, limit: 6, .. })), "{message}");
     assert!(message.contains("effects[0].joint is 8"), "{message}");
 }
 
@@ -219,7 +237,10 @@ fn effect_values_that_do_not_match_their_features_are_refused_at_their_field() {
     let Some(IdentifiedEffect::GearPeriodic(gear)) = model.effects.first_mut() else { panic!("no gear effect") };
     gear.theta.push(0.0);
     let (error, message) = refused(&text_of(&model));
-    assert!(matches!(error.kind(), ErrorKind::ModelCount { found: 7, expected: 6, .. }), "{message}");
+    assert!(
+        matches!(error.kind::<CommonKind>(), Some(CommonKind::ModelCount { found: 7, expected: 6, .. })),
+        "{message}"
+    );
     assert!(message.contains("effects[0].theta"), "{message}");
     // The second effect's field is placed at its own occurrence, past the first effect's.
     let (model, text) = with_effects();
@@ -228,7 +249,7 @@ fn effect_values_that_do_not_match_their_features_are_refused_at_their_field() {
     assert!(text.contains(&reference), "{text}");
     let broken = text.replacen(&reference, "reference_s: inf", 1);
     let (error, message) = refused(&broken);
-    assert!(matches!(error.kind(), ErrorKind::NotFinite { .. }), "{message}");
+    assert!(matches!(error.kind::<CommonKind>(), Some(CommonKind::NotFinite { .. })), "{message}");
     let line = broken.lines().position(|l| l.contains("reference_s: inf")).unwrap() + 1;
     assert!(message.starts_with(&format!("m.ron:{line}:")), "{message}");
     assert!(message.contains("effects[1].reference_s[0]"), "{message}");
@@ -239,7 +260,7 @@ fn a_finite_but_absurd_translation_is_refused_at_its_field() {
     // 1e308 is finite: before, it was read, and every prediction was NaN (cargo xtask fuzz).
     let (error, message) = refused(&first_translation_set_to("1e308"));
     assert!(
-        matches!(error.kind(), ErrorKind::ModelValue { field, .. } if field == "kinematics.joints[0]"),
+        matches!(error.kind::<CommonKind>(), Some(CommonKind::ModelValue { field, .. }) if field == "kinematics.joints[0]"),
         "{message}"
     );
     assert!(message.contains("1e308") && message.contains("larger than any robot cell"), "{message}");
@@ -252,7 +273,7 @@ fn a_vanishing_feature_scale_is_refused_not_left_to_predict_nan() {
     let Some(IdentifiedEffect::GearPeriodic(gear)) = model.effects.first_mut() else { panic!("no gear effect") };
     gear.scale[1] = 1e-320;
     let (error, message) = refused(&text_of(&model));
-    assert!(matches!(error.kind(), ErrorKind::RonFormat { .. }), "{message}");
+    assert!(matches!(error.kind::<CommonKind>(), Some(CommonKind::RonFormat { .. })), "{message}");
     assert!(message.contains("effects: part 1 (gear_periodic"), "{message}");
 }
 
@@ -293,7 +314,10 @@ fn an_absurd_effect_coefficient_is_refused_at_its_field() {
     let Some(IdentifiedEffect::TimeDrift(drift)) = model.effects.get_mut(1) else { panic!("no drift") };
     drift.theta[0] = -1e308;
     let (error, message) = refused(&text_of(&model));
-    assert!(matches!(error.kind(), ErrorKind::ModelValue { field, .. } if field == "effects[1].theta[0]"), "{message}");
+    assert!(
+        matches!(error.kind::<CommonKind>(), Some(CommonKind::ModelValue { field, .. }) if field == "effects[1].theta[0]"),
+        "{message}"
+    );
 }
 
 /// `text` with the first `from` after `robot_description:` replaced by `to`.

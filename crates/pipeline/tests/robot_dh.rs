@@ -1,7 +1,7 @@
 //! DH tables in the robot RON: a flange given with a table, and every refusal at its line and
 //! column (the forward kinematics of every form are in `robot_forms.rs`).
 
-use errors::ErrorKind;
+use errors::CommonKind;
 use robot::RobotDescription;
 
 const TABLE: &str = r#"Robot(
@@ -32,7 +32,7 @@ fn refuse(text: &str) -> (usize, usize, String) {
     let e = RobotDescription::parse(text, "three.ron").expect_err("a RON error");
     let shown = e.to_string();
     assert!(shown.starts_with("three.ron:"), "{shown}");
-    let (Some((line, column)), ErrorKind::RonFormat { message }) = (e.position(), e.kind()) else {
+    let (Some((line, column)), Some(CommonKind::RonFormat { message })) = (e.position(), e.kind::<CommonKind>()) else {
         panic!("expected a RON error, got {e:?}")
     };
     (line as usize, column, message.clone())

@@ -1,6 +1,6 @@
 //! The robot description files: the committed fixtures, and the bad inputs refused.
 
-use errors::ErrorKind;
+use errors::CommonKind;
 use poe::{DhConvention, DhRow, JointKind, LocalPoe};
 use robot::RobotDescription;
 use std::f64::consts::FRAC_PI_2;
@@ -55,7 +55,7 @@ Robot(
 
 fn refuse(text: &str) -> (usize, usize, String) {
     let e = RobotDescription::parse(text, "robot.ron").expect_err("a RON error");
-    let (Some((line, column)), ErrorKind::RonFormat { message }) = (e.position(), e.kind()) else {
+    let (Some((line, column)), Some(CommonKind::RonFormat { message })) = (e.position(), e.kind::<CommonKind>()) else {
         panic!("expected a RON error, got {e:?}")
     };
     (line as usize, column, message.clone())
@@ -148,7 +148,8 @@ fn dynamics_without_stiffness_read_and_a_short_stiffness_list_is_refused() {
 /// The refusal of a value that must be finite: its field and where it is.
 fn refuse_not_finite(text: &str) -> (usize, usize, String, String) {
     let e = RobotDescription::parse(text, "robot.ron").expect_err("a NotFinite error");
-    let (Some((line, column)), ErrorKind::NotFinite { field, .. }) = (e.position(), e.kind()) else {
+    let (Some((line, column)), Some(CommonKind::NotFinite { field, .. })) = (e.position(), e.kind::<CommonKind>())
+    else {
         panic!("expected a NotFinite error, got {e:?}")
     };
     (line as usize, column, field.clone(), e.to_string())
@@ -224,7 +225,7 @@ fn finite_but_absurd_geometry_is_refused_at_its_field() {
     let text = GOOD.replace("position: (1.0, 0.0, 1.0)", "position: (1.0, 0.0, 2e3)");
     let error = RobotDescription::parse(&text, "robot.ron").unwrap_err();
     assert!(
-        matches!(error.kind(), ErrorKind::ModelValue { field, .. } if field == "flange.position")
+        matches!(error.kind::<CommonKind>(), Some(CommonKind::ModelValue { field, .. }) if field == "flange.position")
             && matches!(error.position(), Some((8, _))),
         "{error}"
     );

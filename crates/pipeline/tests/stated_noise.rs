@@ -3,7 +3,7 @@
 //! setting the diagnosis's noise floor.
 
 use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel, joint_ranges, simulate, simulated_cell};
-use errors::ErrorKind;
+use measurements::ErrorKind;
 use measurements::{MeasurementSet, ReadOptions, StatedSigma, parse_measurements};
 use model::Method;
 use pipeline::{FitOptions, FitWarning};
@@ -32,17 +32,26 @@ fn stated_uncertainties_are_read_written_and_refused_where_partial_or_not_positi
     // Two axes of three: refused by the missing one's name, at the end of the header.
     let partial = "q1_rad,x_mm,y_mm,z_mm,std_x_mm,std_z_mm\n0.1,1,2,3,0.01,0.03\n";
     let error = parse_measurements(partial.as_bytes(), "t.csv", &ReadOptions::default()).unwrap_err();
-    assert!(matches!(error.kind(), ErrorKind::MissingColumn { name } if name == "std_y_mm"), "{error}");
+    assert!(
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::MissingColumn { name }) if name == "std_y_mm"),
+        "{error}"
+    );
     assert_eq!(error.position(), Some((1, 7)));
     // A zero σ: at its line and column.
     let zero = "q1_rad,x_mm,y_mm,z_mm,std_x_mm,std_y_mm,std_z_mm\n0.1,1,2,3,0.01,0.02,0.03\n0.2,1,2,3,0.01,0,0.03\n";
     let error = parse_measurements(zero.as_bytes(), "t.csv", &ReadOptions::default()).unwrap_err();
-    assert!(matches!(error.kind(), ErrorKind::NotAStandardDeviation { name, .. } if name == "std_y_mm"), "{error}");
+    assert!(
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::NotAStandardDeviation { name, .. }) if name == "std_y_mm"),
+        "{error}"
+    );
     assert!(error.to_string().starts_with("t.csv:3:6: std_y_mm is 0"), "{error}");
     // A stated σ is not an input of the model.
     let options = ReadOptions::default().with_inputs(vec!["std_x_mm".into()]);
     let error = parse_measurements(text.as_bytes(), "t.csv", &options).unwrap_err();
-    assert!(matches!(error.kind(), ErrorKind::NotAnInput { .. }) && error.position() == Some((1, 5)), "{error}");
+    assert!(
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::NotAnInput { .. })) && error.position() == Some((1, 5)),
+        "{error}"
+    );
 }
 
 /// A perturbed IRB 4400 measured by a tracker whose noise is 5 µm on most rows, 25 µm on every

@@ -2,9 +2,10 @@
 //! Euler angle columns, and a column map for any other header; every refusal at its file, line
 //! and column.
 
-use errors::{ColumnMapFault, DecimalFault, Error, ErrorKind};
+use errors::Error;
 use lie::{Matrix3, SO3};
 use measurements::{ColumnMap, Decimal, Delimiter, ReadOptions, parse_measurements};
+use measurements::{ColumnMapFault, DecimalFault, ErrorKind};
 use poe::JointKind;
 
 fn two_joints() -> ReadOptions {
@@ -50,7 +51,7 @@ fn a_decimal_comma_in_a_comma_separated_file_is_refused_at_its_cell() {
     // Unquoted, the comma splits the number into two fields.
     let (error, message) = refuse("q1_rad,q2_rad,x_mm,y_mm,z_mm\n0,1,1000,5,2,3\n", &two_joints());
     assert!(
-        matches!(error.kind(), ErrorKind::FieldCount { found: 6, expected: 5, .. })
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::FieldCount { found: 6, expected: 5, .. }))
             && matches!(error.position(), Some((2, 6))),
         "{message}"
     );
@@ -58,7 +59,7 @@ fn a_decimal_comma_in_a_comma_separated_file_is_refused_at_its_cell() {
     // Quoted, it is one cell with a decimal comma.
     let (error, message) = refuse("q1_rad,q2_rad,x_mm,y_mm,z_mm\n0,1,\"1000,5\",2,3\n", &two_joints());
     assert!(
-        matches!(error.kind(), ErrorKind::DecimalMark { fault: DecimalFault::CommaInCommaFile, .. })
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::DecimalMark { fault: DecimalFault::CommaInCommaFile, .. }))
             && matches!(error.position(), Some((2, 3))),
         "{message}"
     );
@@ -69,8 +70,10 @@ fn a_decimal_comma_in_a_comma_separated_file_is_refused_at_its_cell() {
 fn a_decimal_mark_that_changes_within_a_file_is_refused_at_its_cell() {
     let (error, message) = refuse("q1_rad;q2_rad;x_mm;y_mm;z_mm\n0,5;1;2;3;4\n0;1;2.5;3;4\n", &two_joints());
     assert!(
-        matches!(error.kind(), ErrorKind::DecimalMark { fault: DecimalFault::Other { expected: ',' }, .. })
-            && matches!(error.position(), Some((3, 3))),
+        matches!(
+            error.kind::<ErrorKind>(),
+            Some(ErrorKind::DecimalMark { fault: DecimalFault::Other { expected: ',' }, .. })
+        ) && matches!(error.position(), Some((3, 3))),
         "{message}"
     );
     assert_eq!(
@@ -80,7 +83,8 @@ fn a_decimal_mark_that_changes_within_a_file_is_refused_at_its_cell() {
     // Thousands separators are not guessed at.
     let (error, message) = refuse("q1_rad;q2_rad;x_mm;y_mm;z_mm\n0;1;1.000,5;3;4\n", &two_joints());
     assert!(
-        matches!(error.kind(), ErrorKind::NotANumber { .. }) && matches!(error.position(), Some((2, 3))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::NotANumber { .. }))
+            && matches!(error.position(), Some((2, 3))),
         "{message}"
     );
 }
@@ -121,13 +125,14 @@ fn euler_angles_together_with_a_quaternion_are_refused() {
     let header = "q1_rad,q2_rad,x_mm,y_mm,z_mm,qw,qx,qy,qz,rx_deg,ry_deg,rz_deg";
     let (error, message) = refuse(&format!("{header}\n0,0,1,2,3,1,0,0,0,0,0,0\n"), &two_joints());
     assert!(
-        matches!(error.kind(), ErrorKind::OrientationTwice { .. }) && matches!(error.position(), Some((1, 10))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::OrientationTwice { .. }))
+            && matches!(error.position(), Some((1, 10))),
         "{message}"
     );
     assert!(message.starts_with("export.csv:1:10: column 'rx_deg': the orientation is already given by 'qw'"));
     let (error, message) = refuse("q1_rad,q2_rad,x_mm,y_mm,z_mm,rx_deg,rz_deg\n0,0,1,2,3,0,0\n", &two_joints());
     assert!(
-        matches!(error.kind(), ErrorKind::MissingColumn { name, .. } if name == "ry_deg")
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::MissingColumn { name, .. }) if name == "ry_deg")
             && matches!(error.position(), Some((_, 8))),
         "{message}"
     );
@@ -155,7 +160,8 @@ fn a_column_map_naming_a_header_the_file_lacks_is_refused() {
     let columns = map("q1_rad=Joint 1,q2_rad=Joint 2,x_mm=X [mm],y_mm=Y [mm],z_mm=Z [mm]");
     let (error, message) = refuse(EXPORT, &two_joints().with_columns(columns));
     assert!(
-        matches!(error.kind(), ErrorKind::MappedHeaderMissing { .. }) && matches!(error.position(), Some((1, 12))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::MappedHeaderMissing { .. }))
+            && matches!(error.position(), Some((1, 12))),
         "{message}"
     );
     assert_eq!(message, "export.csv:1:12: --columns maps x_mm to the header 'X [mm]', which the file does not have");
@@ -166,7 +172,8 @@ fn a_column_map_onto_a_name_the_file_already_has_is_a_duplicate() {
     let columns = map("x_mm=X");
     let (error, message) = refuse("q1_rad,q2_rad,x_mm,X,y_mm,z_mm\n0,0,1,1,2,3\n", &two_joints().with_columns(columns));
     assert!(
-        matches!(error.kind(), ErrorKind::DuplicateColumn { .. }) && matches!(error.position(), Some((1, 4))),
+        matches!(error.kind::<ErrorKind>(), Some(ErrorKind::DuplicateColumn { .. }))
+            && matches!(error.position(), Some((1, 4))),
         "{message}"
     );
 }
@@ -186,7 +193,7 @@ fn bad_column_maps_are_refused_at_their_character() {
     for (text, column, fault) in cases {
         let error = text.parse::<ColumnMap>().expect_err(text);
         assert!(
-            matches!(error.kind(), ErrorKind::ColumnMap { fault: f, .. } if *f == fault)
+            matches!(error.kind::<ErrorKind>(), Some(ErrorKind::ColumnMap { fault: f, .. }) if *f == fault)
                 && error.position() == Some((1, column)),
             "{text}: {error}"
         );

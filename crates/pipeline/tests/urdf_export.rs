@@ -4,12 +4,12 @@
 
 use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel};
 use cell::{UrdfTemplate, export_urdf};
-use errors::ErrorKind;
 use lie::{SE3, Vector3};
 use measurements::MeasurementSet;
 use model::{CalibratedModel, Method};
 use pipeline::FitOptions;
 use poe::LocalPoe;
+use robot::ErrorKind;
 use robot::{ChainEnds, NominalTolerance, RobotDescription, UrdfDocument, in_base_frame};
 
 /// Tracker data of a perturbed `robot` (noise only, so every method fits).
@@ -138,7 +138,7 @@ fn a_description_the_model_was_not_fitted_with_is_refused() {
     let chain = document.chain(&ChainEnds::default()).unwrap();
     let template = UrdfTemplate::Like { document: &document, chain: &chain };
     match export_urdf(&model, template, None, &NominalTolerance::default()) {
-        Err(e) if matches!(e.kind(), ErrorKind::NominalMismatch { .. }) => {
+        Err(e) if matches!(e.kind::<ErrorKind>(), Some(ErrorKind::NominalMismatch { .. })) => {
             assert!(e.to_string().contains("give the robot description the model was fitted with"), "{e}")
         }
         other => panic!("expected a mismatch, got {other:?}"),
@@ -151,7 +151,7 @@ fn what_a_urdf_cannot_hold_is_measured_on_the_training_data_or_refused() {
     let (model, training) = fitted(&irb, Method::PoeGp, false);
     let template = UrdfTemplate::Plain { nominal: Some((&irb, "irb4400.ron")) };
     match export_urdf(&model, template, None, &NominalTolerance::default()) {
-        Err(e) if matches!(e.kind(), ErrorKind::ExportNeedsData { .. }) => {
+        Err(e) if matches!(e.kind::<cell::ErrorKind>(), Some(cell::ErrorKind::ExportNeedsData { .. })) => {
             assert!(e.to_string().contains("gaussian_process"), "{e}")
         }
         other => panic!("expected a refusal, got {other:?}"),

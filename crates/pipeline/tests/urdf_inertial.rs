@@ -2,8 +2,8 @@
 //! the equivalent RON file, links on fixed joints and mimic stages folded into the joint they ride
 //! on, no mass model where a joint's body states none, and bad values refused at their element.
 
-use errors::ErrorKind;
 use lie::{SE3, SO3, Vector3};
+use robot::ErrorKind;
 use robot::{ChainEnds, RobotDescription, UrdfDocument};
 
 /// `iiwa7.urdf`'s link origins at the zero configuration (the arm straight up, frames parallel to
@@ -170,7 +170,9 @@ fn bad_inertials_are_refused_at_their_element() {
             Ok(_) => panic!("{case}: read, not refused"),
             Err(e) => e,
         };
-        let (Some((line, column)), ErrorKind::UrdfFormat { message }) = (error.position(), error.kind()) else {
+        let (Some((line, column)), Some(ErrorKind::UrdfFormat { message })) =
+            (error.position(), error.kind::<ErrorKind>())
+        else {
             panic!("{case}: {error}");
         };
         assert_eq!((line as usize, column), position, "{case}: {error}");

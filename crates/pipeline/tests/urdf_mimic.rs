@@ -4,7 +4,7 @@
 
 mod mimic_common;
 
-use errors::ErrorKind;
+use errors::CommonKind;
 use lie::Vector3;
 use mimic_common::{assert_refused, chain, joint_by_joint, largest_difference, mimic_position, random_q, refusal};
 use poe::JointKind;
@@ -318,7 +318,8 @@ fn a_robot_file_may_give_a_joint_scale_and_a_scale_out_of_bounds_is_refused_at_i
     for bad in ["0.0", "-3.0", "1e9", "inf"] {
         let text = SCALED_RON.replace("scale: 3.0", &format!("scale: {bad}"));
         let e = RobotDescription::parse(&text, "column.ron").expect_err(bad);
-        let (Some((line, column)), ErrorKind::RonFormat { message }) = (e.position(), e.kind()) else {
+        let (Some((line, column)), Some(CommonKind::RonFormat { message })) = (e.position(), e.kind::<CommonKind>())
+        else {
             panic!("{bad}: {e:?}")
         };
         assert_eq!((line as usize, column), position_of(&text, &format!("scale: {bad}")), "{bad}: {message}");
@@ -341,7 +342,9 @@ fn a_model_file_with_a_scale_out_of_bounds_is_refused_at_it() {
     let broken = text.replacen("scale: 3.0", "scale: 0.0", 1);
     let (line, column) = position_of(&broken, "scale: 0.0");
     let e = model::parse_model(&broken, "model.ron").expect_err("a refusal");
-    let (Some((l, c)), ErrorKind::RonFormat { message }) = (e.position(), e.kind()) else { panic!("{e:?}") };
+    let (Some((l, c)), Some(CommonKind::RonFormat { message })) = (e.position(), e.kind::<CommonKind>()) else {
+        panic!("{e:?}")
+    };
     assert_eq!((l as usize, c), (line, column), "{message}");
     assert!(message.contains("scale is 0e0"), "{message}");
 }

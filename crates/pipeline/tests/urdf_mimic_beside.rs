@@ -8,7 +8,6 @@ mod mimic_common;
 
 use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoiseModel};
 use cell::{UrdfTemplate, export_urdf};
-use errors::ErrorKind;
 use lie::Vector3;
 use measurements::MeasurementSet;
 use mimic_common::{assert_refused, chain, joint_by_joint, largest_difference, random_q};
@@ -17,6 +16,7 @@ use pipeline::FitOptions;
 use poe::{JointKind, LocalPoe};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use robot::ErrorKind;
 use robot::{ChainEnds, NominalTolerance, RobotDescription, UrdfDocument};
 
 fn shipped_text() -> String {
@@ -293,7 +293,7 @@ fn a_stage_of_a_joint_above_the_chains_base_is_refused() {
     let text = text.replace("<mimic joint=\"motor\" multiplier=\"0.5\" offset=\"0.2\"/>", "");
     let ends = ChainEnds { base_link: Some("l1".into()), tip_link: Some("tip".into()) };
     let error = UrdfDocument::parse(&text, "arm.urdf").and_then(|d| d.chain(&ends)).unwrap_err();
-    let ErrorKind::UrdfFormat { message } = error.kind() else { panic!("{error:?}") };
+    let Some(ErrorKind::UrdfFormat { message }) = error.kind::<ErrorKind>() else { panic!("{error:?}") };
     assert!(
         message.starts_with("mimic joint 's2': follows joint 's1', which moves the chain's base link itself"),
         "{message}"

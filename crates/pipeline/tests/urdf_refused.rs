@@ -1,6 +1,6 @@
 //! Every URDF the robot reader refuses, each at the file, line and column at fault.
 
-use errors::ErrorKind;
+use robot::ErrorKind;
 use robot::{ChainEnds, RobotDescription, UrdfDocument};
 
 /// A two-joint arm; each test breaks one thing.
@@ -34,9 +34,10 @@ fn ends(base: Option<&str>, tip: Option<&str>) -> ChainEnds {
 fn refuse_with(text: &str, ends: &ChainEnds) -> (usize, usize, String) {
     let result = UrdfDocument::parse(text, "arm.urdf").and_then(|d| d.chain(ends));
     match result {
-        Err(e) if matches!(e.kind(), ErrorKind::UrdfFormat { .. }) => {
+        Err(e) if matches!(e.kind::<ErrorKind>(), Some(ErrorKind::UrdfFormat { .. })) => {
             let shown = e.to_string();
-            let (Some((line, column)), ErrorKind::UrdfFormat { message }) = (e.position(), e.kind()) else {
+            let (Some((line, column)), Some(ErrorKind::UrdfFormat { message })) = (e.position(), e.kind::<ErrorKind>())
+            else {
                 unreachable!()
             };
             assert_eq!(shown, format!("arm.urdf:{line}:{column}: {message}"));

@@ -6,7 +6,8 @@
 //! POE model has 6(n + tools) parameters, of which only some are identifiable: Chen, Yang et al.).
 //! The information of a set of poses is then `M = Σ A_iᵀ A_i`, in units of the noise.
 
-use errors::{Error, ErrorKind};
+use crate::ErrorKind;
+use errors::Error;
 use nalgebra::{DMatrix, SymmetricEigen};
 use poe::{LocalPoe, RowKind};
 use rayon::prelude::*;

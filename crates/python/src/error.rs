@@ -16,8 +16,8 @@ pyo3::create_exception!(
 /// the message.
 pub fn to_py(error: errors::Error) -> PyErr {
     let message = error.to_string();
-    match error.kind() {
-        errors::ErrorKind::Io { source } if source.kind() == std::io::ErrorKind::NotFound => {
+    match error.kind::<errors::CommonKind>() {
+        Some(errors::CommonKind::Io { source }) if source.kind() == std::io::ErrorKind::NotFound => {
             PyFileNotFoundError::new_err(message)
         }
         _ => {

@@ -5,7 +5,7 @@ use crate::robot::Robot;
 use crate::types::Measurements;
 use ::diagnose::DiagnoseOptions;
 use calib::flow::{CampaignShape, ShapeFault};
-use errors::{Error, ErrorKind};
+use errors::Error;
 use measurements::ReadOptions;
 use pyo3::prelude::*;
 use std::path::PathBuf;
@@ -37,10 +37,10 @@ pub fn diagnose(
         // The folder `calib diagnose --report` writes, through the report crate's one writer.
         let folder = report.as_deref().map(|folder| (folder, "report", &inputs));
         let (diagnosis, written) = calib::flow::diagnose(description, set, &options, folder).map_err(|e| {
-            match (e.kind(), &report) {
+            match (e.kind::<::report::ErrorKind>(), &report) {
                 // A chart or the embedded JSON (only the report's writer raises them): named by
                 // the folder they were for, as before the report crate had an error type of its own.
-                (errors::ErrorKind::Plot { .. } | errors::ErrorKind::EvaluationJson { .. }, Some(folder)) => {
+                (Some(::report::ErrorKind::Plot { .. } | ::report::ErrorKind::EvaluationJson { .. }), Some(folder)) => {
                     errors::Error::io(folder.display().to_string(), std::io::Error::other(e.to_string()))
                 }
                 _ => e,
@@ -76,7 +76,10 @@ pub fn simulate(
     out: Option<PathBuf>,
 ) -> PyResult<Measurements> {
     if rows > campaign::MAX_ROWS {
-        return Err(argument("rows", Error::new(ErrorKind::TooManySimulatedRows { rows, max: campaign::MAX_ROWS })));
+        return Err(argument(
+            "rows",
+            Error::new(campaign::ErrorKind::TooManySimulatedRows { rows, max: campaign::MAX_ROWS }),
+        ));
     }
     if rows == 0 {
         return Err(argument("rows", "at least one pose is needed"));

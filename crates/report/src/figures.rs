@@ -2,8 +2,9 @@
 //! projections coloured by error, an effect's curve with its σ band, and the scatter plots of the
 //! diagnosis.
 
+use crate::ErrorKind;
 use crate::content::{EffectCurve, RowError};
-use errors::{Error, ErrorKind};
+use errors::Error;
 use plotters::prelude::*;
 
 /// Grey for the model before calibration (or the geometric model of the diagnosis).

@@ -2,10 +2,11 @@
 //! printable). Every number a test compares carries its full value in a `data-value` attribute
 //! next to the rounded text, under a `data-key` naming it.
 
+use crate::ErrorKind;
 use crate::content::{ErrorStats, GroupedErrors, Report};
 use crate::figures;
 use diagnose::Diagnosis;
-use errors::{Error, ErrorKind};
+use errors::Error;
 use std::fmt::Write;
 
 /// The sections of a calibration report, in order: `(id, heading)`. The diagnosis section is

@@ -7,7 +7,7 @@
 //! The after-calibration numbers are `calib eval --json`'s own: [`model::evaluate`] and
 //! [`model::EvalReport`], embedded in the page as they serialise. Charts are drawn with
 //! `plotters`' SVG backend. Errors are `errors::Error`, as in every calibration crate: a chart that
-//! cannot be drawn is `errors::ErrorKind::Plot`.
+//! cannot be drawn is this crate's `ErrorKind::Plot`.
 //!
 //! ```
 //! use campaign::{Perturbation, joint_ranges, paper_effects, simulate, simulated_cell};
@@ -44,6 +44,7 @@
 mod build;
 mod content;
 mod diagnosis;
+mod error_kind;
 mod figures;
 mod folder;
 mod html;
@@ -55,6 +56,7 @@ pub use content::{
     KernelScales, ModelSummary, Report, RobotSummary, RowError,
 };
 pub use diagnosis::diagnosis_figures;
+pub use error_kind::ErrorKind;
 pub use folder::write_diagnosis_report;
 pub use html::{SECTIONS, render_html};
 pub use iso9283::{Iso9283, RepeatOptions};

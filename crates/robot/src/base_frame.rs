@@ -12,7 +12,8 @@
 //! is the calibrated joint 1 frame at zero (`T_{0,1}(0) = I`), which is the nominal base frame for
 //! descriptions whose joint 1 turns about the base z axis through the origin (all RON fixtures).
 
-use errors::{Error, ErrorKind};
+use crate::ErrorKind;
+use errors::Error;
 use lie::SE3;
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};

@@ -8,6 +8,12 @@ use lie::SE3;
 /// overflow, and the model would then predict NaN poses instead of being refused here.
 pub const MAX_TRANSLATION_M: f64 = 1.0e3;
 
+/// The range of a linear joint's screw lead (a robot file's `pitch_mm`, a `screw_periodic` item's
+/// pitch), mm: the finest ball-screw leads sold are 0.5 mm (miniature screws, THK/NSK catalogues),
+/// and a rack's pinion turns once in well under 10 m; a value outside is a unit mistake (metres for
+/// millimetres, or the reverse) or a typing error.
+pub const PITCH_BOUNDS_MM: (f64, f64) = (0.01, 10_000.0);
+
 /// The first translation among `transforms` that is not finite or beyond [`MAX_TRANSLATION_M`],
 /// with its position in the list.
 pub fn bad_translation(transforms: impl Iterator<Item = SE3>) -> Option<(usize, f64)> {

@@ -21,6 +21,7 @@
 mod base_frame;
 mod bounds;
 mod description;
+mod error_kind;
 mod read;
 mod robot_check;
 mod robot_dh;
@@ -30,7 +31,8 @@ mod urdf_mimic;
 mod urdf_model;
 mod urdf_steps;
 pub mod xml_outline;
-pub use bounds::{MAX_TRANSLATION_M, bad_translation};
+pub use bounds::{MAX_TRANSLATION_M, PITCH_BOUNDS_MM, bad_translation};
+pub use error_kind::ErrorKind;
 
 pub use base_frame::{NominalTolerance, axis_changes, check_nominal, in_base_frame, tracker_from_base};
 pub use description::{

@@ -6,7 +6,7 @@ use crate::robot_dh::DhTable;
 use crate::urdf_chain::{ChainEnds, UrdfDocument};
 use crate::{FlangeDescription, JointDescription, RobotDescription, SCALE_BOUNDS, scale_in_bounds};
 use errors::ron_position::{field_position, ron_options};
-use errors::{Error, ErrorKind};
+use errors::{CommonKind, Error};
 use lie::Vector3;
 use poe::JointKind;
 use serde::Deserialize;
@@ -37,7 +37,7 @@ impl RobotFile {
     fn into_description(self, text: &str, file: &str) -> Result<RobotDescription, Error> {
         let at = |field: &str, message: &str| {
             let (line, column) = field_position(text, field, 0);
-            Error::at_line(file.to_owned(), line as u64, column, ErrorKind::RonFormat { message: message.to_owned() })
+            Error::at_line(file.to_owned(), line as u64, column, CommonKind::RonFormat { message: message.to_owned() })
         };
         let (joints, flange) = match (self.joints, self.dh) {
             (Some(_), Some(_)) => return Err(at("dh", "give the kinematics as `joints` or as a `dh` table, not both")),
@@ -85,7 +85,7 @@ impl RobotDescription {
                 file,
                 1,
                 1,
-                ErrorKind::RonFormat {
+                CommonKind::RonFormat {
                     message: "--base-link and --tip-link choose the chain of a URDF (.urdf), not of a RON robot file"
                         .into(),
                 },
@@ -114,7 +114,7 @@ impl RobotDescription {
     fn validate(&self, text: &str, file: &str) -> Result<(), Error> {
         let at = |field: &str, index: usize, message: String| {
             let (line, column) = field_position(text, field, index);
-            Error::at_line(file.to_owned(), line as u64, column, ErrorKind::RonFormat { message })
+            Error::at_line(file.to_owned(), line as u64, column, CommonKind::RonFormat { message })
         };
         if self.joints.is_empty() {
             return Err(at("joints", 0, "a robot needs at least one joint".into()));
@@ -136,7 +136,7 @@ impl RobotDescription {
             }
             if let Some(pitch) = joint.pitch_mm {
                 let before = self.joints[..i].iter().filter(|j| j.pitch_mm.is_some()).count();
-                let (lo, hi) = errors::PITCH_BOUNDS_MM;
+                let (lo, hi) = crate::PITCH_BOUNDS_MM;
                 if joint.kind != JointKind::Prismatic {
                     let message = format!(
                         "joint {}: pitch_mm is a linear axis's screw lead, and joint {} is {:?}",

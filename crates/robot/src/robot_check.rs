@@ -3,9 +3,10 @@
 //! field, so that the user is sent to the line at fault (a NaN flange once surfaced as "the poses
 //! are too alike to register the tracker: rank 0 of 13").
 
+use crate::ErrorKind;
 use crate::RobotDescription;
 use errors::ron_position::field_position;
-use errors::{Error, ErrorKind, Place};
+use errors::{CommonKind, Error, Place};
 
 /// Checks the flange, the tool and the dynamics of `robot`, read from `text`.
 pub(crate) fn check_values(robot: &RobotDescription, text: &str, file: &str) -> Result<(), Error> {
@@ -17,10 +18,10 @@ pub(crate) fn check_values(robot: &RobotDescription, text: &str, file: &str) -> 
                 file,
                 line as u64,
                 column,
-                ErrorKind::ModelValue { field: name, value, limit: crate::MAX_TRANSLATION_M },
+                CommonKind::ModelValue { field: name, value, limit: crate::MAX_TRANSLATION_M },
             )
         } else {
-            Error::at_line(file, line as u64, column, ErrorKind::NotFinite { field: name, value })
+            Error::at_line(file, line as u64, column, CommonKind::NotFinite { field: name, value })
         }
     };
     // Not finite, or beyond a kilometre (in m, m/s² or rad): larger than any robot, and its
@@ -63,7 +64,7 @@ pub(crate) fn check_values(robot: &RobotDescription, text: &str, file: &str) -> 
         // The radii-difference check names no single field: point at the first radius.
         let field = if field.contains(' ') { "anchor_radius_m" } else { field };
         let (line, column) = field_position(text, field, 0);
-        return Err(Error::at_line(file.to_owned(), line as u64, column, ErrorKind::RonFormat { message }));
+        return Err(Error::at_line(file.to_owned(), line as u64, column, CommonKind::RonFormat { message }));
     }
     Ok(())
 }
@@ -166,7 +167,7 @@ mod tests {
         let error = RobotDescription::parse(TWO_COAXIAL, "coaxial.ron").unwrap_err();
         let message = error.to_string();
         assert!(
-            matches!(error.kind(), ErrorKind::RepeatedJointAxis { first: 1, second: 2, .. })
+            matches!(error.kind::<ErrorKind>(), Some(ErrorKind::RepeatedJointAxis { first: 1, second: 2, .. }))
                 && matches!(error.position(), Some((5, _))),
             "{message}"
         );

@@ -6,7 +6,7 @@
 
 use crate::description::{FlangeDescription, JointDescription};
 use errors::ron_position::field_position;
-use errors::{Error, ErrorKind};
+use errors::{CommonKind, Error};
 use poe::{DhConvention, DhRow, JointKind, LocalPoe};
 use serde::{Deserialize, Serialize};
 
@@ -72,7 +72,7 @@ impl DhTable {
                 file.to_owned(),
                 line as u64,
                 column,
-                ErrorKind::RonFormat { message: format!("DH row {}: {message}", row + 1) },
+                CommonKind::RonFormat { message: format!("DH row {}: {message}", row + 1) },
             )
         };
         if self.rows.is_empty() {
@@ -81,7 +81,7 @@ impl DhTable {
                 file.to_owned(),
                 line as u64,
                 column,
-                ErrorKind::RonFormat { message: "a DH table needs at least one row".into() },
+                CommonKind::RonFormat { message: "a DH table needs at least one row".into() },
             ));
         }
         self.rows

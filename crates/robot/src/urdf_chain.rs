@@ -10,13 +10,14 @@
 //! them where their motions add (`urdf_mimic.rs`). The links' `<inertial>` masses become the
 //! load model's data where every joint's body has one (`urdf_inertial.rs`).
 
+use crate::ErrorKind;
 use crate::urdf_inertial::{ChainMasses, LinkInertial, LinkTree, chain_masses, read_inertials};
 use crate::urdf_mimic::{ChainJoint, OffChain, fold, folded_joint};
 use crate::urdf_model::{UrdfJoint, UrdfJointType, UrdfRobot, read_robot};
 use crate::urdf_steps::{ChainStep, StepMimic, StepMotion};
 use crate::xml_outline::{Element, Position, outline};
 use crate::{FlangeDescription, JointDescription, RobotDescription};
-use errors::{Error, ErrorKind};
+use errors::Error;
 use lie::{SE3, SO3, Vector3};
 use poe::JointKind;
 use std::collections::{HashMap, HashSet};

@@ -21,10 +21,11 @@
 //! what needs the masses alone (link deflection, backlash's torque sign) can. Gravity is the floor
 //! mount's, base z up (REP-103's convention for a URDF's base link).
 
+use crate::ErrorKind;
 use crate::urdf_mimic::ChainJoint;
 use crate::urdf_steps::{ChainStep, StepMotion};
 use crate::xml_outline::{Element, Position};
-use errors::{Error, ErrorKind};
+use errors::Error;
 use lie::{SE3, Vector3};
 use std::collections::{HashMap, HashSet};
 

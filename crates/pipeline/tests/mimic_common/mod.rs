@@ -3,10 +3,10 @@
 
 #![allow(dead_code)] // each test file uses its own part
 
-use errors::ErrorKind;
 use lie::{SE3, SO3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use robot::ErrorKind;
 use robot::{ChainEnds, RobotDescription, StepMotion, UrdfChain, UrdfDocument};
 
 pub fn chain(text: &str, ends: &ChainEnds) -> UrdfChain {
@@ -72,9 +72,10 @@ pub fn largest_difference(chain: &UrdfChain, seed: u64) -> f64 {
 /// The refusal of `text`: line, column and message, checked to name the file first.
 pub fn refusal(text: &str) -> (usize, usize, String) {
     match UrdfDocument::parse(text, "arm.urdf").and_then(|d| d.chain(&ChainEnds::default())) {
-        Err(e) if matches!(e.kind(), ErrorKind::UrdfFormat { .. }) => {
+        Err(e) if matches!(e.kind::<ErrorKind>(), Some(ErrorKind::UrdfFormat { .. })) => {
             let shown = e.to_string();
-            let (Some((line, column)), ErrorKind::UrdfFormat { message }) = (e.position(), e.kind()) else {
+            let (Some((line, column)), Some(ErrorKind::UrdfFormat { message })) = (e.position(), e.kind::<ErrorKind>())
+            else {
                 unreachable!()
             };
             assert_eq!(shown, format!("arm.urdf:{line}:{column}: {message}"));
