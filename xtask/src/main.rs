@@ -19,6 +19,7 @@ mod blind_check;
 mod blind_check_cases;
 mod box_plot;
 mod cell_check;
+mod chart;
 mod compensate_check;
 mod convert_ur10;
 mod deps;
