@@ -76,7 +76,7 @@ impl SimulatedEffect for Backlash {
     fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
         let n = cell.robot.joint_count();
         Backlash::validate(self, n)?;
-        cell.dynamics_for("backlash")?.validate(n)
+        Ok(cell.dynamics_for("backlash")?.validate(n)?)
     }
 
     fn needs_dynamics(&self) -> DynamicsNeed {

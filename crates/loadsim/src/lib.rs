@@ -42,11 +42,9 @@ mod backlash;
 mod base_tilt;
 mod cell;
 mod compliance;
-mod counterbalance;
 mod coupling;
 mod deflection;
 mod drift;
-mod dynamics;
 mod effects;
 mod error;
 mod generator;
@@ -66,13 +64,13 @@ pub use backlash::{Backlash, JointBacklash, backlash_joint_regressor};
 pub use base_tilt::BaseTilt;
 pub use cell::{PoseContext, SimulatedCell};
 pub use compliance::{JointCompliance, MAX_FIXED_POINT_ITERATIONS, compliance_deflection, spring_torque};
-pub use counterbalance::Counterbalance;
 pub use coupling::{CouplingFactor, CouplingTerm, JointCoupling};
 pub use deflection::{
     BentLink, LinkBend, LinkDeflection, MAX_FLEXIBILITY_PER_NM2, link_bend, link_deflection_features, moment_beyond,
 };
 pub use drift::{BaseDrift, MAX_DRIFT_PER_S};
-pub use dynamics::{FLOOR_GRAVITY_M_PER_S2, LinkInertia, RobotDynamics, tilted_base_gravity};
+// The robot's dynamics as robot files state them: their own crate, so that `robot` needs no simulator.
+pub use dynamics::{Counterbalance, FLOOR_GRAVITY_M_PER_S2, LinkInertia, RobotDynamics, tilted_base_gravity};
 pub use effects::{Effects, JointOffsets};
 pub use error::Error;
 pub use generator::{
