@@ -1,4 +1,4 @@
-"""One call, one fit (issue 48): every default of ``calib.fit``, ``calib.diagnose`` and
+"""One call, one fit: every default of ``calib.fit``, ``calib.diagnose`` and
 ``calib.simulate`` is the CLI's, read from ``calib <command> --help``, and the calls the same words
 name give the same numbers."""
 

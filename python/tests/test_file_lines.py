@@ -1,4 +1,4 @@
-"""Rows named by the line an editor shows them on (issue 48), from Python as from the CLI: a file
+"""Rows named by the line an editor shows them on, from Python as from the CLI: a file
 with Windows line ends, a blank line and notes over two lines, with faults planted at known rows."""
 
 from __future__ import annotations

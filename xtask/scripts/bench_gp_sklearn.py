@@ -3,7 +3,7 @@
 
 Usage: bench_gp_sklearn.py REQUEST.json RESPONSE.json
 
-The request (written by xtask/src/bench_gp_sklearn.rs) holds the training inputs and outputs, the
+The request (written by xtask/src/experiments/bench_gp_sklearn.rs) holds the training inputs and outputs, the
 test inputs and the kernel's options; the response holds the fit and predict times (seconds), the
 peak resident memory of this process and its workers (bytes), the predicted means at the test
 inputs, and per GP the fitted kernel and its log marginal likelihood (of the normalised outputs).

@@ -1,5 +1,5 @@
 #!/bin/bash
-# Issue 26: the held-out estimate a fit keeps in the model file against the error measured on the
+# The held-out estimate a fit keeps in the model file against the error measured on the
 # odd rows, each UR10 series' even rows fitted; then series B split at random by configuration
 # (even and odd rows together, a repeated configuration kept on one side, Python random.seed(1)),
 # since B's even and odd rows are two arm configurations of each target. Usage (from the worktree

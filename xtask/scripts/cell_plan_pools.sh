@@ -1,5 +1,5 @@
 #!/bin/bash
-# Issue 26: planned against random poses over many candidate pools, not one design. Usage (from the
+# `calib plan`: planned against random poses over many candidate pools, not one design. Usage (from the
 # worktree root, release build): [OPTS='PLAN_OPTIONS_RON'] xtask/scripts/cell_plan_pools.sh SERIES N POOLS
 # Pool p is a random half of the series' even rows (Python random.seed(1000 + p)). From each pool: N rows
 # planned with the nominal geometry (`--full-pose`), N planned with `--model` (`poe` fitted on all the

@@ -1,5 +1,5 @@
 #!/bin/bash
-# Issue 26: `calib plan` settings against random rows, `poe` on N rows of a UR10 series' even rows,
+# `calib plan` settings against random rows, `poe` on N rows of a UR10 series' even rows,
 # tested on its odd rows. Usage (from the worktree root, release build):
 #   xtask/scripts/cell_plan_variants.sh plan SERIES N 'PLAN_OPTIONS_RON' [label]
 #   xtask/scripts/cell_plan_variants.sh random SERIES N SEEDS

@@ -1,4 +1,4 @@
-# Usage: python3 xtask/scripts/ci_units.py CLONE_DIR (issue 49, docs/results/ci-time.md).
+# Usage: python3 xtask/scripts/ci_units.py CLONE_DIR (docs/results/ci-time.md).
 # RUSTC_BOOTSTRAP=1 lets the stable cargo print its unit graph (an unstable option); a measuring
 # tool only, nothing in the build depends on it.
 #

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# A newcomer's cold build and first study, or a fresh-clone CI run, at a revision (issue 24):
+# A newcomer's cold build and first study, or a fresh-clone CI run, at a revision:
 #
 #   xtask/scripts/cold_build.sh study REV OUT_DIR   # fresh clone, empty target, `cargo fetch`
 #                                                   # (not timed), then `cargo run --timings -p
@@ -9,7 +9,7 @@
 #                                                   # `cargo build --timings -p xtask` (what the
 #                                                   # study's first run compiles), wall and CPU
 #                                                   # seconds: CPU is what to compare on a machine
-#                                                   # that other work shares (issue 49)
+#                                                   # that other work shares
 #
 # Run two revisions back to back on an idle machine: the wall times of one machine drift by tens
 # of per cent between days. OUT_DIR gets the log, the `--timings` report and a line in times.txt.

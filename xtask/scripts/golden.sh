@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs the calib CLI over the fixtures and simulated data and keeps every output, so that two
-# builds can be compared byte for byte (issue 24: "the CLI's outputs are byte-identical on the
-# fixtures"):
+# builds can be compared byte for byte (a change that is not meant to change the CLI's outputs
+# leaves them byte-identical on the fixtures):
 #
 #   xtask/scripts/golden.sh BEFORE_BINARY /tmp/golden-before
 #   xtask/scripts/golden.sh target/debug/calib /tmp/golden-after
@@ -77,7 +77,7 @@ run refuse_effect "$calib" fit --robot $irb --data "full.csv" --method poe --eff
 
 # The one wall time a command prints: `report`'s drawing time.
 sed -i -E 's/[0-9.]+ s in all, [0-9.]+ s to draw/(time) s in all, (time) s to draw/' report.out
-# `fit`'s phase times (issue 49): the JSON's `timings` and the text's phases of a second or more.
+# `fit`'s phase times: the JSON's `timings` and the text's phases of a second or more.
 for f in *.out *.err; do
     sed -i -E 's/,"timings":\[[^]]*\]//' "$f"
     sed -i '/^  time (phases of a second or more):$/,/^  wrote /{/^  wrote /!d}' "$f"

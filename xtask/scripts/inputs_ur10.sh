@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The UR10's own signals as GP inputs and as weights (issue 46's must-show): series B and C,
+# The UR10's own signals as GP inputs and as weights: series B and C,
 # even → odd rows and early → late (the first half of the series in file order against the
 # second), poe-gp four ways: plain, --inputs temp_c, the tracker's stated σ as weights (std_*
 # columns), both. Prints one line per fit with the held-out mean errors.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The prior toward the nominal geometry on simulated arms (issue 45): a UR10 (`ur10.urdf`, its upper
+# The prior toward the nominal geometry on simulated arms: a UR10 (`ur10.urdf`, its upper
 # arm and forearm bent under the URDF's masses and payloads of 1-7.5 kg) and the column arm
 # (`column_arm.urdf`, its column bent under the URDF's masses), each with `calib
 # simulate`'s geometric errors (every local frame off by up to 1 mm and 1 mrad per component) and

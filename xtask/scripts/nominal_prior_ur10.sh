@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The prior toward the nominal geometry on the real UR10 (issue 45): fit times on C's even rows and
+# The prior toward the nominal geometry on the real UR10: fit times on C's even rows and
 # held-out errors on C even -> odd, B even -> odd and B's elbow split (rows with q3 > 0 against
 # q3 < 0, each way), beside the nominal geometry placed by `--method base-tool`.
 # Usage: xtask/scripts/nominal_prior_ur10.sh CALIB DATA_DIR OUT_DIR

@@ -1,4 +1,4 @@
-"""Reference for `calib register` (issue 26): the tracker-to-base transform re-fitted by SciPy.
+"""Reference for `calib register`: the tracker-to-base transform re-fitted by SciPy.
 
 Reads the calibrated model's predictions (`calib predict` CSV: x_mm … and qw … in the model's old
 tracker frame) and the measured rows (SPEC CSV) of the same configurations, fits the

@@ -1,6 +1,7 @@
 //! `calib compensate`: joint targets rewritten so that the calibrated robot reaches what they mean.
 
-use cell::{CompensateOptions, TargetFrame};
+use crate::args::{ColumnsArg, ModelArg};
+use cell::TargetFrame;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -14,9 +15,8 @@ use std::path::PathBuf;
 /// as nominal_…), residual_mm, residual_mrad and status (ok, or why the row was refused).
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Calibrated model (RON, from `calib fit`).
-    #[arg(long)]
-    model: PathBuf,
+    #[command(flatten)]
+    model: ModelArg,
     /// The targets (SPEC CSV): joint columns, and for pose targets x_mm, y_mm, z_mm and optionally
     /// qw, qx, qy, qz or rx_deg, ry_deg, rz_deg.
     #[arg(long)]
@@ -28,29 +28,22 @@ pub struct Args {
     /// Frame of pose targets: tracker or base.
     #[arg(long, default_value = "tracker")]
     frame: TargetFrame,
-    /// Map other headers onto the SPEC's names, e.g. `x_mm="X [mm]",qw=Q0`.
-    #[arg(long)]
-    columns: Option<measurements::ColumnMap>,
+    #[command(flatten)]
+    columns: ColumnsArg,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let model = model::read_model(&args.model)?;
-    let robot = args.robot.read_or_kept(&model, &args.model)?;
-    let file = cell::read_targets(&args.targets, &model, args.columns.clone().unwrap_or_default())?;
+    let model = args.model.read()?;
+    let robot = args.robot.read_or_kept(&model, &args.model.model)?;
     let robot_ref = robot.as_ref().map(|(r, f)| (r, f.as_str()));
-    let (solved, summary) = cell::compensate(&model, &file, robot_ref, args.frame, &CompensateOptions::default())?;
+    let calib::flow::CompensatedTargets { file, solved, summary, warnings } =
+        calib::flow::compensate(&model, &args.targets, args.columns.map(), robot_ref, args.frame)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     cell::write_compensated(&mut out, &file, &solved)?;
     out.flush()?;
     eprintln!("{}", file.set.read_summary());
-    for warning in model.extrapolation(&file.set.rows) {
-        eprintln!("warning: {warning}");
-    }
-    for warning in model.outside_training_range(&file.set.rows) {
-        eprintln!("warning: {warning}");
-    }
-    for warning in model.beyond_joint_limits(&file.set.rows) {
+    for warning in &warnings {
         eprintln!("warning: {warning}");
     }
     let refused = summary.rows - summary.ok;

@@ -1,23 +1,16 @@
 //! `calib diagnose`: where the geometric model misses, which effect explains it, how far it shrinks.
 
-use diagnose::{DiagnoseOptions, diagnose};
-use measurements::ReadOptions;
+use crate::args::{JsonFlag, RobotDataArgs};
+use diagnose::DiagnoseOptions;
 use std::path::PathBuf;
 
 /// Diagnose what a geometric calibration leaves: where, which effect, how far it shrinks.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    robot: crate::robot_args::RobotArgs,
-    /// Measurements (SPEC CSV; `;` and decimal commas are detected).
-    #[arg(long)]
-    data: PathBuf,
-    /// Other headers mapped onto the SPEC's column names: NAME=HEADER,… (e.g. x_mm="X [mm]",qw=Q0).
-    #[arg(long)]
-    columns: Option<measurements::ColumnMap>,
-    /// Print one JSON object on stdout instead of the summary.
-    #[arg(long)]
-    json: bool,
+    data: RobotDataArgs,
+    #[command(flatten)]
+    json: JsonFlag,
     /// The instrument's noise per axis, mm, if known (otherwise from repeated poses, or a laser
     /// tracker's default, as the report says).
     #[arg(long)]
@@ -39,19 +32,14 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     {
         return Err(format!("--noise-mm must be a positive number of millimetres, got {noise}").into());
     }
-    let inputs = measurements::InputFiles::new().with("--robot", &args.robot.robot).with("--data", &args.data);
-    let robot = args.robot.read()?;
-    let read = ReadOptions::for_joints(robot.joint_kinds()).with_columns(args.columns.clone().unwrap_or_default());
-    let data = measurements::read_measurements(&args.data, &read)?;
+    let inputs =
+        measurements::InputFiles::new().with("--robot", &args.data.robot.robot).with("--data", &args.data.data.data);
+    let (robot, data) = args.data.read(Vec::new())?;
     let options =
         DiagnoseOptions { folds: args.folds, seed: args.seed, noise_mm: args.noise_mm, ..DiagnoseOptions::default() };
-    let diagnosis = diagnose(&robot, &data, &options)?;
-    let report = args
-        .report
-        .as_deref()
-        .map(|folder| ::report::write_diagnosis_report(&diagnosis, folder, "--report", &inputs))
-        .transpose()?;
-    if args.json {
+    let report = args.report.as_deref().map(|folder| (folder, "--report", &inputs));
+    let (diagnosis, report) = calib::flow::diagnose(&robot, &data, &options, report)?;
+    if args.json.json {
         println!("{}", diagnosis.to_json()?);
         eprintln!("{}", data.read_summary());
     } else {

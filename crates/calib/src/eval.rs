@@ -1,42 +1,22 @@
 //! `calib eval`: the errors of a calibrated model on measurements.
 
-use measurements::ColumnMap;
-use model::EvalReport;
-use std::path::PathBuf;
+use crate::args::{JsonFlag, ModelDataArgs};
 
 /// Evaluate a calibrated model on measurements.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Calibrated model (RON, from `calib fit`).
-    #[arg(long)]
-    model: PathBuf,
-    /// Measurements (SPEC CSV; `;` and decimal commas are detected).
-    #[arg(long)]
-    data: PathBuf,
-    /// Other headers mapped onto the SPEC's column names: NAME=HEADER,… (e.g. x_mm="X [mm]",qw=Q0).
-    #[arg(long)]
-    columns: Option<ColumnMap>,
-    /// Print one JSON object on stdout instead of a table.
-    #[arg(long)]
-    json: bool,
+    #[command(flatten)]
+    data: ModelDataArgs,
+    #[command(flatten)]
+    json: JsonFlag,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let model = model::read_model(&args.model)?;
-    let options = model.read_options(args.columns.clone().unwrap_or_default());
-    let data = measurements::read_measurements(&args.data, &options)?;
-    // Angles a turn away from the fitted range are taken into it, as `calib register` does.
-    let (rows, wrapped) = model::wrapped(&model, &data.rows);
-    let data = measurements::MeasurementSet { rows, ..data };
-    // The one binding of `eval`: joints checked, tools mapped.
-    let bound = model.bind(&data)?;
-    let evaluation = model::evaluate(&model, &bound)?;
-    let finite = |e: &model::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
-    if let Some((row, _)) = data.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
-        return Err(crate::predict::non_finite(&args.model, &data.source, row.line).into());
-    }
-    let report = EvalReport { wrapped, ..EvalReport::new(&model, &bound, &evaluation) };
-    if args.json {
+    let (model, data) = args.data.read()?;
+    // Angles a turn away from the fitted range taken into it, the one binding, the evaluation.
+    let calib::flow::Evaluated { data, evaluation, report } =
+        calib::flow::evaluate(&model, args.data.model_file(), data)?;
+    if args.json.json {
         println!("{}", serde_json::to_string(&report)?);
         eprintln!("{}", data.read_summary());
         for joint in &report.wrapped {
@@ -123,7 +103,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
 
 /// The warning about another tracker placement, with this model's file in the command it names.
 fn placement_text(placement: &model::OtherPlacement, args: &Args) -> String {
-    placement.to_string().replace("--model MODEL", &format!("--model {}", args.model.display()))
+    placement.to_string().replace("--model MODEL", &format!("--model {}", args.data.model_file().display()))
 }
 
 /// The warning about rows far beyond the others, with what the others give.

@@ -1,5 +1,6 @@
 //! `calib export`: the calibrated geometry as a URDF for controllers, planners and simulators.
 
+use crate::args::{JsonFlag, ModelArg};
 use cell::UrdfTemplate;
 use robot::{NominalTolerance, UrdfDocument};
 use std::path::PathBuf;
@@ -15,9 +16,8 @@ use std::path::PathBuf;
 /// revolute joints written as continuous.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Calibrated model (RON, from `calib fit`).
-    #[arg(long)]
-    model: PathBuf,
+    #[command(flatten)]
+    model: ModelArg,
     /// Where to write the URDF.
     #[arg(long)]
     urdf: PathBuf,
@@ -36,20 +36,19 @@ pub struct Args {
     /// for a model with joint compliance or a GP.
     #[arg(long)]
     data: Option<PathBuf>,
-    /// Print the report as one JSON object on stdout.
-    #[arg(long)]
-    json: bool,
+    #[command(flatten)]
+    json: JsonFlag,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     // Refused before any work: the URDF must not replace a file this export reads.
     measurements::InputFiles::new()
-        .with("--model", &args.model)
+        .with("--model", &args.model.model)
         .with_optional("--like", args.like.as_deref())
         .with_optional("--robot", args.robot.robot.as_deref())
         .with_optional("--data", args.data.as_deref())
         .check_output("--urdf", &args.urdf)?;
-    let model = model::read_model(&args.model)?;
+    let model = args.model.read()?;
     let training = match &args.data {
         Some(path) => Some(measurements::read_measurements(path, &model.read_options(Default::default()))?),
         None => None,
@@ -68,14 +67,14 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         }
         // --robot, else the robot the model keeps, as compensate and report take it.
         None => {
-            let nominal = args.robot.read_or_kept(&model, &args.model)?;
+            let nominal = args.robot.read_or_kept(&model, &args.model.model)?;
             let nominal = nominal.as_ref().map(|(description, file)| (description, file.as_str()));
             cell::export_urdf(&model, UrdfTemplate::Plain { nominal }, training.as_ref(), &tolerance)?
         }
     };
     cell::write_urdf(&args.urdf, &export)?;
     let report = &export.report;
-    if args.json {
+    if args.json.json {
         println!("{}", serde_json::to_string(report)?);
         return Ok(());
     }

@@ -1,7 +1,8 @@
 //! `calib fit`: fit a calibration method to measurements and write the model.
 
+use crate::args::{JsonFlag, RobotDataArgs};
+use calib::flow::FitOverrides;
 use effects::{EffectKind, EffectSelection, EffectSpec};
-use measurements::ReadOptions;
 use model::{ErrorSummary, Method};
 use pipeline::{FitOptions, FitReport};
 use std::fmt::Write;
@@ -11,13 +12,7 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     #[command(flatten)]
-    robot: crate::robot_args::RobotArgs,
-    /// Measurements (SPEC CSV; `;` and decimal commas are detected).
-    #[arg(long)]
-    data: PathBuf,
-    /// Other headers mapped onto the SPEC's column names: NAME=HEADER,… (e.g. x_mm="X [mm]",qw=Q0).
-    #[arg(long)]
-    columns: Option<measurements::ColumnMap>,
+    data: RobotDataArgs,
     /// Calibration method: base-tool, poe, poe-gp or poe-gp-load.
     #[arg(long)]
     method: Method,
@@ -45,9 +40,8 @@ pub struct Args {
     /// sets) or auto (sparse above 4000 training rows) [default: auto, or what --options says].
     #[arg(long)]
     gp: Option<model::GpChoice>,
-    /// Print the fit report as one JSON object on stdout (the summary goes to stderr).
-    #[arg(long)]
-    json: bool,
+    #[command(flatten)]
+    json: JsonFlag,
     /// Fit data that the plausibility checks refuse (positions whose spread is not the robot's,
     /// a mirror-image frame, joint values beyond the limits), with a warning instead.
     #[arg(long)]
@@ -66,8 +60,8 @@ fn effects_help() -> String {
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     // Refused before any work: the model must not replace a file this fit reads.
     measurements::InputFiles::new()
-        .with("--robot", &args.robot.robot)
-        .with("--data", &args.data)
+        .with("--robot", &args.data.robot.robot)
+        .with("--data", &args.data.data.data)
         .with_optional("--options", args.options.as_deref())
         .check_output("--out", &args.out)?;
     let progress = crate::progress::Progress::on_terminal("fit");
@@ -80,7 +74,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     summary.push_str(&data.read_summary());
     summary.push('\n');
     summarise(&mut summary, args, &robot.name, &data, &model, &report);
-    if args.json {
+    if args.json.json {
         eprint!("{summary}");
         println!("{}", serde_json::to_string(&report)?);
     } else {
@@ -98,43 +92,22 @@ type Fitted = (robot::RobotDescription, measurements::MeasurementSet, model::Cal
 
 /// The command's work, in the phases its report times: reading, the fit, writing the model.
 fn fit_and_write(args: &Args) -> Result<Fitted, Box<dyn std::error::Error>> {
-    let (robot, data) = timings::phase("read", || -> Result<_, Box<dyn std::error::Error>> {
-        let robot = args.robot.read()?;
-        let options = ReadOptions::for_joints(robot.joint_kinds())
-            .with_columns(args.columns.clone().unwrap_or_default())
-            .with_inputs(input_names(args));
-        let data = measurements::read_measurements(&args.data, &options)?;
-        Ok((robot, data))
-    })?;
+    let (robot, data) =
+        timings::phase("read", || -> Result<_, Box<dyn std::error::Error>> { Ok(args.data.read(input_names(args))?) })?;
     let mut options = match &args.options {
         Some(path) => FitOptions::read(path)?,
         None => FitOptions::default(),
     };
-    match (&args.effects, args.joint_compliance) {
-        (Some(selection), _) => options.effects.selection = selection.clone(),
-        (None, true) => {
-            options.effects.selection = EffectSelection::List(vec![EffectSpec::new(EffectKind::JointCompliance)])
-        }
-        (None, false) => {}
-    }
-    if args.force {
-        options.plausibility.force = true;
-    }
-    if let Some(choice) = args.gp {
-        options.residual_gp.method = choice;
-    }
-    if let Some(inputs) = &args.inputs {
-        if !args.method.uses_gp() {
-            return Err(format!(
-                "--inputs: the inputs are the GP's: method {} has no GP (poe-gp, poe-gp-load)",
-                args.method
-            )
-            .into());
-        }
-        options.residual_gp.inputs = inputs.names().to_vec();
-    }
-    let (model, report) = timings::phase("fit", || pipeline::fit(&robot, &data, args.method, &options))?;
-    timings::phase("write", || model::write_model(&args.out, &model))?;
+    let joint_compliance = || EffectSelection::List(vec![EffectSpec::new(EffectKind::JointCompliance)]);
+    let overrides = FitOverrides {
+        effects: args.effects.clone().or_else(|| args.joint_compliance.then(joint_compliance)),
+        force: args.force,
+        gp: args.gp,
+        inputs: args.inputs.as_ref().map(|names| names.names().to_vec()),
+    };
+    overrides.apply(&mut options, args.method).map_err(|e| format!("--inputs: {e} (poe-gp, poe-gp-load)"))?;
+    let (model, report, ()) =
+        calib::flow::fit_and_write(&robot, &data, args.method, &options, |model| model::write_model(&args.out, model))?;
     Ok((robot, data, model, report))
 }
 

@@ -1,6 +1,7 @@
 //! `calib`: the command-line tool. `main` only parses and dispatches; each subcommand lives in a
 //! file of its own and prints through its own functions.
 
+mod args;
 mod compensate;
 mod diagnose;
 mod eval;

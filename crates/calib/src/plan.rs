@@ -1,7 +1,8 @@
 //! `calib plan`: the poses worth measuring, chosen from candidates (crate `cell`).
 
+use crate::args::{ColumnsArg, JsonFlag};
 use crate::robot_args::RobotArgs;
-use measurements::{ColumnMap, ReadOptions};
+use measurements::ReadOptions;
 use std::path::PathBuf;
 
 /// Choose the poses that determine the identification best, covering every moving joint's range.
@@ -43,12 +44,10 @@ pub struct Args {
     /// --criterion and --noise-mm override it.
     #[arg(long)]
     options: Option<PathBuf>,
-    /// Other headers mapped onto the SPEC's column names: NAME=HEADER,….
-    #[arg(long)]
-    columns: Option<ColumnMap>,
-    /// Print the report as one JSON object on stdout.
-    #[arg(long)]
-    json: bool,
+    #[command(flatten)]
+    columns: ColumnsArg,
+    #[command(flatten)]
+    json: JsonFlag,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
@@ -79,7 +78,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let (set, file) = match &args.candidates {
         Some(path) => {
             let kinds = robot.nominal_model()?.joints().iter().map(|j| j.kind).collect();
-            let read = ReadOptions::for_joints(kinds).with_columns(args.columns.clone().unwrap_or_default());
+            let read = ReadOptions::for_joints(kinds).with_columns(args.columns.map());
             let (data, cells) = measurements::read_configurations_with_cells(path, &read)?;
             notes.push(data.read_summary());
             (
@@ -107,7 +106,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     out.finish()?;
-    if args.json {
+    if args.json.json {
         println!("{}", serde_json::to_string(&plan.report)?);
         for note in &notes {
             eprintln!("{note}");

@@ -1,18 +1,15 @@
 //! `calib register`: a calibrated model carried to a moved tracker or new tools from a few poses
 //! (crate `cell`).
 
-use measurements::ColumnMap;
+use crate::args::{JsonFlag, ModelDataArgs};
 use std::path::PathBuf;
 
-/// Re-fit the tracker-to-base transform and/or the tools from a few poses, everything else held.
+/// Re-fit the tracker-to-base transform and/or the tools from a few poses (--data, full-pose or
+/// position-only), everything else held.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Calibrated model (RON, from `calib fit`).
-    #[arg(long)]
-    model: PathBuf,
-    /// The few measured poses (SPEC CSV; full-pose or position-only).
-    #[arg(long)]
-    data: PathBuf,
+    #[command(flatten)]
+    data: ModelDataArgs,
     /// The registered model (RON); never one of the inputs.
     #[arg(long)]
     out: PathBuf,
@@ -27,28 +24,22 @@ pub struct Args {
     /// The residual-to-held-out ratio above which the robot is said to have changed.
     #[arg(long, default_value_t = cell::RegisterOptions::default().changed_ratio)]
     changed_ratio: f64,
-    /// Other headers mapped onto the SPEC's column names: NAME=HEADER,….
-    #[arg(long)]
-    columns: Option<ColumnMap>,
-    /// Print the report as one JSON object on stdout.
-    #[arg(long)]
-    json: bool,
+    #[command(flatten)]
+    json: JsonFlag,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     measurements::InputFiles::new()
-        .with("--model", &args.model)
-        .with("--data", &args.data)
+        .with("--model", args.data.model_file())
+        .with("--data", &args.data.data.data)
         .check_output("--out", &args.out)?;
-    let model = model::read_model(&args.model)?;
-    let options = model.read_options(args.columns.clone().unwrap_or_default());
-    let data = measurements::read_measurements(&args.data, &options)?;
+    let (model, data) = args.data.read()?;
     let register = cell::RegisterOptions { changed_ratio: args.changed_ratio, ..cell::RegisterOptions::default() };
     let registered = cell::register(&model, &data, args.refit, args.heldout_mm, &register)?;
     let text = cell::checked_model_text(&registered.model, &args.out.display().to_string())?;
     measurements::write_file(&args.out, text.as_bytes())?;
     let report = &registered.report;
-    if args.json {
+    if args.json.json {
         println!("{}", serde_json::to_string(report)?);
         eprintln!("{}", data.read_summary());
         eprintln!("{}", report.verdict_line());

@@ -1,34 +1,31 @@
 //! `calib report`: one self-contained HTML page on a calibrated model and test data.
 
+use crate::args::{DataArgs, ModelArg};
 use diagnose::{DiagnoseOptions, diagnose};
-use measurements::ColumnMap;
 use std::path::PathBuf;
 
-/// Write a calibration report: one HTML file with the errors before and after, ISO 9283 AP/RP,
-/// the effects, the GP, the error over the workspace, the worst poses and the diagnosis.
+/// Write a calibration report: one HTML file with the errors before and after on the test
+/// measurements (--data), ISO 9283 AP/RP, the effects, the GP, the error over the workspace, the
+/// worst poses and the diagnosis.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Calibrated model (RON, from `calib fit`).
-    #[arg(long)]
-    model: PathBuf,
+    #[command(flatten)]
+    model: ModelArg,
     #[command(flatten)]
     robot: crate::robot_args::KeptRobotArgs,
-    /// Test measurements (SPEC CSV; `;` and decimal commas are detected).
-    #[arg(long)]
-    data: PathBuf,
-    /// The training measurements: their angles on the effect curves, and the diagnosis.
+    #[command(flatten)]
+    data: DataArgs,
+    /// The training measurements (read as --data, with its --columns): their angles on the effect
+    /// curves, and the diagnosis.
     #[arg(long)]
     train: Option<PathBuf>,
-    /// Other headers mapped onto the SPEC's column names (both files): NAME=HEADER,…
-    #[arg(long)]
-    columns: Option<ColumnMap>,
     /// The HTML file to write.
     #[arg(long)]
     out: PathBuf,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
-    let mut inputs = measurements::InputFiles::new().with("--model", &args.model).with("--data", &args.data);
+    let mut inputs = measurements::InputFiles::new().with("--model", &args.model.model).with("--data", &args.data.data);
     if let Some(robot) = &args.robot.robot {
         inputs = inputs.with("--robot", robot);
     }
@@ -37,24 +34,27 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     inputs.check_output("--out", &args.out)?;
     let started = std::time::Instant::now();
-    let model = model::read_model(&args.model)?;
-    let Some((robot, robot_file)) = args.robot.read_or_kept(&model, &args.model)? else {
+    let model = args.model.read()?;
+    let Some((robot, robot_file)) = args.robot.read_or_kept(&model, &args.model.model)? else {
         return Err(format!(
             "{}: the model does not keep its robot description (written before it was kept): give --robot",
-            args.model.display()
+            args.model.model.display()
         )
         .into());
     };
-    let options = model.read_options(args.columns.clone().unwrap_or_default());
-    let data = measurements::read_measurements(&args.data, &options)?;
+    let data = args.data.read(model.read_options(Default::default()))?;
     let evaluation = model::evaluate(&model, &model.bind(&data)?)?;
     let finite = |e: &model::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
     if let Some((row, _)) = data.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
-        return Err(crate::predict::non_finite(&args.model, &data.source, row.line).into());
+        return Err(calib::flow::Refused::non_finite(&args.model.model, &data.source, row.line).into());
     }
-    let train = args.train.as_ref().map(|path| measurements::read_measurements(path, &options)).transpose()?;
+    let train = args
+        .train
+        .as_ref()
+        .map(|path| args.data.columns.read(path, model.read_options(Default::default())))
+        .transpose()?;
     let diagnosis = train.as_ref().map(|t| diagnose(&robot, t, &DiagnoseOptions::default())).transpose()?;
-    let model_file = args.model.display().to_string();
+    let model_file = args.model.model.display().to_string();
     let report_inputs = ::report::ReportInputs {
         model: &model,
         model_file: &model_file,

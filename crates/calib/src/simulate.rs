@@ -1,7 +1,8 @@
 //! `calib simulate`: a simulated tracker campaign written as SPEC measurement CSV, to try the other
 //! subcommands without a robot, or to test a calibration on data whose truth is known.
 
-use campaign::{GeneratorConfig, Perturbation, Remount, TorqueSensorNoise};
+use calib::flow::{CampaignShape, ShapeFault};
+use campaign::GeneratorConfig;
 use errors::{Error, ErrorKind};
 use std::path::PathBuf;
 
@@ -83,27 +84,12 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         return Err("--rows: at least one pose is needed".into());
     }
     let config = generator_config(args)?;
-    // The generator draws poses where the tool point moves in all three directions: a planar
-    // chain has none, and would be refused after a million draws as "too strict a threshold".
-    if config.moving_joints.is_empty()
-        && let Some(direction) = robot.planar_direction()
-    {
-        let file = args.robot.robot.display().to_string();
-        return Err(Error::in_file(file, ErrorKind::PlanarChain { direction, joints: robot.joint_count() }).into());
-    }
-    let cell = campaign::campaign_cell(&robot, &Perturbation::default(), &Remount::default(), &config)?;
     // Each row is written as it is drawn (memory of one row, whatever --rows), into the atomic
     // output: a failure or a kill leaves the old file, never a part.
     let mut out = measurements::OutputFile::create(&args.out)?;
-    let rows = campaign::simulate_to_csv(
-        &cell,
-        &effects,
-        &campaign::joint_ranges(&robot),
-        &config,
-        args.full_pose,
-        &mut out,
-        &args.out.display().to_string(),
-    )?;
+    let robot_file = args.robot.robot.display().to_string();
+    let out_name = args.out.display().to_string();
+    let rows = calib::flow::simulate(&robot, &robot_file, &effects, &config, args.full_pose, &mut out, &out_name)?;
     out.finish()?;
 
     let on: Vec<&str> = effect_names(&effects);
@@ -123,45 +109,24 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
 }
 
 /// The generator's configuration from the command line.
-fn generator_config(args: &Args) -> Result<GeneratorConfig, Box<dyn std::error::Error>> {
-    let defaults = GeneratorConfig::default();
-    let payloads_kg = args.payloads.clone().unwrap_or_else(|| defaults.payloads_kg.clone());
-    let mut moving_joints = Vec::new();
-    for &joint in args.moving_joints.iter().flatten() {
-        if joint == 0 {
-            return Err("--moving-joints: joints are numbered from 1".into());
+fn generator_config(args: &Args) -> Result<GeneratorConfig, String> {
+    let shape = CampaignShape {
+        payloads: args.payloads.clone(),
+        moving_joints: args.moving_joints.clone(),
+        fixed_jitter_mrad: args.fixed_jitter_mrad,
+        runs: args.runs,
+        tool_per_payload: args.tool_per_payload,
+        torques: args.torques,
+        torque_sigma_nm: args.torque_sigma_nm,
+    };
+    shape.config(args.rows, args.seed).map_err(|fault| match fault {
+        ShapeFault::JointZero => "--moving-joints: joints are numbered from 1".to_owned(),
+        ShapeFault::JitterWithoutMovingJoints => {
+            "--fixed-jitter-mrad needs --moving-joints (only joints that do not move are held)".to_owned()
         }
-        moving_joints.push(joint - 1);
-    }
-    moving_joints.sort_unstable();
-    moving_joints.dedup();
-    if args.fixed_jitter_mrad.is_some() && moving_joints.is_empty() {
-        return Err("--fixed-jitter-mrad needs --moving-joints (only joints that do not move are held)".into());
-    }
-    let jitter = args.fixed_jitter_mrad.unwrap_or(0.0);
-    if !(jitter.is_finite() && jitter >= 0.0) {
-        return Err(format!("--fixed-jitter-mrad: {jitter} is not a non-negative number").into());
-    }
-    if args.torque_sigma_nm.is_some() && !args.torques {
-        return Err("--torque-sigma-nm needs --torques".into());
-    }
-    if let Some(sigma) = args.torque_sigma_nm.filter(|s| !(s.is_finite() && *s >= 0.0)) {
-        return Err(format!("--torque-sigma-nm: {sigma} is not a non-negative number").into());
-    }
-    let torque_sensor = args.torques.then(|| match args.torque_sigma_nm {
-        Some(sigma_nm) => TorqueSensorNoise { sigma_nm, ..TorqueSensorNoise::default() },
-        None => TorqueSensorNoise::default(),
-    });
-    Ok(GeneratorConfig {
-        sample_count: args.rows,
-        seed: args.seed,
-        payloads_kg,
-        moving_joints,
-        fixed_jitter_rad: jitter * 1e-3,
-        payload_runs: args.runs || args.tool_per_payload,
-        tool_per_run: args.tool_per_payload,
-        torque_sensor,
-        ..defaults
+        ShapeFault::Jitter(jitter) => format!("--fixed-jitter-mrad: {jitter} is not a non-negative number"),
+        ShapeFault::SigmaWithoutTorques => "--torque-sigma-nm needs --torques".to_owned(),
+        ShapeFault::Sigma(sigma) => format!("--torque-sigma-nm: {sigma} is not a non-negative number"),
     })
 }
 

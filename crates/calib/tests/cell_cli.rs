@@ -1,4 +1,4 @@
-//! `calib register` and `calib plan` end to end (issue 26, crate `cell`).
+//! `calib register` and `calib plan` end to end (crate `cell`).
 
 use std::path::{Path, PathBuf};
 
@@ -123,7 +123,7 @@ fn register_carries_a_model_to_a_moved_tracker() {
     for json in [&before_json, &after_json] {
         assert!(!json.contains("other_placement"), "{json}");
     }
-    // The model as it was cannot be used on the moved data, and eval says why (issue 48): one
+    // The model as it was cannot be used on the moved data, and eval says why: one
     // rigid motion leaves what the model leaves on the unmoved rows, and `calib register` is named.
     let (moved_json, stderr) = eval(&model, &rest);
     assert!(json_number(&moved_json, "mean_position_error_mm") > 1000.0);

@@ -112,7 +112,7 @@ fn export_refusals_are_one_line() {
     assert!(message.contains("the robot has 7 joints, the model 6"), "{message}");
     let help = succeeds(&["export", "--help"]);
     assert!(help.contains("--like"), "{help}");
-    // --robot, --base-link and --tip-link are the group compensate and report take (issue 48).
+    // --robot, --base-link and --tip-link are the group compensate and report take.
     for command in ["compensate", "report"] {
         let other = succeeds(&[command, "--help"]);
         for flag in ["--robot <ROBOT>", "--base-link <BASE_LINK>", "--tip-link <TIP_LINK>"] {

@@ -1,4 +1,4 @@
-//! Every place that names a row gives the line an editor shows it on (issue 48): a fault planted
+//! Every place that names a row gives the line an editor shows it on: a fault planted
 //! at a known row of a file with Windows line ends, a blank line and notes over two lines (a quoted
 //! field with a line break) is named at that row's line by the reader's refusal, `fit`'s and
 //! `diagnose`'s gross outliers, `eval`'s suspect rows and the `first_line` of its warnings,

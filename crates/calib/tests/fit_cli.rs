@@ -160,7 +160,7 @@ fn few_rows_per_parameter_fit_with_a_warning_and_enough_without() {
     assert!(!String::from_utf8_lossy(&out.stderr).contains("warning:"));
 }
 
-/// Issue 23: `--effects auto` with a GP method also predicts the held-out error with the GP on
+/// `--effects auto` with a GP method also predicts the held-out error with the GP on
 /// top (a line, and `auto.predicted_with_gp` in `--json`); a method without a GP prints and carries
 /// nothing new.
 #[test]

@@ -1,6 +1,6 @@
-//! Issue 31's table through the binary, the rows that the other files do not hold: inputs a model
-//! does not cover are counted and named, one absurd cell or a degenerate robot is refused with its
-//! place and cause. (`cargo xtask hostile` runs the whole table against a built binary.)
+//! The hostile-input table (nothing lost, no fit that looks right and is not) through the
+//! binary, the rows that the other files do not hold: inputs a model does not cover are counted
+//! and named, one absurd cell or a degenerate robot is refused with its place and cause. (`cargo xtask hostile` runs the whole table against a built binary.)
 
 use std::path::Path;
 

@@ -1,4 +1,4 @@
-//! A URDF with mimic joints on the command line (issue 30): `simulate` → `fit` → `eval` round
+//! A URDF with mimic joints on the command line: `simulate` → `fit` → `eval` round
 //! trips on `column_arm.urdf` (a lifting column of three stages driven by one motor, folded into
 //! one joint), `fit` says what the folding made unobservable, and `export --like` keeps the
 //! mimic joints.
@@ -15,8 +15,8 @@ fn succeeds(args: &[&str]) -> String {
 }
 
 /// Splits `all` after `first` data rows into `train` and `test`, with the prismatic column's
-/// header in metres: `simulate` wrote `q1_rad` for it at the time of writing (another change
-/// renames it to `q1_m`), which `fit` refuses for a prismatic joint.
+/// header in metres (`q1_m`; a `q1_rad` header is renamed), since `fit` refuses `_rad` for a
+/// prismatic joint.
 fn split(all: &Path, first: usize, train: &Path, test: &Path) {
     let content = std::fs::read_to_string(all).unwrap();
     let mut lines = content.lines();
@@ -147,7 +147,7 @@ fn the_shipped_column_arm_fits_from_its_urdf_as_shipped_and_exports_back_in_its_
         ["simulate", "--robot", &robot, "--out", &all, "--rows", "160", "--seed", "4", "--effects", &effects];
     succeeds(&simulate);
     split(Path::new(&all), 120, Path::new(&train), Path::new(&test));
-    // Issue 45's first step: the motor beside the chain is the data's joint 1.
+    // The motor beside the chain is the data's joint 1.
     let fit = ["fit", "--robot", &robot, "--tip-link", "prism", "--data", &train, "--method", "poe", "--out", &model];
     let fitted = succeeds(&fit);
     let folded = "joint 1 is URDF joint 'column_drive' with its mimic joint(s) 'column_stage_1' (multiplier 0.5), \

@@ -230,7 +230,7 @@ fn a_directory_a_fifo_or_a_device_node_is_never_replaced_by_an_output() {
     );
     assert!(folder.is_dir());
 
-    // `/dev/null` through `simulate` only: today's main writes into it there, which is harmless,
+    // `/dev/null` through `simulate` only: were the check missing, simulate would write into it, harmless,
     // where a fit's rename would replace the machine's /dev/null (these tests may run as root).
     let out = calib(&["simulate", "--robot", &text(&robot), "--out", "/dev/null", "--rows", "5"]);
     let message = refused(&out, "simulate --out /dev/null");
@@ -242,7 +242,7 @@ fn a_directory_a_fifo_or_a_device_node_is_never_replaced_by_an_output() {
     let fifo = dir.path().join("fifo");
     match Command::new("mkfifo").arg(&fifo).status() {
         Ok(status) if status.success() => {
-            // fit, not simulate: opening a FIFO for writing with no reader would block today's main.
+            // fit, not simulate: were the check missing, opening a FIFO for writing with no reader would block.
             let message = refused(&fit_to(&robot, &data, &text(&fifo)), "fit --out a FIFO");
             assert_eq!(
                 message,

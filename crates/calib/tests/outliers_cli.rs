@@ -1,4 +1,4 @@
-//! Gross outliers end to end (issue 31): one row a metre off among 300 good ones is named by its
+//! Gross outliers end to end: one row a metre off among 300 good ones is named by its
 //! line in `calib fit` and `calib diagnose`, and does not spoil the model.
 
 use std::path::{Path, PathBuf};

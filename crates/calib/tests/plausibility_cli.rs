@@ -1,5 +1,5 @@
-//! `calib fit` refuses data that fit as well as the right data but describe another robot
-//! (issue 31): metres or inches under `_mm` columns, two position columns swapped, degrees under
+//! `calib fit` refuses data that fit as well as the right data but describe another robot:
+//! metres or inches under `_mm` columns, two position columns swapped, degrees under
 //! `_rad` columns; `--force` fits them with a warning; simulated data of every fixture pass.
 
 use std::path::{Path, PathBuf};

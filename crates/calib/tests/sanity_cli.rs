@@ -1,4 +1,4 @@
-//! Issue 31, "no fit that looks right and is not", through the binary: a model is never credited
+//! No fit that looks right and is not, through the binary: a model is never credited
 //! with what it did not calibrate, and input that cannot be physical is refused with its place.
 
 use std::path::Path;

@@ -203,7 +203,7 @@ fn campaign_shape_arguments_that_do_not_fit_are_refused_with_one_line() {
     assert!(!Path::new(&out).exists(), "nothing is written when the input is refused");
 }
 
-/// Issue 30: a prismatic joint (a lifting column) is written as `q1_m` and what `simulate` writes
+/// A prismatic joint (a lifting column) is written as `q1_m` and what `simulate` writes
 /// `fit` reads back (it refused its own file when the column was written as `q1_rad`).
 #[test]
 fn a_lifting_column_is_written_in_metres_and_fits_back() {

@@ -1,4 +1,4 @@
-//! `docs/SPEC.md` against the code (issue 48): the SPEC's tables are read here, the commands run
+//! `docs/SPEC.md` against the code: the SPEC's tables are read here, the commands run
 //! on simulated data, and every column, `--effects` item, model-file field and JSON key must be
 //! where the SPEC says, in both directions, so that neither can change without the other.
 //!

@@ -190,7 +190,7 @@ pub fn simulate_campaign(
     Ok((cell, data))
 }
 
-/// The shape of a real 7-axis campaign (issue 11): joints 1 and 2 moving, the others at 0 within
+/// The shape of a real 7-axis campaign: joints 1 and 2 moving, the others at 0 within
 /// 2 mrad, four consecutive runs with 0, 1.25, 2.5 and 5 kg, the probe remounted for each (one
 /// tool per run), measured joint torques with the default sensor noise.
 pub fn payload_run_campaign(sample_count: usize, seed: u64) -> GeneratorConfig {

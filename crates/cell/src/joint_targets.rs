@@ -319,7 +319,7 @@ pub fn write_compensated<W: Write>(writer: W, file: &TargetFile, solved: &[Solve
             .enumerate()
             .map(|(i, name)| if joint_columns.contains(&i) { format!("nominal_{name}") } else { name.clone() }),
     );
-    // Each row's line in the targets file (issue 48), last: version 2's columns keep their places.
+    // Each row's line in the targets file, last: version 2's columns keep their places.
     header.extend(["residual_mm", "residual_mrad", "status", "line"].map(String::from));
     out.write_record(&header)?;
     for ((cells, solved), row) in file.cells.rows.iter().zip(solved).zip(&file.set.rows) {

@@ -53,7 +53,7 @@
 //! # Ok::<(), errors::Error>(())
 //! ```
 //!
-//! Re-registration (issue 26): carry a calibrated model to a moved tracker or a new tool from a
+//! Re-registration: carry a calibrated model to a moved tracker or a new tool from a
 //! few measured poses (`calib register`). Choosing the poses worth measuring (`calib plan`) is
 //! the crate `planning`.
 //!

@@ -389,7 +389,7 @@ mod tests {
         // point shows it, so a point 10 cm away may be predicted millimetres off: the warning says
         // so whatever the outcome. The verdict must agree with what the new point's test poses
         // show: since the fit holds the links near the nominal geometry where the data leave them
-        // free (the nominal prior, issue 30), this flange is close enough (test poses 1.07× the
+        // free (the nominal prior), this flange is close enough (test poses 1.07× the
         // model's held-out error), and the verdict is `Consistent`; before the prior it was
         // millimetres off and `RobotChanged`.
         let (model, few, test, heldout) = scenario(false, Method::Poe);

@@ -3,12 +3,10 @@
 //! inner products a matrix product left in the column.
 //!
 //! As in [`crate::one_input`]: [`exp_nonpositive`] instead of the library's `exp`, and `pulp`'s
-//! run-time dispatch so that the loops are compiled for AVX2 + FMA (and AVX-512) and vectorised.
-//! Profiled on the UR10 fit (n = 1,387, d = 6, additive default kernel, serial), the library `exp`
-//! and the scalar closures of these two loops took 17 % of the whole fit. Measured with
-//! `bench-gp --lml-floor 1387` (serial, one LML + gradient): SE-ARD 0.098 → 0.078 s, SE-ARD +
-//! additive 0.093 → 0.085 s, against a floor of 0.051 s. The Matérn shape keeps the scalar path in
-//! `gram.rs`.
+//! run-time dispatch so that the loops are compiled for AVX2 + FMA (and AVX-512) and vectorised:
+//! with the library's `exp` these two loops were a sixth of a whole GP fit
+//! (`docs/results/lml-floor.md` has the profile and the timings). The Matérn shape keeps the scalar
+//! path in `gram.rs`.
 
 use crate::exp::{ARCH, LANES, exp_nonpositive, pairwise};
 

@@ -208,7 +208,7 @@ pub(crate) fn build_candidates(
         // from the joint's gravity-regressor compliance. Not on a prismatic joint whose stated
         // force keeps its sign: its force is its load's weight along the axis, `−(g·a) Σ m`, whose
         // sign no mass model changes (a balancer of the robot file is in the stated force), so a
-        // learnt side would only follow the noise or the payload (issue 30: a vertical column).
+        // learnt side would only follow the noise or the payload (a vertical column).
         let constant_force =
             robot.joints[j].kind == robot::JointType::Prismatic && !built.iter().any(|c| c.effect == Effect::Backlash);
         let side = built.iter().position(|c| {

@@ -18,7 +18,7 @@ pub enum NoiseSource {
     Repeats,
     /// Given by the user (`--noise-mm`).
     Given,
-    /// The tracker's own stated standard deviation of every row (`std_x_mm` …, issue 46).
+    /// The tracker's own stated standard deviation of every row (`std_x_mm` …).
     Stated,
     /// The default of the instrument class the data come from (a laser tracker), at the measured
     /// distances: see [`NoiseFloor::instrument`].

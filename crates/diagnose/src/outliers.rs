@@ -1,4 +1,4 @@
-//! Gross outliers before anything is attributed (issue 31).
+//! Gross outliers before anything is attributed.
 //!
 //! A row a metre off is not the structure of any effect, yet it dominates every held-out error
 //! and every selection, and a GP finds "structure" in the joints it happens to sit at. So the

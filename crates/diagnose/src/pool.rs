@@ -52,7 +52,7 @@ pub struct PriorOptions {
     /// specify ≤ 1 arcmin, 0.29 mrad, of lost motion and transmission error) and of any joint
     /// encoder, so a coefficient the data determine is not shrunk; but over part of a turn most
     /// combinations of harmonics are seen by no pose, and without this bound a series reaches
-    /// 20 mm at a pose at the edge of the range (the UR10's home pose, issue 11).
+    /// 20 mm at a pose at the edge of the range (the UR10's home pose).
     pub series_rad: f64,
 }
 
@@ -597,7 +597,7 @@ mod tests {
         (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
     }
 
-    /// The shape of issue 11's 7-axis arm in a linear problem: four well-excited kinematic
+    /// The shape of a real 7-axis campaign in a linear problem: four well-excited kinematic
     /// columns; two that only the jitter of joints held still excites (1e-3 of the others), except
     /// one pose each where that joint did move; an effect column worth 1.5 noise σ per row.
     fn heavy_tailed_shape(poses: usize) -> (Design, Vec<f64>) {

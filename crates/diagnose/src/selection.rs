@@ -122,11 +122,11 @@ pub struct SelectionOptions {
     pub max_effects: usize,
     /// The orders a periodic error of a joint's own angle may take; each fold picks one by
     /// cross-validation on its training rows. Up to 48: the blind check draws harmonics up to 40,
-    /// and a real UR10's joint errors need 24–32 (issue 11).
+    /// and a real UR10's joint errors need 24–32.
     pub series_orders: Vec<u32>,
     /// The order a fit on every row uses for a selected series minimises
     /// `(1 − w) · random folds + w · arcs`: its mean held-out error over the random folds, and
-    /// over arcs of every other moving joint left out in turn (module `arcs`; issue 23: order
+    /// over arcs of every other moving joint left out in turn (module `arcs`: order
     /// selection that also sees gaps). 0.5 weighs poses like the training poses and poses off
     /// them alike (no measurement chose it); 0 is the random folds alone, as before.
     pub arc_order_weight: f64,

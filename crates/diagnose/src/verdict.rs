@@ -22,7 +22,7 @@ pub struct VerdictOptions {
     /// the choice of its hyperparameters moves it by).
     pub structure_min_gain: f64,
     /// The share of the explainable reduction of the mean held-out error a named effect must
-    /// achieve: "most", i.e. more than half (issue 11).
+    /// achieve: "most", i.e. more than half.
     pub min_explained_fraction: f64,
     /// `none` means the geometric model is at the noise floor: with nothing selected and a
     /// held-out error above this multiple of the floor the verdict is `unknown` even when the GP

@@ -194,7 +194,7 @@ impl NewEffect for Backlash {
     /// `δq_j = b_j sign(τ_j)`: the sign of the stated (or stand-in) static torque, first among the
     /// joint's candidates; with measured torques also their sign, fourth. A sign that never
     /// changes over the rows (the weight on a vertical column, whatever the masses) makes `b_j` a
-    /// constant joint offset, which the geometry already holds (issue 30): the diagnosis drops
+    /// constant joint offset, which the geometry already holds: the diagnosis drops
     /// such a candidate, as every candidate whose features never change
     /// ([`IdentifiedEffect::features_constant`]). A learnt side is the diagnosis's own (module
     /// `learnt_side`).

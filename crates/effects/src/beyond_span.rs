@@ -1,5 +1,5 @@
 //! What a term driven by time or temperature (`time_drift`, `thermal`) is beyond the span of
-//! `t_s` / `temp_c` it was fitted on (issue 30): held at its value at the span's nearer end, or
+//! `t_s` / `temp_c` it was fitted on: held at its value at the span's nearer end, or
 //! fallen back to zero (the geometry's own placement and size). A term driven by the payload's
 //! load has a third rule, extended as fitted (`payload_span.rs`). Each kind keeps the rule it had
 //! before the choice was made by data (drift: zero; growth: held), which is what a model file

@@ -4,7 +4,7 @@
 //!
 //! A series is known only near the angles it was fitted on: a series of order 48 fitted on a 130°
 //! arc says nothing of the rest of the circle, and past the last training angle it can reach tens
-//! of millimetres within a few degrees (issue 23: UR10 series B, 20 mm). So the series is fitted
+//! of millimetres within a few degrees (UR10 series B, 20 mm). So the series is fitted
 //! and applied *held and faded*: at an angle outside the fitted angles (past either end, or in a
 //! gap wider than half the shortest period) it is evaluated at the nearest fitted angle and
 //! multiplied by a raised-cosine taper that reaches zero [`GearPeriodic::taper_rad`] away, where

@@ -112,7 +112,7 @@ pub struct JointCompliance {
     /// Their values: radians of deflection per unit of the scaled regressor.
     pub theta: Vec<f64>,
     /// The payloads (and measured torques) of the training rows and the rule beyond them
-    /// (issue 30, `PayloadSpan`: held at the nearer end unless the fit chose otherwise). Absent
+    /// (`PayloadSpan`: held at the nearer end unless the fit chose otherwise). Absent
     /// in model files written before it was recorded: extended as fitted, as they were.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub payload_span: Option<PayloadSpan>,

@@ -29,7 +29,7 @@
 /// The default of the fit's `EffectOptions::hold_beyond_span`, also what the diagnosis uses: thermal
 /// growth and drift are applied as fitted up to this fraction of their fitted span beyond either
 /// end, held (growth) or faded to zero (drift) further out. 1: a linear term is trusted as far
-/// beyond its data as the data reaches (issue 30; see `EffectOptions::hold_beyond_span`).
+/// beyond its data as the data reaches (see `EffectOptions::hold_beyond_span`).
 pub const HOLD_BEYOND_SPAN: f64 = 1.0;
 
 mod beyond_span;

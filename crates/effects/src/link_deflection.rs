@@ -1,4 +1,4 @@
-//! Link deflection (issue 30): the link of a joint bends under the gravity moment of everything
+//! Link deflection: the link of a joint bends under the gravity moment of everything
 //! beyond it, and the arm beyond turns with the link's far end by `θ_a = f_a L(q) (e_a · M(q))`
 //! about the link's midpoint, about the x and y axes `e_a` of the joint's frame
 //! (`loadsim::link_deflection_features`; a column's lever `L` grows with its extension). One
@@ -50,7 +50,7 @@ pub struct LinkDeflection {
     pub scale: Vec<f64>,
     /// The far end's rotation about each axis, rad per unit of the scaled feature.
     pub theta: Vec<f64>,
-    /// The payloads of the training rows and the rule beyond them (issue 30, `PayloadSpan`: the
+    /// The payloads of the training rows and the rule beyond them (`PayloadSpan`: the
     /// moment held at the nearer end's payload unless the fit chose otherwise). Absent in model
     /// files written before it was recorded: extended as fitted, as they were.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -1,5 +1,5 @@
 //! What a term driven by the payload's gravity load (`joint_compliance`, `link_deflection`) is
-//! beyond the payloads it was fitted on (issue 30): held at the lightest or heaviest trained
+//! beyond the payloads it was fitted on: held at the lightest or heaviest trained
 //! payload ([`BeyondSpan::Hold`], the default), fallen back to zero (the geometry alone), or
 //! extended as fitted ([`BeyondSpan::Extend`], a straight line in the load; what a model file
 //! written before the span was recorded does everywhere). The fit keeps the hold unless leaving

@@ -3,7 +3,7 @@
 //!
 //! A parameter's value is the effect's size at the RMS of its scaled feature over the training
 //! rows, in the unit of the twist it moves the pose along ([`Direction`]): a joint's own unit for
-//! a joint's displacement (rad, and mm for a prismatic joint: issue 30, a linear axis reads in
+//! a joint's displacement (rad, and mm for a prismatic joint: a linear axis reads in
 //! millimetres everywhere), m or rad for a fixed twist's component, a strain for the arm's growth,
 //! rad for a link's bending. On a prismatic joint the generalised force that gravity, a payload
 //! or a drive exerts is a force along the axis, not a torque, and its names say so: a compliance

@@ -21,7 +21,7 @@ pub struct Thermal {
     pub theta: Vec<f64>,
     /// `[min, max]` of `temp_c` on the training rows widened by `EffectOptions::hold_beyond_span`
     /// of its width at either end, °C: outside it the temperature is held at the nearer end, so that a term fitted within one session is never carried on as a straight
-    /// line (issue 30). Absent in older model files: applied as fitted, everywhere.
+    /// line. Absent in older model files: applied as fitted, everywhere.
     #[serde(default)]
     pub fitted_span: Option<[f64; 2]>,
     /// Beyond `fitted_span`: held at the nearer end's temperature (the default, and what files

@@ -22,7 +22,7 @@ pub struct TimeDrift {
     /// `[min, max]` of `t_s` on the training rows widened by `EffectOptions::hold_beyond_span` of
     /// its width at either end, s: outside it the drift falls back to zero (the geometry's own
     /// placement), so that a term fitted within one session is never carried on as a straight
-    /// line into another (issue 30). Absent in older model files: applied as fitted, everywhere.
+    /// line into another. Absent in older model files: applied as fitted, everywhere.
     #[serde(default)]
     pub fitted_span: Option<[f64; 2]>,
     /// Beyond `fitted_span`: zero (the default, and what files written before the choice mean)
@@ -151,7 +151,7 @@ mod tests {
         Measurement { temp_c: Some(temp_c), t_s: Some(t_s), ..Measurement::at(vec![0.0], lie::Vector3::zeros()) }
     }
 
-    /// Issue 30: a drift fitted over one 73-minute session was applied as a straight line eight
+    /// A drift fitted over one 73-minute session must not run on as a straight line eight
     /// days later. Outside the fitted span the time and the temperature are held at its ends.
     #[test]
     fn a_drift_and_a_thermal_growth_are_held_at_the_ends_of_the_span_they_were_fitted_on() {

@@ -143,7 +143,7 @@ proptest! {
 
     #[test]
     fn a_read_rotation_is_written_as_it_was_read(r in so3()) {
-        // Issue 48: a model file written, read and written again is the same bytes. The
+        // A model file written, read and written again is the same bytes. The
         // quaternion of the matrix read differs from the one written in the last digit; the one
         // read is written back.
         let json = serde_json::to_string(&r).unwrap();

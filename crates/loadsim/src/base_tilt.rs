@@ -1,4 +1,4 @@
-//! A base that tilts under the arm's own weight, read by an inclinometer on it (issue 46): the
+//! A base that tilts under the arm's own weight, read by an inclinometer on it: the
 //! cause of the error is a signal the cell measures. A robot on a mobile platform, a column on a
 //! soft floor or a light stand turns as a whole under the gravity moment of the arm and its
 //! payload about the base, `M = Σ_k m_k c_k × g` (links and payload, base frame), as a rotational

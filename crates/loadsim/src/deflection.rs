@@ -1,5 +1,5 @@
 //! Link deflection: a long link (a lifting column, a boom) bends elastically under the gravity
-//! wrench of everything beyond it, and the rest of the arm turns with its far end (issue 30).
+//! wrench of everything beyond it, and the rest of the arm turns with its far end.
 //!
 //! The link of joint `j` runs from joint `j`'s axis point at its zero (where the link is clamped:
 //! a column's foot) to joint `j + 1`'s (or to the tool for the last joint), length `L(q)`: for a

@@ -1,4 +1,4 @@
-//! A record's line as an editor counts it (issue 48). The CSV layer's own count is the line where
+//! A record's line as an editor counts it. The CSV layer's own count is the line where
 //! it *started looking* for a record: it counts `\n` only, and skips blank lines and the `\n` of a
 //! `\r\n` at the start of the next record, so in a file with Windows line ends every row after the
 //! first was named one line early (the first data row "line 1"), and a blank line shifted every

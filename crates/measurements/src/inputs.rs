@@ -1,4 +1,4 @@
-//! Measured signals that may explain the error, beside the joints (issue 46): any numeric column
+//! Measured signals that may explain the error, beside the joints: any numeric column
 //! named by `--inputs` (an inclinometer, a motor temperature, the room temperature), kept per row
 //! by name and in the unit the column's name states, as written (no conversion: a model learns
 //! from them in whatever unit they were measured in, and records that unit).

@@ -38,7 +38,7 @@ pub(crate) struct Layout {
     pub torques: Vec<Column>,
     /// The columns of [`Expectation::inputs`], in its order.
     pub inputs: Vec<Column>,
-    /// The stated standard deviations of the position, `std_x_mm` … (issue 46): all three or none.
+    /// The stated standard deviations of the position, `std_x_mm` …: all three or none.
     pub position_std: Option<[Column; 3]>,
     /// The stated standard deviations of the orientation, `std_rx_mrad` …: all three or none.
     pub rotation_std: Option<[Column; 3]>,

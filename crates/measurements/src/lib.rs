@@ -39,7 +39,7 @@ pub use input_files::InputFiles;
 pub use inputs::{INPUT_UNITS, InputColumn, InputNames, Inputs, input_unit};
 pub use outliers::{OutlierLine, list_lines, without};
 pub use output_file::{FileKind, MAX_SYMLINKS, OutputFile, output_target, write_file};
-/// A row's stated standard deviations (`std_x_mm` …, issue 46), as the identification weighs them.
+/// A row's stated standard deviations (`std_x_mm` …), as the identification weighs them.
 pub use poe::identify::StatedSigma;
 
 pub use column_map::{ColumnMap, ColumnMapFault};

@@ -1,4 +1,4 @@
-//! Gross outliers by the line of the file they stand on (issue 31): the identification names
+//! Gross outliers by the line of the file they stand on: the identification names
 //! them by observation (`poe::identify::RobustReport`), the user needs the CSV line.
 
 use crate::MeasurementSet;
@@ -106,7 +106,7 @@ mod tests {
 
     #[test]
     fn a_value_within_the_spread_is_not_a_negative_count_of_sigmas() {
-        // Issue 48: UR10 C even rows, 500 mm added to one z: its rotation was "-1 robust sigmas".
+        // UR10 C even rows, 500 mm added to one z: its rotation was "-1 robust sigmas".
         let row = OutlierLine::new(402, 499.862, 2398.2, Some(0.448), Some(-0.7));
         assert_eq!(row.rotation_sigmas, Some(0.0));
         assert_eq!(row.to_string(), "line 402 (499.862 mm, 2398 robust sigmas; 0.448 mrad, within the spread)");

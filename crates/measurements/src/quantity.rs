@@ -29,8 +29,7 @@ pub(crate) enum Quantity {
     Time,
     /// `tau<k>_nm`.
     Torque(usize),
-    /// `std_x_mm`, `std_y_m`, …: the tracker's stated standard deviation of position axis 0, 1, 2
-    /// (issue 46).
+    /// `std_x_mm`, `std_y_m`, …: the tracker's stated standard deviation of position axis 0, 1, 2.
     PositionStd {
         axis: usize,
         scale: f64,

@@ -41,7 +41,7 @@ pub struct CalibratedModel {
     /// the training rows'. Files written before it was kept have none (no σ, no fallback by it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub effect_uncertainty: Option<crate::EffectUncertainty>,
-    /// The posterior uncertainty of the kinematics (issue 45): for rows that put a joint outside
+    /// The posterior uncertainty of the kinematics: for rows that put a joint outside
     /// the range the model was fitted on, the error the geometry's own uncertainty predicts
     /// there. Kept by fits under the prior toward the nominal geometry; files written before it
     /// was kept have none.

@@ -1,10 +1,10 @@
 //! What a fit knows of its effects' parameters, carried to every row a model is applied at: the
 //! posterior covariance of each effect's parameters (`poe::identify::Identification::
 //! correction_covariance`), stored as its Cholesky factor, gives the standard deviation of the
-//! effect's correction at any row (issue 23: "give each effect's correction a σ where it is
-//! applied"). Where that σ is far above what the training rows had, the effects were fitted on
-//! nothing like the row (a joint combination never excited, a gap, beyond a range), and the model
-//! falls back to the geometry fitted alone there (`model_parts`, [`EffectUncertainty::weight`]).
+//! effect's correction at any row it is applied at. Where that σ is far above what the training
+//! rows had, the effects were fitted on nothing like the row (a joint combination never excited,
+//! a gap, beyond a range), and the model falls back to the geometry fitted alone there
+//! (`model_parts`, [`EffectUncertainty::weight`]).
 
 use effects::{IdentifiedEffect, RowTwists};
 use errors::Error;

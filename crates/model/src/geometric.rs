@@ -50,8 +50,8 @@ pub fn fit_geometry(
     Ok(GeometricFit { model: identification.model, registered, report: identification.report })
 }
 
-/// [`fit_geometry`] with the full identification under a prior toward the placed nominal model
-/// (issue 30): `prior` is the standard deviation of a link's translation (m) and rotation (rad)
+/// [`fit_geometry`] with the full identification under a prior toward the placed nominal model:
+/// `prior` is the standard deviation of a link's translation (m) and rotation (rad)
 /// about it; `None` is [`fit_geometry`].
 pub fn fit_geometry_with_prior(
     nominal: &LocalPoe,

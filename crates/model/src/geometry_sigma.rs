@@ -1,6 +1,6 @@
-//! The geometry's own posterior uncertainty, carried to the rows a model is applied at (issue 45:
-//! "`eval`/`predict` give, for rows outside every fitted configuration, the error the geometry's
-//! own uncertainty predicts there beside the warning"). The fit under the prior toward the
+//! The geometry's own posterior uncertainty, carried to the rows a model is applied at: for rows
+//! outside every fitted configuration, `eval` and `predict` give the error the geometry's own
+//! uncertainty predicts there beside the warning. The fit under the prior toward the
 //! nominal geometry keeps the covariance of the kinematic parameters (directions the training
 //! poses determine poorly keep about the prior's width, the nominal's tolerance; the others what
 //! the data gives); at a row, `σ = ‖Lᵀ g‖` of the tool point's position, `g` the identification

@@ -1,4 +1,4 @@
-//! The fit's own estimate of the model's held-out error, kept in the model file (issue 26) so
+//! The fit's own estimate of the model's held-out error, kept in the model file so
 //! that `calib register` can judge a registration's residual without being told it. Files
 //! written before it was kept have none (`register` then asks for `--heldout-mm`).
 

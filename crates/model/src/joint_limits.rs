@@ -1,4 +1,4 @@
-//! The robot's joint limits, kept in the model file by `fit` (issue 31): `eval`, `predict` and
+//! The robot's joint limits, kept in the model file by `fit`: `eval`, `predict` and
 //! `compensate` count the rows that put a joint beyond them. Such a row is a pose the arm cannot
 //! take (degrees under `_rad`, a file of another robot, a typo), and whatever the model answers
 //! there was never measured. The fitted span (`training_range.rs`) says where the model was

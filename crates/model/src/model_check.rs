@@ -243,7 +243,7 @@ impl CalibratedModel {
     /// The checks above bound what they can name; this catches any finite but absurd value they
     /// leave (1e308 in the GP's training outputs, a feature scale of 1e-320) that would make
     /// predictions NaN or kilometres off, and names the part. A sound model passes: the rows are
-    /// inside what it was fitted on (issue 23: at every joint 1 rad, a GP fitted with the wrist
+    /// inside what it was fitted on (at every joint 1 rad, a GP fitted with the wrist
     /// within 2 mrad of zero extrapolated beyond a kilometre and a sound model was refused).
     fn check_values(&self, at: &Located<'_>) -> Result<(), Error> {
         if let Some(range) = &self.training_range

@@ -1,4 +1,4 @@
-//! Data measured from another tracker placement than the model's (issues 26 and 48). A model
+//! Data measured from another tracker placement than the model's. A model
 //! predicts in the tracker frame it was fitted in; rows measured after the tracker moved miss by
 //! the move, a rigid motion of every point, however good the model. `eval` fits one rigid motion
 //! of the predicted tool points onto the measured ones (Kabsch): where it explains most of the

@@ -1,7 +1,7 @@
 //! Repeated configurations: rows whose joint vectors agree within a tolerance, a pose measured
 //! more than once. A held-out estimate that leaves one row out keeps its twin, and what a GP or
 //! an effect learns from the twin is the row's own value; leaving the whole group out is the
-//! estimate of a pose the fit has not seen (issue 26: 284 of UR10 series B's 748 even rows repeat
+//! estimate of a pose the fit has not seen (284 of UR10 series B's 748 even rows repeat
 //! a configuration to 1e-4 rad, and its GP's leave-one-out error said 0.107 mm where the odd rows
 //! measure 0.272).
 

@@ -108,7 +108,7 @@ pub struct ResidualGpOptions {
     /// instead of three searches of their own; the position outputs are fitted as `gp` says.
     pub rotation_follows_position: bool,
     /// Where the GP knows little of a row, its correction fades out and the model falls back to
-    /// the geometry (issue 23): with `s` the share of the GP's prior variance of the position
+    /// the geometry: with `s` the share of the GP's prior variance of the position
     /// outputs that its posterior keeps at the row, measured from what it keeps at its training
     /// rows ([`GpFadeRule`]: 0 at a typical training row, 1 where the training rows say nothing
     /// of it), the correction applies in full while `s` is at most this value and fades linearly
@@ -121,8 +121,8 @@ pub struct ResidualGpOptions {
     /// median of all of them took longer than the sparse GP's own search. The exact GP's comes
     /// from its leave-one-out over every row, which the fit computes anyway. At least 1.
     pub fade_share_rows: usize,
-    /// Measured signals taken as inputs beside the joints and the payload (`calib fit --inputs`,
-    /// issue 46): columns of the measurement file by name (after `--columns`), in this order. The
+    /// Measured signals taken as inputs beside the joints and the payload (`calib fit --inputs`):
+    /// columns of the measurement file by name (after `--columns`), in this order. The
     /// GP standardises every input, so each is used in the unit it was measured in.
     pub inputs: Vec<String>,
     /// The fallback GP's ([`ResidualGp::fallback`]) full-data searches after its warm-start
@@ -477,7 +477,7 @@ pub struct ResidualGp {
     pub tool_points: Vec<Option<Vector3>>,
     /// The GP of what the geometry fitted alone ([`crate::CalibratedModel::fallback_kinematics`])
     /// leaves on the same training rows, its hyperparameters searched on those residuals
-    /// ([`ResidualGp::fit_fallback`]; issue 23): where the effects fade out and the pose blends to
+    /// ([`ResidualGp::fit_fallback`]): where the effects fade out and the pose blends to
     /// the geometry alone, the correction blends to this GP's, so that off the effects' angles the
     /// model is the GP-corrected geometry (what `poe-gp` without effects would give) rather than
     /// the geometry with a GP learnt on what the effects left. Absent without effects, for the

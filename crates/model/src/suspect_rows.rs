@@ -1,4 +1,4 @@
-//! Rows of an evaluation far beyond the rest (issue 23): a test row that every model misses by
+//! Rows of an evaluation far beyond the rest: a test row that every model misses by
 //! ten times the spread of the others is more likely an error of the measurement than of the
 //! model, and its error alone can set the evaluation's maximum. `eval` keeps every number as
 //! measured and names such rows beside them, with the maximum and mean without them, so a user

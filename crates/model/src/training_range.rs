@@ -1,4 +1,4 @@
-//! The range of every input a model was fitted on, recorded in the model file (issue 23): the
+//! The range of every input a model was fitted on, recorded in the model file: the
 //! check on reading walks the parts at rows inside it, where a sound model is sound, instead of at
 //! joint values it may never have seen (every joint at 1 rad refused a sound GP fitted with the
 //! wrist held within 2 mrad of zero). Model files written before it existed have none and read.
@@ -23,7 +23,7 @@ pub struct TrainingRange {
     /// Per joint, `[min, max]` of the measured torque, N·m, where every row had them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub torques_nm: Option<Vec<[f64; 2]>>,
-    /// The measured signals the model takes as inputs (`--inputs`, issue 46), each with its
+    /// The measured signals the model takes as inputs (`--inputs`), each with its
     /// unit and `[min, max]` over the training rows, in the order the model takes them. Absent
     /// in files written before there were inputs, and for models that take none.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]

@@ -1,4 +1,4 @@
-//! Revolute angles taken modulo 2π for the model's coverage (issue 26): a joint whose limits span
+//! Revolute angles taken modulo 2π for the model's coverage: a joint whose limits span
 //! more than a turn reaches the same link positions at `q` and `q ± 2π`, so poses measured one
 //! turn away from the training poses (UR10 series D's joint 1 against C's) are where the model
 //! was fitted once the turn is taken off. Only where the limits allow the other turn, only for a

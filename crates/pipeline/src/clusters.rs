@@ -1,4 +1,4 @@
-//! Configuration clusters (issue 30): the groups of rows that lie on one inverse-kinematic
+//! Configuration clusters: the groups of rows that lie on one inverse-kinematic
 //! branch of the arm (elbow up or down, wrist flipped or not), found from the robot and the data,
 //! not named for one robot. A joint separates branches where the manipulator Jacobian's
 //! determinant changes sign at angles of that joint alone, whatever the other joints are (for a
@@ -12,7 +12,7 @@
 //! A prismatic joint whose values in the data span at least `min_height_span_m` (a lifting
 //! column, a track) splits the rows at its median: the lower and the upper half are clusters of
 //! their own, so that the prior's strength is also chosen by how a fit on one half carries to the
-//! other (issue 30: "a column height").
+//! other: a column's height is a configuration as much as an arm's branch.
 
 use errors::Error;
 use measurements::Measurement;

@@ -57,22 +57,22 @@ pub struct EffectOptions {
     pub gear: effects::GearOptions,
     /// Thermal growth and drift are applied as fitted up to this fraction of their fitted span
     /// of `temp_c` / `t_s` beyond either end; further out the growth is held at that value (a
-    /// function of the temperature) and the drift falls back to zero (issue 30: a drift
+    /// function of the temperature) and the drift falls back to zero (a drift
     /// fitted within a 73-minute session was carried on as a straight line eight days later). 1:
     /// a linear term is trusted as far beyond its data as the data reaches (the simulated warm-up
     /// and drift campaigns of `tests/effects.rs` are tested 0.6 of their span past the training
     /// rows, where the simulated physics is linear); a day later it is held.
     pub hold_beyond_span: f64,
     /// The measuring sessions of the training rows (split by gaps in `t_s`), from which the fit
-    /// chooses whether a drift or a thermal growth is held or zero beyond the span above (issue 30).
+    /// chooses whether a drift or a thermal growth is held or zero beyond the span above.
     pub sessions: SessionOptions,
     /// The payload groups of the training rows, from which the fit chooses whether a term driven
     /// by the payload's load (joint compliance, link deflection) is held, zero or extended beyond
-    /// the payloads it was fitted on (issue 30).
+    /// the payloads it was fitted on.
     pub payloads: PayloadOptions,
     /// Where the posterior σ of the geometry-and-effects model at a row (the tool point's
     /// position) exceeds this multiple of the largest σ over the training rows, the model falls
-    /// back to the geometry fitted alone, fully from twice it (issue 23; `model::EffectUncertainty`).
+    /// back to the geometry fitted alone, fully from twice it (`model::EffectUncertainty`).
     /// Such a row excites a combination of the effects' parameters that no training row did (the
     /// home pose of UR10 series D, fitted on D's even rows: σ 26 mm against at most 0.21 mm on the
     /// training rows, and the effects miss it by 28 mm where the geometry misses by 0.3). The σ
@@ -127,9 +127,9 @@ pub struct FitOptions {
     /// and `force`, which turns their refusals into warnings.
     #[serde(default)]
     pub plausibility: crate::PlausibilityOptions,
-    /// The prior toward the nominal geometry and how its strength is chosen (issue 30).
+    /// The prior toward the nominal geometry and how its strength is chosen.
     pub nominal_prior: crate::NominalPriorOptions,
-    /// How the held-out estimate kept in the model treats repeated configurations (issue 26).
+    /// How the held-out estimate kept in the model treats repeated configurations.
     pub heldout: model::HeldoutOptions,
 }
 
@@ -243,7 +243,7 @@ pub struct SessionOptions {
     /// A gap in `t_s` between rows consecutive in time longer than this many times the median
     /// gap starts a new session. 20: within a session a robot moves to a pose and settles in
     /// seconds to a minute, and pauses for a tool change or a re-sighting of the tracker last a
-    /// few times that (the generator's 30 s per pose; issue 30's campaign, 444 poses in 73
+    /// few times that (the generator's 30 s per pose; a real campaign, 444 poses in 73
     /// minutes, ~10 s apart); a new session starts hours to days later, a thousand times the
     /// spacing and more. Any ratio between the two splits the same way.
     pub gap_ratio: f64,
@@ -279,7 +279,7 @@ pub struct PayloadOptions {
     /// heaviest of two leaves one payload to fit on, and at one payload its share of a joint's
     /// torque is a point mass at the tool, the same columns as the last link's own mass moments
     /// (`loadsim::gravity_regressor`), so the fold's term has not seen the load change while the
-    /// full fit's has; with three the fold keeps two. The issue's own threshold ("several").
+    /// full fit's has; with three the fold keeps two, the fewest that can be called several.
     pub min_groups: usize,
 }
 

@@ -1,13 +1,13 @@
-//! The prior toward the nominal geometry (issues 30 and 45): how strongly the identification holds
+//! The prior toward the nominal geometry: how strongly the identification holds
 //! the links' local transforms at the nominal model (at its fitted base and tool placement).
 //!
 //! Never weaker than the posterior with the nominal's manufacturing tolerance as the prior's
-//! width (issue 45): one plain solve gives the scale of the residual, the tolerance is weighed
+//! width: one plain solve gives the scale of the residual, the tolerance is weighed
 //! against it (the likelihood's noise is what the geometry leaves, not the tracker's alone), so
 //! that directions of the parameter space the training poses determine poorly stay within the
 //! tolerance of the nominal even where the data has one configuration cluster and nothing can be
 //! held out. Where it has several, stronger candidates are chosen by cross-validation that holds
-//! out whole configuration clusters (`clusters.rs`), as in issue 30: a fit on one branch cannot
+//! out whole configuration clusters (`clusters.rs`): a fit on one branch cannot
 //! say how it does on another, and the held-out clusters say how strongly to hold it.
 
 use crate::clusters::{self, BranchJoint, Cluster, HeightSplit, ScanOptions};
@@ -68,9 +68,11 @@ pub struct NominalPriorOptions {
     /// the arm's gravity and lever arms by as much; a track held at one position varies by
     /// micrometres).
     pub min_height_span_m: f64,
-    /// Above this many rows the fit has no prior (the report says so): 20,000. The choice costs an extra fit per candidate and held-out cluster (about 30 on
-    /// a 6-axis arm with four clusters): on issue 31's 242,000-row, 65.7 MB campaign it took the
-    /// fit from 48 s to 265 s and its peak from 253 MB past the 400 MB bound. A campaign of
+    /// Above this many rows the fit has no prior (the report says so): 20,000. The choice costs an extra
+    /// fit per candidate and held-out cluster (about 30 on a 6-axis arm with four clusters): on
+    /// the 242,000-row, 65.7 MB campaign of `cargo xtask hostile --with-memory` it would take the
+    /// fit from under a minute to several and its peak past the 400 MB bound
+    /// (`docs/results/nominal-prior.md`). A campaign of
     /// 20,000 poses is dense over the configurations it will be used in, which is where the prior
     /// matters least; the real campaigns this was measured on have 300–3,000 rows.
     pub max_rows: usize,
@@ -210,7 +212,7 @@ pub struct PriorChoice {
     pub with_effects: Option<EffectsPrior>,
 }
 
-/// The prior toward the nominal geometry in the fit with effects (issue 45). The chosen σ is in
+/// The prior toward the nominal geometry in the fit with effects. The chosen σ is in
 /// the units of the stated noise, weighed against the residual the geometry alone leaves
 /// (`residual_scale`); with the effects identified that residual is smaller (a compliance the
 /// geometry alone left as millimetres is down to the noise), and the same prior width in
@@ -344,7 +346,7 @@ fn heldout(model: &LocalPoe, data: &MeasurementSet, options: &IdentificationOpti
         .collect()
 }
 
-/// Chooses the prior's strength for a fit of `scope` on `data` (issue 30): each candidate of
+/// Chooses the prior's strength for a fit of `scope` on `data`: each candidate of
 /// `prior.translations_m` is fitted with each configuration cluster held out in turn and judged on
 /// it, every row once. The candidate with the lowest mean held-out criterion is the best; the one
 /// chosen is the first listed (the weakest prior, none first) whose mean is within one standard

@@ -1,5 +1,5 @@
 //! The payload groups of the training rows, and what a term driven by the payload's load
-//! (`joint_compliance`, `link_deflection`) is beyond the payloads it was fitted on (issue 30): held
+//! (`joint_compliance`, `link_deflection`) is beyond the payloads it was fitted on: held
 //! at the lightest or heaviest ([`BeyondSpan::Hold`], the kinds' own rule), zero, or extended as
 //! fitted ([`BeyondSpan::Extend`], linear in the load). Chosen by leaving out the lightest and the
 //! heaviest payload group in turn, each then beyond the span of the rest, exactly as a heavier

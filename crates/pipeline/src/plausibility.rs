@@ -1,4 +1,4 @@
-//! Plausibility checks that `fit` runs before it fits anything (issue 31): data in the wrong unit,
+//! Plausibility checks that `fit` runs before it fits anything: data in the wrong unit,
 //! in a mirror-image frame, or with joint angles beyond the robot's limits fit without complaint
 //! (metres under `_mm` columns gave "after: mean 0.0006 mm"), so they are refused here, each with
 //! the numbers that show it. `force` turns the refusals into warnings.

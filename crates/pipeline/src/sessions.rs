@@ -1,6 +1,6 @@
 //! Measuring sessions in the training rows, and what a term driven by time or temperature
 //! (`time_drift`, `thermal`) is beyond the span it was fitted on, chosen by leaving one session out
-//! at a time (issue 30): held at its value at the span's end ([`BeyondSpan::Hold`]) or fallen back
+//! at a time: held at its value at the span's end ([`BeyondSpan::Hold`]) or fallen back
 //! to the geometry ([`BeyondSpan::Zero`]). A robot re-measured days later starts from a placement
 //! of its own: whether the end of the last session or the geometry's average placement is nearer
 //! to it is a property of the cell (a foundation that settles one way, or a tracker re-sighted

@@ -1,4 +1,4 @@
-//! Issue 30: no candidate without meaning on a joint kind. A lifting column carries the weight of
+//! No candidate without meaning on a joint kind. A lifting column carries the weight of
 //! everything above it, so the gravity force along its axis never changes sign: a backlash term
 //! there is `b · sign(F)`, one constant over every pose, a joint offset the geometry already
 //! holds. The diagnosis does not offer it (nor `--effects auto` pick it), while a shoulder whose

@@ -107,7 +107,7 @@ fn too_few_rows_are_refused() {
     assert!(matches!(error.kind(), errors::ErrorKind::TooFewRows { rows: 30, needed: 50, .. }), "{error}");
 }
 
-/// The 7-axis campaign of issue 11: joints 1 and 2 move, the others sit at 0 within 2 mrad;
+/// A real 7-axis campaign's shape: joints 1 and 2 move, the others sit at 0 within 2 mrad;
 /// four payload runs (0, 1.25, 2.5, 5 kg) with the probe remounted for each; full pose; measured
 /// torques. Only joint 2 is compliant.
 #[test]
@@ -172,7 +172,7 @@ fn a_coupling_between_joints_is_unknown_with_the_joints_it_depends_on() {
     }
 }
 
-/// Issue 30: a prismatic joint (a lifting column) is reported in millimetres, gets no series of
+/// A prismatic joint (a lifting column) is reported in millimetres, gets no series of
 /// its "angle", and a fit asked for one refuses, naming the joint; a revolute joint's series on
 /// the same arm is still found.
 #[test]

@@ -131,7 +131,7 @@ fn a_model_with_every_effect_reads_back_and_predicts_the_same() {
     }
 }
 
-/// The 7-axis campaign of issue 11 (joints 1 and 2 moving, the others at 0 within 2 mrad, four
+/// A real 7-axis campaign's shape (joints 1 and 2 moving, the others at 0 within 2 mrad, four
 /// payload runs with a tool each, measured torques), full pose, split even / odd rows.
 fn campaign(effects: &Effects, seed: u64) -> (MeasurementSet, MeasurementSet) {
     let robot = testkit::robot("iiwa7.ron");
@@ -365,7 +365,7 @@ fn a_gear_series_warns_where_it_is_used_outside_the_angles_it_was_fitted_on() {
 }
 
 /// 1,500 poses of the IRB 4400 with the gear error of joint 2 and the tracker's noise (seed 53),
-/// over the whole range of every joint: the tests of issue 23 cut gaps into it.
+/// over the whole range of every joint: the gap tests below cut gaps into it.
 fn joint_2_gear_campaign(seed: u64) -> (RobotDescription, MeasurementSet) {
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
@@ -379,7 +379,7 @@ fn joint_2_gear_campaign(seed: u64) -> (RobotDescription, MeasurementSet) {
     (robot, all)
 }
 
-/// Issue 23: a gear series fitted on poses that leave a 40° gap in joint 2 and stop short of its
+/// A gear series fitted on poses that leave a 40° gap in joint 2 and stop short of its
 /// range is held and faded there, so the corrected model is no worse than the geometry alone in
 /// the gap and past the end (it was 4–5× worse on the real UR10 before), and better where it was
 /// fitted.
@@ -451,7 +451,7 @@ fn a_gear_series_falls_back_to_the_geometry_in_a_gap_and_past_the_end_of_its_ang
     }
 }
 
-/// Issue 23: where the effects fade and the pose falls back to the geometry fitted alone, the GP
+/// Where the effects fade and the pose falls back to the geometry fitted alone, the GP
 /// falls back with it to one conditioned on what the geometry alone leaves (the same
 /// hyperparameters), so that off the effects' angles `poe-gp` with effects is no worse than
 /// `poe-gp` without. A smooth error in joint 3 (covered everywhere) beside joint 2's gear error:
@@ -503,10 +503,10 @@ fn where_the_effects_fade_the_gp_falls_back_with_the_geometry() {
     assert!((read - fitted).abs() <= 1e-9 * fitted, "{read} mm read back against {fitted} mm");
 }
 
-/// Issue 23: the diagnosis's folds see gaps. On poses that leave a 40° gap in joint 2 and stop
+/// The diagnosis's folds see gaps. On poses that leave a 40° gap in joint 2 and stop
 /// short of its range, random folds predict the error of poses like the training ones; the arcs of
 /// joint 2 held out predict what the corrected model does in the gap and past the end: never less
-/// than it, and within 30 % (the issue asks 25 %; seed 53 is 26 % pessimistic).
+/// than it, and within 30 % (the aim is 25 %; seed 53 is 26 % pessimistic).
 #[test]
 fn the_diagnosis_predicts_the_error_in_a_gap_and_past_the_end_from_arcs_of_the_joint_held_out() {
     // Three campaigns (seeds 53, 7, 91; the diagnosis picks order 12 on each, the simulated
@@ -534,7 +534,7 @@ fn the_diagnosis_predicts_the_error_in_a_gap_and_past_the_end_from_arcs_of_the_j
         );
         assert!(!chosen.is_empty(), "seed {seed}: the gear error is found");
         // Random folds promise about a tenth of what the fit gives there; the arcs' prediction is
-        // within 25 % of the fitted error (issue 23).
+        // within 25 % of the fitted error.
         assert!(diagnosis.heldout_after_selected_mm < 0.5 * fitted, "seed {seed}: random folds see the gap now?");
         assert!(
             (joint_2.after_mm - fitted).abs() <= 0.25 * fitted,
@@ -544,7 +544,7 @@ fn the_diagnosis_predicts_the_error_in_a_gap_and_past_the_end_from_arcs_of_the_j
     }
 }
 
-/// Issue 30: a drift fitted within one session was applied as a straight line eight days later.
+/// A drift fitted within one session was applied as a straight line eight days later.
 /// Session 2 repeats session 1's drift from its own start (its placement drifts again from where
 /// it began), recorded eight days later: the drift fitted on session 1 falls back to the geometry
 /// there, so `--effects time_drift` is no worse than without it, where the line was far worse.
@@ -586,7 +586,7 @@ fn a_drift_fitted_in_one_session_is_not_carried_into_another_days_later() {
     assert!(line > 10.0 * alone, "the line carried on: {line} mm");
 }
 
-/// Issue 23, the effects' σ: trained on poses whose elbow follows the shoulder (`|q2 + q3| < 0.15`
+/// The effects' σ: trained on poses whose elbow follows the shoulder (`|q2 + q3| < 0.15`
 /// rad), effects whose regressors depend on the arm's configuration are determined only along that
 /// band. Rows inside every joint's fitted range but off the band (`|q2 + q3| > 0.6`) excite
 /// parameter combinations no training row did: the posterior σ says so, and there the model falls
@@ -714,7 +714,7 @@ fn the_sigmas_columns_are_the_derivatives_of_the_prediction() {
     }
 }
 
-/// Issue 23, order selection that sees gaps: a selected series' order minimises the weighted sum
+/// Order selection that sees gaps: a selected series' order minimises the weighted sum
 /// of its random folds' and its arcs' held-out curves, both reported; with the weight at 0 the
 /// arcs are not computed and the order is the random folds' minimum, as before. Trained with a
 /// 40° gap in joint 2 (seed 53), the random folds alone pick 32 harmonics for a series whose

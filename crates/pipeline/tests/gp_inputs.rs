@@ -1,4 +1,4 @@
-//! Measured signals as inputs of the GP (issue 46, `calib fit --inputs`): learnt beside the
+//! Measured signals as inputs of the GP (`calib fit --inputs`): learnt beside the
 //! joints, kept in the model with their spans, required by name wherever the model is used.
 
 use campaign::{Effects, GeneratorConfig, Perturbation, TrackerNoise, joint_ranges, simulate, simulated_cell};

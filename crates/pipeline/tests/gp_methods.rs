@@ -132,7 +132,7 @@ fn fit_report_gives_the_gp_leave_one_out_error_near_the_held_out_error() {
     }
 }
 
-/// Every training configuration measured twice (issue 26: a third of UR10 series B's rows): a
+/// Every training configuration measured twice (a third of UR10 series B's rows): a
 /// row left out alone keeps its twin, whose value the GP returns, so the per-row leave-one-out
 /// error flatters the model; the model keeps the error with each configuration left out whole,
 /// near what fresh poses measure, and the report gives both.
@@ -173,7 +173,7 @@ fn repeated_configurations_are_left_out_together_in_the_stored_heldout_estimate(
     }
 }
 
-/// Issue 23: where the GP's training rows say nothing of a pose, its correction fades and the
+/// Where the GP's training rows say nothing of a pose, its correction fades and the
 /// model is the geometry it was fitted with, with a σ that counts what it no longer corrects; at
 /// the training poses nothing fades.
 #[test]

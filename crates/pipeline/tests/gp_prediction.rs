@@ -1,4 +1,4 @@
-//! Issue 23: `--effects auto`'s held-out prediction with the GP stage on top. The diagnosis's
+//! `--effects auto`'s held-out prediction with the GP stage on top. The diagnosis's
 //! folds (random rows, and arcs of each moving joint's angles) are used again after the final GP's
 //! hyperparameters are chosen: each fold's GP is conditioned on its training rows' residuals alone.
 
@@ -51,7 +51,7 @@ fn coupled_campaign(seed: u64) -> (RobotDescription, MeasurementSet) {
 
 /// On poses that leave a 40° gap in joint 2 and stop short of its range (the campaign of
 /// `effects.rs`'s gap tests, with a coupling only the GP takes): the prediction with the GP is
-/// within 25 % (issue 23) of what `poe-gp --effects auto` does, on poses like the training poses
+/// within 25 % of what `poe-gp --effects auto` does, on poses like the training poses
 /// (even rows → odd rows, random folds) and in the gap and past the end (joint 2's arcs). Without
 /// the GP the random folds' prediction is far above the fitted error there, so the GP's share is
 /// what is checked; a GP that saw the held-out rows would predict them near its noise.
@@ -63,8 +63,7 @@ fn the_prediction_with_the_gp_meets_the_fitted_error_like_the_training_poses_and
 }
 
 /// The same on the gap tests' other seeds: four more `poe-gp --effects auto` fits of 1,500-row
-/// campaigns, a minute in the debug profile, so `cargo xtask long-tests` runs it and CI does not
-/// (issue 49).
+/// campaigns, a minute in the debug profile, so `cargo xtask long-tests` runs it and CI does not.
 #[test]
 #[ignore = "long (the same property as the test above on two more seeds): cargo xtask long-tests"]
 fn the_prediction_with_the_gp_meets_the_fitted_error_on_more_seeds() {

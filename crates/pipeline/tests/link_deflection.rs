@@ -1,4 +1,4 @@
-//! Link deflection (issue 30) on the column-mounted arm of `column_arm.urdf` (a lifting column of
+//! Link deflection on the column-mounted arm of `column_arm.urdf` (a lifting column of
 //! three stages on one motor, folded into one prismatic joint, and a UR10): the column bends under
 //! the gravity moment of the arm, more the higher it stands. Simulated with the tracker's noise,
 //! the term takes the held-out error down to the noise where the geometry alone cannot, its model

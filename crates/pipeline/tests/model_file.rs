@@ -300,7 +300,7 @@ fn the_robot_a_model_keeps_is_checked_as_a_robot_file_and_against_the_kinematics
     assert_eq!(line, field_line, "{message}");
 }
 
-/// The effects' uncertainty (issue 23) is checked on reading: a factor of the wrong size, a number
+/// The effects' uncertainty is checked on reading: a factor of the wrong size, a number
 /// that is not one, a free parameter the kinematics lacks and a fallback limit that is not above
 /// zero are refused at the field, with its line and column.
 #[test]

@@ -1,4 +1,4 @@
-//! Issue 23: every model `fit` writes, `eval` reads. `calib fit --method poe-gp-load --effects
+//! Every model `fit` writes, `eval` reads. `calib fit --method poe-gp-load --effects
 //! auto` on a 7-axis campaign wrote a model that the check on reading refused (it probed the GP at
 //! every joint at 1 rad, far from the wrist's 2 mrad). Over methods × effects × data shapes, the
 //! model written by `write_model` reads back with `read_model` and predicts the same poses.
@@ -26,7 +26,7 @@ const ROWS: usize = 100;
 fn shapes() -> Vec<Shape> {
     let effects = Effects { tracker_noise: Some(TrackerNoise::default()), ..paper_effects() };
     let iiwa = testkit::robot("iiwa7.ron");
-    // The campaign of the issue: joints 1–2 moving, the others within 2 mrad of 0, four payload
+    // A real 7-axis campaign's shape: joints 1–2 moving, the others within 2 mrad of 0, four payload
     // runs with a tool each, measured torques; full pose and position only.
     let campaign = |full_pose: bool| {
         let config = payload_run_campaign(ROWS, 23);
@@ -58,7 +58,7 @@ const METHODS: [Method; 4] = [Method::BaseTool, Method::Poe, Method::PoeGp, Meth
 
 /// Every pair of shape and method, shape and effects, method and effects, in 12 fits of the 36
 /// (the effects list rotates with shape and method); the first shape's `poe-gp-load --effects
-/// auto` is issue 23's case.
+/// auto` is the fullest model a fit writes.
 #[test]
 fn every_method_shape_and_effects_pair_writes_reads_back_and_predicts_the_same() {
     let dir = tempfile::tempdir().unwrap();
@@ -71,7 +71,7 @@ fn every_method_shape_and_effects_pair_writes_reads_back_and_predicts_the_same()
 }
 
 /// All 36 fits of methods × effects × data shapes: the test above covers each pair of them in a
-/// third of the time, so `cargo xtask long-tests` runs this and CI does not (issue 49).
+/// third of the time, so `cargo xtask long-tests` runs this and CI does not.
 #[test]
 #[ignore = "long (every combination of the pairs the test above covers): cargo xtask long-tests"]
 fn every_model_fit_writes_reads_back_and_predicts_the_same() {
@@ -106,7 +106,7 @@ fn round_trip(shape: &Shape, method: Method, effects: &str, dir: &std::path::Pat
     }
 }
 
-/// The model read from `path`, written again, is the file's bytes (issue 48: quaternions
+/// The model read from `path`, written again, is the file's bytes (quaternions
 /// differed in the last digit).
 fn assert_rewritten_as_read(path: &std::path::Path, read: &model::CalibratedModel, case: &str) {
     let written = std::fs::read_to_string(path).unwrap();
@@ -159,7 +159,8 @@ fn a_model_file_without_a_training_range_still_reads() {
     assert_eq!(again.training_range, None);
 }
 
-/// A `poe-gp-load` model of the issue's campaign with joint compliance, and its file text.
+/// A `poe-gp-load` model of the 7-axis campaign (`shapes()`'s first) with joint compliance, and
+/// its file text.
 fn campaign_model() -> (model::CalibratedModel, String) {
     let shape = shapes().remove(0);
     let options = FitOptions::default().with_effects("joint_compliance".parse().unwrap());

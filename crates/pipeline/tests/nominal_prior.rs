@@ -1,4 +1,4 @@
-//! The prior toward the nominal geometry (issues 30 and 45): fitted on one wrist configuration and
+//! The prior toward the nominal geometry: fitted on one wrist configuration and
 //! evaluated on the flipped one, a calibrated model is no further off than the nominal geometry
 //! (at its fitted base and tool placement), and `eval` says the rows lie outside the fitted range.
 //! The prior is never weaker than the nominal's tolerance against the residual a plain fit leaves.
@@ -39,8 +39,8 @@ fn gear_error() -> PeriodicError {
 fn wrist(seed: u64, count: usize, flipped: bool) -> MeasurementSet {
     let robot = ur10();
     // A well-made arm: 0.1 mm and 0.1 mrad per component, so that the nominal geometry misses
-    // by under a millimetre and the non-geometric error is as large as the geometric one (the
-    // case of issue 30: poe 12.9 mm on the third solution space against the nominal's 10.5).
+    // by under a millimetre and the non-geometric error is as large as the geometric one (where a
+    // fit on one solution space can do worse than the nominal on another).
     let geometry = Perturbation { translation_m: 1e-4, rotation_rad: 1e-4, ..Perturbation::default() };
     let turn = |lower_rad: f64, upper_rad: f64| JointRange { lower_rad, upper_rad };
     let wrist = if flipped { turn(-PI + 0.2, -0.2) } else { turn(0.2, PI - 0.2) };
@@ -182,7 +182,7 @@ fn eval_splits_the_error_at_the_fitted_range_and_names_a_glitch_inside_it() {
 
 /// An arm on a lifting column (seven joints: the column, folded from its URDF mimic stages, and
 /// six revolute ones) has configuration clusters too: the arm's branches from its six revolute
-/// joints, and the column's lower and upper half (issue 30: "a column height"), and a prior.
+/// joints, and the column's lower and upper half, and a prior.
 #[test]
 fn a_column_arms_clusters_are_its_branches_and_the_halves_of_its_column() {
     let robot = testkit::robot("column_arm.urdf");
@@ -208,7 +208,7 @@ fn a_column_arms_clusters_are_its_branches_and_the_halves_of_its_column() {
 }
 
 /// The posterior keeps what the training poses cannot determine at about the nominal's
-/// tolerance, and says so where it matters (issue 45): a 7-axis arm fitted with only joints 1 and
+/// tolerance, and says so where it matters: a 7-axis arm fitted with only joints 1 and
 /// 2 moving (the others within 2 mrad of zero) cannot know its outer links' errors, and on poses
 /// that move every joint `eval` gives, beside the warning, the error the geometry's own
 /// uncertainty predicts there: of the size of the error it makes (a σ of the tolerance against an
@@ -222,7 +222,7 @@ fn outside_the_fitted_joints_eval_gives_the_error_the_geometrys_uncertainty_pred
     let turn = |lower_rad: f64, upper_rad: f64| JointRange { lower_rad, upper_rad };
     let outer = turn(-1.0, 1.0);
     let ranges = [turn(-2.0, 2.0), turn(-1.5, 1.5), outer, outer, outer, outer, outer];
-    // Trained as issue 11's campaign: joints 1 and 2 moving, the others at 0 within 2 mrad.
+    // Trained as a real 7-axis campaign: joints 1 and 2 moving, the others at 0 within 2 mrad.
     let config = GeneratorConfig {
         sample_count: 200,
         seed: 7,

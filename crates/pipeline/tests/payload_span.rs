@@ -1,4 +1,4 @@
-//! Issue 30: a joint compliance fitted on some payloads and used with a heavier one is held at the
+//! A joint compliance fitted on some payloads and used with a heavier one is held at the
 //! heaviest trained payload, falls back to zero, or is extended as fitted, chosen by leaving out
 //! the lightest and the heaviest payload in turn. Simulated: the IRB 4400 under its own weight and
 //! the paper's payloads (1, 2.5, 3.5, 5 and 7.5 kg drawn per pose) through linear joint compliance,

@@ -1,4 +1,4 @@
-//! Issue 30: the effects on a prismatic joint read in its units. A lifting column's backlash is
+//! The effects on a prismatic joint read in its units. A lifting column's backlash is
 //! a half band in mm and its compliance is along the axis under the force, where a revolute
 //! joint's are in rad under a torque; the model file keeps SI units either way.
 

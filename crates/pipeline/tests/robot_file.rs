@@ -230,7 +230,7 @@ fn finite_but_absurd_geometry_is_refused_at_its_field() {
     );
 }
 
-/// Issue 30: a linear axis may state its screw lead; older files without it read as before, and a
+/// A linear axis may state its screw lead; older files without it read as before, and a
 /// lead on a revolute joint or out of bounds is refused at it.
 #[test]
 fn a_screw_pitch_reads_on_a_prismatic_joint_and_is_refused_elsewhere_or_out_of_bounds() {

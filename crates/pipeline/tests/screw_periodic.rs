@@ -1,4 +1,4 @@
-//! Issue 30: a linear axis driven by a ball screw errs periodically in its own position, with the
+//! A linear axis driven by a ball screw errs periodically in its own position, with the
 //! screw's lead as period. Simulated on the column of `column_ur10.ron` (a 10 mm lead, 2.5 m of
 //! lift) with the tracker's noise, `screw_periodic` takes the held-out error to the noise where the
 //! geometry alone cannot, its parameters are reported in mm, its model file reads back, a bad item

@@ -1,4 +1,4 @@
-//! Issue 30: a drift fitted on some measuring sessions and used on a later one is either held at
+//! A drift fitted on some measuring sessions and used on a later one is either held at
 //! the end of its span or falls back to the geometry, chosen by leaving one training session out at
 //! a time. Simulated: four sessions on days 0, 1, 3 and 8, each with the placement drifting from
 //! its own start and an offset of its own; fitted on the first three, evaluated on the fourth.

@@ -1,4 +1,4 @@
-//! The tracker's stated uncertainty of each row (issue 46): read from `std_x_mm` … `std_rz_mrad`,
+//! The tracker's stated uncertainty of each row: read from `std_x_mm` … `std_rz_mrad`,
 //! kept by the writer, weighting the identification, naming a row stated far above the rest, and
 //! setting the diagnosis's noise floor.
 

@@ -1,4 +1,4 @@
-//! A URDF's `<inertial>` masses as the load model's data (issue 30): the same `RobotDynamics` as
+//! A URDF's `<inertial>` masses as the load model's data: the same `RobotDynamics` as
 //! the equivalent RON file, links on fixed joints and mimic stages folded into the joint they ride
 //! on, no mass model where a joint's body states none, and bad values refused at their element.
 

@@ -1,4 +1,4 @@
-//! Mimic joints folded into the joint that drives them (issue 30): the description's forward
+//! Mimic joints folded into the joint that drives them: the description's forward
 //! kinematics equal the URDF chain evaluated joint by joint, every mimic at `multiplier · q +
 //! offset`; chains whose mimic joints do not fold are refused at the `<mimic>` element.
 

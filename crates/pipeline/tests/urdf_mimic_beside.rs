@@ -1,4 +1,4 @@
-//! Mimic stages driven from beside the chain (issue 45): a shipped URDF draws a telescopic column
+//! Mimic stages driven from beside the chain: a shipped URDF draws a telescopic column
 //! as one actuated joint moving a pseudo link, the chain running through mimic stages of it. The
 //! stages fold into one joint whose value is the driver's; the shipped column arm loads, moves as
 //! its URDF joint by joint, equals the same chain folded by hand, fits to the same numbers and

@@ -1,4 +1,4 @@
-//! The expected held-out error of a design when the geometry cannot model everything (issue 26).
+//! The expected held-out error of a design when the geometry cannot model everything.
 //!
 //! The I-optimal design ([`crate::design`]) lowers the parameters' variance under white tracker
 //! noise. On a real robot most of what a geometric fit leaves is not noise but a smooth function

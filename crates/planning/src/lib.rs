@@ -1,4 +1,4 @@
-//! Pose planning (`calib plan`, issue 26): which of many candidate joint configurations to
+//! Pose planning (`calib plan`): which of many candidate joint configurations to
 //! measure, and in which order.
 //!
 //! [`plan()`] makes the identification of `poe`'s local POE model best determined: the

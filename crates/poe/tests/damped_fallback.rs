@@ -1,4 +1,4 @@
-//! Issue 23: on a 7-axis arm whose joints 3–7 barely move (the wrist held within 2 mrad of zero,
+//! On a 7-axis arm whose joints 3–7 barely move (the wrist held within 2 mrad of zero,
 //! positions only) the pseudo-inverse Gauss–Newton direction overshoots along the weakly
 //! determined directions so far that no halving of it lowers the cost, and the fit stopped at
 //! its start after 0 iterations. Damped steps must be tried before giving up.

@@ -179,7 +179,7 @@ fn registration_refuses_too_few_rows() {
     ));
 }
 
-/// Issue 31: one row a metre off among 300 good ones is named and left out, so that the model's
+/// One row a metre off among 300 good ones is named and left out, so that the model's
 /// held-out error stays within 1.2 times that of the fit without it; under plain least squares
 /// the same row spoils the model (the test can fail), and on clean data the robust loss changes
 /// nothing.

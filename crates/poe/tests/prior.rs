@@ -1,4 +1,4 @@
-//! The prior toward a model (issue 30): a strong one holds the links at its centre whatever the
+//! The prior toward a model: a strong one holds the links at its centre whatever the
 //! start, while the base placement and the tools still fit; none at all is the plain
 //! least-squares fit; between them the links move from the one to the other.
 

@@ -1,6 +1,7 @@
 //! `calib._calib`, the native half of the Python package `calib` (sources in `python/calib`, built
-//! by maturin from `python/pyproject.toml`). It calls the same library functions as the `calib`
-//! binary, with the same inputs, so that a number in Python equals the CLI's to the last bit:
+//! by maturin from `python/pyproject.toml`). It runs the flows of the `calib` binary (`calib::flow`,
+//! the library half of the crate `calib`) with the same inputs, so that a number in Python equals
+//! the CLI's to the last bit:
 //! files are read by the same readers, arrays are written as CSV text (Rust's shortest
 //! round-trip form, so every `f64` reads back unchanged) and parsed by the same parser, and
 //! faer runs sequentially as in the binary's `main`.

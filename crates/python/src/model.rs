@@ -1,13 +1,13 @@
-//! `Model` and `fit`: what `calib fit`, `eval`, `predict` and `compensate` do, on the same
-//! pipeline calls in the same order as `crates/calib/src/{fit,eval,predict,compensate}.rs`.
+//! `Model` and `fit`: what `calib fit`, `eval`, `predict` and `compensate` do, through the flows
+//! those commands run (`calib::flow`).
 
 use crate::error::{argument, to_py};
 use crate::robot::Robot;
 use crate::types::{Measurements, Model, matrix};
-use cell::CompensateOptions;
+use calib::flow::{FitOverrides, Refused};
 use effects::EffectSelection;
 use measurements::{BoundSet, Measurement};
-use model::{CalibratedModel, EvalReport, GpChoice, Method, PredictedPose};
+use model::{CalibratedModel, GpChoice, Method};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pipeline::FitOptions;
 use pyo3::prelude::*;
@@ -41,30 +41,25 @@ pub fn fit(
         }
         (None, None) => FitOptions::default(),
     };
-    if let Some(effects) = effects {
-        options.effects.selection = effects.parse::<EffectSelection>().map_err(to_py)?;
-    }
-    if force {
-        options.plausibility.force = true;
-    }
-    if let Some(gp) = gp {
-        options.residual_gp.method = gp.parse::<GpChoice>().map_err(|e| argument("gp", e))?;
-    }
-    // As `calib fit --inputs`: the GP's, so refused for a method without one.
-    if let Some(inputs) = inputs.filter(|i| !i.is_empty()) {
-        if !method.uses_gp() {
-            return Err(argument("inputs", format!("the inputs are the GP's: method {method} has no GP")));
-        }
-        let names = measurements::InputNames::new(inputs, "inputs").map_err(|e| argument("inputs", e))?;
-        options.residual_gp.inputs = names.names().to_vec();
-    }
+    // The flags over the options, as `calib fit` sets them.
+    let overrides = FitOverrides {
+        effects: effects.map(str::parse::<EffectSelection>).transpose().map_err(to_py)?,
+        force,
+        gp: gp.map(str::parse::<GpChoice>).transpose().map_err(|e| argument("gp", e))?,
+        inputs: inputs
+            .filter(|i| !i.is_empty())
+            .map(|i| measurements::InputNames::new(i, "inputs").map(|names| names.names().to_vec()))
+            .transpose()
+            .map_err(|e| argument("inputs", e))?,
+    };
+    overrides.apply(&mut options, method).map_err(|e| argument("inputs", e))?;
     let (robot, data) = (&robot.description, &data.set);
     let ((model, fitted), report) = py
         .detach(|| {
             // The phases timed as `calib fit` times them (its report's `timings`).
             let (fitted, timings) = timings::record(|| {
-                let (fitted, report) = timings::phase("fit", || pipeline::fit(robot, data, method, &options))?;
-                let held = timings::phase("write", || as_its_file_holds(&fitted))?;
+                let (fitted, report, held) =
+                    calib::flow::fit_and_write(robot, data, method, &options, as_its_file_holds)?;
                 Ok::<_, errors::Error>(((held, fitted), report))
             });
             fitted.map(|(models, report)| (models, (report, timings)))
@@ -163,22 +158,9 @@ impl Model {
         py: Python<'py>,
         data: &Measurements,
     ) -> PyResult<(String, Bound<'py, PyArray1<f64>>, Option<Bound<'py, PyArray1<f64>>>, Vec<String>)> {
-        let model = &self.model;
-        // Angles a turn away from the fitted range are taken into it, as `calib eval` does.
-        let (rows, wrapped) = model::wrapped(model, &data.set.rows);
-        let set = &measurements::MeasurementSet { rows, ..data.set.clone() };
-        let (evaluation, report) = py
-            .detach(|| {
-                let bound = model.bind(set)?;
-                let evaluation = model::evaluate(model, &bound)?;
-                let report = EvalReport { wrapped, ..EvalReport::new(model, &bound, &evaluation) };
-                Ok::<_, errors::Error>((evaluation, report))
-            })
-            .map_err(to_py)?;
-        let finite = |e: &model::PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
-        if let Some((row, _)) = set.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
-            return Err(crate::error::CalibError::new_err(non_finite(&self.name, &set.source, row.line)));
-        }
+        let (model, name) = (&self.model, Path::new(&self.name));
+        let evaluated = py.detach(|| calib::flow::evaluate(model, name, data.set.clone())).map_err(refused)?;
+        let (evaluation, report) = (&evaluated.evaluation, &evaluated.report);
         let mut warnings: Vec<String> = report.wrapped.iter().map(ToString::to_string).collect();
         if report.orientations_not_evaluated {
             warnings.push(model::ORIENTATIONS_NOT_EVALUATED.to_owned());
@@ -197,8 +179,7 @@ impl Model {
 
     /// `calib predict` on a measurement set (tools matched by name, as the CLI matches them).
     fn predict_set<'py>(&self, py: Python<'py>, data: &Measurements) -> PyResult<Predicted<'py>> {
-        let (rows, wrapped) = model::wrapped(&self.model, &data.set.rows);
-        let set = measurements::MeasurementSet { rows, ..data.set.clone() };
+        let (set, wrapped) = calib::flow::wrapped(&self.model, data.set.clone());
         let bound = self.model.bind(&set).map_err(to_py)?;
         self.predict_rows(py, &bound, &wrapped)
     }
@@ -329,17 +310,16 @@ impl Model {
         };
         let model = &self.model;
         let robot_ref = robot.map(|r| (&r.description, r.path.as_str()));
-        let (file, solved, summary, csv) = py
+        let (compensated, csv) = py
             .detach(|| {
-                let file = cell::read_targets(&targets, model, columns)?;
-                let (solved, summary) =
-                    cell::compensate(model, &file, robot_ref, frame, &CompensateOptions::default())?;
+                let compensated = calib::flow::compensate(model, &targets, columns, robot_ref, frame)?;
                 let mut csv = Vec::new();
-                cell::write_compensated(&mut csv, &file, &solved)
+                cell::write_compensated(&mut csv, &compensated.file, &compensated.solved)
                     .map_err(|source| errors::Error::io("the compensated targets", source))?;
-                Ok::<_, errors::Error>((file, solved, summary, csv))
+                Ok::<_, errors::Error>((compensated, csv))
             })
             .map_err(to_py)?;
+        let calib::flow::CompensatedTargets { solved, summary, warnings, .. } = compensated;
         let n = model.joint_count();
         let q: Vec<Vec<f64>> =
             solved.iter().map(|s| if s.status.is_ok() { s.q.clone() } else { vec![f64::NAN; n] }).collect();
@@ -347,9 +327,6 @@ impl Model {
         let residual_mrad =
             PyArray1::from_vec(py, solved.iter().map(|s| s.residual_rad.map_or(f64::NAN, |r| r * 1e3)).collect());
         let status = solved.iter().map(|s| s.status.to_string()).collect();
-        let mut warnings: Vec<String> = model.extrapolation(&file.set.rows).iter().map(ToString::to_string).collect();
-        warnings.extend(model.outside_training_range(&file.set.rows).iter().map(ToString::to_string));
-        warnings.extend(model.beyond_joint_limits(&file.set.rows).iter().map(ToString::to_string));
         let summary = serde_json::to_string(&summary).map_err(|e| argument("summary", e))?;
         let csv = String::from_utf8_lossy(&csv).into_owned();
         Ok((csv, matrix(py, q, n)?, residual_mm, residual_mrad, status, summary, warnings))
@@ -377,26 +354,10 @@ impl Model {
         data: &BoundSet<'_>,
         wrapped: &[model::WrappedJoint],
     ) -> PyResult<Predicted<'py>> {
-        let (model, rows, source) = (&self.model, data.rows(), data.set().source.as_str());
-        let (predictions, warnings) = py
-            .detach(|| {
-                let predictions = model.predict(data)?;
-                let mut warnings: Vec<String> = wrapped.iter().map(ToString::to_string).collect();
-                warnings.extend(model.extrapolation(rows).iter().map(ToString::to_string));
-                warnings.extend(model.outside_training_range(rows).iter().map(ToString::to_string));
-                warnings.extend(model.beyond_joint_limits(rows).iter().map(ToString::to_string));
-                warnings.extend(model.sigma_fallback(data)?.iter().map(ToString::to_string));
-                warnings.extend(model.gp_fade(rows)?.iter().map(ToString::to_string));
-                Ok::<_, errors::Error>((predictions, warnings))
-            })
-            .map_err(to_py)?;
-        let finite = |p: &PredictedPose| {
-            let pose = p.pose;
-            pose.translation().iter().chain(pose.rotation().matrix().iter()).all(|v| v.is_finite())
-        };
-        if let Some(row) = rows.iter().zip(&predictions).find_map(|(row, p)| (!finite(p)).then_some(row)) {
-            return Err(crate::error::CalibError::new_err(non_finite(&self.name, source, row.line)));
-        }
+        let (model, name) = (&self.model, Path::new(&self.name));
+        let predicted = py.detach(|| calib::flow::predict(model, name, data, wrapped)).map_err(refused)?;
+        let (predictions, mut warnings) = (predicted.poses, predicted.notes);
+        warnings.extend(predicted.warnings);
         let full = model.full_pose;
         let width = if full { 7 } else { 3 };
         let mut poses = Vec::with_capacity(predictions.len() * width);
@@ -421,10 +382,10 @@ impl Model {
     }
 }
 
-/// The refusal of a model that predicts a non-finite pose (the CLI's words).
-fn non_finite(model: &str, data: &str, line: u64) -> String {
-    format!(
-        "{}: the model predicts a non-finite pose for line {line} of {data}: a value in the model file is beyond any real range",
-        Path::new(model).display()
-    )
+/// A refusal of `eval` or `predict` as a Python exception.
+fn refused(refused: Refused) -> PyErr {
+    match refused {
+        Refused::Error(error) => to_py(error),
+        Refused::NonFinite(message) => crate::error::CalibError::new_err(message),
+    }
 }

@@ -1,4 +1,4 @@
-//! The calibration report (issue 27): typed data in ([`Report`], gathered by [`Report::build`]
+//! The calibration report: typed data in ([`Report`], gathered by [`Report::build`]
 //! from a calibrated model, its robot and measurements), one self-contained HTML page out
 //! ([`render_html`]: inline CSS and SVG, no script, readable offline and printable). The
 //! diagnosis's figures and report folder ([`diagnosis_figures`], [`write_diagnosis_report`]) are

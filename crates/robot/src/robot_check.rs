@@ -76,7 +76,7 @@ const SAME_LINE_TOLERANCE: [f64; 2] = [1e-9, 1e-9];
 /// The first pair of consecutive joints whose motions are one: two revolute joints about the same
 /// line, or two prismatic joints along the same direction. No joint between them moves one off
 /// the other, so their columns of the identification Jacobian are equal at every pose and their
-/// values cannot be told apart (issue 31: "the singularity threshold is too strict"). 1-based.
+/// values cannot be told apart, at any singularity threshold. 1-based.
 pub(crate) fn repeated_axis(robot: &RobotDescription) -> Option<(usize, usize)> {
     use crate::description::JointType;
     use lie::Vector3;

@@ -162,7 +162,7 @@ fn static_torque_adds_the_balancer_on_its_joint_only() {
 }
 
 /// On a prismatic joint the generalised force of gravity is a force along the axis (N, from the
-/// spatial twist `(v, 0)`), what a linear axis's compliance and backlash act under (issue 30): a
+/// spatial twist `(v, 0)`), what a linear axis's compliance and backlash act under: a
 /// tilted track carrying a two-joint arm, against the finite-difference gradient of `V` and the
 /// regressor, with a payload off the tool.
 #[test]

@@ -1,4 +1,4 @@
-//! A Gaussian prior on the kinematic parameters about a given model (issue 30): the
+//! A Gaussian prior on the kinematic parameters about a given model: the
 //! identification becomes a maximum a posteriori fit that keeps what the data determines only
 //! weakly at that model (the nominal geometry at its fitted base and tool placement), instead of
 //! letting noise and non-geometric effects move it. Unlike `IdentificationOptions`'

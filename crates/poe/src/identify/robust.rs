@@ -1,4 +1,4 @@
-//! The identification's robust loss (issue 31): one row a metre off among hundreds of good ones
+//! The identification's robust loss: one row a metre off among hundreds of good ones
 //! must neither spoil the model nor pass without a word.
 //!
 //! Each row's residual is measured by its norm, per kind (the tool point's distance in metres,

@@ -168,7 +168,7 @@ pub fn posterior_covariance(
         correction: correction.map(|(c, _)| c),
         options,
         row_weights: Vec::new(),
-        // Unweighted by the stated per-row noise (issue 46's weights): not yet carried here.
+        // Unweighted by the rows' stated standard deviations: not yet carried here.
         noise: Vec::new(),
         prior: Some(prior),
     };

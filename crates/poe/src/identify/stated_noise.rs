@@ -1,4 +1,4 @@
-//! The instrument's own uncertainty of each observation (issue 46): a laser tracker states a
+//! The instrument's own uncertainty of each observation: a laser tracker states a
 //! standard deviation for every point it measures. An observation's residual is more than its
 //! measurement noise: the model's own error (what the geometry cannot explain, the GP's share)
 //! scatters every row alike. Each residual component is therefore weighted by

@@ -86,7 +86,7 @@ impl fmt::Display for Termination {
 mod tests {
     use super::Termination;
 
-    /// Issue 15: a failed line search once set `converged = true`. Every way to stop says in
+    /// A failed line search is no convergence. Every way to stop says in
     /// words what `converged()` says, and only the three criteria count as convergence.
     #[test]
     fn only_a_met_criterion_is_convergence_and_the_words_say_so() {
