@@ -175,7 +175,7 @@ fn the_diagnosis_folder_keeps_its_file_names() {
     let figures = report::diagnosis_figures(&diagnosis).unwrap();
     let names: Vec<&str> = figures.iter().map(|(n, _)| n.as_str()).collect();
     // The names the diagnosis's markdown links, one per moving joint and per varying condition.
-    assert_eq!(names, ["joint1.svg", "joint2.svg", "payload.svg"]);
+    assert_eq!(names, ["joint1.svg", "joint2.svg", "payload.svg", "temperature.svg", "time.svg"]);
     assert!(figures.iter().all(|(_, svg)| svg.starts_with("<svg")));
     assert!(!r.diagnosis_plot_names.is_empty());
 }
