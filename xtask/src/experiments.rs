@@ -21,6 +21,7 @@ pub mod bench_identify;
 pub mod bench_memory;
 pub mod box_plot;
 pub mod cell_check;
+pub mod chart;
 pub mod compensate_check;
 pub mod convert_ur10;
 pub mod inputs_check;

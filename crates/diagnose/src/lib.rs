@@ -32,7 +32,6 @@
 
 mod arcs;
 mod candidates;
-pub mod chart;
 mod design;
 mod error_kind;
 mod fold_residuals;
@@ -45,7 +44,6 @@ mod report;
 mod selection;
 mod statistics;
 mod structure;
-mod svg;
 mod verdict;
 
 pub use arcs::ArcCheck;
@@ -56,7 +54,7 @@ pub use noise::{NoiseFloor, NoiseSource};
 pub use outliers::{GrossOutliers, OutlierOptions};
 pub use pool::PriorOptions;
 pub use regions::{PoseDiagnosis, Region};
-pub use report::{CandidateScore, DominantHarmonic, OrderScore, SelectedEffect, SeriesShape};
+pub use report::{CandidateScore, DominantHarmonic, ErrorPlot, OrderScore, SelectedEffect, SeriesShape};
 pub use selection::SelectionOptions;
 pub use structure::{GpInput, StructureOptions};
 pub use verdict::{GpCheck, InputScale, Verdict, VerdictOptions};

@@ -1,13 +1,30 @@
 //! The diagnosis as people read it: a ten-second summary, a markdown report with plots written
 //! into a folder, and the SPEC's JSON (the [`Diagnosis`] itself, serialised as it is).
 
+use super::Diagnosis;
 use super::candidates::Effect;
 use super::noise::NoiseSource;
 use super::regions::{PoseDiagnosis, Region};
-use super::{Diagnosis, svg};
 use crate::ErrorKind;
 use errors::Error;
 use serde::{Deserialize, Serialize};
+
+/// One of the diagnosis's scatter plots: the held-out position error of every pose under the
+/// geometric model and with the selected effects, against one quantity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ErrorPlot {
+    /// The file it is written to in the report folder (`joint2.svg`, `payload.svg`, …), which the
+    /// markdown links to.
+    pub file_name: String,
+    /// The plot's title.
+    pub title: String,
+    /// The x axis's name with its unit.
+    pub x_label: String,
+    /// `(x, error in mm)` per pose under the geometric model.
+    pub before_mm: Vec<(f64, f64)>,
+    /// `(x, error in mm)` per pose with the selected effects.
+    pub after_mm: Vec<(f64, f64)>,
+}
 
 /// One candidate tried alone on top of the geometric model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -246,60 +263,49 @@ impl Diagnosis {
         out
     }
 
-    /// The plots, as `(file name, SVG text)`: held-out error against each moving joint, the
-    /// payload, the temperature and the time, before and after.
-    pub fn plots(&self) -> Vec<(String, String)> {
-        let mut plots = Vec::new();
-        let series = |key: &dyn Fn(&PoseDiagnosis) -> f64| -> Vec<svg::Series> {
-            vec![
-                svg::Series {
-                    name: "geometric model".into(),
-                    colour: "#9a9a9a",
-                    points: self.poses.iter().map(|p| (key(p), p.before_error_mm())).collect(),
-                },
-                svg::Series {
-                    name: "with the selected effects".into(),
-                    colour: "#1f6fb4",
-                    points: self.poses.iter().map(|p| (key(p), p.after_error_mm())).collect(),
-                },
-            ]
+    /// The plots, in the order the markdown shows them: held-out error against each moving joint,
+    /// the payload, the temperature and the time (the last three where they vary), before and
+    /// after. Data only: `report::diagnosis_figures` draws them.
+    pub fn error_plots(&self) -> Vec<ErrorPlot> {
+        let plot = |file_name: String, title: String, x_label: String, key: &dyn Fn(&PoseDiagnosis) -> f64| ErrorPlot {
+            file_name,
+            title,
+            x_label,
+            before_mm: self.poses.iter().map(|p| (key(p), p.before_error_mm())).collect(),
+            after_mm: self.poses.iter().map(|p| (key(p), p.after_error_mm())).collect(),
         };
+        let mut plots = Vec::new();
         for &joint in &self.moving_joints {
             let j = joint - 1;
             let title = format!("Held-out error against joint {joint}");
-            let svg = if self.prismatic_joints.contains(&joint) {
-                svg::scatter(&title, &format!("joint {joint} (mm)"), "error (mm)", &series(&|p| p.q[j] * 1e3))
+            let file_name = format!("joint{joint}.svg");
+            plots.push(if self.prismatic_joints.contains(&joint) {
+                plot(file_name, title, format!("joint {joint} (mm)"), &|p| p.q[j] * 1e3)
             } else {
-                svg::scatter(&title, &format!("joint {joint} (deg)"), "error (mm)", &series(&|p| p.q[j].to_degrees()))
-            };
-            plots.push((format!("joint{joint}.svg"), svg));
+                plot(file_name, title, format!("joint {joint} (deg)"), &|p| p.q[j].to_degrees())
+            });
         }
         let varies = |key: &dyn Fn(&PoseDiagnosis) -> Option<f64>| {
             let values: Vec<f64> = self.poses.iter().filter_map(key).collect();
             values.len() == self.poses.len() && values.iter().any(|v| *v != values[0])
         };
         if varies(&|p| Some(p.payload_kg)) {
-            let s = series(&|p| p.payload_kg);
-            plots.push((
-                "payload.svg".into(),
-                svg::scatter("Held-out error against payload", "payload (kg)", "error (mm)", &s),
-            ));
+            let title = "Held-out error against payload".into();
+            plots.push(plot("payload.svg".into(), title, "payload (kg)".into(), &|p| p.payload_kg));
         }
         if varies(&|p| p.temp_c) {
-            let s = series(&|p| p.temp_c.unwrap_or(0.0));
-            plots.push((
-                "temperature.svg".into(),
-                svg::scatter("Held-out error against temperature", "temperature (°C)", "error (mm)", &s),
-            ));
+            let title = "Held-out error against temperature".into();
+            let x_label = "temperature (°C)".into();
+            plots.push(plot("temperature.svg".into(), title, x_label, &|p| p.temp_c.unwrap_or(0.0)));
         }
         if varies(&|p| p.t_s) {
-            let s = series(&|p| p.t_s.unwrap_or(0.0) / 3600.0);
-            plots.push(("time.svg".into(), svg::scatter("Held-out error against time", "time (h)", "error (mm)", &s)));
+            let title = "Held-out error against time".into();
+            plots.push(plot("time.svg".into(), title, "time (h)".into(), &|p| p.t_s.unwrap_or(0.0) / 3600.0));
         }
         plots
     }
 
-    /// The markdown report; `plots` are the file names of [`Diagnosis::plots`], relative to it.
+    /// The markdown report; `plots` are the file names of [`Diagnosis::error_plots`], relative to it.
     pub fn markdown(&self, plots: &[String]) -> String {
         let mut out = format!("# Diagnosis: {}\n\n```\n{}```\n\n", self.robot, self.summary());
         out.push_str("## Which effect\n\nEvery candidate alone on top of the geometric model, cross-validated ");

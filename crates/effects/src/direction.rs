@@ -71,7 +71,7 @@ impl<'a> RowTwists<'a> {
                     let columns =
                         loadsim::thermal_regressor(self.model, self.q, self.tool, 1.0).map_err(Error::load)?;
                     // Column 0 grows the tracker-to-base distance, which is not a robot link.
-                    self.growth = Some(columns.iter().skip(1).map(|c| c.twist).sum());
+                    self.growth = Some(columns.iter().skip(1).copied().sum());
                 }
                 Ok(self.growth.unwrap_or_else(Vector6::zeros))
             }

@@ -1,5 +1,5 @@
 //! Drift: the robot's placement in the tracker frame moves at a constant twist rate, `exp(t ξ̂) T`
-//! (`loadsim::TimeDriftModel`, `loadsim::drift_regressor`): six parameters, `(v, ω)`.
+//! (`loadsim::TimeDriftModel`): six parameters, `(v, ω)`.
 
 use super::{Regressor, check_column_varies, rms_scales};
 use crate::check::{Cursor, EffectFault};

@@ -32,7 +32,7 @@ pub struct ExactGp {
     pub(crate) y: Mat<f64>,
     pub(crate) components: Vec<Component>,
     pub(crate) parallelism: Parallelism,
-    pub(crate) report: FitReport,
+    pub(crate) report: ExactFitReport,
 }
 
 /// One kernel with its factorisation and the outputs it serves.
@@ -48,9 +48,9 @@ pub(crate) struct Component {
     pub(crate) alpha: Mat<f64>,
 }
 
-/// What the fit did, per kernel.
+/// What the exact GP's fit did, per kernel (the sparse GP's: [`crate::SparseFitReport`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct FitReport {
+pub struct ExactFitReport {
     /// One entry per kernel: one per output ([`OutputMode::Independent`]) or one for all
     /// ([`OutputMode::Shared`]).
     pub components: Vec<ComponentReport>,
@@ -513,12 +513,12 @@ impl ExactGp {
             y: yn,
             components,
             parallelism: config.parallelism,
-            report: FitReport { components: reports },
+            report: ExactFitReport { components: reports },
         })
     }
 
     /// What the fit did: hyperparameters, likelihoods, jitter and search per kernel.
-    pub fn report(&self) -> &FitReport {
+    pub fn report(&self) -> &ExactFitReport {
         &self.report
     }
 
@@ -662,7 +662,7 @@ struct StoredExactGp {
     /// Normalised training outputs, one row per point.
     training_outputs: Vec<Vec<f64>>,
     parallelism: Parallelism,
-    report: FitReport,
+    report: ExactFitReport,
 }
 
 impl From<ExactGp> for StoredExactGp {

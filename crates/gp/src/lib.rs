@@ -52,7 +52,7 @@ pub use config::{GpConfig, JitterConfig, OptimiserConfig, OutputMode, Parallelis
 pub use dense::FactorOptions;
 pub use elbo::sparse_evidence_lower_bound;
 pub use error::Error;
-pub use exact::{AdditiveChoice, ComponentReport, ExactGp, FitReport, IsotropicChoice};
+pub use exact::{AdditiveChoice, ComponentReport, ExactFitReport, ExactGp, IsotropicChoice};
 pub use fixed_folds::FoldTargets;
 pub use inducing::InducingSelection;
 pub use kernel::{

@@ -76,7 +76,7 @@ impl SimulatedEffect for BacklashModel {
     fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
         let n = cell.robot.joint_count();
         BacklashModel::validate(self, n)?;
-        cell.dynamics_for("backlash")?.validate(n)
+        Ok(cell.dynamics_for("backlash")?.validate(n)?)
     }
 
     fn needs_dynamics(&self) -> DynamicsNeed {

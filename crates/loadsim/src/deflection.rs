@@ -172,7 +172,7 @@ impl SimulatedEffect for LinkDeflectionModel {
     fn validate(&self, cell: &SimulatedCell) -> Result<(), Error> {
         let n = cell.robot.joint_count();
         LinkDeflectionModel::validate(self, n)?;
-        cell.dynamics_for("link deflection")?.validate(n)
+        Ok(cell.dynamics_for("link deflection")?.validate(n)?)
     }
 
     fn needs_dynamics(&self) -> DynamicsNeed {

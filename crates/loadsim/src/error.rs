@@ -95,6 +95,21 @@ impl From<poe::Error> for Error {
     }
 }
 
+impl From<dynamics::Error> for Error {
+    fn from(error: dynamics::Error) -> Self {
+        match error {
+            dynamics::Error::LengthMismatch { field, given, expected } => {
+                Error::LengthMismatch { field, given, expected }
+            }
+            dynamics::Error::UnknownJoint { field, joint_index, joint_count } => {
+                Error::UnknownJoint { field, joint_index, joint_count }
+            }
+            dynamics::Error::InvalidParameter { field, value } => Error::InvalidParameter { field, value },
+            dynamics::Error::MissingStiffness { effect } => Error::MissingStiffness { effect },
+        }
+    }
+}
+
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -164,5 +179,18 @@ mod tests {
         let error = Error::UnknownJoint { field: "backlash", joint_index: usize::MAX, joint_count: 6 };
         assert_eq!(error.to_string(), format!("backlash names joint {} but the robot has 6 joints", usize::MAX));
         assert!(Error::SelfCoupling { joint_index: usize::MAX }.to_string().contains(&usize::MAX.to_string()));
+    }
+
+    #[test]
+    fn a_refusal_of_the_robots_dynamics_reads_the_same_through_loadsim() {
+        let refusals = [
+            dynamics::Error::LengthMismatch { field: "links", given: 5, expected: 6 },
+            dynamics::Error::UnknownJoint { field: "counterbalance", joint_index: 6, joint_count: 6 },
+            dynamics::Error::InvalidParameter { field: "links.mass_kg", value: -1.0 },
+            dynamics::Error::MissingStiffness { effect: "joint compliance" },
+        ];
+        for refusal in refusals {
+            assert_eq!(Error::from(refusal.clone()).to_string(), refusal.to_string());
+        }
     }
 }

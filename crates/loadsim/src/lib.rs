@@ -6,10 +6,11 @@
 //! tool each).
 //!
 //! Every effect is a forward model with named parameters, usable alone or combined through
-//! [`Effects`], and each has a *regressor*: the effect written as linear in its parameters
-//! ([`compliance_regressor`], [`backlash_regressor`], [`periodic_regressor`],
-//! [`thermal_regressor`], [`drift_regressor`], and [`gravity_regressor`] for the gravity torque
-//! without known masses), for `calib diagnose`.
+//! [`Effects`]. The pieces of them that the `effects` crate's regressors are built on are here
+//! too, written as linear in their parameters: [`backlash_joint_regressor`],
+//! [`periodic_joint_regressor`], [`thermal_regressor`], and [`gravity_regressor`] for the gravity
+//! torque without known masses. The robot's masses, stiffness and balancer ([`RobotDynamics`]) are
+//! the `dynamics` crate's, re-exported here.
 //!
 //! Conventions: SI units; twists `(v, ω)`; pose errors are left perturbations
 //! `log(T' T⁻¹)^∨`; gravity torque `τ = −∂V/∂q` (the generalised force of gravity, so a joint
@@ -42,11 +43,9 @@ mod backlash;
 mod base_tilt;
 mod cell;
 mod compliance;
-mod counterbalance;
 mod coupling;
 mod deflection;
 mod drift;
-mod dynamics;
 mod effects;
 mod error;
 mod generator;
@@ -54,7 +53,6 @@ mod gravity;
 mod gravity_regressor;
 mod kinds;
 mod periodic;
-mod regressor;
 mod screw;
 mod simulated;
 mod singularity;
@@ -66,14 +64,14 @@ pub use backlash::{BacklashModel, JointBacklash, backlash_joint_regressor};
 pub use base_tilt::BaseTilt;
 pub use cell::{PoseContext, SimulatedCell};
 pub use compliance::{JointComplianceModel, MAX_FIXED_POINT_ITERATIONS, compliance_deflection, spring_torque};
-pub use counterbalance::Counterbalance;
 pub use coupling::{CouplingFactor, CouplingModel, CouplingTerm};
 pub use deflection::{
     BentLink, LinkBend, LinkDeflectionModel, MAX_FLEXIBILITY_PER_NM2, link_bend, link_deflection_features,
     moment_beyond,
 };
 pub use drift::{MAX_DRIFT_PER_S, TimeDriftModel};
-pub use dynamics::{FLOOR_GRAVITY_M_PER_S2, LinkInertia, RobotDynamics, tilted_base_gravity};
+// The robot's dynamics as robot files state them: their own crate, so that `robot` needs no simulator.
+pub use dynamics::{Counterbalance, FLOOR_GRAVITY_M_PER_S2, LinkInertia, RobotDynamics, tilted_base_gravity};
 pub use effects::{Effects, JointOffsets};
 pub use error::Error;
 pub use generator::{
@@ -86,15 +84,11 @@ pub use gravity::{
 pub use gravity_regressor::gravity_regressor;
 pub use kinds::EffectKind;
 pub use periodic::{GearPeriodicModel, Harmonic, periodic_joint_regressor};
-pub use regressor::{
-    EffectParameter, RegressorColumn, backlash_regressor, compliance_regressor, drift_regressor, periodic_regressor,
-    thermal_regressor,
-};
 pub use screw::{MAX_SCREW_ERROR_M, ScrewHarmonic, ScrewPeriodicModel};
 pub use simulated::{
     DynamicsNeed, EntryFault, MAX_JOINT_ERROR_RAD, MAX_ORDER, PoseInput, RobotFacts, SimulatedEffect, beyond, short,
 };
 pub use singularity::{smallest_singular_value, smallest_singular_value_of_joints, tool_point_jacobian};
-pub use thermal::{MAX_EXPANSION_PER_K, MAX_TEMPERATURE_C, ThermalModel};
+pub use thermal::{MAX_EXPANSION_PER_K, MAX_TEMPERATURE_C, ThermalModel, thermal_regressor};
 pub use torque_sensor::TorqueSensorNoise;
 pub use tracker_noise::{MAX_NOISE, TrackerNoiseModel};

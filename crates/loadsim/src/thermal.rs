@@ -10,7 +10,7 @@
 
 use crate::Error;
 use crate::{EntryFault, PoseContext, RobotFacts, SimulatedCell, SimulatedEffect, beyond};
-use lie::SE3;
+use lie::{SE3, Vector3, Vector6};
 use poe::LocalPoe;
 use serde::{Deserialize, Serialize};
 
@@ -110,4 +110,24 @@ impl SimulatedEffect for ThermalModel {
     fn grown_model(&self, model: &LocalPoe, context: &PoseContext) -> Result<Option<LocalPoe>, Error> {
         self.grown_model(model, context.temp_c).map(Some)
     }
+}
+
+/// The pose change per unit of each expansion coefficient, one per constant transform (n joints,
+/// then the tool): growing transform `i` by the strain `α_i ΔT` moves the pose by
+/// `α_i ΔT (R_{i-1}(q) t_i, 0)` exactly (module doc), a left-perturbation twist `(v, ω)` in the
+/// model's reference frame. With a tracker-frame model, entry 0 grows the tracker-to-base
+/// distance, which is not a robot link: leave it out there.
+pub fn thermal_regressor(model: &LocalPoe, q: &[f64], tool: usize, delta_t_k: f64) -> Result<Vec<Vector6>, Error> {
+    model.forward(q, tool)?;
+    let frames = model.frames(q)?;
+    let before = std::iter::once(SE3::identity()).chain(frames.iter().copied());
+    let transforms =
+        model.joints().iter().map(|j| j.previous_from_joint_zero).chain(std::iter::once(model.tools()[tool]));
+    Ok(before
+        .zip(transforms)
+        .map(|(frame, local)| {
+            let v: Vector3 = frame.rotation().act(&local.translation()) * delta_t_k;
+            Vector6::new(v.x, v.y, v.z, 0.0, 0.0, 0.0)
+        })
+        .collect())
 }

@@ -429,7 +429,7 @@ impl GpModel {
 #[serde(rename_all = "snake_case")]
 pub enum GpFitReport {
     /// The exact GP's report.
-    Exact(gp::FitReport),
+    Exact(gp::ExactFitReport),
     /// The sparse GP's report.
     Sparse(gp::SparseFitReport),
 }

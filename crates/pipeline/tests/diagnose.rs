@@ -88,8 +88,7 @@ fn a_report_has_a_plot_per_joint_and_the_tables() {
         ..DiagnoseOptions::default()
     };
     let d = diagnose(&blind(&robot), &data, &options).unwrap();
-    let plots = d.plots();
-    let names: Vec<String> = plots.iter().map(|(n, _)| n.clone()).collect();
+    let names: Vec<String> = d.error_plots().into_iter().map(|plot| plot.file_name).collect();
     for j in 1..=6 {
         assert!(names.contains(&format!("joint{j}.svg")), "{names:?}");
     }

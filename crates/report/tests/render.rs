@@ -42,7 +42,7 @@ fn rendered() -> &'static Rendered {
         options.effects.selection = EffectSelection::List(vec![EffectSpec::gear_periodic(2, 2)]);
         let (model, _) = pipeline::fit(&robot, &train, Method::PoeGp, &options).unwrap();
         let diagnosis = diagnose(&robot, &train, &DiagnoseOptions::default()).unwrap();
-        let diagnosis_plot_names = diagnosis.plots().into_iter().map(|(name, _)| name).collect();
+        let diagnosis_plot_names = diagnosis.error_plots().into_iter().map(|plot| plot.file_name).collect();
         let inputs = report::ReportInputs {
             model: &model,
             model_file: "model.ron",
@@ -172,9 +172,11 @@ fn the_diagnosis_folder_keeps_its_file_names() {
     let cell = campaign_cell(&robot, &Perturbation::default(), &Remount::default(), &config).unwrap();
     let train = simulate(&cell, &campaign::paper_effects(), &joint_ranges(&robot), &config, false).unwrap();
     let diagnosis = diagnose(&robot, &train, &DiagnoseOptions::default()).unwrap();
-    let ours: Vec<String> = report::diagnosis_figures(&diagnosis).unwrap().into_iter().map(|(n, _)| n).collect();
-    let theirs: Vec<String> = diagnosis.plots().into_iter().map(|(n, _)| n).collect();
-    assert_eq!(ours, theirs);
+    let figures = report::diagnosis_figures(&diagnosis).unwrap();
+    let names: Vec<&str> = figures.iter().map(|(n, _)| n.as_str()).collect();
+    // The names the diagnosis's markdown links, one per moving joint and per varying condition.
+    assert_eq!(names, ["joint1.svg", "joint2.svg", "payload.svg", "temperature.svg", "time.svg"]);
+    assert!(figures.iter().all(|(_, svg)| svg.starts_with("<svg")));
     assert!(!r.diagnosis_plot_names.is_empty());
 }
 

@@ -128,7 +128,7 @@ pub struct RobotDescription {
     /// Link masses, centres of mass and joint stiffness, for the load model (a URDF's `<inertial>`
     /// masses, without stiffness, where every joint carries one).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub dynamics: Option<loadsim::RobotDynamics>,
+    pub dynamics: Option<dynamics::RobotDynamics>,
     /// The joints that fold a URDF's mimic joints into their actuated joint (empty for a RON file).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub folded: Vec<FoldedJoint>,

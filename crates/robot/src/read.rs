@@ -30,7 +30,7 @@ struct RobotFile {
     #[serde(default)]
     tool: Option<[f64; 3]>,
     #[serde(default)]
-    dynamics: Option<loadsim::RobotDynamics>,
+    dynamics: Option<dynamics::RobotDynamics>,
 }
 
 impl RobotFile {

@@ -49,16 +49,16 @@ pub(crate) fn check_values(robot: &RobotDescription, text: &str, file: &str) -> 
     if let Some(balancer) = &dynamics.counterbalance
         && let Err(error) = balancer.validate(robot.joint_count())
     {
-        // loadsim names the field as `counterbalance.<name>`; the file writes `<name>:`.
+        // dynamics names the field as `counterbalance.<name>`; the file writes `<name>:`.
         let (field, message) = match &error {
-            loadsim::Error::InvalidParameter { field, value } if !value.is_finite() => {
+            dynamics::Error::InvalidParameter { field, value } if !value.is_finite() => {
                 let name = field.rsplit('.').next().unwrap_or(field);
                 return Err(not_finite(name, 0, format!("counterbalance.{name}"), *value));
             }
-            loadsim::Error::InvalidParameter { field, .. } => {
+            dynamics::Error::InvalidParameter { field, .. } => {
                 (field.rsplit('.').next().unwrap_or("counterbalance"), error.to_string())
             }
-            loadsim::Error::UnknownJoint { .. } => ("joint_index", error.to_string()),
+            dynamics::Error::UnknownJoint { .. } => ("joint_index", error.to_string()),
             _ => ("counterbalance", error.to_string()),
         };
         // The radii-difference check names no single field: point at the first radius.

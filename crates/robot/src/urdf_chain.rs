@@ -47,7 +47,7 @@ pub struct UrdfChain {
     pub joints: Vec<ChainJoint>,
     /// The links' masses as the load model's data (no stiffness: a URDF has none), where every
     /// joint's body has an `<inertial>`.
-    pub dynamics: Option<loadsim::RobotDynamics>,
+    pub dynamics: Option<dynamics::RobotDynamics>,
     /// The joints (1-based) whose body has no `<inertial>`, for which no mass model is made.
     pub joints_without_mass: Vec<usize>,
 }

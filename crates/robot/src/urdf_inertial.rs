@@ -1,4 +1,4 @@
-//! A URDF's masses as the load model's data (`loadsim::RobotDynamics`): each link's `<inertial>`,
+//! A URDF's masses as the load model's data (`dynamics::RobotDynamics`): each link's `<inertial>`,
 //! its `<mass value>` and the `xyz` of its `<origin>` (the centre of mass in the link's frame; the
 //! `rpy` turns only the inertia tensor, which the load model does not use).
 //!
@@ -115,7 +115,7 @@ fn triple(text: &str) -> Option<[f64; 3]> {
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum ChainMasses {
     /// Every joint's body has a mass.
-    Known(loadsim::RobotDynamics),
+    Known(dynamics::RobotDynamics),
     /// These joints' bodies have no `<inertial>`: no mass model.
     Missing(Vec<usize>),
 }
@@ -176,13 +176,13 @@ pub(crate) fn chain_masses(
         .map(|&(mass_kg, moment, centres, count)| {
             // Massless links all: the centre is never weighed; their plain mean keeps it finite.
             let com = if mass_kg > 0.0 { moment / mass_kg } else { centres / count as f64 };
-            loadsim::LinkInertia { mass_kg, com_m: com.into() }
+            dynamics::LinkInertia { mass_kg, com_m: com.into() }
         })
         .collect();
-    Ok(ChainMasses::Known(loadsim::RobotDynamics {
+    Ok(ChainMasses::Known(dynamics::RobotDynamics {
         links,
         stiffness_nm_per_rad: Vec::new(),
         counterbalance: None,
-        gravity_m_per_s2: loadsim::FLOOR_GRAVITY_M_PER_S2,
+        gravity_m_per_s2: dynamics::FLOOR_GRAVITY_M_PER_S2,
     }))
 }

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use diagnose::chart::{Canvas, escape};
+use crate::experiments::chart::{Canvas, escape};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::bench_gp_residuals::{heldout_mm, residuals};

@@ -1,10 +1,10 @@
 //! A hand-written SVG box plot (the paper's Fig. 1 kind): one box per group, Tukey whiskers,
 //! outliers as circles, every value drawn as a dot beside its box.
 //!
-//! Drawn on the frame `diagnose::chart` shares with the diagnosis's plots (hand-written SVG; see
-//! there for why not `plotters`).
+//! Drawn on the experiments' shared frame, `chart.rs` (hand-written SVG; see there for why not
+//! `plotters`).
 
-use diagnose::chart::{Canvas, escape, linear_ticks};
+use crate::experiments::chart::{Canvas, escape, linear_ticks};
 use std::fmt::Write;
 
 /// One box: its label under the axis and the values it summarises.

@@ -1,4 +1,4 @@
-//! Properties of the load model, the effects, their regressors and the dataset generator.
+//! Properties of the load model, the effects, their linearisations and the dataset generator.
 // Joint-indexed loops read like the formulas they check.
 #![allow(clippy::needless_range_loop)]
 

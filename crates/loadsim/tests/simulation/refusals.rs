@@ -91,10 +91,10 @@ fn a_balancer_whose_spring_can_reach_zero_length_is_refused() {
         force_at_zero_n: 0.0,
         stiffness_n_per_m: 1e4,
     };
-    assert!(matches!(balancer.validate(6), Err(Error::InvalidParameter { .. })));
+    assert!(matches!(balancer.validate(6).map_err(Error::from), Err(Error::InvalidParameter { .. })));
     let elsewhere = Counterbalance { joint_index: 6, anchor_radius_m: 0.3, ..balancer };
     assert_eq!(
-        elsewhere.validate(6),
+        elsewhere.validate(6).map_err(Error::from),
         Err(Error::UnknownJoint { field: "counterbalance", joint_index: 6, joint_count: 6 })
     );
 }

@@ -1,19 +1,24 @@
-//! Each effect's regressor against its forward model: the pose error the forward model produces
-//! is, to first order (exactly for thermal growth and drift), the regressor columns times the
-//! parameters.
+//! Each effect's forward model against its linearisation: the pose error the forward model
+//! produces is, to first order (exactly for thermal growth and drift), the sum over the joints of
+//! each joint's spatial twist `S_j(q)` times its joint-space offset (Lynch & Park, *Modern
+//! Robotics*, §5.1.1), or the thermal columns times the coefficients.
 
 use crate::robot::{irb4400, pose_error, random_q, with_tool};
 use lie::{SE3, SO3, Twist, Vector3, Vector6};
 use loadsim::{
-    BacklashModel, Effects, GearPeriodicModel, Harmonic, JointComplianceModel, Payload, PoseContext, RegressorColumn,
-    RobotDynamics, SimulatedCell, ThermalModel, TimeDriftModel, backlash_regressor, compliance_regressor,
-    drift_regressor, periodic_regressor, static_torque, thermal_regressor,
+    BacklashModel, Effects, GearPeriodicModel, Harmonic, JointComplianceModel, Payload, PoseContext, RobotDynamics,
+    SimulatedCell, ThermalModel, TimeDriftModel, backlash_joint_regressor, periodic_joint_regressor, static_torque,
+    thermal_regressor,
 };
+use poe::LocalPoe;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-fn combine(columns: &[RegressorColumn], parameters: &[f64]) -> Vector6 {
-    columns.iter().zip(parameters).fold(Vector6::zeros(), |sum, (c, p)| sum + c.twist * *p)
+/// `Σ_j S_j(q) δq_j`: the first-order pose error of the joint offsets `dq`.
+fn joint_offsets_twist(model: &LocalPoe, q: &[f64], dq: &[f64]) -> Vector6 {
+    let twists = model.spatial_twists(q).unwrap();
+    assert_eq!(twists.len(), dq.len());
+    twists.iter().zip(dq).fold(Vector6::zeros(), |sum, (s, d)| sum + s.to_vector() * *d)
 }
 
 /// Forward-model pose error of `effects` against the plain geometric model, base frame.
@@ -30,7 +35,7 @@ fn stiff(dynamics: &RobotDynamics, factor: f64) -> RobotDynamics {
 }
 
 #[test]
-fn compliance_regressor_predicts_the_compliance_pose_error() {
+fn the_compliance_pose_error_is_its_joint_offsets_to_first_order() {
     let robot = irb4400();
     let model = with_tool(&robot.model, 0.2);
     // 100× stiffer than the fixture so that the second-order remainder is 1e-5 of the effect.
@@ -42,16 +47,15 @@ fn compliance_regressor_predicts_the_compliance_pose_error() {
         let q = random_q(&robot.ranges, &mut rng);
         let context = PoseContext { payload: Payload::at_tool(rng.random_range(0.0..60.0)), ..PoseContext::default() };
         let torque = static_torque(&model, &dynamics, &q, 0, &context.payload).unwrap();
-        let columns = compliance_regressor(&model, &q, &torque).unwrap();
-        let c: Vec<f64> = dynamics.stiffness_nm_per_rad.iter().map(|k| 1.0 / k).collect();
-        let predicted = combine(&columns, &c);
+        let dq: Vec<f64> = dynamics.stiffness_nm_per_rad.iter().zip(&torque).map(|(k, t)| t / k).collect();
+        let predicted = joint_offsets_twist(&model, &q, &dq);
         let actual = forward_error(&cell, &effects, &q, &context);
         assert!((predicted - actual).norm() < 1e-3 * actual.norm(), "{predicted:?} vs {actual:?}");
     }
 }
 
 #[test]
-fn backlash_regressor_predicts_the_backlash_pose_error() {
+fn the_backlash_pose_error_is_its_joint_offsets_to_first_order() {
     let robot = irb4400();
     let cell = SimulatedCell::new(robot.model.clone(), Some(robot.dynamics.clone()));
     let half_bands = [3e-6, 5e-6, 4e-6, 8e-6, 6e-6, 7e-6];
@@ -68,14 +72,16 @@ fn backlash_regressor_predicts_the_backlash_pose_error() {
         let q = random_q(&robot.ranges, &mut rng);
         let context = PoseContext::default();
         let torque = static_torque(&robot.model, &robot.dynamics, &q, 0, &context.payload).unwrap();
-        let predicted = combine(&backlash_regressor(&robot.model, &q, &torque).unwrap(), &half_bands);
+        let signs = backlash_joint_regressor(&torque);
+        let dq: Vec<f64> = signs.iter().zip(&half_bands).map(|(s, b)| s * b).collect();
+        let predicted = joint_offsets_twist(&robot.model, &q, &dq);
         let actual = forward_error(&cell, &effects, &q, &context);
         assert!((predicted - actual).norm() < 1e-3 * actual.norm(), "{predicted:?} vs {actual:?}");
     }
 }
 
 #[test]
-fn periodic_regressor_predicts_the_gear_error_pose_error_per_harmonic() {
+fn the_gear_error_pose_error_is_its_joint_offsets_to_first_order() {
     let robot = irb4400();
     let cell = SimulatedCell::new(robot.model.clone(), None);
     let harmonics = vec![
@@ -87,11 +93,13 @@ fn periodic_regressor_predicts_the_gear_error_pose_error_per_harmonic() {
     let mut rng = ChaCha8Rng::seed_from_u64(22);
     for _ in 0..20 {
         let q = random_q(&robot.ranges, &mut rng);
-        let mut predicted = Vector6::zeros();
+        let mut dq = vec![0.0; q.len()];
         for h in &harmonics {
-            let columns = periodic_regressor(&robot.model, &q, h.joint_index, h.order).unwrap();
-            predicted += combine(&columns, &h.cos_sin_coefficients());
+            let [c, s] = periodic_joint_regressor(q[h.joint_index], h.order);
+            let [a, b] = h.cos_sin_coefficients();
+            dq[h.joint_index] += a * c + b * s;
         }
+        let predicted = joint_offsets_twist(&robot.model, &q, &dq);
         let actual = forward_error(&cell, &effects, &q, &PoseContext::default());
         assert!((predicted - actual).norm() < 1e-3 * actual.norm(), "{predicted:?} vs {actual:?}");
     }
@@ -111,7 +119,7 @@ fn thermal_regressor_is_exact_per_link() {
         let context = PoseContext { temp_c: rng.random_range(5.0..40.0), ..PoseContext::default() };
         let columns = thermal_regressor(&model, &q, 0, context.temp_c - 20.0).unwrap();
         assert_eq!(columns.len(), 7);
-        let predicted = combine(&columns, &alphas);
+        let predicted = columns.iter().zip(&alphas).fold(Vector6::zeros(), |sum, (c, a)| sum + c * *a);
         // Exactly linear: the pose error is a pure translation and the log of a pure translation
         // is that translation.
         let actual = forward_error(&cell, &effects, &q, &context);
@@ -120,7 +128,7 @@ fn thermal_regressor_is_exact_per_link() {
 }
 
 #[test]
-fn drift_regressor_is_exact_in_the_tracker_frame() {
+fn drift_is_the_twist_rate_times_the_time_exactly_in_the_tracker_frame() {
     let robot = irb4400();
     let mut cell = SimulatedCell::new(robot.model.clone(), None);
     cell.tracker_from_base = SE3::new(SO3::from_rpy(0.1, -0.2, 2.5), Vector3::new(3.0, -1.0, 0.4));
@@ -128,7 +136,7 @@ fn drift_regressor_is_exact_in_the_tracker_frame() {
     let effects = Effects { drift: Some(drift), ..Effects::default() };
     let q = [0.2, 0.3, -0.1, 0.5, 0.6, -0.7];
     for t_s in [0.0, 600.0, 7200.0, 36000.0] {
-        let predicted = combine(&drift_regressor(t_s), &drift.twist_per_s);
+        let predicted = Vector6::from(drift.twist_per_s) * t_s;
         let actual = forward_error(&cell, &effects, &q, &PoseContext { t_s, ..PoseContext::default() });
         assert!((predicted - actual).norm() < 1e-12, "t {t_s}: {predicted:?} vs {actual:?}");
         assert!((Twist::from_vector(&predicted).exp().to_matrix() - drift.motion_at(t_s).to_matrix()).norm() < 1e-15);
@@ -136,18 +144,6 @@ fn drift_regressor_is_exact_in_the_tracker_frame() {
 }
 
 #[test]
-fn joint_regressors_scale_with_the_spatial_twist_of_their_joint() {
-    // A regressor column of joint j is parallel to the joint's spatial twist.
-    let robot = irb4400();
-    let q = [0.2, 0.3, -0.1, 0.5, 0.6, -0.7];
-    let twists = robot.model.spatial_twists(&q).unwrap();
-    let torque = [1.0, -2.0, 3.0, -4.0, 5.0, -6.0];
-    for (j, column) in compliance_regressor(&robot.model, &q, &torque).unwrap().iter().enumerate() {
-        assert!((column.twist - twists[j].to_vector() * torque[j]).norm() < 1e-15);
-    }
-    for (j, column) in backlash_regressor(&robot.model, &q, &torque).unwrap().iter().enumerate() {
-        assert!((column.twist - twists[j].to_vector() * torque[j].signum()).norm() < 1e-15);
-    }
-    let zero = backlash_regressor(&robot.model, &q, &[0.0; 6]).unwrap();
-    assert!(zero.iter().all(|c| c.twist == Vector6::zeros()), "no torque, no side of the play");
+fn backlash_takes_no_side_where_the_joint_carries_no_torque() {
+    assert_eq!(backlash_joint_regressor(&[2.0, -0.5, 0.0, -0.0]), vec![1.0, -1.0, 0.0, 0.0]);
 }

@@ -99,7 +99,7 @@ impl RobotDynamics {
 
     /// The stacked inertial parameters `π = (m_1, m_1 c_1, …, m_n, m_n c_n)` (4 per link, `c_k` at
     /// the zero configuration in the base frame), so that the links' gravity torque is
-    /// `Y(q) · π` with `Y` from [`crate::gravity_regressor`].
+    /// `Y(q) · π` with `Y` from `loadsim::gravity_regressor`.
     pub fn inertial_parameters(&self) -> DVector<f64> {
         DVector::from_iterator(
             4 * self.links.len(),

@@ -1,6 +1,7 @@
-//! The frame every chart of ours shares, as SVG text: the canvas with its title, grid lines with
-//! tick labels, the plot area's border and the axis label. The diagnosis's scatter plots and the
-//! experiments' box plots draw their marks inside it.
+//! The frame the experiments' charts share, as SVG text: the canvas with its title, grid lines
+//! with tick labels, the plot area's border and the axis label. The box plots and the GP sweep's
+//! plots draw their marks inside it. (The calibration report's and the diagnosis's charts are
+//! `report`'s, drawn with `plotters`.)
 //!
 //! Hand-written rather than through `plotters`: its text layout needs a system font library
 //! (font-kit / fontconfig) that a clean CI machine may lack, and these charts need no more than
