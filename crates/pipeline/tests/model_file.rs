@@ -295,9 +295,9 @@ fn gp_training_data_that_overflow_its_weights_are_refused() {
 #[test]
 fn a_file_that_calls_the_residual_gp_compensation_reads_as_the_same_model() {
     let (model, text) = fitted(false);
-    assert!(model.residual_gp.is_some() && text.contains("\n    residual_gp: ("), "{text}");
+    assert!(model.residual_gp.is_some() && text.contains("\n    residual_gp: Some(("), "{text}");
     assert!(!text.contains("compensation"), "the old name is written again");
-    let old = text.replacen("\n    residual_gp: (", "\n    compensation: (", 1);
+    let old = text.replacen("\n    residual_gp: Some((", "\n    compensation: Some((", 1);
     let read = model::parse_model(&old, "old.ron").unwrap();
     assert_eq!(text_of(&read), text);
     let (_, message) = refused(&old.replacen("with_payload: true", "with_payload: false", 1));
