@@ -128,5 +128,3 @@ impl std::error::Error for CommonKind {
         }
     }
 }
-
-impl crate::Kind for CommonKind {}

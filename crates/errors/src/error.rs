@@ -10,6 +10,9 @@ use std::fmt;
 /// place, its `source()` the error it wraps, if any.
 pub trait Kind: std::error::Error + Send + Sync + 'static {}
 
+// Here rather than beside `CommonKind`, so that the modules do not import each other.
+impl Kind for CommonKind {}
+
 /// What went wrong ([`kind`](Error::kind)) and where ([`place`](Error::place)): its message is the
 /// place's `file:line:column: ` (or `file: `) followed by the kind's.
 ///
