@@ -70,10 +70,10 @@ impl BacklashTerm {
     /// The torque of the joint at one row, whose sign is the feature.
     pub fn torque(&self, row: &Measurement, tool: usize) -> Result<f64, Error> {
         let j = self.joint;
-        let missing = Error::new(ErrorKind::EffectJoint { joint: j + 1, joint_count: row.q.len() });
+        let missing = || Error::new(ErrorKind::EffectJoint { joint: j + 1, joint_count: row.q.len() });
         match &self.sign {
             TorqueSign::Measured => match &row.torques_nm {
-                Some(tau) => tau.get(j).copied().ok_or(missing),
+                Some(tau) => tau.get(j).copied().ok_or_else(missing),
                 None => Err(Error::new(ErrorKind::EffectNeedsColumn {
                     line: row.line,
                     effect: "backlash",
@@ -84,11 +84,11 @@ impl BacklashTerm {
                 let payload = Payload::at_tool(row.payload_kg);
                 let torque =
                     loadsim::static_torque(&load.base_model, dynamics, &row.q, tool, &payload).map_err(Error::load)?;
-                torque.get(j).copied().ok_or(missing)
+                torque.get(j).copied().ok_or_else(missing)
             }
             TorqueSign::Learnt { load, columns, coefficients } => {
                 let regressors = load.regressors(row, tool)?;
-                let row = regressors.get(j).ok_or(missing)?;
+                let row = regressors.get(j).ok_or_else(missing)?;
                 Ok(columns.iter().zip(coefficients).map(|(&c, k)| row.get(c).copied().unwrap_or(0.0) * k).sum())
             }
         }

@@ -57,7 +57,7 @@ impl<'a> RowTwists<'a> {
                 spatial
                     .get(j)
                     .map(Twist::to_vector)
-                    .ok_or(Error::new(ErrorKind::EffectJoint { joint: j + 1, joint_count }))
+                    .ok_or_else(|| Error::new(ErrorKind::EffectJoint { joint: j + 1, joint_count }))
             }
             Direction::Component(k) => {
                 let mut twist = Vector6::zeros();

@@ -302,7 +302,7 @@ impl Regressor for GearPeriodicTerm {
         let q = *row
             .q
             .get(self.joint)
-            .ok_or(Error::new(ErrorKind::EffectJoint { joint: self.joint + 1, joint_count: row.q.len() }))?;
+            .ok_or_else(|| Error::new(ErrorKind::EffectJoint { joint: self.joint + 1, joint_count: row.q.len() }))?;
         Ok(self.features_at(q))
     }
 

@@ -56,7 +56,7 @@ impl TorqueFit {
         for (row, tool) in data.iter() {
             let all = load.regressors(row, tool)?;
             regressors.push(all.get(joint).cloned().unwrap_or_default());
-            let tau = row.torques_nm.as_ref().and_then(|t| t.get(joint)).copied().ok_or(Error::new(
+            let tau = row.torques_nm.as_ref().and_then(|t| t.get(joint)).copied().ok_or_else(|| Error::new(
                 ErrorKind::EffectNeedsColumn { line: row.line, effect: "joint_compliance", column: "tau1_nm" },
             ))?;
             measured.push(tau);
@@ -204,7 +204,7 @@ impl Regressor for JointComplianceTerm {
                     .get(t.joint)
                     .and_then(|r| r.get(t.column))
                     .copied()
-                    .ok_or(Error::new(ErrorKind::EffectJoint { joint: t.joint + 1, joint_count: torques.len() }))?;
+                    .ok_or_else(|| Error::new(ErrorKind::EffectJoint { joint: t.joint + 1, joint_count: torques.len() }))?;
                 Ok(value / t.scale)
             })
             .collect()

@@ -75,7 +75,7 @@ impl ScrewPeriodicTerm {
         row.q
             .get(joint)
             .copied()
-            .ok_or(Error::new(ErrorKind::EffectJoint { joint: joint + 1, joint_count: row.q.len() }))
+            .ok_or_else(|| Error::new(ErrorKind::EffectJoint { joint: joint + 1, joint_count: row.q.len() }))
     }
 }
 

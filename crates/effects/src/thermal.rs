@@ -39,7 +39,7 @@ impl ThermalTerm {
         let temps: Vec<f64> = rows
             .iter()
             .map(|r| {
-                r.temp_c.ok_or(Error::new(ErrorKind::EffectNeedsColumn {
+                r.temp_c.ok_or_else(|| Error::new(ErrorKind::EffectNeedsColumn {
                     line: r.line,
                     effect: "thermal",
                     column: "temp_c",
@@ -65,7 +65,7 @@ impl Regressor for ThermalTerm {
     }
 
     fn features(&self, row: &Measurement, _tool: usize) -> Result<Vec<f64>, Error> {
-        let t = row.temp_c.ok_or(Error::new(ErrorKind::EffectNeedsColumn {
+        let t = row.temp_c.ok_or_else(|| Error::new(ErrorKind::EffectNeedsColumn {
             line: row.line,
             effect: "thermal",
             column: "temp_c",

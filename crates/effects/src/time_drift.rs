@@ -40,7 +40,7 @@ impl TimeDriftTerm {
         let times: Vec<f64> = rows
             .iter()
             .map(|r| {
-                r.t_s.ok_or(Error::new(ErrorKind::EffectNeedsColumn {
+                r.t_s.ok_or_else(|| Error::new(ErrorKind::EffectNeedsColumn {
                     line: r.line,
                     effect: "time_drift",
                     column: "t_s",
@@ -66,7 +66,7 @@ impl Regressor for TimeDriftTerm {
     }
 
     fn features(&self, row: &Measurement, _tool: usize) -> Result<Vec<f64>, Error> {
-        let t = row.t_s.ok_or(Error::new(ErrorKind::EffectNeedsColumn {
+        let t = row.t_s.ok_or_else(|| Error::new(ErrorKind::EffectNeedsColumn {
             line: row.line,
             effect: "time_drift",
             column: "t_s",

@@ -31,9 +31,7 @@ pub(crate) fn factor_in_place(mut a: Mat<f64>, par: Par) -> Result<Mat<f64>, usi
     let n = a.nrows();
     cholesky_lower_in_place(a.as_mut(), &FactorOptions::default(), par)?;
     for j in 1..n {
-        for i in 0..j {
-            a[(i, j)] = 0.0;
-        }
+        a.col_mut(j).subrows_mut(0, j).fill(0.0);
     }
     Ok(a)
 }
@@ -85,9 +83,7 @@ impl Factor {
             if !(l[(j, j)] > 0.0 && l[(j, j)].is_finite()) || (j..n).any(|i| !l[(i, j)].is_finite()) {
                 return Err(j);
             }
-            for i in 0..j {
-                l[(i, j)] = 0.0;
-            }
+            l.col_mut(j).subrows_mut(0, j).fill(0.0);
         }
         Ok(Self { l })
     }

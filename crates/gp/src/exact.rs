@@ -490,7 +490,10 @@ impl ExactGp {
         let xs = inputs.apply_points(&raw);
         let yn = outputs.normalise(y);
         let [groups, followers] = output_groups(&how, config, m)?;
-        let fits = GroupFits { xs: &xs, yn: &yn, config, how: &how };
+        // A group per pool thread or more: one thread per group, as nested parallelism only adds synchronisation.
+        let busy = config.parallelism == Parallelism::Rayon && groups.len() >= rayon::current_num_threads();
+        let one_thread = GpConfig { parallelism: Parallelism::Sequential, ..config.clone() };
+        let fits = GroupFits { xs: &xs, yn: &yn, config: if busy { &one_thread } else { config }, how: &how };
         let fit_group = |(g, cols): (usize, &Vec<usize>)| fits.with_isotropic(fits.fit_searched(g, cols)?, cols);
         let fitted: Vec<_> = match config.parallelism {
             Parallelism::Sequential => groups.iter().enumerate().map(fit_group).collect(),
@@ -499,7 +502,7 @@ impl ExactGp {
         let mut fitted = fitted.into_iter().collect::<Result<Vec<_>, _>>()?;
         // Each follower group from the fitted kernel that explains it best, refined on all rows.
         let leaders: Vec<Kernel> = fitted.iter().map(|(_, r)| r.kernel.clone()).collect();
-        let follow = |cols: &Vec<usize>| fits.follow(&leaders, cols);
+        let follow = |cols: &Vec<usize>| GroupFits { config, ..fits }.follow(&leaders, cols);
         let followed: Vec<_> = match config.parallelism {
             Parallelism::Sequential => followers.iter().map(follow).collect(),
             Parallelism::Rayon => followers.par_iter().map(follow).collect(),

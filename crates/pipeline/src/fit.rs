@@ -291,6 +291,7 @@ pub fn fit(
     let mut auto = None;
     let specs = effect_specs(&inputs, &mut auto)?;
     let (identification, effects) = if specs.is_empty() {
+        geometry_alone_uncertainty(&inputs, &geometry, &mut model)?;
         (geometry.report, EffectsFit::default())
     } else {
         let on = EffectsBasis { scope, registered: &geometry.registered, prior: &mut geometry.prior };
@@ -426,7 +427,7 @@ fn fit_geometry_alone(inputs: &Inputs<'_>, method: Method, scope: Scope) -> Resu
     let GeometricFit { model: kinematics, registered, report } = timings::phase("identification", || {
         fit_geometry_with_prior(&nominal, data, scope, prior_sigmas, &options.identification)
     })?;
-    let mut model = CalibratedModel {
+    let model = CalibratedModel {
         schema_version: SCHEMA_VERSION,
         robot: robot.name.clone(),
         method,
@@ -444,26 +445,34 @@ fn fit_geometry_alone(inputs: &Inputs<'_>, method: Method, scope: Scope) -> Resu
         fit_warnings: Some(Vec::new()),
         robot_description: Some(robot.clone()),
     };
-    // The geometry's own uncertainty: its posterior under the nominal's tolerance, whatever
-    // strength the held-out clusters chose for the fit (a stronger one says how to fit, not how
-    // far the geometry may be off where the data does not reach). Without a prior the directions
-    // no training pose sees have no variance, and a σ would say nothing.
-    if let Some(widths) = nominal_prior.as_ref().and_then(crate::PriorChoice::posterior) {
+    Ok((model, Geometry { registered, report, prior: nominal_prior }))
+}
+
+/// The geometry's own uncertainty: its posterior under the nominal's tolerance, whatever
+/// strength the held-out clusters chose for the fit (a stronger one says how to fit, not how
+/// far the geometry may be off where the data does not reach). Without a prior the directions
+/// no training pose sees have no variance, and a σ would say nothing.
+fn geometry_alone_uncertainty(
+    inputs: &Inputs<'_>,
+    geometry: &Geometry,
+    model: &mut CalibratedModel,
+) -> Result<(), Error> {
+    if let Some(widths) = geometry.prior.as_ref().and_then(crate::PriorChoice::posterior) {
         let mask = ParameterMask::all(model.kinematics.layout());
         model.geometry_uncertainty = timings::phase("geometry uncertainty", || {
             geometry_uncertainty(
                 &model.kinematics,
-                &registered,
+                &geometry.registered,
                 widths,
                 &mask,
                 None,
-                data,
+                inputs.data,
                 inputs.bound,
-                &options.identification,
+                &inputs.options.identification,
             )
         })?;
     }
-    Ok((model, Geometry { registered, report, prior: nominal_prior }))
+    Ok(())
 }
 
 /// Where the effects' fit starts from: the geometry fitted alone.
