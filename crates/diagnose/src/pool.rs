@@ -17,8 +17,9 @@ use super::statistics::mean;
 use crate::ErrorKind;
 use errors::Error;
 use faer::linalg::matmul::matmul;
+use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
-use faer::{Accum, Mat, Par, Side};
+use faer::{Accum, Mat, MatRef, Par, Side};
 use lie::Vector6;
 use poe::LocalPoe;
 use rayon::prelude::*;
@@ -159,6 +160,33 @@ impl Factor {
     }
 }
 
+/// `xᵀ x`: its lower triangle multiplied, then mirrored. The product's SIMD kernels keep one
+/// accumulator per entry and add a column pair's products in row order whatever the tile, the
+/// triangle or the matrix's width, and `a·b = b·a` exactly; so the mirror is bit for bit the upper
+/// triangle a full product would give, and an entry is the same in any pool over the same rows
+/// that holds both its columns (test `a_gram_entry_does_not_depend_on_the_other_columns`).
+fn gram(x: MatRef<'_, f64>) -> Mat<f64> {
+    let n = x.ncols();
+    let mut g = Mat::<f64>::zeros(n, n);
+    triangular::matmul(
+        g.as_mut(),
+        BlockStructure::TriangularLower,
+        Accum::Replace,
+        x.transpose(),
+        BlockStructure::Rectangular,
+        x,
+        BlockStructure::Rectangular,
+        1.0,
+        Par::Seq,
+    );
+    for j in 0..n {
+        for i in j + 1..n {
+            g[(j, i)] = g[(i, j)];
+        }
+    }
+    g
+}
+
 /// The prior precision of an effect parameter whose weighted column is `column`: `1/sd²`, or
 /// [`PriorOptions::effect_m`] of RMS tool displacement.
 fn effect_precision(column: &[f64], sd: Option<f64>, k: usize, w: f64, prior: &PriorOptions) -> f64 {
@@ -245,8 +273,7 @@ impl Pool {
                 }
                 let yf: Vec<f64> = rows_f.iter().map(|&r| design.y[r]).collect();
                 let ym = Mat::<f64>::from_fn(rows_f.len(), 1, |r, _| yf[r]);
-                let mut g = Mat::<f64>::zeros(columns, columns);
-                matmul(g.as_mut(), Accum::Replace, xf.transpose(), xf.as_ref(), 1.0, Par::Seq);
+                let g = gram(xf.as_ref());
                 let mut b = Mat::<f64>::zeros(columns, 1);
                 matmul(b.as_mut(), Accum::Replace, xf.transpose(), ym.as_ref(), 1.0, Par::Seq);
                 (xf, yf, g, (0..columns).map(|c| b[(c, 0)]).collect::<Vec<f64>>())
@@ -689,6 +716,30 @@ mod tests {
         let t = m / (sd / (d.len() as f64).sqrt());
         assert!(t < selection.critical_z, "t = {t}");
         assert!(selection.steps[0].z > selection.critical_z);
+    }
+
+    #[test]
+    fn a_gram_entry_does_not_depend_on_the_other_columns() {
+        // 701 rows: more than one block of the product's depth; widths that leave partial tiles.
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let x = Mat::<f64>::from_fn(701, 45, |_, _| normal(&mut rng));
+        let mut full = Mat::<f64>::zeros(45, 45);
+        matmul(full.as_mut(), Accum::Replace, x.transpose(), x.as_ref(), 1.0, Par::Seq);
+        let g = gram(x.as_ref());
+        let bits = |m: &Mat<f64>, i: usize, j: usize| m[(i, j)].to_bits();
+        for i in 0..45 {
+            for j in 0..45 {
+                assert_eq!(bits(&g, i, j), bits(&full, i, j), "({i}, {j}) against the full product");
+            }
+        }
+        // A subset of the columns, in order: the same entries, whatever tiles they now fall in.
+        let subset: Vec<usize> = (0..45).filter(|c| c % 3 != 1 || *c > 40).collect();
+        let sub = gram(Mat::<f64>::from_fn(701, subset.len(), |r, c| x[(r, subset[c])]).as_ref());
+        for (i, &a) in subset.iter().enumerate() {
+            for (j, &b) in subset.iter().enumerate() {
+                assert_eq!(bits(&sub, i, j), bits(&g, a, b), "columns ({a}, {b}) in the subset");
+            }
+        }
     }
 
     #[test]
