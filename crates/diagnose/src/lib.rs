@@ -426,15 +426,7 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
     let pooled = Pooled::new(robot, &nominal, &geometry, bound, options)?;
     let (pool, terms) = (&pooled.pool, &pooled.terms);
     let mut selection = timings::phase("selection", || selection::select(pool, terms, &options.selection))?;
-    let arc_inputs = arcs::ArcInputs {
-        design: &geometry.design,
-        kinematic_prior: &pooled.kinematic_prior,
-        prior: &options.prior,
-        gear: &effects::GearOptions::default(),
-        folds: options.arc_folds,
-    };
-    let order_curves = choose_series_orders(&arc_inputs, data, &geometry.moving, &pooled, &mut selection, options)?;
-    let (arcs, heldout_folds) = arc_checks(&arc_inputs, data, &geometry.moving, &pooled, &selection)?;
+    let (order_curves, arcs, heldout_folds) = over_arcs(&geometry, data, &pooled, &mut selection, options)?;
     let all_selected = selection.last();
     let checks = StructureChecks::run(&geometry, data, &pooled.fold, &selection, options)?;
     let noise = noise_floor(data, options);
@@ -569,21 +561,41 @@ impl Pooled {
     }
 }
 
+/// What the arcs decide and measure: each selected series' order (its curves), then the arc
+/// checks and the folds, from one pool per moving joint.
+fn over_arcs(
+    geometry: &Geometry,
+    data: &MeasurementSet,
+    pooled: &Pooled,
+    selection: &mut Selection,
+    options: &DiagnoseOptions,
+) -> Result<(Vec<Vec<OrderScore>>, Vec<ArcCheck>, HeldoutFolds), Error> {
+    let arc_inputs = arcs::ArcInputs {
+        design: &geometry.design,
+        kinematic_prior: &pooled.kinematic_prior,
+        prior: &options.prior,
+        gear: &effects::GearOptions::default(),
+        folds: options.arc_folds,
+    };
+    let arc_pools = timings::phase("arc pools", || {
+        arcs::ArcPools::new(&arc_inputs, data, &geometry.moving, selection, &|t| pooled.columns_of(t))
+    });
+    let order_curves = choose_series_orders(&arc_pools, pooled, selection, options)?;
+    let (arcs, heldout_folds) = arc_checks(&arc_inputs, &arc_pools, data, pooled, selection)?;
+    Ok((order_curves, arcs, heldout_folds))
+}
+
 /// Each selected series' order: its random folds' curve and its curve over the other joints'
 /// arcs, weighed (`SelectionOptions::arc_order_weight`). Returns every selected step's curve.
 fn choose_series_orders(
-    arc_inputs: &arcs::ArcInputs<'_>,
-    data: &MeasurementSet,
-    moving: &[usize],
+    arc_pools: &arcs::ArcPools,
     pooled: &Pooled,
     selection: &mut Selection,
     options: &DiagnoseOptions,
 ) -> Result<Vec<Vec<OrderScore>>, Error> {
     let weight = options.selection.arc_order_weight;
     let arc_curves = if weight > 0.0 {
-        timings::phase("arc order curves", || {
-            arcs::order_curves(arc_inputs, data, moving, &pooled.terms, selection, &|t| pooled.columns_of(t))
-        })?
+        timings::phase("arc order curves", || arcs::order_curves(arc_pools, &pooled.terms, selection))?
     } else {
         vec![None; selection.steps.len()]
     };
@@ -617,20 +629,19 @@ fn choose_series_orders(
 /// are left out; and the random folds and the arcs fold by fold, for a stage fitted on top.
 fn arc_checks(
     arc_inputs: &arcs::ArcInputs<'_>,
+    arc_pools: &arcs::ArcPools,
     data: &MeasurementSet,
-    moving: &[usize],
     pooled: &Pooled,
     selection: &Selection,
 ) -> Result<(Vec<ArcCheck>, HeldoutFolds), Error> {
-    let (arcs, arc_folds): (Vec<ArcCheck>, Vec<(usize, Vec<FoldResiduals>)>) = timings::phase("arcs", || {
-        arcs::arc_checks(arc_inputs, data, moving, &pooled.terms, selection, &|t| pooled.columns_of(t))
-    })?
-    .into_iter()
-    .map(|(check, folds)| {
-        let joint = check.joint;
-        (check, (joint, folds))
-    })
-    .unzip();
+    let (arcs, arc_folds): (Vec<ArcCheck>, Vec<(usize, Vec<FoldResiduals>)>) =
+        timings::phase("arcs", || arcs::arc_checks(arc_inputs, arc_pools, data, &pooled.terms, selection))?
+            .into_iter()
+            .map(|(check, folds)| {
+                let joint = check.joint;
+                (check, (joint, folds))
+            })
+            .unzip();
     let heldout_folds = HeldoutFolds {
         rows: data.rows.clone(),
         random: fold_residuals::random_folds(&pooled.pool, &selection.last().fold_columns)?,
