@@ -27,6 +27,10 @@ use rayon::prelude::*;
 /// One fold's weighted rows `X_f`, targets `y_f`, Gram matrix `X_fᵀ X_f` and `X_fᵀ y_f`.
 type FoldProducts = (Mat<f64>, Vec<f64>, Mat<f64>, Vec<f64>);
 
+/// Per set of new columns and fold: their products with every column up to them, and with the
+/// targets.
+type CrossProducts = (Vec<Vec<Mat<f64>>>, Vec<Vec<Vec<f64>>>);
+
 /// The prior standard deviation of each column's parameter.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
@@ -187,6 +191,80 @@ fn gram(x: MatRef<'_, f64>) -> Mat<f64> {
     g
 }
 
+/// Each fold's weighted rows, targets and products (module doc); `column(c)` is pool column `c`
+/// on every row.
+///
+/// One fold per task, each product sequential: the sums run in the same order on any number of
+/// threads, so the pool (and the diagnosis) is the same serial or parallel.
+fn fold_products<'a>(
+    design: &Design,
+    column: &(dyn Fn(usize) -> &'a [f64] + Sync),
+    columns: usize,
+    fold_poses: &[Vec<usize>],
+) -> Vec<FoldProducts> {
+    let k = design.rows_per_pose;
+    fold_poses
+        .par_iter()
+        .map(|poses_f| {
+            let rows_f: Vec<usize> = poses_f.iter().flat_map(|&i| (0..k).map(move |r| i * k + r)).collect();
+            // Gathered a column at a time from contiguous columns: a closure per entry
+            // (`Mat::from_fn`) was a fifth of the whole diagnosis on 400-column pools.
+            let mut xf = Mat::<f64>::zeros(rows_f.len(), columns);
+            for c in 0..columns {
+                let source = column(c);
+                for (target, &r) in xf.col_as_slice_mut(c).iter_mut().zip(&rows_f) {
+                    *target = source[r];
+                }
+            }
+            let yf: Vec<f64> = rows_f.iter().map(|&r| design.y[r]).collect();
+            let ym = Mat::<f64>::from_fn(rows_f.len(), 1, |r, _| yf[r]);
+            let g = gram(xf.as_ref());
+            let mut b = Mat::<f64>::zeros(columns, 1);
+            matmul(b.as_mut(), Accum::Replace, xf.transpose(), ym.as_ref(), 1.0, Par::Seq);
+            (xf, yf, g, (0..columns).map(|c| b[(c, 0)]).collect::<Vec<f64>>())
+        })
+        .collect()
+}
+
+/// `Xᵀ X` and `Xᵀ y` over every fold but one, every fold but a pair (with `pairs`), and every
+/// fold, in [`Pool::gram`]'s order, from each fold's own.
+fn left_out_products(fold_gram: &[Mat<f64>], fold_xty: &[Vec<f64>], pairs: bool) -> (Vec<Mat<f64>>, Vec<Vec<f64>>) {
+    let (folds, columns) = (fold_gram.len(), fold_xty.first().map_or(0, Vec::len));
+    let mut gram_all = Mat::<f64>::zeros(columns, columns);
+    let mut xty_all = vec![0.0; columns];
+    for (g, b) in fold_gram.iter().zip(fold_xty) {
+        gram_all += g;
+        xty_all.iter_mut().zip(b).for_each(|(t, v)| *t += v);
+    }
+    let without = |out: &[usize]| {
+        let mut g = gram_all.clone();
+        let mut b = xty_all.clone();
+        for &f in out {
+            g -= &fold_gram[f];
+            b.iter_mut().zip(&fold_xty[f]).for_each(|(t, v)| *t -= v);
+        }
+        (g, b)
+    };
+    let mut gram = Vec::new();
+    let mut xty = Vec::new();
+    let mut push = |(g, b): (Mat<f64>, Vec<f64>)| {
+        gram.push(g);
+        xty.push(b);
+    };
+    for f in 0..folds {
+        push(without(&[f]));
+    }
+    if pairs {
+        for f in 0..folds {
+            for g in f + 1..folds {
+                push(without(&[f, g]));
+            }
+        }
+    }
+    push((gram_all, xty_all));
+    (gram, xty)
+}
+
 /// The prior precision of an effect parameter whose weighted column is `column`: `1/sd²`, or
 /// [`PriorOptions::effect_m`] of RMS tool displacement.
 fn effect_precision(column: &[f64], sd: Option<f64>, k: usize, w: f64, prior: &PriorOptions) -> f64 {
@@ -256,29 +334,7 @@ impl Pool {
         for (i, &f) in fold.iter().enumerate() {
             fold_poses[f].push(i);
         }
-        // One fold per task, each product sequential: the sums run in the same order on any number
-        // of threads, so the pool (and the diagnosis) is the same serial or parallel.
-        let per_fold: Vec<FoldProducts> = fold_poses
-            .par_iter()
-            .map(|poses_f| {
-                let rows_f: Vec<usize> = poses_f.iter().flat_map(|&i| (0..k).map(move |r| i * k + r)).collect();
-                // Gathered a column at a time from contiguous columns: a closure per entry
-                // (`Mat::from_fn`) was a fifth of the whole diagnosis on 400-column pools.
-                let mut xf = Mat::<f64>::zeros(rows_f.len(), columns);
-                for c in 0..columns {
-                    let source = column(c);
-                    for (target, &r) in xf.col_as_slice_mut(c).iter_mut().zip(&rows_f) {
-                        *target = source[r];
-                    }
-                }
-                let yf: Vec<f64> = rows_f.iter().map(|&r| design.y[r]).collect();
-                let ym = Mat::<f64>::from_fn(rows_f.len(), 1, |r, _| yf[r]);
-                let g = gram(xf.as_ref());
-                let mut b = Mat::<f64>::zeros(columns, 1);
-                matmul(b.as_mut(), Accum::Replace, xf.transpose(), ym.as_ref(), 1.0, Par::Seq);
-                (xf, yf, g, (0..columns).map(|c| b[(c, 0)]).collect::<Vec<f64>>())
-            })
-            .collect();
+        let per_fold = fold_products(design, &column, columns, &fold_poses);
         let mut x = Vec::with_capacity(folds);
         let mut y = Vec::with_capacity(folds);
         let mut fold_gram = Vec::with_capacity(folds);
@@ -289,38 +345,7 @@ impl Pool {
             fold_gram.push(g);
             fold_xty.push(b);
         }
-        let mut gram_all = Mat::<f64>::zeros(columns, columns);
-        let mut xty_all = vec![0.0; columns];
-        for (g, b) in fold_gram.iter().zip(&fold_xty) {
-            gram_all += g;
-            xty_all.iter_mut().zip(b).for_each(|(t, v)| *t += v);
-        }
-        let without = |out: &[usize]| {
-            let mut g = gram_all.clone();
-            let mut b = xty_all.clone();
-            for &f in out {
-                g -= &fold_gram[f];
-                b.iter_mut().zip(&fold_xty[f]).for_each(|(t, v)| *t -= v);
-            }
-            (g, b)
-        };
-        let mut gram = Vec::new();
-        let mut xty = Vec::new();
-        let mut push = |(g, b): (Mat<f64>, Vec<f64>)| {
-            gram.push(g);
-            xty.push(b);
-        };
-        for f in 0..folds {
-            push(without(&[f]));
-        }
-        if pairs {
-            for f in 0..folds {
-                for g in f + 1..folds {
-                    push(without(&[f, g]));
-                }
-            }
-        }
-        push((gram_all, xty_all));
+        let (gram, xty) = left_out_products(&fold_gram, &fold_xty, pairs);
         Self {
             k,
             weights: design.weights,
@@ -374,8 +399,28 @@ impl Pool {
             end += set.len();
         }
         let total = end;
-        // Per set and fold: the products of its new columns with every column up to them (what
-        // `extend` of that set alone would multiply), and with the targets.
+        let (cross, cross_y) = self.grow_rows(sets, &ranges, first, total);
+        for index in 0..self.gram.len() {
+            self.grow_gram(index, &ranges, first, (&cross, &cross_y));
+        }
+        for column in sets.iter().flatten() {
+            self.precision.push(effect_precision(column, sd, k, self.weights.position_m, prior));
+            self.prior_mean.push(0.0);
+        }
+        ranges
+    }
+
+    /// Appends the columns of `sets` (at `ranges`, after the `first` there are) to every fold's
+    /// rows; returns per set and fold the products of its new columns with every column up to
+    /// them (what `extend` of that set alone would multiply), and with the targets.
+    fn grow_rows(
+        &mut self,
+        sets: &[Vec<Vec<f64>>],
+        ranges: &[std::ops::Range<usize>],
+        first: usize,
+        total: usize,
+    ) -> CrossProducts {
+        let k = self.k;
         let mut cross: Vec<Vec<Mat<f64>>> = vec![Vec::with_capacity(self.folds()); sets.len()];
         let mut cross_y: Vec<Vec<Vec<f64>>> = vec![Vec::with_capacity(self.folds()); sets.len()];
         for f in 0..self.folds() {
@@ -385,7 +430,7 @@ impl Pool {
             for c in 0..first {
                 xf.col_as_slice_mut(c).copy_from_slice(self.x[f].col_as_slice(c));
             }
-            for (set, range) in sets.iter().zip(&ranges) {
+            for (set, range) in sets.iter().zip(ranges) {
                 for (l, column) in set.iter().enumerate() {
                     for (r, v) in xf.col_as_slice_mut(range.start + l).iter_mut().enumerate() {
                         *v = column[poses[r / k] * k + r % k];
@@ -411,38 +456,44 @@ impl Pool {
             }
             self.x[f] = xf;
         }
-        for index in 0..self.gram.len() {
-            let left_out = self.left_out_of(index);
-            let mut g = Mat::<f64>::zeros(total, total);
-            for c in 0..first {
-                g.col_as_slice_mut(c)[..first].copy_from_slice(&self.gram[index].col_as_slice(c)[..first]);
-            }
-            // Each set writes its own columns (rows up to its end) and, mirrored, its own rows
-            // left of it: no entry is written by two sets.
-            for (s, range) in ranges.iter().enumerate() {
-                let (old, m) = (range.start, range.len());
-                let mut added_y = vec![0.0; m];
-                for f in (0..self.folds()).filter(|f| !left_out.contains(f)) {
-                    for l in 0..m {
-                        for r in 0..range.end {
-                            let v = cross[s][f][(r, l)];
-                            g[(r, old + l)] += v;
-                            if r < old {
-                                g[(old + l, r)] += v;
-                            }
+        (cross, cross_y)
+    }
+
+    /// Grows Gram matrix `index` from its `first` columns by the sets' products (`grow_rows`)
+    /// over the folds it keeps, and its `Xᵀ y` alike.
+    fn grow_gram(
+        &mut self,
+        index: usize,
+        ranges: &[std::ops::Range<usize>],
+        first: usize,
+        (cross, cross_y): (&[Vec<Mat<f64>>], &[Vec<Vec<f64>>]),
+    ) {
+        let total = ranges.last().map_or(first, |r| r.end);
+        let left_out = self.left_out_of(index);
+        let mut g = Mat::<f64>::zeros(total, total);
+        for c in 0..first {
+            g.col_as_slice_mut(c)[..first].copy_from_slice(&self.gram[index].col_as_slice(c)[..first]);
+        }
+        // Each set writes its own columns (rows up to its end) and, mirrored, its own rows
+        // left of it: no entry is written by two sets.
+        for (s, range) in ranges.iter().enumerate() {
+            let (old, m) = (range.start, range.len());
+            let mut added_y = vec![0.0; m];
+            for f in (0..self.folds()).filter(|f| !left_out.contains(f)) {
+                for l in 0..m {
+                    for r in 0..range.end {
+                        let v = cross[s][f][(r, l)];
+                        g[(r, old + l)] += v;
+                        if r < old {
+                            g[(old + l, r)] += v;
                         }
-                        added_y[l] += cross_y[s][f][l];
                     }
+                    added_y[l] += cross_y[s][f][l];
                 }
-                self.xty[index].extend(added_y);
             }
-            self.gram[index] = g;
+            self.xty[index].extend(added_y);
         }
-        for column in sets.iter().flatten() {
-            self.precision.push(effect_precision(column, sd, k, self.weights.position_m, prior));
-            self.prior_mean.push(0.0);
-        }
-        ranges
+        self.gram[index] = g;
     }
 
     /// The weighted residual rows `y − X β` of the poses of fold `fold` (in their order).
