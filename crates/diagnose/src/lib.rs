@@ -573,6 +573,9 @@ impl Pooled {
     }
 }
 
+/// Each selected series' order curve, the arc checks and the folds (`over_arcs`).
+type OverArcs = (Vec<Vec<OrderScore>>, Vec<ArcCheck>, HeldoutFolds);
+
 /// What the arcs decide and measure: each selected series' order (its curves), then the arc
 /// checks and the folds, from one pool per moving joint.
 fn over_arcs(
@@ -581,7 +584,7 @@ fn over_arcs(
     pooled: &Pooled,
     selection: &mut Selection,
     options: &DiagnoseOptions,
-) -> Result<(Vec<Vec<OrderScore>>, Vec<ArcCheck>, HeldoutFolds), Error> {
+) -> Result<OverArcs, Error> {
     let arc_inputs = arcs::ArcInputs {
         design: &geometry.design,
         kinematic_prior: &pooled.kinematic_prior,

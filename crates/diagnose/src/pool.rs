@@ -399,9 +399,9 @@ impl Pool {
             end += set.len();
         }
         let total = end;
-        let (cross, cross_y) = self.grow_rows(sets, &ranges, first, total);
+        let products = self.grow_rows(sets, &ranges, first, total);
         for index in 0..self.gram.len() {
-            self.grow_gram(index, &ranges, first, (&cross, &cross_y));
+            self.grow_gram(index, &ranges, first, &products);
         }
         for column in sets.iter().flatten() {
             self.precision.push(effect_precision(column, sd, k, self.weights.position_m, prior));
@@ -466,7 +466,7 @@ impl Pool {
         index: usize,
         ranges: &[std::ops::Range<usize>],
         first: usize,
-        (cross, cross_y): (&[Vec<Mat<f64>>], &[Vec<Vec<f64>>]),
+        (cross, cross_y): &CrossProducts,
     ) {
         let total = ranges.last().map_or(first, |r| r.end);
         let left_out = self.left_out_of(index);
