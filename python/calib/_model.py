@@ -130,7 +130,9 @@ class Model:
 
     def eval(self, data: Union[Measurements, PathLike, Any]) -> EvalReport:
         """The model's errors on measurements, as ``calib eval --json`` reports them, with the
-        error of every row (``position_errors_mm``, ``rotation_errors_mrad``)."""
+        error of every row (``position_errors_mm``, ``rotation_errors_mrad``). What ``calib eval``
+        prints as ``note: …`` and ``warning: …`` is raised as :class:`CalibWarning`, the same texts
+        in the same order, and kept in the report's ``warnings``."""
         data = _measurements(data, self)
         text, position, rotation, warnings = self._core.eval(data._core)
         warn_all(warnings)

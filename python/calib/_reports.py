@@ -63,7 +63,7 @@ class FitReport:
             after=ErrorSummary.from_dict(d["after"]),
             identification=d["identification"],
             effects=d["effects"],
-            residual_gp=d.get("compensation"),
+            residual_gp=d.get("residual_gp"),
             auto=d.get("auto"),
             plausibility=d.get("plausibility"),
             outliers=d["outliers"],
@@ -73,8 +73,8 @@ class FitReport:
 
     @property
     def compensation(self) -> Optional[Dict[str, Any]]:
-        """The old name of :attr:`residual_gp` (the JSON key keeps it), still read; "compensation"
-        now means :meth:`Model.compensate`'s joint targets alone."""
+        """The old name of :attr:`residual_gp` (the JSON key's before SPEC version 5), still read;
+        "compensation" now means :meth:`Model.compensate`'s joint targets alone."""
         return self.residual_gp
 
     def as_dict(self) -> Dict[str, Any]:

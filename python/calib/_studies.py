@@ -63,7 +63,8 @@ def simulate(
     """A simulated tracker campaign, row for row what ``calib simulate`` writes with the same
     arguments (read back through the CSV reader), and written to ``out`` where given.
 
-    ``effects`` is a RON file of loadsim's effects (default: joint compliance and tracker noise);
+    ``effects`` is a RON file of loadsim's effects, its fields spelt as ``--effects`` items
+    (``joint_compliance``, ``time_drift``, …; default: joint compliance and tracker noise);
     ``moving_joints`` are 1-based; see ``calib simulate --help`` for the rest.
     """
     core = _calib.simulate(

@@ -292,3 +292,71 @@ def test_angles_a_turn_away_are_wrapped_as_the_cli_wraps_them(cli, tmp_path):
     with warns_exactly("modulo 2π", f"temp_c {OUTSIDE}", f"t_s {OUTSIDE}", FADE):
         report = model.eval(test)
     assert report.as_dict() == theirs and theirs["wrapped"][0]["joint"] == 1
+
+
+def _cli_eval_notices(cli, model, data):
+    """What `calib eval` says beside its numbers, without `note: ` / `warning: `: as `--json` prints
+    it on stderr, held equal to what the text prints on stdout."""
+    kinds = ("note: ", "warning: ")
+    printed = cli.run("eval", "--model", model, "--data", data, "--json").stderr.splitlines()
+    from_json = [line for line in printed if line.startswith(kinds)]
+    text = cli.run("eval", "--model", model, "--data", data).stdout.splitlines()
+    from_text = [line[2:] for line in text if line[2:].startswith(kinds) and line.startswith("  ")]
+    assert from_json == from_text
+    return [line.split(": ", 1)[1] for line in from_json]
+
+
+def _eval_cases(cli, campaign, tmp_path):
+    """Four evaluations that each make `eval` speak, as (model file, data file, what it must say)."""
+    header, *rows = campaign["whole"].read_text().splitlines(keepends=True)
+    names = header.strip().split(",")
+
+    def planted(row, name, delta):
+        cells = row.rstrip("\n").split(",")
+        cells[names.index(name)] = repr(float(cells[names.index(name)]) + delta)
+        return ",".join(cells) + "\n"
+
+    # Trained on the even rows, tested on the odd ones (within the fitted time and temperature,
+    # where eval judges rows), with a row 40 mm off (a suspect row) and a payload never trained.
+    even, odd = tmp_path / "even.csv", tmp_path / "odd.csv"
+    even.write_text(header + "".join(rows[0::2]))
+    tested = rows[1::2]
+    tested[9] = planted(tested[9], "y_mm", 40.0)
+    tested[8] = planted(tested[8], "payload_kg", 50.0)
+    odd.write_text(header + "".join(tested))
+    planted_gp = tmp_path / "even.ron"
+    cli.run("fit", "--robot", ROBOT, "--data", even, "--method", "poe-gp", "--out", planted_gp)
+    # The campaign's test rows put joint 2 outside the fitted range: the geometry's own σ there.
+    gp = tmp_path / "gp.ron"
+    cli.run("fit", "--robot", ROBOT, "--data", campaign["train"], "--method", "poe-gp", "--out", gp)
+    # Another seed places the tracker elsewhere.
+    elsewhere = tmp_path / "elsewhere.csv"
+    cli.run("simulate", "--robot", ROBOT, "--rows", "40", "--seed", "8", "--full-pose", "--out", elsewhere)
+    poe = tmp_path / "poe.ron"
+    cli.run("fit", "--robot", ROBOT, "--data", campaign["train"], "--method", "poe", "--out", poe)
+    # Positions only: a model that cannot judge the test rows' orientations.
+    keep = [i for i, name in enumerate(names) if name not in ("qw", "qx", "qy", "qz")]
+    lines = campaign["train"].read_text().splitlines()
+    positions = tmp_path / "positions.csv"
+    positions.write_text("".join(",".join(line.split(",")[i] for i in keep) + "\n" for line in lines))
+    pos = tmp_path / "pos.ron"
+    cli.run("fit", "--robot", ROBOT, "--data", positions, "--method", "poe", "--out", pos)
+    return [
+        (planted_gp, odd, ["robust sigmas of the other rows", PAYLOAD]),
+        (gp, campaign["test"], [f"joint 2 {OUTSIDE}", "geometry's own uncertainty"]),
+        (poe, elsewhere, ["another tracker placement", f"calib register --model {poe} "]),
+        (pos, campaign["test"], ["orientations in the data are not evaluated", OUTSIDE]),
+    ]
+
+
+def test_eval_warns_what_the_cli_prints_in_its_order(cli, campaign, tmp_path):
+    for model, data, expected in _eval_cases(cli, campaign, tmp_path):
+        theirs = _cli_eval_notices(cli, model, data)
+        for words in expected:
+            assert any(words in line for line in theirs), (words, theirs)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            report = calib.Model.load(model).eval(data)
+        ours = [str(w.message) for w in caught if issubclass(w.category, calib.CalibWarning)]
+        assert ours == theirs
+        assert report.warnings == theirs

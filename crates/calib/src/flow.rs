@@ -84,27 +84,90 @@ pub fn wrapped(model: &CalibratedModel, data: MeasurementSet) -> (MeasurementSet
     (MeasurementSet { rows, ..data }, wrapped)
 }
 
-/// `eval`'s result: the rows evaluated (wrapped into the fitted range), each row's error and the
-/// report.
+/// `eval`'s result: the rows evaluated (wrapped into the fitted range), each row's error, the
+/// report and what is said beside it.
 #[derive(Debug)]
 pub struct Evaluated {
     pub data: MeasurementSet,
     pub evaluation: Evaluation,
     pub report: EvalReport,
+    pub notices: EvalNotices,
 }
 
 /// `eval`: `data` wrapped into the fitted range, bound once (joints checked, tools mapped) and
-/// evaluated; a non-finite error refused (`model_file` names the model in the refusal).
-pub fn evaluate(model: &CalibratedModel, model_file: &Path, data: MeasurementSet) -> Result<Evaluated, Refused> {
+/// evaluated; a non-finite error refused. `model_name` names the model in the refusal; where
+/// `from_file`, it is the file the model was read from, and the command a warning suggests names it.
+pub fn evaluate(
+    model: &CalibratedModel,
+    model_name: &Path,
+    from_file: bool,
+    data: MeasurementSet,
+) -> Result<Evaluated, Refused> {
     let (data, wrapped) = wrapped(model, data);
     let bound = model.bind(&data)?;
     let evaluation = model::evaluate(model, &bound)?;
     let finite = |e: &PoseError| e.position_mm.is_finite() && e.rotation_mrad.is_none_or(f64::is_finite);
     if let Some((row, _)) = data.rows.iter().zip(&evaluation.errors).find(|(_, e)| !finite(e)) {
-        return Err(Refused::non_finite(model_file, &data.source, row.line));
+        return Err(Refused::non_finite(model_name, &data.source, row.line));
     }
     let report = EvalReport { wrapped, ..EvalReport::new(model, &bound, &evaluation) };
-    Ok(Evaluated { data, evaluation, report })
+    let notices = EvalNotices::of(&report, from_file.then_some(model_name));
+    Ok(Evaluated { data, evaluation, report, notices })
+}
+
+/// What `eval` says beside its numbers, in the order every front end gives it: `calib eval` prints
+/// each as `note: …` or `warning: …`, the Python package raises each as a warning. Built here once,
+/// so that the two cannot drift apart.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct EvalNotices {
+    /// The joints wrapped by whole turns into the fitted range, then the orientations a
+    /// position-only model leaves unjudged.
+    pub notes: Vec<String>,
+    /// What deserves caution: first what points at the data (another tracker placement, rows far
+    /// beyond the others), then the rows beyond what the model was fitted on.
+    pub warnings: Vec<String>,
+}
+
+impl EvalNotices {
+    /// The notes and warnings of `report`; `model_file` (where the model was read from one) is
+    /// named in the command the placement warning suggests, `MODEL` otherwise.
+    pub fn of(report: &EvalReport, model_file: Option<&Path>) -> Self {
+        let mut notes: Vec<String> = report.wrapped.iter().map(ToString::to_string).collect();
+        if report.orientations_not_evaluated {
+            notes.push(model::ORIENTATIONS_NOT_EVALUATED.to_owned());
+        }
+        let mut warnings: Vec<String> = Vec::new();
+        if let Some(placement) = &report.other_placement {
+            let text = placement.to_string();
+            warnings.push(match model_file {
+                Some(file) => text.replace("--model MODEL", &format!("--model {}", file.display())),
+                None => text,
+            });
+        }
+        warnings.extend(report.suspect_rows.iter().map(suspect_text));
+        warnings.extend(report.warnings.iter().map(ToString::to_string));
+        warnings.extend(report.out_of_range.iter().map(ToString::to_string));
+        warnings.extend(report.geometry_sigma.iter().map(ToString::to_string));
+        warnings.extend(report.beyond_joint_limits.iter().map(ToString::to_string));
+        warnings.extend(report.sigma_fallback.iter().map(ToString::to_string));
+        warnings.extend(report.gp_fade.iter().map(ToString::to_string));
+        Self { notes, warnings }
+    }
+}
+
+/// The warning about rows far beyond the others, with what the others give.
+fn suspect_text(suspects: &model::SuspectRows) -> String {
+    let w = &suspects.without;
+    format!(
+        "{} row(s) lie beyond {} robust sigmas of the other rows' errors: {}; a measurement error \
+         (a tracker glitch, a row measured twice apart) more likely than the model's; without them: \
+         mean {:.4} mm, max {:.4} mm (the numbers above keep them)",
+        suspects.rows.len(),
+        suspects.threshold_sigmas,
+        measurements::list_lines(&suspects.rows),
+        w.mean_position_error_mm,
+        w.max_position_error_mm
+    )
 }
 
 /// `predict`'s result: a pose per row, and what `predict` says beside them.

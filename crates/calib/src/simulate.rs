@@ -35,8 +35,9 @@ pub struct Args {
     /// Measure the orientation too (a 6-DOF probe): writes qw, qx, qy, qz.
     #[arg(long)]
     full_pose: bool,
-    /// Effects (RON, loadsim's `Effects`: compliance, backlash, periodic, thermal, drift,
-    /// deflection, screw, tracker_noise, coupling; a field left out is off) [default: joint compliance and tracker noise].
+    /// Effects (RON, loadsim's `Effects`: joint_compliance, backlash, gear_periodic, thermal,
+    /// time_drift, link_deflection, screw_periodic, tracker_noise, coupling, the `--effects` names of
+    /// `calib fit`; a field left out is off) [default: joint compliance and tracker noise].
     #[arg(long)]
     effects: Option<PathBuf>,
     /// Payloads, kg, one drawn per pose [default: the paper's 1,2.5,3.5,5,7.5].

@@ -256,7 +256,7 @@ fn campaign() -> Campaign {
         "--json",
     ]);
     let paths = check_json("fit", &fit);
-    for planted in ["outliers[].line", "warnings[].rows[].line", "compensation.leave_one_out.n", "effects[].label"] {
+    for planted in ["outliers[].line", "warnings[].rows[].line", "residual_gp.leave_one_out.n", "effects[].label"] {
         assert!(paths.contains(planted), "fit --json: {planted} not printed");
     }
     campaign

@@ -4,7 +4,7 @@
 
 use errors::ron_position::{field_position, field_position_in, ron_options};
 use errors::{CommonKind, Error};
-use loadsim::{DynamicsNeed, Effects, RobotFacts};
+use loadsim::{DynamicsNeed, EffectKind, Effects, RobotFacts};
 use robot::RobotDescription;
 use ron::Value;
 use std::path::Path;
@@ -36,10 +36,20 @@ pub fn parse_effects(text: &str, file: &str) -> Result<Effects, Error> {
     let effects: Effects = ron_options().from_str(text).map_err(syntax)?;
     let given: Value = ron_options().from_str(text).map_err(syntax)?;
     // The parsed effects written back hold every field they know, switched on or not.
-    let known = ron::to_string(&effects)
+    let mut known = ron::to_string(&effects)
         .ok()
         .and_then(|written| ron::from_str::<Value>(&written).ok())
         .ok_or_else(|| at(1, 1, "the effects do not write back as RON".into()))?;
+    // They are written as the SPEC names; the spellings before SPEC version 5 read as those.
+    if let Value::Map(fields) = &mut known {
+        for kind in EffectKind::ALL {
+            if let (Some(field), Some(former)) = (kind.simulated_field(), kind.former_field())
+                && let Some(value) = fields.get(&Value::String(field.to_owned())).cloned()
+            {
+                fields.insert(former, value);
+            }
+        }
+    }
     match unknown_field(&given, &known) {
         Some(name) => {
             let (line, column) = field_position(text, &name, 0);
@@ -87,8 +97,7 @@ pub fn check_effects(effects: &Effects, robot: &RobotDescription, text: &str, fi
     };
     let active = effects.active();
     for (kind, effect) in &active {
-        // `active` holds only simulated kinds, which all have a field.
-        let section = kind.simulated_field().unwrap_or(kind.name());
+        let section = spelled_in(text, *kind);
         let what = match effect.needs_dynamics() {
             DynamicsNeed::Nothing => continue,
             DynamicsNeed::Masses => "link masses",
@@ -107,10 +116,21 @@ pub fn check_effects(effects: &Effects, robot: &RobotDescription, text: &str, fi
     let facts =
         RobotFacts { joints: &joints, dynamics: robot.dynamics.as_ref(), pitch_bounds_mm: robot::PITCH_BOUNDS_MM };
     for (kind, effect) in &active {
-        let section = kind.simulated_field().unwrap_or(kind.name());
+        let section = spelled_in(text, *kind);
         effect.check_entries(&facts).map_err(|f| at(section, &f.field, f.index, f.message))?;
     }
     Ok(())
+}
+
+/// The field of `kind` as `text` spells it: the SPEC name, or the spelling of a file written before
+/// SPEC version 5, so that a refusal names the field the file has.
+fn spelled_in(text: &str, kind: EffectKind) -> &'static str {
+    // `active` holds only simulated kinds, which all have a field.
+    let field = kind.simulated_field().unwrap_or(kind.name());
+    match kind.former_field() {
+        Some(former) if field_position(text, field, 0) == (1, 1) && field_position(text, former, 0) != (1, 1) => former,
+        _ => field,
+    }
 }
 
 #[cfg(test)]
@@ -259,5 +279,46 @@ mod tests {
         let text = "(\n  deflection: (links: [(joint_index: 0, flexibility_per_nm2: (1e-7, 1e-7))]))";
         let effects = parse_effects(text, "e.ron").unwrap();
         check_effects(&effects, &robot, text, "e.ron").unwrap();
+    }
+
+    #[test]
+    fn each_effect_reads_under_its_effects_name_and_under_its_former_field_alike() {
+        let samples = [
+            (EffectKind::JointCompliance, "(payload_only: true)"),
+            (
+                EffectKind::GearPeriodic,
+                "(harmonics: [(joint_index: 1, order: 2.0, amplitude_rad: 1e-5, phase_rad: 0.0)])",
+            ),
+            (EffectKind::TimeDrift, "(twist_per_s: (0.0, 0.0, 0.0, 0.0, 0.0, 1e-9))"),
+            (EffectKind::LinkDeflection, "(links: [(joint_index: 0, flexibility_per_nm2: (1e-7, 2e-7))])"),
+            (
+                EffectKind::ScrewPeriodic,
+                "(harmonics: [(joint_index: 0, pitch_m: 0.01, order: 1.0, amplitude_m: 2e-5, phase_rad: 0.0)])",
+            ),
+        ];
+        let renamed: Vec<EffectKind> = EffectKind::ALL.iter().copied().filter(|k| k.former_field().is_some()).collect();
+        assert_eq!(renamed, samples.map(|(kind, _)| kind), "a sample for every kind spelt otherwise before");
+        for (kind, value) in samples {
+            let (field, former) = (kind.simulated_field().unwrap(), kind.former_field().unwrap());
+            assert_eq!(field, kind.name(), "the file's field is the --effects name");
+            let new = parse_effects(&format!("({field}: {value}, tracker_noise: ())"), "new.ron").unwrap();
+            assert!(new.is_on(kind) && new.is_on(EffectKind::TrackerNoise), "{field}");
+            let old = parse_effects(&format!("({former}: {value}, tracker_noise: ())"), "old.ron").unwrap();
+            assert_eq!(old, new, "{former}");
+            let written = ron::to_string(&new).unwrap();
+            assert!(written.starts_with(&format!("({field}:")) || written.contains(&format!(",{field}:")), "{written}");
+            let both = format!("(\n  {field}: {value},\n  {former}: {value})");
+            let message = parse_effects(&both, "both.ron").unwrap_err().to_string();
+            assert!(message.starts_with("both.ron:3:") && message.contains("duplicate"), "{message}");
+        }
+        // A refusal names the field as the file spells it, at its place.
+        let mut robot = testkit::robot("irb4400.ron");
+        robot.dynamics = None;
+        for field in ["joint_compliance", "compliance"] {
+            let text = format!("(\n  tracker_noise: (),\n  {field}: ())");
+            let effects = parse_effects(&text, "e.ron").unwrap();
+            let message = check_effects(&effects, &robot, &text, "e.ron").unwrap_err().to_string();
+            assert!(message.starts_with(&format!("e.ron:3:3: {field}: needs the robot's masses")), "{message}");
+        }
     }
 }

@@ -13,17 +13,20 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 macro_rules! effects_struct {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident: $sim:ty)?, )* }
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident
+                     $(=> $field:ident $(as $file:literal | $former:literal)?: $sim:ty)?, )* }
      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// Which effects act and with which parameters, a field per kind of
         /// [`effect_kinds!`](crate::effect_kinds) that the simulator models (named as its line
-        /// says); `None` switches an effect off. The default has none: the measured pose is then
+        /// says; serde spells each as the SPEC name, the spelling of files before SPEC version 5
+        /// still read); `None` switches an effect off. The default has none: the measured pose is then
         /// the geometric model's.
         #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
         #[serde(default)]
         pub struct Effects {
             $( $(
                 #[doc = concat!("[`EffectKind::", stringify!($kind), "`] (`", stringify!($name), "`): its simulation, `None` when off.")]
+                $( #[serde(rename = $file, alias = $former)] )?
                 pub $field: Option<$sim>,
             )? )*
             $( $(#[$sdoc])* pub $sfield: Option<$ssim>, )*

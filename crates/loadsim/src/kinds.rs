@@ -8,8 +8,8 @@
 /// Calls the macro `$callback` with the list of effect kinds, in a fixed order:
 ///
 /// ```text
-/// identified { $( #[doc] Kind spec_name: KindTerm $( => simulated_field: KindModel )?, )* }
-/// simulated { $( #[doc] Kind spec_name => simulated_field: KindModel, )* }
+/// identified { $( #[doc] Kind spec_name: KindTerm $( => rust_field $(as "spec_name" | "former")?: KindModel )?, )* }
+/// simulated { $( #[doc] Kind spec_name => rust_field: KindModel, )* }
 /// ```
 ///
 /// `identified` kinds have a regressor in the `effects` crate: the type `KindTerm` in its module
@@ -18,16 +18,18 @@
 /// names keep the two sides apart: `effects::GearPeriodicTerm` is what the fit identifies and a
 /// model file holds, `loadsim::GearPeriodicModel` the simulator's ground truth.
 /// `simulated` kinds exist only in the simulator. `spec_name` is the SPEC's name (serde, the
-/// `--effects` item, the diagnosis JSON). Where a kind is simulated, `simulated_field` is the field
-/// of [`crate::Effects`] (and of the effects file of `calib simulate`) that switches it on, and
-/// `KindModel` the type it holds there, which implements [`crate::SimulatedEffect`] (the effect's
-/// simulation: its checks and its place in the forward model). An identified kind may have no
-/// simulation: it is then fitted, diagnosed and read from model files, and
-/// [`EffectKind::simulated_field`] is `None`.
+/// `--effects` item, the diagnosis JSON). Where a kind is simulated, `rust_field` is the field
+/// of [`crate::Effects`] that switches it on, and `KindModel` the type it holds there, which
+/// implements [`crate::SimulatedEffect`] (the effect's simulation: its checks and its place in the
+/// forward model). The effects file of `calib simulate` spells every field as the SPEC name: where
+/// the Rust field is spelt otherwise, `as "spec_name" | "former"` gives the file's spelling (serde
+/// needs it as a literal) and the spelling of files before SPEC version 5, which still reads. An
+/// identified kind may have no simulation: it is then fitted, diagnosed and read from model files,
+/// and [`EffectKind::simulated_field`] is `None`.
 ///
 /// ```
 /// macro_rules! names {
-///     (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident: $sim:ty)?, )* }
+///     (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident $(as $file:literal | $former:literal)?: $sim:ty)?, )* }
 ///      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
 ///         [$(stringify!($name)),*]
 ///     };
@@ -41,19 +43,21 @@ macro_rules! effect_kinds {
         $callback! {
             identified {
                 /// Joint compliance under gravity and payload.
-                JointCompliance joint_compliance: JointComplianceTerm => compliance: $crate::JointComplianceModel,
+                JointCompliance joint_compliance: JointComplianceTerm
+                    => compliance as "joint_compliance" | "compliance": $crate::JointComplianceModel,
                 /// Backlash following the sign of the static torque.
                 Backlash backlash: BacklashTerm => backlash: $crate::BacklashModel,
                 /// A periodic error of a joint in its own angle (gear or encoder).
-                GearPeriodic gear_periodic: GearPeriodicTerm => periodic: $crate::GearPeriodicModel,
+                GearPeriodic gear_periodic: GearPeriodicTerm => periodic as "gear_periodic" | "periodic": $crate::GearPeriodicModel,
                 /// Thermal growth of the links with `temp_c`.
                 Thermal thermal: ThermalTerm => thermal: $crate::ThermalModel,
                 /// Drift of the robot's placement with `t_s`.
-                TimeDrift time_drift: TimeDriftTerm => drift: $crate::TimeDriftModel,
+                TimeDrift time_drift: TimeDriftTerm => drift as "time_drift" | "drift": $crate::TimeDriftModel,
                 /// A link bending under the gravity moment of everything beyond it.
-                LinkDeflection link_deflection: LinkDeflectionTerm => deflection: $crate::LinkDeflectionModel,
+                LinkDeflection link_deflection: LinkDeflectionTerm
+                    => deflection as "link_deflection" | "deflection": $crate::LinkDeflectionModel,
                 /// A periodic error of a linear axis in its own position, per screw or rack pitch.
-                ScrewPeriodic screw_periodic: ScrewPeriodicTerm => screw: $crate::ScrewPeriodicModel,
+                ScrewPeriodic screw_periodic: ScrewPeriodicTerm => screw as "screw_periodic" | "screw": $crate::ScrewPeriodicModel,
             }
             simulated {
                 /// Tracker measurement noise.
@@ -66,7 +70,7 @@ macro_rules! effect_kinds {
 }
 
 macro_rules! effect_kind_enum {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident: $sim:ty)?, )* }
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident $(as $file:literal | $former:literal)?: $sim:ty)?, )* }
      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// The kinds of effect, named as in the SPEC (`--effects`, the model file, the `calib
         /// diagnose` JSON), generated from [`effect_kinds!`](crate::effect_kinds).
@@ -103,15 +107,28 @@ macro_rules! effect_kind_enum {
                 Self::IDENTIFIED.contains(&self)
             }
 
-            /// The field of [`Effects`](crate::Effects) (and of `calib simulate`'s effects file)
-            /// that holds it; `None` for a kind the simulator does not model.
+            /// The field of `calib simulate`'s effects file that holds it (the SPEC name);
+            /// `None` for a kind the simulator does not model.
             pub fn simulated_field(self) -> Option<&'static str> {
                 match self {
                     $( EffectKind::$kind => {
-                        let field: &[&'static str] = &[$(stringify!($field))?];
+                        // The list's literal where it gives one, before the Rust field's name.
+                        let field: &[&'static str] = &[$($($file,)? stringify!($field))?];
                         field.first().copied()
                     } )*
                     $( EffectKind::$skind => Some(stringify!($sfield)), )*
+                }
+            }
+
+            /// The spelling of [`EffectKind::simulated_field`] in effects files before SPEC
+            /// version 5, where it was another (still read); `None` where it was the same.
+            pub fn former_field(self) -> Option<&'static str> {
+                match self {
+                    $( EffectKind::$kind => {
+                        let former: &[&'static str] = &[$($($former)?)?];
+                        former.first().copied()
+                    } )*
+                    $( EffectKind::$skind => None, )*
                 }
             }
         }
@@ -136,6 +153,8 @@ mod tests {
         }
         assert_eq!(EffectKind::from_name("gear"), None);
         assert!(EffectKind::GearPeriodic.is_identified() && !EffectKind::Coupling.is_identified());
-        assert_eq!(EffectKind::GearPeriodic.simulated_field(), Some("periodic"));
+        assert_eq!(EffectKind::GearPeriodic.simulated_field(), Some("gear_periodic"));
+        assert_eq!(EffectKind::GearPeriodic.former_field(), Some("periodic"));
+        assert_eq!(EffectKind::Backlash.former_field(), None);
     }
 }

@@ -48,7 +48,7 @@ pub struct FitReport {
     /// The effects identified with the geometry, their parameters by name.
     pub effects: Vec<EffectReport>,
     /// The GP stage's report, for the GP methods: its hyperparameters.
-    #[serde(skip_serializing_if = "Option::is_none", rename = "compensation")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub residual_gp: Option<ResidualGpReport>,
     /// The prior toward the nominal geometry: the configuration clusters of the data,
     /// each candidate strength's error on them held out, the chosen one and why (absent for

@@ -111,9 +111,9 @@ impl Default for EffectOptions {
 pub struct FitOptions {
     /// The geometric identification.
     pub identification: IdentificationOptions,
-    /// The GP on the residual, step 2 (methods `poe-gp`, `poe-gp-load`); `compensation` in an
-    /// options file, the word of the SPEC's first versions.
-    #[serde(rename = "compensation")]
+    /// The GP on the residual, step 2 (methods `poe-gp`, `poe-gp-load`). Options files written
+    /// before SPEC version 5 call the section `compensation`, which still reads.
+    #[serde(alias = "compensation")]
     pub residual_gp: ResidualGpOptions,
     /// Non-geometric effects identified with the geometry, before any GP. Beyond the paper.
     pub effects: EffectOptions,
@@ -194,7 +194,7 @@ impl FitOptions {
                 "initial_relative" => "a finite number above 0",
                 _ => "a number of at least 0",
             };
-            return Err((last, format!("compensation.gp.{field} is {value}, expected {expected}")));
+            return Err((last, format!("residual_gp.gp.{field} is {value}, expected {expected}")));
         }
         self.effects.gear.validate().map_err(|e| e.in_file("effects.gear"))?;
         let hold = self.effects.hold_beyond_span;
@@ -289,7 +289,7 @@ mod tests {
 
     #[test]
     fn a_gp_field_given_alone_keeps_the_stages_kernel_and_search() {
-        let options = FitOptions::parse("(compensation: (gp: (optimiser: (max_iterations: 100))))", "fit.ron").unwrap();
+        let options = FitOptions::parse("(residual_gp: (gp: (optimiser: (max_iterations: 100))))", "fit.ron").unwrap();
         let default = ResidualGpOptions::default().gp;
         let gp = &options.residual_gp.gp;
         assert_eq!(gp.optimiser.max_iterations, 100);
@@ -343,12 +343,12 @@ mod tests {
 
     #[test]
     fn the_gp_fade_can_be_given_or_turned_off_and_a_ratio_outside_zero_to_one_is_refused_at_its_field() {
-        let options = FitOptions::parse("(compensation: (fade_above_variance_ratio: Some(0.25)))", "fit.ron").unwrap();
+        let options = FitOptions::parse("(residual_gp: (fade_above_variance_ratio: Some(0.25)))", "fit.ron").unwrap();
         assert_eq!(options.residual_gp.fade_above_variance_ratio, Some(0.25));
-        let options = FitOptions::parse("(compensation: (fade_above_variance_ratio: None))", "fit.ron").unwrap();
+        let options = FitOptions::parse("(residual_gp: (fade_above_variance_ratio: None))", "fit.ron").unwrap();
         assert_eq!(options.residual_gp.fade_above_variance_ratio, None);
         for bad in ["1.0", "-0.1", "NaN"] {
-            let text = format!("(compensation: (\n  fade_above_variance_ratio: Some({bad})))");
+            let text = format!("(residual_gp: (\n  fade_above_variance_ratio: Some({bad})))");
             let message = FitOptions::parse(&text, "fit.ron").unwrap_err().to_string();
             assert!(message.contains("fit.ron:2:3") && message.contains("fade_above_variance_ratio is"), "{message}");
         }
@@ -357,15 +357,34 @@ mod tests {
     #[test]
     fn bad_gp_fields_are_refused_with_file_line_and_column() {
         let error =
-            FitOptions::parse("(compensation: (gp: (\n  optimiser: (max_iteration: 1))))", "fit.ron").unwrap_err();
+            FitOptions::parse("(residual_gp: (gp: (\n  optimiser: (max_iteration: 1))))", "fit.ron").unwrap_err();
         let message = error.to_string();
         assert!(message.contains("fit.ron:2:") && message.contains("max_iteration"), "{message}");
-        let error = FitOptions::parse("(compensation: (gp: (optimiser: (\n    function_tolerance: -1.0))))", "fit.ron")
+        let error = FitOptions::parse("(residual_gp: (gp: (optimiser: (\n    function_tolerance: -1.0))))", "fit.ron")
             .unwrap_err();
         let message = error.to_string();
         assert!(message.contains("fit.ron:2:5") && message.contains("function_tolerance is -1"), "{message}");
-        let error = FitOptions::parse("(compensation: (gp: (jitter: (growth: 0.5))))", "fit.ron").unwrap_err();
+        let error = FitOptions::parse("(residual_gp: (gp: (jitter: (growth: 0.5))))", "fit.ron").unwrap_err();
         let message = error.to_string();
-        assert!(message.contains("fit.ron:1:31") && message.contains("jitter.growth is 0.5"), "{message}");
+        assert!(message.contains("fit.ron:1:30") && message.contains("jitter.growth is 0.5"), "{message}");
+    }
+
+    #[test]
+    fn an_options_file_that_calls_the_section_compensation_reads_as_the_same_options() {
+        let new = "(residual_gp: (fade_above_variance_ratio: None, fade_share_rows: 50, gp: (optimiser: (seed: 4))))";
+        let options = FitOptions::parse(new, "fit.ron").unwrap();
+        assert_ne!(options, FitOptions::default(), "the section was read");
+        let old = new.replacen("residual_gp", "compensation", 1);
+        assert_eq!(FitOptions::parse(&old, "old.ron").unwrap(), options, "{old}");
+        let both = "(residual_gp: (fade_share_rows: 50), compensation: (fade_share_rows: 50))";
+        assert!(FitOptions::parse(both, "both.ron").is_err(), "the section given twice is refused");
+        let message = FitOptions::parse(
+            "(compensation: (
+  fade_share_rows: 0))",
+            "old.ron",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(message.contains("old.ron:2:3") && message.contains("fade_share_rows is 0"), "{message}");
     }
 }

@@ -151,7 +151,7 @@ impl Model {
 
     /// `calib eval --json`: the report's JSON text, the position error of each row (mm), the
     /// rotation error of each row (mrad; `None` unless data and model are full pose) and the
-    /// warnings the CLI prints.
+    /// notes and warnings the CLI prints, in its order (`calib::flow::EvalNotices`).
     #[allow(clippy::type_complexity)]
     fn eval<'py>(
         &self,
@@ -159,18 +159,14 @@ impl Model {
         data: &Measurements,
     ) -> PyResult<(String, Bound<'py, PyArray1<f64>>, Option<Bound<'py, PyArray1<f64>>>, Vec<String>)> {
         let (model, name) = (&self.model, Path::new(&self.name));
-        let evaluated = py.detach(|| calib::flow::evaluate(model, name, data.set.clone())).map_err(refused)?;
-        let (evaluation, report) = (&evaluated.evaluation, &evaluated.report);
-        let mut warnings: Vec<String> = report.wrapped.iter().map(ToString::to_string).collect();
-        if report.orientations_not_evaluated {
-            warnings.push(model::ORIENTATIONS_NOT_EVALUATED.to_owned());
-        }
-        warnings.extend(report.other_placement.iter().map(ToString::to_string));
-        warnings.extend(report.warnings.iter().map(ToString::to_string));
-        warnings.extend(report.out_of_range.iter().map(ToString::to_string));
-        warnings.extend(report.beyond_joint_limits.iter().map(ToString::to_string));
-        warnings.extend(report.sigma_fallback.iter().map(ToString::to_string));
-        warnings.extend(report.gp_fade.iter().map(ToString::to_string));
+        // A model loaded from a file is named by it, as the CLI names its `--model`.
+        let from_file = self.fitted.is_none();
+        let evaluated =
+            py.detach(|| calib::flow::evaluate(model, name, from_file, data.set.clone())).map_err(refused)?;
+        let calib::flow::Evaluated { evaluation, report, notices, .. } = evaluated;
+        // `calib eval`'s notes, then its warnings: the same list, raised in the same order.
+        let mut warnings = notices.notes;
+        warnings.extend(notices.warnings);
         let json = serde_json::to_string(&report).map_err(|e| argument("report", e))?;
         let position = PyArray1::from_vec(py, evaluation.errors.iter().map(|e| e.position_mm).collect());
         let rotation: Option<Vec<f64>> = evaluation.errors.iter().map(|e| e.rotation_mrad).collect();
