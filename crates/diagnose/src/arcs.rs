@@ -66,105 +66,190 @@ pub(crate) struct ArcInputs<'a> {
     pub folds: usize,
 }
 
-/// The arc check of every joint in `moving` (0-based) for the selection's effects; `columns_of`
-/// gives a term's weighted columns and prior sd. Beside each check, its folds: the blended
-/// residual each arc's fit leaves on every row (its training rows blended as the fold's model
-/// would blend them, the series' coverage of their own angles).
+/// Per moving joint, its arcs as folds and one pool over them that holds every selected step's
+/// columns in full: the order curves take a series at each of its orders, the arc checks every
+/// step at its chosen order. Both are column subsets of the same rows, whose Gram entries do not
+/// depend on the other columns a pool holds (module `pool`), so one pool per joint serves both
+/// with the numbers a pool of the subset alone would give.
+pub(crate) struct ArcPools {
+    /// Per joint of `moving`, in its order: the 0-based joint, each row's arc and the pool.
+    joints: Vec<(usize, Vec<usize>, Pool)>,
+    /// The kinematic columns (the first ones).
+    kinematic: usize,
+    /// Where each selected step's columns start in every pool.
+    offsets: Vec<usize>,
+    /// How many columns each step has in full.
+    widths: Vec<usize>,
+}
+
+impl ArcPools {
+    /// The pools of `moving`'s joints (0-based) for the selection's steps; `columns_of` gives a
+    /// term's weighted columns and prior sd.
+    pub(crate) fn new(
+        inputs: &ArcInputs<'_>,
+        data: &MeasurementSet,
+        moving: &[usize],
+        selection: &Selection,
+        columns_of: &dyn Fn(usize) -> (Vec<Vec<f64>>, Option<f64>),
+    ) -> Self {
+        let kinematic = inputs.design.kinematic.ncols();
+        let full: Vec<(Vec<Vec<f64>>, Option<f64>)> = selection.steps.iter().map(|s| columns_of(s.term)).collect();
+        let widths: Vec<usize> = full.iter().map(|(c, _)| c.len()).collect();
+        let offsets = widths
+            .iter()
+            .scan(kinematic, |next, &w| {
+                let at = *next;
+                *next += w;
+                Some(at)
+            })
+            .collect();
+        let blocks: Vec<Block<'_>> = full.iter().map(|(c, sd)| (c.as_slice(), *sd)).collect();
+        // Each joint's pool on its own, side by side, collected in the joints' order.
+        let joints = moving
+            .par_iter()
+            .map(|&joint| {
+                let fold = arc_folds(data, joint, inputs.folds);
+                let (design, prior, folds) = (inputs.design, inputs.kinematic_prior, inputs.folds);
+                let pool = Pool::single_folds(design, prior, &blocks, &fold, folds, inputs.prior);
+                (joint, fold, pool)
+            })
+            .collect();
+        Self { joints, kinematic, offsets, widths }
+    }
+
+    /// Step `s`'s columns in the pools, its first `width`.
+    fn columns(&self, s: usize, width: usize) -> std::ops::Range<usize> {
+        self.offsets[s]..self.offsets[s] + width.min(self.widths[s])
+    }
+
+    /// How many of step `s`'s columns it takes at the order the fit on every row uses.
+    fn at_its_order(&self, s: usize, step: &Step) -> usize {
+        step.scored.order.map_or(self.widths[s], |h| (2 * h as usize).min(self.widths[s]))
+    }
+}
+
+/// The arc check of every joint of `pools` for the selection's effects. Beside each check, its
+/// folds: the blended residual each arc's fit leaves on every row (its training rows blended as
+/// the fold's model would blend them, the series' coverage of their own angles).
 pub(crate) fn arc_checks(
     inputs: &ArcInputs<'_>,
+    pools: &ArcPools,
     data: &MeasurementSet,
-    moving: &[usize],
     terms: &[Term],
     selection: &Selection,
-    columns_of: &dyn Fn(usize) -> (Vec<Vec<f64>>, Option<f64>),
 ) -> Result<Vec<(ArcCheck, Vec<FoldResiduals>)>, Error> {
-    // The selected terms' columns, each at the order the fit on every row uses.
-    let mut owned: Vec<(Vec<Vec<f64>>, Option<f64>)> = Vec::new();
-    let mut series: Vec<Option<(usize, u32)>> = Vec::new();
-    for step in &selection.steps {
-        let (columns, sd) = at_its_order(step, columns_of);
-        let gear = match &terms[step.term].model {
+    // The selected series, each at the order the fit on every row uses.
+    let series: Vec<(usize, u32)> = selection
+        .steps
+        .iter()
+        .filter_map(|step| match &terms[step.term].model {
             IdentifiedEffect::GearPeriodic(g) => step.scored.order.map(|h| (g.joint, h)),
             _ => None,
-        };
-        series.push(gear);
-        owned.push((columns, sd));
-    }
-    let blocks: Vec<Block<'_>> = owned.iter().map(|(c, sd)| (c.as_slice(), *sd)).collect();
-    let kinematic = inputs.design.kinematic.ncols();
-    let width: usize = owned.iter().map(|(c, _)| c.len()).sum();
-    let all: Vec<usize> = (0..kinematic + width).collect();
-    // Each joint's arcs on their own pool, side by side, collected in the joints' order.
-    moving
+        })
+        .collect();
+    // The kinematics, then every selected step at its order.
+    let kinematic = pools.kinematic;
+    let all: Vec<usize> = (0..kinematic)
+        .chain(selection.steps.iter().enumerate().flat_map(|(s, step)| pools.columns(s, pools.at_its_order(s, step))))
+        .collect();
+    // Each joint's arcs side by side, collected in the joints' order.
+    pools
+        .joints
         .par_iter()
-        .map(|&joint| -> Result<(ArcCheck, Vec<FoldResiduals>), Error> {
-            let fold = arc_folds(data, joint, inputs.folds);
-            let pool =
-                Pool::single_folds(inputs.design, inputs.kinematic_prior, &blocks, &fold, inputs.folds, inputs.prior);
-            let mut before = Vec::with_capacity(data.rows.len());
-            let mut after = Vec::with_capacity(data.rows.len());
-            let mut folds = Vec::with_capacity(inputs.folds);
-            for f in 0..inputs.folds {
-                let poses = pool.fold_poses(f);
-                if poses.is_empty() {
-                    continue;
-                }
-                let base = pool.solve(&[f], &all[..kinematic])?;
-                let full = if width == 0 { base.clone() } else { pool.solve(&[f], &all)? };
-                let betas = [base, full];
-                let residuals = pool.residuals(f, &all, &betas);
-                // Each series' coverage as its fit on this fold's training rows records it.
-                let coverage: Vec<AngleCoverage> = series
-                    .iter()
-                    .flatten()
-                    .map(|&(j, h)| {
-                        let angles: Vec<f64> = (0..data.rows.len())
-                            .filter(|&i| fold[i] != f)
-                            .filter_map(|i| data.rows[i].q.get(j).copied())
-                            .collect();
-                        AngleCoverage::of(j, &(1..=h).collect::<Vec<u32>>(), &angles, inputs.gear)
-                    })
-                    .collect();
-                // The training rows, blended as this fold's model blends them: each series by the
-                // coverage of its own fit's angles.
-                let mut fold_residuals = vec![Vector6::zeros(); data.rows.len()];
-                let mut alone = vec![(Vector6::zeros(), 1.0); data.rows.len()];
-                for g in (0..inputs.folds).filter(|&g| g != f) {
-                    let fitted = pool.residuals(g, &all, &betas);
-                    for ((&i, b), a) in pool.fold_poses(g).iter().zip(&fitted[0]).zip(&fitted[1]) {
-                        let w: f64 = coverage.iter().map(|s| s.held_and_weight(data.rows[i].q[s.joint]).1).product();
-                        fold_residuals[i] = a * w + b * (1.0 - w);
-                        alone[i] = (*b, w);
-                    }
-                }
-                for ((&i, b), a) in poses.iter().zip(&residuals[0]).zip(&residuals[1]) {
-                    // A held-out arc of the joint's own angles is where its series knows nothing:
-                    // faded whole, whatever the width of the arc (the model fades it in a gap wider
-                    // than half its shortest period; an arc of a fifth of the rows may be narrower).
-                    let w: f64 = coverage
-                        .iter()
-                        .map(|g| if g.joint == joint { 0.0 } else { g.held_and_weight(data.rows[i].q[g.joint]).1 })
-                        .product();
-                    let blended: Vector6 = a * w + b * (1.0 - w);
-                    before.push(b.fixed_rows::<3>(0).norm());
-                    after.push(blended.fixed_rows::<3>(0).norm());
-                    fold_residuals[i] = blended;
-                    alone[i] = (*b, w);
-                }
-                folds.push(FoldResiduals { held_out: poses.to_vec(), residuals: fold_residuals, alone });
-            }
-            let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64 * 1e3;
-            let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max) * 1e3;
-            let check = ArcCheck {
-                joint: joint + 1,
-                before_mm: mean(&before),
-                after_mm: mean(&after),
-                before_max_mm: max(&before),
-                after_max_mm: max(&after),
-            };
-            Ok((check, folds))
+        .map(|(joint, fold, pool)| {
+            JointArcs { inputs, data, joint: *joint, fold, pool, all: &all, kinematic, series: &series }.check()
         })
         .collect()
+}
+
+/// One joint's arcs: its pool, and the columns and series of the selected steps.
+struct JointArcs<'a> {
+    inputs: &'a ArcInputs<'a>,
+    data: &'a MeasurementSet,
+    /// The 0-based joint whose arcs are left out.
+    joint: usize,
+    /// Each row's arc.
+    fold: &'a [usize],
+    pool: &'a Pool,
+    /// The kinematic columns, then every selected step's at its order.
+    all: &'a [usize],
+    kinematic: usize,
+    /// Each selected series' joint and order.
+    series: &'a [(usize, u32)],
+}
+
+impl JointArcs<'_> {
+    /// The joint's check and its folds.
+    fn check(&self) -> Result<(ArcCheck, Vec<FoldResiduals>), Error> {
+        let mut before = Vec::with_capacity(self.data.rows.len());
+        let mut after = Vec::with_capacity(self.data.rows.len());
+        let mut folds = Vec::with_capacity(self.inputs.folds);
+        for f in 0..self.inputs.folds {
+            if !self.pool.fold_poses(f).is_empty() {
+                folds.push(self.arc(f, &mut before, &mut after)?);
+            }
+        }
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64 * 1e3;
+        let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max) * 1e3;
+        let check = ArcCheck {
+            joint: self.joint + 1,
+            before_mm: mean(&before),
+            after_mm: mean(&after),
+            before_max_mm: max(&before),
+            after_max_mm: max(&after),
+        };
+        Ok((check, folds))
+    }
+
+    /// Arc `f` held out: appends its poses' errors before and after to `before` and `after`;
+    /// returns its fold.
+    fn arc(&self, f: usize, before: &mut Vec<f64>, after: &mut Vec<f64>) -> Result<FoldResiduals, Error> {
+        let (data, pool, all, fold) = (self.data, self.pool, self.all, self.fold);
+        let poses = pool.fold_poses(f);
+        let base = pool.solve(&[f], &all[..self.kinematic])?;
+        let full = if all.len() == self.kinematic { base.clone() } else { pool.solve(&[f], all)? };
+        let betas = [base, full];
+        let residuals = pool.residuals(f, all, &betas);
+        // Each series' coverage as its fit on this fold's training rows records it.
+        let coverage: Vec<AngleCoverage> = self
+            .series
+            .iter()
+            .map(|&(j, h)| {
+                let angles: Vec<f64> = (0..data.rows.len())
+                    .filter(|&i| fold[i] != f)
+                    .filter_map(|i| data.rows[i].q.get(j).copied())
+                    .collect();
+                AngleCoverage::of(j, &(1..=h).collect::<Vec<u32>>(), &angles, self.inputs.gear)
+            })
+            .collect();
+        // The training rows, blended as this fold's model blends them: each series by the
+        // coverage of its own fit's angles.
+        let mut fold_residuals = vec![Vector6::zeros(); data.rows.len()];
+        let mut alone = vec![(Vector6::zeros(), 1.0); data.rows.len()];
+        for g in (0..self.inputs.folds).filter(|&g| g != f) {
+            let fitted = pool.residuals(g, all, &betas);
+            for ((&i, b), a) in pool.fold_poses(g).iter().zip(&fitted[0]).zip(&fitted[1]) {
+                let w: f64 = coverage.iter().map(|s| s.held_and_weight(data.rows[i].q[s.joint]).1).product();
+                fold_residuals[i] = a * w + b * (1.0 - w);
+                alone[i] = (*b, w);
+            }
+        }
+        for ((&i, b), a) in poses.iter().zip(&residuals[0]).zip(&residuals[1]) {
+            // A held-out arc of the joint's own angles is where its series knows nothing:
+            // faded whole, whatever the width of the arc (the model fades it in a gap wider
+            // than half its shortest period; an arc of a fifth of the rows may be narrower).
+            let w: f64 = coverage
+                .iter()
+                .map(|g| if g.joint == self.joint { 0.0 } else { g.held_and_weight(data.rows[i].q[g.joint]).1 })
+                .product();
+            let blended: Vector6 = a * w + b * (1.0 - w);
+            before.push(b.fixed_rows::<3>(0).norm());
+            after.push(blended.fixed_rows::<3>(0).norm());
+            fold_residuals[i] = blended;
+            alone[i] = (*b, w);
+        }
+        Ok(FoldResiduals { held_out: poses.to_vec(), residuals: fold_residuals, alone })
+    }
 }
 
 /// The mean of `value` over `arcs`; `None` without any.
@@ -172,17 +257,25 @@ pub(crate) fn mean_of(arcs: &[ArcCheck], value: impl Fn(&ArcCheck) -> f64) -> Op
     (!arcs.is_empty()).then(|| arcs.iter().map(value).sum::<f64>() / arcs.len() as f64)
 }
 
-/// A step's weighted columns (`columns_of`) and prior sd, a series' cut to the order the fit on
-/// every row uses.
-fn at_its_order(
-    step: &Step,
-    columns_of: &dyn Fn(usize) -> (Vec<Vec<f64>>, Option<f64>),
-) -> (Vec<Vec<f64>>, Option<f64>) {
-    let (mut columns, sd) = columns_of(step.term);
-    if let Some(h) = step.scored.order {
-        columns.truncate(2 * h as usize);
-    }
-    (columns, sd)
+/// The selected series with a curve: (step, its joint, its orders that its columns reach), where
+/// another joint moves.
+fn series_with_curves(pools: &ArcPools, terms: &[Term], selection: &Selection) -> Vec<(usize, usize, Vec<u32>)> {
+    selection
+        .steps
+        .iter()
+        .enumerate()
+        .filter_map(|(s, step)| {
+            let term = &terms[step.term];
+            let (Some(orders), IdentifiedEffect::GearPeriodic(gear)) = (&term.orders, &term.model) else {
+                return None;
+            };
+            if !pools.joints.iter().any(|&(k, _, _)| k != gear.joint) {
+                return None;
+            }
+            let orders = orders.iter().copied().filter(|&h| 2 * h as usize <= pools.widths[s]).collect();
+            Some((s, gear.joint, orders))
+        })
+        .collect()
 }
 
 /// A series' orders and its mean held-out position error at each, m.
@@ -194,44 +287,15 @@ pub(crate) type OrderCurve = (Vec<u32>, Vec<f64>);
 /// other joint moves. The series' own joint's arcs are left out of this: there the model fades
 /// the series whole, whatever its order.
 ///
-/// One pool per moving joint serves every series: it holds every selected step's columns in
-/// full, and each series' fits take the columns of the others at their orders and its own at
-/// each of its orders (a pool per series and joint built the same Gram matrices again for each).
+/// Each joint's pool (`ArcPools`) serves every series: each series' fits take the columns of the
+/// other steps at their orders and its own at each of its orders.
 pub(crate) fn order_curves(
-    inputs: &ArcInputs<'_>,
-    data: &MeasurementSet,
-    moving: &[usize],
+    pools: &ArcPools,
     terms: &[Term],
     selection: &Selection,
-    columns_of: &dyn Fn(usize) -> (Vec<Vec<f64>>, Option<f64>),
 ) -> Result<Vec<Option<OrderCurve>>, Error> {
-    let kinematic = inputs.design.kinematic.ncols();
     let steps = &selection.steps;
-    // Every step's columns in full, and how many of them it takes at its chosen order.
-    let full: Vec<(Vec<Vec<f64>>, Option<f64>)> = steps.iter().map(|step| columns_of(step.term)).collect();
-    let at_order: Vec<usize> = steps.iter().map(|step| at_its_order(step, columns_of).0.len()).collect();
-    let mut offsets = Vec::with_capacity(steps.len());
-    let mut next = kinematic;
-    for (columns, _) in &full {
-        offsets.push(next);
-        next += columns.len();
-    }
-    // The series with a curve: (step, its joint, its orders that its columns reach).
-    let curves: Vec<(usize, usize, Vec<u32>)> = steps
-        .iter()
-        .enumerate()
-        .filter_map(|(s, step)| {
-            let term = &terms[step.term];
-            let (Some(orders), IdentifiedEffect::GearPeriodic(gear)) = (&term.orders, &term.model) else {
-                return None;
-            };
-            if !moving.iter().any(|&k| k != gear.joint) {
-                return None;
-            }
-            let orders = orders.iter().copied().filter(|&h| 2 * h as usize <= full[s].0.len()).collect();
-            Some((s, gear.joint, orders))
-        })
-        .collect();
+    let curves = series_with_curves(pools, terms, selection);
     let mut sums: Vec<Vec<f64>> = curves.iter().map(|(_, _, orders)| vec![0.0; orders.len()]).collect();
     let mut counts = vec![0usize; curves.len()];
     // Each series' columns: the kinematics, the other steps at their orders, then this series in
@@ -239,43 +303,37 @@ pub(crate) fn order_curves(
     let columns: Vec<(Vec<usize>, Vec<usize>)> = curves
         .iter()
         .map(|&(s, _, _)| {
-            let base = (0..kinematic)
-                .chain((0..steps.len()).filter(|&t| t != s).flat_map(|t| offsets[t]..offsets[t] + at_order[t]))
-                .collect();
-            (base, (offsets[s]..offsets[s] + full[s].0.len()).collect())
+            let others = (0..steps.len()).filter(|&t| t != s);
+            let base =
+                (0..pools.kinematic).chain(others.flat_map(|t| pools.columns(t, pools.at_its_order(t, &steps[t]))));
+            (base.collect(), pools.columns(s, pools.widths[s]).collect())
         })
         .collect();
-    if !curves.is_empty() {
-        let blocks: Vec<Block<'_>> = full.iter().map(|(c, sd)| (c.as_slice(), *sd)).collect();
-        for &k in moving {
-            if curves.iter().all(|&(_, joint, _)| joint == k) {
-                continue;
+    for (k, _, pool) in &pools.joints {
+        if curves.iter().all(|(_, joint, _)| joint == k) {
+            continue;
+        }
+        // Every (series, fold) pair's held-out residuals side by side, then summed in the
+        // serial order, so the curve is the same to the bit.
+        let pairs: Vec<(usize, usize)> = curves
+            .iter()
+            .enumerate()
+            .filter(|(_, (_, joint, _))| joint != k)
+            .flat_map(|(c, _)| (0..pool.folds()).map(move |f| (c, f)))
+            .filter(|&(_, f)| !pool.fold_poses(f).is_empty())
+            .collect();
+        let residuals = pairs
+            .par_iter()
+            .map(|&(c, f)| {
+                let (base, series) = &columns[c];
+                pool.series_residuals(&[f], &[f], base, series, &curves[c].2)
+            })
+            .collect::<Result<Vec<_>, Error>>()?;
+        for (&(c, f), residuals) in pairs.iter().zip(&residuals) {
+            for (total, r) in sums[c].iter_mut().zip(&residuals[0]) {
+                *total += r.iter().map(|v| v.fixed_rows::<3>(0).norm()).sum::<f64>();
             }
-            let fold = arc_folds(data, k, inputs.folds);
-            let pool =
-                Pool::single_folds(inputs.design, inputs.kinematic_prior, &blocks, &fold, inputs.folds, inputs.prior);
-            // Every (series, fold) pair's held-out residuals side by side, then summed in the
-            // serial order, so the curve is the same to the bit.
-            let pairs: Vec<(usize, usize)> = curves
-                .iter()
-                .enumerate()
-                .filter(|(_, (_, joint, _))| *joint != k)
-                .flat_map(|(c, _)| (0..inputs.folds).map(move |f| (c, f)))
-                .filter(|&(_, f)| !pool.fold_poses(f).is_empty())
-                .collect();
-            let residuals = pairs
-                .par_iter()
-                .map(|&(c, f)| {
-                    let (base, series) = &columns[c];
-                    pool.series_residuals(&[f], &[f], base, series, &curves[c].2)
-                })
-                .collect::<Result<Vec<_>, Error>>()?;
-            for (&(c, f), residuals) in pairs.iter().zip(&residuals) {
-                for (total, r) in sums[c].iter_mut().zip(&residuals[0]) {
-                    *total += r.iter().map(|v| v.fixed_rows::<3>(0).norm()).sum::<f64>();
-                }
-                counts[c] += pool.fold_poses(f).len();
-            }
+            counts[c] += pool.fold_poses(f).len();
         }
     }
     let mut out = vec![None; steps.len()];

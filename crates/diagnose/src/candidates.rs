@@ -171,36 +171,58 @@ pub(crate) fn build_candidates(
         longest_order: settings.orders.iter().copied().max().unwrap_or(1),
         options: settings.inputs,
     };
-    let nonzero = |columns: &[Vec<f64>]| columns.iter().flatten().any(|v| v.abs() > 1e-12);
-    let with_columns = |offered: Vec<CandidateModel>| -> Result<Vec<Candidate>, Error> {
-        let mut kept = Vec::new();
-        for offer in offered {
-            let columns = columns_of(design, &offer.effect, model, data)?;
-            // Columns that are all zero, or features the same on every row (a constant joint offset
-            // or frame change, which the geometry holds): nothing this candidate could explain.
-            if columns.is_empty()
-                || (offer.only_if_nonzero && !nonzero(&columns))
-                || offer.effect.features_constant(data)?
-            {
-                continue;
-            }
-            kept.push(Candidate {
-                effect: Effect::from(offer.effect.effect_kind()),
-                joints: offer.effect.joints(),
-                columns,
-                prior_sd: offer.series.then_some(settings.series_sd),
-                orders: offer.series.then(|| settings.orders.to_vec()),
-                model: offer.effect,
-            });
-        }
-        Ok(kept)
-    };
+    let keep = |offered| with_columns(design, model, data, settings, offered);
     // Each joint's candidates are independent: built in parallel, then numbered in joint order,
     // so the candidate list (and everything after it) is the same on any number of threads.
     let per_joint: Vec<Vec<Candidate>> = (0..n)
         .into_par_iter()
-        .map(|j| with_columns(IdentifiedEffect::joint_candidates(&context, j)?))
+        .map(|j| keep(IdentifiedEffect::joint_candidates(&context, j)?))
         .collect::<Result<_, _>>()?;
+    let (mut candidates, sides) = numbered(robot, per_joint, &load);
+    candidates.extend(keep(IdentifiedEffect::global_candidates(&context)?)?);
+    Ok((candidates, sides))
+}
+
+/// The candidates of `offered` with their columns, each kept where its columns can explain
+/// something.
+fn with_columns(
+    design: &Design,
+    model: &LocalPoe,
+    data: &BoundSet<'_>,
+    settings: &Settings<'_>,
+    offered: Vec<CandidateModel>,
+) -> Result<Vec<Candidate>, Error> {
+    let nonzero = |columns: &[Vec<f64>]| columns.iter().flatten().any(|v| v.abs() > 1e-12);
+    let mut kept = Vec::new();
+    for offer in offered {
+        let columns = columns_of(design, &offer.effect, model, data)?;
+        // Columns that are all zero, or features the same on every row (a constant joint offset
+        // or frame change, which the geometry holds): nothing this candidate could explain.
+        if columns.is_empty()
+            || (offer.only_if_nonzero && !nonzero(&columns))
+            || offer.effect.features_constant(data)?
+        {
+            continue;
+        }
+        kept.push(Candidate {
+            effect: Effect::from(offer.effect.effect_kind()),
+            joints: offer.effect.joints(),
+            columns,
+            prior_sd: offer.series.then_some(settings.series_sd),
+            orders: offer.series.then(|| settings.orders.to_vec()),
+            model: offer.effect,
+        });
+    }
+    Ok(kept)
+}
+
+/// Every joint's candidates in joint order, and per joint with a gravity-regressor compliance
+/// candidate, what its learnt backlash side is learnt from.
+fn numbered(
+    robot: &RobotDescription,
+    per_joint: Vec<Vec<Candidate>>,
+    load: &LoadFrame,
+) -> (Vec<Candidate>, Vec<SideSource>) {
     let mut candidates = Vec::new();
     let mut sides = Vec::new();
     for (j, built) in per_joint.into_iter().enumerate() {
@@ -223,6 +245,5 @@ pub(crate) fn build_candidates(
         }
         candidates.extend(built);
     }
-    candidates.extend(with_columns(IdentifiedEffect::global_candidates(&context)?)?);
-    Ok((candidates, sides))
+    (candidates, sides)
 }

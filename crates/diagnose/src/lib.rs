@@ -309,8 +309,6 @@ fn series_shapes(
     selection: &Selection,
     data: &MeasurementSet,
 ) -> Result<Vec<Option<SeriesShape>>, Error> {
-    const SAMPLES: usize = 720;
-    const REPORTED: usize = 3;
     let width = |s: &selection::Step| s.scored.order.map_or(terms[s.term].columns.len(), |h| 2 * h as usize);
     let mut columns = pool.kinematic_columns();
     let mut starts = Vec::new();
@@ -329,7 +327,6 @@ fn series_shapes(
             out.push(None);
             continue;
         };
-        let joint = gear.joint;
         // The parameters multiply the features `cos hq / scale`, `sin hq / scale`.
         let coefficient = |l: usize| beta[start + l] / gear.scale.get(l).copied().unwrap_or(1.0);
         let series = |q: f64| -> f64 {
@@ -340,50 +337,65 @@ fn series_shapes(
                 })
                 .sum()
         };
-        let at_rows: Vec<f64> = data.rows.iter().map(|r| series(r.q[joint])).collect();
-        let row_mean = statistics::mean(&at_rows);
-        let rms = (at_rows.iter().map(|v| (v - row_mean).powi(2)).sum::<f64>() / at_rows.len().max(1) as f64).sqrt();
-        let (low, high) = data
-            .rows
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| (a.min(r.q[joint]), b.max(r.q[joint])));
-        let q: Vec<f64> = (0..SAMPLES).map(|i| low + (high - low) * i as f64 / (SAMPLES - 1) as f64).collect();
-        let mut f: Vec<f64> = q.iter().map(|&q| series(q)).collect();
-        let sample_mean = statistics::mean(&f);
-        f.iter_mut().for_each(|v| *v -= sample_mean);
-        let window: Vec<f64> =
-            (0..SAMPLES).map(|i| 0.5 - 0.5 * (std::f64::consts::TAU * i as f64 / (SAMPLES - 1) as f64).cos()).collect();
-        let gain: f64 = window.iter().sum();
-        let shortest_resolved = (std::f64::consts::TAU / (high - low).max(f64::MIN_POSITIVE)).ceil().max(1.0) as u32;
-        let orders: Vec<u32> = (shortest_resolved..=order).collect();
-        let amplitude: Vec<f64> = orders
-            .iter()
-            .map(|&h| {
-                let (mut re, mut im) = (0.0, 0.0);
-                for ((&v, &w), &a) in f.iter().zip(&window).zip(&q) {
-                    let (sin, cos) = (f64::from(h) * a).sin_cos();
-                    re += w * v * cos;
-                    im += w * v * sin;
-                }
-                2.0 * (re * re + im * im).sqrt() / gain
-            })
-            .collect();
-        let mut dominant: Vec<DominantHarmonic> = (0..amplitude.len())
-            .filter(|&i| {
-                (i == 0 || amplitude[i] >= amplitude[i - 1])
-                    && (i + 1 == amplitude.len() || amplitude[i] > amplitude[i + 1])
-            })
-            .map(|i| DominantHarmonic {
-                order: orders[i],
-                period_deg: 360.0 / f64::from(orders[i]),
-                amplitude_urad: amplitude[i] * 1e6,
-            })
-            .collect();
-        dominant.sort_by(|a, b| b.amplitude_urad.total_cmp(&a.amplitude_urad));
-        dominant.truncate(REPORTED);
-        out.push(Some(SeriesShape { rms_urad: rms * 1e6, range_deg: (high - low).to_degrees(), dominant }));
+        out.push(Some(series_shape(&series, data, gear.joint, order)));
     }
     Ok(out)
+}
+
+/// Points of the joint's range a series is sampled on for its periodogram.
+const SHAPE_SAMPLES: usize = 720;
+
+/// The shape of the joint error `series` of `joint` (0-based) up to `order`: its RMS over the
+/// rows, and the local maxima of its windowed periodogram over the joint's range in the data.
+fn series_shape(series: &dyn Fn(f64) -> f64, data: &MeasurementSet, joint: usize, order: u32) -> SeriesShape {
+    const REPORTED: usize = 3;
+    let at_rows: Vec<f64> = data.rows.iter().map(|r| series(r.q[joint])).collect();
+    let row_mean = statistics::mean(&at_rows);
+    let rms = (at_rows.iter().map(|v| (v - row_mean).powi(2)).sum::<f64>() / at_rows.len().max(1) as f64).sqrt();
+    let (low, high) =
+        data.rows.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), r| (a.min(r.q[joint]), b.max(r.q[joint])));
+    let q: Vec<f64> = (0..SHAPE_SAMPLES).map(|i| low + (high - low) * i as f64 / (SHAPE_SAMPLES - 1) as f64).collect();
+    let shortest_resolved = (std::f64::consts::TAU / (high - low).max(f64::MIN_POSITIVE)).ceil().max(1.0) as u32;
+    let orders: Vec<u32> = (shortest_resolved..=order).collect();
+    let amplitude = periodogram(series, &q, &orders);
+    let mut dominant: Vec<DominantHarmonic> = (0..amplitude.len())
+        .filter(|&i| {
+            (i == 0 || amplitude[i] >= amplitude[i - 1])
+                && (i + 1 == amplitude.len() || amplitude[i] > amplitude[i + 1])
+        })
+        .map(|i| DominantHarmonic {
+            order: orders[i],
+            period_deg: 360.0 / f64::from(orders[i]),
+            amplitude_urad: amplitude[i] * 1e6,
+        })
+        .collect();
+    dominant.sort_by(|a, b| b.amplitude_urad.total_cmp(&a.amplitude_urad));
+    dominant.truncate(REPORTED);
+    SeriesShape { rms_urad: rms * 1e6, range_deg: (high - low).to_degrees(), dominant }
+}
+
+/// The amplitude of each of `orders` in `series` sampled at `q`, its mean removed and
+/// Hann-windowed.
+fn periodogram(series: &dyn Fn(f64) -> f64, q: &[f64], orders: &[u32]) -> Vec<f64> {
+    let mut f: Vec<f64> = q.iter().map(|&q| series(q)).collect();
+    let sample_mean = statistics::mean(&f);
+    f.iter_mut().for_each(|v| *v -= sample_mean);
+    let window: Vec<f64> = (0..SHAPE_SAMPLES)
+        .map(|i| 0.5 - 0.5 * (std::f64::consts::TAU * i as f64 / (SHAPE_SAMPLES - 1) as f64).cos())
+        .collect();
+    let gain: f64 = window.iter().sum();
+    orders
+        .iter()
+        .map(|&h| {
+            let (mut re, mut im) = (0.0, 0.0);
+            for ((&v, &w), &a) in f.iter().zip(&window).zip(q) {
+                let (sin, cos) = (f64::from(h) * a).sin_cos();
+                re += w * v * cos;
+                im += w * v * sin;
+            }
+            2.0 * (re * re + im * im).sqrt() / gain
+        })
+        .collect()
 }
 
 /// Diagnoses `data` measured on `robot`.
@@ -426,15 +438,7 @@ fn diagnosis(robot: &RobotDescription, bound: &BoundSet<'_>, options: &DiagnoseO
     let pooled = Pooled::new(robot, &nominal, &geometry, bound, options)?;
     let (pool, terms) = (&pooled.pool, &pooled.terms);
     let mut selection = timings::phase("selection", || selection::select(pool, terms, &options.selection))?;
-    let arc_inputs = arcs::ArcInputs {
-        design: &geometry.design,
-        kinematic_prior: &pooled.kinematic_prior,
-        prior: &options.prior,
-        gear: &effects::GearOptions::default(),
-        folds: options.arc_folds,
-    };
-    let order_curves = choose_series_orders(&arc_inputs, data, &geometry.moving, &pooled, &mut selection, options)?;
-    let (arcs, heldout_folds) = arc_checks(&arc_inputs, data, &geometry.moving, &pooled, &selection)?;
+    let (order_curves, arcs, heldout_folds) = over_arcs(&geometry, data, &pooled, &mut selection, options)?;
     let all_selected = selection.last();
     let checks = StructureChecks::run(&geometry, data, &pooled.fold, &selection, options)?;
     let noise = noise_floor(data, options);
@@ -569,21 +573,44 @@ impl Pooled {
     }
 }
 
+/// Each selected series' order curve, the arc checks and the folds (`over_arcs`).
+type OverArcs = (Vec<Vec<OrderScore>>, Vec<ArcCheck>, HeldoutFolds);
+
+/// What the arcs decide and measure: each selected series' order (its curves), then the arc
+/// checks and the folds, from one pool per moving joint.
+fn over_arcs(
+    geometry: &Geometry,
+    data: &MeasurementSet,
+    pooled: &Pooled,
+    selection: &mut Selection,
+    options: &DiagnoseOptions,
+) -> Result<OverArcs, Error> {
+    let arc_inputs = arcs::ArcInputs {
+        design: &geometry.design,
+        kinematic_prior: &pooled.kinematic_prior,
+        prior: &options.prior,
+        gear: &effects::GearOptions::default(),
+        folds: options.arc_folds,
+    };
+    let arc_pools = timings::phase("arc pools", || {
+        arcs::ArcPools::new(&arc_inputs, data, &geometry.moving, selection, &|t| pooled.columns_of(t))
+    });
+    let order_curves = choose_series_orders(&arc_pools, pooled, selection, options)?;
+    let (arcs, heldout_folds) = arc_checks(&arc_inputs, &arc_pools, data, pooled, selection)?;
+    Ok((order_curves, arcs, heldout_folds))
+}
+
 /// Each selected series' order: its random folds' curve and its curve over the other joints'
 /// arcs, weighed (`SelectionOptions::arc_order_weight`). Returns every selected step's curve.
 fn choose_series_orders(
-    arc_inputs: &arcs::ArcInputs<'_>,
-    data: &MeasurementSet,
-    moving: &[usize],
+    arc_pools: &arcs::ArcPools,
     pooled: &Pooled,
     selection: &mut Selection,
     options: &DiagnoseOptions,
 ) -> Result<Vec<Vec<OrderScore>>, Error> {
     let weight = options.selection.arc_order_weight;
     let arc_curves = if weight > 0.0 {
-        timings::phase("arc order curves", || {
-            arcs::order_curves(arc_inputs, data, moving, &pooled.terms, selection, &|t| pooled.columns_of(t))
-        })?
+        timings::phase("arc order curves", || arcs::order_curves(arc_pools, &pooled.terms, selection))?
     } else {
         vec![None; selection.steps.len()]
     };
@@ -617,20 +644,19 @@ fn choose_series_orders(
 /// are left out; and the random folds and the arcs fold by fold, for a stage fitted on top.
 fn arc_checks(
     arc_inputs: &arcs::ArcInputs<'_>,
+    arc_pools: &arcs::ArcPools,
     data: &MeasurementSet,
-    moving: &[usize],
     pooled: &Pooled,
     selection: &Selection,
 ) -> Result<(Vec<ArcCheck>, HeldoutFolds), Error> {
-    let (arcs, arc_folds): (Vec<ArcCheck>, Vec<(usize, Vec<FoldResiduals>)>) = timings::phase("arcs", || {
-        arcs::arc_checks(arc_inputs, data, moving, &pooled.terms, selection, &|t| pooled.columns_of(t))
-    })?
-    .into_iter()
-    .map(|(check, folds)| {
-        let joint = check.joint;
-        (check, (joint, folds))
-    })
-    .unzip();
+    let (arcs, arc_folds): (Vec<ArcCheck>, Vec<(usize, Vec<FoldResiduals>)>) =
+        timings::phase("arcs", || arcs::arc_checks(arc_inputs, arc_pools, data, &pooled.terms, selection))?
+            .into_iter()
+            .map(|(check, folds)| {
+                let joint = check.joint;
+                (check, (joint, folds))
+            })
+            .unzip();
     let heldout_folds = HeldoutFolds {
         rows: data.rows.clone(),
         random: fold_residuals::random_folds(&pooled.pool, &selection.last().fold_columns)?,

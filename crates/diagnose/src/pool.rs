@@ -17,14 +17,19 @@ use super::statistics::mean;
 use crate::ErrorKind;
 use errors::Error;
 use faer::linalg::matmul::matmul;
+use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
-use faer::{Accum, Mat, Par, Side};
+use faer::{Accum, Mat, MatRef, Par, Side};
 use lie::Vector6;
 use poe::LocalPoe;
 use rayon::prelude::*;
 
 /// One fold's weighted rows `X_f`, targets `y_f`, Gram matrix `X_fᵀ X_f` and `X_fᵀ y_f`.
 type FoldProducts = (Mat<f64>, Vec<f64>, Mat<f64>, Vec<f64>);
+
+/// Per set of new columns and fold: their products with every column up to them, and with the
+/// targets.
+type CrossProducts = (Vec<Vec<Mat<f64>>>, Vec<Vec<Vec<f64>>>);
 
 /// The prior standard deviation of each column's parameter.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -159,6 +164,107 @@ impl Factor {
     }
 }
 
+/// `xᵀ x`: its lower triangle multiplied, then mirrored. The product's SIMD kernels keep one
+/// accumulator per entry and add a column pair's products in row order whatever the tile, the
+/// triangle or the matrix's width, and `a·b = b·a` exactly; so the mirror is bit for bit the upper
+/// triangle a full product would give, and an entry is the same in any pool over the same rows
+/// that holds both its columns (test `a_gram_entry_does_not_depend_on_the_other_columns`).
+fn gram(x: MatRef<'_, f64>) -> Mat<f64> {
+    let n = x.ncols();
+    let mut g = Mat::<f64>::zeros(n, n);
+    triangular::matmul(
+        g.as_mut(),
+        BlockStructure::TriangularLower,
+        Accum::Replace,
+        x.transpose(),
+        BlockStructure::Rectangular,
+        x,
+        BlockStructure::Rectangular,
+        1.0,
+        Par::Seq,
+    );
+    for j in 0..n {
+        for i in j + 1..n {
+            g[(j, i)] = g[(i, j)];
+        }
+    }
+    g
+}
+
+/// Each fold's weighted rows, targets and products (module doc); `column(c)` is pool column `c`
+/// on every row.
+///
+/// One fold per task, each product sequential: the sums run in the same order on any number of
+/// threads, so the pool (and the diagnosis) is the same serial or parallel.
+fn fold_products<'a>(
+    design: &Design,
+    column: &(dyn Fn(usize) -> &'a [f64] + Sync),
+    columns: usize,
+    fold_poses: &[Vec<usize>],
+) -> Vec<FoldProducts> {
+    let k = design.rows_per_pose;
+    fold_poses
+        .par_iter()
+        .map(|poses_f| {
+            let rows_f: Vec<usize> = poses_f.iter().flat_map(|&i| (0..k).map(move |r| i * k + r)).collect();
+            // Gathered a column at a time from contiguous columns: a closure per entry
+            // (`Mat::from_fn`) was a fifth of the whole diagnosis on 400-column pools.
+            let mut xf = Mat::<f64>::zeros(rows_f.len(), columns);
+            for c in 0..columns {
+                let source = column(c);
+                for (target, &r) in xf.col_as_slice_mut(c).iter_mut().zip(&rows_f) {
+                    *target = source[r];
+                }
+            }
+            let yf: Vec<f64> = rows_f.iter().map(|&r| design.y[r]).collect();
+            let ym = Mat::<f64>::from_fn(rows_f.len(), 1, |r, _| yf[r]);
+            let g = gram(xf.as_ref());
+            let mut b = Mat::<f64>::zeros(columns, 1);
+            matmul(b.as_mut(), Accum::Replace, xf.transpose(), ym.as_ref(), 1.0, Par::Seq);
+            (xf, yf, g, (0..columns).map(|c| b[(c, 0)]).collect::<Vec<f64>>())
+        })
+        .collect()
+}
+
+/// `Xᵀ X` and `Xᵀ y` over every fold but one, every fold but a pair (with `pairs`), and every
+/// fold, in [`Pool::gram`]'s order, from each fold's own.
+fn left_out_products(fold_gram: &[Mat<f64>], fold_xty: &[Vec<f64>], pairs: bool) -> (Vec<Mat<f64>>, Vec<Vec<f64>>) {
+    let (folds, columns) = (fold_gram.len(), fold_xty.first().map_or(0, Vec::len));
+    let mut gram_all = Mat::<f64>::zeros(columns, columns);
+    let mut xty_all = vec![0.0; columns];
+    for (g, b) in fold_gram.iter().zip(fold_xty) {
+        gram_all += g;
+        xty_all.iter_mut().zip(b).for_each(|(t, v)| *t += v);
+    }
+    let without = |out: &[usize]| {
+        let mut g = gram_all.clone();
+        let mut b = xty_all.clone();
+        for &f in out {
+            g -= &fold_gram[f];
+            b.iter_mut().zip(&fold_xty[f]).for_each(|(t, v)| *t -= v);
+        }
+        (g, b)
+    };
+    let mut gram = Vec::new();
+    let mut xty = Vec::new();
+    let mut push = |(g, b): (Mat<f64>, Vec<f64>)| {
+        gram.push(g);
+        xty.push(b);
+    };
+    for f in 0..folds {
+        push(without(&[f]));
+    }
+    if pairs {
+        for f in 0..folds {
+            for g in f + 1..folds {
+                push(without(&[f, g]));
+            }
+        }
+    }
+    push((gram_all, xty_all));
+    (gram, xty)
+}
+
 /// The prior precision of an effect parameter whose weighted column is `column`: `1/sd²`, or
 /// [`PriorOptions::effect_m`] of RMS tool displacement.
 fn effect_precision(column: &[f64], sd: Option<f64>, k: usize, w: f64, prior: &PriorOptions) -> f64 {
@@ -228,30 +334,7 @@ impl Pool {
         for (i, &f) in fold.iter().enumerate() {
             fold_poses[f].push(i);
         }
-        // One fold per task, each product sequential: the sums run in the same order on any number
-        // of threads, so the pool (and the diagnosis) is the same serial or parallel.
-        let per_fold: Vec<FoldProducts> = fold_poses
-            .par_iter()
-            .map(|poses_f| {
-                let rows_f: Vec<usize> = poses_f.iter().flat_map(|&i| (0..k).map(move |r| i * k + r)).collect();
-                // Gathered a column at a time from contiguous columns: a closure per entry
-                // (`Mat::from_fn`) was a fifth of the whole diagnosis on 400-column pools.
-                let mut xf = Mat::<f64>::zeros(rows_f.len(), columns);
-                for c in 0..columns {
-                    let source = column(c);
-                    for (target, &r) in xf.col_as_slice_mut(c).iter_mut().zip(&rows_f) {
-                        *target = source[r];
-                    }
-                }
-                let yf: Vec<f64> = rows_f.iter().map(|&r| design.y[r]).collect();
-                let ym = Mat::<f64>::from_fn(rows_f.len(), 1, |r, _| yf[r]);
-                let mut g = Mat::<f64>::zeros(columns, columns);
-                matmul(g.as_mut(), Accum::Replace, xf.transpose(), xf.as_ref(), 1.0, Par::Seq);
-                let mut b = Mat::<f64>::zeros(columns, 1);
-                matmul(b.as_mut(), Accum::Replace, xf.transpose(), ym.as_ref(), 1.0, Par::Seq);
-                (xf, yf, g, (0..columns).map(|c| b[(c, 0)]).collect::<Vec<f64>>())
-            })
-            .collect();
+        let per_fold = fold_products(design, &column, columns, &fold_poses);
         let mut x = Vec::with_capacity(folds);
         let mut y = Vec::with_capacity(folds);
         let mut fold_gram = Vec::with_capacity(folds);
@@ -262,38 +345,7 @@ impl Pool {
             fold_gram.push(g);
             fold_xty.push(b);
         }
-        let mut gram_all = Mat::<f64>::zeros(columns, columns);
-        let mut xty_all = vec![0.0; columns];
-        for (g, b) in fold_gram.iter().zip(&fold_xty) {
-            gram_all += g;
-            xty_all.iter_mut().zip(b).for_each(|(t, v)| *t += v);
-        }
-        let without = |out: &[usize]| {
-            let mut g = gram_all.clone();
-            let mut b = xty_all.clone();
-            for &f in out {
-                g -= &fold_gram[f];
-                b.iter_mut().zip(&fold_xty[f]).for_each(|(t, v)| *t -= v);
-            }
-            (g, b)
-        };
-        let mut gram = Vec::new();
-        let mut xty = Vec::new();
-        let mut push = |(g, b): (Mat<f64>, Vec<f64>)| {
-            gram.push(g);
-            xty.push(b);
-        };
-        for f in 0..folds {
-            push(without(&[f]));
-        }
-        if pairs {
-            for f in 0..folds {
-                for g in f + 1..folds {
-                    push(without(&[f, g]));
-                }
-            }
-        }
-        push((gram_all, xty_all));
+        let (gram, xty) = left_out_products(&fold_gram, &fold_xty, pairs);
         Self {
             k,
             weights: design.weights,
@@ -347,8 +399,28 @@ impl Pool {
             end += set.len();
         }
         let total = end;
-        // Per set and fold: the products of its new columns with every column up to them (what
-        // `extend` of that set alone would multiply), and with the targets.
+        let products = self.grow_rows(sets, &ranges, first, total);
+        for index in 0..self.gram.len() {
+            self.grow_gram(index, &ranges, first, &products);
+        }
+        for column in sets.iter().flatten() {
+            self.precision.push(effect_precision(column, sd, k, self.weights.position_m, prior));
+            self.prior_mean.push(0.0);
+        }
+        ranges
+    }
+
+    /// Appends the columns of `sets` (at `ranges`, after the `first` there are) to every fold's
+    /// rows; returns per set and fold the products of its new columns with every column up to
+    /// them (what `extend` of that set alone would multiply), and with the targets.
+    fn grow_rows(
+        &mut self,
+        sets: &[Vec<Vec<f64>>],
+        ranges: &[std::ops::Range<usize>],
+        first: usize,
+        total: usize,
+    ) -> CrossProducts {
+        let k = self.k;
         let mut cross: Vec<Vec<Mat<f64>>> = vec![Vec::with_capacity(self.folds()); sets.len()];
         let mut cross_y: Vec<Vec<Vec<f64>>> = vec![Vec::with_capacity(self.folds()); sets.len()];
         for f in 0..self.folds() {
@@ -358,7 +430,7 @@ impl Pool {
             for c in 0..first {
                 xf.col_as_slice_mut(c).copy_from_slice(self.x[f].col_as_slice(c));
             }
-            for (set, range) in sets.iter().zip(&ranges) {
+            for (set, range) in sets.iter().zip(ranges) {
                 for (l, column) in set.iter().enumerate() {
                     for (r, v) in xf.col_as_slice_mut(range.start + l).iter_mut().enumerate() {
                         *v = column[poses[r / k] * k + r % k];
@@ -384,38 +456,44 @@ impl Pool {
             }
             self.x[f] = xf;
         }
-        for index in 0..self.gram.len() {
-            let left_out = self.left_out_of(index);
-            let mut g = Mat::<f64>::zeros(total, total);
-            for c in 0..first {
-                g.col_as_slice_mut(c)[..first].copy_from_slice(&self.gram[index].col_as_slice(c)[..first]);
-            }
-            // Each set writes its own columns (rows up to its end) and, mirrored, its own rows
-            // left of it: no entry is written by two sets.
-            for (s, range) in ranges.iter().enumerate() {
-                let (old, m) = (range.start, range.len());
-                let mut added_y = vec![0.0; m];
-                for f in (0..self.folds()).filter(|f| !left_out.contains(f)) {
-                    for l in 0..m {
-                        for r in 0..range.end {
-                            let v = cross[s][f][(r, l)];
-                            g[(r, old + l)] += v;
-                            if r < old {
-                                g[(old + l, r)] += v;
-                            }
+        (cross, cross_y)
+    }
+
+    /// Grows Gram matrix `index` from its `first` columns by the sets' products (`grow_rows`)
+    /// over the folds it keeps, and its `Xᵀ y` alike.
+    fn grow_gram(
+        &mut self,
+        index: usize,
+        ranges: &[std::ops::Range<usize>],
+        first: usize,
+        (cross, cross_y): &CrossProducts,
+    ) {
+        let total = ranges.last().map_or(first, |r| r.end);
+        let left_out = self.left_out_of(index);
+        let mut g = Mat::<f64>::zeros(total, total);
+        for c in 0..first {
+            g.col_as_slice_mut(c)[..first].copy_from_slice(&self.gram[index].col_as_slice(c)[..first]);
+        }
+        // Each set writes its own columns (rows up to its end) and, mirrored, its own rows
+        // left of it: no entry is written by two sets.
+        for (s, range) in ranges.iter().enumerate() {
+            let (old, m) = (range.start, range.len());
+            let mut added_y = vec![0.0; m];
+            for f in (0..self.folds()).filter(|f| !left_out.contains(f)) {
+                for l in 0..m {
+                    for r in 0..range.end {
+                        let v = cross[s][f][(r, l)];
+                        g[(r, old + l)] += v;
+                        if r < old {
+                            g[(old + l, r)] += v;
                         }
-                        added_y[l] += cross_y[s][f][l];
                     }
+                    added_y[l] += cross_y[s][f][l];
                 }
-                self.xty[index].extend(added_y);
             }
-            self.gram[index] = g;
+            self.xty[index].extend(added_y);
         }
-        for column in sets.iter().flatten() {
-            self.precision.push(effect_precision(column, sd, k, self.weights.position_m, prior));
-            self.prior_mean.push(0.0);
-        }
-        ranges
+        self.gram[index] = g;
     }
 
     /// The weighted residual rows `y − X β` of the poses of fold `fold` (in their order).
@@ -689,6 +767,30 @@ mod tests {
         let t = m / (sd / (d.len() as f64).sqrt());
         assert!(t < selection.critical_z, "t = {t}");
         assert!(selection.steps[0].z > selection.critical_z);
+    }
+
+    #[test]
+    fn a_gram_entry_does_not_depend_on_the_other_columns() {
+        // 701 rows: more than one block of the product's depth; widths that leave partial tiles.
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let x = Mat::<f64>::from_fn(701, 45, |_, _| normal(&mut rng));
+        let mut full = Mat::<f64>::zeros(45, 45);
+        matmul(full.as_mut(), Accum::Replace, x.transpose(), x.as_ref(), 1.0, Par::Seq);
+        let g = gram(x.as_ref());
+        let bits = |m: &Mat<f64>, i: usize, j: usize| m[(i, j)].to_bits();
+        for i in 0..45 {
+            for j in 0..45 {
+                assert_eq!(bits(&g, i, j), bits(&full, i, j), "({i}, {j}) against the full product");
+            }
+        }
+        // A subset of the columns, in order: the same entries, whatever tiles they now fall in.
+        let subset: Vec<usize> = (0..45).filter(|c| c % 3 != 1 || *c > 40).collect();
+        let sub = gram(Mat::<f64>::from_fn(701, subset.len(), |r, c| x[(r, subset[c])]).as_ref());
+        for (i, &a) in subset.iter().enumerate() {
+            for (j, &b) in subset.iter().enumerate() {
+                assert_eq!(bits(&sub, i, j), bits(&g, a, b), "columns ({a}, {b}) in the subset");
+            }
+        }
     }
 
     #[test]

@@ -173,7 +173,25 @@ impl Diagnosis {
             self.n,
             list(&self.moving_joints)
         ));
-        let verdict = match self.verdict.effect {
+        out.push_str(&self.gross_outliers.summary_line().unwrap_or_default());
+        out.push_str(&format!("  verdict:        {}\n", self.verdict_text()));
+        self.summary_errors(&mut out);
+        for s in &self.selected {
+            out.push_str(&format!(
+                "  selected:       {} -> {:.4} mm (z = {:.1})\n",
+                describe_selected(s),
+                s.heldout_after_mm,
+                s.z
+            ));
+        }
+        self.summary_structure(&mut out);
+        self.summary_floor_and_runners(&mut out);
+        out
+    }
+
+    /// The verdict as the summary words it.
+    fn verdict_text(&self) -> String {
+        match self.verdict.effect {
             _ if self.gross_outliers.attribution_refused => self.gross_outliers.verdict_reason().unwrap_or_default(),
             Effect::None => "none: nothing beats the noise floor significantly".to_owned(),
             Effect::Unknown if self.verdict.joints.is_empty() => {
@@ -191,9 +209,12 @@ impl Diagnosis {
                 list(&self.verdict.joints)
             ),
             _ => describe(self.verdict.effect, &self.verdict.joints, None),
-        };
-        out.push_str(&self.gross_outliers.summary_line().unwrap_or_default());
-        out.push_str(&format!("  verdict:        {verdict}\n"));
+        }
+    }
+
+    /// The summary's held-out errors: with the verdict's effect, every selected effect, and off
+    /// the poses.
+    fn summary_errors(&self, out: &mut String) {
         let change = |after: f64| 100.0 * (1.0 - after / self.heldout_before_mm.max(f64::MIN_POSITIVE));
         out.push_str(&format!(
             "  held-out error: {:.4} mm -> {:.4} mm with the verdict's effect ({:.0} % less)\n",
@@ -217,14 +238,10 @@ impl Diagnosis {
                 per_joint.join(", ")
             ));
         }
-        for s in &self.selected {
-            out.push_str(&format!(
-                "  selected:       {} -> {:.4} mm (z = {:.1})\n",
-                describe_selected(s),
-                s.heldout_after_mm,
-                s.z
-            ));
-        }
+    }
+
+    /// The summary's GP lines: what any smooth model could reach, and what is left.
+    fn summary_structure(&self, out: &mut String) {
         if let Some(gp) = &self.explainable {
             out.push_str(&format!(
                 "  a GP on the joint angles: {:.4} mm held out (what any smooth model could reach)",
@@ -241,6 +258,10 @@ impl Diagnosis {
                 r.heldout_after_gp_mm, r.z
             ));
         }
+    }
+
+    /// The summary's last lines: the noise floor, the best candidates alone, the worst region.
+    fn summary_floor_and_runners(&self, out: &mut String) {
         out.push_str(&format!(
             "  noise floor:    {:.4} mm ({:.4} mm per axis, {})\n",
             self.noise.floor_mm,
@@ -260,7 +281,6 @@ impl Diagnosis {
                 r.dimension, r.bin, r.n, r.before_mm, r.after_mm
             ));
         }
-        out
     }
 
     /// The plots, in the order the markdown shows them: held-out error against each moving joint,
@@ -308,6 +328,19 @@ impl Diagnosis {
     /// The markdown report; `plots` are the file names of [`Diagnosis::error_plots`], relative to it.
     pub fn markdown(&self, plots: &[String]) -> String {
         let mut out = format!("# Diagnosis: {}\n\n```\n{}```\n\n", self.robot, self.summary());
+        self.markdown_which(&mut out);
+        self.markdown_where(&mut out);
+        if !plots.is_empty() {
+            out.push_str("\n## Plots\n\n");
+            for p in plots {
+                out.push_str(&format!("![{p}]({p})\n\n"));
+            }
+        }
+        out
+    }
+
+    /// The report's *Which effect*: every candidate alone, the selected steps, the GP checks.
+    fn markdown_which(&self, out: &mut String) {
         out.push_str("## Which effect\n\nEvery candidate alone on top of the geometric model, cross-validated ");
         out.push_str(&format!(
             "({} poses; a step is kept when its signed-rank z exceeds {:.2}):\n\n",
@@ -353,6 +386,10 @@ impl Diagnosis {
                 ));
             }
         }
+    }
+
+    /// The report's *Where*: the held-out error by region against the noise floor.
+    fn markdown_where(&self, out: &mut String) {
         out.push_str(&format!(
             "\n## Where\n\nHeld-out position error by region (mm), noise floor {:.4} mm ({}).\n\n",
             self.noise.floor_mm,
@@ -370,12 +407,5 @@ impl Diagnosis {
                 r.before_mm / self.noise.floor_mm.max(f64::MIN_POSITIVE)
             ));
         }
-        if !plots.is_empty() {
-            out.push_str("\n## Plots\n\n");
-            for p in plots {
-                out.push_str(&format!("![{p}]({p})\n\n"));
-            }
-        }
-        out
     }
 }

@@ -163,30 +163,7 @@ pub(crate) fn score(pool: &Pool, base: &[Vec<usize>], term: &Term) -> Result<Sco
         });
     };
     let orders: Vec<u32> = orders.iter().copied().filter(|&h| 2 * h as usize <= term.columns.len()).collect();
-    let position_sum = |residuals: &[Vector6]| residuals.iter().map(|r| r.fixed_rows::<3>(0).norm()).sum::<f64>();
-    // Inner cross-validation: for outer fold f, each other fold g in turn is validated by a fit on
-    // every fold but f and g. The pair {f, g} has one training set, so one factorisation serves
-    // both f's and g's inner curves when their bases agree.
-    let mut inner_sum = vec![vec![0.0; orders.len()]; folds];
-    for f in 0..folds {
-        for g in f + 1..folds {
-            if base[f] == base[g] {
-                let both = pool.series_residuals(&[f, g], &[g, f], &base[f], &term.columns, &orders)?;
-                for (outer, validated) in [(f, &both[0]), (g, &both[1])] {
-                    for (sum, r) in inner_sum[outer].iter_mut().zip(validated) {
-                        *sum += position_sum(r);
-                    }
-                }
-            } else {
-                for (outer, v) in [(f, g), (g, f)] {
-                    let one = pool.series_residuals(&[f, g], &[v], &base[outer], &term.columns, &orders)?;
-                    for (sum, r) in inner_sum[outer].iter_mut().zip(&one[0]) {
-                        *sum += position_sum(r);
-                    }
-                }
-            }
-        }
-    }
+    let inner_sum = inner_curves(pool, base, &term.columns, &orders)?;
     let mut fold_orders = Vec::with_capacity(folds);
     let mut outer_sum = vec![0.0; orders.len()];
     let mut residuals = vec![Vector6::zeros(); pool.poses()];
@@ -213,6 +190,40 @@ pub(crate) fn score(pool: &Pool, base: &[Vec<usize>], term: &Term) -> Result<Sco
         fold_orders,
         curve: orders.iter().zip(&outer_sum).map(|(&h, &sum)| (h, sum / rows)).collect(),
     })
+}
+
+/// The position error of residuals, summed.
+fn position_sum(residuals: &[Vector6]) -> f64 {
+    residuals.iter().map(|r| r.fixed_rows::<3>(0).norm()).sum::<f64>()
+}
+
+/// Inner cross-validation of a series over `columns` on top of `base` (each fold's): for outer
+/// fold f, each other fold g in turn is validated by a fit on every fold but f and g. The pair
+/// {f, g} has one training set, so one factorisation serves both f's and g's inner curves when
+/// their bases agree. Returns per outer fold, per order, the summed position error.
+fn inner_curves(pool: &Pool, base: &[Vec<usize>], columns: &[usize], orders: &[u32]) -> Result<Vec<Vec<f64>>, Error> {
+    let folds = pool.folds();
+    let mut inner_sum = vec![vec![0.0; orders.len()]; folds];
+    for f in 0..folds {
+        for g in f + 1..folds {
+            if base[f] == base[g] {
+                let both = pool.series_residuals(&[f, g], &[g, f], &base[f], columns, orders)?;
+                for (outer, validated) in [(f, &both[0]), (g, &both[1])] {
+                    for (sum, r) in inner_sum[outer].iter_mut().zip(validated) {
+                        *sum += position_sum(r);
+                    }
+                }
+            } else {
+                for (outer, v) in [(f, g), (g, f)] {
+                    let one = pool.series_residuals(&[f, g], &[v], &base[outer], columns, orders)?;
+                    for (sum, r) in inner_sum[outer].iter_mut().zip(&one[0]) {
+                        *sum += position_sum(r);
+                    }
+                }
+            }
+        }
+    }
+    Ok(inner_sum)
 }
 
 /// Greedy forward selection: at each step every remaining term is cross-validated on top of those

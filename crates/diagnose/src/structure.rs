@@ -120,17 +120,7 @@ pub(crate) fn residual_structure(
         .zip(link1)
         .map(|(r, rotation)| rotation.inverse().act(&Vector3::new(r[0], r[1], r[2])))
         .collect();
-    let config = gp::GpConfig {
-        kernel: gp::KernelChoice::SquaredExponentialArd,
-        outputs: gp::OutputMode::Shared,
-        optimiser: gp::OptimiserConfig {
-            restarts: 0,
-            max_iterations: options.max_iterations,
-            ..gp::OptimiserConfig::default()
-        },
-        parallelism: gp::Parallelism::Sequential,
-        ..gp::GpConfig::default()
-    };
+    let config = gp_config(options);
     let fit_fold = |f: usize| -> Result<FoldFit, Error> {
         let train: Vec<usize> = (0..n).filter(|&i| fold[i] != f).collect();
         let stride = train.len().div_ceil(options.max_training_rows.max(1)).max(1);
@@ -160,10 +150,32 @@ pub(crate) fn residual_structure(
     };
     use rayon::prelude::*;
     let per_fold: Vec<FoldFit> = (0..folds).into_par_iter().map(fit_fold).collect::<Result<_, _>>()?;
+    Ok(gathered(&per_fold, n, names))
+}
+
+/// One fold's GP: ARD squared exponential shared by the three position axes, one search without
+/// restarts, sequential (the folds run side by side).
+fn gp_config(options: &StructureOptions) -> gp::GpConfig {
+    gp::GpConfig {
+        kernel: gp::KernelChoice::SquaredExponentialArd,
+        outputs: gp::OutputMode::Shared,
+        optimiser: gp::OptimiserConfig {
+            restarts: 0,
+            max_iterations: options.max_iterations,
+            ..gp::OptimiserConfig::default()
+        },
+        parallelism: gp::Parallelism::Sequential,
+        ..gp::GpConfig::default()
+    }
+}
+
+/// The folds' fits gathered: each held-out pose's error, and each input's length scale as the
+/// geometric mean over the folds that fitted one.
+fn gathered(per_fold: &[FoldFit], n: usize, names: Vec<GpInput>) -> Structure {
     let mut errors = vec![0.0; n];
     let mut log_scales = vec![0.0; names.len()];
     let mut counted = 0usize;
-    for (left, scales) in &per_fold {
+    for (left, scales) in per_fold {
         for (i, v) in left {
             errors[*i] = v.norm();
         }
@@ -176,5 +188,5 @@ pub(crate) fn residual_structure(
     }
     let length_scales =
         log_scales.iter().map(|s| if counted > 0 { (s / counted as f64).exp() } else { f64::INFINITY }).collect();
-    Ok(Structure { errors, inputs: names, length_scales })
+    Structure { errors, inputs: names, length_scales }
 }
