@@ -11,7 +11,7 @@
 //! say how it does on another, and the held-out clusters say how strongly to hold it.
 
 use crate::clusters::{self, BranchJoint, Cluster, HeightSplit, ScanOptions};
-use errors::Error;
+use errors::{Error, OptionOutOfRange, OptionValue, option};
 use measurements::MeasurementSet;
 use model::geometric::observations;
 use poe::LocalPoe;
@@ -97,69 +97,30 @@ impl Default for NominalPriorOptions {
 }
 
 impl NominalPriorOptions {
-    /// Checks every value once: the field's name and what was expected.
-    pub fn validate(&self) -> Result<(), (&'static str, String)> {
-        if self.translations_m.is_empty() || self.translations_m.iter().any(|t| t.is_nan() || *t <= 0.0) {
-            return Err((
-                "translations_m",
-                format!(
-                    "nominal_prior.translations_m is {:?}, expected at least one number above 0 (inf for no prior)",
-                    self.translations_m
-                ),
-            ));
-        }
-        let checks: [(&'static str, f64, bool, &str); 6] = [
-            (
-                "tolerance_translation_m",
-                self.tolerance_translation_m,
-                self.tolerance_translation_m.is_finite() && self.tolerance_translation_m > 0.0,
-                "a finite number above 0",
-            ),
-            (
-                "tolerance_rotation_rad",
-                self.tolerance_rotation_rad,
-                self.tolerance_rotation_rad.is_finite() && self.tolerance_rotation_rad > 0.0,
-                "a finite number above 0",
-            ),
-            (
-                "min_height_span_m",
-                self.min_height_span_m,
-                self.min_height_span_m.is_finite() && self.min_height_span_m > 0.0,
-                "a finite number above 0",
-            ),
-            ("length_m", self.length_m, self.length_m.is_finite() && self.length_m > 0.0, "a finite number above 0"),
-            (
-                "min_cluster_share",
-                self.min_cluster_share,
-                self.min_cluster_share > 0.0 && self.min_cluster_share <= 0.5,
-                "a number above 0 and at most 0.5",
-            ),
-            (
-                "scan_tolerance_rad",
-                self.scan_tolerance_rad,
-                self.scan_tolerance_rad.is_finite() && self.scan_tolerance_rad > 0.0,
-                "a finite number above 0",
-            ),
-        ];
-        for (name, value, ok, expected) in checks {
-            if !ok {
-                return Err((name, format!("nominal_prior.{name} is {value}, expected {expected}")));
-            }
-        }
-        if self.scan_steps < 8 {
-            return Err((
-                "scan_steps",
-                format!("nominal_prior.scan_steps is {}, expected at least 8", self.scan_steps),
-            ));
-        }
-        if self.max_rows == 0 {
-            return Err(("max_rows", "nominal_prior.max_rows is 0, expected at least 1".into()));
-        }
-        if self.scan_probes < 2 {
-            let probes = self.scan_probes;
-            return Err(("scan_probes", format!("nominal_prior.scan_probes is {probes}, expected at least 2")));
-        }
-        Ok(())
+    /// Checks every value once: the field at fault, its value and what is expected.
+    pub fn validate(&self) -> Result<(), OptionOutOfRange> {
+        let translations = &self.translations_m;
+        OptionOutOfRange::check(
+            "translations_m",
+            OptionValue::Shown(format!("{translations:?}")),
+            !translations.is_empty() && translations.iter().all(|t| !t.is_nan() && *t > 0.0),
+            "at least one number above 0 (inf for no prior)",
+        )?;
+        option::above("tolerance_translation_m", self.tolerance_translation_m, 0.0)?;
+        option::above("tolerance_rotation_rad", self.tolerance_rotation_rad, 0.0)?;
+        option::above("min_height_span_m", self.min_height_span_m, 0.0)?;
+        option::above("length_m", self.length_m, 0.0)?;
+        let share = self.min_cluster_share;
+        OptionOutOfRange::check(
+            "min_cluster_share",
+            share,
+            share > 0.0 && share <= 0.5,
+            "a number above 0 and at most 0.5",
+        )?;
+        option::above("scan_tolerance_rad", self.scan_tolerance_rad, 0.0)?;
+        option::count_at_least("scan_steps", self.scan_steps, 8)?;
+        option::at_least_one("max_rows", self.max_rows)?;
+        option::count_at_least("scan_probes", self.scan_probes, 2)
     }
 }
 
@@ -575,6 +536,61 @@ fn one_standard_error(sigmas: &[Option<(f64, f64)>], rows: &[Vec<(f64, f64)>]) -
 #[cfg(test)]
 mod tests {
     use super::{NominalPriorOptions, PriorChoice};
+
+    #[test]
+    fn the_default_options_validate_and_a_bad_value_is_refused_with_its_field_value_and_range() {
+        assert_eq!(NominalPriorOptions::default().validate(), Ok(()));
+        let cases = [
+            (
+                NominalPriorOptions { translations_m: vec![], ..Default::default() },
+                "translations_m is [], expected at least one number above 0 (inf for no prior)",
+            ),
+            (
+                NominalPriorOptions { translations_m: vec![1e-3, 0.0], ..Default::default() },
+                "translations_m is [0.001, 0.0], expected at least one number above 0 (inf for no prior)",
+            ),
+            (
+                NominalPriorOptions { tolerance_translation_m: 0.0, ..Default::default() },
+                "tolerance_translation_m is 0, expected a finite number above 0",
+            ),
+            (
+                NominalPriorOptions { tolerance_rotation_rad: f64::INFINITY, ..Default::default() },
+                "tolerance_rotation_rad is inf, expected a finite number above 0",
+            ),
+            (
+                NominalPriorOptions { min_height_span_m: -1.0, ..Default::default() },
+                "min_height_span_m is -1, expected a finite number above 0",
+            ),
+            (
+                NominalPriorOptions { length_m: f64::NAN, ..Default::default() },
+                "length_m is NaN, expected a finite number above 0",
+            ),
+            (
+                NominalPriorOptions { min_cluster_share: 0.6, ..Default::default() },
+                "min_cluster_share is 0.6, expected a number above 0 and at most 0.5",
+            ),
+            (
+                NominalPriorOptions { scan_tolerance_rad: 0.0, ..Default::default() },
+                "scan_tolerance_rad is 0, expected a finite number above 0",
+            ),
+            (NominalPriorOptions { scan_steps: 7, ..Default::default() }, "scan_steps is 7, expected at least 8"),
+            (NominalPriorOptions { max_rows: 0, ..Default::default() }, "max_rows is 0, expected at least 1"),
+            (NominalPriorOptions { scan_probes: 1, ..Default::default() }, "scan_probes is 1, expected at least 2"),
+        ];
+        for (options, message) in cases {
+            let (field, text) = options.validate().unwrap_err().in_file("nominal_prior");
+            assert_eq!(text, format!("nominal_prior.{message}"));
+            assert!(message.starts_with(field), "{field}: {message}");
+        }
+        let at_limits = NominalPriorOptions {
+            min_cluster_share: 0.5,
+            scan_steps: 8,
+            scan_probes: 2,
+            max_rows: 1,
+            ..Default::default()
+        };
+        assert_eq!(at_limits.validate(), Ok(()));
+    }
 
     fn posterior(scale: f64) -> PriorChoice {
         let prior = NominalPriorOptions::default();

@@ -12,7 +12,7 @@
 //! ball). The two steps alternate; each lowers the sum of squares.
 
 use crate::ErrorKind;
-use errors::Error;
+use errors::{Error, OptionOutOfRange, OptionValue, option};
 use lie::{Matrix3, Vector3};
 use measurements::{BoundSet, MeasurementSet};
 use poe::JointKind;
@@ -95,42 +95,26 @@ impl Default for PlausibilityOptions {
 }
 
 impl PlausibilityOptions {
-    /// Checks every value once: the field at fault and what is expected.
-    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+    /// Checks every value once: the field at fault, its value and what is expected.
+    pub fn validate(&self) -> Result<(), OptionOutOfRange> {
         let (lo, hi) = self.scale_band;
-        if !(lo.is_finite() && hi.is_finite() && 0.0 < lo && lo <= 1.0 && hi >= 1.0) {
-            return Err((
-                "scale_band",
-                format!("plausibility.scale_band is ({lo}, {hi}), expected 0 < low ≤ 1 ≤ high"),
-            ));
-        }
-        // (field, value, lowest accepted, whether the lowest itself is accepted)
-        let bounded = [
-            ("unit_factor_tolerance", self.unit_factor_tolerance, 1.0, false),
-            ("reflection_ratio", self.reflection_ratio, 0.0, false),
-            ("max_tool_offset_m", self.max_tool_offset_m, 0.0, false),
-            ("limit_margin_rad", self.limit_margin_rad, 0.0, true),
-            ("limit_margin_m", self.limit_margin_m, 0.0, true),
-            ("planar_ratio", self.planar_ratio, 0.0, false),
-            ("wrong_minimum_ratio", self.wrong_minimum_ratio, 1.0, true),
-        ];
-        for (field, value, lowest, inclusive) in bounded {
-            if !(value.is_finite() && (value > lowest || (inclusive && value == lowest))) {
-                let expected = if inclusive { "of at least" } else { "above" };
-                return Err((
-                    field,
-                    format!("plausibility.{field} is {value}, expected a finite number {expected} {lowest}"),
-                ));
-            }
-        }
-        if self.reflection_ratio > 1.0 {
-            let value = self.reflection_ratio;
-            return Err(("reflection_ratio", format!("plausibility.reflection_ratio is {value}, expected at most 1")));
-        }
-        if self.max_iterations == 0 {
-            return Err(("max_iterations", "plausibility.max_iterations is 0, expected at least 1".into()));
-        }
-        Ok(())
+        let accepted = lo.is_finite() && hi.is_finite() && 0.0 < lo && lo <= 1.0 && hi >= 1.0;
+        OptionOutOfRange::check(
+            "scale_band",
+            OptionValue::Shown(format!("({lo}, {hi})")),
+            accepted,
+            "0 < low ≤ 1 ≤ high",
+        )?;
+        option::above("unit_factor_tolerance", self.unit_factor_tolerance, 1.0)?;
+        option::above("reflection_ratio", self.reflection_ratio, 0.0)?;
+        option::above("max_tool_offset_m", self.max_tool_offset_m, 0.0)?;
+        option::at_least("limit_margin_rad", self.limit_margin_rad, 0.0)?;
+        option::at_least("limit_margin_m", self.limit_margin_m, 0.0)?;
+        option::above("planar_ratio", self.planar_ratio, 0.0)?;
+        option::at_least("wrong_minimum_ratio", self.wrong_minimum_ratio, 1.0)?;
+        let ratio = self.reflection_ratio;
+        OptionOutOfRange::check("reflection_ratio", ratio, ratio <= 1.0, "at most 1")?;
+        option::at_least_one("max_iterations", self.max_iterations)
     }
 }
 
@@ -434,9 +418,63 @@ mod tests {
     }
 
     #[test]
-    fn the_default_options_validate_and_a_band_without_one_is_refused() {
+    fn the_default_options_validate_and_a_bad_value_is_refused_with_its_field_value_and_range() {
         assert_eq!(PlausibilityOptions::default().validate(), Ok(()));
-        let options = PlausibilityOptions { scale_band: (1.1, 1.3), ..PlausibilityOptions::default() };
-        assert_eq!(options.validate().unwrap_err().0, "scale_band");
+        let refused = |options: PlausibilityOptions| options.validate().unwrap_err().in_file("plausibility");
+        let band = refused(PlausibilityOptions { scale_band: (1.1, 1.3), ..PlausibilityOptions::default() });
+        assert_eq!(band, ("scale_band", "plausibility.scale_band is (1.1, 1.3), expected 0 < low ≤ 1 ≤ high".into()));
+        let cases = [
+            (
+                PlausibilityOptions { unit_factor_tolerance: 1.0, ..Default::default() },
+                "unit_factor_tolerance is 1, expected a finite number above 1",
+            ),
+            (
+                PlausibilityOptions { reflection_ratio: 0.0, ..Default::default() },
+                "reflection_ratio is 0, expected a finite number above 0",
+            ),
+            (
+                PlausibilityOptions { reflection_ratio: 2.0, ..Default::default() },
+                "reflection_ratio is 2, expected at most 1",
+            ),
+            (
+                PlausibilityOptions { max_tool_offset_m: f64::INFINITY, ..Default::default() },
+                "max_tool_offset_m is inf, expected a finite number above 0",
+            ),
+            (
+                PlausibilityOptions { limit_margin_rad: -0.1, ..Default::default() },
+                "limit_margin_rad is -0.1, expected a finite number of at least 0",
+            ),
+            (
+                PlausibilityOptions { limit_margin_m: f64::NAN, ..Default::default() },
+                "limit_margin_m is NaN, expected a finite number of at least 0",
+            ),
+            (
+                PlausibilityOptions { planar_ratio: 0.0, ..Default::default() },
+                "planar_ratio is 0, expected a finite number above 0",
+            ),
+            (
+                PlausibilityOptions { wrong_minimum_ratio: 0.5, ..Default::default() },
+                "wrong_minimum_ratio is 0.5, expected a finite number of at least 1",
+            ),
+            (
+                PlausibilityOptions { max_iterations: 0, ..Default::default() },
+                "max_iterations is 0, expected at least 1",
+            ),
+        ];
+        for (options, message) in cases {
+            let (field, text) = refused(options);
+            assert_eq!(text, format!("plausibility.{message}"));
+            assert!(message.starts_with(field), "{field}: {message}");
+        }
+        // Limits themselves are accepted where the range includes them.
+        let at_limits = PlausibilityOptions {
+            limit_margin_rad: 0.0,
+            limit_margin_m: 0.0,
+            wrong_minimum_ratio: 1.0,
+            reflection_ratio: 1.0,
+            scale_band: (1.0, 1.0),
+            ..Default::default()
+        };
+        assert_eq!(at_limits.validate(), Ok(()));
     }
 }
