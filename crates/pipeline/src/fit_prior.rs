@@ -321,16 +321,7 @@ pub fn choose(
     identification: &IdentificationOptions,
     prior: &NominalPriorOptions,
 ) -> Result<PriorChoice, Error> {
-    if !prior.choose {
-        return Ok(PriorChoice::without(Vec::new(), Vec::new(), prior, "switched off (nominal_prior.choose)".into()));
-    }
-    if data.rows.len() > prior.max_rows {
-        let reason = format!(
-            "{} rows, more than nominal_prior.max_rows = {}: the fit as without a prior (the prior costs a plain \
-             fit more, and a fit per candidate and cluster)",
-            data.rows.len(),
-            prior.max_rows
-        );
+    if let Some(reason) = skipped(data, prior) {
         return Ok(PriorChoice::without(Vec::new(), Vec::new(), prior, reason));
     }
     let base = Posterior::new(nominal, data, identification, prior)?;
@@ -348,12 +339,7 @@ pub fn choose(
         return Ok(base.without(reason, prior));
     }
     let splits = cluster_splits(&folds, data);
-    // The posterior first (the weakest, which the one-standard-error rule prefers), then the
-    // stronger candidates.
-    let posterior = base.posterior;
-    let stronger = prior.translations_m.iter().filter(|&&t| t.is_finite() && t < posterior.0);
-    let sigmas: Vec<Option<(f64, f64)>> =
-        std::iter::once(Some(posterior)).chain(stronger.map(|&t| Some((t, t / prior.length_m)))).collect();
+    let sigmas = candidate_sigmas(base.posterior, prior);
     let (usable, rows) = held_out_rows(nominal, &splits, &sigmas, identification);
     if usable.is_empty() {
         let reason =
@@ -362,28 +348,30 @@ pub fn choose(
                 .to_owned();
         return Ok(base.without(reason, prior));
     }
-    let (candidates, chosen) = one_standard_error(&sigmas, &rows);
     let held_out: Vec<String> = usable.iter().map(|&s| splits[s].0.clone()).collect();
-    let reason = format!(
-        "{}; {} configuration clusters held out in turn: held-out RMS {:.4} mm, {:.4} mm at the tolerance",
-        base.tolerance,
-        held_out.len(),
-        candidates[chosen].heldout_rms_position_mm,
-        candidates[0].heldout_rms_position_mm
-    );
-    Ok(PriorChoice {
-        branch_joints: base.branch_joints,
-        height_splits: base.height_splits,
-        clusters: base.found,
-        tolerance: (prior.tolerance_translation_m, prior.tolerance_rotation_rad),
-        residual_scale: Some(base.scale),
-        held_out,
-        translation_m: candidates[chosen].translation_m,
-        rotation_rad: candidates[chosen].rotation_rad,
-        candidates,
-        reason,
-        with_effects: None,
+    Ok(base.held_out_choice(held_out, &sigmas, &rows, prior))
+}
+
+/// Why the fit has no prior without looking at the data's clusters: switched off, or too many rows.
+fn skipped(data: &MeasurementSet, prior: &NominalPriorOptions) -> Option<String> {
+    if !prior.choose {
+        return Some("switched off (nominal_prior.choose)".into());
+    }
+    (data.rows.len() > prior.max_rows).then(|| {
+        format!(
+            "{} rows, more than nominal_prior.max_rows = {}: the fit as without a prior (the prior costs a plain \
+             fit more, and a fit per candidate and cluster)",
+            data.rows.len(),
+            prior.max_rows
+        )
     })
+}
+
+/// The candidates held out: the posterior first (the weakest, which the one-standard-error rule
+/// prefers), then the stronger of `translations_m`.
+fn candidate_sigmas(posterior: (f64, f64), prior: &NominalPriorOptions) -> Vec<Option<(f64, f64)>> {
+    let stronger = prior.translations_m.iter().filter(|&&t| t.is_finite() && t < posterior.0);
+    std::iter::once(Some(posterior)).chain(stronger.map(|&t| Some((t, t / prior.length_m)))).collect()
 }
 
 /// The data's configuration clusters and the posterior of the nominal's tolerance, what every
@@ -429,6 +417,39 @@ impl Posterior {
             prior.tolerance_rotation_rad * 1e3
         );
         Ok(Self { branch_joints, height_splits, found, scale, posterior, tolerance })
+    }
+
+    /// The choice among the candidates (`sigmas`) by their rows held out in the clusters
+    /// `held_out` (per candidate, every row's criterion and squared error): the one-standard-error
+    /// rule's.
+    fn held_out_choice(
+        self,
+        held_out: Vec<String>,
+        sigmas: &[Option<(f64, f64)>],
+        rows: &[Vec<(f64, f64)>],
+        prior: &NominalPriorOptions,
+    ) -> PriorChoice {
+        let (candidates, chosen) = one_standard_error(sigmas, rows);
+        let reason = format!(
+            "{}; {} configuration clusters held out in turn: held-out RMS {:.4} mm, {:.4} mm at the tolerance",
+            self.tolerance,
+            held_out.len(),
+            candidates[chosen].heldout_rms_position_mm,
+            candidates[0].heldout_rms_position_mm
+        );
+        PriorChoice {
+            branch_joints: self.branch_joints,
+            height_splits: self.height_splits,
+            clusters: self.found,
+            tolerance: (prior.tolerance_translation_m, prior.tolerance_rotation_rad),
+            residual_scale: Some(self.scale),
+            held_out,
+            translation_m: candidates[chosen].translation_m,
+            rotation_rad: candidates[chosen].rotation_rad,
+            candidates,
+            reason,
+            with_effects: None,
+        }
     }
 
     /// The fit under the posterior, for `reason`: nothing held out chose otherwise.

@@ -160,6 +160,24 @@ pub(crate) fn check(
     if data.rows.len() < 4 || !data.positions_measured {
         return Ok(Findings { report: None, refusals });
     }
+    let (start, flanges) = nominal_flanges(robot, data)?;
+    let measured: Vec<Vector3> = data.rows.iter().map(|r| r.position).collect();
+    // A planar chain's tool moves in a plane: data that leave every plane are another robot's,
+    // and fit it with the axes tilted to reach them (refused first: it explains the rest).
+    let planar = robot.planar_direction().map(|direction| (direction, out_of_plane(&measured)));
+    refusals.extend(planar.and_then(|planar| planar_refusal(robot, data, planar, &measured, options)));
+    let problem = Alignment::new(bound, &flanges, &measured, options);
+    let (report, rotation_rms, reflection_rms) = alignment_report(&problem, start, planar.map(|(_, d)| d));
+    refusals.extend(scale_or_handedness(data, &report, rotation_rms, reflection_rms, options));
+    Ok(Findings { report: Some(report), refusals })
+}
+
+/// The start of the fitted tool offset (the description's tool, where it has one) and, per row,
+/// the nominal model's flange at its joints: rotation and position.
+fn nominal_flanges(
+    robot: &RobotDescription,
+    data: &MeasurementSet,
+) -> Result<(Vector3, Vec<(Matrix3, Vector3)>), Error> {
     // The nominal model's flange: its tool, where the description has one, is only the start of
     // the fitted tool offset.
     let mut nominal = robot.nominal_model()?;
@@ -170,32 +188,45 @@ pub(crate) fn check(
         let pose = nominal.forward(&row.q, 0).map_err(Error::kinematics)?;
         flanges.push((pose.rotation().matrix(), pose.translation()));
     }
-    let measured: Vec<Vector3> = data.rows.iter().map(|r| r.position).collect();
-    // A planar chain's tool moves in a plane: data that leave every plane are another robot's,
-    // and fit it with the axes tilted to reach them (refused first: it explains the rest).
-    let planar = robot.planar_direction().map(|direction| (direction, out_of_plane(&measured)));
-    if let Some((direction, out_of_plane)) = planar {
-        let spread = spread(&measured);
-        if out_of_plane > options.planar_ratio * spread {
-            refusals.push(Error::in_file(
-                data.source.clone(),
-                ErrorKind::PlanarChainData {
-                    robot: robot.name.clone(),
-                    direction,
-                    joints: robot.joint_count(),
-                    out_of_plane_mm: out_of_plane * 1e3,
-                    spread_mm: spread * 1e3,
-                    ratio: options.planar_ratio,
-                },
-            ));
-        }
-    }
-    let tools = bound.tools();
-    let tool_count = data.tools.len().max(1 + tools.iter().copied().max().unwrap_or(0));
-    let problem = Alignment { flanges: &flanges, tools, measured: &measured, tool_count, options };
+    Ok((start, flanges))
+}
+
+/// A planar chain's refusal of data further from their best plane (`out_of_plane`, m, with the
+/// chain's axis `direction`) than `planar_ratio` of their spread.
+fn planar_refusal(
+    robot: &RobotDescription,
+    data: &MeasurementSet,
+    (direction, out_of_plane): ([f64; 3], f64),
+    measured: &[Vector3],
+    options: &PlausibilityOptions,
+) -> Option<Error> {
+    let spread = spread(measured);
+    (out_of_plane > options.planar_ratio * spread).then(|| {
+        Error::in_file(
+            data.source.clone(),
+            ErrorKind::PlanarChainData {
+                robot: robot.name.clone(),
+                direction,
+                joints: robot.joint_count(),
+                out_of_plane_mm: out_of_plane * 1e3,
+                spread_mm: spread * 1e3,
+                ratio: options.planar_ratio,
+            },
+        )
+    })
+}
+
+/// The best rotation and the best reflection of the nominal tool points onto the measured
+/// points: the report (`out_of_plane`: a planar chain's distance of the data from their plane,
+/// m), and the RMS residual of each, m.
+fn alignment_report(
+    problem: &Alignment<'_>,
+    start: Vector3,
+    out_of_plane: Option<f64>,
+) -> (PlausibilityReport, f64, f64) {
     let rotation = problem.fit(start, 1.0);
     let reflection = problem.fit(start, -1.0);
-    let measured_spread = spread(&measured);
+    let measured_spread = spread(problem.measured);
     let robot_spread = spread(&rotation.points);
     let scale_ratio = (measured_spread > 0.0 && robot_spread > 0.0).then(|| measured_spread / robot_spread);
     let report = PlausibilityReport {
@@ -204,14 +235,27 @@ pub(crate) fn check(
         scale_ratio,
         rotation_rms_mm: rotation.rms * 1e3,
         reflection_rms_mm: reflection.rms * 1e3,
-        out_of_plane_mm: planar.map(|(_, distance)| distance * 1e3),
+        out_of_plane_mm: out_of_plane.map(|distance| distance * 1e3),
     };
+    (report, rotation.rms, reflection.rms)
+}
+
+/// The refusal of a spread ratio outside `scale_band` (a unit mistake, named where it is near
+/// one's factor) or, only where the scale is right, of data a reflection fits far better than a
+/// rotation (a left-handed frame).
+fn scale_or_handedness(
+    data: &MeasurementSet,
+    report: &PlausibilityReport,
+    rotation_rms: f64,
+    reflection_rms: f64,
+    options: &PlausibilityOptions,
+) -> Option<Error> {
     let (lo, hi) = options.scale_band;
-    if let Some(ratio) = scale_ratio
+    if let Some(ratio) = report.scale_ratio
         && !(lo..=hi).contains(&ratio)
     {
         let column_unit = data.position_unit.unwrap_or("mm");
-        refusals.push(Error::in_file(
+        Some(Error::in_file(
             data.source.clone(),
             ErrorKind::PositionScale {
                 measured_spread_mm: report.measured_spread_mm,
@@ -221,19 +265,20 @@ pub(crate) fn check(
                 likely_unit: likely_unit(ratio, column_unit, options.unit_factor_tolerance),
                 band: options.scale_band,
             },
-        ));
-    } else if rotation.rms > 0.0 && reflection.rms < options.reflection_ratio * rotation.rms {
+        ))
+    } else if rotation_rms > 0.0 && reflection_rms < options.reflection_ratio * rotation_rms {
         // Only where the scale is right: a scaled point cloud fits neither, and says nothing.
-        refusals.push(Error::in_file(
+        Some(Error::in_file(
             data.source.clone(),
             ErrorKind::LeftHandedFrame {
                 rotation_rms_mm: report.rotation_rms_mm,
                 reflection_rms_mm: report.reflection_rms_mm,
                 reflection_ratio: options.reflection_ratio,
             },
-        ));
+        ))
+    } else {
+        None
     }
-    Ok(Findings { report: Some(report), refusals })
 }
 
 /// The first joint value beyond its limits by more than the margin, in file order.
@@ -320,7 +365,20 @@ struct Aligned {
     rms: f64,
 }
 
-impl Alignment<'_> {
+impl<'a> Alignment<'a> {
+    /// The alignment of `bound`'s rows: their nominal flanges, their tools (one per tool of the
+    /// data, or per index the rows use, whichever is more) and their measured positions.
+    fn new(
+        bound: &'a BoundSet<'_>,
+        flanges: &'a [(Matrix3, Vector3)],
+        measured: &'a [Vector3],
+        options: &'a PlausibilityOptions,
+    ) -> Self {
+        let tools = bound.tools();
+        let tool_count = bound.set().tools.len().max(1 + tools.iter().copied().max().unwrap_or(0));
+        Self { flanges, tools, measured, tool_count, options }
+    }
+
     /// The best alignment with `det R = determinant` (1 a rotation, −1 a reflection), every tool
     /// started at `start`.
     fn fit(&self, start: Vector3, determinant: f64) -> Aligned {
