@@ -58,8 +58,21 @@ fn detected(cases: &[Case]) -> Vec<&Case> {
 
 fn report(cases: &[Case]) -> String {
     let mut out = String::new();
+    summary(&mut out, cases);
+    per_class(&mut out, cases);
+    confusion(&mut out, cases);
+    every_case(&mut out, cases);
+    out
+}
+
+/// How many of `set` have the right verdict.
+fn right(set: &[&Case]) -> usize {
+    set.iter().filter(|c| c.right()).count()
+}
+
+/// The overall rates.
+fn summary(out: &mut String, cases: &[Case]) {
     let all: Vec<&Case> = cases.iter().collect();
-    let right = |set: &[&Case]| set.iter().filter(|c| c.right()).count();
     let effects: Vec<&Case> = cases.iter().filter(|c| c.class != Class::None).collect();
     let strong: Vec<&Case> = effects.iter().copied().filter(|c| c.magnitude_mm >= 3.0 * c.floor_mm).collect();
     let nones: Vec<&Case> = cases.iter().filter(|c| c.class == Class::None).collect();
@@ -87,6 +100,10 @@ fn report(cases: &[Case]) -> String {
         100.0 * SHRINK_TOLERANCE,
         percent(found.iter().filter(|c| shrink_right(c)).count(), found.len())
     );
+}
+
+/// The table of each class's rates.
+fn per_class(out: &mut String, cases: &[Case]) {
     let _ = writeln!(out, "\n## Per class\n");
     let _ = writeln!(
         out,
@@ -125,6 +142,10 @@ fn report(cases: &[Case]) -> String {
             ratios[ratios.len() / 2]
         );
     }
+}
+
+/// The confusion matrix of class against verdict.
+fn confusion(out: &mut String, cases: &[Case]) {
     // Every verdict the diagnosis can give, from the one list of kinds: a kind added there gets
     // its column, so that no verdict is left out of the matrix unseen.
     let labels: Vec<Effect> = std::iter::once(Effect::None)
@@ -148,6 +169,10 @@ fn report(cases: &[Case]) -> String {
         }
         out.push('\n');
     }
+}
+
+/// One row per case.
+fn every_case(out: &mut String, cases: &[Case]) {
     let _ = writeln!(out, "\n## Every case\n");
     let _ = writeln!(
         out,
@@ -174,10 +199,10 @@ fn report(cases: &[Case]) -> String {
             c.oracle_mm
         );
     }
-    out
 }
 
-pub fn run(args: &Args) -> Result<()> {
+/// The robots the cases draw on, from `fixtures/robots`.
+fn robots() -> Result<Robots> {
     let read = |name: &str| -> Result<RobotDescription> {
         let path = PathBuf::from("fixtures/robots").join(name);
         let robot = RobotDescription::read(&path).with_context(|| path.display().to_string())?;
@@ -189,7 +214,11 @@ pub fn run(args: &Args) -> Result<()> {
     // The column has no masses in its file: its cases draw their own (module `blind_check_cases`).
     let column_path = PathBuf::from("fixtures/robots/column_ur10.ron");
     let column = RobotDescription::read(&column_path).with_context(|| column_path.display().to_string())?;
-    let robots = Robots { irb4400: read("irb4400.ron")?, iiwa7: read("iiwa7.ron")?, column };
+    Ok(Robots { irb4400: read("irb4400.ron")?, iiwa7: read("iiwa7.ron")?, column })
+}
+
+pub fn run(args: &Args) -> Result<()> {
+    let robots = robots()?;
     let indices: Vec<usize> = if args.only.is_empty() { (0..args.cases).collect() } else { args.only.clone() };
     if let Some(folder) = &args.dump {
         std::fs::create_dir_all(folder).with_context(|| folder.display().to_string())?;
@@ -224,20 +253,27 @@ pub fn run(args: &Args) -> Result<()> {
         std::fs::write(path, body).with_context(|| path.display().to_string())?;
     }
     if let Some(required) = args.require_top1 {
-        let right = cases.iter().filter(|c| c.right()).count();
-        let nones: Vec<&Case> = cases.iter().filter(|c| c.class == Class::None).collect();
-        let alarms = nones.iter().filter(|c| c.verdict != Effect::None).count();
-        let couplings: Vec<&Case> = cases.iter().filter(|c| c.class == Class::Coupling).collect();
-        let unknown = couplings.iter().filter(|c| c.right()).count();
-        if (right as f64) < required * cases.len() as f64 {
-            bail!("top-1 {right}/{} is below the required {required}", cases.len());
-        }
-        if alarms as f64 > 0.1 * nones.len() as f64 {
-            bail!("{alarms} false alarms in {} none cases, more than one in ten", nones.len());
-        }
-        if (unknown as f64) < 0.9 * couplings.len() as f64 {
-            bail!("{unknown} of {} coupling cases called unknown, fewer than nine in ten", couplings.len());
-        }
+        require(&cases, required)?;
+    }
+    Ok(())
+}
+
+/// `--require-top1`: the top-1 rate, the false alarms in `none` cases and the coupling cases
+/// called `unknown`.
+fn require(cases: &[Case], required: f64) -> Result<()> {
+    let right = cases.iter().filter(|c| c.right()).count();
+    let nones: Vec<&Case> = cases.iter().filter(|c| c.class == Class::None).collect();
+    let alarms = nones.iter().filter(|c| c.verdict != Effect::None).count();
+    let couplings: Vec<&Case> = cases.iter().filter(|c| c.class == Class::Coupling).collect();
+    let unknown = couplings.iter().filter(|c| c.right()).count();
+    if (right as f64) < required * cases.len() as f64 {
+        bail!("top-1 {right}/{} is below the required {required}", cases.len());
+    }
+    if alarms as f64 > 0.1 * nones.len() as f64 {
+        bail!("{alarms} false alarms in {} none cases, more than one in ten", nones.len());
+    }
+    if (unknown as f64) < 0.9 * couplings.len() as f64 {
+        bail!("{unknown} of {} coupling cases called unknown, fewer than nine in ten", couplings.len());
     }
     Ok(())
 }

@@ -26,11 +26,11 @@
 use crate::simulation::{mean_distance_mm, perturbed_robot, ranges, simulate, tracker_placement};
 use anyhow::{Context, Result, bail};
 use campaign::{Perturbation, Remount, campaign_cell, payload_run_campaign};
-use diagnose::{DiagnoseOptions, Effect, StructureOptions, diagnose};
+use diagnose::{DiagnoseOptions, Diagnosis, Effect, StructureOptions, diagnose};
 use loadsim::{
     BacklashModel, BentLink, CouplingFactor, CouplingModel, CouplingTerm, Effects, GearPeriodicModel, GeneratorConfig,
-    Harmonic, JointBacklash, JointComplianceModel, LinkDeflectionModel, RobotDynamics, SimulatedCell, ThermalModel,
-    TimeDriftModel, TrackerNoiseModel,
+    Harmonic, JointBacklash, JointComplianceModel, JointRange, LinkDeflectionModel, RobotDynamics, SimulatedCell,
+    ThermalModel, TimeDriftModel, TrackerNoiseModel,
 };
 use measurements::MeasurementSet;
 use model::Method;
@@ -165,6 +165,15 @@ impl Hidden {
                 }
                 effects.compliance = Some(JointComplianceModel::default());
             }
+            _ => self.add_model(scale, effects),
+        }
+    }
+
+    /// Adds the effect's model at `scale` to `effects`: every kind but compliance, which `apply`
+    /// adds with the stiffness it changes.
+    fn add_model(&self, scale: f64, effects: &mut Effects) {
+        match self {
+            Hidden::Compliance(_) | Hidden::ComplianceAll => {}
             Hidden::Backlash(joints) => {
                 effects.backlash = Some(BacklashModel {
                     joints: joints
@@ -330,125 +339,30 @@ pub fn run_case(robots: &Robots, index: usize, seed: u64, rows: usize, dump: Opt
         Class::Deflection => &robots.column,
         _ => &robots.irb4400,
     };
-    let n = robot.joint_count();
-    let loaded: Vec<usize> = (1..n).collect();
-    let hidden: Vec<Hidden> = match class {
-        Class::None => vec![],
-        Class::Gear => vec![draw_gear(&mut rng, n)],
-        Class::Compliance => vec![Hidden::Compliance(draw_joints(&mut rng, &loaded, 2))],
-        Class::Backlash => vec![Hidden::Backlash(draw_joints(&mut rng, &loaded, 2))],
-        Class::Thermal => vec![Hidden::Thermal],
-        Class::Drift => vec![Hidden::Drift],
-        Class::JointOne => {
-            if rng.random_bool(0.5) {
-                vec![Hidden::Compliance(vec![0])]
-            } else {
-                vec![Hidden::Backlash(vec![0])]
-            }
-        }
-        Class::TwoEffects => {
-            let first = rng.random_range(0..3);
-            let second = (first + rng.random_range(1..3)) % 3;
-            vec![draw_kind(&mut rng, first, &loaded, n), draw_kind(&mut rng, second, &loaded, n)]
-        }
-        Class::Coupling => {
-            let joint = rng.random_range(1..5);
-            let mut sources: Vec<usize> = (0..n).filter(|&s| s != joint).collect();
-            let a = sources.remove(rng.random_range(0..sources.len()));
-            let b = sources[rng.random_range(0..sources.len())];
-            let factor = |rng: &mut ChaCha8Rng, s: usize| {
-                (s, f64::from(rng.random_range(1..=3_u32)), rng.random_range(0.0..std::f64::consts::TAU))
-            };
-            vec![Hidden::Coupling(joint, vec![factor(&mut rng, a), factor(&mut rng, b)])]
-        }
-        Class::SevenAxis => {
-            full_pose = true;
-            vec![Hidden::ComplianceAll]
-        }
-        Class::Deflection => vec![Hidden::Deflection(0, [rng.random_range(0.3..1.0), rng.random_range(0.3..1.0)])],
-    };
+    let hidden = draw_hidden(class, &mut rng, robot.joint_count());
+    if class == Class::SevenAxis {
+        full_pose = true;
+    }
     let gravity = (class == Class::JointOne).then(|| {
         loadsim::tilted_base_gravity(rng.random_range(0.5..1.6), rng.random_range(0.0..std::f64::consts::TAU))
     });
-    let (mut cell, config) = if class == Class::SevenAxis {
-        let config = payload_run_campaign(rows, rng.random());
-        let cell = campaign_cell(robot, &Perturbation::default(), &Remount::default(), &config)?;
-        (cell, config)
-    } else {
-        let tool_m = rng.random_range(0.1..0.3);
-        let geometry = perturbed_robot(robot, &mut rng, 0.002, 0.002, tool_m)?;
-        let dynamics = match class {
-            // The truth's masses: the stand-in's bars, each 0.5–1.5 times as heavy.
-            Class::Deflection => {
-                let mut truth = effects::stand_in_dynamics(robot);
-                truth.links.iter_mut().for_each(|l| l.mass_kg *= rng.random_range(0.5..1.5));
-                Some(truth)
-            }
-            _ => robot.dynamics.clone(),
-        };
-        let mut cell = SimulatedCell::new(geometry, dynamics);
-        cell.tracker_from_base = tracker_placement(&mut rng);
-        (cell, GeneratorConfig { sample_count: rows, seed: rng.random(), ..GeneratorConfig::default() })
-    };
+    let (mut cell, config) = truth_cell(class, robot, rows, &mut rng)?;
     if let (Some(g), Some(d)) = (gravity, cell.dynamics.as_mut()) {
         d.gravity_m_per_s2 = g;
     }
-    let base_dynamics = cell.dynamics.clone();
-    let ranges = ranges(robot);
-    let sim = |cell: &SimulatedCell, effects: &Effects, full_pose: bool| -> Result<MeasurementSet> {
-        simulate(cell, effects, &ranges, &config, full_pose)
-    };
-    let with_noise =
-        |effects: &Effects| Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..effects.clone() };
-    let clean_none = sim(&cell, &Effects::default(), full_pose)?;
-    let noisy_none = sim(&cell, &with_noise(&Effects::default()), full_pose)?;
+    let sim = Simulator { robot, ranges: ranges(robot), config };
+    let clean_none = sim.run(&cell, &Effects::default(), full_pose)?;
+    let noisy_none = sim.run(&cell, &with_noise(&Effects::default()), full_pose)?;
     let floor_mm = mean_distance_mm(&clean_none, &noisy_none);
-    // What a geometric fit leaves, on positions alone (with orientations, a fit weighted for a
-    // tracker's orientation noise can trade position for orientation error and overstate it).
-    let left_after_fit = |data: &MeasurementSet| -> Result<f64> {
-        let mut positions = data.clone();
-        positions.full_pose = false;
-        positions.rows.iter_mut().for_each(|r| r.orientation = None);
-        let (_, report) = pipeline::fit(robot, &positions, Method::Poe, &FitOptions::default())?;
-        Ok(report.after.mean_position_error_mm)
-    };
-    let mut effects = Effects::default();
-    let mut dynamics = base_dynamics.clone();
-    let mut magnitude_mm = f64::INFINITY;
-    for h in &hidden {
-        let target_mm = floor_mm * 1.2 * (4.0 / (1.2 * floor_mm)).powf(rng.random_range(0.0..1.0));
-        let alone = |scale: f64| -> Result<f64> {
-            let mut e = Effects::default();
-            let mut d = base_dynamics.clone();
-            h.apply(scale, &mut e, &mut d);
-            let mut c = cell.clone();
-            c.dynamics = d;
-            left_after_fit(&sim(&c, &e, false)?)
-        };
-        let left = alone(1.0)?;
-        if left <= 0.0 {
-            bail!("case {index}: {h:?} leaves nothing after a geometric fit");
-        }
-        let scale = (target_mm / left).min(h.cap());
-        magnitude_mm = magnitude_mm.min(alone(scale)?);
-        h.apply(scale, &mut effects, &mut dynamics);
-    }
-    if hidden.is_empty() {
-        magnitude_mm = 0.0;
-    }
+    let (effects, dynamics, magnitude_mm) = hide(&sim, &cell, &hidden, floor_mm, &mut rng, index)?;
     cell.dynamics = dynamics;
-    let data = sim(&cell, &with_noise(&effects), full_pose)?;
+    let data = sim.run(&cell, &with_noise(&effects), full_pose)?;
     if let Some(folder) = dump {
         let path = folder.join(format!("case{index}.csv"));
         let file = std::fs::File::create(&path).with_context(|| path.display().to_string())?;
         data.write_csv(std::io::BufWriter::new(file)).with_context(|| path.display().to_string())?;
     }
-    let blind_robot = blind(robot, gravity);
-    let options = DiagnoseOptions::default();
-    let diagnosis = diagnose(&blind_robot, &data, &options).with_context(|| format!("case {index}"))?;
-    let oracle_options =
-        DiagnoseOptions { structure: StructureOptions { enabled: false, ..StructureOptions::default() }, ..options };
-    let oracle = diagnose(&blind_robot, &noisy_none, &oracle_options)?;
+    let (diagnosis, oracle) = diagnose_blind(&blind(robot, gravity), &data, &noisy_none, index)?;
     let truths: Vec<(Effect, Vec<usize>)> = hidden.iter().map(Hidden::truth).collect();
     let selected_effects: Vec<Effect> = diagnosis.selected.iter().map(|s| s.effect).collect();
     Ok(Case {
@@ -465,4 +379,153 @@ pub fn run_case(robots: &Robots, index: usize, seed: u64, rows: usize, dump: Opt
         after_mm: diagnosis.heldout_after_selected_mm,
         oracle_mm: oracle.heldout_before_mm,
     })
+}
+
+/// The hidden effects of a case of `class` on a robot of `n` joints, drawn from `rng`.
+fn draw_hidden(class: Class, rng: &mut ChaCha8Rng, n: usize) -> Vec<Hidden> {
+    let loaded: Vec<usize> = (1..n).collect();
+    match class {
+        Class::None => vec![],
+        Class::Gear => vec![draw_gear(rng, n)],
+        Class::Compliance => vec![Hidden::Compliance(draw_joints(rng, &loaded, 2))],
+        Class::Backlash => vec![Hidden::Backlash(draw_joints(rng, &loaded, 2))],
+        Class::Thermal => vec![Hidden::Thermal],
+        Class::Drift => vec![Hidden::Drift],
+        Class::JointOne => {
+            if rng.random_bool(0.5) {
+                vec![Hidden::Compliance(vec![0])]
+            } else {
+                vec![Hidden::Backlash(vec![0])]
+            }
+        }
+        Class::TwoEffects => {
+            let first = rng.random_range(0..3);
+            let second = (first + rng.random_range(1..3)) % 3;
+            vec![draw_kind(rng, first, &loaded, n), draw_kind(rng, second, &loaded, n)]
+        }
+        Class::Coupling => {
+            let joint = rng.random_range(1..5);
+            let mut sources: Vec<usize> = (0..n).filter(|&s| s != joint).collect();
+            let a = sources.remove(rng.random_range(0..sources.len()));
+            let b = sources[rng.random_range(0..sources.len())];
+            let factor = |rng: &mut ChaCha8Rng, s: usize| {
+                (s, f64::from(rng.random_range(1..=3_u32)), rng.random_range(0.0..std::f64::consts::TAU))
+            };
+            vec![Hidden::Coupling(joint, vec![factor(rng, a), factor(rng, b)])]
+        }
+        Class::SevenAxis => vec![Hidden::ComplianceAll],
+        Class::Deflection => vec![Hidden::Deflection(0, [rng.random_range(0.3..1.0), rng.random_range(0.3..1.0)])],
+    }
+}
+
+/// The true cell of a case (perturbed geometry, tool, tracker and masses drawn from `rng`) and the
+/// generator of its poses.
+fn truth_cell(
+    class: Class,
+    robot: &RobotDescription,
+    rows: usize,
+    rng: &mut ChaCha8Rng,
+) -> Result<(SimulatedCell, GeneratorConfig)> {
+    if class == Class::SevenAxis {
+        let config = payload_run_campaign(rows, rng.random());
+        let cell = campaign_cell(robot, &Perturbation::default(), &Remount::default(), &config)?;
+        return Ok((cell, config));
+    }
+    let tool_m = rng.random_range(0.1..0.3);
+    let geometry = perturbed_robot(robot, rng, 0.002, 0.002, tool_m)?;
+    let dynamics = match class {
+        // The truth's masses: the stand-in's bars, each 0.5–1.5 times as heavy.
+        Class::Deflection => {
+            let mut truth = effects::stand_in_dynamics(robot);
+            truth.links.iter_mut().for_each(|l| l.mass_kg *= rng.random_range(0.5..1.5));
+            Some(truth)
+        }
+        _ => robot.dynamics.clone(),
+    };
+    let mut cell = SimulatedCell::new(geometry, dynamics);
+    cell.tracker_from_base = tracker_placement(rng);
+    Ok((cell, GeneratorConfig { sample_count: rows, seed: rng.random(), ..GeneratorConfig::default() }))
+}
+
+/// A case's poses: the robot, its joint ranges and the generator.
+struct Simulator<'a> {
+    robot: &'a RobotDescription,
+    ranges: Vec<JointRange>,
+    config: GeneratorConfig,
+}
+
+impl Simulator<'_> {
+    fn run(&self, cell: &SimulatedCell, effects: &Effects, full_pose: bool) -> Result<MeasurementSet> {
+        simulate(cell, effects, &self.ranges, &self.config, full_pose)
+    }
+
+    /// What a geometric fit leaves, on positions alone (with orientations, a fit weighted for a
+    /// tracker's orientation noise can trade position for orientation error and overstate it).
+    fn left_after_fit(&self, data: &MeasurementSet) -> Result<f64> {
+        let mut positions = data.clone();
+        positions.full_pose = false;
+        positions.rows.iter_mut().for_each(|r| r.orientation = None);
+        let (_, report) = pipeline::fit(self.robot, &positions, Method::Poe, &FitOptions::default())?;
+        Ok(report.after.mean_position_error_mm)
+    }
+}
+
+/// `effects` with the tracker's default noise.
+fn with_noise(effects: &Effects) -> Effects {
+    Effects { tracker_noise: Some(TrackerNoiseModel::default()), ..effects.clone() }
+}
+
+/// Scales each hidden effect so that a geometric fit leaves of it alone a size drawn from `rng`
+/// between 1.2× the noise floor and 4 mm (within its cap), and adds them up: the effects, the
+/// cell's dynamics with them, and the smallest size (0 without hidden effects).
+fn hide(
+    sim: &Simulator<'_>,
+    cell: &SimulatedCell,
+    hidden: &[Hidden],
+    floor_mm: f64,
+    rng: &mut ChaCha8Rng,
+    index: usize,
+) -> Result<(Effects, Option<RobotDynamics>, f64)> {
+    let base_dynamics = &cell.dynamics;
+    let mut effects = Effects::default();
+    let mut dynamics = base_dynamics.clone();
+    let mut magnitude_mm = f64::INFINITY;
+    for h in hidden {
+        let target_mm = floor_mm * 1.2 * (4.0 / (1.2 * floor_mm)).powf(rng.random_range(0.0..1.0));
+        let alone = |scale: f64| -> Result<f64> {
+            let mut e = Effects::default();
+            let mut d = base_dynamics.clone();
+            h.apply(scale, &mut e, &mut d);
+            let mut c = cell.clone();
+            c.dynamics = d;
+            sim.left_after_fit(&sim.run(&c, &e, false)?)
+        };
+        let left = alone(1.0)?;
+        if left <= 0.0 {
+            bail!("case {index}: {h:?} leaves nothing after a geometric fit");
+        }
+        let scale = (target_mm / left).min(h.cap());
+        magnitude_mm = magnitude_mm.min(alone(scale)?);
+        h.apply(scale, &mut effects, &mut dynamics);
+    }
+    if hidden.is_empty() {
+        magnitude_mm = 0.0;
+    }
+    Ok((effects, dynamics, magnitude_mm))
+}
+
+/// The diagnosis of a case's data by the blind robot, and the oracle's: the same poses and noise
+/// without the effects, diagnosed without the structure search.
+fn diagnose_blind(
+    blind_robot: &RobotDescription,
+    data: &MeasurementSet,
+    noisy_none: &MeasurementSet,
+    index: usize,
+) -> Result<(Diagnosis, Diagnosis)> {
+    let options = DiagnoseOptions::default();
+    let diagnosis = diagnose(blind_robot, data, &options).with_context(|| format!("case {index}"))?;
+    let oracle_options =
+        DiagnoseOptions { structure: StructureOptions { enabled: false, ..StructureOptions::default() }, ..options };
+    let oracle = diagnose(blind_robot, noisy_none, &oracle_options)?;
+    Ok((diagnosis, oracle))
 }

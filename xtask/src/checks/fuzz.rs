@@ -206,78 +206,102 @@ fn fuzz_reader(reader: Reader, args: &Args, scratch: &Path) -> Result<Tally> {
             .context("progress style")?
             .progress_chars("=> "),
     );
-    let limit = Duration::from_millis(args.timeout_ms);
-    // Making the seeds (simulating, fitting models) takes seconds, not a case's time.
-    let setup_limit = Duration::from_secs(600).max(limit);
     let mut next = 0;
     while next < args.cases {
-        let mut worker = spawn(reader, args, next, scratch)?;
-        let mut current: Option<(u64, Instant)> = None;
-        let mut ready = false;
-        loop {
-            let wait = match current {
-                _ if !ready => setup_limit,
-                Some((_, started)) => limit.saturating_sub(started.elapsed()).max(Duration::from_millis(1)),
-                None => limit,
-            };
-            match worker.events.recv_timeout(wait) {
-                Ok(Event::Line(line)) => {
-                    let mut words = line.splitn(5, ' ');
-                    match (words.next(), words.next(), words.next(), words.next()) {
-                        (Some("ready"), ..) => ready = true,
-                        (Some("start"), Some(case), ..) => current = Some((case.parse()?, Instant::now())),
-                        (Some("done"), Some(case), Some(kind), Some(micros)) => {
-                            let case: u64 = case.parse()?;
-                            let took = Duration::from_micros(micros.parse()?);
-                            let kind = ["accepted", "refused", "unlocated", "late", "panic"]
-                                .into_iter()
-                                .find(|k| *k == kind)
-                                .with_context(|| format!("worker said {line}"))?;
-                            tally.record(kind, case, words.next().unwrap_or(""));
-                            if took > tally.slowest.0 {
-                                tally.slowest = (took, case);
-                            }
-                            current = None;
-                            next = case + 1;
-                            bar.inc(1);
-                        }
-                        (Some("peak"), Some(kib), ..) => tally.peak_kib = tally.peak_kib.max(kib.parse()?),
-                        _ => bail!("the worker said: {line}"),
-                    }
-                }
-                Ok(Event::End) | Err(RecvTimeoutError::Disconnected) => {
-                    if let Some((case, _)) = current {
-                        tally.record("crash", case, &death(&mut worker));
-                        next = case + 1;
-                        bar.inc(1);
-                    } else if next < args.cases {
-                        bail!("{}", death(&mut worker));
-                    } else {
-                        let _ = worker.child.wait();
-                    }
-                    break;
-                }
-                Err(RecvTimeoutError::Timeout) => {
-                    let Some((case, started)) = current else {
-                        let _ = worker.child.kill();
-                        bail!("the worker stalled outside a case (setup or input generation)");
-                    };
-                    if started.elapsed() < limit {
-                        continue;
-                    }
-                    let _ = worker.child.kill();
-                    let _ = worker.child.wait();
-                    tally.record("hang", case, &format!("no answer within {limit:?}"));
-                    tally.slowest = tally.slowest.max((limit, case));
-                    next = case + 1;
-                    bar.inc(1);
-                    break;
-                }
-            }
-        }
+        next = run_worker(reader, args, scratch, next, &mut tally, &bar)?;
     }
     bar.finish_and_clear();
     Ok(tally)
+}
+
+/// What the worker listened to is doing.
+struct Listening {
+    /// The case it started and when, until it says the case is done.
+    current: Option<(u64, Instant)>,
+    /// Whether it has made its seeds.
+    ready: bool,
+    /// The case after the last one done.
+    next: u64,
+}
+
+/// One worker from case `next` until it ends, crashes or hangs; returns the case to go on from.
+fn run_worker(
+    reader: Reader,
+    args: &Args,
+    scratch: &Path,
+    next: u64,
+    tally: &mut Tally,
+    bar: &ProgressBar,
+) -> Result<u64> {
+    let limit = Duration::from_millis(args.timeout_ms);
+    // Making the seeds (simulating, fitting models) takes seconds, not a case's time.
+    let setup_limit = Duration::from_secs(600).max(limit);
+    let mut worker = spawn(reader, args, next, scratch)?;
+    let mut state = Listening { current: None, ready: false, next };
+    loop {
+        let wait = match state.current {
+            _ if !state.ready => setup_limit,
+            Some((_, started)) => limit.saturating_sub(started.elapsed()).max(Duration::from_millis(1)),
+            None => limit,
+        };
+        match worker.events.recv_timeout(wait) {
+            Ok(Event::Line(line)) => heard(&line, &mut state, tally, bar)?,
+            Ok(Event::End) | Err(RecvTimeoutError::Disconnected) => {
+                if let Some((case, _)) = state.current {
+                    tally.record("crash", case, &death(&mut worker));
+                    state.next = case + 1;
+                    bar.inc(1);
+                } else if state.next < args.cases {
+                    bail!("{}", death(&mut worker));
+                } else {
+                    let _ = worker.child.wait();
+                }
+                return Ok(state.next);
+            }
+            Err(RecvTimeoutError::Timeout) => {
+                let Some((case, started)) = state.current else {
+                    let _ = worker.child.kill();
+                    bail!("the worker stalled outside a case (setup or input generation)");
+                };
+                if started.elapsed() < limit {
+                    continue;
+                }
+                let _ = worker.child.kill();
+                let _ = worker.child.wait();
+                tally.record("hang", case, &format!("no answer within {limit:?}"));
+                tally.slowest = tally.slowest.max((limit, case));
+                bar.inc(1);
+                return Ok(case + 1);
+            }
+        }
+    }
+}
+
+/// One line of the worker's: ready, a case started or done, or its peak memory.
+fn heard(line: &str, state: &mut Listening, tally: &mut Tally, bar: &ProgressBar) -> Result<()> {
+    let mut words = line.splitn(5, ' ');
+    match (words.next(), words.next(), words.next(), words.next()) {
+        (Some("ready"), ..) => state.ready = true,
+        (Some("start"), Some(case), ..) => state.current = Some((case.parse()?, Instant::now())),
+        (Some("done"), Some(case), Some(kind), Some(micros)) => {
+            let case: u64 = case.parse()?;
+            let took = Duration::from_micros(micros.parse()?);
+            let kind = ["accepted", "refused", "unlocated", "late", "panic"]
+                .into_iter()
+                .find(|k| *k == kind)
+                .with_context(|| format!("worker said {line}"))?;
+            tally.record(kind, case, words.next().unwrap_or(""));
+            if took > tally.slowest.0 {
+                tally.slowest = (took, case);
+            }
+            state.current = None;
+            state.next = case + 1;
+            bar.inc(1);
+        }
+        (Some("peak"), Some(kib), ..) => tally.peak_kib = tally.peak_kib.max(kib.parse()?),
+        _ => bail!("the worker said: {line}"),
+    }
+    Ok(())
 }
 
 fn dump(reader: Reader, args: &Args, case: u64, out: &Path) -> Result<()> {
@@ -309,6 +333,31 @@ fn tempfolder() -> Result<PathBuf> {
     Ok(folder)
 }
 
+/// The table of every reader's tally.
+fn print_tallies(tallies: &[(Reader, Tally)]) {
+    println!(
+        "\n| reader | inputs | accepted | refused, located | refused, unlocated | accepted, then failed | panics | crashes | hangs | slowest (ms, case) | peak RSS (MiB) |"
+    );
+    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    for (reader, t) in tallies {
+        println!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.1} (#{}) | {} |",
+            reader.name(),
+            t.inputs,
+            t.accepted,
+            t.refused,
+            t.unlocated,
+            t.late,
+            t.panics,
+            t.crashes,
+            t.hangs,
+            t.slowest.0.as_secs_f64() * 1e3,
+            t.slowest.1,
+            t.peak_kib / 1024
+        );
+    }
+}
+
 pub fn run(args: &Args) -> Result<()> {
     let readers = args.reader.readers();
     if let (Some(case), Some(out)) = (args.dump, &args.out) {
@@ -334,27 +383,7 @@ pub fn run(args: &Args) -> Result<()> {
         tallies.push((reader, tally));
     }
     let _ = std::fs::remove_dir_all(&scratch);
-    println!(
-        "\n| reader | inputs | accepted | refused, located | refused, unlocated | accepted, then failed | panics | crashes | hangs | slowest (ms, case) | peak RSS (MiB) |"
-    );
-    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
-    for (reader, t) in &tallies {
-        println!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.1} (#{}) | {} |",
-            reader.name(),
-            t.inputs,
-            t.accepted,
-            t.refused,
-            t.unlocated,
-            t.late,
-            t.panics,
-            t.crashes,
-            t.hangs,
-            t.slowest.0.as_secs_f64() * 1e3,
-            t.slowest.1,
-            t.peak_kib / 1024
-        );
-    }
+    print_tallies(&tallies);
     let mut failures = 0;
     for (reader, t) in &tallies {
         failures += t.failures(args.unusable_ok.contains(reader));

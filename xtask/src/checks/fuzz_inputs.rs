@@ -374,13 +374,27 @@ fn swap(bytes: &mut Vec<u8>, first: (usize, usize), second: (usize, usize)) {
 
 /// One mutation of `bytes`.
 fn mutate(bytes: &mut Vec<u8>, reader: Reader, rng: &mut ChaCha8Rng) {
+    match rng.random_range(0..18) {
+        kind @ 0..=5 => mutate_tokens(bytes, reader, rng, kind),
+        kind @ 6..=8 => mutate_lines(bytes, rng, kind),
+        kind @ 9..=11 => mutate_bytes(bytes, rng, kind),
+        kind => mutate_at_scale(bytes, rng, kind),
+    }
+}
+
+/// A position in `bytes` (its end included), drawn from `rng`.
+fn at(bytes: &[u8], rng: &mut ChaCha8Rng) -> usize {
+    if bytes.is_empty() { 0 } else { rng.random_range(0..=bytes.len()) }
+}
+
+/// Mutations 0–5: of one token or two.
+fn mutate_tokens(bytes: &mut Vec<u8>, reader: Reader, rng: &mut ChaCha8Rng, kind: i32) {
     let spans = tokens(bytes);
     let token = |rng: &mut ChaCha8Rng| spans.choose(rng).copied().unwrap_or((0, 0));
     let words_only: Vec<(usize, usize)> =
         spans.iter().copied().filter(|&(a, b)| b > a + 1 || bytes[a].is_ascii_alphanumeric()).collect();
     let word = |rng: &mut ChaCha8Rng| words_only.choose(rng).copied().unwrap_or((0, 0));
-    let at = |rng: &mut ChaCha8Rng| if bytes.is_empty() { 0 } else { rng.random_range(0..=bytes.len()) };
-    match rng.random_range(0..18) {
+    match kind {
         // A cell (token) deleted, duplicated, or swapped with another.
         0 => replace(bytes, token(rng), b""),
         1 => {
@@ -398,7 +412,13 @@ fn mutate(bytes: &mut Vec<u8>, reader: Reader, rng: &mut ChaCha8Rng) {
         }
         // A number or a name replaced by one the format must handle or refuse.
         3 | 4 => replace(bytes, word(rng), NUMBERS.choose(rng).unwrap_or(&"").as_bytes()),
-        5 => replace(bytes, word(rng), words(reader).choose(rng).unwrap_or(&"").as_bytes()),
+        _ => replace(bytes, word(rng), words(reader).choose(rng).unwrap_or(&"").as_bytes()),
+    }
+}
+
+/// Mutations 6–8: of whole lines.
+fn mutate_lines(bytes: &mut Vec<u8>, rng: &mut ChaCha8Rng, kind: i32) {
+    match kind {
         // Lines deleted, duplicated (up to thousands of times), swapped.
         6 => {
             if let Some(&line) = lines(bytes).choose(rng) {
@@ -412,7 +432,7 @@ fn mutate(bytes: &mut Vec<u8>, reader: Reader, rng: &mut ChaCha8Rng) {
                 bytes.splice(b..b, line);
             }
         }
-        8 => {
+        _ => {
             let all = lines(bytes);
             if all.len() >= 2 {
                 let i = rng.random_range(0..all.len() - 1);
@@ -420,31 +440,43 @@ fn mutate(bytes: &mut Vec<u8>, reader: Reader, rng: &mut ChaCha8Rng) {
                 swap(bytes, all[i], all[j]);
             }
         }
+    }
+}
+
+/// Mutations 9–11: of bytes, regardless of the format.
+fn mutate_bytes(bytes: &mut Vec<u8>, rng: &mut ChaCha8Rng, kind: i32) {
+    match kind {
         // Truncated anywhere, even inside a UTF-8 sequence.
         9 => {
-            let end = at(rng);
+            let end = at(bytes, rng);
             bytes.truncate(end);
         }
         10 => {
-            let position = at(rng);
+            let position = at(bytes, rng);
             bytes.splice(position..position, INVALID_UTF8.choose(rng).unwrap_or(&&b"\xff"[..]).iter().copied());
         }
-        11 => {
+        _ => {
             if !bytes.is_empty() {
                 let i = rng.random_range(0..bytes.len());
                 bytes[i] ^= 1 << rng.random_range(0..8);
             }
         }
+    }
+}
+
+/// Mutations 12–17: long lines, deep nesting, many distinct names, separators, noise.
+fn mutate_at_scale(bytes: &mut Vec<u8>, rng: &mut ChaCha8Rng, kind: i32) {
+    match kind {
         // A long line: a token repeated up to 200,000 times (100,000-column headers).
         12 => {
-            let span = token(rng);
+            let span = tokens(bytes).choose(rng).copied().unwrap_or((0, 0));
             let copies = log_count(rng, 200_000).min(MAX_LEN / (span.1 - span.0).max(1));
             let run = bytes[span.0..span.1].repeat(copies);
             bytes.splice(span.1..span.1, run);
         }
         // Deep nesting.
         13 => {
-            let position = at(rng);
+            let position = at(bytes, rng);
             let run = OPENERS.choose(rng).unwrap_or(&"(").repeat(log_count(rng, 100_000));
             bytes.splice(position..position, run.into_bytes());
         }
@@ -455,7 +487,7 @@ fn mutate(bytes: &mut Vec<u8>, reader: Reader, rng: &mut ChaCha8Rng) {
         }
         // Many distinct cells, names or elements: what makes a lookup by scanning quadratic.
         15 => {
-            let position = at(rng);
+            let position = at(bytes, rng);
             let count = log_count(rng, 100_000);
             let (prefix, suffix) = [(",c", ""), (";c", ""), ("<link name=\"l", "\"/>"), (" a", "=\"\""), ("\nr", ",t")]
                 [rng.random_range(0..5)];
@@ -464,14 +496,14 @@ fn mutate(bytes: &mut Vec<u8>, reader: Reader, rng: &mut ChaCha8Rng) {
         }
         // Deep nesting that closes again: a recursive walk of the tree.
         16 => {
-            let position = at(rng);
+            let position = at(bytes, rng);
             let depth = log_count(rng, 100_000);
             let (open, close) = [("(", ")"), ("[", "]"), ("<a>", "</a>"), ("Some(", ")")][rng.random_range(0..4)];
             let run = open.repeat(depth) + &close.repeat(depth);
             bytes.splice(position..position, run.into_bytes());
         }
         _ => {
-            let position = at(rng);
+            let position = at(bytes, rng);
             let noise: Vec<u8> = (0..rng.random_range(1..16)).map(|_| rng.random()).collect();
             bytes.splice(position..position, noise);
         }

@@ -11,13 +11,13 @@
 
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
-use measurements::{MeasurementSet, ReadOptions};
+use measurements::MeasurementSet;
 use robot::RobotDescription;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
 
-use super::bench_fit_data::{Files, even_odd, position_only, simulate, spread, ur10_series, write_pair};
+use super::bench_fit_data::{Files, even_odd, position_only, read_csv, simulate, spread, ur10_series, write_pair};
 use super::bench_fit_run::{heldout_of_eval, measure, phases_of_fit};
 use super::bench_fit_sklearn::{PipelineOptions, SklearnKernel, SklearnSide, python_env, sklearn_pipeline};
 use super::bench_fit_table::{Budget, Measured, Outcome, Row, Run, RunResult, Side, table};
@@ -341,12 +341,32 @@ fn measure_row(
     python: &Result<PathBuf, String>,
     bar: &ProgressBar,
 ) -> anyhow::Result<Outcome> {
-    let args = inputs.args;
     bar.set_message(format!("{}: preparing the data", key.label()));
     let files = match inputs.files(key)? {
         Ok(files) => files,
         Err(why) => return Ok(Outcome::Skipped(why)),
     };
+    let results = timed_runs(key, inputs, binaries, &files, bar);
+    let mut sides =
+        results.into_iter().map(|r| r.and_then(|runs| Side::from_runs(&runs).ok_or_else(|| "no run".into())));
+    let calib = sides.next().unwrap_or_else(|| Err("no binary".into()));
+    let base = sides.next();
+    let sklearn = key.sklearn().map(|kernel| sklearn_side(key, kernel, inputs, &files, python, bar));
+    let data =
+        format!("{} / {}, {}", files.rows.0, files.rows.1, if files.full_pose { "full pose" } else { "position only" });
+    Ok(Outcome::Measured(Box::new(Measured { data, calib, base, sklearn })))
+}
+
+/// `runs` runs of each binary on the row's files, alternating which goes first, until
+/// `--repeat-limit-s` is spent; a binary that fails runs no more.
+fn timed_runs(
+    key: RowKey,
+    inputs: &Inputs,
+    binaries: &[(&str, &Path)],
+    files: &Files,
+    bar: &ProgressBar,
+) -> Vec<Result<Vec<RunResult>, String>> {
+    let args = inputs.args;
     let robot = inputs.robot_path(key);
     let runs = if args.quick { 1 } else { args.runs.max(1) };
     let mut results: Vec<Result<Vec<RunResult>, String>> = vec![Ok(Vec::new()); binaries.len()];
@@ -365,7 +385,7 @@ fn measure_row(
             let Ok(done) = &mut results[which] else { continue };
             let message = |s: f64| format!("{}: {name} run {}/{runs}, {s:.0} s", key.label(), run + 1);
             let tick = |s: f64| bar.set_message(message(s));
-            match one_run(calib, key, &robot, &files, &inputs.work, &tick) {
+            match one_run(calib, key, &robot, files, &inputs.work, &tick) {
                 Ok(result) => {
                     spent_s += result.cost.wall_s;
                     bar.suspend(|| eprintln!("  {}", message(result.cost.wall_s)));
@@ -378,39 +398,41 @@ fn measure_row(
             }
         }
     }
-    let mut sides =
-        results.into_iter().map(|r| r.and_then(|runs| Side::from_runs(&runs).ok_or_else(|| "no run".into())));
-    let calib = sides.next().unwrap_or_else(|| Err("no binary".into()));
-    let base = sides.next();
-    let sklearn = key.sklearn().map(|kernel| {
-        let restarts = kernel.restarts(args.quick);
-        let side = match python {
-            Err(why) => SklearnSide::Skipped(why.clone()),
-            Ok(python) => {
-                bar.set_message(format!("{}: scikit-learn (stopped after {} s)", key.label(), args.sklearn_timeout_s));
-                let options = PipelineOptions {
-                    python: python.clone(),
-                    kernel,
-                    restarts,
-                    with_payload: matches!(key.work(), Work::Fit { method: "poe-gp-load", .. }),
-                    timeout: Duration::from_secs_f64(args.sklearn_timeout_s),
-                    scipy_identify: args.scipy_identify,
-                };
-                let robot = inputs.robot(key);
-                let read = |p: &Path| {
-                    measurements::read_measurements(p, &ReadOptions::for_joints(robot.joint_kinds()))
-                        .with_context(|| p.display().to_string())
-                };
-                let run = || sklearn_pipeline(robot, &read(&files.train)?, &read(&files.test)?, &options);
-                run().unwrap_or_else(|e| SklearnSide::Skipped(format!("failed: {e:#}")))
-            }
-        };
-        bar.suspend(|| eprintln!("  scikit-learn: {}", side.note()));
-        (kernel.text(restarts), side)
-    });
-    let data =
-        format!("{} / {}, {}", files.rows.0, files.rows.1, if files.full_pose { "full pose" } else { "position only" });
-    Ok(Outcome::Measured(Box::new(Measured { data, calib, base, sklearn })))
+    results
+}
+
+/// The scikit-learn pipeline once on the row's files (skipped without its interpreter), with the
+/// kernel's text.
+fn sklearn_side(
+    key: RowKey,
+    kernel: SklearnKernel,
+    inputs: &Inputs,
+    files: &Files,
+    python: &Result<PathBuf, String>,
+    bar: &ProgressBar,
+) -> (String, SklearnSide) {
+    let args = inputs.args;
+    let restarts = kernel.restarts(args.quick);
+    let side = match python {
+        Err(why) => SklearnSide::Skipped(why.clone()),
+        Ok(python) => {
+            bar.set_message(format!("{}: scikit-learn (stopped after {} s)", key.label(), args.sklearn_timeout_s));
+            let options = PipelineOptions {
+                python: python.clone(),
+                kernel,
+                restarts,
+                with_payload: matches!(key.work(), Work::Fit { method: "poe-gp-load", .. }),
+                timeout: Duration::from_secs_f64(args.sklearn_timeout_s),
+                scipy_identify: args.scipy_identify,
+            };
+            let robot = inputs.robot(key);
+            let run =
+                || sklearn_pipeline(robot, &read_csv(&files.train, robot)?, &read_csv(&files.test, robot)?, &options);
+            run().unwrap_or_else(|e| SklearnSide::Skipped(format!("failed: {e:#}")))
+        }
+    };
+    bar.suspend(|| eprintln!("  scikit-learn: {}", side.note()));
+    (kernel.text(restarts), side)
 }
 
 /// `/proc/loadavg`'s 1, 5 and 15 minute averages.
@@ -443,6 +465,36 @@ fn calib_binary(args: &Args) -> anyhow::Result<(PathBuf, String)> {
     Ok((path.clone(), format!("{} (release, built from {at})", path.display())))
 }
 
+/// Each selected row in turn, under a spinner; the rows measured, and the error that stopped
+/// them (named by its row) if one did.
+fn measure_rows(
+    keys: &[RowKey],
+    inputs: &mut Inputs,
+    binaries: &[(&str, &Path)],
+    python: &Result<PathBuf, String>,
+) -> (Vec<Row>, anyhow::Result<()>) {
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {elapsed} {msg}").unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    bar.enable_steady_tick(Duration::from_millis(250));
+    let mut rows = Vec::new();
+    let mut result = Ok(());
+    for (i, &key) in keys.iter().enumerate() {
+        bar.suspend(|| eprintln!("bench-fit [{}/{}] {} (load {})", i + 1, keys.len(), key.label(), load_average()));
+        match measure_row(key, inputs, binaries, python, &bar) {
+            Ok(outcome) => rows.push(Row { label: key.label(), budget: key.budget(), outcome }),
+            Err(e) => {
+                bar.suspend(|| eprintln!("  failed: {e:#}"));
+                result = Err(e.context(key.label()));
+                break;
+            }
+        }
+    }
+    bar.finish_and_clear();
+    (rows, result)
+}
+
 /// Runs the selected rows and prints the table; fails after printing it if a command failed.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let keys = selected(&args.only);
@@ -464,25 +516,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         binaries.push(("base", base));
     }
     let load_start = load_average();
-    let bar = ProgressBar::new_spinner();
-    bar.set_style(
-        ProgressStyle::with_template("{spinner} {elapsed} {msg}").unwrap_or_else(|_| ProgressStyle::default_spinner()),
-    );
-    bar.enable_steady_tick(Duration::from_millis(250));
-    let mut rows = Vec::new();
-    let mut result = Ok(());
-    for (i, &key) in keys.iter().enumerate() {
-        bar.suspend(|| eprintln!("bench-fit [{}/{}] {} (load {})", i + 1, keys.len(), key.label(), load_average()));
-        match measure_row(key, &mut inputs, &binaries, &python, &bar) {
-            Ok(outcome) => rows.push(Row { label: key.label(), budget: key.budget(), outcome }),
-            Err(e) => {
-                bar.suspend(|| eprintln!("  failed: {e:#}"));
-                result = Err(e.context(key.label()));
-                break;
-            }
-        }
-    }
-    bar.finish_and_clear();
+    let (rows, result) = measure_rows(&keys, &mut inputs, &binaries, &python);
     let _ = std::fs::remove_dir_all(&work);
     let run = Run {
         machine: format!(

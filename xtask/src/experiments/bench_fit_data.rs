@@ -22,6 +22,12 @@ pub struct Files {
     pub full_pose: bool,
 }
 
+/// A SPEC CSV of `robot`'s joints; an error names the file.
+pub fn read_csv(path: &Path, robot: &RobotDescription) -> anyhow::Result<MeasurementSet> {
+    measurements::read_measurements(path, &ReadOptions::for_joints(robot.joint_kinds()))
+        .with_context(|| path.display().to_string())
+}
+
 /// A UR10 series, full pose where the source has orientations, all rows in measurement order:
 /// converted from the data set when `dir` holds it (`Series_C/…`), else read from converted CSVs
 /// (`C.csv` or `ur10_C.csv`, or the even and odd rows `C_even.csv` and `C_odd.csv` put back in
@@ -30,8 +36,7 @@ pub fn ur10_series(dir: &Path, robot: &RobotDescription, series: &str) -> anyhow
     if dir.join(format!("Series_{series}")).is_dir() {
         return super::convert_ur10::read_series(dir, series, true).map(Some);
     }
-    let options = ReadOptions::for_joints(robot.joint_kinds());
-    let read = |p: &Path| measurements::read_measurements(p, &options).with_context(|| p.display().to_string());
+    let read = |p: &Path| read_csv(p, robot);
     let stems = [series.to_owned(), format!("ur10_{series}")];
     for stem in &stems {
         let whole = dir.join(format!("{stem}.csv"));

@@ -295,8 +295,42 @@ fn budget_cell(row: &Row, m: &Measured, quick: bool) -> String {
 /// The markdown: what the run was measured on, the table, then the phases, the scikit-learn
 /// side, the rows skipped or failed, and what the columns mean.
 pub fn table(run: &Run, rows: &[Row]) -> String {
-    let with_base = run.base.is_some();
     let mut md = String::new();
+    preamble(&mut md, run);
+    let head = columns(run.base.is_some());
+    let _ = writeln!(md, "\n| {} |", head.join(" | "));
+    let align: Vec<&str> =
+        head.iter().enumerate().map(|(i, _)| if i < 2 || i + 1 == head.len() { "---" } else { "---:" }).collect();
+    let _ = writeln!(md, "|{}|", align.join("|"));
+    let mut phases = Vec::new();
+    let mut notes = Vec::new();
+    for row in rows {
+        let cells = match &row.outcome {
+            Outcome::Skipped(why) => {
+                let mut cells = vec![row.label.to_owned(), format!("data absent: {why}")];
+                cells.resize(head.len(), dash());
+                cells
+            }
+            Outcome::Measured(m) => measured_cells(run, row, m, &mut phases, &mut notes),
+        };
+        let _ = writeln!(md, "| {} |", cells.join(" | "));
+    }
+    if !phases.is_empty() {
+        let _ = writeln!(
+            md,
+            "\nPhases of 1 s or more (`calib fit --json`'s timings, run nearest the median), wall (CPU) s:\n\n{}",
+            phases.join("\n")
+        );
+    }
+    if !notes.is_empty() {
+        let _ = writeln!(md, "\nThe scikit-learn side and failures:\n\n{}", notes.join("\n"));
+    }
+    md.push_str(LEGEND);
+    md
+}
+
+/// The command, the machine and its load, the binaries, and what `--quick` means.
+fn preamble(md: &mut String, run: &Run) {
     let _ = writeln!(md, "`{}`\n", run.command);
     let _ = writeln!(
         md,
@@ -316,6 +350,10 @@ pub fn table(run: &Run, rows: &[Row]) -> String {
              without restarts: a smoke run, not the budgets' measurement; the budgets are not judged."
         );
     }
+}
+
+/// The table's columns (the base binary's with `with_base`).
+fn columns(with_base: bool) -> Vec<&'static str> {
     let mut head =
         vec!["row", "train / test", "runs", "wall (s)", "CPU (s)", "peak (MiB)", "held-out (mm)", "held-out (mrad)"];
     if with_base {
@@ -330,71 +368,51 @@ pub fn table(run: &Run, rows: &[Row]) -> String {
         ]);
     }
     head.extend(["scikit-learn (s)", "its (mm)", "its (mrad)", "scikit-learn / calib", "budget: verdict"]);
-    let _ = writeln!(md, "\n| {} |", head.join(" | "));
-    let align: Vec<&str> =
-        head.iter().enumerate().map(|(i, _)| if i < 2 || i + 1 == head.len() { "---" } else { "---:" }).collect();
-    let _ = writeln!(md, "|{}|", align.join("|"));
-    let mut phases = Vec::new();
-    let mut notes = Vec::new();
-    for row in rows {
-        let m = match &row.outcome {
-            Outcome::Skipped(why) => {
-                let mut cells = vec![row.label.to_owned(), format!("data absent: {why}")];
-                cells.resize(head.len(), dash());
-                let _ = writeln!(md, "| {} |", cells.join(" | "));
-                continue;
-            }
-            Outcome::Measured(m) => m,
+    head
+}
+
+/// A measured row's cells; its phases and notes go to `phases` and `notes`.
+fn measured_cells(
+    run: &Run,
+    row: &Row,
+    m: &Measured,
+    phases: &mut Vec<String>,
+    notes: &mut Vec<String>,
+) -> Vec<String> {
+    let mut cells = vec![row.label.to_owned(), m.data.clone()];
+    cells.extend(side_cells(&m.calib));
+    match &m.calib {
+        Ok(s) => phases.push(format!("- {}: {}", row.label, phases_text(&s.phases))),
+        Err(e) => notes.push(format!("- {}: `calib` failed: {e}", row.label)),
+    }
+    if let Some(base) = &m.base {
+        cells.extend(side_cells(base));
+        let ratio = match (&m.calib, base) {
+            (Ok(s), Ok(b)) => format!("{:.2}×", s.wall_s / b.wall_s),
+            _ => dash(),
         };
-        let mut cells = vec![row.label.to_owned(), m.data.clone()];
-        cells.extend(side_cells(&m.calib));
-        match &m.calib {
-            Ok(s) => phases.push(format!("- {}: {}", row.label, phases_text(&s.phases))),
-            Err(e) => notes.push(format!("- {}: `calib` failed: {e}", row.label)),
+        cells.push(ratio);
+        match base {
+            Ok(b) => phases.push(format!("- {} (base): {}", row.label, phases_text(&b.phases))),
+            Err(e) => notes.push(format!("- {}: the base binary failed: {e}", row.label)),
         }
-        if let Some(base) = &m.base {
-            cells.extend(side_cells(base));
-            let ratio = match (&m.calib, base) {
-                (Ok(s), Ok(b)) => format!("{:.2}×", s.wall_s / b.wall_s),
-                _ => dash(),
+    } else if run.base.is_some() {
+        cells.extend(std::iter::repeat_n(dash(), 7));
+    }
+    match (&m.sklearn, &m.calib) {
+        (Some((kernel, side)), calib) => {
+            let (mm, mrad) = match side {
+                SklearnSide::Done { heldout_mm, heldout_mrad, .. } => heldout_cells(Some((*heldout_mm, *heldout_mrad))),
+                _ => (dash(), dash()),
             };
-            cells.push(ratio);
-            match base {
-                Ok(b) => phases.push(format!("- {} (base): {}", row.label, phases_text(&b.phases))),
-                Err(e) => notes.push(format!("- {}: the base binary failed: {e}", row.label)),
-            }
-        } else if with_base {
-            cells.extend(std::iter::repeat_n(dash(), 7));
+            let ratio = calib.as_ref().map_or_else(|_| dash(), |s| ratio_cell(row.budget, s, side));
+            cells.extend([side.seconds_text(), mm, mrad, ratio]);
+            notes.push(format!("- {}: scikit-learn `{kernel}`; {}", row.label, side.note()));
         }
-        match (&m.sklearn, &m.calib) {
-            (Some((kernel, side)), calib) => {
-                let (mm, mrad) = match side {
-                    SklearnSide::Done { heldout_mm, heldout_mrad, .. } => {
-                        heldout_cells(Some((*heldout_mm, *heldout_mrad)))
-                    }
-                    _ => (dash(), dash()),
-                };
-                let ratio = calib.as_ref().map_or_else(|_| dash(), |s| ratio_cell(row.budget, s, side));
-                cells.extend([side.seconds_text(), mm, mrad, ratio]);
-                notes.push(format!("- {}: scikit-learn `{kernel}`; {}", row.label, side.note()));
-            }
-            (None, _) => cells.extend([dash(), dash(), dash(), dash()]),
-        }
-        cells.push(budget_cell(row, m, run.quick));
-        let _ = writeln!(md, "| {} |", cells.join(" | "));
+        (None, _) => cells.extend([dash(), dash(), dash(), dash()]),
     }
-    if !phases.is_empty() {
-        let _ = writeln!(
-            md,
-            "\nPhases of 1 s or more (`calib fit --json`'s timings, run nearest the median), wall (CPU) s:\n\n{}",
-            phases.join("\n")
-        );
-    }
-    if !notes.is_empty() {
-        let _ = writeln!(md, "\nThe scikit-learn side and failures:\n\n{}", notes.join("\n"));
-    }
-    md.push_str(LEGEND);
-    md
+    cells.push(budget_cell(row, m, run.quick));
+    cells
 }
 
 /// What the columns mean, printed under the table.

@@ -394,21 +394,34 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         return Ok(());
     }
+    synthetic(args)
+}
+
+/// The markdown of `--synthetic`, each line printed as it is written.
+#[derive(Default)]
+struct Lines(String);
+
+impl Lines {
+    fn line(&mut self, s: String) {
+        println!("{s}");
+        self.0.push_str(&s);
+        self.0.push('\n');
+    }
+}
+
+/// `--synthetic`: the exact GP beside scikit-learn, Cholesky against the machine's peak, the sparse GP
+/// against the exact one.
+fn synthetic(args: &Args) -> anyhow::Result<()> {
     let sizes: Vec<usize> = if args.quick { vec![100, 300] } else { vec![100, 300, 1000, 3000] };
     let max_n = *sizes.iter().max().unwrap_or(&100);
     let sparse_sizes: Vec<usize> = if args.quick { vec![1000] } else { vec![3000, 10000] };
     let d = data(max_n.max(*sparse_sizes.iter().max().unwrap_or(&0)), 2024);
     let threads = rayon::current_num_threads();
-    let mut out = String::new();
-    let mut line = |s: String| {
-        println!("{s}");
-        out.push_str(&s);
-        out.push('\n');
-    };
+    let mut out = Lines::default();
 
-    line("# gp benchmark (`cargo xtask bench-gp`)".into());
-    line(String::new());
-    line(format!(
+    out.line("# gp benchmark (`cargo xtask bench-gp`)".into());
+    out.line(String::new());
+    out.line(format!(
         "Machine: {} ({} cores visible, rayon pool of {threads} threads). Data: d = {DIM} (6 joint angles + payload), \
          {OUTPUTS} outputs sharing one kernel (`OutputMode::Shared`), the paper's Eq. 5 kernel, inputs standardised, \
          outputs normalised, {} random restarts besides the default start; predictions at {TEST_POINTS} points \
@@ -417,16 +430,28 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
         args.restarts
     ));
-    line(String::new());
+    out.line(String::new());
 
+    exact_section(&mut out, &d, &sizes, args)?;
+    cholesky_section(&mut out, &d, max_n)?;
+    sparse_section(&mut out, &d, &sparse_sizes, args.restarts)?;
+
+    if let Some(path) = &args.out {
+        std::fs::write(path, &out.0).with_context(|| path.display().to_string())?;
+    }
+    Ok(())
+}
+
+/// Our exact GP at each size, scikit-learn at those up to `--sklearn-max-n`, and the log–log slopes.
+fn exact_section(out: &mut Lines, d: &Data, sizes: &[usize], args: &Args) -> anyhow::Result<()> {
     let skl_sizes: Vec<usize> = sizes.iter().copied().filter(|&n| n <= args.sklearn_max_n).collect();
     let mut our_rows = Vec::new();
-    for &n in &sizes {
+    for &n in sizes {
         eprintln!("gp n={n} …");
-        our_rows.push(ours(&d, n, args.restarts)?);
+        our_rows.push(ours(d, n, args.restarts)?);
     }
     let skl = if sklearn_available() && !skl_sizes.is_empty() {
-        match sklearn(&d, &skl_sizes, args.restarts) {
+        match sklearn(d, &skl_sizes, args.restarts) {
             Ok(r) => Some(r),
             Err(e) => {
                 eprintln!("scikit-learn comparison skipped: {e:#}");
@@ -438,13 +463,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None
     };
 
-    line("## Exact GP: fit (with hyperparameter search) and predict".into());
-    line(String::new());
-    line("| n | fit (s) | fit serial (s) | fit, 6 independent kernels (s) | predict (s) | LML | test RMSE | sklearn fit (s) | sklearn predict (s) | sklearn LML | fit speed-up | LML − sklearn |".into());
-    line("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|".into());
+    out.line("## Exact GP: fit (with hyperparameter search) and predict".into());
+    out.line(String::new());
+    out.line("| n | fit (s) | fit serial (s) | fit, 6 independent kernels (s) | predict (s) | LML | test RMSE | sklearn fit (s) | sklearn predict (s) | sklearn LML | fit speed-up | LML − sklearn |".into());
+    out.line("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|".into());
     for r in &our_rows {
         let s = skl.as_ref().and_then(|rows| skl_sizes.iter().position(|&n| n == r.n).and_then(|i| rows.get(i)));
-        line(format!(
+        out.line(format!(
             "| {} | {:.3} | {} | {} | {:.4} | {:.2} | {:.4} | {} | {} | {} | {} | {} |",
             r.n,
             r.fit,
@@ -460,41 +485,49 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             fmt_opt(s.map(|s| r.lml - s.lml), |v| format!("{v:+.4}")),
         ));
     }
-    line(String::new());
+    out.line(String::new());
     let slope = log_log_slope(&our_rows.iter().map(|r| (r.n, r.fit)).collect::<Vec<_>>());
-    line(format!("Log–log slope of gp fit time against n over n = {sizes:?}: **{slope:.2}**."));
+    out.line(format!("Log–log slope of gp fit time against n over n = {sizes:?}: **{slope:.2}**."));
     if let Some(rows) = &skl
         && rows.len() >= 2
     {
         let pts: Vec<(usize, f64)> = skl_sizes.iter().copied().zip(rows.iter().map(|r| r.fit)).collect();
-        line(format!("scikit-learn: **{:.2}** over n = {skl_sizes:?}.", log_log_slope(&pts)));
+        out.line(format!("scikit-learn: **{:.2}** over n = {skl_sizes:?}.", log_log_slope(&pts)));
     }
-    line(String::new());
+    out.line(String::new());
+    Ok(())
+}
 
-    line("## Cholesky against the machine's peak".into());
-    line(String::new());
+/// The Cholesky factorisation's GFLOP/s at the largest n against faer's matrix product.
+fn cholesky_section(out: &mut Lines, d: &Data, max_n: usize) -> anyhow::Result<()> {
+    out.line("## Cholesky against the machine's peak".into());
+    out.line(String::new());
     let peak = peak_gflops(2000, Par::rayon(0));
     let peak_seq = peak_gflops(2000, Par::Seq);
     let chol = cholesky_gflops(&d.x, max_n, Par::rayon(0))?;
     let chol_seq = cholesky_gflops(&d.x, max_n, Par::Seq)?;
-    line("| | rayon (GFLOP/s) | serial (GFLOP/s) |".into());
-    line("|---|---:|---:|".into());
-    line(format!("| faer matmul 2000×2000 (peak) | {peak:.1} | {peak_seq:.1} |"));
-    line(format!("| Cholesky n = {max_n} | {chol:.1} | {chol_seq:.1} |"));
-    line(format!("| peak / Cholesky | {:.2}× | {:.2}× |", peak / chol, peak_seq / chol_seq));
-    line(String::new());
+    out.line("| | rayon (GFLOP/s) | serial (GFLOP/s) |".into());
+    out.line("|---|---:|---:|".into());
+    out.line(format!("| faer matmul 2000×2000 (peak) | {peak:.1} | {peak_seq:.1} |"));
+    out.line(format!("| Cholesky n = {max_n} | {chol:.1} | {chol_seq:.1} |"));
+    out.line(format!("| peak / Cholesky | {:.2}× | {:.2}× |", peak / chol, peak_seq / chol_seq));
+    out.line(String::new());
+    Ok(())
+}
 
-    line("## Sparse GP (VFE/DTC, m k-means inducing points, hyperparameters from a 600-point subset) against the exact GP".into());
-    line(String::new());
-    line("The exact GP uses the sparse fit's hyperparameters (no search), so the columns compare the approximation itself; test RMSE is against the noiseless truth at the test points (noise std ≈ 0.02).".into());
-    line(String::new());
-    line("| n | m | sparse fit with subset search (s) | sparse fit, fixed hyperparameters (s) | sparse predict (s) | sparse RMSE | exact fit, fixed hyperparameters (s) | exact predict (s) | exact RMSE |".into());
-    line("|---:|---:|---:|---:|---:|---:|---:|---:|---:|".into());
+/// The sparse GP against the exact GP on the sparse fit's hyperparameters.
+fn sparse_section(out: &mut Lines, d: &Data, sparse_sizes: &[usize], restarts: usize) -> anyhow::Result<()> {
+    out.line("## Sparse GP (VFE/DTC, m k-means inducing points, hyperparameters from a 600-point subset) against the exact GP".into());
+    out.line(String::new());
+    out.line("The exact GP uses the sparse fit's hyperparameters (no search), so the columns compare the approximation itself; test RMSE is against the noiseless truth at the test points (noise std ≈ 0.02).".into());
+    out.line(String::new());
+    out.line("| n | m | sparse fit with subset search (s) | sparse fit, fixed hyperparameters (s) | sparse predict (s) | sparse RMSE | exact fit, fixed hyperparameters (s) | exact predict (s) | exact RMSE |".into());
+    out.line("|---:|---:|---:|---:|---:|---:|---:|---:|---:|".into());
     for (n, m) in sparse_sizes.iter().flat_map(|&n| [(n, 300), (n, 1000)]).filter(|&(n, m)| m < n) {
         eprintln!("sparse n={n} m={m} …");
         let (x, y) = (sub(&d.x, n), sub(&d.y, n));
         let sc = SparseConfig {
-            gp: config(args.restarts, OutputMode::Shared, Parallelism::Rayon),
+            gp: config(restarts, OutputMode::Shared, Parallelism::Rayon),
             inducing_points: m,
             hyperparameter_subset: 600,
             ..SparseConfig::default()
@@ -515,16 +548,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let t = Instant::now();
         let pe = exact.predict(d.x_test.as_ref())?;
         let exact_predict = t.elapsed().as_secs_f64();
-        line(format!(
+        out.line(format!(
             "| {n} | {m} | {sparse_fit:.3} | {sparse_fixed:.3} | {sparse_predict:.4} | {:.4} | {exact_fit:.3} | {exact_predict:.4} | {:.4} |",
             rmse(&ps.mean, &d.y_test_clean),
             rmse(&pe.mean, &d.y_test_clean)
         ));
     }
-    line(String::new());
-
-    if let Some(path) = &args.out {
-        std::fs::write(path, &out).with_context(|| path.display().to_string())?;
-    }
+    out.line(String::new());
     Ok(())
 }

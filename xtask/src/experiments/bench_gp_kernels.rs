@@ -197,50 +197,69 @@ pub fn run(args: &KernelArgs) -> anyhow::Result<String> {
         ProgressStyle::with_template("kernels {msg} [{bar:30}] {pos}/{len} {elapsed}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    // (mean held-out error, spread over the seeds, fit time summed over the seeds, log marginal
-    // likelihood summed over the seeds).
     let mut table = vec![vec![(f64::NAN, f64::NAN, f64::NAN, f64::NAN); sets.len()]; kernels.len()];
     for (s, set) in sets.iter().enumerate() {
-        for (k, (name, choice, outputs)) in kernels.iter().enumerate() {
-            let (mut errors, mut seconds, mut lml) = (Vec::new(), 0.0, 0.0);
-            for &seed in seeds {
-                bar.set_message(format!("{} / {name} / seed {seed}", set.name));
-                let mut config = ResidualGpOptions::default().gp;
-                config.kernel = *choice;
-                config.outputs = *outputs;
-                config.optimiser.seed = seed;
-                if let Some(m) = args.search_memory {
-                    config.optimiser.memory = m;
-                }
-                if let Some(t) = args.search_tolerance {
-                    config.optimiser.function_tolerance = t;
-                }
-                if let Some(r) = args.search_warm_rows {
-                    config.optimiser.warm_start_rows = r;
-                }
-                if let Some(b) = args.additive_by_bic {
-                    config.additive_by_bic = b;
-                }
-                let start = perturbed_start(*choice, set.train.inputs.ncols(), seed)?;
-                let t = Instant::now();
-                let model = ExactGp::fit_from(set.train.inputs.as_ref(), set.train.outputs.as_ref(), &start, &config)
-                    .with_context(|| format!("{} / {name}", set.name))?;
-                seconds += t.elapsed().as_secs_f64();
-                lml += model.log_marginal_likelihood();
-                let mean = model.predict_mean(set.test.inputs.as_ref())?;
-                errors.push(heldout_mm(&mean, &set.test));
-                bar.inc(1);
-            }
-            let mean = errors.iter().sum::<f64>() / errors.len() as f64;
-            let spread = errors.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
-                - errors.iter().fold(f64::INFINITY, |a, &b| a.min(b));
-            table[k][s] = (mean, spread, seconds, lml);
+        for (k, candidate) in kernels.iter().enumerate() {
+            table[k][s] = measure(args, set, candidate, &bar)?;
         }
     }
     bar.finish_and_clear();
+    Ok(markdown(&sets, &kernels, seeds, &table))
+}
+
+/// One candidate on one set, once per search seed: (mean held-out error, spread over the seeds,
+/// fit time summed over the seeds, log marginal likelihood summed over the seeds).
+fn measure(
+    args: &KernelArgs,
+    set: &Residuals,
+    (name, choice, outputs): &(&str, KernelChoice, OutputMode),
+    bar: &ProgressBar,
+) -> anyhow::Result<(f64, f64, f64, f64)> {
+    let (mut errors, mut seconds, mut lml) = (Vec::new(), 0.0, 0.0);
+    for &seed in &args.search_seeds {
+        bar.set_message(format!("{} / {name} / seed {seed}", set.name));
+        let mut config = ResidualGpOptions::default().gp;
+        config.kernel = *choice;
+        config.outputs = *outputs;
+        config.optimiser.seed = seed;
+        if let Some(m) = args.search_memory {
+            config.optimiser.memory = m;
+        }
+        if let Some(t) = args.search_tolerance {
+            config.optimiser.function_tolerance = t;
+        }
+        if let Some(r) = args.search_warm_rows {
+            config.optimiser.warm_start_rows = r;
+        }
+        if let Some(b) = args.additive_by_bic {
+            config.additive_by_bic = b;
+        }
+        let start = perturbed_start(*choice, set.train.inputs.ncols(), seed)?;
+        let t = Instant::now();
+        let model = ExactGp::fit_from(set.train.inputs.as_ref(), set.train.outputs.as_ref(), &start, &config)
+            .with_context(|| format!("{} / {name}", set.name))?;
+        seconds += t.elapsed().as_secs_f64();
+        lml += model.log_marginal_likelihood();
+        let mean = model.predict_mean(set.test.inputs.as_ref())?;
+        errors.push(heldout_mm(&mean, &set.test));
+        bar.inc(1);
+    }
+    let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+    let spread =
+        errors.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b)) - errors.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+    Ok((mean, spread, seconds, lml))
+}
+
+/// The table: one row per kernel, the best error of each set in bold.
+fn markdown(
+    sets: &[Residuals],
+    kernels: &[(&str, KernelChoice, OutputMode)],
+    seeds: &[u64],
+    table: &[Vec<(f64, f64, f64, f64)>],
+) -> String {
     let mut md = String::new();
     let _ = write!(md, "| kernel |");
-    for set in &sets {
+    for set in sets {
         let _ = write!(md, " {} (mm) |", set.name);
     }
     let _ = writeln!(
@@ -267,5 +286,5 @@ pub fn run(args: &KernelArgs) -> anyhow::Result<String> {
         let lml: f64 = table[k].iter().map(|c| c.3).sum::<f64>() / seeds.len() as f64;
         let _ = writeln!(md, " {ratio:.4} | {time:.1} | {lml:.3} |");
     }
-    Ok(md)
+    md
 }

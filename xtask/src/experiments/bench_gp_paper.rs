@@ -16,19 +16,17 @@
 //! leave-one-out error on its training rows is shown beside it. Times are the GP fit alone, wall
 //! clock, on the same residuals.
 
-use anyhow::Context;
 use std::fmt::Write;
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use faer::Mat;
 use gp::{ExactGp, Kernel};
-use model::ResidualGpOptions;
 use robot::RobotDescription;
 
 use campaign::paper_effects;
 
-use super::bench_gp_residuals::{Residuals, heldout_mm, real, simulated_campaign};
+use super::bench_gp_residuals::{Residuals, fit_timed, heldout_mm, real, simulated_campaign};
 use super::bench_gp_sklearn::{SklearnOptions, available, fit_predict};
 use super::reproduce_sim::robot_for;
 use super::reproduce_sim_params::Preset;
@@ -64,6 +62,35 @@ fn leave_one_out_mm(model: &ExactGp, set: &Residuals) -> anyhow::Result<f64> {
 
 /// Runs the comparison and returns the markdown table.
 pub fn run(args: &PaperArgs, ur10_data: &std::path::Path) -> anyhow::Result<String> {
+    let sets = data_sets(args, ur10_data)?;
+    let with_sklearn = available();
+    if !with_sklearn {
+        eprintln!(
+            "scikit-learn is not importable by {}: its columns stay empty",
+            super::bench_gp_sklearn::python().display()
+        );
+    }
+    let timeout = Duration::from_secs_f64(args.paper_sklearn_timeout_s);
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "| data | train / test | outputs | gp held-out (mm) | gp leave-one-out (mm) | gp training (mm) | gp fit (s) | \
+         Eq. 5 kept | scikit-learn | its held-out (mm) | its fit (s) | error ratio gp / sklearn | speed-up |"
+    );
+    let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|");
+    for (set, isotropic) in &sets {
+        eprintln!("{} …", set.name);
+        let row = row(set, *isotropic, with_sklearn, timeout)?;
+        // Each row as soon as it is measured: a long run stopped half-way keeps what it did.
+        eprintln!("{row}");
+        let _ = writeln!(md, "{row}");
+    }
+    Ok(md)
+}
+
+/// The simulated campaigns (unless skipped) and the UR10 sets found under `ur10_data`, kept by
+/// `--paper-only`; each with whether scikit-learn's kernel is the isotropic Eq. 5 one.
+fn data_sets(args: &PaperArgs, ur10_data: &std::path::Path) -> anyhow::Result<Vec<(Residuals, bool)>> {
     let robot =
         |file: &str| RobotDescription::read(&PathBuf::from("fixtures/robots").join(file)).map_err(anyhow::Error::from);
     // (residuals, the scikit-learn kernel compared with).
@@ -98,75 +125,51 @@ pub fn run(args: &PaperArgs, ur10_data: &std::path::Path) -> anyhow::Result<Stri
     if sets.is_empty() {
         anyhow::bail!("--paper-only {:?} matches no data set", args.paper_only);
     }
-    let with_sklearn = available();
-    if !with_sklearn {
-        eprintln!(
-            "scikit-learn is not importable by {}: its columns stay empty",
-            super::bench_gp_sklearn::python().display()
-        );
-    }
-    let timeout = Duration::from_secs_f64(args.paper_sklearn_timeout_s);
-    let mut md = String::new();
-    let _ = writeln!(
-        md,
-        "| data | train / test | outputs | gp held-out (mm) | gp leave-one-out (mm) | gp training (mm) | gp fit (s) | \
-         Eq. 5 kept | scikit-learn | its held-out (mm) | its fit (s) | error ratio gp / sklearn | speed-up |"
-    );
-    let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|");
-    for (set, isotropic) in &sets {
-        eprintln!("{} …", set.name);
-        let config = ResidualGpOptions::default().gp;
-        let t = Instant::now();
-        let model = ExactGp::fit(set.train.inputs.as_ref(), set.train.outputs.as_ref(), &config)
-            .with_context(|| set.name.clone())?;
-        let ours_s = t.elapsed().as_secs_f64();
-        let ours = heldout_mm(&model.predict_mean(set.test.inputs.as_ref())?, &set.test);
-        let training = heldout_mm(&model.predict_mean(set.train.inputs.as_ref())?, &set.train);
-        let loo = leave_one_out_mm(&model, set)?;
-        let components = &model.report().components;
-        let kept = components.iter().filter(|c| matches!(c.kernel, Kernel::Quadratic(_))).count();
-        let options = SklearnOptions {
-            linear: false,
-            isotropic: *isotropic,
-            restarts: if *isotropic { 2 } else { 1 },
-            independent: true,
-            processes: 2,
-            timeout,
-        };
-        let kernel = if *isotropic {
-            "C·RBF + C + DotProduct + White, 2 restarts"
-        } else {
-            "C·RBF(ARD) + C + White, 1 restart"
-        };
-        let sk = if with_sklearn {
-            fit_predict(&set.train.inputs, &positions(&set.train.outputs), &set.test.inputs, &options)?
-        } else {
-            None
-        };
-        let (sk_err, sk_s, ratio, speedup) = match &sk {
-            Some(r) => {
-                let e = heldout_mm(&r.mean, &set.test);
-                (
-                    format!("{e:.4}"),
-                    format!("{:.1}", r.fit_s),
-                    format!("{:.3}", ours / e),
-                    format!("{:.1}×", r.fit_s / ours_s),
-                )
-            }
-            None if with_sklearn => ("–".into(), format!("> {}", timeout.as_secs()), "–".into(), "–".into()),
-            None => ("–".into(), "–".into(), "–".into(), "–".into()),
-        };
-        let row = format!(
-            "| {} | {} / {} | {} | {ours:.4} | {loo:.4} | {training:.4} | {ours_s:.2} | {kept} of {} | {kernel} | {sk_err} | {sk_s} | {ratio} | {speedup} |",
-            set.name,
-            set.train.inputs.nrows(),
-            set.test.inputs.nrows(),
-            set.train.outputs.ncols(),
-            components.len(),
-        );
-        // Each row as soon as it is measured: a long run stopped half-way keeps what it did.
-        eprintln!("{row}");
-        let _ = writeln!(md, "{row}");
-    }
-    Ok(md)
+    Ok(sets)
+}
+
+/// One set's row: our GP's errors and fit time beside scikit-learn's.
+fn row(set: &Residuals, isotropic: bool, with_sklearn: bool, timeout: Duration) -> anyhow::Result<String> {
+    let (model, ours_s) = fit_timed(set)?;
+    let ours = heldout_mm(&model.predict_mean(set.test.inputs.as_ref())?, &set.test);
+    let training = heldout_mm(&model.predict_mean(set.train.inputs.as_ref())?, &set.train);
+    let loo = leave_one_out_mm(&model, set)?;
+    let components = &model.report().components;
+    let kept = components.iter().filter(|c| matches!(c.kernel, Kernel::Quadratic(_))).count();
+    let options = SklearnOptions {
+        linear: false,
+        isotropic,
+        restarts: if isotropic { 2 } else { 1 },
+        independent: true,
+        processes: 2,
+        timeout,
+    };
+    let kernel =
+        if isotropic { "C·RBF + C + DotProduct + White, 2 restarts" } else { "C·RBF(ARD) + C + White, 1 restart" };
+    let sk = if with_sklearn {
+        fit_predict(&set.train.inputs, &positions(&set.train.outputs), &set.test.inputs, &options)?
+    } else {
+        None
+    };
+    let (sk_err, sk_s, ratio, speedup) = match &sk {
+        Some(r) => {
+            let e = heldout_mm(&r.mean, &set.test);
+            (
+                format!("{e:.4}"),
+                format!("{:.1}", r.fit_s),
+                format!("{:.3}", ours / e),
+                format!("{:.1}×", r.fit_s / ours_s),
+            )
+        }
+        None if with_sklearn => ("–".into(), format!("> {}", timeout.as_secs()), "–".into(), "–".into()),
+        None => ("–".into(), "–".into(), "–".into(), "–".into()),
+    };
+    Ok(format!(
+        "| {} | {} / {} | {} | {ours:.4} | {loo:.4} | {training:.4} | {ours_s:.2} | {kept} of {} | {kernel} | {sk_err} | {sk_s} | {ratio} | {speedup} |",
+        set.name,
+        set.train.inputs.nrows(),
+        set.test.inputs.nrows(),
+        set.train.outputs.ncols(),
+        components.len(),
+    ))
 }

@@ -4,12 +4,14 @@
 
 use anyhow::Context;
 use std::path::Path;
+use std::time::Instant;
 
 use campaign::{GeneratorConfig, Perturbation, Remount, paper_effects, payload_run_campaign, simulate_campaign};
 use faer::Mat;
+use gp::ExactGp;
 use lie::SE3;
 use measurements::{MeasurementSet, ReadOptions};
-use model::{Method, ResidualFrame, ResidualSet};
+use model::{Method, ResidualFrame, ResidualGpOptions, ResidualSet};
 use pipeline::FitOptions;
 use robot::RobotDescription;
 
@@ -23,6 +25,16 @@ pub struct Residuals {
     pub test: ResidualSet,
     /// The geometric model's poses at the test rows: what a predicted residual corrects.
     pub test_poses: Vec<SE3>,
+}
+
+/// The GP stage (`ResidualGpOptions::default()`'s GP) fitted on `set`'s training rows, and the
+/// wall seconds of that fit alone.
+pub fn fit_timed(set: &Residuals) -> anyhow::Result<(ExactGp, f64)> {
+    let config = ResidualGpOptions::default().gp;
+    let t = Instant::now();
+    let model = ExactGp::fit(set.train.inputs.as_ref(), set.train.outputs.as_ref(), &config)
+        .with_context(|| set.name.clone())?;
+    Ok((model, t.elapsed().as_secs_f64()))
 }
 
 /// Rows `0, 2, 4, …` and `1, 3, 5, …`.

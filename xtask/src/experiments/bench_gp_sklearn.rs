@@ -131,10 +131,15 @@ pub fn fit_predict_with(
     }
     let text = std::fs::read_to_string(&response).with_context(|| response.display().to_string())?;
     let _ = std::fs::remove_dir_all(&dir);
-    let v: serde_json::Value = serde_json::from_str(&text)?;
+    response_of(&text, y.ncols()).map(Some)
+}
+
+/// The script's answer: the fit's seconds and peak memory, the predicted mean (`cols` outputs) and
+/// each fitted kernel with its log marginal likelihood.
+fn response_of(text: &str, cols: usize) -> anyhow::Result<SklearnResult> {
+    let v: serde_json::Value = serde_json::from_str(text)?;
     let num = |k: &str| v[k].as_f64().with_context(|| format!("scikit-learn response lacks {k}"));
     let mean_rows = v["mean"].as_array().context("scikit-learn response lacks mean")?;
-    let cols = y.ncols();
     let mut mean = Mat::zeros(mean_rows.len(), cols);
     for (i, r) in mean_rows.iter().enumerate() {
         for j in 0..cols {
@@ -149,5 +154,5 @@ pub fn fit_predict_with(
                 .collect()
         })
         .unwrap_or_default();
-    Ok(Some(SklearnResult { fit_s: num("fit_s")?, peak_bytes: num("peak_bytes")?, mean, fitted }))
+    Ok(SklearnResult { fit_s: num("fit_s")?, peak_bytes: num("peak_bytes")?, mean, fitted })
 }

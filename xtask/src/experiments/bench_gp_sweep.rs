@@ -165,6 +165,63 @@ fn predicted(sizes: &[usize], cells: &[Cell], n: usize, power: i32) -> Option<f6
 
 /// Runs the sweep; returns the markdown (with the SVG written beside `svg_path`).
 pub fn run(args: &SweepArgs, svg_path: Option<&Path>) -> anyhow::Result<String> {
+    let sweep = prepare(args)?;
+    let with_sklearn = available();
+
+    let bar = ProgressBar::new((args.sizes.len() * 3) as u64);
+    bar.set_style(
+        ProgressStyle::with_template("bench-gp sweep {msg} [{bar:30}] {pos}/{len} {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let (mut exact, mut sparse, mut sklearn) = (Vec::new(), Vec::new(), Vec::new());
+    for &n in &args.sizes {
+        let train = sweep.work.join(format!("train-{n}.csv"));
+        head_rows(&sweep.csv, n, &train)?;
+        for (gp, cells, power) in [("exact", &mut exact, 3), ("sparse", &mut sparse, 1)] {
+            bar.set_message(format!("n = {n}, {gp}"));
+            let cell = fit_gp(&sweep, args, cells, n, gp, power, &train)?;
+            bar.suspend(|| eprintln!("n = {n}, {gp}: {}", cell.markdown()));
+            cells.push(cell);
+            bar.inc(1);
+        }
+        bar.set_message(format!("n = {n}, scikit-learn"));
+        let cell = if with_sklearn {
+            fit_sklearn(&sweep, args, &sklearn, n, &train)?
+        } else {
+            Cell::Skipped("scikit-learn not importable".into())
+        };
+        bar.suspend(|| eprintln!("n = {n}, scikit-learn: {}", cell.markdown()));
+        sklearn.push(cell);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    let md = table(&args.sizes, &exact, &sparse, &sklearn);
+    if let Some(path) = svg_path {
+        let series =
+            [("exact GP", &exact, "#1f77b4"), ("sparse GP", &sparse, "#2ca02c"), ("scikit-learn", &sklearn, "#d62728")];
+        let svg = plot(&args.sizes, &series);
+        std::fs::write(path, svg).with_context(|| path.display().to_string())?;
+    }
+    Ok(md)
+}
+
+/// What every size shares: the binary, the robot, the campaign and its last rows to test on.
+struct Sweep {
+    calib: PathBuf,
+    robot: PathBuf,
+    work: PathBuf,
+    /// The campaign's CSV text.
+    csv: String,
+    /// The test rows' file.
+    test: PathBuf,
+    description: robot::RobotDescription,
+    read_options: measurements::ReadOptions,
+    test_set: measurements::MeasurementSet,
+}
+
+/// Builds `calib`, simulates the campaign (unless the work folder has it) and writes its test rows.
+fn prepare(args: &SweepArgs) -> anyhow::Result<Sweep> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().context("no workspace root")?.to_path_buf();
     let calib = calib_binary(&root)?;
     let robot = root.join("fixtures/robots/irb4400.ron");
@@ -192,83 +249,77 @@ pub fn run(args: &SweepArgs, svg_path: Option<&Path>) -> anyhow::Result<String> 
     let description = robot::RobotDescription::read(&robot)?;
     let read_options = measurements::ReadOptions::for_joints(description.joint_kinds());
     let test_set = measurements::read_measurements(&test, &read_options)?;
-    let with_sklearn = available();
+    Ok(Sweep { calib, robot, work, csv, test, description, read_options, test_set })
+}
 
-    let bar = ProgressBar::new((args.sizes.len() * 3) as u64);
-    bar.set_style(
-        ProgressStyle::with_template("bench-gp sweep {msg} [{bar:30}] {pos}/{len} {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    let (mut exact, mut sparse, mut sklearn) = (Vec::new(), Vec::new(), Vec::new());
-    for &n in &args.sizes {
-        let train = work.join(format!("train-{n}.csv"));
-        head_rows(&csv, n, &train)?;
-        for (gp, cells, power) in [("exact", &mut exact, 3), ("sparse", &mut sparse, 1)] {
-            bar.set_message(format!("n = {n}, {gp}"));
-            let guess = predicted(&args.sizes, cells, n, power);
-            let memory_gb = 3.0 * (n as f64).powi(2) * 8.0 / 1e9;
-            let cell = match guess {
-                Some(t) if gp == "exact" && t > args.exact_budget_s => {
-                    Cell::Skipped(format!("skipped: predicted {t:.0} s, {memory_gb:.1} GB"))
-                }
-                _ => {
-                    let model = work.join(format!("model-{gp}-{n}.ron"));
-                    let mut command = Command::new(&calib);
-                    command
-                        .args(["fit", "--method", "poe-gp-load", "--gp", gp, "--robot"])
-                        .arg(&robot)
-                        .arg("--data")
-                        .arg(&train)
-                        .arg("--out")
-                        .arg(&model);
-                    let (seconds, peak_mb) = run_measured(&mut command)?;
-                    Cell::Measured { seconds, peak_mb, heldout_mm: heldout_of(&calib, &model, &test)? }
-                }
-            };
-            bar.suspend(|| eprintln!("n = {n}, {gp}: {}", cell.markdown()));
-            cells.push(cell);
-            bar.inc(1);
+/// `calib fit --gp GP` on the first `n` rows (`train`), or skipped where the exact GP's time
+/// predicted from `cells` (the smaller sizes, as n^`power`) exceeds the budget.
+fn fit_gp(
+    sweep: &Sweep,
+    args: &SweepArgs,
+    cells: &[Cell],
+    n: usize,
+    gp: &str,
+    power: i32,
+    train: &Path,
+) -> anyhow::Result<Cell> {
+    let guess = predicted(&args.sizes, cells, n, power);
+    let memory_gb = 3.0 * (n as f64).powi(2) * 8.0 / 1e9;
+    Ok(match guess {
+        Some(t) if gp == "exact" && t > args.exact_budget_s => {
+            Cell::Skipped(format!("skipped: predicted {t:.0} s, {memory_gb:.1} GB"))
         }
-        bar.set_message(format!("n = {n}, scikit-learn"));
-        let guess = predicted(&args.sizes, &sklearn, n, 3);
-        let cell = if !with_sklearn {
-            Cell::Skipped("scikit-learn not importable".into())
-        } else if sklearn.iter().any(|c: &Cell| c.seconds().is_none()) {
-            // A smaller size was already stopped: this one would be too.
-            Cell::Skipped(format!("skipped: predicted {:.0} s", guess.unwrap_or(f64::INFINITY)))
-        } else {
-            let train_set = measurements::read_measurements(&train, &read_options)?;
-            let r = residuals(format!("n = {n}"), &description, &train_set, &test_set, true)?;
-            let options = SklearnOptions {
-                linear: false,
-                isotropic: false,
-                restarts: 1,
-                independent: true,
-                processes: 2,
-                timeout: Duration::from_secs_f64(args.sklearn_timeout_s),
-            };
-            match fit_predict(&r.train.inputs, &r.train.outputs, &r.test.inputs, &options)? {
-                Some(s) => Cell::Measured {
-                    seconds: s.fit_s,
-                    peak_mb: s.peak_bytes / 1e6,
-                    heldout_mm: heldout_mm(&s.mean, &r.test),
-                },
-                None => Cell::Skipped(format!("stopped after {:.0} s", args.sklearn_timeout_s)),
-            }
-        };
-        bar.suspend(|| eprintln!("n = {n}, scikit-learn: {}", cell.markdown()));
-        sklearn.push(cell);
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
+        _ => {
+            let model = sweep.work.join(format!("model-{gp}-{n}.ron"));
+            let mut command = Command::new(&sweep.calib);
+            command
+                .args(["fit", "--method", "poe-gp-load", "--gp", gp, "--robot"])
+                .arg(&sweep.robot)
+                .arg("--data")
+                .arg(train)
+                .arg("--out")
+                .arg(&model);
+            let (seconds, peak_mb) = run_measured(&mut command)?;
+            Cell::Measured { seconds, peak_mb, heldout_mm: heldout_of(&sweep.calib, &model, &sweep.test)? }
+        }
+    })
+}
 
+/// scikit-learn on the residuals `poe` leaves on the first `n` rows, unless a smaller size was
+/// already stopped.
+fn fit_sklearn(sweep: &Sweep, args: &SweepArgs, sklearn: &[Cell], n: usize, train: &Path) -> anyhow::Result<Cell> {
+    let guess = predicted(&args.sizes, sklearn, n, 3);
+    if sklearn.iter().any(|c: &Cell| c.seconds().is_none()) {
+        // A smaller size was already stopped: this one would be too.
+        return Ok(Cell::Skipped(format!("skipped: predicted {:.0} s", guess.unwrap_or(f64::INFINITY))));
+    }
+    let train_set = measurements::read_measurements(train, &sweep.read_options)?;
+    let r = residuals(format!("n = {n}"), &sweep.description, &train_set, &sweep.test_set, true)?;
+    let options = SklearnOptions {
+        linear: false,
+        isotropic: false,
+        restarts: 1,
+        independent: true,
+        processes: 2,
+        timeout: Duration::from_secs_f64(args.sklearn_timeout_s),
+    };
+    Ok(match fit_predict(&r.train.inputs, &r.train.outputs, &r.test.inputs, &options)? {
+        Some(s) => {
+            Cell::Measured { seconds: s.fit_s, peak_mb: s.peak_bytes / 1e6, heldout_mm: heldout_mm(&s.mean, &r.test) }
+        }
+        None => Cell::Skipped(format!("stopped after {:.0} s", args.sklearn_timeout_s)),
+    })
+}
+
+/// The markdown table of every size and the log–log slopes.
+fn table(sizes: &[usize], exact: &[Cell], sparse: &[Cell], sklearn: &[Cell]) -> String {
     let mut md = String::new();
     let _ = writeln!(
         md,
         "| n | exact: fit (s) | peak (MB) | held out (mm) | sparse: fit (s) | peak (MB) | held out (mm) | scikit-learn: fit (s) | peak (MB) | held out (mm) |"
     );
     let _ = writeln!(md, "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
-    for (i, n) in args.sizes.iter().enumerate() {
+    for (i, n) in sizes.iter().enumerate() {
         let _ =
             writeln!(md, "| {n} | {} | {} | {} |", exact[i].markdown(), sparse[i].markdown(), sklearn[i].markdown());
     }
@@ -277,17 +328,11 @@ pub fn run(args: &SweepArgs, svg_path: Option<&Path>) -> anyhow::Result<String> 
         md,
         "\nLog–log slope of fit time against n (least squares over the measured sizes): exact {}, sparse {}, \
          scikit-learn {}.",
-        fmt(slope(&args.sizes, &exact)),
-        fmt(slope(&args.sizes, &sparse)),
-        fmt(slope(&args.sizes, &sklearn))
+        fmt(slope(sizes, exact)),
+        fmt(slope(sizes, sparse)),
+        fmt(slope(sizes, sklearn))
     );
-    if let Some(path) = svg_path {
-        let series =
-            [("exact GP", &exact, "#1f77b4"), ("sparse GP", &sparse, "#2ca02c"), ("scikit-learn", &sklearn, "#d62728")];
-        let svg = plot(&args.sizes, &series);
-        std::fs::write(path, svg).with_context(|| path.display().to_string())?;
-    }
-    Ok(md)
+    md
 }
 
 /// Fit time against n, both axes logarithmic, one polyline per method.

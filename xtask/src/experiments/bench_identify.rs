@@ -141,61 +141,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
          | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n",
     );
     for &rows in &args.rows {
-        let mut rng = ChaCha8Rng::seed_from_u64(rows as u64);
-        let configurations = loadsim::sample_configurations(
-            &cell.robot,
-            0,
-            &campaign::joint_ranges(&robot),
-            &loadsim::GeneratorConfig { sample_count: rows, seed: rows as u64, ..Default::default() },
-        )?;
-        let observations: Vec<Observation> = configurations
-            .into_iter()
-            .map(|q| {
-                let pose = truth.forward(&q, 0).expect("six joints");
-                let dp = Vector3::new(gaussian(&mut rng), gaussian(&mut rng), gaussian(&mut rng)) * SIGMA;
-                let dr = Vector3::new(gaussian(&mut rng), gaussian(&mut rng), gaussian(&mut rng)) * SIGMA;
-                let noisy = SE3::new(lie::SO3::exp(&dr) * pose.rotation(), pose.translation() + dp);
-                Observation { q, tool: 0, target: Target::Pose(noisy), stated_sigma: None }
-            })
-            .collect();
+        let observations = noisy_poses(&robot, &cell.robot, &truth, rows)?;
         let start = register(&nominal, &observations)?;
-        let mask = ParameterMask::all(start.layout());
-        // One core, as the SciPy fit runs.
-        faer::set_global_parallelism(faer::Par::Seq);
-        let mut times = Vec::new();
-        let mut last = None;
-        for _ in 0..args.repeats.max(1) {
-            let begin = Instant::now();
-            let fit = identify(&start, &observations, &mask, &options)?;
-            times.push(begin.elapsed().as_secs_f64());
-            last = Some(fit);
-        }
-        times.sort_by(f64::total_cmp);
-        let ours_s = times[times.len() / 2];
-        let fit = last.context("no fit")?;
-        let ours_rms = fit.report.iterations.last().map_or(f64::NAN, |r| r.rms_position_m);
-        let _ = write!(
-            table,
-            "| {rows} | {:.2} | {} | {:.4} |",
-            ours_s * 1e3,
-            fit.report.iteration_count(),
-            ours_rms * 1e3
-        );
-        if python {
-            let repeats = if rows > 300 { 1 } else { args.repeats.clamp(1, 3) };
-            let result = scipy_identify(Path::new("python3"), &start, &observations, SIGMA, SIGMA, repeats)?;
-            let theirs = result.seconds;
-            let _ = writeln!(
-                table,
-                " {:.1} | {} | {:.4} | {:.0}× |",
-                theirs * 1e3,
-                result.evaluations,
-                result.rms_position_m * 1e3,
-                theirs / ours_s
-            );
-        } else {
-            let _ = writeln!(table, " – | – | – | – |");
-        }
+        timed_row(&mut table, args, rows, &start, &observations, &options, python)?;
     }
     println!("{table}");
     if let Some(path) = &args.out {
@@ -206,6 +154,78 @@ registration, calib's iterative least squares (one core) against `scipy.optimize
 finite-difference Jacobian) on the same weighted residual. Median of the timed fits.\n\n{table}"
         );
         std::fs::write(path, body).with_context(|| path.display().to_string())?;
+    }
+    Ok(())
+}
+
+/// `rows` poses of the true robot (`truth`, in the tracker frame) with SIGMA of noise on each
+/// component, at configurations drawn for `true_base` (the true robot in its base frame).
+fn noisy_poses(
+    robot: &RobotDescription,
+    true_base: &LocalPoe,
+    truth: &LocalPoe,
+    rows: usize,
+) -> anyhow::Result<Vec<Observation>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(rows as u64);
+    let configurations = loadsim::sample_configurations(
+        true_base,
+        0,
+        &campaign::joint_ranges(robot),
+        &loadsim::GeneratorConfig { sample_count: rows, seed: rows as u64, ..Default::default() },
+    )?;
+    Ok(configurations
+        .into_iter()
+        .map(|q| {
+            let pose = truth.forward(&q, 0).expect("six joints");
+            let dp = Vector3::new(gaussian(&mut rng), gaussian(&mut rng), gaussian(&mut rng)) * SIGMA;
+            let dr = Vector3::new(gaussian(&mut rng), gaussian(&mut rng), gaussian(&mut rng)) * SIGMA;
+            let noisy = SE3::new(lie::SO3::exp(&dr) * pose.rotation(), pose.translation() + dp);
+            Observation { q, tool: 0, target: Target::Pose(noisy), stated_sigma: None }
+        })
+        .collect())
+}
+
+/// One size's row: the median of `--repeats` timed fits from `start`, and SciPy's (when `python`).
+fn timed_row(
+    table: &mut String,
+    args: &Args,
+    rows: usize,
+    start: &LocalPoe,
+    observations: &[Observation],
+    options: &IdentificationOptions,
+    python: bool,
+) -> anyhow::Result<()> {
+    let mask = ParameterMask::all(start.layout());
+    // One core, as the SciPy fit runs.
+    faer::set_global_parallelism(faer::Par::Seq);
+    let mut times = Vec::new();
+    let mut last = None;
+    for _ in 0..args.repeats.max(1) {
+        let begin = Instant::now();
+        let fit = identify(start, observations, &mask, options)?;
+        times.push(begin.elapsed().as_secs_f64());
+        last = Some(fit);
+    }
+    times.sort_by(f64::total_cmp);
+    let ours_s = times[times.len() / 2];
+    let fit = last.context("no fit")?;
+    let ours_rms = fit.report.iterations.last().map_or(f64::NAN, |r| r.rms_position_m);
+    let _ =
+        write!(table, "| {rows} | {:.2} | {} | {:.4} |", ours_s * 1e3, fit.report.iteration_count(), ours_rms * 1e3);
+    if python {
+        let repeats = if rows > 300 { 1 } else { args.repeats.clamp(1, 3) };
+        let result = scipy_identify(Path::new("python3"), start, observations, SIGMA, SIGMA, repeats)?;
+        let theirs = result.seconds;
+        let _ = writeln!(
+            table,
+            " {:.1} | {} | {:.4} | {:.0}× |",
+            theirs * 1e3,
+            result.evaluations,
+            result.rms_position_m * 1e3,
+            theirs / ours_s
+        );
+    } else {
+        let _ = writeln!(table, " – | – | – | – |");
     }
     Ok(())
 }

@@ -112,55 +112,13 @@ pub fn box_plot(title: &str, y_label: &str, groups: &[BoxGroup], log: bool) -> S
         let colour = COLOURS[k % COLOURS.len()];
         let centre = LEFT + slot * (k as f64 + 0.5);
         let half = (slot * 0.22).min(40.0);
-        // One `<tspan>` per line of the label: SVG text does not wrap.
-        let _ = write!(out, r#"<text x="{centre:.1}" y="{:.1}" text-anchor="middle">"#, TOP + ph + 18.0);
-        for (i, line) in group.label.lines().enumerate() {
-            let dy = if i == 0 { 0.0 } else { 14.0 };
-            let _ = write!(out, r#"<tspan x="{centre:.1}" dy="{dy}">{}</tspan>"#, escape(line));
-        }
-        out.push_str("</text>");
+        label(&mut out, centre, TOP + ph + 18.0, &group.label);
         let Some(s) = BoxStatistics::of(&group.values.iter().copied().filter(|v| !log || *v > 0.0).collect::<Vec<_>>())
         else {
             continue;
         };
-        let (left, right) = (centre - half, centre + half);
-        let _ = write!(out, r##"<g stroke="#333333" fill="none">"##);
-        let _ = write!(
-            out,
-            r#"<line x1="{centre:.1}" y1="{:.1}" x2="{centre:.1}" y2="{:.1}"/><line x1="{centre:.1}" y1="{:.1}" x2="{centre:.1}" y2="{:.1}"/>"#,
-            sy(s.whisker_low),
-            sy(s.q1),
-            sy(s.q3),
-            sy(s.whisker_high)
-        );
-        for w in [s.whisker_low, s.whisker_high] {
-            let _ = write!(
-                out,
-                r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}"/>"#,
-                centre - half / 2.0,
-                sy(w),
-                centre + half / 2.0,
-                sy(w)
-            );
-        }
-        out.push_str("</g>");
-        let _ = write!(
-            out,
-            r##"<rect x="{left:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{colour}" fill-opacity="0.35" stroke="#333333"/>"##,
-            sy(s.q3),
-            right - left,
-            (sy(s.q1) - sy(s.q3)).max(0.5)
-        );
-        let _ = write!(
-            out,
-            r##"<line x1="{left:.1}" y1="{:.1}" x2="{right:.1}" y2="{:.1}" stroke="#000000" stroke-width="2"/>"##,
-            sy(s.median),
-            sy(s.median)
-        );
-        for o in &s.outliers {
-            let _ =
-                write!(out, r##"<circle cx="{centre:.1}" cy="{:.1}" r="3.5" fill="none" stroke="#333333"/>"##, sy(*o));
-        }
+        draw_box(&mut out, &s, centre, half, colour, &sy);
+        let right = centre + half;
         // Every value as a small dot to the right of its box: ten folds are few enough to show.
         let _ = write!(out, r#"<g fill="{colour}">"#);
         for v in group.values.iter().filter(|v| v.is_finite() && (!log || **v > 0.0)) {
@@ -170,6 +128,58 @@ pub fn box_plot(title: &str, y_label: &str, groups: &[BoxGroup], log: bool) -> S
     }
     out.push_str("</svg>\n");
     out
+}
+
+/// The label under a box, one `<tspan>` per line: SVG text does not wrap.
+fn label(out: &mut String, centre: f64, y: f64, text: &str) {
+    let _ = write!(out, r#"<text x="{centre:.1}" y="{y:.1}" text-anchor="middle">"#);
+    for (i, line) in text.lines().enumerate() {
+        let dy = if i == 0 { 0.0 } else { 14.0 };
+        let _ = write!(out, r#"<tspan x="{centre:.1}" dy="{dy}">{}</tspan>"#, escape(line));
+    }
+    out.push_str("</text>");
+}
+
+/// One box of half-width `half` at `centre`: whiskers, the quartiles' box, the median and the
+/// outliers, `sy` mapping a value to its y.
+fn draw_box(out: &mut String, s: &BoxStatistics, centre: f64, half: f64, colour: &str, sy: &dyn Fn(f64) -> f64) {
+    let (left, right) = (centre - half, centre + half);
+    let _ = write!(out, r##"<g stroke="#333333" fill="none">"##);
+    let _ = write!(
+        out,
+        r#"<line x1="{centre:.1}" y1="{:.1}" x2="{centre:.1}" y2="{:.1}"/><line x1="{centre:.1}" y1="{:.1}" x2="{centre:.1}" y2="{:.1}"/>"#,
+        sy(s.whisker_low),
+        sy(s.q1),
+        sy(s.q3),
+        sy(s.whisker_high)
+    );
+    for w in [s.whisker_low, s.whisker_high] {
+        let _ = write!(
+            out,
+            r#"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}"/>"#,
+            centre - half / 2.0,
+            sy(w),
+            centre + half / 2.0,
+            sy(w)
+        );
+    }
+    out.push_str("</g>");
+    let _ = write!(
+        out,
+        r##"<rect x="{left:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{colour}" fill-opacity="0.35" stroke="#333333"/>"##,
+        sy(s.q3),
+        right - left,
+        (sy(s.q1) - sy(s.q3)).max(0.5)
+    );
+    let _ = write!(
+        out,
+        r##"<line x1="{left:.1}" y1="{:.1}" x2="{right:.1}" y2="{:.1}" stroke="#000000" stroke-width="2"/>"##,
+        sy(s.median),
+        sy(s.median)
+    );
+    for o in &s.outliers {
+        let _ = write!(out, r##"<circle cx="{centre:.1}" cy="{:.1}" r="3.5" fill="none" stroke="#333333"/>"##, sy(*o));
+    }
 }
 
 #[cfg(test)]

@@ -14,7 +14,7 @@
 //!   `--effects`, 300 planned against 300 random even rows for `poe-gp --effects auto`.
 
 use anyhow::{Context, Result};
-use campaign::{Effects, GeneratorConfig, Perturbation};
+use campaign::{Effects, GeneratorConfig, Perturbation, SimulatedCell};
 use cell::{Refit, RegisterOptions};
 use effects::EffectSelection;
 use lie::{SE3, SO3, Vector3};
@@ -215,8 +215,6 @@ fn register_ur10(args: &Args, md: &mut String) -> Result<()> {
 
 fn register_simulated(args: &Args, md: &mut String) -> Result<()> {
     let robot = RobotDescription::read(&args.irb4400)?;
-    let ranges = campaign::joint_ranges(&robot);
-    let effects = campaign::paper_effects();
     let _ = writeln!(
         md,
         "\n## Simulated truth: the tracker moved and a new tool, 20 poses registered\n\nIRB 4400 of the paper's \
@@ -241,41 +239,58 @@ fn register_simulated(args: &Args, md: &mut String) -> Result<()> {
             * SE3::new(SO3::exp(&Vector3::new(0.0, 0.3, 0.1)), Vector3::new(0.06, -0.05, 0.06));
         new_tool.robot.set_tools(vec![tool]);
         new_tool.tool = 0;
-        let config = |rows: usize, offset: u64| GeneratorConfig {
-            sample_count: rows,
-            seed: seed * 10 + offset,
-            ..GeneratorConfig::default()
-        };
         for (full_pose, new) in [(true, true), (true, false), (false, false), (false, true)] {
-            let train = campaign::simulate(&original, &effects, &ranges, &config(300, 0), full_pose)?;
-            let test = campaign::simulate(&original, &effects, &ranges, &config(1000, 1), full_pose)?;
-            let (model, _) = pipeline::fit(&robot, &train, Method::PoeGpLoad, &FitOptions::default())?;
-            let before = mean_error(&model, &test)?;
             let moved = if new { &new_tool } else { &same_tool };
-            let renamed = |mut set: MeasurementSet| {
-                if new {
-                    set.tools = vec!["probe2".into()];
-                }
-                set
-            };
-            let few = renamed(campaign::simulate(moved, &effects, &ranges, &config(20, 2), full_pose)?);
-            let moved_test = renamed(campaign::simulate(moved, &effects, &ranges, &config(1000, 3), full_pose)?);
-            let refit = Refit { base: true, tools: new };
-            let registered = cell::register(&model, &few, refit, Some(before), &RegisterOptions::default())?;
-            let after = mean_error(&registered.model, &moved_test)?;
-            let warnings: Vec<String> = registered.report.warnings.iter().map(|w| format!("{w:?}")).collect();
-            let _ = writeln!(
-                md,
-                "| {seed} | {} | {} | {before:.4} | {after:.4} | {:.3} | {:.4} | {:?} | {} |",
-                if full_pose { "full pose" } else { "position" },
-                if new { "new" } else { "same" },
-                after / before,
-                registered.report.residual.mean_position_error_mm,
-                registered.report.verdict,
-                warnings.join(", ")
-            );
+            register_row(md, &robot, &original, moved, seed, full_pose, new)?;
         }
     }
+    Ok(())
+}
+
+/// One row: `poe-gp-load` fitted on the original cell, registered on 20 poses of the `moved` one
+/// (with its new tool when `new`), both tested on 1,000 poses.
+fn register_row(
+    md: &mut String,
+    robot: &RobotDescription,
+    original: &SimulatedCell,
+    moved: &SimulatedCell,
+    seed: u64,
+    full_pose: bool,
+    new: bool,
+) -> Result<()> {
+    let ranges = campaign::joint_ranges(robot);
+    let effects = campaign::paper_effects();
+    let config = |rows: usize, offset: u64| GeneratorConfig {
+        sample_count: rows,
+        seed: seed * 10 + offset,
+        ..GeneratorConfig::default()
+    };
+    let train = campaign::simulate(original, &effects, &ranges, &config(300, 0), full_pose)?;
+    let test = campaign::simulate(original, &effects, &ranges, &config(1000, 1), full_pose)?;
+    let (model, _) = pipeline::fit(robot, &train, Method::PoeGpLoad, &FitOptions::default())?;
+    let before = mean_error(&model, &test)?;
+    let renamed = |mut set: MeasurementSet| {
+        if new {
+            set.tools = vec!["probe2".into()];
+        }
+        set
+    };
+    let few = renamed(campaign::simulate(moved, &effects, &ranges, &config(20, 2), full_pose)?);
+    let moved_test = renamed(campaign::simulate(moved, &effects, &ranges, &config(1000, 3), full_pose)?);
+    let refit = Refit { base: true, tools: new };
+    let registered = cell::register(&model, &few, refit, Some(before), &RegisterOptions::default())?;
+    let after = mean_error(&registered.model, &moved_test)?;
+    let warnings: Vec<String> = registered.report.warnings.iter().map(|w| format!("{w:?}")).collect();
+    let _ = writeln!(
+        md,
+        "| {seed} | {} | {} | {before:.4} | {after:.4} | {:.3} | {:.4} | {:?} | {} |",
+        if full_pose { "full pose" } else { "position" },
+        if new { "new" } else { "same" },
+        after / before,
+        registered.report.residual.mean_position_error_mm,
+        registered.report.verdict,
+        warnings.join(", ")
+    );
     Ok(())
 }
 

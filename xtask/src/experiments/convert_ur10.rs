@@ -190,22 +190,7 @@ pub fn read_with_goals(input: &Path, series: &str, full_pose: bool) -> anyhow::R
     })?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or("").split(';').map(str::trim).collect();
-    let column = |name: &str| {
-        header
-            .iter()
-            .position(|h| *h == name)
-            .ok_or_else(|| anyhow::anyhow!("{}:1: no column '{name}'", file.display()))
-    };
-    let joints: Vec<usize> = JOINTS.iter().map(|j| column(j)).collect::<Result<_, _>>()?;
-    let position = [column("measurement_x")?, column("measurement_y")?, column("measurement_z")?];
-    let angles = [column("measurement_rx")?, column("measurement_ry")?, column("measurement_rz")?];
-    let temperature = column("measurement_temperature")?;
-    // The tracker's stated standard deviation of every row: mm, and degrees of the
-    // three angles, kept as std_x_mm … and std_rx_mrad ….
-    let position_std = [column("measurement_std_x")?, column("measurement_std_y")?, column("measurement_std_z")?];
-    let angle_std = [column("measurement_std_rx")?, column("measurement_std_ry")?, column("measurement_std_rz")?];
-    let stamp = column("Timestamp")?;
-    let goal = [column("Goal x")?, column("Goal y")?, column("Goal z")?];
+    let columns = Columns::find(&header, &file)?;
     let mut rows = Vec::new();
     let mut goals_mm = Vec::new();
     for (index, raw) in lines.enumerate() {
@@ -213,24 +198,74 @@ pub fn read_with_goals(input: &Path, series: &str, full_pose: bool) -> anyhow::R
         if raw.trim().is_empty() {
             continue;
         }
+        let (row, goal_mm) = columns.row(raw, &file, line, full_pose)?;
+        goals_mm.push(goal_mm);
+        rows.push(row);
+    }
+    // A time column only when every stamp survived.
+    if rows.iter().any(|r| r.t_s.is_none()) {
+        rows.iter_mut().for_each(|r| r.t_s = None);
+    } else if let Some(t0) = rows.first().and_then(|r| r.t_s) {
+        rows.iter_mut().for_each(|r| r.t_s = r.t_s.map(|t| t - t0));
+    }
+    Ok(Series { set: MeasurementSet::from_rows(&file.display().to_string(), rows, vec![]), goals_mm })
+}
+
+/// Where a row's values are in the data set's CSV.
+struct Columns {
+    joints: Vec<usize>,
+    position: [usize; 3],
+    angles: [usize; 3],
+    temperature: usize,
+    position_std: [usize; 3],
+    angle_std: [usize; 3],
+    stamp: usize,
+    goal: [usize; 3],
+}
+
+impl Columns {
+    /// Each column's place in `header` (line 1 of `file`); the first missing is refused.
+    fn find(header: &[&str], file: &Path) -> anyhow::Result<Self> {
+        let column = |name: &str| {
+            header
+                .iter()
+                .position(|h| *h == name)
+                .ok_or_else(|| anyhow::anyhow!("{}:1: no column '{name}'", file.display()))
+        };
+        let joints: Vec<usize> = JOINTS.iter().map(|j| column(j)).collect::<Result<_, _>>()?;
+        let position = [column("measurement_x")?, column("measurement_y")?, column("measurement_z")?];
+        let angles = [column("measurement_rx")?, column("measurement_ry")?, column("measurement_rz")?];
+        let temperature = column("measurement_temperature")?;
+        // The tracker's stated standard deviation of every row: mm, and degrees of the
+        // three angles, kept as std_x_mm … and std_rx_mrad ….
+        let position_std = [column("measurement_std_x")?, column("measurement_std_y")?, column("measurement_std_z")?];
+        let angle_std = [column("measurement_std_rx")?, column("measurement_std_ry")?, column("measurement_std_rz")?];
+        let stamp = column("Timestamp")?;
+        let goal = [column("Goal x")?, column("Goal y")?, column("Goal z")?];
+        Ok(Columns { joints, position, angles, temperature, position_std, angle_std, stamp, goal })
+    }
+
+    /// Data row `raw` (line `line` of `file`) as a measurement, and its goal.
+    fn row(&self, raw: &str, file: &Path, line: usize, full_pose: bool) -> anyhow::Result<(Measurement, Vector3)> {
         let cells: Vec<&str> = raw.split(';').collect();
-        let cell =
-            |c: usize| -> anyhow::Result<f64> { number(cells.get(c).copied().unwrap_or(""), &file, line, c + 1) };
-        let q = joints.iter().map(|&c| cell(c)).collect::<Result<Vec<_>, _>>()?;
+        let cell = |c: usize| -> anyhow::Result<f64> { number(cells.get(c).copied().unwrap_or(""), file, line, c + 1) };
+        let (position, angles, goal) = (self.position, self.angles, self.goal);
+        let (position_std, angle_std) = (self.position_std, self.angle_std);
+        let q = self.joints.iter().map(|&c| cell(c)).collect::<Result<Vec<_>, _>>()?;
         let p = Vector3::new(cell(position[0])?, cell(position[1])?, cell(position[2])?) * 1e-3;
         // The goal in metres, as the planner wrote it.
-        goals_mm.push(Vector3::new(cell(goal[0])?, cell(goal[1])?, cell(goal[2])?) * 1e3);
+        let goal_mm = Vector3::new(cell(goal[0])?, cell(goal[1])?, cell(goal[2])?) * 1e3;
         let orientation =
             if full_pose { Some(rotation(cell(angles[0])?, cell(angles[1])?, cell(angles[2])?)) } else { None };
-        rows.push(Measurement {
+        let row = Measurement {
             line: line as u64,
             q,
             position: p,
             orientation,
             payload_kg: 0.0,
             tool: 0,
-            temp_c: Some(cell(temperature)?),
-            t_s: cells.get(stamp).and_then(|s| seconds(s)),
+            temp_c: Some(cell(self.temperature)?),
+            t_s: cells.get(self.stamp).and_then(|s| seconds(s)),
             torques_nm: None,
             inputs: measurements::Inputs::default(),
             std: Some(measurements::StatedSigma {
@@ -245,15 +280,9 @@ pub fn read_with_goals(input: &Path, series: &str, full_pose: bool) -> anyhow::R
                     cell(angle_std[2])?.to_radians(),
                 ]),
             }),
-        });
+        };
+        Ok((row, goal_mm))
     }
-    // A time column only when every stamp survived.
-    if rows.iter().any(|r| r.t_s.is_none()) {
-        rows.iter_mut().for_each(|r| r.t_s = None);
-    } else if let Some(t0) = rows.first().and_then(|r| r.t_s) {
-        rows.iter_mut().for_each(|r| r.t_s = r.t_s.map(|t| t - t0));
-    }
-    Ok(Series { set: MeasurementSet::from_rows(&file.display().to_string(), rows, vec![]), goals_mm })
 }
 
 fn write(set: &MeasurementSet, path: &Path) -> anyhow::Result<()> {

@@ -21,7 +21,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use robot::RobotDescription;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -221,25 +221,39 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let first_days: Vec<usize> = (0..n).filter(|&i| days.day[i] < last).collect();
     let last_day: Vec<usize> = (0..n).filter(|&i| days.day[i] == last).collect();
     if let Some(dir) = &args.dump {
-        std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
-        for (name, rows) in [
-            ("days", (0..n).collect()),
-            ("even", even.clone()),
-            ("odd", odd.clone()),
-            ("first_days", first_days.clone()),
-            ("last_day", last_day.clone()),
-        ] {
-            let path = dir.join(format!("{name}.csv"));
-            let mut text = Vec::new();
-            days.measured.subset(&rows).write_csv(&mut text)?;
-            std::fs::write(&path, text).with_context(|| path.display().to_string())?;
-        }
+        let all: Vec<usize> = (0..n).collect();
+        let splits =
+            [("days", &all), ("even", &even), ("odd", &odd), ("first_days", &first_days), ("last_day", &last_day)];
+        dump(dir, &days, &splits)?;
     }
     let sklearn = !args.no_sklearn && bench_gp_sklearn::available();
     let rows = [
         split("even → odd rows", &robot, &days, &even, &odd, sklearn)?,
         split("days 1–3 → day 4", &robot, &days, &first_days, &last_day, sklearn)?,
     ];
+    let out = markdown(args, &days, &tilt, &rows);
+    print!("{out}");
+    if let Some(path) = &args.out {
+        std::fs::write(path, &out).with_context(|| path.display().to_string())?;
+    }
+    Ok(())
+}
+
+/// Every row, the rows of each split and of each day as SPEC CSVs in `dir`.
+fn dump(dir: &Path, days: &Days, splits: &[(&str, &Vec<usize>)]) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    for (name, rows) in splits {
+        let path = dir.join(format!("{name}.csv"));
+        let mut text = Vec::new();
+        days.measured.subset(rows).write_csv(&mut text)?;
+        std::fs::write(&path, text).with_context(|| path.display().to_string())?;
+    }
+    Ok(())
+}
+
+/// The command, the signals' spans, and one table row per split.
+fn markdown(args: &Args, days: &Days, tilt: &BaseTilt, rows: &[Row]) -> String {
+    let n = days.measured.rows.len();
     let span = |k: usize| {
         let values = days.measured.rows.iter().map(|r| r.inputs.values()[k]);
         let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
@@ -268,7 +282,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "| held out | noise floor | poe | poe-gp | poe-gp --inputs | ratio to floor (poe-gp / with inputs) | gp ExactGp on poe residuals, same inputs | scikit-learn ARD, same residuals and inputs |\n",
     );
     out.push_str("|---|---|---|---|---|---|---|---|\n");
-    for r in &rows {
+    for r in rows {
         let sk = r.sklearn_mm.map_or("–".to_owned(), |v| format!("{v:.4}"));
         let _ = writeln!(
             out,
@@ -283,9 +297,5 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             r.calib_on_residuals_mm
         );
     }
-    print!("{out}");
-    if let Some(path) = &args.out {
-        std::fs::write(path, &out).with_context(|| path.display().to_string())?;
-    }
-    Ok(())
+    out
 }

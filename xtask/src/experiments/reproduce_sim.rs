@@ -204,62 +204,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let tests = seeds.tests.iter().map(|&s| dataset(sizes.test, s)).collect::<anyhow::Result<Vec<_>>>()?;
     let magnitudes = magnitudes(&cell, &effects, &ranges, &generator(sizes.training, seeds.training), full_pose)?;
 
-    // Fold k holds the k-th of `folds` nearly equal slices of a seeded shuffle of the rows.
-    let mut order: Vec<usize> = (0..train.rows.len()).collect();
-    order.shuffle(&mut ChaCha8Rng::seed_from_u64(seeds.folds));
-    let folds: Vec<(MeasurementSet, MeasurementSet)> = (0..sizes.folds)
-        .map(|k| {
-            let (start, end) = (k * order.len() / sizes.folds, (k + 1) * order.len() / sizes.folds);
-            let held: Vec<usize> = order[start..end].to_vec();
-            let kept: Vec<usize> = order[..start].iter().chain(&order[end..]).copied().collect();
-            (train.subset(&kept), train.subset(&held))
-        })
-        .collect();
-
+    let folds = folds(&train, sizes.folds, seeds.folds);
     let variants = variants(&sizes);
-    let bar = ProgressBar::new(((sizes.folds + 1) * variants.len()) as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} fits {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    bar.set_message(format!("reproduce-sim ({}, {} folds + test sets)", args.preset.name(), sizes.folds));
-    // Every (variant, fold) fit is independent: run them on the rayon pool; results come back in
-    // order, and each is the same whichever thread ran it.
-    let jobs: Vec<(usize, Option<usize>)> =
-        (0..variants.len()).flat_map(|v| (0..sizes.folds).map(Some).chain([None]).map(move |f| (v, f))).collect();
-    let test_refs: Vec<&MeasurementSet> = tests.iter().collect();
-    let results: Vec<FitResult> = jobs
-        .par_iter()
-        .map(|&(v, fold)| {
-            let result = match fold {
-                Some(k) => fit_and_test(&robot, &variants[v], &folds[k].0, &[&folds[k].1]),
-                None => fit_and_test(&robot, &variants[v], &train, &test_refs),
-            };
-            bar.inc(1);
-            result
-        })
-        .collect::<anyhow::Result<_>>()?;
-    bar.finish_and_clear();
-
-    let per_variant = sizes.folds + 1;
+    let results = fit_all(&robot, &variants, &folds, &train, &tests, args.preset)?;
     let outcome = Outcome {
-        variants: variants
-            .iter()
-            .enumerate()
-            .map(|(v, variant)| {
-                let mine = &results[v * per_variant..(v + 1) * per_variant];
-                VariantResult {
-                    key: variant.key,
-                    label: variant.label,
-                    paper_faithful: variant.paper_faithful,
-                    beyond: variant.beyond,
-                    cv: mine[..sizes.folds].iter().map(|(_, _, e)| e[0]).collect(),
-                    test: mine[sizes.folds].2.clone(),
-                    training: mine[sizes.folds].0,
-                    leave_one_out: mine[sizes.folds].1,
-                }
-            })
-            .collect(),
+        variants: variant_results(&variants, &results, sizes.folds),
         magnitudes,
         seconds: started.elapsed().as_secs_f64(),
     };
@@ -277,8 +226,85 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         full_pose,
         variants: &variants,
     })?;
+    write_outputs(args, &out_dir, &params, &outcome, sizes.folds)
+}
 
-    std::fs::create_dir_all(&out_dir).with_context(|| out_dir.display().to_string())?;
+/// The cross-validation folds (training rows, held-out rows): fold k holds the k-th of `count`
+/// nearly equal slices of a seeded shuffle of the rows.
+fn folds(train: &MeasurementSet, count: usize, seed: u64) -> Vec<(MeasurementSet, MeasurementSet)> {
+    let mut order: Vec<usize> = (0..train.rows.len()).collect();
+    order.shuffle(&mut ChaCha8Rng::seed_from_u64(seed));
+    (0..count)
+        .map(|k| {
+            let (start, end) = (k * order.len() / count, (k + 1) * order.len() / count);
+            let held: Vec<usize> = order[start..end].to_vec();
+            let kept: Vec<usize> = order[..start].iter().chain(&order[end..]).copied().collect();
+            (train.subset(&kept), train.subset(&held))
+        })
+        .collect()
+}
+
+/// Every variant on every fold, then on the whole training set against the test sets: for each
+/// variant in order, its folds in order, then its test.
+fn fit_all(
+    robot: &RobotDescription,
+    variants: &[Variant],
+    folds: &[(MeasurementSet, MeasurementSet)],
+    train: &MeasurementSet,
+    tests: &[MeasurementSet],
+    preset: Preset,
+) -> anyhow::Result<Vec<FitResult>> {
+    let bar = ProgressBar::new(((folds.len() + 1) * variants.len()) as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} fits {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_message(format!("reproduce-sim ({}, {} folds + test sets)", preset.name(), folds.len()));
+    // Every (variant, fold) fit is independent: run them on the rayon pool; results come back in
+    // order, and each is the same whichever thread ran it.
+    let jobs: Vec<(usize, Option<usize>)> =
+        (0..variants.len()).flat_map(|v| (0..folds.len()).map(Some).chain([None]).map(move |f| (v, f))).collect();
+    let test_refs: Vec<&MeasurementSet> = tests.iter().collect();
+    let results: Vec<FitResult> = jobs
+        .par_iter()
+        .map(|&(v, fold)| {
+            let result = match fold {
+                Some(k) => fit_and_test(robot, &variants[v], &folds[k].0, &[&folds[k].1]),
+                None => fit_and_test(robot, &variants[v], train, &test_refs),
+            };
+            bar.inc(1);
+            result
+        })
+        .collect::<anyhow::Result<_>>()?;
+    bar.finish_and_clear();
+    Ok(results)
+}
+
+/// Each variant's cross-validation and test errors, from `fit_all`'s results.
+fn variant_results(variants: &[Variant], results: &[FitResult], folds: usize) -> Vec<VariantResult> {
+    let per_variant = folds + 1;
+    variants
+        .iter()
+        .enumerate()
+        .map(|(v, variant)| {
+            let mine = &results[v * per_variant..(v + 1) * per_variant];
+            VariantResult {
+                key: variant.key,
+                label: variant.label,
+                paper_faithful: variant.paper_faithful,
+                beyond: variant.beyond,
+                cv: mine[..folds].iter().map(|(_, _, e)| e[0]).collect(),
+                test: mine[folds].2.clone(),
+                training: mine[folds].0,
+                leave_one_out: mine[folds].1,
+            }
+        })
+        .collect()
+}
+
+/// The box plot, the report and (with `--json`) the JSON; the summary on stdout.
+fn write_outputs(args: &Args, out_dir: &Path, params: &Params, outcome: &Outcome, folds: usize) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out_dir).with_context(|| out_dir.display().to_string())?;
     let stem = match args.preset {
         Preset::Physical => "reproduce-sim".to_owned(),
         preset => format!("reproduce-sim-{}", preset.name()),
@@ -286,15 +312,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let svg_name = format!("{stem}-cv.svg");
     let groups: Vec<BoxGroup> =
         outcome.variants.iter().map(|v| BoxGroup { label: v.short_label(), values: v.cv.clone() }).collect();
-    let title = format!("{}-fold cross-validation, simulated IRB 4400 ({} preset)", sizes.folds, args.preset.name());
+    let title = format!("{folds}-fold cross-validation, simulated IRB 4400 ({} preset)", args.preset.name());
     let svg = box_plot(&title, "mean position error per fold (mm, log scale)", &groups, true);
     let write = |path: PathBuf, text: &str| std::fs::write(&path, text).with_context(|| path.display().to_string());
     write(out_dir.join(&svg_name), &svg)?;
-    write(out_dir.join(format!("{stem}.md")), &markdown(&params, &outcome, &svg_name))?;
+    write(out_dir.join(format!("{stem}.md")), &markdown(params, outcome, &svg_name))?;
     if let Some(path) = &args.json {
-        write(path.clone(), &json(&params, &outcome))?;
+        write(path.clone(), &json(params, outcome))?;
     }
-    println!("{}", super::reproduce_sim_report::summary(&params, &outcome));
+    println!("{}", super::reproduce_sim_report::summary(params, outcome));
     println!("wrote {} and {}", out_dir.join(format!("{stem}.md")).display(), out_dir.join(&svg_name).display());
     Ok(())
 }

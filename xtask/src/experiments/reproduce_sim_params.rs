@@ -157,18 +157,31 @@ fn round(values: impl IntoIterator<Item = f64>, scale: f64, digits: usize) -> St
 pub fn parameters_section(p: &Params) -> String {
     let mut out =
         String::from("## Parameters and their sources\n\n| parameter | value | source |\n| --- | --- | --- |\n");
-    let mut row = |name: &str, value: String, source: &str| {
-        let _ = writeln!(out, "| {name} | {value} | {source} |");
-    };
-    let d = &p.dynamics;
-    let g = &p.generator;
+    cell_rows(&mut out, p);
+    dynamics_rows(&mut out, &p.dynamics, p.preset);
+    effect_rows(&mut out, p);
+    sampling_rows(&mut out, p);
+    fit_rows(&mut out, &p.fit_options);
+    out.push_str(DIFFERENCES);
+    out
+}
+
+/// One row of the parameters table.
+fn row(out: &mut String, name: &str, value: String, source: &str) {
+    let _ = writeln!(out, "| {name} | {value} | {source} |");
+}
+
+/// The robot, its perturbation, the tool, the tracker and what it measures.
+fn cell_rows(out: &mut String, p: &Params) {
     let pert = &p.perturbation;
     row(
+        out,
         "robot",
         format!("{} (`{}`), nominal local POE from its zero-configuration axes", p.robot_name, p.robot_file),
         "ABB IRB 4400 product specification, tabulated in the project SPEC",
     );
     row(
+        out,
         "true robot",
         format!(
             "every local frame (6 joints and the tool) moved by exp(ξ), each component of ξ uniform in ±{} mm / ±{} mrad",
@@ -180,8 +193,14 @@ tenths of a mrad to a mrad; the uncalibrated arm then misses by millimetres, the
 before calibration (e.g. Nubiola & Bonev 2013, IRB 1600: 0.97 mm mean, 2.2 mm max). The paper says only \
 \"slightly perturbed\"; the base-tool row scales with this choice",
     );
-    row("tool", format!("{} m along the flange's z axis", pert.tool_m), "a T-Mac probe on a short adapter (estimate)");
     row(
+        out,
+        "tool",
+        format!("{} m along the flange's z axis", pert.tool_m),
+        "a T-Mac probe on a short adapter (estimate)",
+    );
+    row(
+        out,
         "tracker placement",
         format!(
             "{:.2} m from the base, levelled, random bearing and yaw; tracker_from_base translation ({}) m",
@@ -191,16 +210,23 @@ before calibration (e.g. Nubiola & Bonev 2013, IRB 1600: 0.97 mm mean, 2.2 mm ma
         "drawn 3–5 m from the base, within the AT901's accurate range (estimate)",
     );
     row(
+        out,
         "measurements",
         if p.full_pose { "full pose (position and orientation)".into() } else { "position only".into() },
         "paper: Leica AT901 with a T-Mac 6-DOF probe",
     );
+}
+
+/// Masses, centres of mass, stiffness and balancer.
+fn dynamics_rows(out: &mut String, d: &RobotDynamics, preset: Preset) {
     row(
+        out,
         "link masses",
         format!("{} kg (links 1–6)", round(d.links.iter().map(|l| l.mass_kg), 1.0, 0)),
         "fixture comments: ABB spec 3HAC9117-1 gives about 1 t for the manipulator; the split is an ENGINEERING ESTIMATE",
     );
     row(
+        out,
         "centres of mass",
         d.links.iter().map(|l| format!("({})", round(l.com_m, 1.0, 2))).collect::<Vec<_>>().join(", ")
             + " m, zero configuration",
@@ -208,12 +234,13 @@ before calibration (e.g. Nubiola & Bonev 2013, IRB 1600: 0.97 mm mean, 2.2 mm ma
     );
     let stiffness = round(d.stiffness_nm_per_rad.iter().copied(), 1.0, 0);
     row(
+        out,
         "joint stiffness",
-        match p.preset {
+        match preset {
             Preset::Physical => format!("{stiffness} N·m/rad"),
             Preset::PaperLike => format!("{stiffness} N·m/rad (the fixture's divided by {PAPER_LIKE_SOFTENING})"),
         },
-        match p.preset {
+        match preset {
             Preset::Physical => {
                 "fixture comments: identified 6R arms (Dumas et al., Robotica 2011, KUKA KR240-2) are of order 1e6 on \
 joints 1–3 and 1e5–1e6 on the wrist; round values taken, ENGINEERING ESTIMATE"
@@ -224,6 +251,7 @@ joints 1–3 and 1e5–1e6 on the wrist; round values taken, ENGINEERING ESTIMAT
         },
     );
     row(
+        out,
         "balancer",
         d.counterbalance.as_ref().map_or("none".into(), |c| {
             format!(
@@ -237,7 +265,13 @@ joints 1–3 and 1e5–1e6 on the wrist; round values taken, ENGINEERING ESTIMAT
         }),
         "fixture comments: the IRB 4400 has a spring balancer on axis 2 (product manual 3HAC022032-001); 85 % balanced, ENGINEERING ESTIMATE",
     );
+}
+
+/// The load model, the payloads, the tracker noise and the effects left out.
+fn effect_rows(out: &mut String, p: &Params) {
+    let g = &p.generator;
     row(
+        out,
         "load model",
         match p.effects.compliance {
             Some(c) if c.payload_only => "δq = C τ, payload weight only".into(),
@@ -255,12 +289,14 @@ payloads\"; the arm's own weight on joints this soft would leave POE 5 mm)"
         },
     );
     row(
+        out,
         "payloads",
         format!("{} kg, one drawn uniformly per pose, at the tool point", list(&g.payloads_kg)),
         "paper, Section IV-A",
     );
     if let Some(n) = p.effects.tracker_noise {
         row(
+            out,
             "tracker noise (σ)",
             format!(
                 "radial {} µm, transverse {} µm + {} µm/m, orientation {:.4}° per axis",
@@ -274,11 +310,18 @@ payloads\"; the arm's own weight on joints this soft would leave POE 5 mm)"
         );
     }
     row(
+        out,
         "other effects",
         "none (no backlash, gear error, thermal growth, drift)".into(),
         "the paper simulates loading only",
     );
+}
+
+/// How the poses are drawn, how many, and the seeds.
+fn sampling_rows(out: &mut String, p: &Params) {
+    let g = &p.generator;
     row(
+        out,
         "joint sampling",
         format!(
             "uniform within the limits less {:.0}°, poses with a tool-point Jacobian singular value below {} rejected",
@@ -288,12 +331,14 @@ payloads\"; the arm's own weight on joints this soft would leave POE 5 mm)"
         "paper: \"randomly generated within the workspace\"; margin and rejection are loadsim's defaults",
     );
     row(
+        out,
         "poses",
         format!("{} training, {} folds, 3 test sets of {}", p.sizes.training, p.sizes.folds, p.sizes.test),
         if p.quick { "`--quick` (the paper: 300, 10, 3 × 100)" } else { "paper, Section IV-A" },
     );
     let s = &p.seeds;
     row(
+        out,
         "seeds",
         format!(
             "study {}; cell {}, training {}, tests {}, folds {}",
@@ -305,9 +350,14 @@ payloads\"; the arm's own weight on joints this soft would leave POE 5 mm)"
         ),
         "ChaCha8 streams drawn from the study seed",
     );
-    if let Some(o) = p.fit_options.get("poe") {
+}
+
+/// The fit options of the POE and GP rows.
+fn fit_rows(out: &mut String, fit_options: &BTreeMap<String, FitOptions>) {
+    if let Some(o) = fit_options.get("poe") {
         let id = &o.identification;
         row(
+            out,
             "identification",
             format!(
                 "{:?}, ≤ {} iterations, residuals weighted by σ = {} mm and {} mrad",
@@ -319,34 +369,33 @@ payloads\"; the arm's own weight on joints this soft would leave POE 5 mm)"
             "poe `IdentificationOptions::default()` (paper Section III-A: iterative least squares)",
         );
     }
-    if let Some(o) = p.fit_options.get("poe-gp") {
-        let gp = &o.residual_gp.gp;
+    if let Some(o) = fit_options.get("poe-gp") {
         row(
+            out,
             "GP (our rows)",
-            format!(
-                "{:?} kernel, {:?} residual frame, {:?} outputs, random restarts: {}, inputs standardised: {}",
-                gp.kernel, o.residual_gp.residual_frame, gp.outputs, gp.optimiser.restarts, gp.standardise_inputs
-            ),
+            format!("{}, inputs standardised: {}", gp_choice(o), o.residual_gp.gp.standardise_inputs),
             "pipeline `ResidualGpOptions::default()` (no random restart, as `calib fit`), but one thread per fit: the \
 fits themselves run in parallel",
         );
     }
-    if let Some(o) = p.fit_options.get("paper:poe-gp") {
+    if let Some(o) = fit_options.get("paper:poe-gp") {
         row(
+            out,
             "GP (Eq. 5, Eq. 8 rows)",
-            format!(
-                "{:?} kernel, {:?} residual frame, {:?} outputs, random restarts: {}",
-                o.residual_gp.gp.kernel,
-                o.residual_gp.residual_frame,
-                o.residual_gp.gp.outputs,
-                o.residual_gp.gp.optimiser.restarts
-            ),
+            gp_choice(o),
             "paper Eq. 5 (Bishop PRML 6.63) and Eq. 8; one kernel for the six components because Eq. 11 uses one K \
 for all (and scikit-learn's regressor shares its kernel across the columns of a multi-output target)",
         );
     }
-    out.push_str(DIFFERENCES);
-    out
+}
+
+/// The GP's kernel, residual frame, outputs and restarts, as both GP rows state them.
+fn gp_choice(o: &FitOptions) -> String {
+    let gp = &o.residual_gp.gp;
+    format!(
+        "{:?} kernel, {:?} residual frame, {:?} outputs, random restarts: {}",
+        gp.kernel, o.residual_gp.residual_frame, gp.outputs, gp.optimiser.restarts
+    )
 }
 
 const DIFFERENCES: &str = "

@@ -201,6 +201,18 @@ fn table(outcome: &Outcome) -> String {
 /// The markdown report.
 pub fn markdown(params: &Params, outcome: &Outcome, svg_name: &str) -> String {
     let mut out = String::new();
+    intro(&mut out, params, outcome);
+    table_section(&mut out, outcome);
+    cv_section(&mut out, params, outcome, svg_name);
+    load_section(&mut out, params, outcome);
+    out.push_str(&reading(params, outcome));
+    out.push_str(&beyond_reading(outcome));
+    out.push_str(&super::reproduce_sim_params::parameters_section(params));
+    out
+}
+
+/// The title, the command, the study in a paragraph and what the preset is.
+fn intro(out: &mut String, params: &Params, outcome: &Outcome) {
     let preset = params.preset.name();
     let _ = writeln!(
         out,
@@ -244,6 +256,10 @@ about 0.1 mm, too little for the paper's gains; see `reproduce-sim.md` for the p
 `PAPER_LIKE_SOFTENING` in `xtask/src/experiments/reproduce_sim.rs` for why this factor.\n"
         );
     }
+}
+
+/// Table I, the reductions by POE+GP with loading, and whether the paper's ordering holds.
+fn table_section(out: &mut String, outcome: &Outcome) {
     let _ = writeln!(out, "## Table I: test sets (mm)\n");
     out.push_str(&table(outcome));
     let _ = writeln!(
@@ -269,6 +285,10 @@ about 0.1 mm, too little for the paper's gains; see `reproduce-sim.md` for the p
         "\nThe paper's ordering base-tool > POE > POE + GP > POE + GP with loading: {}.\n",
         held.join(", ")
     );
+}
+
+/// The cross-validation's box plot and statistics (the paper's Fig. 1).
+fn cv_section(out: &mut String, params: &Params, outcome: &Outcome, svg_name: &str) {
     let _ = writeln!(out, "## Cross-validation (the paper's Fig. 1)\n");
     let _ = writeln!(out, "![{}-fold cross-validation box plot]({svg_name})\n", params.sizes.folds);
     let _ = writeln!(out, "| method | median | mean | min | max |\n| --- | ---: | ---: | ---: | ---: |");
@@ -279,6 +299,10 @@ about 0.1 mm, too little for the paper's gains; see `reproduce-sim.md` for the p
             let _ = writeln!(out, "| {} | {:.3} | {mean:.3} | {lo:.3} | {hi:.3} |", v.label, s.median);
         }
     }
+}
+
+/// How far the compliance and the tracker noise move the tool.
+fn load_section(out: &mut String, params: &Params, outcome: &Outcome) {
     let m = &outcome.magnitudes;
     let loaded_by = match params.effects.compliance {
         Some(c) if c.payload_only => "under the payload alone, as simulated here".to_owned(),
@@ -295,10 +319,6 @@ the sag that is a fixed function of the joint angles near the mean payload; what
 be learnt with the payload as an input.\n",
         m.compliance_mm, m.noise_mm
     );
-    out.push_str(&reading(params, outcome));
-    out.push_str(&beyond_reading(outcome));
-    out.push_str(&super::reproduce_sim_params::parameters_section(params));
-    out
 }
 
 /// What the rows beyond the paper show.
@@ -366,6 +386,13 @@ and its draw (seeded).",
         paper_mean("poe-gp"),
         100.0 * (1.0 - paper_mean("poe-gp") / paper_mean("poe"))
     );
+    payload_reading(&mut out, outcome, gp, load);
+    out.push('\n');
+    out
+}
+
+/// What the payload input gives, ours and with the paper's own GP.
+fn payload_reading(out: &mut String, outcome: &Outcome, gp: f64, load: f64) {
     let gain = 100.0 * (1.0 - load / gp);
     let paper_gain = 100.0 * (1.0 - paper_mean("poe-gp-load") / paper_mean("poe-gp"));
     if gain < 0.5 * paper_gain {
@@ -400,6 +427,4 @@ counts as far away however close its joint angles are."
         }
         out.push('\n');
     }
-    out.push('\n');
-    out
 }

@@ -111,6 +111,46 @@ fn bar(len: usize) -> ProgressBar {
 
 /// The methods table (position only and full pose).
 fn methods(args: &Args, robot: &RobotDescription) -> Result<String> {
+    let (rows, sizes) = method_rows(args, robot)?;
+    let mut md = String::new();
+    let _ = writeln!(md, "# The real UR10: every method\n");
+    let _ = writeln!(
+        md,
+        "Data: series {} of the IPA UR10 data set (Landgraf, Ernst, Schleth, Fabritius, Huber, *A hybrid neural \
+         network approach for increasing the absolute accuracy of industrial robots*, CASE 2021; MIT licence; not part of \
+         this repository): a UR10 measured with a Leica laser tracker and a T-Mac at random poses, no payload variation. \
+         {} ({} training poses, {} test poses). Orientation from the tracker's rx, ry, rz as R = Rx Ry Rz. Produced by \
+         `cargo xtask ur10`; the diagnosis: below.\n",
+        args.dataset.series,
+        split_name(args.split),
+        sizes.0,
+        sizes.1
+    );
+    let _ = writeln!(md, "| data | method | mean (mm) | RMS (mm) | max (mm) | rotation mean (mrad) | fit time (s) |");
+    let _ = writeln!(md, "| --- | --- | ---: | ---: | ---: | ---: | ---: |");
+    for r in &rows {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.3} | {:.3} | {:.3} | {} | {:.1} |",
+            r.data,
+            r.method,
+            r.mean_mm,
+            r.rms_mm,
+            r.max_mm,
+            r.rotation_mrad.map_or("–".into(), |v| format!("{v:.3}")),
+            r.fit_s
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\n`poe-gp-load` equals `poe-gp` here: the data set has one payload, so the payload input is constant."
+    );
+    Ok(md)
+}
+
+/// Every method fitted on the training rows and evaluated on the test rows, position only and full
+/// pose; and the numbers of training and test rows.
+fn method_rows(args: &Args, robot: &RobotDescription) -> Result<(Vec<Row>, (usize, usize))> {
     let paper = ResidualGpOptions {
         gp: gp::GpConfig { kernel: gp::KernelChoice::Quadratic, ..gp::GpConfig::default() },
         residual_frame: ResidualFrame::Tracker,
@@ -153,40 +193,7 @@ fn methods(args: &Args, robot: &RobotDescription) -> Result<String> {
         }
     }
     progress.finish_and_clear();
-    let mut md = String::new();
-    let _ = writeln!(md, "# The real UR10: every method\n");
-    let _ = writeln!(
-        md,
-        "Data: series {} of the IPA UR10 data set (Landgraf, Ernst, Schleth, Fabritius, Huber, *A hybrid neural \
-         network approach for increasing the absolute accuracy of industrial robots*, CASE 2021; MIT licence; not part of \
-         this repository): a UR10 measured with a Leica laser tracker and a T-Mac at random poses, no payload variation. \
-         {} ({} training poses, {} test poses). Orientation from the tracker's rx, ry, rz as R = Rx Ry Rz. Produced by \
-         `cargo xtask ur10`; the diagnosis: below.\n",
-        args.dataset.series,
-        split_name(args.split),
-        sizes.0,
-        sizes.1
-    );
-    let _ = writeln!(md, "| data | method | mean (mm) | RMS (mm) | max (mm) | rotation mean (mrad) | fit time (s) |");
-    let _ = writeln!(md, "| --- | --- | ---: | ---: | ---: | ---: | ---: |");
-    for r in &rows {
-        let _ = writeln!(
-            md,
-            "| {} | {} | {:.3} | {:.3} | {:.3} | {} | {:.1} |",
-            r.data,
-            r.method,
-            r.mean_mm,
-            r.rms_mm,
-            r.max_mm,
-            r.rotation_mrad.map_or("–".into(), |v| format!("{v:.3}")),
-            r.fit_s
-        );
-    }
-    let _ = writeln!(
-        md,
-        "\n`poe-gp-load` equals `poe-gp` here: the data set has one payload, so the payload input is constant."
-    );
-    Ok(md)
+    Ok((rows, sizes))
 }
 
 /// One series' diagnosis, timed, and the verdict's effect fitted and tested.
@@ -279,6 +286,15 @@ fn check_series(args: &Args, robot: &RobotDescription, series: &str) -> Result<C
 
 fn diagnosis_section(args: &Args, checked: &[Checked]) -> String {
     let mut md = String::new();
+    diagnosis_intro(&mut md, args);
+    verdict_table(&mut md, checked);
+    range_table(&mut md, checked);
+    series_summaries(&mut md, checked);
+    md
+}
+
+/// The heading, the data, how it was produced and how to do the same by hand.
+fn diagnosis_intro(md: &mut String, args: &Args) {
     let _ = writeln!(md, "{DIAGNOSIS_HEADING}: the verdict, and its prediction tested\n");
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     let _ = writeln!(
@@ -300,6 +316,10 @@ fn diagnosis_section(args: &Args, checked: &[Checked]) -> String {
         load.split_whitespace().take(3).collect::<Vec<_>>().join(" "),
         args.repeats.max(1)
     );
+}
+
+/// Each series' verdict, predicted and fitted errors, and the diagnosis's time.
+fn verdict_table(md: &mut String, checked: &[Checked]) {
     let _ = writeln!(
         md,
         "| series | train / test poses | verdict | joints | held out before (mm) | predicted (mm) | `poe`, test rows (mm) | fitted, test rows (mm) | fitted / predicted | diagnose (s) | CPU (s) |"
@@ -324,6 +344,10 @@ fn diagnosis_section(args: &Args, checked: &[Checked]) -> String {
             c.cpu_seconds[c.cpu_seconds.len() / 2]
         );
     }
+}
+
+/// The fitted effect inside and outside the training rows' joint ranges.
+fn range_table(md: &mut String, checked: &[Checked]) {
     let _ = writeln!(
         md,
         "\nThe fitted effect on the test rows whose every joint angle lies within the training rows' range, and on \
@@ -346,6 +370,10 @@ fn diagnosis_section(args: &Args, checked: &[Checked]) -> String {
             );
         }
     }
+}
+
+/// Each series' fitted effects and diagnosis summary, and where the full report is.
+fn series_summaries(md: &mut String, checked: &[Checked]) {
     for c in checked {
         let _ = writeln!(md, "\n### Series {}\n", c.series);
         if !c.effects.is_empty() {
@@ -358,7 +386,6 @@ fn diagnosis_section(args: &Args, checked: &[Checked]) -> String {
         "\nThe full report of series {} with plots: [ur10-diagnosis/diagnosis.md](ur10-diagnosis/diagnosis.md).",
         checked.first().map_or("C", |c| c.series.as_str())
     );
-    md
 }
 
 pub fn run(args: &Args) -> Result<()> {
