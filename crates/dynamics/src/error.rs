@@ -2,9 +2,9 @@
 
 use std::fmt;
 
-/// What is wrong with a robot's dynamics. `loadsim::Error` has a variant of the same name and
-/// text for each (`From`, which matches every kind: exhaustive, so that a kind added here must be
-/// given its place there), so that a simulation's refusal reads the same whichever crate checked.
+/// What is wrong with a robot's dynamics. `loadsim` refuses its own settings in these kinds too
+/// (`loadsim::Error::Dynamics`, whose message is this one's), so that a simulation's refusal reads
+/// the same whichever crate checked.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Error {
     /// A list that needs one entry per joint (or per link) has the wrong length.

@@ -161,7 +161,7 @@ mod tests {
         let error = Error::in_file("poses.csv", CommonKind::NotFinite { field: "x".into(), value: f64::NAN });
         assert_eq!(error.to_string(), "poses.csv: x is NaN, a finite number is needed");
         assert_eq!(error.position(), None);
-        let error = Error::new(OptionOutOfRange { field: "ridge", value: -1.0, expected: "a positive finite number" });
+        let error = Error::new(OptionOutOfRange::new("ridge", -1.0, "a positive finite number"));
         assert_eq!(error.to_string(), "option ridge = -1: expected a positive finite number");
         assert!(error.place().is_none());
     }

@@ -34,5 +34,5 @@ pub mod ron_position;
 
 pub use common::CommonKind;
 pub use error::{Error, Kind};
-pub use option::OptionOutOfRange;
+pub use option::{OptionOutOfRange, OptionValue};
 pub use place::Place;

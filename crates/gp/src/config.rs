@@ -212,22 +212,18 @@ impl GpConfig {
     /// Refuses numbers that would make the fit meaningless (bounds are checked against the kernel
     /// when the fit starts).
     pub fn validate(&self) -> Result<(), Error> {
-        let o = &self.optimiser;
-        let j = &self.jitter;
+        let (o, j) = (&self.optimiser, &self.jitter);
         let refine = o.refine_function_tolerance.unwrap_or(o.function_tolerance);
-        let checks: [(&'static str, f64, bool); 6] = [
-            ("optimiser.memory", o.memory as f64, o.memory >= 1),
-            ("optimiser.gradient_tolerance", o.gradient_tolerance, o.gradient_tolerance >= 0.0),
-            ("optimiser.function_tolerance", o.function_tolerance, o.function_tolerance >= 0.0),
-            ("optimiser.refine_function_tolerance", refine, refine >= 0.0),
-            ("jitter.initial_relative", j.initial_relative, j.initial_relative > 0.0 && j.initial_relative.is_finite()),
-            ("jitter.growth", j.growth, j.growth > 1.0 && j.growth.is_finite()),
+        let (initial, at_least_0) = (j.initial_relative, "a number of at least 0");
+        let checks: [(&'static str, f64, bool, &'static str); 6] = [
+            ("optimiser.memory", o.memory as f64, o.memory >= 1, "at least 1"),
+            ("optimiser.gradient_tolerance", o.gradient_tolerance, o.gradient_tolerance >= 0.0, at_least_0),
+            ("optimiser.function_tolerance", o.function_tolerance, o.function_tolerance >= 0.0, at_least_0),
+            ("optimiser.refine_function_tolerance", refine, refine >= 0.0, at_least_0),
+            ("jitter.initial_relative", initial, initial > 0.0 && initial.is_finite(), "a finite number above 0"),
+            ("jitter.growth", j.growth, j.growth > 1.0 && j.growth.is_finite(), "a finite number above 1"),
         ];
-        for (field, value, ok) in checks {
-            if !ok {
-                return Err(Error::InvalidConfig { field, value });
-            }
-        }
-        Ok(())
+        let refused = checks.into_iter().find(|check| !check.2);
+        refused.map_or(Ok(()), |(field, value, _, expected)| Err(Error::InvalidOption { field, value, expected }))
     }
 }

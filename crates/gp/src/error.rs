@@ -66,7 +66,16 @@ pub enum Error {
         /// Upper bound given (natural scale).
         upper: f64,
     },
-    /// A numeric configuration field is out of its valid range.
+    /// An option of the configuration is outside its range (the shape of `poe`'s refusals too).
+    InvalidOption {
+        /// Which field, by its path in the config struct (`jitter.growth`).
+        field: &'static str,
+        /// The value given.
+        value: f64,
+        /// What it must be.
+        expected: &'static str,
+    },
+    /// A configuration that does not fit the data or the other settings (kernels, groups).
     InvalidConfig {
         /// Which field, by its name in the config struct.
         field: &'static str,
@@ -141,6 +150,7 @@ impl fmt::Display for Error {
             Self::InvalidBounds { index, lower, upper } => {
                 write!(f, "bounds of hyperparameter {index} are [{lower}, {upper}], need 0 < lower <= upper < inf")
             }
+            Self::InvalidOption { field, value, expected: e } => write!(f, "option {field} = {value}: expected {e}"),
             Self::InvalidConfig { field, value } => write!(f, "configuration field `{field}` = {value} is invalid"),
             Self::CholeskyFailed { size, pivot, jitter_tried } => write!(
                 f,

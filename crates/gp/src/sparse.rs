@@ -70,16 +70,10 @@ impl SparseConfig {
     /// Refuses numbers that would make the fit meaningless.
     pub fn validate(&self) -> Result<(), Error> {
         self.gp.validate()?;
-        let checks: [(&'static str, usize, bool); 2] = [
-            ("inducing_points", self.inducing_points, self.inducing_points >= 1),
-            ("hyperparameter_subset", self.hyperparameter_subset, self.hyperparameter_subset >= 2),
-        ];
-        for (field, value, ok) in checks {
-            if !ok {
-                return Err(Error::InvalidConfig { field, value: value as f64 });
-            }
-        }
-        Ok(())
+        let (points, subset) = (self.inducing_points, self.hyperparameter_subset);
+        let checks = [("inducing_points", points, 1, "at least 1"), ("hyperparameter_subset", subset, 2, "at least 2")];
+        let refused = checks.into_iter().find(|&(_, value, least, _)| value < least);
+        refused.map_or(Ok(()), |(field, n, _, expected)| Err(Error::InvalidOption { field, value: n as f64, expected }))
     }
 }
 

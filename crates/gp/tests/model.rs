@@ -290,7 +290,7 @@ fn bad_configuration_is_refused_with_its_numbers() {
     let bad_growth = GpConfig { jitter: gp::JitterConfig { growth: 1.0, ..Default::default() }, ..GpConfig::default() };
     assert_eq!(
         ExactGp::fit(x.as_ref(), y.as_ref(), &bad_growth).err(),
-        Some(Error::InvalidConfig { field: "jitter.growth", value: 1.0 })
+        Some(Error::InvalidOption { field: "jitter.growth", value: 1.0, expected: "a finite number above 1" })
     );
 }
 

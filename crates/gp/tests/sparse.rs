@@ -153,7 +153,7 @@ fn more_inducing_points_than_training_points_are_refused() {
     let config = SparseConfig { inducing_points: 0, ..SparseConfig::default() };
     assert_eq!(
         SparseGp::fit(x.as_ref(), y.as_ref(), &config).err(),
-        Some(Error::InvalidConfig { field: "inducing_points", value: 0.0 })
+        Some(Error::InvalidOption { field: "inducing_points", value: 0.0, expected: "at least 1" })
     );
 }
 

@@ -35,10 +35,17 @@ impl BacklashModel {
     pub fn validate(&self, joint_count: usize) -> Result<(), Error> {
         for entry in &self.joints {
             if entry.joint_index >= joint_count {
-                return Err(Error::UnknownJoint { field: "backlash", joint_index: entry.joint_index, joint_count });
+                return Err(Error::from(dynamics::Error::UnknownJoint {
+                    field: "backlash",
+                    joint_index: entry.joint_index,
+                    joint_count,
+                }));
             }
             if !(entry.half_band_rad.is_finite() && entry.half_band_rad >= 0.0) {
-                return Err(Error::InvalidParameter { field: "backlash.half_band_rad", value: entry.half_band_rad });
+                return Err(Error::from(dynamics::Error::InvalidParameter {
+                    field: "backlash.half_band_rad",
+                    value: entry.half_band_rad,
+                }));
             }
         }
         Ok(())

@@ -46,7 +46,7 @@ impl BaseTilt {
             ("base_tilt.inclinometer_noise_rad", self.inclinometer_noise_rad),
         ];
         match fields.into_iter().find(|(_, v)| !(v.is_finite() && *v >= 0.0)) {
-            Some((field, value)) => Err(Error::InvalidParameter { field, value }),
+            Some((field, value)) => Err(Error::from(dynamics::Error::InvalidParameter { field, value })),
             None => Ok(()),
         }
     }

@@ -51,28 +51,39 @@ impl CouplingModel {
     pub fn validate(&self, joint_count: usize) -> Result<(), Error> {
         for term in &self.terms {
             if term.joint_index >= joint_count {
-                return Err(Error::UnknownJoint { field: "coupling", joint_index: term.joint_index, joint_count });
+                return Err(Error::from(dynamics::Error::UnknownJoint {
+                    field: "coupling",
+                    joint_index: term.joint_index,
+                    joint_count,
+                }));
             }
             if !term.amplitude_rad.is_finite() {
-                return Err(Error::InvalidParameter { field: "coupling.amplitude_rad", value: term.amplitude_rad });
+                return Err(Error::from(dynamics::Error::InvalidParameter {
+                    field: "coupling.amplitude_rad",
+                    value: term.amplitude_rad,
+                }));
             }
             if term.factors.is_empty() {
-                return Err(Error::LengthMismatch { field: "coupling.factors", given: 0, expected: 1 });
+                return Err(Error::from(dynamics::Error::LengthMismatch {
+                    field: "coupling.factors",
+                    given: 0,
+                    expected: 1,
+                }));
             }
             for factor in &term.factors {
                 if factor.source_joint_index >= joint_count {
-                    return Err(Error::UnknownJoint {
+                    return Err(Error::from(dynamics::Error::UnknownJoint {
                         field: "coupling.source_joint_index",
                         joint_index: factor.source_joint_index,
                         joint_count,
-                    });
+                    }));
                 }
                 if factor.source_joint_index == term.joint_index {
                     return Err(Error::SelfCoupling { joint_index: term.joint_index });
                 }
                 for (field, value) in [("coupling.order", factor.order), ("coupling.phase_rad", factor.phase_rad)] {
                     if !value.is_finite() {
-                        return Err(Error::InvalidParameter { field, value });
+                        return Err(Error::from(dynamics::Error::InvalidParameter { field, value }));
                     }
                 }
             }

@@ -73,7 +73,11 @@ impl LinkBend {
 pub fn link_bend(model: &LocalPoe, q: &[f64], tool: usize, joint: usize) -> Result<LinkBend, Error> {
     let n = model.joint_count();
     if joint >= n {
-        return Err(Error::UnknownJoint { field: "link_deflection", joint_index: joint, joint_count: n });
+        return Err(Error::from(dynamics::Error::UnknownJoint {
+            field: "link_deflection",
+            joint_index: joint,
+            joint_count: n,
+        }));
     }
     let frames = model.frames(q)?;
     let joints = model.joints();
@@ -133,10 +137,17 @@ impl LinkDeflectionModel {
     pub fn validate(&self, joint_count: usize) -> Result<(), Error> {
         for link in &self.links {
             if link.joint_index >= joint_count {
-                return Err(Error::UnknownJoint { field: "deflection", joint_index: link.joint_index, joint_count });
+                return Err(Error::from(dynamics::Error::UnknownJoint {
+                    field: "deflection",
+                    joint_index: link.joint_index,
+                    joint_count,
+                }));
             }
             if let Some(&value) = link.flexibility_per_nm2.iter().find(|f| !(f.is_finite() && **f >= 0.0)) {
-                return Err(Error::InvalidParameter { field: "deflection.flexibility_per_nm2", value });
+                return Err(Error::from(dynamics::Error::InvalidParameter {
+                    field: "deflection.flexibility_per_nm2",
+                    value,
+                }));
             }
         }
         Ok(())
@@ -324,10 +335,16 @@ mod tests {
     #[test]
     fn a_link_beyond_the_robot_or_a_negative_flexibility_is_refused() {
         let bad_joint = LinkDeflectionModel { links: vec![BentLink { joint_index: 3, flexibility_per_nm2: [0.0; 2] }] };
-        assert!(matches!(bad_joint.validate(3), Err(Error::UnknownJoint { joint_index: 3, .. })));
+        assert!(matches!(
+            bad_joint.validate(3),
+            Err(Error::Dynamics { source: dynamics::Error::UnknownJoint { joint_index: 3, .. } })
+        ));
         let negative =
             LinkDeflectionModel { links: vec![BentLink { joint_index: 0, flexibility_per_nm2: [1e-7, -1.0] }] };
-        assert!(matches!(negative.validate(3), Err(Error::InvalidParameter { .. })));
+        assert!(matches!(
+            negative.validate(3),
+            Err(Error::Dynamics { source: dynamics::Error::InvalidParameter { .. } })
+        ));
         let nan =
             LinkDeflectionModel { links: vec![BentLink { joint_index: 0, flexibility_per_nm2: [f64::NAN, 0.0] }] };
         assert!(nan.validate(3).is_err());

@@ -29,7 +29,7 @@ impl TimeDriftModel {
     /// Checks that every component is finite.
     pub fn validate(&self) -> Result<(), Error> {
         match self.twist_per_s.iter().find(|x| !x.is_finite()) {
-            Some(&value) => Err(Error::InvalidParameter { field: "drift.twist_per_s", value }),
+            Some(&value) => Err(Error::from(dynamics::Error::InvalidParameter { field: "drift.twist_per_s", value })),
             None => Ok(()),
         }
     }

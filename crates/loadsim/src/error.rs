@@ -11,39 +11,16 @@ pub enum Error {
         /// The error of the `poe` crate.
         source: poe::Error,
     },
-    /// A list that needs one entry per joint (or per link) has the wrong length.
-    LengthMismatch {
-        /// Which list, e.g. `"stiffness_nm_per_rad"`.
-        field: &'static str,
-        /// Entries given.
-        given: usize,
-        /// Entries needed.
-        expected: usize,
-    },
-    /// A joint index refers to no joint of the robot.
-    UnknownJoint {
-        /// Which setting carried it, e.g. `"backlash"`.
-        field: &'static str,
-        /// The 0-based index given.
-        joint_index: usize,
-        /// The robot's joint count.
-        joint_count: usize,
-    },
-    /// A number is out of its physical range (negative stiffness, NaN, …).
-    InvalidParameter {
-        /// Which parameter.
-        field: &'static str,
-        /// The value given.
-        value: f64,
+    /// A setting does not fit the robot (a list's length, a joint index, a number out of its
+    /// physical range, a stiffness the robot does not give): the kinds `dynamics` refuses a
+    /// robot's dynamics with, and the same text whichever crate checked.
+    Dynamics {
+        /// The refusal, in the kinds of the `dynamics` crate.
+        source: dynamics::Error,
     },
     /// An effect needs the robot's masses and stiffness, but the robot description has none.
     MissingDynamics {
         /// The effect that needs them.
-        effect: &'static str,
-    },
-    /// An effect needs the joint stiffness, but the robot's dynamics give masses only (a URDF's).
-    MissingStiffness {
-        /// The effect that needs it.
         effect: &'static str,
     },
     /// A joint range is empty once the margin is taken off both ends.
@@ -96,17 +73,8 @@ impl From<poe::Error> for Error {
 }
 
 impl From<dynamics::Error> for Error {
-    fn from(error: dynamics::Error) -> Self {
-        match error {
-            dynamics::Error::LengthMismatch { field, given, expected } => {
-                Error::LengthMismatch { field, given, expected }
-            }
-            dynamics::Error::UnknownJoint { field, joint_index, joint_count } => {
-                Error::UnknownJoint { field, joint_index, joint_count }
-            }
-            dynamics::Error::InvalidParameter { field, value } => Error::InvalidParameter { field, value },
-            dynamics::Error::MissingStiffness { effect } => Error::MissingStiffness { effect },
-        }
+    fn from(source: dynamics::Error) -> Self {
+        Error::Dynamics { source }
     }
 }
 
@@ -114,26 +82,11 @@ impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Error::Kinematics { source } => write!(f, "kinematic model: {source}"),
-            Error::LengthMismatch { field, given, expected } => {
-                write!(f, "{field} has {given} entries, {expected} expected")
-            }
-            Error::UnknownJoint { field, joint_index, joint_count } => {
-                // A user's file can hold usize::MAX: no overflow when numbering it from 1.
-                write!(
-                    f,
-                    "{field} names joint {} but the robot has {joint_count} joints",
-                    joint_index.saturating_add(1)
-                )
-            }
-            Error::InvalidParameter { field, value } => write!(f, "{field} = {value} is out of range"),
+            // Transparent: the message is the robot's dynamics' own.
+            Error::Dynamics { source } => fmt::Display::fmt(source, f),
             Error::MissingDynamics { effect } => {
                 write!(f, "{effect} needs link masses and joint stiffness, but the robot has no `dynamics`")
             }
-            Error::MissingStiffness { effect } => write!(
-                f,
-                "{effect} needs the joint stiffness, but the robot's `dynamics` give masses only (a URDF has no \
-                 stiffness): give `stiffness_nm_per_rad` in a RON robot file"
-            ),
             Error::EmptyJointRange { joint_index, lower_rad, upper_rad, margin_rad } => write!(
                 f,
                 "joint {} range [{lower_rad}, {upper_rad}] rad is empty after a margin of {margin_rad} rad",
@@ -165,6 +118,8 @@ impl std::error::Error for Error {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             Error::Kinematics { source } => Some(source),
+            // Transparent, as its message: what the `dynamics` error wraps, not the error itself.
+            Error::Dynamics { source } => std::error::Error::source(source),
             _ => None,
         }
     }
@@ -176,7 +131,8 @@ mod tests {
 
     #[test]
     fn the_largest_joint_index_a_file_can_hold_is_shown_without_overflow() {
-        let error = Error::UnknownJoint { field: "backlash", joint_index: usize::MAX, joint_count: 6 };
+        let error =
+            Error::from(dynamics::Error::UnknownJoint { field: "backlash", joint_index: usize::MAX, joint_count: 6 });
         assert_eq!(error.to_string(), format!("backlash names joint {} but the robot has 6 joints", usize::MAX));
         assert!(Error::SelfCoupling { joint_index: usize::MAX }.to_string().contains(&usize::MAX.to_string()));
     }

@@ -213,11 +213,15 @@ impl<'a> ConfigurationSampler<'a> {
     ) -> Result<Self, Error> {
         let n = model.joint_count();
         if ranges.len() != n {
-            return Err(Error::LengthMismatch { field: "joint ranges", given: ranges.len(), expected: n });
+            return Err(Error::from(dynamics::Error::LengthMismatch {
+                field: "joint ranges",
+                given: ranges.len(),
+                expected: n,
+            }));
         }
         let margin = config.limit_margin_rad;
         if !(margin.is_finite() && margin >= 0.0) {
-            return Err(Error::InvalidParameter { field: "limit_margin_rad", value: margin });
+            return Err(Error::from(dynamics::Error::InvalidParameter { field: "limit_margin_rad", value: margin }));
         }
         let bounds: Vec<(f64, f64)> = ranges.iter().map(|r| (r.lower_rad + margin, r.upper_rad - margin)).collect();
         for (joint_index, (r, (lo, hi))) in ranges.iter().zip(&bounds).enumerate() {
@@ -278,14 +282,18 @@ impl<'a> ConfigurationSampler<'a> {
 fn fixed_values(config: &GeneratorConfig, bounds: &[(f64, f64)]) -> Result<Vec<Option<f64>>, Error> {
     let n = bounds.len();
     if let Some(&joint_index) = config.moving_joints.iter().find(|&&j| j >= n) {
-        return Err(Error::UnknownJoint { field: "moving_joints", joint_index, joint_count: n });
+        return Err(Error::from(dynamics::Error::UnknownJoint { field: "moving_joints", joint_index, joint_count: n }));
     }
     if !config.fixed_at_rad.is_empty() && config.fixed_at_rad.len() != n {
-        return Err(Error::LengthMismatch { field: "fixed_at_rad", given: config.fixed_at_rad.len(), expected: n });
+        return Err(Error::from(dynamics::Error::LengthMismatch {
+            field: "fixed_at_rad",
+            given: config.fixed_at_rad.len(),
+            expected: n,
+        }));
     }
     let jitter = config.fixed_jitter_rad;
     if !(jitter.is_finite() && jitter >= 0.0) {
-        return Err(Error::InvalidParameter { field: "fixed_jitter_rad", value: jitter });
+        return Err(Error::from(dynamics::Error::InvalidParameter { field: "fixed_jitter_rad", value: jitter }));
     }
     (0..n)
         .map(|j| {
@@ -295,7 +303,7 @@ fn fixed_values(config: &GeneratorConfig, bounds: &[(f64, f64)]) -> Result<Vec<O
             let (lo, hi) = bounds[j];
             match config.fixed_at_rad.get(j) {
                 Some(&at) if at.is_finite() && (lo..=hi).contains(&at) => Ok(Some(at)),
-                Some(&value) => Err(Error::InvalidParameter { field: "fixed_at_rad", value }),
+                Some(&value) => Err(Error::from(dynamics::Error::InvalidParameter { field: "fixed_at_rad", value })),
                 None => Ok(Some(0f64.clamp(lo, hi))),
             }
         })
@@ -332,10 +340,10 @@ pub fn generate_each<E: From<Error>>(
 ) -> Result<(), E> {
     effects.validate(cell)?;
     if config.payloads_kg.is_empty() {
-        return Err(Error::LengthMismatch { field: "payloads_kg", given: 0, expected: 1 }.into());
+        return Err(Error::from(dynamics::Error::LengthMismatch { field: "payloads_kg", given: 0, expected: 1 }).into());
     }
     if let Some(&m) = config.payloads_kg.iter().find(|m| !(m.is_finite() && **m >= 0.0)) {
-        return Err(Error::InvalidParameter { field: "payloads_kg", value: m }.into());
+        return Err(Error::from(dynamics::Error::InvalidParameter { field: "payloads_kg", value: m }).into());
     }
     let runs = config.payloads_kg.len();
     if config.tool_per_run && cell.robot.tool_count() < runs {

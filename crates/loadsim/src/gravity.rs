@@ -31,10 +31,10 @@ impl Payload {
 
     fn validate(&self) -> Result<(), Error> {
         if !(self.mass_kg.is_finite() && self.mass_kg >= 0.0) {
-            return Err(Error::InvalidParameter { field: "payload_kg", value: self.mass_kg });
+            return Err(Error::from(dynamics::Error::InvalidParameter { field: "payload_kg", value: self.mass_kg }));
         }
         if let Some(&c) = self.com_offset_m.iter().find(|c| !c.is_finite()) {
-            return Err(Error::InvalidParameter { field: "payload com_offset_m", value: c });
+            return Err(Error::from(dynamics::Error::InvalidParameter { field: "payload com_offset_m", value: c }));
         }
         Ok(())
     }

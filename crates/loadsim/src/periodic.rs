@@ -45,7 +45,11 @@ impl GearPeriodicModel {
     pub fn validate(&self, joint_count: usize) -> Result<(), Error> {
         for h in &self.harmonics {
             if h.joint_index >= joint_count {
-                return Err(Error::UnknownJoint { field: "periodic", joint_index: h.joint_index, joint_count });
+                return Err(Error::from(dynamics::Error::UnknownJoint {
+                    field: "periodic",
+                    joint_index: h.joint_index,
+                    joint_count,
+                }));
             }
             for (field, value) in [
                 ("periodic.order", h.order),
@@ -53,7 +57,7 @@ impl GearPeriodicModel {
                 ("periodic.phase_rad", h.phase_rad),
             ] {
                 if !value.is_finite() {
-                    return Err(Error::InvalidParameter { field, value });
+                    return Err(Error::from(dynamics::Error::InvalidParameter { field, value }));
                 }
             }
         }

@@ -39,18 +39,27 @@ impl ScrewPeriodicModel {
         for h in &self.harmonics {
             let joint_count = prismatic.len();
             match prismatic.get(h.joint_index) {
-                None => return Err(Error::UnknownJoint { field: "screw", joint_index: h.joint_index, joint_count }),
+                None => {
+                    return Err(Error::from(dynamics::Error::UnknownJoint {
+                        field: "screw",
+                        joint_index: h.joint_index,
+                        joint_count,
+                    }));
+                }
                 Some(false) => return Err(Error::NotPrismatic { field: "screw", joint_index: h.joint_index }),
                 Some(true) => {}
             }
             if !(h.pitch_m.is_finite() && h.pitch_m > 0.0) {
-                return Err(Error::InvalidParameter { field: "screw.pitch_m", value: h.pitch_m });
+                return Err(Error::from(dynamics::Error::InvalidParameter {
+                    field: "screw.pitch_m",
+                    value: h.pitch_m,
+                }));
             }
             for (field, value) in
                 [("screw.order", h.order), ("screw.amplitude_m", h.amplitude_m), ("screw.phase_rad", h.phase_rad)]
             {
                 if !value.is_finite() {
-                    return Err(Error::InvalidParameter { field, value });
+                    return Err(Error::from(dynamics::Error::InvalidParameter { field, value }));
                 }
             }
         }
@@ -127,9 +136,12 @@ mod tests {
         let half = screw.deflection(&[0.1234 + 0.005, 0.5])[0];
         assert!((a + half).abs() < 1e-15, "half a pitch on, the first harmonic is opposite: {a} {half}");
         assert!(matches!(screw.validate(&[false]), Err(Error::NotPrismatic { joint_index: 0, .. })));
-        assert!(matches!(screw.validate(&[]), Err(Error::UnknownJoint { .. })));
+        assert!(matches!(screw.validate(&[]), Err(Error::Dynamics { source: dynamics::Error::UnknownJoint { .. } })));
         let mut bad = screw.clone();
         bad.harmonics[0].pitch_m = 0.0;
-        assert!(matches!(bad.validate(&[true]), Err(Error::InvalidParameter { field: "screw.pitch_m", .. })));
+        assert!(matches!(
+            bad.validate(&[true]),
+            Err(Error::Dynamics { source: dynamics::Error::InvalidParameter { field: "screw.pitch_m", .. } })
+        ));
     }
 }

@@ -86,7 +86,8 @@ impl EntryFault {
     /// (`thermal.reference_temp_c` → `reference_temp_c`; the section itself otherwise).
     pub fn of_section(error: &Error) -> Self {
         let field = match error {
-            Error::InvalidParameter { field, .. } | Error::LengthMismatch { field, .. } => {
+            Error::Dynamics { source: dynamics::Error::InvalidParameter { field, .. } }
+            | Error::Dynamics { source: dynamics::Error::LengthMismatch { field, .. } } => {
                 field.rsplit('.').next().unwrap_or(field).to_owned()
             }
             _ => String::new(),

@@ -40,7 +40,7 @@ pub fn smallest_singular_value_of_joints(
     let jacobian = tool_point_jacobian(model, q, tool)?;
     let n = jacobian.ncols();
     if let Some(&joint_index) = joints.iter().find(|&&j| j >= n) {
-        return Err(Error::UnknownJoint { field: "moving_joints", joint_index, joint_count: n });
+        return Err(Error::from(dynamics::Error::UnknownJoint { field: "moving_joints", joint_index, joint_count: n }));
     }
     let columns = DMatrix::from_fn(6, joints.len(), |r, c| jacobian[(r, joints[c])]);
     Ok(columns.singular_values().iter().copied().fold(f64::INFINITY, f64::min))

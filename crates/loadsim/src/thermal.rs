@@ -38,17 +38,22 @@ impl ThermalModel {
     /// Checks the values against a robot with `joint_count` joints.
     pub fn validate(&self, joint_count: usize) -> Result<(), Error> {
         if !self.reference_temp_c.is_finite() {
-            return Err(Error::InvalidParameter { field: "thermal.reference_temp_c", value: self.reference_temp_c });
+            return Err(Error::from(dynamics::Error::InvalidParameter {
+                field: "thermal.reference_temp_c",
+                value: self.reference_temp_c,
+            }));
         }
         if !self.link_expansion_per_k.is_empty() && self.link_expansion_per_k.len() != joint_count + 1 {
-            return Err(Error::LengthMismatch {
+            return Err(Error::from(dynamics::Error::LengthMismatch {
                 field: "thermal.link_expansion_per_k",
                 given: self.link_expansion_per_k.len(),
                 expected: joint_count + 1,
-            });
+            }));
         }
         match std::iter::once(&self.expansion_per_k).chain(&self.link_expansion_per_k).find(|a| !a.is_finite()) {
-            Some(&value) => Err(Error::InvalidParameter { field: "thermal.expansion_per_k", value }),
+            Some(&value) => {
+                Err(Error::from(dynamics::Error::InvalidParameter { field: "thermal.expansion_per_k", value }))
+            }
             None => Ok(()),
         }
     }
@@ -67,7 +72,7 @@ impl ThermalModel {
     pub fn grown_model(&self, model: &LocalPoe, temp_c: f64) -> Result<LocalPoe, Error> {
         self.validate(model.joint_count())?;
         if !temp_c.is_finite() {
-            return Err(Error::InvalidParameter { field: "temp_c", value: temp_c });
+            return Err(Error::from(dynamics::Error::InvalidParameter { field: "temp_c", value: temp_c }));
         }
         let delta = temp_c - self.reference_temp_c;
         let coefficients = self.coefficients(model.joint_count());

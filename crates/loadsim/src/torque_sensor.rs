@@ -38,14 +38,16 @@ impl TorqueSensorNoise {
     /// Checks the values against a robot with `joint_count` joints.
     pub fn validate(&self, joint_count: usize) -> Result<(), Error> {
         if !self.joint_sigma_nm.is_empty() && self.joint_sigma_nm.len() != joint_count {
-            return Err(Error::LengthMismatch {
+            return Err(Error::from(dynamics::Error::LengthMismatch {
                 field: "torque_sensor.joint_sigma_nm",
                 given: self.joint_sigma_nm.len(),
                 expected: joint_count,
-            });
+            }));
         }
         match std::iter::once(&self.sigma_nm).chain(&self.joint_sigma_nm).find(|s| !(s.is_finite() && **s >= 0.0)) {
-            Some(&value) => Err(Error::InvalidParameter { field: "torque_sensor.sigma_nm", value }),
+            Some(&value) => {
+                Err(Error::from(dynamics::Error::InvalidParameter { field: "torque_sensor.sigma_nm", value }))
+            }
             None => Ok(()),
         }
     }

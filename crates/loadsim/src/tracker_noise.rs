@@ -48,7 +48,7 @@ impl TrackerNoiseModel {
             ("tracker_noise.orientation_sigma_rad", self.orientation_sigma_rad),
         ] {
             if !(value.is_finite() && value >= 0.0) {
-                return Err(Error::InvalidParameter { field, value });
+                return Err(Error::from(dynamics::Error::InvalidParameter { field, value }));
             }
         }
         Ok(())

@@ -6,6 +6,7 @@
 //! it and names `calib register`, which fits the new placement from a few rows.
 
 use crate::{ErrorSummary, PoseError, pose_error};
+use errors::OptionOutOfRange;
 use lie::{SE3, Vector3};
 use measurements::Measurement;
 use serde::{Deserialize, Serialize};
@@ -34,17 +35,11 @@ impl Default for OtherPlacementOptions {
 
 impl OtherPlacementOptions {
     /// Refuses a share outside (0, 1) or fewer rows than a rigid motion has parameters.
-    pub fn validate(&self) -> Result<(), String> {
-        if !(self.explained_share > 0.0 && self.explained_share < 1.0) {
-            return Err(format!("explained_share must lie in (0, 1), not {}", self.explained_share));
-        }
-        if self.min_rows < 7 {
-            return Err(format!(
-                "min_rows must be at least 7 (a rigid motion has 6 parameters), not {}",
-                self.min_rows
-            ));
-        }
-        Ok(())
+    pub fn validate(&self) -> Result<(), OptionOutOfRange> {
+        let share = self.explained_share;
+        OptionOutOfRange::check("explained_share", share, share > 0.0 && share < 1.0, "a number in (0, 1)")?;
+        let expected = "at least 7 (a rigid motion has 6 parameters)";
+        OptionOutOfRange::check("min_rows", self.min_rows as f64, self.min_rows >= 7, expected)
     }
 }
 
@@ -172,13 +167,27 @@ mod tests {
     }
 
     #[test]
-    fn options_out_of_range_are_refused() {
-        for options in [
-            OtherPlacementOptions { explained_share: 1.0, ..Default::default() },
-            OtherPlacementOptions { explained_share: f64::NAN, ..Default::default() },
-            OtherPlacementOptions { min_rows: 6, ..Default::default() },
+    fn options_out_of_range_are_refused_with_their_field_value_and_range() {
+        for (options, message) in [
+            (
+                OtherPlacementOptions { explained_share: 1.0, ..Default::default() },
+                "explained_share = 1: expected a number in (0, 1)",
+            ),
+            (
+                OtherPlacementOptions { explained_share: f64::NAN, ..Default::default() },
+                "explained_share = NaN: expected a number in (0, 1)",
+            ),
+            (
+                OtherPlacementOptions { explained_share: 0.0, ..Default::default() },
+                "explained_share = 0: expected a number in (0, 1)",
+            ),
+            (
+                OtherPlacementOptions { min_rows: 6, ..Default::default() },
+                "min_rows = 6: expected at least 7 (a rigid motion has 6 parameters)",
+            ),
         ] {
-            assert!(options.validate().is_err(), "{options:?}");
+            assert_eq!(options.validate().unwrap_err().to_string(), format!("option {message}"), "{options:?}");
         }
+        assert!(OtherPlacementOptions { min_rows: 7, explained_share: 0.99 }.validate().is_ok());
     }
 }

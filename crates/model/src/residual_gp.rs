@@ -213,20 +213,21 @@ impl Default for ResidualGpOptions {
 }
 
 impl ResidualGpOptions {
-    /// The first option outside its range: its name and a message.
-    pub fn validate_fade(&self) -> Result<(), (&'static str, String)> {
-        match self.fade_above_variance_ratio {
-            Some(r) if !(0.0..1.0).contains(&r) => Err((
-                "fade_above_variance_ratio",
-                format!("residual_gp.fade_above_variance_ratio is {r}, expected a number in [0, 1) or None"),
-            )),
-            _ if self.fade_share_rows == 0 => {
-                Err(("fade_share_rows", "residual_gp.fade_share_rows is 0, expected at least 1".to_owned()))
-            }
-            _ => measurements::InputNames::new(self.inputs.clone(), "residual_gp.inputs")
-                .map(|_| ())
-                .map_err(|e| ("inputs", format!("residual_gp.inputs: {}", e.dyn_kind()))),
+    /// The fade's options: the first outside its range, with its value and what is expected.
+    pub fn validate_fade(&self) -> Result<(), errors::OptionOutOfRange> {
+        if let Some(r) = self.fade_above_variance_ratio {
+            let accepted = (0.0..1.0).contains(&r);
+            errors::OptionOutOfRange::check("fade_above_variance_ratio", r, accepted, "a number in [0, 1) or None")?;
         }
+        errors::option::at_least_one("fade_share_rows", self.fade_share_rows)
+    }
+
+    /// The GP's inputs, refused as [`measurements::InputNames`] refuses a list of names (not a
+    /// range): the field and the message.
+    pub fn validate_inputs(&self) -> Result<(), (&'static str, String)> {
+        measurements::InputNames::new(self.inputs.clone(), "residual_gp.inputs")
+            .map(|_| ())
+            .map_err(|e| ("inputs", format!("residual_gp.inputs: {}", e.dyn_kind())))
     }
 }
 

@@ -175,27 +175,26 @@ impl FitOptions {
 
     /// Checks every value once: the identification's, and the effects' prior.
     pub fn validate(&self) -> Result<(), (&'static str, String)> {
-        if let Err(poe::Error::InvalidOption { name, value, expected }) = self.identification.validate() {
-            return Err((name, format!("identification.{name} is {value}, expected {expected}")));
-        }
+        // poe and gp know no `errors`: their refusal of an option has its shape, carried over whole.
+        self.identification.validate().map_err(|error| match error {
+            poe::Error::InvalidOption { name, value, expected } => {
+                OptionOutOfRange::new(name, value, expected).in_file("identification")
+            }
+            other => ("identification", format!("identification: {other}")),
+        })?;
         option::at_least_one("max_iterations", self.effects.max_iterations).map_err(|e| e.in_file("effects"))?;
         let redundancy = self.min_redundancy;
         let accepted = redundancy.is_finite() && redundancy >= 1.0;
         OptionOutOfRange::check("min_redundancy", redundancy, accepted, "a finite number of at least 1")
             .map_err(|e| e.in_file(""))?;
-        self.residual_gp.validate_fade()?;
-        if let Err(gp::Error::InvalidConfig { field, value }) = self.residual_gp.gp.validate() {
-            // The field's own name, where the file gives it (`function_tolerance:` for
-            // `optimiser.function_tolerance`).
-            let last = field.rsplit('.').next().unwrap_or(field);
-            let expected = match last {
-                "memory" => "at least 1",
-                "growth" => "a finite number above 1",
-                "initial_relative" => "a finite number above 0",
-                _ => "a number of at least 0",
-            };
-            return Err((last, format!("residual_gp.gp.{field} is {value}, expected {expected}")));
-        }
+        self.residual_gp.validate_fade().map_err(|e| e.in_file("residual_gp"))?;
+        self.residual_gp.validate_inputs()?;
+        self.residual_gp.gp.validate().map_err(|error| match error {
+            gp::Error::InvalidOption { field, value, expected } => {
+                OptionOutOfRange::new(field, value, expected).in_file("residual_gp.gp")
+            }
+            other => ("gp", format!("residual_gp.gp: {other}")),
+        })?;
         self.effects.gear.validate().map_err(|e| e.in_file("effects.gear"))?;
         let hold = self.effects.hold_beyond_span;
         let accepted = hold.is_finite() && hold >= 0.0;
@@ -207,8 +206,8 @@ impl FitOptions {
         let accepted = !ratio.is_nan() && ratio >= 1.0;
         OptionOutOfRange::check("fallback_sigma_ratio", ratio, accepted, "a number of at least 1 (inf for never)")
             .map_err(|e| e.in_file("effects"))?;
-        self.plausibility.validate()?;
-        self.nominal_prior.validate()?;
+        self.plausibility.validate().map_err(|e| e.in_file("plausibility"))?;
+        self.nominal_prior.validate().map_err(|e| e.in_file("nominal_prior"))?;
         self.heldout.validate().map_err(|e| e.in_file("heldout"))?;
         let prior = self.effects.prior_sigma;
         OptionOutOfRange::check(
@@ -347,10 +346,47 @@ mod tests {
         assert_eq!(options.residual_gp.fade_above_variance_ratio, Some(0.25));
         let options = FitOptions::parse("(residual_gp: (fade_above_variance_ratio: None))", "fit.ron").unwrap();
         assert_eq!(options.residual_gp.fade_above_variance_ratio, None);
-        for bad in ["1.0", "-0.1", "NaN"] {
+        for (bad, shown) in [("1.0", "1"), ("-0.1", "-0.1"), ("NaN", "NaN")] {
             let text = format!("(residual_gp: (\n  fade_above_variance_ratio: Some({bad})))");
             let message = FitOptions::parse(&text, "fit.ron").unwrap_err().to_string();
-            assert!(message.contains("fit.ron:2:3") && message.contains("fade_above_variance_ratio is"), "{message}");
+            let expected = format!(
+                "fit.ron:2:3: residual_gp.fade_above_variance_ratio is {shown}, expected a number in [0, 1) or None"
+            );
+            assert_eq!(message, expected);
+        }
+        let rows = ResidualGpOptions { fade_share_rows: 0, ..ResidualGpOptions::default() };
+        let refused = rows.validate_fade().unwrap_err();
+        assert_eq!(refused.to_string(), "option fade_share_rows = 0: expected at least 1");
+        let text = "(residual_gp: (\n  fade_share_rows: 0))";
+        let message = FitOptions::parse(text, "fit.ron").unwrap_err().to_string();
+        assert_eq!(message, "fit.ron:2:3: residual_gp.fade_share_rows is 0, expected at least 1");
+    }
+
+    /// poe's and gp's refusals of an option carry field, value and range over whole, placed at
+    /// the field's last part in the file (`huber_threshold:` for `robust.huber_threshold`).
+    #[test]
+    fn a_refusal_of_an_identification_or_gp_option_names_its_field_value_and_range_at_its_place() {
+        let cases = [
+            ("(identification: (\n  rcond: 2.0))", "fit.ron:2:3: identification.rcond is 2, expected below 1"),
+            (
+                "(identification: (robust: (\n    huber_threshold: -1.0)))",
+                "fit.ron:2:5: identification.robust.huber_threshold is -1, expected a finite number above 0",
+            ),
+            (
+                "(residual_gp: (gp: (optimiser: (\n    memory: 0))))",
+                "fit.ron:2:5: residual_gp.gp.optimiser.memory is 0, expected at least 1",
+            ),
+            (
+                "(residual_gp: (gp: (jitter: (\n    initial_relative: 0.0))))",
+                "fit.ron:2:5: residual_gp.gp.jitter.initial_relative is 0, expected a finite number above 0",
+            ),
+            (
+                "(residual_gp: (gp: (jitter: (\n    growth: 1.0))))",
+                "fit.ron:2:5: residual_gp.gp.jitter.growth is 1, expected a finite number above 1",
+            ),
+        ];
+        for (text, expected) in cases {
+            assert_eq!(FitOptions::parse(text, "fit.ron").unwrap_err().to_string(), expected, "{text}");
         }
     }
 

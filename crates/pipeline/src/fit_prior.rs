@@ -11,7 +11,7 @@
 //! say how it does on another, and the held-out clusters say how strongly to hold it.
 
 use crate::clusters::{self, BranchJoint, Cluster, HeightSplit, ScanOptions};
-use errors::Error;
+use errors::{Error, OptionOutOfRange, OptionValue, option};
 use measurements::MeasurementSet;
 use model::geometric::observations;
 use poe::LocalPoe;
@@ -97,69 +97,30 @@ impl Default for NominalPriorOptions {
 }
 
 impl NominalPriorOptions {
-    /// Checks every value once: the field's name and what was expected.
-    pub fn validate(&self) -> Result<(), (&'static str, String)> {
-        if self.translations_m.is_empty() || self.translations_m.iter().any(|t| t.is_nan() || *t <= 0.0) {
-            return Err((
-                "translations_m",
-                format!(
-                    "nominal_prior.translations_m is {:?}, expected at least one number above 0 (inf for no prior)",
-                    self.translations_m
-                ),
-            ));
-        }
-        let checks: [(&'static str, f64, bool, &str); 6] = [
-            (
-                "tolerance_translation_m",
-                self.tolerance_translation_m,
-                self.tolerance_translation_m.is_finite() && self.tolerance_translation_m > 0.0,
-                "a finite number above 0",
-            ),
-            (
-                "tolerance_rotation_rad",
-                self.tolerance_rotation_rad,
-                self.tolerance_rotation_rad.is_finite() && self.tolerance_rotation_rad > 0.0,
-                "a finite number above 0",
-            ),
-            (
-                "min_height_span_m",
-                self.min_height_span_m,
-                self.min_height_span_m.is_finite() && self.min_height_span_m > 0.0,
-                "a finite number above 0",
-            ),
-            ("length_m", self.length_m, self.length_m.is_finite() && self.length_m > 0.0, "a finite number above 0"),
-            (
-                "min_cluster_share",
-                self.min_cluster_share,
-                self.min_cluster_share > 0.0 && self.min_cluster_share <= 0.5,
-                "a number above 0 and at most 0.5",
-            ),
-            (
-                "scan_tolerance_rad",
-                self.scan_tolerance_rad,
-                self.scan_tolerance_rad.is_finite() && self.scan_tolerance_rad > 0.0,
-                "a finite number above 0",
-            ),
-        ];
-        for (name, value, ok, expected) in checks {
-            if !ok {
-                return Err((name, format!("nominal_prior.{name} is {value}, expected {expected}")));
-            }
-        }
-        if self.scan_steps < 8 {
-            return Err((
-                "scan_steps",
-                format!("nominal_prior.scan_steps is {}, expected at least 8", self.scan_steps),
-            ));
-        }
-        if self.max_rows == 0 {
-            return Err(("max_rows", "nominal_prior.max_rows is 0, expected at least 1".into()));
-        }
-        if self.scan_probes < 2 {
-            let probes = self.scan_probes;
-            return Err(("scan_probes", format!("nominal_prior.scan_probes is {probes}, expected at least 2")));
-        }
-        Ok(())
+    /// Checks every value once: the field at fault, its value and what is expected.
+    pub fn validate(&self) -> Result<(), OptionOutOfRange> {
+        let translations = &self.translations_m;
+        OptionOutOfRange::check(
+            "translations_m",
+            OptionValue::Shown(format!("{translations:?}")),
+            !translations.is_empty() && translations.iter().all(|t| !t.is_nan() && *t > 0.0),
+            "at least one number above 0 (inf for no prior)",
+        )?;
+        option::above("tolerance_translation_m", self.tolerance_translation_m, 0.0)?;
+        option::above("tolerance_rotation_rad", self.tolerance_rotation_rad, 0.0)?;
+        option::above("min_height_span_m", self.min_height_span_m, 0.0)?;
+        option::above("length_m", self.length_m, 0.0)?;
+        let share = self.min_cluster_share;
+        OptionOutOfRange::check(
+            "min_cluster_share",
+            share,
+            share > 0.0 && share <= 0.5,
+            "a number above 0 and at most 0.5",
+        )?;
+        option::above("scan_tolerance_rad", self.scan_tolerance_rad, 0.0)?;
+        option::count_at_least("scan_steps", self.scan_steps, 8)?;
+        option::at_least_one("max_rows", self.max_rows)?;
+        option::count_at_least("scan_probes", self.scan_probes, 2)
     }
 }
 
@@ -360,16 +321,7 @@ pub fn choose(
     identification: &IdentificationOptions,
     prior: &NominalPriorOptions,
 ) -> Result<PriorChoice, Error> {
-    if !prior.choose {
-        return Ok(PriorChoice::without(Vec::new(), Vec::new(), prior, "switched off (nominal_prior.choose)".into()));
-    }
-    if data.rows.len() > prior.max_rows {
-        let reason = format!(
-            "{} rows, more than nominal_prior.max_rows = {}: the fit as without a prior (the prior costs a plain \
-             fit more, and a fit per candidate and cluster)",
-            data.rows.len(),
-            prior.max_rows
-        );
+    if let Some(reason) = skipped(data, prior) {
         return Ok(PriorChoice::without(Vec::new(), Vec::new(), prior, reason));
     }
     let base = Posterior::new(nominal, data, identification, prior)?;
@@ -387,12 +339,7 @@ pub fn choose(
         return Ok(base.without(reason, prior));
     }
     let splits = cluster_splits(&folds, data);
-    // The posterior first (the weakest, which the one-standard-error rule prefers), then the
-    // stronger candidates.
-    let posterior = base.posterior;
-    let stronger = prior.translations_m.iter().filter(|&&t| t.is_finite() && t < posterior.0);
-    let sigmas: Vec<Option<(f64, f64)>> =
-        std::iter::once(Some(posterior)).chain(stronger.map(|&t| Some((t, t / prior.length_m)))).collect();
+    let sigmas = candidate_sigmas(base.posterior, prior);
     let (usable, rows) = held_out_rows(nominal, &splits, &sigmas, identification);
     if usable.is_empty() {
         let reason =
@@ -401,28 +348,30 @@ pub fn choose(
                 .to_owned();
         return Ok(base.without(reason, prior));
     }
-    let (candidates, chosen) = one_standard_error(&sigmas, &rows);
     let held_out: Vec<String> = usable.iter().map(|&s| splits[s].0.clone()).collect();
-    let reason = format!(
-        "{}; {} configuration clusters held out in turn: held-out RMS {:.4} mm, {:.4} mm at the tolerance",
-        base.tolerance,
-        held_out.len(),
-        candidates[chosen].heldout_rms_position_mm,
-        candidates[0].heldout_rms_position_mm
-    );
-    Ok(PriorChoice {
-        branch_joints: base.branch_joints,
-        height_splits: base.height_splits,
-        clusters: base.found,
-        tolerance: (prior.tolerance_translation_m, prior.tolerance_rotation_rad),
-        residual_scale: Some(base.scale),
-        held_out,
-        translation_m: candidates[chosen].translation_m,
-        rotation_rad: candidates[chosen].rotation_rad,
-        candidates,
-        reason,
-        with_effects: None,
+    Ok(base.held_out_choice(held_out, &sigmas, &rows, prior))
+}
+
+/// Why the fit has no prior without looking at the data's clusters: switched off, or too many rows.
+fn skipped(data: &MeasurementSet, prior: &NominalPriorOptions) -> Option<String> {
+    if !prior.choose {
+        return Some("switched off (nominal_prior.choose)".into());
+    }
+    (data.rows.len() > prior.max_rows).then(|| {
+        format!(
+            "{} rows, more than nominal_prior.max_rows = {}: the fit as without a prior (the prior costs a plain \
+             fit more, and a fit per candidate and cluster)",
+            data.rows.len(),
+            prior.max_rows
+        )
     })
+}
+
+/// The candidates held out: the posterior first (the weakest, which the one-standard-error rule
+/// prefers), then the stronger of `translations_m`.
+fn candidate_sigmas(posterior: (f64, f64), prior: &NominalPriorOptions) -> Vec<Option<(f64, f64)>> {
+    let stronger = prior.translations_m.iter().filter(|&&t| t.is_finite() && t < posterior.0);
+    std::iter::once(Some(posterior)).chain(stronger.map(|&t| Some((t, t / prior.length_m)))).collect()
 }
 
 /// The data's configuration clusters and the posterior of the nominal's tolerance, what every
@@ -468,6 +417,39 @@ impl Posterior {
             prior.tolerance_rotation_rad * 1e3
         );
         Ok(Self { branch_joints, height_splits, found, scale, posterior, tolerance })
+    }
+
+    /// The choice among the candidates (`sigmas`) by their rows held out in the clusters
+    /// `held_out` (per candidate, every row's criterion and squared error): the one-standard-error
+    /// rule's.
+    fn held_out_choice(
+        self,
+        held_out: Vec<String>,
+        sigmas: &[Option<(f64, f64)>],
+        rows: &[Vec<(f64, f64)>],
+        prior: &NominalPriorOptions,
+    ) -> PriorChoice {
+        let (candidates, chosen) = one_standard_error(sigmas, rows);
+        let reason = format!(
+            "{}; {} configuration clusters held out in turn: held-out RMS {:.4} mm, {:.4} mm at the tolerance",
+            self.tolerance,
+            held_out.len(),
+            candidates[chosen].heldout_rms_position_mm,
+            candidates[0].heldout_rms_position_mm
+        );
+        PriorChoice {
+            branch_joints: self.branch_joints,
+            height_splits: self.height_splits,
+            clusters: self.found,
+            tolerance: (prior.tolerance_translation_m, prior.tolerance_rotation_rad),
+            residual_scale: Some(self.scale),
+            held_out,
+            translation_m: candidates[chosen].translation_m,
+            rotation_rad: candidates[chosen].rotation_rad,
+            candidates,
+            reason,
+            with_effects: None,
+        }
     }
 
     /// The fit under the posterior, for `reason`: nothing held out chose otherwise.
@@ -575,6 +557,61 @@ fn one_standard_error(sigmas: &[Option<(f64, f64)>], rows: &[Vec<(f64, f64)>]) -
 #[cfg(test)]
 mod tests {
     use super::{NominalPriorOptions, PriorChoice};
+
+    #[test]
+    fn the_default_options_validate_and_a_bad_value_is_refused_with_its_field_value_and_range() {
+        assert_eq!(NominalPriorOptions::default().validate(), Ok(()));
+        let cases = [
+            (
+                NominalPriorOptions { translations_m: vec![], ..Default::default() },
+                "translations_m is [], expected at least one number above 0 (inf for no prior)",
+            ),
+            (
+                NominalPriorOptions { translations_m: vec![1e-3, 0.0], ..Default::default() },
+                "translations_m is [0.001, 0.0], expected at least one number above 0 (inf for no prior)",
+            ),
+            (
+                NominalPriorOptions { tolerance_translation_m: 0.0, ..Default::default() },
+                "tolerance_translation_m is 0, expected a finite number above 0",
+            ),
+            (
+                NominalPriorOptions { tolerance_rotation_rad: f64::INFINITY, ..Default::default() },
+                "tolerance_rotation_rad is inf, expected a finite number above 0",
+            ),
+            (
+                NominalPriorOptions { min_height_span_m: -1.0, ..Default::default() },
+                "min_height_span_m is -1, expected a finite number above 0",
+            ),
+            (
+                NominalPriorOptions { length_m: f64::NAN, ..Default::default() },
+                "length_m is NaN, expected a finite number above 0",
+            ),
+            (
+                NominalPriorOptions { min_cluster_share: 0.6, ..Default::default() },
+                "min_cluster_share is 0.6, expected a number above 0 and at most 0.5",
+            ),
+            (
+                NominalPriorOptions { scan_tolerance_rad: 0.0, ..Default::default() },
+                "scan_tolerance_rad is 0, expected a finite number above 0",
+            ),
+            (NominalPriorOptions { scan_steps: 7, ..Default::default() }, "scan_steps is 7, expected at least 8"),
+            (NominalPriorOptions { max_rows: 0, ..Default::default() }, "max_rows is 0, expected at least 1"),
+            (NominalPriorOptions { scan_probes: 1, ..Default::default() }, "scan_probes is 1, expected at least 2"),
+        ];
+        for (options, message) in cases {
+            let (field, text) = options.validate().unwrap_err().in_file("nominal_prior");
+            assert_eq!(text, format!("nominal_prior.{message}"));
+            assert!(message.starts_with(field), "{field}: {message}");
+        }
+        let at_limits = NominalPriorOptions {
+            min_cluster_share: 0.5,
+            scan_steps: 8,
+            scan_probes: 2,
+            max_rows: 1,
+            ..Default::default()
+        };
+        assert_eq!(at_limits.validate(), Ok(()));
+    }
 
     fn posterior(scale: f64) -> PriorChoice {
         let prior = NominalPriorOptions::default();

@@ -12,7 +12,7 @@
 //! ball). The two steps alternate; each lowers the sum of squares.
 
 use crate::ErrorKind;
-use errors::Error;
+use errors::{Error, OptionOutOfRange, OptionValue, option};
 use lie::{Matrix3, Vector3};
 use measurements::{BoundSet, MeasurementSet};
 use poe::JointKind;
@@ -95,42 +95,26 @@ impl Default for PlausibilityOptions {
 }
 
 impl PlausibilityOptions {
-    /// Checks every value once: the field at fault and what is expected.
-    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+    /// Checks every value once: the field at fault, its value and what is expected.
+    pub fn validate(&self) -> Result<(), OptionOutOfRange> {
         let (lo, hi) = self.scale_band;
-        if !(lo.is_finite() && hi.is_finite() && 0.0 < lo && lo <= 1.0 && hi >= 1.0) {
-            return Err((
-                "scale_band",
-                format!("plausibility.scale_band is ({lo}, {hi}), expected 0 < low ≤ 1 ≤ high"),
-            ));
-        }
-        // (field, value, lowest accepted, whether the lowest itself is accepted)
-        let bounded = [
-            ("unit_factor_tolerance", self.unit_factor_tolerance, 1.0, false),
-            ("reflection_ratio", self.reflection_ratio, 0.0, false),
-            ("max_tool_offset_m", self.max_tool_offset_m, 0.0, false),
-            ("limit_margin_rad", self.limit_margin_rad, 0.0, true),
-            ("limit_margin_m", self.limit_margin_m, 0.0, true),
-            ("planar_ratio", self.planar_ratio, 0.0, false),
-            ("wrong_minimum_ratio", self.wrong_minimum_ratio, 1.0, true),
-        ];
-        for (field, value, lowest, inclusive) in bounded {
-            if !(value.is_finite() && (value > lowest || (inclusive && value == lowest))) {
-                let expected = if inclusive { "of at least" } else { "above" };
-                return Err((
-                    field,
-                    format!("plausibility.{field} is {value}, expected a finite number {expected} {lowest}"),
-                ));
-            }
-        }
-        if self.reflection_ratio > 1.0 {
-            let value = self.reflection_ratio;
-            return Err(("reflection_ratio", format!("plausibility.reflection_ratio is {value}, expected at most 1")));
-        }
-        if self.max_iterations == 0 {
-            return Err(("max_iterations", "plausibility.max_iterations is 0, expected at least 1".into()));
-        }
-        Ok(())
+        let accepted = lo.is_finite() && hi.is_finite() && 0.0 < lo && lo <= 1.0 && hi >= 1.0;
+        OptionOutOfRange::check(
+            "scale_band",
+            OptionValue::Shown(format!("({lo}, {hi})")),
+            accepted,
+            "0 < low ≤ 1 ≤ high",
+        )?;
+        option::above("unit_factor_tolerance", self.unit_factor_tolerance, 1.0)?;
+        option::above("reflection_ratio", self.reflection_ratio, 0.0)?;
+        option::above("max_tool_offset_m", self.max_tool_offset_m, 0.0)?;
+        option::at_least("limit_margin_rad", self.limit_margin_rad, 0.0)?;
+        option::at_least("limit_margin_m", self.limit_margin_m, 0.0)?;
+        option::above("planar_ratio", self.planar_ratio, 0.0)?;
+        option::at_least("wrong_minimum_ratio", self.wrong_minimum_ratio, 1.0)?;
+        let ratio = self.reflection_ratio;
+        OptionOutOfRange::check("reflection_ratio", ratio, ratio <= 1.0, "at most 1")?;
+        option::at_least_one("max_iterations", self.max_iterations)
     }
 }
 
@@ -176,6 +160,24 @@ pub(crate) fn check(
     if data.rows.len() < 4 || !data.positions_measured {
         return Ok(Findings { report: None, refusals });
     }
+    let (start, flanges) = nominal_flanges(robot, data)?;
+    let measured: Vec<Vector3> = data.rows.iter().map(|r| r.position).collect();
+    // A planar chain's tool moves in a plane: data that leave every plane are another robot's,
+    // and fit it with the axes tilted to reach them (refused first: it explains the rest).
+    let planar = robot.planar_direction().map(|direction| (direction, out_of_plane(&measured)));
+    refusals.extend(planar.and_then(|planar| planar_refusal(robot, data, planar, &measured, options)));
+    let problem = Alignment::new(bound, &flanges, &measured, options);
+    let (report, rotation_rms, reflection_rms) = alignment_report(&problem, start, planar.map(|(_, d)| d));
+    refusals.extend(scale_or_handedness(data, &report, rotation_rms, reflection_rms, options));
+    Ok(Findings { report: Some(report), refusals })
+}
+
+/// The start of the fitted tool offset (the description's tool, where it has one) and, per row,
+/// the nominal model's flange at its joints: rotation and position.
+fn nominal_flanges(
+    robot: &RobotDescription,
+    data: &MeasurementSet,
+) -> Result<(Vector3, Vec<(Matrix3, Vector3)>), Error> {
     // The nominal model's flange: its tool, where the description has one, is only the start of
     // the fitted tool offset.
     let mut nominal = robot.nominal_model()?;
@@ -186,32 +188,45 @@ pub(crate) fn check(
         let pose = nominal.forward(&row.q, 0).map_err(Error::kinematics)?;
         flanges.push((pose.rotation().matrix(), pose.translation()));
     }
-    let measured: Vec<Vector3> = data.rows.iter().map(|r| r.position).collect();
-    // A planar chain's tool moves in a plane: data that leave every plane are another robot's,
-    // and fit it with the axes tilted to reach them (refused first: it explains the rest).
-    let planar = robot.planar_direction().map(|direction| (direction, out_of_plane(&measured)));
-    if let Some((direction, out_of_plane)) = planar {
-        let spread = spread(&measured);
-        if out_of_plane > options.planar_ratio * spread {
-            refusals.push(Error::in_file(
-                data.source.clone(),
-                ErrorKind::PlanarChainData {
-                    robot: robot.name.clone(),
-                    direction,
-                    joints: robot.joint_count(),
-                    out_of_plane_mm: out_of_plane * 1e3,
-                    spread_mm: spread * 1e3,
-                    ratio: options.planar_ratio,
-                },
-            ));
-        }
-    }
-    let tools = bound.tools();
-    let tool_count = data.tools.len().max(1 + tools.iter().copied().max().unwrap_or(0));
-    let problem = Alignment { flanges: &flanges, tools, measured: &measured, tool_count, options };
+    Ok((start, flanges))
+}
+
+/// A planar chain's refusal of data further from their best plane (`out_of_plane`, m, with the
+/// chain's axis `direction`) than `planar_ratio` of their spread.
+fn planar_refusal(
+    robot: &RobotDescription,
+    data: &MeasurementSet,
+    (direction, out_of_plane): ([f64; 3], f64),
+    measured: &[Vector3],
+    options: &PlausibilityOptions,
+) -> Option<Error> {
+    let spread = spread(measured);
+    (out_of_plane > options.planar_ratio * spread).then(|| {
+        Error::in_file(
+            data.source.clone(),
+            ErrorKind::PlanarChainData {
+                robot: robot.name.clone(),
+                direction,
+                joints: robot.joint_count(),
+                out_of_plane_mm: out_of_plane * 1e3,
+                spread_mm: spread * 1e3,
+                ratio: options.planar_ratio,
+            },
+        )
+    })
+}
+
+/// The best rotation and the best reflection of the nominal tool points onto the measured
+/// points: the report (`out_of_plane`: a planar chain's distance of the data from their plane,
+/// m), and the RMS residual of each, m.
+fn alignment_report(
+    problem: &Alignment<'_>,
+    start: Vector3,
+    out_of_plane: Option<f64>,
+) -> (PlausibilityReport, f64, f64) {
     let rotation = problem.fit(start, 1.0);
     let reflection = problem.fit(start, -1.0);
-    let measured_spread = spread(&measured);
+    let measured_spread = spread(problem.measured);
     let robot_spread = spread(&rotation.points);
     let scale_ratio = (measured_spread > 0.0 && robot_spread > 0.0).then(|| measured_spread / robot_spread);
     let report = PlausibilityReport {
@@ -220,14 +235,27 @@ pub(crate) fn check(
         scale_ratio,
         rotation_rms_mm: rotation.rms * 1e3,
         reflection_rms_mm: reflection.rms * 1e3,
-        out_of_plane_mm: planar.map(|(_, distance)| distance * 1e3),
+        out_of_plane_mm: out_of_plane.map(|distance| distance * 1e3),
     };
+    (report, rotation.rms, reflection.rms)
+}
+
+/// The refusal of a spread ratio outside `scale_band` (a unit mistake, named where it is near
+/// one's factor) or, only where the scale is right, of data a reflection fits far better than a
+/// rotation (a left-handed frame).
+fn scale_or_handedness(
+    data: &MeasurementSet,
+    report: &PlausibilityReport,
+    rotation_rms: f64,
+    reflection_rms: f64,
+    options: &PlausibilityOptions,
+) -> Option<Error> {
     let (lo, hi) = options.scale_band;
-    if let Some(ratio) = scale_ratio
+    if let Some(ratio) = report.scale_ratio
         && !(lo..=hi).contains(&ratio)
     {
         let column_unit = data.position_unit.unwrap_or("mm");
-        refusals.push(Error::in_file(
+        Some(Error::in_file(
             data.source.clone(),
             ErrorKind::PositionScale {
                 measured_spread_mm: report.measured_spread_mm,
@@ -237,19 +265,20 @@ pub(crate) fn check(
                 likely_unit: likely_unit(ratio, column_unit, options.unit_factor_tolerance),
                 band: options.scale_band,
             },
-        ));
-    } else if rotation.rms > 0.0 && reflection.rms < options.reflection_ratio * rotation.rms {
+        ))
+    } else if rotation_rms > 0.0 && reflection_rms < options.reflection_ratio * rotation_rms {
         // Only where the scale is right: a scaled point cloud fits neither, and says nothing.
-        refusals.push(Error::in_file(
+        Some(Error::in_file(
             data.source.clone(),
             ErrorKind::LeftHandedFrame {
                 rotation_rms_mm: report.rotation_rms_mm,
                 reflection_rms_mm: report.reflection_rms_mm,
                 reflection_ratio: options.reflection_ratio,
             },
-        ));
+        ))
+    } else {
+        None
     }
-    Ok(Findings { report: Some(report), refusals })
 }
 
 /// The first joint value beyond its limits by more than the margin, in file order.
@@ -336,7 +365,20 @@ struct Aligned {
     rms: f64,
 }
 
-impl Alignment<'_> {
+impl<'a> Alignment<'a> {
+    /// The alignment of `bound`'s rows: their nominal flanges, their tools (one per tool of the
+    /// data, or per index the rows use, whichever is more) and their measured positions.
+    fn new(
+        bound: &'a BoundSet<'_>,
+        flanges: &'a [(Matrix3, Vector3)],
+        measured: &'a [Vector3],
+        options: &'a PlausibilityOptions,
+    ) -> Self {
+        let tools = bound.tools();
+        let tool_count = bound.set().tools.len().max(1 + tools.iter().copied().max().unwrap_or(0));
+        Self { flanges, tools, measured, tool_count, options }
+    }
+
     /// The best alignment with `det R = determinant` (1 a rotation, −1 a reflection), every tool
     /// started at `start`.
     fn fit(&self, start: Vector3, determinant: f64) -> Aligned {
@@ -434,9 +476,63 @@ mod tests {
     }
 
     #[test]
-    fn the_default_options_validate_and_a_band_without_one_is_refused() {
+    fn the_default_options_validate_and_a_bad_value_is_refused_with_its_field_value_and_range() {
         assert_eq!(PlausibilityOptions::default().validate(), Ok(()));
-        let options = PlausibilityOptions { scale_band: (1.1, 1.3), ..PlausibilityOptions::default() };
-        assert_eq!(options.validate().unwrap_err().0, "scale_band");
+        let refused = |options: PlausibilityOptions| options.validate().unwrap_err().in_file("plausibility");
+        let band = refused(PlausibilityOptions { scale_band: (1.1, 1.3), ..PlausibilityOptions::default() });
+        assert_eq!(band, ("scale_band", "plausibility.scale_band is (1.1, 1.3), expected 0 < low ≤ 1 ≤ high".into()));
+        let cases = [
+            (
+                PlausibilityOptions { unit_factor_tolerance: 1.0, ..Default::default() },
+                "unit_factor_tolerance is 1, expected a finite number above 1",
+            ),
+            (
+                PlausibilityOptions { reflection_ratio: 0.0, ..Default::default() },
+                "reflection_ratio is 0, expected a finite number above 0",
+            ),
+            (
+                PlausibilityOptions { reflection_ratio: 2.0, ..Default::default() },
+                "reflection_ratio is 2, expected at most 1",
+            ),
+            (
+                PlausibilityOptions { max_tool_offset_m: f64::INFINITY, ..Default::default() },
+                "max_tool_offset_m is inf, expected a finite number above 0",
+            ),
+            (
+                PlausibilityOptions { limit_margin_rad: -0.1, ..Default::default() },
+                "limit_margin_rad is -0.1, expected a finite number of at least 0",
+            ),
+            (
+                PlausibilityOptions { limit_margin_m: f64::NAN, ..Default::default() },
+                "limit_margin_m is NaN, expected a finite number of at least 0",
+            ),
+            (
+                PlausibilityOptions { planar_ratio: 0.0, ..Default::default() },
+                "planar_ratio is 0, expected a finite number above 0",
+            ),
+            (
+                PlausibilityOptions { wrong_minimum_ratio: 0.5, ..Default::default() },
+                "wrong_minimum_ratio is 0.5, expected a finite number of at least 1",
+            ),
+            (
+                PlausibilityOptions { max_iterations: 0, ..Default::default() },
+                "max_iterations is 0, expected at least 1",
+            ),
+        ];
+        for (options, message) in cases {
+            let (field, text) = refused(options);
+            assert_eq!(text, format!("plausibility.{message}"));
+            assert!(message.starts_with(field), "{field}: {message}");
+        }
+        // Limits themselves are accepted where the range includes them.
+        let at_limits = PlausibilityOptions {
+            limit_margin_rad: 0.0,
+            limit_margin_m: 0.0,
+            wrong_minimum_ratio: 1.0,
+            reflection_ratio: 1.0,
+            scale_band: (1.0, 1.0),
+            ..Default::default()
+        };
+        assert_eq!(at_limits.validate(), Ok(()));
     }
 }

@@ -82,13 +82,16 @@ fn a_moving_joint_the_robot_lacks_and_a_fixed_value_outside_the_range_are_refuse
     let (cell, ranges) = iiwa_cell_with_tools(4);
     let config = GeneratorConfig { moving_joints: vec![1, 7], ..two_joint_runs() };
     let refused = generate(&cell, &Effects::default(), &ranges, &config).unwrap_err();
-    assert_eq!(refused, Error::UnknownJoint { field: "moving_joints", joint_index: 7, joint_count: 7 });
+    assert_eq!(
+        refused,
+        Error::from(dynamics::Error::UnknownJoint { field: "moving_joints", joint_index: 7, joint_count: 7 })
+    );
     let config = GeneratorConfig { fixed_at_rad: vec![0.0, 0.0, 4.0, 0.0, 0.0, 0.0, 0.0], ..two_joint_runs() };
     let refused = generate(&cell, &Effects::default(), &ranges, &config).unwrap_err();
-    assert_eq!(refused, Error::InvalidParameter { field: "fixed_at_rad", value: 4.0 });
+    assert_eq!(refused, Error::from(dynamics::Error::InvalidParameter { field: "fixed_at_rad", value: 4.0 }));
     let config = GeneratorConfig { fixed_jitter_rad: -1e-3, ..two_joint_runs() };
     let refused = generate(&cell, &Effects::default(), &ranges, &config).unwrap_err();
-    assert_eq!(refused, Error::InvalidParameter { field: "fixed_jitter_rad", value: -1e-3 });
+    assert_eq!(refused, Error::from(dynamics::Error::InvalidParameter { field: "fixed_jitter_rad", value: -1e-3 }));
 }
 
 #[test]
@@ -133,7 +136,10 @@ fn torques_need_dynamics_and_a_valid_sensor() {
         ..two_joint_runs()
     };
     let refused = generate(&cell, &Effects::default(), &ranges, &bad).unwrap_err();
-    assert_eq!(refused, Error::LengthMismatch { field: "torque_sensor.joint_sigma_nm", given: 6, expected: 7 });
+    assert_eq!(
+        refused,
+        Error::from(dynamics::Error::LengthMismatch { field: "torque_sensor.joint_sigma_nm", given: 6, expected: 7 })
+    );
     cell.dynamics = None;
     let config = GeneratorConfig { torque_sensor: Some(TorqueSensorNoise::default()), ..two_joint_runs() };
     let refused = generate(&cell, &Effects::default(), &ranges, &config).unwrap_err();

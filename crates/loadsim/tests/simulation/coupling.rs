@@ -58,13 +58,23 @@ fn bad_coupling_settings_are_refused() {
     outside.terms[0].factors[0].source_joint_index = 6;
     assert_eq!(
         outside.validate(n),
-        Err(Error::UnknownJoint { field: "coupling.source_joint_index", joint_index: 6, joint_count: 6 })
+        Err(Error::from(dynamics::Error::UnknownJoint {
+            field: "coupling.source_joint_index",
+            joint_index: 6,
+            joint_count: 6
+        }))
     );
     let mut empty = joint3_by_q2_q4(1e-3);
     empty.terms[0].factors.clear();
-    assert_eq!(empty.validate(n), Err(Error::LengthMismatch { field: "coupling.factors", given: 0, expected: 1 }));
+    assert_eq!(
+        empty.validate(n),
+        Err(Error::from(dynamics::Error::LengthMismatch { field: "coupling.factors", given: 0, expected: 1 }))
+    );
     let not_a_number = joint3_by_q2_q4(f64::NAN);
-    assert!(matches!(not_a_number.validate(n), Err(Error::InvalidParameter { field: "coupling.amplitude_rad", .. })));
+    assert!(matches!(
+        not_a_number.validate(n),
+        Err(Error::Dynamics { source: dynamics::Error::InvalidParameter { field: "coupling.amplitude_rad", .. } })
+    ));
     let cell = SimulatedCell::new(irb4400().model, None);
     let effects = Effects { coupling: Some(own), ..Effects::default() };
     assert_eq!(

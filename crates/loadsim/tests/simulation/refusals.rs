@@ -12,7 +12,7 @@ fn dynamics_with_the_wrong_link_count_is_refused() {
     let mut dynamics = robot.dynamics.clone();
     dynamics.links.pop();
     let refused = gravity_torque(&robot.model, &dynamics, &[0.0; 6], 0, &Payload::default()).unwrap_err();
-    assert_eq!(refused, Error::LengthMismatch { field: "links", given: 5, expected: 6 });
+    assert_eq!(refused, Error::from(dynamics::Error::LengthMismatch { field: "links", given: 5, expected: 6 }));
 }
 
 #[test]
@@ -20,14 +20,14 @@ fn non_positive_stiffness_is_refused() {
     let robot = irb4400();
     let dynamics = massless(vec![1e6, 1e6, -3.0, 1e5, 1e5, 1e5]);
     let refused = gravity_torque(&robot.model, &dynamics, &[0.0; 6], 0, &Payload::default()).unwrap_err();
-    assert_eq!(refused, Error::InvalidParameter { field: "stiffness_nm_per_rad", value: -3.0 });
+    assert_eq!(refused, Error::from(dynamics::Error::InvalidParameter { field: "stiffness_nm_per_rad", value: -3.0 }));
 }
 
 #[test]
 fn negative_payload_is_refused() {
     let robot = irb4400();
     let refused = gravity_torque(&robot.model, &robot.dynamics, &[0.0; 6], 0, &Payload::at_tool(-1.0)).unwrap_err();
-    assert_eq!(refused, Error::InvalidParameter { field: "payload_kg", value: -1.0 });
+    assert_eq!(refused, Error::from(dynamics::Error::InvalidParameter { field: "payload_kg", value: -1.0 }));
 }
 
 #[test]
@@ -38,7 +38,10 @@ fn backlash_on_a_joint_the_robot_lacks_is_refused() {
     backlash.joints[2].joint_index = 6;
     let effects = Effects { backlash: Some(backlash), ..Effects::default() };
     let refused = effects.true_pose(&cell, &[0.0; 6], &PoseContext::default()).unwrap_err();
-    assert_eq!(refused, Error::UnknownJoint { field: "backlash", joint_index: 6, joint_count: 6 });
+    assert_eq!(
+        refused,
+        Error::from(dynamics::Error::UnknownJoint { field: "backlash", joint_index: 6, joint_count: 6 })
+    );
 }
 
 #[test]
@@ -57,7 +60,7 @@ fn compliance_on_masses_without_stiffness_is_refused_and_what_needs_masses_alone
     let effects = Effects { compliance: Some(JointComplianceModel::default()), ..Effects::default() };
     let q = [0.1, 0.3, -0.2, 0.0, 0.4, 0.0];
     let refused = effects.true_pose(&cell, &q, &PoseContext::default()).unwrap_err();
-    assert_eq!(refused, Error::MissingStiffness { effect: "joint compliance" });
+    assert_eq!(refused, Error::from(dynamics::Error::MissingStiffness { effect: "joint compliance" }));
     assert!(refused.to_string().contains("stiffness_nm_per_rad"), "{refused}");
     let backlash = Effects { backlash: Some(BacklashModel::uniform(6, 1e-4)), ..Effects::default() };
     let moved = backlash.true_pose(&cell, &q, &PoseContext::default()).unwrap();
@@ -78,7 +81,10 @@ fn thermal_coefficients_of_the_wrong_length_are_refused() {
     let thermal = ThermalModel { link_expansion_per_k: vec![1e-5; 6], ..Default::default() };
     let effects = Effects { thermal: Some(thermal), ..Effects::default() };
     let refused = effects.true_pose(&cell, &[0.0; 6], &PoseContext::default()).unwrap_err();
-    assert_eq!(refused, Error::LengthMismatch { field: "thermal.link_expansion_per_k", given: 6, expected: 7 });
+    assert_eq!(
+        refused,
+        Error::from(dynamics::Error::LengthMismatch { field: "thermal.link_expansion_per_k", given: 6, expected: 7 })
+    );
 }
 
 #[test]
@@ -91,11 +97,14 @@ fn a_balancer_whose_spring_can_reach_zero_length_is_refused() {
         force_at_zero_n: 0.0,
         stiffness_n_per_m: 1e4,
     };
-    assert!(matches!(balancer.validate(6).map_err(Error::from), Err(Error::InvalidParameter { .. })));
+    assert!(matches!(
+        balancer.validate(6).map_err(Error::from),
+        Err(Error::Dynamics { source: dynamics::Error::InvalidParameter { .. } })
+    ));
     let elsewhere = Counterbalance { joint_index: 6, anchor_radius_m: 0.3, ..balancer };
     assert_eq!(
         elsewhere.validate(6).map_err(Error::from),
-        Err(Error::UnknownJoint { field: "counterbalance", joint_index: 6, joint_count: 6 })
+        Err(Error::from(dynamics::Error::UnknownJoint { field: "counterbalance", joint_index: 6, joint_count: 6 }))
     );
 }
 
