@@ -18,40 +18,56 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         calib::flow::evaluate(&model, args.data.model_file(), data)?;
     if args.json.json {
         println!("{}", serde_json::to_string(&report)?);
-        eprintln!("{}", data.read_summary());
-        for joint in &report.wrapped {
-            eprintln!("note: {joint}");
-        }
-        if report.orientations_not_evaluated {
-            eprintln!("note: {}", model::ORIENTATIONS_NOT_EVALUATED);
-        }
-        if let Some(placement) = &report.other_placement {
-            eprintln!("warning: {}", placement_text(placement, args));
-        }
-        for warning in &report.warnings {
-            eprintln!("warning: {warning}");
-        }
-        for warning in &report.out_of_range {
-            eprintln!("warning: {warning}");
-        }
-        if let Some(predicted) = &report.geometry_sigma {
-            eprintln!("warning: {predicted}");
-        }
-        for warning in &report.beyond_joint_limits {
-            eprintln!("warning: {warning}");
-        }
-        if let Some(suspects) = &report.suspect_rows {
-            eprintln!("warning: {}", suspect_text(suspects));
-        }
-        if let Some(fallen) = &report.sigma_fallback {
-            eprintln!("warning: {fallen}");
-        }
-        if let Some(faded) = &report.gp_fade {
-            eprintln!("warning: {faded}");
-        }
+        print_json_notes(&data, &report, args);
         return Ok(());
     }
-    let s = &evaluation.summary;
+    print_text(&model, &data, &evaluation.summary, &report, args);
+    Ok(())
+}
+
+/// The notes and warnings of `--json`, on stderr beside the report on stdout.
+fn print_json_notes(data: &measurements::MeasurementSet, report: &model::EvalReport, args: &Args) {
+    eprintln!("{}", data.read_summary());
+    for joint in &report.wrapped {
+        eprintln!("note: {joint}");
+    }
+    if report.orientations_not_evaluated {
+        eprintln!("note: {}", model::ORIENTATIONS_NOT_EVALUATED);
+    }
+    if let Some(placement) = &report.other_placement {
+        eprintln!("warning: {}", placement_text(placement, args));
+    }
+    for warning in &report.warnings {
+        eprintln!("warning: {warning}");
+    }
+    for warning in &report.out_of_range {
+        eprintln!("warning: {warning}");
+    }
+    if let Some(predicted) = &report.geometry_sigma {
+        eprintln!("warning: {predicted}");
+    }
+    for warning in &report.beyond_joint_limits {
+        eprintln!("warning: {warning}");
+    }
+    if let Some(suspects) = &report.suspect_rows {
+        eprintln!("warning: {}", suspect_text(suspects));
+    }
+    if let Some(fallen) = &report.sigma_fallback {
+        eprintln!("warning: {fallen}");
+    }
+    if let Some(faded) = &report.gp_fade {
+        eprintln!("warning: {faded}");
+    }
+}
+
+/// The evaluation for a reader: the errors, then the notes and warnings.
+fn print_text(
+    model: &model::CalibratedModel,
+    data: &measurements::MeasurementSet,
+    s: &model::ErrorSummary,
+    report: &model::EvalReport,
+    args: &Args,
+) {
     println!("{}", data.read_summary());
     println!("{} model of {} on {} ({} rows)", model.method, model.robot, args.data.display(), s.n);
     println!(
@@ -98,7 +114,6 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(faded) = &report.gp_fade {
         println!("  warning: {faded}");
     }
-    Ok(())
 }
 
 /// The warning about another tracker placement, with this model's file in the command it names.
