@@ -118,6 +118,9 @@ fn plan_options(
     Ok((options, unmodelled))
 }
 
+/// The cells of --candidates and its delimiter, to write the chosen rows back unchanged.
+type FileCells = (measurements::Cells, u8);
+
 /// The candidates, from --candidates (with its cells and delimiter, to write the chosen rows back
 /// unchanged) or drawn within the joint limits; what was read or drawn goes to `notes`.
 fn candidates(
@@ -125,7 +128,7 @@ fn candidates(
     robot: &robot::RobotDescription,
     model: Option<&model::CalibratedModel>,
     notes: &mut Vec<String>,
-) -> Result<(planning::CandidateSet, Option<(measurements::Cells, u8)>), Box<dyn std::error::Error>> {
+) -> Result<(planning::CandidateSet, Option<FileCells>), Box<dyn std::error::Error>> {
     Ok(match &args.candidates {
         Some(path) => {
             let kinds = robot.nominal_model()?.joints().iter().map(|j| j.kind).collect();
