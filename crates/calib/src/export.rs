@@ -53,31 +53,41 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         Some(path) => Some(measurements::read_measurements(path, &model.read_options(Default::default()))?),
         None => None,
     };
-    let tolerance = NominalTolerance::default();
-    let export = match &args.like {
-        Some(like) => {
-            let document = UrdfDocument::read(like)?;
-            let chain = document.chain(&args.robot.ends())?;
-            cell::export_urdf(
-                &model,
-                UrdfTemplate::Like { document: &document, chain: &chain },
-                training.as_ref(),
-                &tolerance,
-            )?
-        }
-        // --robot, else the robot the model keeps, as compensate and report take it.
-        None => {
-            let nominal = args.robot.read_or_kept(&model, &args.model.model)?;
-            let nominal = nominal.as_ref().map(|(description, file)| (description, file.as_str()));
-            cell::export_urdf(&model, UrdfTemplate::Plain { nominal }, training.as_ref(), &tolerance)?
-        }
-    };
+    let export = export(args, &model, training.as_ref())?;
     cell::write_urdf(&args.urdf, &export)?;
     let report = &export.report;
     if args.json.json {
         println!("{}", serde_json::to_string(report)?);
         return Ok(());
     }
+    print_summary(args, report);
+    Ok(())
+}
+
+/// The export, written like --like's URDF, else as a URDF of our own on the nominal description.
+fn export(
+    args: &Args,
+    model: &model::CalibratedModel,
+    training: Option<&measurements::MeasurementSet>,
+) -> Result<cell::UrdfExport, Box<dyn std::error::Error>> {
+    let tolerance = NominalTolerance::default();
+    Ok(match &args.like {
+        Some(like) => {
+            let document = UrdfDocument::read(like)?;
+            let chain = document.chain(&args.robot.ends())?;
+            cell::export_urdf(model, UrdfTemplate::Like { document: &document, chain: &chain }, training, &tolerance)?
+        }
+        // --robot, else the robot the model keeps, as compensate and report take it.
+        None => {
+            let nominal = args.robot.read_or_kept(model, &args.model.model)?;
+            let nominal = nominal.as_ref().map(|(description, file)| (description, file.as_str()));
+            cell::export_urdf(model, UrdfTemplate::Plain { nominal }, training, &tolerance)?
+        }
+    })
+}
+
+/// What was written, for a reader.
+fn print_summary(args: &Args, report: &cell::UrdfExportReport) {
     println!(
         "wrote {} ({}): base link {}, tracker link {}",
         args.urdf.display(),
@@ -119,5 +129,4 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     }
     let tip = report.tool_links.first().map_or("tool", String::as_str);
     println!("  read it back with: --robot {} --tip-link {tip}", args.urdf.display());
-    Ok(())
 }

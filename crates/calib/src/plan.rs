@@ -60,37 +60,10 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let robot = args.robot.read()?;
     let model = args.model.as_deref().map(model::read_model).transpose()?;
     let full_pose = args.full_pose || model.as_ref().is_some_and(|m| m.full_pose);
-    let (mut options, given) = match &args.options {
-        Some(path) => {
-            let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-            let file = path.display().to_string();
-            (planning::PlanOptions::parse(&text, &file)?, planning::UnmodelledGiven::of_text(&text, &file)?)
-        }
-        None => (planning::PlanOptions::default(), planning::UnmodelledGiven::default()),
-    };
-    // Unless the options set it, the unmodelled error is the model's own held-out error.
-    let unmodelled = options.set_unmodelled_from(model.as_ref(), given);
-    options.criterion = args.criterion.unwrap_or(options.criterion);
-    options.position_noise_mm = args.noise_mm.unwrap_or(options.position_noise_mm);
-    options.validate()?;
+    let (options, unmodelled) = plan_options(args, model.as_ref())?;
     let started = std::time::Instant::now();
     let mut notes = Vec::new();
-    let (set, file) = match &args.candidates {
-        Some(path) => {
-            let kinds = robot.nominal_model()?.joints().iter().map(|j| j.kind).collect();
-            let read = ReadOptions::for_joints(kinds).with_columns(args.columns.map());
-            let (data, cells) = measurements::read_configurations_with_cells(path, &read)?;
-            notes.push(data.read_summary());
-            (
-                planning::file_candidates(&data, &robot, model.as_ref())?,
-                Some((cells, data.format.dialect.delimiter.byte())),
-            )
-        }
-        None => {
-            notes.push(format!("drew {} candidates within the joint limits (seed {})", args.generate, args.seed));
-            (planning::generated_candidates(&robot, model.as_ref(), args.generate, args.seed)?, None)
-        }
-    };
+    let (set, file) = candidates(args, &robot, model.as_ref(), &mut notes)?;
     for tool in &set.unknown_tools {
         notes.push(format!("warning: tool '{tool}' is not in the model: planned with its first tool"));
     }
@@ -121,6 +94,54 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         println!("planned in {seconds:.2} s; wrote {} rows to {}", plan.order.len(), args.out.display());
     }
     Ok(())
+}
+
+/// The planning options: --options' file (or the defaults), the unmodelled error from the model
+/// unless the file sets it, --criterion and --noise-mm over both; validated.
+fn plan_options(
+    args: &Args,
+    model: Option<&model::CalibratedModel>,
+) -> Result<(planning::PlanOptions, planning::UnmodelledSetting), Box<dyn std::error::Error>> {
+    let (mut options, given) = match &args.options {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let file = path.display().to_string();
+            (planning::PlanOptions::parse(&text, &file)?, planning::UnmodelledGiven::of_text(&text, &file)?)
+        }
+        None => (planning::PlanOptions::default(), planning::UnmodelledGiven::default()),
+    };
+    // Unless the options set it, the unmodelled error is the model's own held-out error.
+    let unmodelled = options.set_unmodelled_from(model, given);
+    options.criterion = args.criterion.unwrap_or(options.criterion);
+    options.position_noise_mm = args.noise_mm.unwrap_or(options.position_noise_mm);
+    options.validate()?;
+    Ok((options, unmodelled))
+}
+
+/// The cells of --candidates and its delimiter, to write the chosen rows back unchanged.
+type FileCells = (measurements::Cells, u8);
+
+/// The candidates, from --candidates (with its cells and delimiter, to write the chosen rows back
+/// unchanged) or drawn within the joint limits; what was read or drawn goes to `notes`.
+fn candidates(
+    args: &Args,
+    robot: &robot::RobotDescription,
+    model: Option<&model::CalibratedModel>,
+    notes: &mut Vec<String>,
+) -> Result<(planning::CandidateSet, Option<FileCells>), Box<dyn std::error::Error>> {
+    Ok(match &args.candidates {
+        Some(path) => {
+            let kinds = robot.nominal_model()?.joints().iter().map(|j| j.kind).collect();
+            let read = ReadOptions::for_joints(kinds).with_columns(args.columns.map());
+            let (data, cells) = measurements::read_configurations_with_cells(path, &read)?;
+            notes.push(data.read_summary());
+            (planning::file_candidates(&data, robot, model)?, Some((cells, data.format.dialect.delimiter.byte())))
+        }
+        None => {
+            notes.push(format!("drew {} candidates within the joint limits (seed {})", args.generate, args.seed));
+            (planning::generated_candidates(robot, model, args.generate, args.seed)?, None)
+        }
+    })
 }
 
 fn parse_criterion(s: &str) -> Result<planning::Criterion, String> {

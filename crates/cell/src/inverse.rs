@@ -209,96 +209,122 @@ pub fn solve_targets(
     limits: Option<&[(f64, f64)]>,
     options: &InverseOptions,
 ) -> Result<Vec<Solved>, Error> {
-    let n = model.joint_count();
-    let mut q: Vec<Vec<f64>> = targets.iter().map(|t| t.seed.clone()).collect();
-    let mut iterations = vec![0; targets.len()];
-    let mut residual: Vec<(Vector3, Vector3)> = vec![(Vector3::zeros(), Vector3::zeros()); targets.len()];
-    let mut open: Vec<usize> = (0..targets.len()).collect();
-    let row = |i: usize, q: &[f64]| Measurement {
+    let iterates = newton(model, targets, options)?;
+    targets.par_iter().enumerate().map(|(i, target)| solved(model, target, &iterates, i, limits, options)).collect()
+}
+
+/// Each target's joint values, steps taken and last position and rotation errors.
+struct Iterates {
+    q: Vec<Vec<f64>>,
+    iterations: Vec<usize>,
+    residual: Vec<(Vector3, Vector3)>,
+}
+
+/// The row that puts the joints at `q` for `target`, on its target's model tool.
+fn target_row(target: &PoseTarget, q: &[f64]) -> Measurement {
+    Measurement {
         line: 0,
         q: q.to_vec(),
         position: Vector3::zeros(),
         orientation: None,
-        payload_kg: targets[i].payload_kg,
-        tool: targets[i].tool,
+        payload_kg: target.payload_kg,
+        tool: target.tool,
         temp_c: None,
         t_s: None,
         torques_nm: None,
-        inputs: targets[i].inputs.clone(),
+        inputs: target.inputs.clone(),
         std: None,
+    }
+}
+
+/// Newton steps from each target's seed, all open targets predicted together, until each is
+/// within tolerance or out of iterations.
+fn newton(model: &CalibratedModel, targets: &[PoseTarget], options: &InverseOptions) -> Result<Iterates, Error> {
+    let mut it = Iterates {
+        q: targets.iter().map(|t| t.seed.clone()).collect(),
+        iterations: vec![0; targets.len()],
+        residual: vec![(Vector3::zeros(), Vector3::zeros()); targets.len()],
     };
+    let mut open: Vec<usize> = (0..targets.len()).collect();
     loop {
         // Made here from the targets, each row on its target's model tool.
-        let rows = BoundSet::made_for_model("the targets", open.iter().map(|&i| row(i, &q[i])).collect());
+        let rows =
+            BoundSet::made_for_model("the targets", open.iter().map(|&i| target_row(&targets[i], &it.q[i])).collect());
         let poses = model.predict(&rows)?;
         let mut still = Vec::with_capacity(open.len());
         for (&i, predicted) in open.iter().zip(&poses) {
-            residual[i] = errors(&targets[i], &predicted.pose);
-            let (point, rotation) = residual[i];
+            it.residual[i] = errors(&targets[i], &predicted.pose);
+            let (point, rotation) = it.residual[i];
             let done =
                 point.norm() <= options.position_tolerance_m && rotation.norm() <= options.rotation_tolerance_rad;
-            if !done && iterations[i] < options.max_iterations {
+            if !done && it.iterations[i] < options.max_iterations {
                 still.push(i);
             }
         }
         open = still;
         if open.is_empty() {
-            break;
+            return Ok(it);
         }
         let steps: Vec<Result<DVector<f64>, Error>> = open
             .par_iter()
             .map(|&i| {
                 let target = &targets[i];
-                let j = jacobian(model, &q[i], target.tool, target.orientation)?;
-                Ok(step(j, residual[i].0, residual[i].1, target.orientation, options))
+                let j = jacobian(model, &it.q[i], target.tool, target.orientation)?;
+                Ok(step(j, it.residual[i].0, it.residual[i].1, target.orientation, options))
             })
             .collect();
         for (&i, dq) in open.iter().zip(steps) {
             let dq = dq?;
-            for (value, change) in q[i].iter_mut().zip(dq.iter()) {
+            for (value, change) in it.q[i].iter_mut().zip(dq.iter()) {
                 *value += change;
             }
-            iterations[i] += 1;
+            it.iterations[i] += 1;
         }
     }
-    targets
-        .par_iter()
-        .enumerate()
-        .map(|(i, target)| {
-            let (point, rotation) = residual[i];
-            let status = if point.norm() > options.accept_position_m || rotation.norm() > options.accept_rotation_rad {
-                TargetStatus::NoConvergence {
-                    iterations: iterations[i],
-                    position_m: point.norm(),
-                    rotation_rad: rotation.norm(),
-                }
-            } else {
-                TargetStatus::Ok
-            };
-            let smallest = jacobian(model, &q[i], target.tool, target.orientation)?
-                .singular_values()
-                .iter()
-                .copied()
-                .fold(f64::INFINITY, f64::min);
-            let status = if smallest < options.min_singular_value {
-                TargetStatus::Singular { smallest, floor: options.min_singular_value }
-            } else {
-                status
-            };
-            let status = match (status, limits) {
-                (TargetStatus::Ok, Some(limits)) => outside(&q[i], limits, model).unwrap_or(TargetStatus::Ok),
-                (status, _) => status,
-            };
-            debug_assert_eq!(q[i].len(), n);
-            Ok(Solved {
-                q: q[i].clone(),
-                residual_m: point.norm(),
-                residual_rad: target.orientation.then(|| rotation.norm()),
-                iterations: iterations[i],
-                status,
-            })
-        })
-        .collect()
+}
+
+/// Target `i`'s solution and its status: not converged, near a singularity, or (when `limits`
+/// are given) outside them, in that order of precedence.
+fn solved(
+    model: &CalibratedModel,
+    target: &PoseTarget,
+    it: &Iterates,
+    i: usize,
+    limits: Option<&[(f64, f64)]>,
+    options: &InverseOptions,
+) -> Result<Solved, Error> {
+    let (point, rotation) = it.residual[i];
+    let status = if point.norm() > options.accept_position_m || rotation.norm() > options.accept_rotation_rad {
+        TargetStatus::NoConvergence {
+            iterations: it.iterations[i],
+            position_m: point.norm(),
+            rotation_rad: rotation.norm(),
+        }
+    } else {
+        TargetStatus::Ok
+    };
+    let smallest = jacobian(model, &it.q[i], target.tool, target.orientation)?
+        .singular_values()
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let status = if smallest < options.min_singular_value {
+        TargetStatus::Singular { smallest, floor: options.min_singular_value }
+    } else {
+        status
+    };
+    let status = match (status, limits) {
+        (TargetStatus::Ok, Some(limits)) => outside(&it.q[i], limits, model).unwrap_or(TargetStatus::Ok),
+        (status, _) => status,
+    };
+    debug_assert_eq!(it.q[i].len(), model.joint_count());
+    Ok(Solved {
+        q: it.q[i].clone(),
+        residual_m: point.norm(),
+        residual_rad: target.orientation.then(|| rotation.norm()),
+        iterations: it.iterations[i],
+        status,
+    })
 }
 
 /// The first joint outside its limits.

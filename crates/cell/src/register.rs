@@ -41,7 +41,38 @@ pub fn register(
     options.validate()?;
     data.check_joints(&model.joint_kinds())?;
     let use_rotation = data.full_pose && model.full_pose;
-    // The model's tool of every data tool; new ones are measured against the model's first tool.
+    let known = model_tools(model, data, refit)?;
+    let slots = tool_slots(data, refit);
+    let tool_count = slots.iter().flatten().count();
+    let unknowns = Unknowns { frame: refit.base, tools: tool_count, tool_rotations: use_rotation };
+    check_counts(data, &slots, unknowns, use_rotation, options)?;
+
+    // Angles one turn away from the training poses are taken back into the fitted range.
+    let (rows, wrapped) = model::wrapped(model, &data.rows);
+    let data = &MeasurementSet { rows, ..data.clone() };
+    let rows = registration_rows(model, data, &known, &slots, use_rotation)?;
+    let fit = register_rows(&rows, unknowns, &options.registration)?;
+    let (registered, tools) = carried(model, data, &known, &slots, &fit);
+    let warnings = warnings(model, data, refit, use_rotation, &tools, options);
+    let heldout = match heldout_mm {
+        Some(given) => Some(Heldout { mm: given, from: HeldoutFrom::Given }),
+        None => model.heldout.map(|h| Heldout { mm: h.mean_position_error_mm, from: HeldoutFrom::ModelFile(h.source) }),
+    };
+    let report = RegisterReport::new(
+        &registered,
+        data,
+        Fitted { refit, parameters: unknowns.count(), fit: &fit, tools },
+        heldout,
+        options,
+        wrapped,
+        warnings,
+    )?;
+    Ok(Registered { model: registered, report })
+}
+
+/// The model's tool of every data tool (`None` for a new one); a new tool is refused, at its
+/// first row, unless tools are re-fitted.
+fn model_tools(model: &CalibratedModel, data: &MeasurementSet, refit: Refit) -> Result<Vec<Option<usize>>, Error> {
     let column = data.tool_column.unwrap_or(1);
     let mut known = Vec::with_capacity(data.tools.len());
     for (index, name) in data.tools.iter().enumerate() {
@@ -57,9 +88,14 @@ pub fn register(
         }
         known.push(found);
     }
+    Ok(known)
+}
+
+/// Each data tool's slot among the re-fitted tools: the data tools that appear, in order, when
+/// tools are re-fitted; none otherwise.
+fn tool_slots(data: &MeasurementSet, refit: Refit) -> Vec<Option<usize>> {
     let used: Vec<bool> = (0..data.tools.len()).map(|t| data.rows.iter().any(|r| r.tool == t)).collect();
-    // Slots: the data tools that appear, in order, when tools are re-fitted.
-    let slots: Vec<Option<usize>> = if refit.tools {
+    if refit.tools {
         let mut next = 0;
         used.iter()
             .map(|&u| {
@@ -71,19 +107,22 @@ pub fn register(
             .collect()
     } else {
         vec![None; data.tools.len()]
-    };
-    let tool_count = slots.iter().flatten().count();
-    let unknowns = Unknowns { frame: refit.base, tools: tool_count, tool_rotations: use_rotation };
-    check_counts(data, &slots, unknowns, use_rotation, options)?;
+    }
+}
 
-    // Angles one turn away from the training poses are taken back into the fitted range.
-    let (rows, wrapped) = model::wrapped(model, &data.rows);
-    let data = &MeasurementSet { rows, ..data.clone() };
+/// Each row's measured pose beside the model's prediction, with its tool's slot.
+fn registration_rows(
+    model: &CalibratedModel,
+    data: &MeasurementSet,
+    known: &[Option<usize>],
+    slots: &[Option<usize>],
+    use_rotation: bool,
+) -> Result<Vec<RegistrationRow>, Error> {
     // Each row on its model tool, a new tool measured against the model's first (`known`): the
     // binding of this path, made here since new tools are allowed.
     let on_model_tools = data.rows.iter().map(|r| Measurement { tool: known[r.tool].unwrap_or(0), ..r.clone() });
     let predicted = model.predict(&BoundSet::made_for_model(&data.source, on_model_tools.collect()))?;
-    let rows: Vec<RegistrationRow> = data
+    Ok(data
         .rows
         .iter()
         .zip(&predicted)
@@ -93,9 +132,18 @@ pub fn register(
             rotation: if use_rotation { row.orientation } else { None },
             slot: slots[row.tool],
         })
-        .collect();
-    let fit = register_rows(&rows, unknowns, &options.registration)?;
-    let (registered, tools) = carried(model, data, &known, &slots, &fit);
+        .collect())
+}
+
+/// What the registration cannot carry or could not see, in the report's order.
+fn warnings(
+    model: &CalibratedModel,
+    data: &MeasurementSet,
+    refit: Refit,
+    use_rotation: bool,
+    tools: &[RegisteredTool],
+    options: &RegisterOptions,
+) -> Vec<RegisterWarning> {
     let mut warnings = Vec::new();
     if refit.base && model.effects.iter().any(|e| e.kind() == "time_drift") {
         warnings.push(RegisterWarning::DriftInOldFrame);
@@ -109,20 +157,7 @@ pub fn register(
     if data.full_pose && !model.full_pose {
         warnings.push(RegisterWarning::OrientationsIgnored);
     }
-    let heldout = match heldout_mm {
-        Some(given) => Some(Heldout { mm: given, from: HeldoutFrom::Given }),
-        None => model.heldout.map(|h| Heldout { mm: h.mean_position_error_mm, from: HeldoutFrom::ModelFile(h.source) }),
-    };
-    let report = RegisterReport::new(
-        &registered,
-        data,
-        Fitted { refit, parameters: unknowns.count(), fit: &fit, tools },
-        heldout,
-        options,
-        wrapped,
-        warnings,
-    )?;
-    Ok(Registered { model: registered, report })
+    warnings
 }
 
 /// Refuses too few poses for what is re-fitted, with the counts.

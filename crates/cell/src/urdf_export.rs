@@ -117,34 +117,8 @@ pub fn export_urdf(
     tolerance: &NominalTolerance,
 ) -> Result<UrdfExport, Error> {
     let not_in_urdf: Vec<String> = model.non_geometric_parts();
-    let training_error = match training {
-        Some(data) => {
-            // Every model below is this one with parts left out: the same joints and tools.
-            let data = &model.bind(data)?;
-            let parts = model.parts();
-            let without_each = (0..parts.len())
-                .filter(|&k| !parts[k].in_urdf())
-                .map(|k| {
-                    let error = model::evaluate(&model.without_part(k), data)?.summary;
-                    Ok(PartError { part: parts[k].name(), error })
-                })
-                .collect::<Result<_, Error>>()?;
-            Some(TrainingErrors {
-                model: model::evaluate(model, data)?.summary,
-                urdf: model::evaluate(&model.geometry_only(), data)?.summary,
-                without_each,
-            })
-        }
-        None if !not_in_urdf.is_empty() => return Err(Error::new(ErrorKind::ExportNeedsData { parts: not_in_urdf })),
-        None => None,
-    };
-    let (nominal, nominal_file) = match template {
-        UrdfTemplate::Plain { nominal: Some((robot, file)) } => (Some(robot.nominal_model()?), file.to_owned()),
-        UrdfTemplate::Plain { nominal: None } => (None, String::new()),
-        UrdfTemplate::Like { document, chain } => {
-            (Some(chain.description().nominal_model()?), document.file().to_owned())
-        }
-    };
+    let training_error = training_errors(model, training, &not_in_urdf)?;
+    let (nominal, nominal_file) = template_nominal(template)?;
     if let UrdfTemplate::Like { document, chain } = template {
         check_joint_kinds(document, chain, &model.joint_kinds())?;
     }
@@ -165,15 +139,7 @@ pub fn export_urdf(
         }
     };
     let axis_changes = match &nominal {
-        Some(nominal) => axis_changes(&in_base, nominal)?
-            .into_iter()
-            .zip(&written.joint_names)
-            .map(|((offset, angle), joint)| AxisChange {
-                joint: joint.clone(),
-                offset_mm: offset * 1e3,
-                angle_mrad: angle * 1e3,
-            })
-            .collect(),
+        Some(nominal) => axis_change_list(&in_base, nominal, &written.joint_names)?,
         None => Vec::new(),
     };
     let base_frame = match &nominal {
@@ -194,6 +160,60 @@ pub fn export_urdf(
         training_error,
     };
     Ok(UrdfExport { text: written.text, report })
+}
+
+/// The nominal model `template` holds, if any, and the name of its file.
+fn template_nominal(template: UrdfTemplate<'_>) -> Result<(Option<LocalPoe>, String), Error> {
+    Ok(match template {
+        UrdfTemplate::Plain { nominal: Some((robot, file)) } => (Some(robot.nominal_model()?), file.to_owned()),
+        UrdfTemplate::Plain { nominal: None } => (None, String::new()),
+        UrdfTemplate::Like { document, chain } => {
+            (Some(chain.description().nominal_model()?), document.file().to_owned())
+        }
+    })
+}
+
+/// Each movable joint's change from `nominal`, named as the written URDF names it.
+fn axis_change_list(in_base: &LocalPoe, nominal: &LocalPoe, joint_names: &[String]) -> Result<Vec<AxisChange>, Error> {
+    Ok(axis_changes(in_base, nominal)?
+        .into_iter()
+        .zip(joint_names)
+        .map(|((offset, angle), joint)| AxisChange {
+            joint: joint.clone(),
+            offset_mm: offset * 1e3,
+            angle_mrad: angle * 1e3,
+        })
+        .collect())
+}
+
+/// The training error of the model, of its geometry alone and without each part a URDF cannot
+/// hold (`not_in_urdf`); without training data, none, and refused when there are such parts.
+fn training_errors(
+    model: &CalibratedModel,
+    training: Option<&MeasurementSet>,
+    not_in_urdf: &[String],
+) -> Result<Option<TrainingErrors>, Error> {
+    match training {
+        Some(data) => {
+            // Every model below is this one with parts left out: the same joints and tools.
+            let data = &model.bind(data)?;
+            let parts = model.parts();
+            let without_each = (0..parts.len())
+                .filter(|&k| !parts[k].in_urdf())
+                .map(|k| {
+                    let error = model::evaluate(&model.without_part(k), data)?.summary;
+                    Ok(PartError { part: parts[k].name(), error })
+                })
+                .collect::<Result<_, Error>>()?;
+            Ok(Some(TrainingErrors {
+                model: model::evaluate(model, data)?.summary,
+                urdf: model::evaluate(&model.geometry_only(), data)?.summary,
+                without_each,
+            }))
+        }
+        None if !not_in_urdf.is_empty() => Err(Error::new(ErrorKind::ExportNeedsData { parts: not_in_urdf.to_vec() })),
+        None => Ok(None),
+    }
 }
 
 /// Writes the URDF text to `path`, atomically ([`measurements::write_file`]).
@@ -228,7 +248,6 @@ fn write_plain(
     tool_links: &[String],
 ) -> Result<Written, Error> {
     let n = in_base.joint_count();
-    let link = |i: usize| if i == 0 { "base_link".to_owned() } else { format!("link_{i}") };
     let mut text = String::from("<?xml version=\"1.0\"?>\n");
     let _ = writeln!(
         text,
@@ -236,14 +255,10 @@ fn write_plain(
         if limits.is_some() { "joint 1 as the nominal description places it" } else { "the calibrated joint 1 frame" }
     );
     let _ = writeln!(text, "<robot name=\"{}\">", escape(name));
-    // A joint that moves `scale` ≠ 1 per unit of its value (folded mimic stages) is written as a
-    // joint to an intermediate link and a mimic stage on the same axis with multiplier
-    // `scale − 1`: the motions about (along) one line add, so the pair moves as the model's joint.
-    let drive = |i: usize| format!("link_{}_drive", i + 1);
     for i in 0..=n {
-        let _ = writeln!(text, "  <link name=\"{}\"/>", link(i));
+        let _ = writeln!(text, "  <link name=\"{}\"/>", plain_link(i));
         if i < n && in_base.joints()[i].scale != 1.0 {
-            let _ = writeln!(text, "  <link name=\"{}\"/>", drive(i));
+            let _ = writeln!(text, "  <link name=\"{}\"/>", drive_link(i));
         }
     }
     for tool in tool_links.iter().map(String::as_str).chain(["tracker"]) {
@@ -251,52 +266,10 @@ fn write_plain(
     }
     for (i, joint) in in_base.joints().iter().enumerate() {
         let bounds = limits.and_then(|l| l.get(i)).copied().filter(|(lo, hi)| lo.is_finite() && hi.is_finite());
-        let kind = match (joint.kind, bounds) {
-            (JointKind::Revolute, Some(_)) => "revolute",
-            (JointKind::Revolute, None) => "continuous",
-            (JointKind::Prismatic, Some(_)) => "prismatic",
-            (JointKind::Prismatic, None) => return Err(Error::new(ErrorKind::PrismaticWithoutLimits { joint: i + 1 })),
-        };
-        let staged = joint.scale != 1.0;
-        let _ = writeln!(
-            text,
-            "  <joint name=\"joint_{}\" type=\"{kind}\">\n    <parent link=\"{}\"/>\n    <child link=\"{}\"/>\n    {}\n    <axis xyz=\"0 0 1\"/>",
-            i + 1,
-            link(i),
-            if staged { drive(i) } else { link(i + 1) },
-            origin_element(&joint.previous_from_joint_zero)
-        );
-        if let Some((lower, upper)) = bounds {
-            let _ = writeln!(text, "    <limit lower=\"{lower:?}\" upper=\"{upper:?}\" effort=\"0\" velocity=\"0\"/>");
-        }
-        let _ = writeln!(text, "  </joint>");
-        if staged {
-            let multiplier = joint.scale - 1.0;
-            let _ = writeln!(
-                text,
-                "  <joint name=\"joint_{}_stage\" type=\"{kind}\">\n    <parent link=\"{}\"/>\n    <child link=\"{}\"/>\n    <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n    <axis xyz=\"0 0 1\"/>",
-                i + 1,
-                drive(i),
-                link(i + 1)
-            );
-            if let Some((lower, upper)) = bounds {
-                let (a, b) = (lower * multiplier, upper * multiplier);
-                let _ = writeln!(
-                    text,
-                    "    <limit lower=\"{:?}\" upper=\"{:?}\" effort=\"0\" velocity=\"0\"/>",
-                    a.min(b),
-                    a.max(b)
-                );
-            }
-            let _ = writeln!(
-                text,
-                "    <mimic joint=\"joint_{}\" multiplier=\"{multiplier:?}\" offset=\"0\"/>\n  </joint>",
-                i + 1
-            );
-        }
+        write_plain_joint(&mut text, i, joint, bounds)?;
     }
     for (tool, link_name) in in_base.tools().iter().zip(tool_links) {
-        fixed_joint(&mut text, "  ", &link(n), link_name, tool);
+        fixed_joint(&mut text, "  ", &plain_link(n), link_name, tool);
     }
     fixed_joint(&mut text, "  ", "base_link", "tracker", &base_from_tracker);
     let _ = writeln!(text, "</robot>");
@@ -308,6 +281,65 @@ fn write_plain(
         tool_links: tool_links.to_vec(),
         joint_names: (1..=n).map(|i| format!("joint_{i}")).collect(),
     })
+}
+
+/// The link after joint `i` (0-based) in a plain URDF: `base_link` before the first joint.
+fn plain_link(i: usize) -> String {
+    if i == 0 { "base_link".to_owned() } else { format!("link_{i}") }
+}
+
+/// The intermediate link of joint `i` (0-based) when it moves `scale` ≠ 1 per unit of its value.
+fn drive_link(i: usize) -> String {
+    format!("link_{}_drive", i + 1)
+}
+
+/// Joint `i` (0-based) of a plain URDF, with its limits `bounds` where finite. A joint that moves
+/// `scale` ≠ 1 per unit of its value (folded mimic stages) is written as a joint to an
+/// intermediate link and a mimic stage on the same axis with multiplier `scale − 1`: the motions
+/// about (along) one line add, so the pair moves as the model's joint.
+fn write_plain_joint(text: &mut String, i: usize, joint: &poe::Joint, bounds: Option<(f64, f64)>) -> Result<(), Error> {
+    let kind = match (joint.kind, bounds) {
+        (JointKind::Revolute, Some(_)) => "revolute",
+        (JointKind::Revolute, None) => "continuous",
+        (JointKind::Prismatic, Some(_)) => "prismatic",
+        (JointKind::Prismatic, None) => return Err(Error::new(ErrorKind::PrismaticWithoutLimits { joint: i + 1 })),
+    };
+    let staged = joint.scale != 1.0;
+    let _ = writeln!(
+        text,
+        "  <joint name=\"joint_{}\" type=\"{kind}\">\n    <parent link=\"{}\"/>\n    <child link=\"{}\"/>\n    {}\n    <axis xyz=\"0 0 1\"/>",
+        i + 1,
+        plain_link(i),
+        if staged { drive_link(i) } else { plain_link(i + 1) },
+        origin_element(&joint.previous_from_joint_zero)
+    );
+    if let Some((lower, upper)) = bounds {
+        let _ = writeln!(text, "    <limit lower=\"{lower:?}\" upper=\"{upper:?}\" effort=\"0\" velocity=\"0\"/>");
+    }
+    let _ = writeln!(text, "  </joint>");
+    if !staged {
+        return Ok(());
+    }
+    let multiplier = joint.scale - 1.0;
+    let _ = writeln!(
+        text,
+        "  <joint name=\"joint_{}_stage\" type=\"{kind}\">\n    <parent link=\"{}\"/>\n    <child link=\"{}\"/>\n    <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n    <axis xyz=\"0 0 1\"/>",
+        i + 1,
+        drive_link(i),
+        plain_link(i + 1)
+    );
+    if let Some((lower, upper)) = bounds {
+        let (a, b) = (lower * multiplier, upper * multiplier);
+        let _ = writeln!(
+            text,
+            "    <limit lower=\"{:?}\" upper=\"{:?}\" effort=\"0\" velocity=\"0\"/>",
+            a.min(b),
+            a.max(b)
+        );
+    }
+    let _ =
+        writeln!(text, "    <mimic joint=\"joint_{}\" multiplier=\"{multiplier:?}\" offset=\"0\"/>\n  </joint>", i + 1);
+    Ok(())
 }
 
 #[cfg(test)]

@@ -68,78 +68,15 @@ pub(crate) fn write_like(
     base_from_tracker: SE3,
     tool_links: &[String],
 ) -> Result<Written, Error> {
-    let nominal = chain.description().nominal_model()?;
-    let zero = vec![0.0; nominal.joint_count()];
-    let (nominal_frames, calibrated_frames) =
-        (nominal.frames(&zero).map_err(Error::kinematics)?, in_base.frames(&zero).map_err(Error::kinematics)?);
-    let link_frames = chain.link_frames();
-    let text = document.text();
-    // (byte offset, bytes replaced, new text), applied from the end.
-    let mut edits: Vec<(usize, usize, String)> = Vec::new();
-    let mut calibrated_link = SE3::identity();
-    let mut last: Option<(String, SE3)> = None;
-    let mut joint_names = Vec::new();
-    // The description's joint of each step (its actuated joint's, or that of the joint it
-    // follows), and whether the step starts that joint on the chain.
-    let mut joint_of: Vec<Option<(usize, bool)>> = vec![None; chain.steps.len()];
-    for (i, joint) in chain.joints.iter().enumerate() {
-        for &k in std::iter::once(&joint.first).chain(&joint.stages) {
-            if let Some(slot) = joint_of.get_mut(k) {
-                *slot = Some((i, k == joint.first));
-            }
-        }
-    }
-    for ((step, nominal_link), joint) in chain.steps.iter().zip(&link_frames).zip(&joint_of) {
-        if step.motion == StepMotion::Fixed {
-            calibrated_link = calibrated_link * step.from_to;
-            continue;
-        }
-        let Some((i, first)) = *joint else {
-            return Err(document.error_at("joint", &step.joint, format!("joint '{}' is not folded", step.joint)));
-        };
-        let link_in_poe = nominal_frames[i].inverse() * *nominal_link;
-        if !first {
-            // A stage keeps its origin; the tools hang from the last one the chain reaches.
-            calibrated_link = calibrated_link * step.from_to * step.zero_motion();
-            last = Some((step.to_link.clone(), link_in_poe));
-            continue;
-        }
-        // The joint's first step on the chain (its actuated joint, or the first stage of a driver
-        // beside the chain, at its offset at zero) carries the calibrated frame.
-        let new_link = calibrated_frames[i] * link_in_poe;
-        let origin = calibrated_link.inverse() * new_link * step.zero_motion().inverse();
-        calibrated_link = new_link;
-        let Some(element) = document.element("joint", &step.joint) else {
-            return Err(document.error_at(
-                "joint",
-                &step.joint,
-                format!("joint '{}' is not a top-level element", step.joint),
-            ));
-        };
-        let replacement = origin_element(&origin);
-        match element.child("origin") {
-            Some(old) => edits.push((old.span.0, old.span.1 - old.span.0, replacement)),
-            None => {
-                let at = element.children.first().map_or(element.span.1, |c| c.span.0);
-                edits.push((at, 0, format!("{replacement}\n    ")));
-            }
-        }
-        joint_names.push(chain.joints[i].actuated(&chain.steps).joint.clone());
-        last = Some((step.to_link.clone(), link_in_poe));
-    }
-    let Some((flange_link, flange_in_poe)) = last else {
+    let Origins { mut edits, joint_names, last } = calibrated_origins(document, chain, in_base)?;
+    let Some(flange) = last else {
         return Err(document.error_at("link", &chain.tip_link, "the chain has no movable joint".into()));
     };
     let tool_links: Vec<String> = tool_links.iter().map(|t| free_link_name(document, t)).collect();
     let tracker_link = free_link_name(document, "tracker");
-    let mut added = String::from("\n  <!-- Added by calib export: the calibrated tools and the tracker frame. -->\n");
-    for (tool, name) in in_base.tools().iter().zip(&tool_links) {
-        let _ = std::fmt::Write::write_fmt(&mut added, format_args!("  <link name=\"{}\"/>\n", escape(name)));
-        fixed_joint(&mut added, "  ", &flange_link, name, &(flange_in_poe.inverse() * *tool));
-    }
-    let _ = std::fmt::Write::write_fmt(&mut added, format_args!("  <link name=\"{}\"/>\n", escape(&tracker_link)));
-    fixed_joint(&mut added, "  ", &chain.base_link, &tracker_link, &base_from_tracker);
+    let added = added_links(chain, in_base, &flange, &tool_links, &tracker_link, &base_from_tracker);
     let root = document.root();
+    let text = document.text();
     let end_tag = text[..root.span.1].rfind("</").unwrap_or(root.span.1);
     edits.push((end_tag, 0, added));
     edits.push((
@@ -166,4 +103,104 @@ pub(crate) fn write_like(
         tool_links,
         joint_names,
     })
+}
+
+/// An edit of the URDF's text: byte offset, bytes replaced, new text (applied from the end).
+type Edit = (usize, usize, String);
+
+/// The calibrated origins of the chain's movable joints, as edits of the text.
+struct Origins {
+    edits: Vec<Edit>,
+    /// The name of each description joint given a calibrated origin, in chain order.
+    joint_names: Vec<String>,
+    /// The last movable step's child link and its frame in its POE joint's frame: the tools hang
+    /// from it. `None` when the chain has no movable joint.
+    last: Option<(String, SE3)>,
+}
+
+/// Walks the chain from the base: each joint's first step on the chain gets the origin that puts
+/// its child link at `W'_i = P'_i D_i`; fixed joints and later stages keep theirs.
+fn calibrated_origins(document: &UrdfDocument, chain: &UrdfChain, in_base: &LocalPoe) -> Result<Origins, Error> {
+    let nominal = chain.description().nominal_model()?;
+    let zero = vec![0.0; nominal.joint_count()];
+    let (nominal_frames, calibrated_frames) =
+        (nominal.frames(&zero).map_err(Error::kinematics)?, in_base.frames(&zero).map_err(Error::kinematics)?);
+    let link_frames = chain.link_frames();
+    let mut origins = Origins { edits: Vec::new(), joint_names: Vec::new(), last: None };
+    let mut calibrated_link = SE3::identity();
+    for ((step, nominal_link), joint) in chain.steps.iter().zip(&link_frames).zip(&joint_of_steps(chain)) {
+        if step.motion == StepMotion::Fixed {
+            calibrated_link = calibrated_link * step.from_to;
+            continue;
+        }
+        let Some((i, first)) = *joint else {
+            return Err(document.error_at("joint", &step.joint, format!("joint '{}' is not folded", step.joint)));
+        };
+        let link_in_poe = nominal_frames[i].inverse() * *nominal_link;
+        if !first {
+            // A stage keeps its origin; the tools hang from the last one the chain reaches.
+            calibrated_link = calibrated_link * step.from_to * step.zero_motion();
+            origins.last = Some((step.to_link.clone(), link_in_poe));
+            continue;
+        }
+        // The joint's first step on the chain (its actuated joint, or the first stage of a driver
+        // beside the chain, at its offset at zero) carries the calibrated frame.
+        let new_link = calibrated_frames[i] * link_in_poe;
+        let origin = calibrated_link.inverse() * new_link * step.zero_motion().inverse();
+        calibrated_link = new_link;
+        origins.edits.push(origin_edit(document, &step.joint, &origin)?);
+        origins.joint_names.push(chain.joints[i].actuated(&chain.steps).joint.clone());
+        origins.last = Some((step.to_link.clone(), link_in_poe));
+    }
+    Ok(origins)
+}
+
+/// The description's joint of each step (its actuated joint's, or that of the joint it follows),
+/// and whether the step starts that joint on the chain.
+fn joint_of_steps(chain: &UrdfChain) -> Vec<Option<(usize, bool)>> {
+    let mut joint_of: Vec<Option<(usize, bool)>> = vec![None; chain.steps.len()];
+    for (i, joint) in chain.joints.iter().enumerate() {
+        for &k in std::iter::once(&joint.first).chain(&joint.stages) {
+            if let Some(slot) = joint_of.get_mut(k) {
+                *slot = Some((i, k == joint.first));
+            }
+        }
+    }
+    joint_of
+}
+
+/// The edit that gives the `<joint>` named `joint` the origin `origin`: its `<origin>` replaced,
+/// or one put before its first child.
+fn origin_edit(document: &UrdfDocument, joint: &str, origin: &SE3) -> Result<Edit, Error> {
+    let Some(element) = document.element("joint", joint) else {
+        return Err(document.error_at("joint", joint, format!("joint '{joint}' is not a top-level element")));
+    };
+    let replacement = origin_element(origin);
+    Ok(match element.child("origin") {
+        Some(old) => (old.span.0, old.span.1 - old.span.0, replacement),
+        None => {
+            let at = element.children.first().map_or(element.span.1, |c| c.span.0);
+            (at, 0, format!("{replacement}\n    "))
+        }
+    })
+}
+
+/// The links and fixed joints added at the end of the robot: each tool hanging from the flange
+/// link (`flange`: its name and its frame in its POE joint's frame), and the tracker from the base.
+fn added_links(
+    chain: &UrdfChain,
+    in_base: &LocalPoe,
+    (flange_link, flange_in_poe): &(String, SE3),
+    tool_links: &[String],
+    tracker_link: &str,
+    base_from_tracker: &SE3,
+) -> String {
+    let mut added = String::from("\n  <!-- Added by calib export: the calibrated tools and the tracker frame. -->\n");
+    for (tool, name) in in_base.tools().iter().zip(tool_links) {
+        let _ = std::fmt::Write::write_fmt(&mut added, format_args!("  <link name=\"{}\"/>\n", escape(name)));
+        fixed_joint(&mut added, "  ", flange_link, name, &(flange_in_poe.inverse() * *tool));
+    }
+    let _ = std::fmt::Write::write_fmt(&mut added, format_args!("  <link name=\"{}\"/>\n", escape(tracker_link)));
+    fixed_joint(&mut added, "  ", &chain.base_link, tracker_link, base_from_tracker);
+    added
 }

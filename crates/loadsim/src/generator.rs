@@ -338,27 +338,8 @@ pub fn generate_each<E: From<Error>>(
     config: &GeneratorConfig,
     mut sink: impl FnMut(Sample) -> Result<(), E>,
 ) -> Result<(), E> {
-    effects.validate(cell)?;
-    if config.payloads_kg.is_empty() {
-        return Err(Error::from(dynamics::Error::LengthMismatch { field: "payloads_kg", given: 0, expected: 1 }).into());
-    }
-    if let Some(&m) = config.payloads_kg.iter().find(|m| !(m.is_finite() && **m >= 0.0)) {
-        return Err(Error::from(dynamics::Error::InvalidParameter { field: "payloads_kg", value: m }).into());
-    }
+    check_campaign(cell, effects, config)?;
     let runs = config.payloads_kg.len();
-    if config.tool_per_run && cell.robot.tool_count() < runs {
-        return Err(Error::Campaign {
-            field: "tool_per_run",
-            needs: "one tool of the cell per payload run",
-            given: cell.robot.tool_count(),
-            expected: runs,
-        }
-        .into());
-    }
-    if let Some(sensor) = &config.torque_sensor {
-        sensor.validate(cell.robot.joint_count())?;
-        cell.dynamics_for("measured torques")?;
-    }
     // The cell as each run measures it: its own tool, or the cell's.
     let cells: Vec<SimulatedCell> = (0..runs)
         .map(|r| SimulatedCell { tool: if config.tool_per_run { r } else { cell.tool }, ..cell.clone() })
@@ -396,6 +377,33 @@ pub fn generate_each<E: From<Error>>(
             tool: run_cell.tool,
             torques_nm,
         })?;
+    }
+    Ok(())
+}
+
+/// Refuses a campaign the cell cannot run: effects that do not fit it, no payload or one that is
+/// not a mass, fewer tools than runs where each run has its own, a torque sensor without the
+/// dynamics it needs.
+fn check_campaign(cell: &SimulatedCell, effects: &Effects, config: &GeneratorConfig) -> Result<(), Error> {
+    effects.validate(cell)?;
+    if config.payloads_kg.is_empty() {
+        return Err(Error::from(dynamics::Error::LengthMismatch { field: "payloads_kg", given: 0, expected: 1 }));
+    }
+    if let Some(&m) = config.payloads_kg.iter().find(|m| !(m.is_finite() && **m >= 0.0)) {
+        return Err(Error::from(dynamics::Error::InvalidParameter { field: "payloads_kg", value: m }));
+    }
+    let runs = config.payloads_kg.len();
+    if config.tool_per_run && cell.robot.tool_count() < runs {
+        return Err(Error::Campaign {
+            field: "tool_per_run",
+            needs: "one tool of the cell per payload run",
+            given: cell.robot.tool_count(),
+            expected: runs,
+        });
+    }
+    if let Some(sensor) = &config.torque_sensor {
+        sensor.validate(cell.robot.joint_count())?;
+        cell.dynamics_for("measured torques")?;
     }
     Ok(())
 }

@@ -75,22 +75,86 @@ impl Layout {
     /// Reads and checks the header. Allocates only in proportion to the header's length: a column
     /// named `q99999999999_rad` is refused, never used as a size.
     pub fn from_header(header: &csv::StringRecord, expect: &Expectation<'_>) -> Result<Self, Error> {
+        let width = header.len();
+        let Found {
+            names,
+            joints,
+            torques,
+            position,
+            quaternion,
+            euler,
+            payload,
+            tool,
+            temp,
+            time,
+            position_std,
+            rotation_std,
+            mut ignored,
+        } = Found::classify(header, expect)?;
+        check_mapped_headers(header, expect, width)?;
+
+        let inputs = input_columns(&names, expect, width)?;
+        if !inputs.is_empty() {
+            let taken: HashSet<&str> = expect.inputs.iter().map(String::as_str).collect();
+            ignored.retain(|name| !taken.contains(name.as_str()));
+        }
+        let joints = check_joints(joints, expect, width)?;
+        let torques = check_torques(torques, joints.len(), &names, expect, width)?;
+
+        let position = position_columns(position, expect, width)?;
+        let orientation = orientation(quaternion, euler, &names, (expect.file, expect.line), width)?;
+        let position_std = all_or_none(position_std, ["std_x_mm", "std_y_mm", "std_z_mm"], expect, width)?;
+        let rotation_std = all_or_none(rotation_std, ["std_rx_mrad", "std_ry_mrad", "std_rz_mrad"], expect, width)?;
+        Ok(Self {
+            joints,
+            position,
+            orientation,
+            payload,
+            tool,
+            temp,
+            time,
+            torques,
+            inputs,
+            position_std,
+            rotation_std,
+            ignored,
+            names,
+        })
+    }
+}
+
+/// The header's columns by quantity, each name seen once, before they are checked against each
+/// other and against the robot.
+#[derive(Default)]
+struct Found {
+    names: Vec<String>,
+    /// `(k, column, kind)` of each joint column, in header order.
+    joints: Vec<(usize, Column, JointKind)>,
+    /// `(k, column)` of each torque column, in header order.
+    torques: Vec<(usize, Column)>,
+    position: [Option<Column>; 3],
+    quaternion: [Option<Column>; 4],
+    euler: [Option<Column>; 3],
+    payload: Option<Column>,
+    tool: Option<usize>,
+    temp: Option<Column>,
+    time: Option<Column>,
+    position_std: [Option<Column>; 3],
+    rotation_std: [Option<Column>; 3],
+    ignored: Vec<String>,
+}
+
+impl Found {
+    /// Each header cell's quantity, by its name after `expect.columns` maps it; a name (or a
+    /// quantity) seen twice is refused at its second column.
+    fn classify(header: &csv::StringRecord, expect: &Expectation<'_>) -> Result<Self, Error> {
         let (file, line) = (expect.file, expect.line);
         let width = header.len();
-        let at_end = |name: String| Error::at_line(file.to_owned(), line, width + 1, ErrorKind::MissingColumn { name });
-        let mut names: Vec<String> = Vec::with_capacity(width);
+        let mut found = Self { names: Vec::with_capacity(width), ..Self::default() };
         // Sets, not scans of the lists: a header of 400,000 columns took minutes when each name was
         // compared with every earlier one (found by `cargo xtask fuzz`).
         let mut seen: HashSet<String> = HashSet::with_capacity(width);
         let (mut joint_numbers, mut torque_numbers) = (HashSet::new(), HashSet::new());
-        let mut joints: Vec<(usize, Column, JointKind)> = Vec::new();
-        let mut torques: Vec<(usize, Column)> = Vec::new();
-        let mut position = [None; 3];
-        let mut quaternion = [None; 4];
-        let mut euler = [None; 3];
-        let (mut payload, mut tool, mut temp, mut time) = (None, None, None, None);
-        let (mut position_std, mut rotation_std) = ([None; 3], [None; 3]);
-        let mut ignored = Vec::new();
         for (index, raw) in header.iter().enumerate() {
             let raw = raw.trim();
             let name = expect.columns.target_of(raw).unwrap_or(raw).to_owned();
@@ -102,99 +166,115 @@ impl Layout {
             let column = |scale| Column { index, scale };
             let fresh = match quantity(&name) {
                 Some(Quantity::Joint { index: k, kind, scale }) => {
-                    joints.push((k, column(scale), kind));
+                    found.joints.push((k, column(scale), kind));
                     joint_numbers.insert(k)
                 }
                 Some(Quantity::Torque(k)) => {
-                    torques.push((k, column(1.0)));
+                    found.torques.push((k, column(1.0)));
                     torque_numbers.insert(k)
                 }
-                Some(Quantity::Position { axis, scale }) => position[axis].replace(column(scale)).is_none(),
-                Some(Quantity::Quaternion(k)) => quaternion[k].replace(column(1.0)).is_none(),
-                Some(Quantity::Euler { axis, scale }) => euler[axis].replace(column(scale)).is_none(),
-                Some(Quantity::Payload) => payload.replace(column(1.0)).is_none(),
-                Some(Quantity::Tool) => tool.replace(index).is_none(),
-                Some(Quantity::Temperature) => temp.replace(column(1.0)).is_none(),
-                Some(Quantity::Time) => time.replace(column(1.0)).is_none(),
-                Some(Quantity::PositionStd { axis, scale }) => position_std[axis].replace(column(scale)).is_none(),
-                Some(Quantity::RotationStd { axis, scale }) => rotation_std[axis].replace(column(scale)).is_none(),
+                Some(Quantity::Position { axis, scale }) => found.position[axis].replace(column(scale)).is_none(),
+                Some(Quantity::Quaternion(k)) => found.quaternion[k].replace(column(1.0)).is_none(),
+                Some(Quantity::Euler { axis, scale }) => found.euler[axis].replace(column(scale)).is_none(),
+                Some(Quantity::Payload) => found.payload.replace(column(1.0)).is_none(),
+                Some(Quantity::Tool) => found.tool.replace(index).is_none(),
+                Some(Quantity::Temperature) => found.temp.replace(column(1.0)).is_none(),
+                Some(Quantity::Time) => found.time.replace(column(1.0)).is_none(),
+                Some(Quantity::PositionStd { axis, scale }) => {
+                    found.position_std[axis].replace(column(scale)).is_none()
+                }
+                Some(Quantity::RotationStd { axis, scale }) => {
+                    found.rotation_std[axis].replace(column(scale)).is_none()
+                }
                 None => {
-                    ignored.push(name.clone());
+                    found.ignored.push(name.clone());
                     true
                 }
             };
             if !fresh {
                 return Err(duplicate());
             }
-            names.push(name);
+            found.names.push(name);
         }
-        for (target, mapped) in expect.columns.entries() {
-            if !header.iter().any(|h| h.trim() == mapped) {
-                return Err(Error::at_line(
-                    file.to_owned(),
-                    line,
-                    width + 1,
-                    ErrorKind::MappedHeaderMissing { target: target.clone(), header: mapped.clone() },
-                ));
-            }
-        }
+        Ok(found)
+    }
+}
 
-        let inputs = input_columns(&names, expect, width)?;
-        if !inputs.is_empty() {
-            let taken: HashSet<&str> = expect.inputs.iter().map(String::as_str).collect();
-            ignored.retain(|name| !taken.contains(name.as_str()));
-        }
-        let joints = check_joints(joints, expect, width)?;
-        let n = joints.len();
-        torques.sort_by_key(|(k, _)| *k);
-        if let Some((k, c)) = torques.iter().find(|(k, _)| *k > n) {
+/// A column the header lacks, placed one past its last column.
+fn missing_at_end(expect: &Expectation<'_>, width: usize, name: String) -> Error {
+    Error::at_line(expect.file.to_owned(), expect.line, width + 1, ErrorKind::MissingColumn { name })
+}
+
+/// Every header `expect.columns` maps from must be in the file: a map that names nothing is a typo.
+fn check_mapped_headers(header: &csv::StringRecord, expect: &Expectation<'_>, width: usize) -> Result<(), Error> {
+    for (target, mapped) in expect.columns.entries() {
+        if !header.iter().any(|h| h.trim() == mapped) {
             return Err(Error::at_line(
-                file.to_owned(),
-                line,
-                c.index + 1,
-                ErrorKind::ColumnBeyondJoints { name: names[c.index].clone(), index: *k, joints: n },
+                expect.file.to_owned(),
+                expect.line,
+                width + 1,
+                ErrorKind::MappedHeaderMissing { target: target.clone(), header: mapped.clone() },
             ));
         }
-        if !torques.is_empty()
-            && let Some(k) = (1..=n).find(|k| torques.get(k - 1).is_none_or(|(j, _)| j != k))
-        {
-            return Err(at_end(format!("tau{k}_nm")));
-        }
+    }
+    Ok(())
+}
 
-        let any_position = position.iter().any(Option::is_some);
-        let position = match position {
-            [Some(x), Some(y), Some(z)] => Some([x, y, z]),
-            _ if expect.positions || any_position => {
-                let k = position.iter().position(Option::is_none).unwrap_or(0);
-                return Err(at_end(["x_mm", "y_mm", "z_mm"][k].into()));
-            }
-            _ => None,
-        };
-        let orientation = orientation(quaternion, euler, &names, (file, line), width)?;
-        // A stated uncertainty of some axes only is refused by the first name missing: a row
-        // weighted on one axis and not on another would be weighted by accident.
-        let all_or_none = |columns: [Option<Column>; 3], names: [&str; 3]| match columns {
-            [Some(x), Some(y), Some(z)] => Ok(Some([x, y, z])),
-            [None, None, None] => Ok(None),
-            _ => Err(at_end(names[columns.iter().position(Option::is_none).unwrap_or(0)].into())),
-        };
-        let position_std = all_or_none(position_std, ["std_x_mm", "std_y_mm", "std_z_mm"])?;
-        let rotation_std = all_or_none(rotation_std, ["std_rx_mrad", "std_ry_mrad", "std_rz_mrad"])?;
-        Ok(Self {
-            joints,
-            position,
-            orientation,
-            payload,
-            tool,
-            temp,
-            time,
-            torques: torques.into_iter().map(|(_, c)| c).collect(),
-            inputs,
-            position_std,
-            rotation_std,
-            ignored,
-            names,
-        })
+/// The torque columns in joint order, checked: none beyond the `n` joints, and, when there are
+/// any, one for every joint.
+fn check_torques(
+    mut torques: Vec<(usize, Column)>,
+    n: usize,
+    names: &[String],
+    expect: &Expectation<'_>,
+    width: usize,
+) -> Result<Vec<Column>, Error> {
+    torques.sort_by_key(|(k, _)| *k);
+    if let Some((k, c)) = torques.iter().find(|(k, _)| *k > n) {
+        return Err(Error::at_line(
+            expect.file.to_owned(),
+            expect.line,
+            c.index + 1,
+            ErrorKind::ColumnBeyondJoints { name: names[c.index].clone(), index: *k, joints: n },
+        ));
+    }
+    if !torques.is_empty()
+        && let Some(k) = (1..=n).find(|k| torques.get(k - 1).is_none_or(|(j, _)| j != k))
+    {
+        return Err(missing_at_end(expect, width, format!("tau{k}_nm")));
+    }
+    Ok(torques.into_iter().map(|(_, c)| c).collect())
+}
+
+/// The three position columns, or none when the file may leave them out and has none of them.
+fn position_columns(
+    position: [Option<Column>; 3],
+    expect: &Expectation<'_>,
+    width: usize,
+) -> Result<Option<[Column; 3]>, Error> {
+    let any_position = position.iter().any(Option::is_some);
+    match position {
+        [Some(x), Some(y), Some(z)] => Ok(Some([x, y, z])),
+        _ if expect.positions || any_position => {
+            let k = position.iter().position(Option::is_none).unwrap_or(0);
+            Err(missing_at_end(expect, width, ["x_mm", "y_mm", "z_mm"][k].into()))
+        }
+        _ => Ok(None),
+    }
+}
+
+/// A stated uncertainty's three columns, or none. Some axes only are refused by the first name
+/// missing: a row weighted on one axis and not on another would be weighted by accident.
+fn all_or_none(
+    columns: [Option<Column>; 3],
+    names: [&str; 3],
+    expect: &Expectation<'_>,
+    width: usize,
+) -> Result<Option<[Column; 3]>, Error> {
+    match columns {
+        [Some(x), Some(y), Some(z)] => Ok(Some([x, y, z])),
+        [None, None, None] => Ok(None),
+        _ => Err(missing_at_end(expect, width, names[columns.iter().position(Option::is_none).unwrap_or(0)].into())),
     }
 }
 

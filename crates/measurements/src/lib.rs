@@ -280,30 +280,15 @@ fn parse_keeping<R: Read>(
         .trim(csv::Trim::All)
         .from_reader(body);
     let delimiter = dialect.delimiter;
-    let header = csv.headers().map_err(|e| syntax_error(&e, file, delimiter, body))?.clone();
-    if header.is_empty() || (header.len() == 1 && header[0].is_empty()) {
-        return Err(Error::at_line(file.to_owned(), 1, 1, ErrorKind::EmptyFile));
-    }
     // Every row by the line an editor shows it on (module `file_lines`): the header's, 1 unless
     // blank lines precede it, then each record's from the same counter.
     let mut lines = LineCounter::new(body);
-    let header_line = header.position().map_or(1, |p| lines.record_line(p.byte()));
-    let expect = Expectation {
-        file,
-        line: header_line,
-        joints: options.joints.as_deref(),
-        positions: positions_required,
-        columns: &options.columns,
-        inputs: &options.inputs,
-    };
-    let layout = Layout::from_header(&header, &expect)?;
+    let header = read_header(&mut csv, &mut lines, (file, body, delimiter), options, positions_required)?;
     if let Some(cells) = cells.as_deref_mut() {
-        cells.header = header.iter().map(str::to_owned).collect();
+        cells.header = header.record.iter().map(str::to_owned).collect();
     }
     let input_names: std::sync::Arc<[String]> = options.inputs.clone().into();
-    let mut tools: Vec<String> = Vec::new();
-    // Each tool's index by name: a file whose every row names another tool stays linear.
-    let mut tool_index: HashMap<String, usize> = HashMap::new();
+    let mut tools = Tools::default();
     let mut rows = Vec::new();
     let mut record = csv::StringRecord::new();
     loop {
@@ -313,70 +298,8 @@ fn parse_keeping<R: Read>(
             Err(e) => return Err(syntax_error(&e, file, delimiter, body)),
         }
         let line = record.position().map_or(0, |p| lines.record_line(p.byte()));
-        let mut row = Row { record: &record, line, file, names: &layout.names, dialect: &mut dialect };
-        let q = layout
-            .joints
-            .iter()
-            .map(|&(c, kind)| {
-                let range = match kind {
-                    JointKind::Revolute => JOINT_ANGLE_RANGE,
-                    JointKind::Prismatic => JOINT_TRAVEL_RANGE,
-                };
-                row.bounded_numbers(&[c], range).map(|v| v[0])
-            })
-            .collect::<Result<Vec<f64>, Error>>()?;
-        let position = match layout.position {
-            Some(c) => {
-                let p = row.bounded_numbers(&c, POSITION_RANGE)?;
-                Vector3::new(p[0], p[1], p[2])
-            }
-            None => Vector3::zeros(),
-        };
-        let orientation = layout.orientation.as_ref().map(|c| row.orientation(c)).transpose()?;
-        let payload_kg = match layout.payload {
-            Some(c) => {
-                let value = row.number(c)?;
-                if value < 0.0 {
-                    return Err(Error::at_line(
-                        file.to_owned(),
-                        line,
-                        c.index + 1,
-                        ErrorKind::NegativePayload { value },
-                    ));
-                }
-                value
-            }
-            None => 0.0,
-        };
-        let temp_c = layout.temp.map(|c| row.number(c)).transpose()?;
-        let t_s = layout.time.map(|c| row.number(c)).transpose()?;
-        let torques_nm = if layout.torques.is_empty() { None } else { Some(row.numbers(&layout.torques)?) };
-        let inputs = Inputs::new(input_names.clone(), row.numbers(&layout.inputs)?);
-        let std = match (layout.position_std, layout.rotation_std) {
-            (None, None) => None,
-            (p, r) => Some(StatedSigma {
-                position_m: p.map(|c| row.standard_deviations(&c)).transpose()?,
-                rotation_rad: r.map(|c| row.standard_deviations(&c)).transpose()?,
-            }),
-        };
-        let tool_name = layout.tool.and_then(|i| record.get(i)).unwrap_or("");
-        let tool = *tool_index.entry(tool_name.to_owned()).or_insert_with(|| {
-            tools.push(tool_name.to_owned());
-            tools.len() - 1
-        });
-        rows.push(Measurement {
-            line,
-            q,
-            position,
-            orientation,
-            payload_kg,
-            tool,
-            temp_c,
-            t_s,
-            torques_nm,
-            inputs,
-            std,
-        });
+        let mut row = Row { record: &record, line, file, names: &header.layout.names, dialect: &mut dialect };
+        rows.push(read_measurement(&mut row, &header.layout, &input_names, &mut tools)?);
         if let Some(cells) = cells.as_deref_mut() {
             cells.rows.push(record.iter().map(str::to_owned).collect());
         }
@@ -384,7 +307,132 @@ fn parse_keeping<R: Read>(
     if rows.is_empty() {
         return Err(Error::at_line(file.to_owned(), 1, 1, ErrorKind::EmptyFile));
     }
-    Ok(MeasurementSet {
+    Ok(measurement_set(file, header, options, dialect, tools.names, rows))
+}
+
+/// A file's header: its cells, its line and the layout they give.
+struct Header {
+    record: csv::StringRecord,
+    line: u64,
+    layout: Layout,
+}
+
+/// Reads the header and checks it against what the caller expects.
+fn read_header(
+    csv: &mut csv::Reader<&[u8]>,
+    lines: &mut LineCounter<'_>,
+    (file, body, delimiter): (&str, &[u8], Delimiter),
+    options: &ReadOptions,
+    positions_required: bool,
+) -> Result<Header, Error> {
+    let record = csv.headers().map_err(|e| syntax_error(&e, file, delimiter, body))?.clone();
+    if record.is_empty() || (record.len() == 1 && record[0].is_empty()) {
+        return Err(Error::at_line(file.to_owned(), 1, 1, ErrorKind::EmptyFile));
+    }
+    let line = record.position().map_or(1, |p| lines.record_line(p.byte()));
+    let expect = Expectation {
+        file,
+        line,
+        joints: options.joints.as_deref(),
+        positions: positions_required,
+        columns: &options.columns,
+        inputs: &options.inputs,
+    };
+    let layout = Layout::from_header(&record, &expect)?;
+    Ok(Header { record, line, layout })
+}
+
+/// The tools rows name, each once, in the order they first appear.
+#[derive(Default)]
+struct Tools {
+    names: Vec<String>,
+    /// Each tool's index by name: a file whose every row names another tool stays linear.
+    index: HashMap<String, usize>,
+}
+
+impl Tools {
+    /// The index of the tool named `name`, added when new.
+    fn index_of(&mut self, name: &str) -> usize {
+        *self.index.entry(name.to_owned()).or_insert_with(|| {
+            self.names.push(name.to_owned());
+            self.names.len() - 1
+        })
+    }
+}
+
+/// One row's measurement, its cells read in the order of the fields (joints first), so that the
+/// first bad cell in that order is the one refused.
+fn read_measurement(
+    row: &mut Row<'_>,
+    layout: &Layout,
+    input_names: &std::sync::Arc<[String]>,
+    tools: &mut Tools,
+) -> Result<Measurement, Error> {
+    let q = layout
+        .joints
+        .iter()
+        .map(|&(c, kind)| {
+            let range = match kind {
+                JointKind::Revolute => JOINT_ANGLE_RANGE,
+                JointKind::Prismatic => JOINT_TRAVEL_RANGE,
+            };
+            row.bounded_numbers(&[c], range).map(|v| v[0])
+        })
+        .collect::<Result<Vec<f64>, Error>>()?;
+    let position = match layout.position {
+        Some(c) => {
+            let p = row.bounded_numbers(&c, POSITION_RANGE)?;
+            Vector3::new(p[0], p[1], p[2])
+        }
+        None => Vector3::zeros(),
+    };
+    let orientation = layout.orientation.as_ref().map(|c| row.orientation(c)).transpose()?;
+    let payload_kg = payload_kg(row, layout.payload)?;
+    let temp_c = layout.temp.map(|c| row.number(c)).transpose()?;
+    let t_s = layout.time.map(|c| row.number(c)).transpose()?;
+    let torques_nm = if layout.torques.is_empty() { None } else { Some(row.numbers(&layout.torques)?) };
+    let inputs = Inputs::new(input_names.clone(), row.numbers(&layout.inputs)?);
+    let std = match (layout.position_std, layout.rotation_std) {
+        (None, None) => None,
+        (p, r) => Some(StatedSigma {
+            position_m: p.map(|c| row.standard_deviations(&c)).transpose()?,
+            rotation_rad: r.map(|c| row.standard_deviations(&c)).transpose()?,
+        }),
+    };
+    let tool = tools.index_of(layout.tool.and_then(|i| row.record.get(i)).unwrap_or(""));
+    Ok(Measurement { line: row.line, q, position, orientation, payload_kg, tool, temp_c, t_s, torques_nm, inputs, std })
+}
+
+/// The row's payload, kg: 0 without a payload column, never negative.
+fn payload_kg(row: &mut Row<'_>, column: Option<layout::Column>) -> Result<f64, Error> {
+    match column {
+        Some(c) => {
+            let value = row.number(c)?;
+            if value < 0.0 {
+                return Err(Error::at_line(
+                    row.file.to_owned(),
+                    row.line,
+                    c.index + 1,
+                    ErrorKind::NegativePayload { value },
+                ));
+            }
+            Ok(value)
+        }
+        None => Ok(0.0),
+    }
+}
+
+/// The set the rows make, with what the header says of the file's format.
+fn measurement_set(
+    file: &str,
+    header: Header,
+    options: &ReadOptions,
+    dialect: Dialect,
+    tools: Vec<String>,
+    rows: Vec<Measurement>,
+) -> MeasurementSet {
+    let Header { record: header, line: header_line, layout } = header;
+    MeasurementSet {
         header_line,
         source: file.to_owned(),
         joint_count: layout.joints.len(),
@@ -417,7 +465,7 @@ fn parse_keeping<R: Read>(
                 .cloned()
                 .collect(),
         },
-    })
+    }
 }
 
 /// The unit a joint column's name gives, from the factor that turns it into SI.

@@ -162,41 +162,46 @@ impl CalibratedModel {
         })
         .map_err(|fault| fault.into_error(file))?;
         if let Some(residual_gp) = &self.residual_gp {
-            let gp_field = residual_gp_field(text);
-            if residual_gp.with_payload != (self.method == Method::PoeGpLoad) {
-                let message =
-                    format!("{gp_field}.with_payload is {} for method {}", residual_gp.with_payload, self.method);
-                return Err(at.part("with_payload", message));
-            }
-            if residual_gp.full_pose != self.full_pose {
-                let message = format!(
-                    "{gp_field}.full_pose is {}, the model's full_pose {}",
-                    residual_gp.full_pose, self.full_pose
-                );
-                return Err(at.part(gp_field, message));
-            }
-            let inputs = n + usize::from(residual_gp.with_payload) + residual_gp.inputs.len();
-            if residual_gp.gp.input_dim() != inputs {
-                let found = residual_gp.gp.input_dim();
-                return Err(at.count(("gp", 0), format!("{gp_field}.gp"), "inputs", found, inputs));
-            }
-            let bound = 10f64.powf(MAX_HYPERPARAMETER_DECADES);
-            let hyperparameters = residual_gp.gp.kernels().into_iter().flat_map(|k| k.parameters());
-            if let Some(value) = hyperparameters.into_iter().find(|p| !(p.abs() <= bound && p.abs() >= 1.0 / bound)) {
-                let message = format!(
-                    "{gp_field}.gp: a kernel hyperparameter is {value:e}, outside 1e-{MAX_HYPERPARAMETER_DECADES} to \
-                     1e{MAX_HYPERPARAMETER_DECADES} (the GP works on standardised data; an edited or corrupt file)"
-                );
-                return Err(at.part("kernel", message));
-            }
-            let outputs = if self.full_pose { 6 } else { 3 };
-            if residual_gp.gp.output_count() != outputs {
-                let found = residual_gp.gp.output_count();
-                return Err(at.count(("gp", 0), format!("{gp_field}.gp"), "outputs", found, outputs));
-            }
+            self.check_residual_gp(residual_gp, &at)?;
         }
         self.check_inputs(&at)?;
         self.check_values(&at)
+    }
+
+    /// The residual GP against the model: its payload input and pose kind as the method's and
+    /// the model's, its input and output dimensions, its hyperparameters within their bounds.
+    fn check_residual_gp(&self, residual_gp: &crate::ResidualGp, at: &Located<'_>) -> Result<(), Error> {
+        let n = self.kinematics.joint_count();
+        let gp_field = residual_gp_field(at.text);
+        if residual_gp.with_payload != (self.method == Method::PoeGpLoad) {
+            let message = format!("{gp_field}.with_payload is {} for method {}", residual_gp.with_payload, self.method);
+            return Err(at.part("with_payload", message));
+        }
+        if residual_gp.full_pose != self.full_pose {
+            let message =
+                format!("{gp_field}.full_pose is {}, the model's full_pose {}", residual_gp.full_pose, self.full_pose);
+            return Err(at.part(gp_field, message));
+        }
+        let inputs = n + usize::from(residual_gp.with_payload) + residual_gp.inputs.len();
+        if residual_gp.gp.input_dim() != inputs {
+            let found = residual_gp.gp.input_dim();
+            return Err(at.count(("gp", 0), format!("{gp_field}.gp"), "inputs", found, inputs));
+        }
+        let bound = 10f64.powf(MAX_HYPERPARAMETER_DECADES);
+        let hyperparameters = residual_gp.gp.kernels().into_iter().flat_map(|k| k.parameters());
+        if let Some(value) = hyperparameters.into_iter().find(|p| !(p.abs() <= bound && p.abs() >= 1.0 / bound)) {
+            let message = format!(
+                "{gp_field}.gp: a kernel hyperparameter is {value:e}, outside 1e-{MAX_HYPERPARAMETER_DECADES} to \
+                 1e{MAX_HYPERPARAMETER_DECADES} (the GP works on standardised data; an edited or corrupt file)"
+            );
+            return Err(at.part("kernel", message));
+        }
+        let outputs = if self.full_pose { 6 } else { 3 };
+        if residual_gp.gp.output_count() != outputs {
+            let found = residual_gp.gp.output_count();
+            return Err(at.count(("gp", 0), format!("{gp_field}.gp"), "outputs", found, outputs));
+        }
+        Ok(())
     }
 
     /// The measured signals the model takes: named once each, and each with its span in the

@@ -61,23 +61,7 @@ impl RepeatGroups {
         }
         for (i, row) in rows.iter().enumerate() {
             let home = cell(&row.q);
-            // Per joint, the cell offsets a twin can be in: 0, and -1 / +1 near an edge.
-            let offsets: Vec<Vec<i64>> = row
-                .q
-                .iter()
-                .zip(&home)
-                .map(|(v, c)| {
-                    let low = v - *c as f64 * cell_size;
-                    let mut o = vec![0];
-                    if low <= tolerance {
-                        o.push(-1);
-                    }
-                    if cell_size - low <= tolerance {
-                        o.push(1);
-                    }
-                    o
-                })
-                .collect();
+            let offsets = twin_offsets(&row.q, &home, cell_size, tolerance);
             let mut index = vec![0usize; offsets.len()];
             loop {
                 let key: Vec<i64> = home.iter().zip(&index).zip(&offsets).map(|((c, &k), o)| c + o[k]).collect();
@@ -101,17 +85,7 @@ impl RepeatGroups {
                 }
             }
         }
-        let mut by_root: HashMap<usize, usize> = HashMap::new();
-        let mut groups: Vec<Vec<usize>> = Vec::new();
-        for i in 0..n {
-            let root = find(&mut parent, i);
-            let g = *by_root.entry(root).or_insert_with(|| {
-                groups.push(Vec::new());
-                groups.len() - 1
-            });
-            groups[g].push(i);
-        }
-        Self { groups }
+        Self { groups: groups_by_root(&mut parent) }
     }
 
     /// Rows that share their configuration with another row.
@@ -127,6 +101,40 @@ impl RepeatGroups {
 
 fn same_configuration(a: &[f64], b: &[f64], tolerance: f64) -> bool {
     a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= tolerance)
+}
+
+/// Per joint, the cell offsets a twin of `q` (in cell `home`) can be in: 0, and -1 / +1 where
+/// `q` lies within `tolerance` of the cell's edge.
+fn twin_offsets(q: &[f64], home: &[i64], cell_size: f64, tolerance: f64) -> Vec<Vec<i64>> {
+    q.iter()
+        .zip(home)
+        .map(|(v, c)| {
+            let low = v - *c as f64 * cell_size;
+            let mut o = vec![0];
+            if low <= tolerance {
+                o.push(-1);
+            }
+            if cell_size - low <= tolerance {
+                o.push(1);
+            }
+            o
+        })
+        .collect()
+}
+
+/// The rows of each union-find root, groups in the order of their first row.
+fn groups_by_root(parent: &mut [usize]) -> Vec<Vec<usize>> {
+    let mut by_root: HashMap<usize, usize> = HashMap::new();
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for i in 0..parent.len() {
+        let root = find(parent, i);
+        let g = *by_root.entry(root).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[g].push(i);
+    }
+    groups
 }
 
 fn find(parent: &mut [usize], mut i: usize) -> usize {

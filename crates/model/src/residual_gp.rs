@@ -136,50 +136,8 @@ impl Default for ResidualGpOptions {
     fn default() -> Self {
         // What each default was measured against is in docs/results/gp-defaults.md; here the
         // reasons.
-        //
-        // ARD squared exponential plus a first-order additive term (one one-dimensional squared
-        // exponential per input) rather than the paper's Eq. 5 kernel: the additive term learns a
-        // joint's periodic gear error from the poses that move that joint, which the joint ARD
-        // term cannot. The default start and the kernel's nested start (additive term nearly
-        // off), searched on a 500-row warm-start subset; no random restarts, which never reached
-        // the best likelihood on bench-gp's sets.
-        //
-        // The search stops when an iteration raises the log marginal likelihood by less than
-        // 1e-5 of itself (≈ 0.005 nats here, far below the ~1 nat that separates models) and
-        // keeps 20 curvature pairs (the kernel's parameter count on six joints: nearly full
-        // BFGS). The full-data search after the subset starts near its optimum, where an
-        // iteration gains hundredths of a nat for an `n³` factorisation: it stops at 1e-4.
-        let optimiser = gp::OptimiserConfig {
-            restarts: 0,
-            warm_start_rows: 500,
-            memory: 20,
-            function_tolerance: 1e-5,
-            refine_function_tolerance: Some(1e-4),
-            ..gp::OptimiserConfig::default()
-        };
         Self {
-            gp: gp::GpConfig {
-                kernel: gp::KernelChoice::Composite {
-                    shape: gp::StationaryShape::SquaredExponential,
-                    constant: false,
-                    linear: false,
-                    additive: true,
-                },
-                optimiser,
-                // The additive term only where the data pay for it: per output, the kernel with
-                // and without it are both searched (on the warm-start subset when there is one,
-                // then only the chosen one on all rows) and the additive term is kept when it
-                // raises the log marginal likelihood by more than the Schwarz penalty ½ · 2d · ln N.
-                // No threshold of ours: BIC's own.
-                additive_by_bic: true,
-                // The paper's isotropic Eq. 5 kernel beside it, per output, kept where its
-                // closed-form leave-one-out log predictive probability is higher: on a few hundred
-                // poses the ARD length scales, fitted by marginal likelihood, can overfit. Decided
-                // on the warm-start subset's optimum where there is one, so the isotropic kernel
-                // is searched on all rows only where it wins there.
-                isotropic_by_loo: true,
-                ..gp::GpConfig::default()
-            },
+            gp: exact_gp_defaults(),
             method: GpChoice::default(),
             // One exact evaluation with its gradient costs n³ flops (64 GFLOP at n = 4000: a
             // search takes minutes); the sparse GP with 500 inducing points takes seconds there
@@ -209,6 +167,52 @@ impl Default for ResidualGpOptions {
             // the rows an effect's span fades, where its held-out error matched the full search's.
             fallback_refine_iterations: Some(0),
         }
+    }
+}
+
+/// The exact GP's defaults (the reasons for each below).
+fn exact_gp_defaults() -> gp::GpConfig {
+    // ARD squared exponential plus a first-order additive term (one one-dimensional squared
+    // exponential per input) rather than the paper's Eq. 5 kernel: the additive term learns a
+    // joint's periodic gear error from the poses that move that joint, which the joint ARD
+    // term cannot. The default start and the kernel's nested start (additive term nearly
+    // off), searched on a 500-row warm-start subset; no random restarts, which never reached
+    // the best likelihood on bench-gp's sets.
+    //
+    // The search stops when an iteration raises the log marginal likelihood by less than
+    // 1e-5 of itself (≈ 0.005 nats here, far below the ~1 nat that separates models) and
+    // keeps 20 curvature pairs (the kernel's parameter count on six joints: nearly full
+    // BFGS). The full-data search after the subset starts near its optimum, where an
+    // iteration gains hundredths of a nat for an `n³` factorisation: it stops at 1e-4.
+    let optimiser = gp::OptimiserConfig {
+        restarts: 0,
+        warm_start_rows: 500,
+        memory: 20,
+        function_tolerance: 1e-5,
+        refine_function_tolerance: Some(1e-4),
+        ..gp::OptimiserConfig::default()
+    };
+    gp::GpConfig {
+        kernel: gp::KernelChoice::Composite {
+            shape: gp::StationaryShape::SquaredExponential,
+            constant: false,
+            linear: false,
+            additive: true,
+        },
+        optimiser,
+        // The additive term only where the data pay for it: per output, the kernel with
+        // and without it are both searched (on the warm-start subset when there is one,
+        // then only the chosen one on all rows) and the additive term is kept when it
+        // raises the log marginal likelihood by more than the Schwarz penalty ½ · 2d · ln N.
+        // No threshold of ours: BIC's own.
+        additive_by_bic: true,
+        // The paper's isotropic Eq. 5 kernel beside it, per output, kept where its
+        // closed-form leave-one-out log predictive probability is higher: on a few hundred
+        // poses the ARD length scales, fitted by marginal likelihood, can overfit. Decided
+        // on the warm-start subset's optimum where there is one, so the isotropic kernel
+        // is searched on all rows only where it wins there.
+        isotropic_by_loo: true,
+        ..gp::GpConfig::default()
     }
 }
 
@@ -534,6 +538,24 @@ impl GpFadeRule {
     }
 }
 
+/// The rule that fades the correction where the posterior keeps more than `above` of the prior
+/// variance, with the training rows' median share; none where the options turn it off.
+fn fade_rule(
+    gp: &GpModel,
+    x: &Mat<f64>,
+    loo: Option<&gp::LeaveOneOut>,
+    options: &ResidualGpOptions,
+) -> Result<Option<GpFadeRule>, Error> {
+    Ok(match options.fade_above_variance_ratio {
+        Some(above) => Some(GpFadeRule {
+            above,
+            training_share: timings::phase("fade share", || median_share(gp, x, loo, options.fade_share_rows))?,
+            fallback_training_share: None,
+        }),
+        None => None,
+    })
+}
+
 /// The median over the training rows `x` of the share of its prior variance `gp`'s posterior
 /// keeps at a row it has not seen there: for the exact GP, each row left out of it (R&W
 /// Eq. 5.12, the noise taken off: a row's own noisy value would count as knowledge of its
@@ -777,16 +799,7 @@ impl ResidualGp {
                 (GpModel::Exact(model), report, Some(loo), grouped)
             }
         };
-        let fade = match options.fade_above_variance_ratio {
-            Some(above) => Some(GpFadeRule {
-                above,
-                training_share: timings::phase("fade share", || {
-                    median_share(&gp, &x, loo.as_ref(), options.fade_share_rows)
-                })?,
-                fallback_training_share: None,
-            }),
-            None => None,
-        };
+        let fade = fade_rule(&gp, &x, loo.as_ref(), options)?;
         let residual_gp = Self {
             with_payload,
             full_pose: data.full_pose,
@@ -798,21 +811,24 @@ impl ResidualGp {
             fade,
             inputs: options.inputs.clone(),
         };
-        let summary = |mean: Mat<f64>| {
-            let errors: Vec<crate::PoseError> = poses
-                .iter()
-                .zip(&data.rows)
-                .enumerate()
-                .map(|(i, (pose, row))| {
-                    let g = Vector6::from_fn(|c, _| if c < mean.ncols() { mean[(i, c)] } else { 0.0 });
-                    let error = crate::pose_error(&(residual_gp.correction(pose, &g) * *pose), row);
-                    if data.full_pose { error } else { crate::PoseError { rotation_mrad: None, ..error } }
-                })
-                .collect();
-            crate::ErrorSummary::from_errors(&errors)
-        };
-        let report = ResidualGpReport {
-            gp: report,
+        let report = residual_gp.fit_report(report, (loo, leave_group_out), poses, data, options, repeats);
+        Ok((residual_gp, report))
+    }
+
+    /// The fit's report: the GP's own, and the held-out errors its leave-one-out and
+    /// leave-group-out means give the model's poses, with the repeats and the inputs' ranges.
+    fn fit_report(
+        &self,
+        gp: GpFitReport,
+        (loo, leave_group_out): (Option<gp::LeaveOneOut>, Option<Mat<f64>>),
+        poses: &[SE3],
+        data: &MeasurementSet,
+        options: &ResidualGpOptions,
+        repeats: &crate::RepeatGroups,
+    ) -> ResidualGpReport {
+        let summary = |mean: Mat<f64>| self.error_summary(poses, data, &mean);
+        ResidualGpReport {
+            gp,
             leave_one_out: loo.map(|loo| summary(loo.mean)),
             leave_group_out: leave_group_out.map(&summary),
             repeated_rows: repeats.repeated_rows(),
@@ -820,8 +836,22 @@ impl ResidualGp {
             inputs: crate::TrainingRange::of(&data.rows)
                 .map(|range| range.inputs.into_iter().filter(|i| options.inputs.contains(&i.name)).collect())
                 .unwrap_or_default(),
-        };
-        Ok((residual_gp, report))
+        }
+    }
+
+    /// The errors left on `data` when each pose is corrected by the GP's `mean` at its row.
+    fn error_summary(&self, poses: &[SE3], data: &MeasurementSet, mean: &Mat<f64>) -> crate::ErrorSummary {
+        let errors: Vec<crate::PoseError> = poses
+            .iter()
+            .zip(&data.rows)
+            .enumerate()
+            .map(|(i, (pose, row))| {
+                let g = Vector6::from_fn(|c, _| if c < mean.ncols() { mean[(i, c)] } else { 0.0 });
+                let error = crate::pose_error(&(self.correction(pose, &g) * *pose), row);
+                if data.full_pose { error } else { crate::PoseError { rotation_mrad: None, ..error } }
+            })
+            .collect();
+        crate::ErrorSummary::from_errors(&errors)
     }
 
     /// The GP's inputs for `rows`: `(q_1 … q_n[, m], s_1 … s_k)`, the payload where the GP

@@ -9,7 +9,7 @@
 //! only the left-out payloads can earn it.
 
 use crate::fit_options::FitOptions;
-use crate::rule_choice::{FoldFailure, Target, held_out_errors, one_standard_error};
+use crate::rule_choice::{Decision, FoldFailure, Target, held_out_errors, one_standard_error};
 use effects::{BeyondSpan, EffectSpec, IdentifiedEffect};
 use errors::Error;
 use measurements::{Measurement, MeasurementSet};
@@ -99,19 +99,7 @@ pub(crate) fn choose(
     }
     let settings = options.effects.payloads;
     let groups = payload_groups(&data.rows);
-    let keep = |effects: &[IdentifiedEffect], reason: String| -> Vec<PayloadChoice> {
-        targets
-            .iter()
-            .map(|&k| PayloadChoice {
-                effect: effects[k].label(),
-                rule: effects[k].beyond_payload().unwrap_or(BeyondSpan::Hold),
-                span_kg: effects[k].payload_span().map_or([0.0; 2], |s| s.kg),
-                payloads: groups.len(),
-                heldout_mm: None,
-                reason: reason.clone(),
-            })
-            .collect()
-    };
+    let keep = |effects: &[IdentifiedEffect], reason: String| own_rules(effects, &targets, groups.len(), reason);
     if !settings.choose {
         return Ok(keep(effects, "its own rule (effects.payloads.choose is false)".into()));
     }
@@ -124,21 +112,8 @@ pub(crate) fn choose(
         return Ok(keep(effects, reason));
     }
     let folds = [groups[0].clone(), groups[groups.len() - 1].clone()];
-    // A group measured with a tool of its own (a probe remounted per payload run) leaves nothing
-    // that knows its tool when it is left out.
-    for fold in &folds {
-        let inside: std::collections::BTreeSet<usize> = fold.iter().copied().collect();
-        let others: std::collections::BTreeSet<usize> =
-            (0..data.rows.len()).filter(|i| !inside.contains(i)).map(|i| data.rows[i].tool).collect();
-        if let Some(&i) = fold.iter().find(|&&i| !others.contains(&data.rows[i].tool)) {
-            let row = &data.rows[i];
-            let reason = format!(
-                "the rows of payload {} kg carry a tool no other payload's rows carry (line {}): left out, nothing \
-                 predicts them; its own rule",
-                row.payload_kg, row.line
-            );
-            return Ok(keep(effects, reason));
-        }
+    if let Some(reason) = tool_of_its_own(data, &folds) {
+        return Ok(keep(effects, reason));
     }
     let fold_options = crate::rule_choice::fold_options(options, specs);
     let trials: Vec<Target> = targets.iter().map(|&k| Target { effect: k, rules: RULES.to_vec() }).collect();
@@ -158,24 +133,7 @@ pub(crate) fn choose(
         let k = trial.effect;
         let decision = one_standard_error(&trial.rules, errors);
         let heldout = PayloadErrors { hold: decision.means[0], zero: decision.means[1], extend: decision.means[2] };
-        let standard_error = decision.standard_error;
-        let reason = format!(
-            "{} payloads, the lightest ({lightest} kg) and the heaviest ({heaviest} kg) left out in turn: {:.4} mm \
-             held, {:.4} mm zero, {:.4} mm extended ({} rows; {})",
-            groups.len(),
-            heldout.hold,
-            heldout.zero,
-            heldout.extend,
-            decision.rows,
-            if decision.switched {
-                format!(
-                    "{} lower than held by more than one standard error, {standard_error:.4} mm",
-                    decision.chosen.name()
-                )
-            } else {
-                format!("held, no other rule lower by more than one standard error, {standard_error:.4} mm")
-            }
-        );
+        let reason = chosen_reason(&decision, &heldout, groups.len(), (lightest, heaviest));
         effects[k].set_beyond_payload(decision.chosen);
         out.push(PayloadChoice {
             effect: effects[k].label(),
@@ -187,6 +145,68 @@ pub(crate) fn choose(
         });
     }
     Ok(out)
+}
+
+/// Each target effect with the rule it has, and why it was not chosen.
+fn own_rules(effects: &[IdentifiedEffect], targets: &[usize], payloads: usize, reason: String) -> Vec<PayloadChoice> {
+    targets
+        .iter()
+        .map(|&k| PayloadChoice {
+            effect: effects[k].label(),
+            rule: effects[k].beyond_payload().unwrap_or(BeyondSpan::Hold),
+            span_kg: effects[k].payload_span().map_or([0.0; 2], |s| s.kg),
+            payloads,
+            heldout_mm: None,
+            reason: reason.clone(),
+        })
+        .collect()
+}
+
+/// Why the rules cannot be chosen when a left-out group was measured with a tool of its own (a
+/// probe remounted per payload run): then nothing that knows its tool is left to predict it.
+fn tool_of_its_own(data: &MeasurementSet, folds: &[Vec<usize>; 2]) -> Option<String> {
+    for fold in folds {
+        let inside: std::collections::BTreeSet<usize> = fold.iter().copied().collect();
+        let others: std::collections::BTreeSet<usize> =
+            (0..data.rows.len()).filter(|i| !inside.contains(i)).map(|i| data.rows[i].tool).collect();
+        if let Some(&i) = fold.iter().find(|&&i| !others.contains(&data.rows[i].tool)) {
+            let row = &data.rows[i];
+            return Some(format!(
+                "the rows of payload {} kg carry a tool no other payload's rows carry (line {}): left out, nothing \
+                 predicts them; its own rule",
+                row.payload_kg, row.line
+            ));
+        }
+    }
+    None
+}
+
+/// Why `decision` chose its rule: the left-out payloads' errors under each rule and the
+/// standard error that decided.
+fn chosen_reason(
+    decision: &Decision,
+    heldout: &PayloadErrors,
+    payloads: usize,
+    (lightest, heaviest): (f64, f64),
+) -> String {
+    let standard_error = decision.standard_error;
+    format!(
+        "{} payloads, the lightest ({lightest} kg) and the heaviest ({heaviest} kg) left out in turn: {:.4} mm \
+         held, {:.4} mm zero, {:.4} mm extended ({} rows; {})",
+        payloads,
+        heldout.hold,
+        heldout.zero,
+        heldout.extend,
+        decision.rows,
+        if decision.switched {
+            format!(
+                "{} lower than held by more than one standard error, {standard_error:.4} mm",
+                decision.chosen.name()
+            )
+        } else {
+            format!("held, no other rule lower by more than one standard error, {standard_error:.4} mm")
+        }
+    )
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@
 //! and each kind keeps the rule it had (drift: zero; growth: held).
 
 use crate::fit_options::FitOptions;
-use crate::rule_choice::{FoldFailure, Target, held_out_errors, one_standard_error};
+use crate::rule_choice::{Decision, FoldFailure, Target, held_out_errors, one_standard_error};
 use effects::{BeyondSpan, EffectSpec, IdentifiedEffect};
 use errors::Error;
 use measurements::{Measurement, MeasurementSet};
@@ -94,18 +94,7 @@ pub(crate) fn choose(
     }
     let settings = options.effects.sessions;
     let found = sessions(&data.rows, settings.gap_ratio);
-    let keep = |effects: &[IdentifiedEffect], reason: String| -> Vec<SpanChoice> {
-        targets
-            .iter()
-            .map(|&k| SpanChoice {
-                effect: effects[k].label(),
-                rule: effects[k].beyond_span().unwrap_or(BeyondSpan::Zero),
-                sessions: found.len(),
-                heldout_mm: None,
-                reason: reason.clone(),
-            })
-            .collect()
-    };
+    let keep = |effects: &[IdentifiedEffect], reason: String| own_rules(effects, &targets, found.len(), reason);
     if !settings.choose {
         return Ok(keep(effects, "its own rule (effects.sessions.choose is false)".into()));
     }
@@ -147,22 +136,7 @@ pub(crate) fn choose(
             BeyondSpan::Hold => SpanErrors { hold: own_mm, zero: other_mm },
             BeyondSpan::Zero | BeyondSpan::Extend => SpanErrors { hold: other_mm, zero: own_mm },
         };
-        let standard_error = decision.standard_error;
-        let reason = format!(
-            "{} sessions, each left out in turn: {:.4} mm held, {:.4} mm zero beyond the span ({} rows; {})",
-            found.len(),
-            errors.hold,
-            errors.zero,
-            decision.rows,
-            if decision.switched {
-                format!("{} lower by more than one standard error, {standard_error:.4} mm", decision.chosen.name())
-            } else {
-                format!(
-                    "{} kept, the other not lower by more than one standard error, {standard_error:.4} mm",
-                    rule.name()
-                )
-            }
-        );
+        let reason = chosen_reason(&decision, rule, &errors, found.len());
         effects[k].set_beyond_span(decision.chosen);
         out.push(SpanChoice {
             effect: effects[k].label(),
@@ -173,6 +147,38 @@ pub(crate) fn choose(
         });
     }
     Ok(out)
+}
+
+/// Each target effect with the rule it has, and why it was not chosen.
+fn own_rules(effects: &[IdentifiedEffect], targets: &[usize], sessions: usize, reason: String) -> Vec<SpanChoice> {
+    targets
+        .iter()
+        .map(|&k| SpanChoice {
+            effect: effects[k].label(),
+            rule: effects[k].beyond_span().unwrap_or(BeyondSpan::Zero),
+            sessions,
+            heldout_mm: None,
+            reason: reason.clone(),
+        })
+        .collect()
+}
+
+/// Why `decision` chose its rule over the kind's own `rule`: the left-out sessions' errors under
+/// either rule and the standard error that decided.
+fn chosen_reason(decision: &Decision, rule: BeyondSpan, errors: &SpanErrors, sessions: usize) -> String {
+    let standard_error = decision.standard_error;
+    format!(
+        "{} sessions, each left out in turn: {:.4} mm held, {:.4} mm zero beyond the span ({} rows; {})",
+        sessions,
+        errors.hold,
+        errors.zero,
+        decision.rows,
+        if decision.switched {
+            format!("{} lower by more than one standard error, {standard_error:.4} mm", decision.chosen.name())
+        } else {
+            format!("{} kept, the other not lower by more than one standard error, {standard_error:.4} mm", rule.name())
+        }
+    )
 }
 
 #[cfg(test)]

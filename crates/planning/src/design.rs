@@ -325,22 +325,9 @@ impl<'a> Design<'a> {
     /// with `W = M⁻¹ A_sᵀ L⁻ᵀ`, `L Lᵀ = I ± G_s`.
     fn update(&mut self, s: usize, sign: f64) {
         self.updates += 1;
-        let (k, r) = (self.rows.k, self.rows.r);
-        let a_s = self.rows.rows(s);
-        // U = M⁻¹ A_sᵀ, r × k.
-        let mut u = vec![0.0; r * k];
-        for i in 0..r {
-            for j in 0..k {
-                u[i * k + j] = (0..r).map(|l| self.inverse[i * r + l] * a_s[j * r + l]).sum();
-            }
-        }
-        let mut l = [0.0; 36];
-        let g_s = self.variance(s).to_vec();
-        for i in 0..k {
-            for j in 0..k {
-                l[i * k + j] = sign * g_s[i * k + j] + if i == j { 1.0 } else { 0.0 };
-            }
-        }
+        let k = self.rows.k;
+        let u = self.inverse_times_rows(s);
+        let mut l = self.capacitance(s, sign);
         let Some(log_det) = cholesky(&mut l[..k * k], k) else {
             // Only a removal of a pose that alone determines a direction gets here, which the
             // ridge forbids; recompute rather than corrupt the state.
@@ -348,7 +335,42 @@ impl<'a> Design<'a> {
             return;
         };
         self.log_det += log_det;
-        // W = U L⁻ᵀ: solve each row w of W from L wᵀ = uᵀ.
+        let w = self.solve_factor(&u, &l);
+        self.downdate_inverse(&w, sign);
+        let (z, t) =
+            if self.criterion == Criterion::I { self.reach_factors(&w, sign) } else { (Vec::new(), [0.0; 36]) };
+        self.update_candidates(&w, &z, &t, sign);
+    }
+
+    /// `U = M⁻¹ A_sᵀ`, r × k.
+    fn inverse_times_rows(&self, s: usize) -> Vec<f64> {
+        let (k, r) = (self.rows.k, self.rows.r);
+        let a_s = self.rows.rows(s);
+        let mut u = vec![0.0; r * k];
+        for i in 0..r {
+            for j in 0..k {
+                u[i * k + j] = (0..r).map(|l| self.inverse[i * r + l] * a_s[j * r + l]).sum();
+            }
+        }
+        u
+    }
+
+    /// `I ± G_s`, k × k, the matrix whose Cholesky factor is `L`.
+    fn capacitance(&self, s: usize, sign: f64) -> [f64; 36] {
+        let k = self.rows.k;
+        let mut l = [0.0; 36];
+        let g_s = self.variance(s).to_vec();
+        for i in 0..k {
+            for j in 0..k {
+                l[i * k + j] = sign * g_s[i * k + j] + if i == j { 1.0 } else { 0.0 };
+            }
+        }
+        l
+    }
+
+    /// `W = U L⁻ᵀ`: each row w of W solved from `L wᵀ = uᵀ`.
+    fn solve_factor(&self, u: &[f64], l: &[f64; 36]) -> Vec<f64> {
+        let (k, r) = (self.rows.k, self.rows.r);
         let mut w = vec![0.0; r * k];
         for i in 0..r {
             for j in 0..k {
@@ -359,73 +381,62 @@ impl<'a> Design<'a> {
                 w[i * k + j] = v / l[j * k + j];
             }
         }
+        w
+    }
+
+    /// `M⁻¹ ← M⁻¹ ∓ W Wᵀ`.
+    fn downdate_inverse(&mut self, w: &[f64], sign: f64) {
+        let (k, r) = (self.rows.k, self.rows.r);
         for i in 0..r {
             for j in 0..r {
                 let ww: f64 = (0..k).map(|m| w[i * k + m] * w[j * k + m]).sum();
                 self.inverse[i * r + j] -= sign * ww;
             }
         }
-        // I-optimality: with Y = C W, Z = M⁻¹ Y (the old M⁻¹) and T = Wᵀ Y,
-        // Q' = Q − σ(W Zᵀ + Z Wᵀ) + W T Wᵀ, so F_c' = F_c − σ(H Eᵀ + E Hᵀ) + H T Hᵀ, E = A_c Z.
-        let (z, t) = if self.criterion == Criterion::I {
-            let mut y = vec![0.0; r * k];
-            for i in 0..r {
-                for j in 0..k {
-                    y[i * k + j] = (0..r).map(|m| self.spread[i * r + m] * w[m * k + j]).sum();
-                }
+    }
+
+    /// I-optimality: with Y = C W, Z = M⁻¹ Y (the old M⁻¹) and T = Wᵀ Y,
+    /// Q' = Q − σ(W Zᵀ + Z Wᵀ) + W T Wᵀ, so F_c' = F_c − σ(H Eᵀ + E Hᵀ) + H T Hᵀ, E = A_c Z.
+    /// Returns `(Z, T)`; called after [`Self::downdate_inverse`].
+    fn reach_factors(&self, w: &[f64], sign: f64) -> (Vec<f64>, [f64; 36]) {
+        let (k, r) = (self.rows.k, self.rows.r);
+        let mut y = vec![0.0; r * k];
+        for i in 0..r {
+            for j in 0..k {
+                y[i * k + j] = (0..r).map(|m| self.spread[i * r + m] * w[m * k + j]).sum();
             }
-            let mut z = vec![0.0; r * k];
-            for i in 0..r {
-                for j in 0..k {
-                    // M⁻¹ before this update: the new one plus σ W Wᵀ.
-                    z[i * k + j] = (0..r)
-                        .map(|m| {
-                            let ww: f64 = (0..k).map(|n| w[i * k + n] * w[m * k + n]).sum();
-                            (self.inverse[i * r + m] + sign * ww) * y[m * k + j]
-                        })
-                        .sum();
-                }
+        }
+        let mut z = vec![0.0; r * k];
+        for i in 0..r {
+            for j in 0..k {
+                // M⁻¹ before this update: the new one plus σ W Wᵀ.
+                z[i * k + j] = (0..r)
+                    .map(|m| {
+                        let ww: f64 = (0..k).map(|n| w[i * k + n] * w[m * k + n]).sum();
+                        (self.inverse[i * r + m] + sign * ww) * y[m * k + j]
+                    })
+                    .sum();
             }
-            let mut t = [0.0; 36];
-            for i in 0..k {
-                for j in 0..k {
-                    t[i * k + j] = (0..r).map(|m| w[m * k + i] * y[m * k + j]).sum();
-                }
+        }
+        let mut t = [0.0; 36];
+        for i in 0..k {
+            for j in 0..k {
+                t[i * k + j] = (0..r).map(|m| w[m * k + i] * y[m * k + j]).sum();
             }
-            (z, t)
-        } else {
-            (Vec::new(), [0.0; 36])
-        };
+        }
+        (z, t)
+    }
+
+    /// Every candidate's `G_c` (and, for I-optimality, `F_c`) updated with `H = A_c W` and
+    /// `E = A_c Z`, a block of candidates at a time.
+    fn update_candidates(&mut self, w: &[f64], z: &[f64], t: &[f64; 36], sign: f64) {
+        let (k, r) = (self.rows.k, self.rows.r);
         let rows = self.rows;
         let with_reach = self.criterion == Criterion::I;
         // [W | Z]ᵀ (k or 2k rows × r): one product with a block of candidates' rows gives every
         // candidate's `A_c W` and `A_c Z` in a matrix kernel, not k² dot products each.
         let width = if with_reach { 2 * k } else { k };
         let factors = nalgebra::DMatrix::from_fn(width, r, |j, l| if j < k { w[l * k + j] } else { z[l * k + j - k] });
-        let update_one = |g: &mut [f64], f: Option<&mut [f64]>, h: &[f64; 36], e: &[f64; 36]| {
-            for i in 0..k {
-                for j in 0..k {
-                    let hh: f64 = (0..k).map(|m| h[i * k + m] * h[j * k + m]).sum();
-                    g[i * k + j] -= sign * hh;
-                }
-            }
-            if let Some(f) = f {
-                let mut ht = [0.0; 36];
-                for i in 0..k {
-                    for j in 0..k {
-                        ht[i * k + j] = (0..k).map(|m| h[i * k + m] * t[m * k + j]).sum();
-                    }
-                }
-                for i in 0..k {
-                    for j in 0..k {
-                        let cross: f64 =
-                            (0..k).map(|m| h[i * k + m] * e[j * k + m] + e[i * k + m] * h[j * k + m]).sum();
-                        let quad: f64 = (0..k).map(|m| ht[i * k + m] * h[j * k + m]).sum();
-                        f[i * k + j] += -sign * cross + quad;
-                    }
-                }
-            }
-        };
         let kk = k * k;
         let update_block = |block: usize, g: &mut [f64], mut f: Option<&mut [f64]>| {
             let count = g.len() / kk;
@@ -444,7 +455,7 @@ impl<'a> Design<'a> {
                     }
                 }
                 let reach = f.as_deref_mut().map(|f| &mut f[c * kk..(c + 1) * kk]);
-                update_one(&mut g[c * kk..(c + 1) * kk], reach, &h, &e);
+                update_candidate(&mut g[c * kk..(c + 1) * kk], reach, (&h, &e, t), k, sign);
             }
         };
         if with_reach {
@@ -527,6 +538,37 @@ impl<'a> Design<'a> {
                 (0..self.rows.len()).map(|c| (3..6).map(|i| self.variance(c)[i * k + i]).sum()).collect();
             (traces.iter().sum::<f64>() / traces.len().max(1) as f64, traces.iter().copied().fold(0.0, f64::max))
         })
+    }
+}
+
+/// One candidate's `G_c ← G_c ∓ H Hᵀ` and, where `f` is given, `F_c ← F_c ∓ (H Eᵀ + E Hᵀ) + H T Hᵀ`.
+fn update_candidate(
+    g: &mut [f64],
+    f: Option<&mut [f64]>,
+    (h, e, t): (&[f64; 36], &[f64; 36], &[f64; 36]),
+    k: usize,
+    sign: f64,
+) {
+    for i in 0..k {
+        for j in 0..k {
+            let hh: f64 = (0..k).map(|m| h[i * k + m] * h[j * k + m]).sum();
+            g[i * k + j] -= sign * hh;
+        }
+    }
+    if let Some(f) = f {
+        let mut ht = [0.0; 36];
+        for i in 0..k {
+            for j in 0..k {
+                ht[i * k + j] = (0..k).map(|m| h[i * k + m] * t[m * k + j]).sum();
+            }
+        }
+        for i in 0..k {
+            for j in 0..k {
+                let cross: f64 = (0..k).map(|m| h[i * k + m] * e[j * k + m] + e[i * k + m] * h[j * k + m]).sum();
+                let quad: f64 = (0..k).map(|m| ht[i * k + m] * h[j * k + m]).sum();
+                f[i * k + j] += -sign * cross + quad;
+            }
+        }
     }
 }
 

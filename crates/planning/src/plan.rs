@@ -11,7 +11,7 @@ use crate::ErrorKind;
 use crate::bias::{BiasModel, Unmodelled};
 use crate::coverage::{Axis, AxisCoverage, cover, coverage};
 use crate::design::{Criterion, Design};
-use crate::information::{Candidate, RowWeights, candidate_rows};
+use crate::information::{Candidate, CandidateRows, RowWeights, candidate_rows};
 use crate::unmodelled_setting::{UnmodelledFrom, UnmodelledGiven, UnmodelledSetting, per_axis_from_mean};
 use errors::{Error, OptionOutOfRange, option};
 use model::CalibratedModel;
@@ -332,17 +332,8 @@ pub fn plan(
     let mean_trace = rows.a.iter().map(|v| v * v).sum::<f64>() / candidates.len() as f64;
     let prior = options.prior_fraction * mean_trace / rows.r as f64;
     let kinds: Vec<poe::JointKind> = model.joints().iter().map(|j| j.kind).collect();
-    let unmodelled = (options.unmodelled_mm > 0.0).then(|| {
-        let bias = BiasModel {
-            position_ratio: (options.unmodelled_mm / options.position_noise_mm).powi(2),
-            rotation_ratio: (options.unmodelled_mrad / options.rotation_noise_mrad).powi(2),
-            length: options.unmodelled_length_rad,
-            test_points: options.unmodelled_test_points,
-            trials: options.unmodelled_trials.min(options.unmodelled_evaluations / poses).max(1),
-            passes: options.unmodelled_passes,
-        };
-        Unmodelled::new(&rows, candidates, &kinds, prior, bias)
-    });
+    let unmodelled = (options.unmodelled_mm > 0.0)
+        .then(|| Unmodelled::new(&rows, candidates, &kinds, prior, bias_model(options, poses)));
     let mut design = Design::new(&rows, prior, options.criterion);
     let targets: Vec<usize> = [poses / 4, poses / 2].into_iter().filter(|&n| n > 0 && n < poses).collect();
     let mut checkpoints = Vec::new();
@@ -352,14 +343,10 @@ pub fn plan(
         }
     });
     let exchanges = design.exchange(options.exchange_passes, options.exchange_tolerance);
-    let mut unmodelled_exchanges = 0;
-    if let Some(unmodelled) = &unmodelled {
-        let mut chosen = design.chosen().to_vec();
-        unmodelled_exchanges = unmodelled.exchange(&mut chosen);
-        if unmodelled_exchanges > 0 {
-            design = Design::of(&rows, prior, options.criterion, &chosen);
-        }
-    }
+    let unmodelled_exchanges = match &unmodelled {
+        Some(unmodelled) => exchange_for_unmodelled(&mut design, unmodelled, &rows, prior, options.criterion),
+        None => 0,
+    };
     let axes = axes(candidates, options.coverage_bins.min(poses), options.min_joint_span);
     let coverage_swaps = cover(&mut design, &axes);
     checkpoints.push(checkpoint(&design, unmodelled.as_ref(), rows.r, true, options, full_pose));
@@ -388,6 +375,35 @@ pub fn plan(
         checkpoints,
     };
     Ok(Plan { order: measuring_order(candidates, &chosen), report })
+}
+
+/// The model of the error the geometry leaves, in the units the criterion weighs it in.
+fn bias_model(options: &PlanOptions, poses: usize) -> BiasModel {
+    BiasModel {
+        position_ratio: (options.unmodelled_mm / options.position_noise_mm).powi(2),
+        rotation_ratio: (options.unmodelled_mrad / options.rotation_noise_mrad).powi(2),
+        length: options.unmodelled_length_rad,
+        test_points: options.unmodelled_test_points,
+        trials: options.unmodelled_trials.min(options.unmodelled_evaluations / poses).max(1),
+        passes: options.unmodelled_passes,
+    }
+}
+
+/// Exchanges of the chosen poses that lower the expected error with the unmodelled part; the
+/// design is remade from the new choice when any was made. Returns how many were made.
+fn exchange_for_unmodelled<'a>(
+    design: &mut Design<'a>,
+    unmodelled: &Unmodelled<'_>,
+    rows: &'a CandidateRows,
+    prior: f64,
+    criterion: Criterion,
+) -> usize {
+    let mut chosen = design.chosen().to_vec();
+    let made = unmodelled.exchange(&mut chosen);
+    if made > 0 {
+        *design = Design::of(rows, prior, criterion, &chosen);
+    }
+    made
 }
 
 /// The bins of every moving joint and of the payload where it varies.

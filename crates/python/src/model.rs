@@ -202,29 +202,10 @@ impl Model {
         if joints != self.model.joint_count() {
             return Err(argument("q", format!("{joints} columns, the model has {} joints", self.model.joint_count())));
         }
-        let column = |name: &str, values: Option<PyReadonlyArray1<'py, f64>>| -> PyResult<Option<Vec<f64>>> {
-            let Some(values) = values else { return Ok(None) };
-            let values = values.as_array().to_vec();
-            if values.len() != n {
-                return Err(argument(name, format!("{} values for {n} rows", values.len())));
-            }
-            Ok(Some(values))
-        };
-        // The model's signals in its order, each found by name among those given.
-        let mut given: std::collections::HashMap<String, PyReadonlyArray1<'py, f64>> =
-            inputs.unwrap_or_default().into_iter().collect();
-        let names = self.model.input_names();
-        let mut signals = Vec::with_capacity(names.len());
-        for name in &names {
-            let values = given.remove(name).ok_or_else(|| {
-                argument("inputs", format!("no values of '{name}', a measured signal the model takes as an input"))
-            })?;
-            signals.push(column(name, Some(values))?.unwrap_or_default());
-        }
-        let names: std::sync::Arc<[String]> = names.into();
-        let payload = column("payload_kg", payload_kg)?;
-        let temp = column("temp_c", temp_c)?;
-        let time = column("t_s", t_s)?;
+        let (names, signals) = self.signals(inputs, n)?;
+        let payload = array_column("payload_kg", payload_kg, n)?;
+        let temp = array_column("temp_c", temp_c, n)?;
+        let time = array_column("t_s", t_s, n)?;
         let torques = torques_nm.map(|t| t.as_array().to_owned());
         if let Some(t) = &torques
             && t.dim() != (n, joints)
@@ -236,38 +217,9 @@ impl Model {
         {
             return Err(argument("tools", format!("{} values for {n} rows", tools.len())));
         }
+        let columns = RowColumns { q, payload, temp, time, torques, signals, names, tools };
         let source = "predict";
-        let line = |i: usize| i as u64 + 2;
-        let mut rows = Vec::with_capacity(n);
-        for i in 0..n {
-            let row_q: Vec<f64> = q.row(i).to_vec();
-            let payload = payload.as_ref().map_or(0.0, |p| p[i]);
-            let extra = [payload, temp.as_ref().map_or(0.0, |t| t[i]), time.as_ref().map_or(0.0, |t| t[i])];
-            let torque_row = torques.as_ref().map(|t| t.row(i).to_vec()).unwrap_or_default();
-            let signal_row: Vec<f64> = signals.iter().map(|s| s[i]).collect();
-            if let Some(bad) = row_q.iter().chain(&extra).chain(&torque_row).chain(&signal_row).find(|v| !v.is_finite())
-            {
-                return Err(argument("q", format!("row {i} has {bad}: every value must be finite")));
-            }
-            if payload < 0.0 {
-                return Err(argument("payload_kg", format!("row {i} has {payload} kg: a payload is not negative")));
-            }
-            let tool_name = tools.as_ref().map_or("", |t| t[i].as_str());
-            let tool = self.model.tool_index(tool_name, source, line(i), 0).map_err(to_py)?;
-            rows.push(Measurement {
-                line: line(i),
-                q: row_q,
-                position: lie::Vector3::zeros(),
-                orientation: None,
-                payload_kg: payload,
-                tool,
-                temp_c: temp.as_ref().map(|t| t[i]),
-                t_s: time.as_ref().map(|t| t[i]),
-                torques_nm: torques.as_ref().map(|t| t.row(i).to_vec()),
-                inputs: measurements::Inputs::new(names.clone(), signal_row),
-                std: None,
-            });
-        }
+        let rows = (0..n).map(|i| columns.row(i, &self.model, source)).collect::<PyResult<Vec<_>>>()?;
         // Angles a turn away from the fitted range are taken into it, as `calib predict` does.
         let (rows, wrapped) = model::wrapped(&self.model, &rows);
         // Made here, each row's tool the model's index found above.
@@ -340,6 +292,27 @@ impl Model {
 }
 
 impl Model {
+    /// The model's measured signals in its order, each found by name among those `inputs` gives
+    /// (refused by name where missing) and holding `n` values.
+    #[allow(clippy::type_complexity)]
+    fn signals(
+        &self,
+        inputs: Option<Vec<(String, PyReadonlyArray1<'_, f64>)>>,
+        n: usize,
+    ) -> PyResult<(std::sync::Arc<[String]>, Vec<Vec<f64>>)> {
+        let mut given: std::collections::HashMap<String, PyReadonlyArray1<'_, f64>> =
+            inputs.unwrap_or_default().into_iter().collect();
+        let names = self.model.input_names();
+        let mut signals = Vec::with_capacity(names.len());
+        for name in &names {
+            let values = given.remove(name).ok_or_else(|| {
+                argument("inputs", format!("no values of '{name}', a measured signal the model takes as an input"))
+            })?;
+            signals.push(array_column(name, Some(values), n)?.unwrap_or_default());
+        }
+        Ok((names.into(), signals))
+    }
+
     /// The prediction of `rows` as `calib predict` makes it: poses `[x_mm, y_mm, z_mm]` and, for a
     /// full-pose model, `qw, qx, qy, qz`; standard deviations in mm (and mrad); the refusal of a
     /// non-finite pose; the warnings (first the joints `wrapped` into the fitted range, as the
@@ -375,6 +348,64 @@ impl Model {
             None
         };
         Ok((poses, sigma, warnings))
+    }
+}
+
+/// A per-row argument's values, refused by `name` unless there are `n` of them.
+fn array_column(name: &str, values: Option<PyReadonlyArray1<'_, f64>>, n: usize) -> PyResult<Option<Vec<f64>>> {
+    let Some(values) = values else { return Ok(None) };
+    let values = values.as_array().to_vec();
+    if values.len() != n {
+        return Err(argument(name, format!("{} values for {n} rows", values.len())));
+    }
+    Ok(Some(values))
+}
+
+/// The arguments of `predict` on arrays, their lengths checked: one value (or row) per row.
+struct RowColumns<'a> {
+    q: numpy::ndarray::ArrayView2<'a, f64>,
+    payload: Option<Vec<f64>>,
+    temp: Option<Vec<f64>>,
+    time: Option<Vec<f64>>,
+    torques: Option<numpy::ndarray::Array2<f64>>,
+    /// The model's signals, in the order of `names`.
+    signals: Vec<Vec<f64>>,
+    names: std::sync::Arc<[String]>,
+    tools: Option<Vec<String>>,
+}
+
+impl RowColumns<'_> {
+    /// Row `i` as a measurement on the model's tool (named line `i + 2` of `source`): every value
+    /// finite, the payload not negative.
+    fn row(&self, i: usize, model: &CalibratedModel, source: &str) -> PyResult<Measurement> {
+        let line = i as u64 + 2;
+        let (payload, temp, time, torques) = (&self.payload, &self.temp, &self.time, &self.torques);
+        let row_q: Vec<f64> = self.q.row(i).to_vec();
+        let payload = payload.as_ref().map_or(0.0, |p| p[i]);
+        let extra = [payload, temp.as_ref().map_or(0.0, |t| t[i]), time.as_ref().map_or(0.0, |t| t[i])];
+        let torque_row = torques.as_ref().map(|t| t.row(i).to_vec()).unwrap_or_default();
+        let signal_row: Vec<f64> = self.signals.iter().map(|s| s[i]).collect();
+        if let Some(bad) = row_q.iter().chain(&extra).chain(&torque_row).chain(&signal_row).find(|v| !v.is_finite()) {
+            return Err(argument("q", format!("row {i} has {bad}: every value must be finite")));
+        }
+        if payload < 0.0 {
+            return Err(argument("payload_kg", format!("row {i} has {payload} kg: a payload is not negative")));
+        }
+        let tool_name = self.tools.as_ref().map_or("", |t| t[i].as_str());
+        let tool = model.tool_index(tool_name, source, line, 0).map_err(to_py)?;
+        Ok(Measurement {
+            line,
+            q: row_q,
+            position: lie::Vector3::zeros(),
+            orientation: None,
+            payload_kg: payload,
+            tool,
+            temp_c: temp.as_ref().map(|t| t[i]),
+            t_s: time.as_ref().map(|t| t[i]),
+            torques_nm: torques.as_ref().map(|t| t.row(i).to_vec()),
+            inputs: measurements::Inputs::new(self.names.clone(), signal_row),
+            std: None,
+        })
     }
 }
 

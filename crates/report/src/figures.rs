@@ -189,67 +189,84 @@ pub fn histogram(before: Option<&[f64]>, after: &[f64]) -> Result<String, Error>
 /// after calibration, with the colour scale.
 pub fn workspace(rows: &[RowError]) -> Result<String, Error> {
     let (_, e_max) = span(rows.iter().map(|r| r.after_mm).chain([0.0]), (0.0, 1.0));
-    let colour = |e: f64| viridis(e / e_max);
     // Worst last, so that they are drawn on top.
     let mut order: Vec<&RowError> = rows.iter().collect();
     order.sort_by(|a, b| a.after_mm.total_cmp(&b.after_mm));
-    let coordinate = |r: &RowError, k: usize| r.position_m[k];
     svg("workspace", (1100, 440), |root| {
         let (plots, bar) = root.split_horizontally(990);
         let halves = plots.split_evenly((1, 2));
         for (area, (k, name)) in halves.iter().zip([(1, "y (m)"), (2, "z (m)")]) {
-            let (x0, x1) = span(rows.iter().map(|r| coordinate(r, 0)), (0.0, 1.0));
-            let (y0, y1) = span(rows.iter().map(|r| coordinate(r, k)), (0.0, 1.0));
-            let pad = |a: f64, b: f64| (a - 0.03 * (b - a), b + 0.03 * (b - a));
-            let ((x0, x1), (y0, y1)) = (pad(x0, x1), pad(y0, y1));
-            let title = if k == 1 { "From above (tracker x–y)" } else { "From the side (tracker x–z)" };
-            let mut chart = ChartBuilder::on(area)
-                .caption(title, (FONT, WIDE_CAPTION))
-                .margin(10)
-                .x_label_area_size(50)
-                .y_label_area_size(75)
-                .build_cartesian_2d(x0..x1, y0..y1)
-                .map_err(|e| e.to_string())?;
-            chart
-                .configure_mesh()
-                .label_style((FONT, WIDE_LABEL))
-                .axis_desc_style((FONT, WIDE_LABEL))
-                .x_desc("x (m)")
-                .y_desc(name)
-                .draw()
-                .map_err(|e| e.to_string())?;
-            chart
-                .draw_series(
-                    order
-                        .iter()
-                        .map(|r| Circle::new((coordinate(r, 0), coordinate(r, k)), 3, colour(r.after_mm).filled())),
-                )
-                .map_err(|e| e.to_string())?;
+            workspace_view(area, rows, &order, (k, name), e_max)?;
         }
-        let mut scale = ChartBuilder::on(&bar)
-            .margin_top(40)
-            .margin_bottom(50)
-            .y_label_area_size(80)
-            .build_cartesian_2d(0.0..1.0, 0.0..e_max)
-            .map_err(|e| e.to_string())?;
-        scale
-            .configure_mesh()
-            .disable_x_mesh()
-            .disable_x_axis()
-            .label_style((FONT, WIDE_LABEL))
-            .axis_desc_style((FONT, WIDE_LABEL))
-            .y_desc("error (mm)")
-            .draw()
-            .map_err(|e| e.to_string())?;
-        const STEPS: usize = 64;
-        scale
-            .draw_series((0..STEPS).map(|s| {
-                let (a, b) = (e_max * s as f64 / STEPS as f64, e_max * (s + 1) as f64 / STEPS as f64);
-                Rectangle::new([(0.0, a), (1.0, b)], colour(0.5 * (a + b)).filled())
-            }))
-            .map_err(|e| e.to_string())?;
-        Ok(())
+        error_scale(&bar, e_max)
     })
+}
+
+/// One view of the workspace: tracker x against coordinate `k` (named `name`), each pose a dot
+/// coloured by its error (the colour scale's top `e_max`), `order` drawn in turn.
+fn workspace_view(
+    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    rows: &[RowError],
+    order: &[&RowError],
+    (k, name): (usize, &str),
+    e_max: f64,
+) -> Result<(), String> {
+    let colour = |e: f64| viridis(e / e_max);
+    let coordinate = |r: &RowError, k: usize| r.position_m[k];
+    let (x0, x1) = span(rows.iter().map(|r| coordinate(r, 0)), (0.0, 1.0));
+    let (y0, y1) = span(rows.iter().map(|r| coordinate(r, k)), (0.0, 1.0));
+    let pad = |a: f64, b: f64| (a - 0.03 * (b - a), b + 0.03 * (b - a));
+    let ((x0, x1), (y0, y1)) = (pad(x0, x1), pad(y0, y1));
+    let title = if k == 1 { "From above (tracker x–y)" } else { "From the side (tracker x–z)" };
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, (FONT, WIDE_CAPTION))
+        .margin(10)
+        .x_label_area_size(50)
+        .y_label_area_size(75)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .label_style((FONT, WIDE_LABEL))
+        .axis_desc_style((FONT, WIDE_LABEL))
+        .x_desc("x (m)")
+        .y_desc(name)
+        .draw()
+        .map_err(|e| e.to_string())?;
+    chart
+        .draw_series(
+            order.iter().map(|r| Circle::new((coordinate(r, 0), coordinate(r, k)), 3, colour(r.after_mm).filled())),
+        )
+        .map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+/// The colour scale of the workspace's errors, 0 to `e_max` mm, in `bar`.
+fn error_scale(bar: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, e_max: f64) -> Result<(), String> {
+    let colour = |e: f64| viridis(e / e_max);
+    let mut scale = ChartBuilder::on(bar)
+        .margin_top(40)
+        .margin_bottom(50)
+        .y_label_area_size(80)
+        .build_cartesian_2d(0.0..1.0, 0.0..e_max)
+        .map_err(|e| e.to_string())?;
+    scale
+        .configure_mesh()
+        .disable_x_mesh()
+        .disable_x_axis()
+        .label_style((FONT, WIDE_LABEL))
+        .axis_desc_style((FONT, WIDE_LABEL))
+        .y_desc("error (mm)")
+        .draw()
+        .map_err(|e| e.to_string())?;
+    const STEPS: usize = 64;
+    scale
+        .draw_series((0..STEPS).map(|s| {
+            let (a, b) = (e_max * s as f64 / STEPS as f64, e_max * (s + 1) as f64 / STEPS as f64);
+            Rectangle::new([(0.0, a), (1.0, b)], colour(0.5 * (a + b)).filled())
+        }))
+        .map_err(|e| e.to_string())?;
+    Ok(())
 }
 
 /// An effect's joint error over its joint's angle with its σ band, the fitted arcs shaded, and
@@ -277,48 +294,8 @@ pub fn effect_curve(label: &str, curve: &EffectCurve) -> Result<String, Error> {
             .y_desc("joint error (µrad)")
             .draw()
             .map_err(|e| e.to_string())?;
-        chart
-            .draw_series(
-                curve.fitted_deg.iter().map(|&[a, b]| Rectangle::new([(a, y0), (b, y1)], AFTER.mix(0.06).filled())),
-            )
-            .map_err(|e| e.to_string())?
-            .label("fitted angles")
-            .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], AFTER.mix(0.15).filled()));
-        let upper = curve.angle_deg.iter().zip(&curve.error_urad).zip(&curve.sigma_urad).map(|((&a, e), s)| (a, e + s));
-        let lower = curve.angle_deg.iter().zip(&curve.error_urad).zip(&curve.sigma_urad).map(|((&a, e), s)| (a, e - s));
-        let polygon: Vec<(f64, f64)> = upper.chain(lower.rev()).collect();
-        chart
-            .draw_series(std::iter::once(Polygon::new(polygon, AFTER.mix(0.25).filled())))
-            .map_err(|e| e.to_string())?
-            .label("± σ left uncorrected")
-            .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], AFTER.mix(0.25).filled()));
-        chart
-            .draw_series(LineSeries::new(
-                curve.angle_deg.iter().copied().zip(curve.error_urad.iter().copied()),
-                AFTER.stroke_width(2),
-            ))
-            .map_err(|e| e.to_string())?
-            .label("joint error applied")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 12, y)], AFTER.stroke_width(2)));
-        let tick = 0.05 * (y1 - y0);
-        // One tick per pixel of the ~560-pixel plot: a campaign's 1,400 angles drawn as at most
-        // 560 marks, the same picture in a third of the bytes.
-        let distinct = |angles: &[f64]| distinct_at(angles, (x1 - x0) / 560.0);
-        let (training, test) = (distinct(&curve.training_deg), distinct(&curve.test_deg));
-        if !curve.training_deg.is_empty() {
-            chart
-                .draw_series(
-                    training.iter().map(|&a| PathElement::new(vec![(a, y1), (a, y1 - tick)], TRAINING.mix(0.6))),
-                )
-                .map_err(|e| e.to_string())?
-                .label("training angles")
-                .legend(|(x, y)| PathElement::new(vec![(x + 6, y - 5), (x + 6, y + 5)], TRAINING));
-        }
-        chart
-            .draw_series(test.iter().map(|&a| PathElement::new(vec![(a, y0), (a, y0 + tick)], BLACK.mix(0.4))))
-            .map_err(|e| e.to_string())?
-            .label("test angles")
-            .legend(|(x, y)| PathElement::new(vec![(x + 6, y - 5), (x + 6, y + 5)], BLACK.mix(0.5)));
+        draw_effect_error(&mut chart, curve, (y0, y1))?;
+        draw_angle_ticks(&mut chart, curve, (x0, x1), (y0, y1))?;
         let mut entries = vec![
             ("fitted angles", Glyph::Box(AFTER.mix(0.15))),
             ("± σ left uncorrected", Glyph::Box(AFTER.mix(0.25))),
@@ -330,6 +307,68 @@ pub fn effect_curve(label: &str, curve: &EffectCurve) -> Result<String, Error> {
         entries.push(("test angles (bottom)", Glyph::Tick(BLACK.mix(0.5))));
         side_legend(&legend, &entries)
     })
+}
+
+/// A chart of the SVG figures, f64 on both axes.
+type Chart<'a, 'b> = ChartContext<
+    'a,
+    SVGBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// The fitted arcs shaded from `y0` to `y1`, the σ band and the joint error applied.
+fn draw_effect_error(chart: &mut Chart<'_, '_>, curve: &EffectCurve, (y0, y1): (f64, f64)) -> Result<(), String> {
+    chart
+        .draw_series(
+            curve.fitted_deg.iter().map(|&[a, b]| Rectangle::new([(a, y0), (b, y1)], AFTER.mix(0.06).filled())),
+        )
+        .map_err(|e| e.to_string())?
+        .label("fitted angles")
+        .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], AFTER.mix(0.15).filled()));
+    let upper = curve.angle_deg.iter().zip(&curve.error_urad).zip(&curve.sigma_urad).map(|((&a, e), s)| (a, e + s));
+    let lower = curve.angle_deg.iter().zip(&curve.error_urad).zip(&curve.sigma_urad).map(|((&a, e), s)| (a, e - s));
+    let polygon: Vec<(f64, f64)> = upper.chain(lower.rev()).collect();
+    chart
+        .draw_series(std::iter::once(Polygon::new(polygon, AFTER.mix(0.25).filled())))
+        .map_err(|e| e.to_string())?
+        .label("± σ left uncorrected")
+        .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], AFTER.mix(0.25).filled()));
+    chart
+        .draw_series(LineSeries::new(
+            curve.angle_deg.iter().copied().zip(curve.error_urad.iter().copied()),
+            AFTER.stroke_width(2),
+        ))
+        .map_err(|e| e.to_string())?
+        .label("joint error applied")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 12, y)], AFTER.stroke_width(2)));
+    Ok(())
+}
+
+/// The training angles as ticks down from the top, the test angles up from the bottom.
+fn draw_angle_ticks(
+    chart: &mut Chart<'_, '_>,
+    curve: &EffectCurve,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Result<(), String> {
+    let tick = 0.05 * (y1 - y0);
+    // One tick per pixel of the ~560-pixel plot: a campaign's 1,400 angles drawn as at most
+    // 560 marks, the same picture in a third of the bytes.
+    let distinct = |angles: &[f64]| distinct_at(angles, (x1 - x0) / 560.0);
+    let (training, test) = (distinct(&curve.training_deg), distinct(&curve.test_deg));
+    if !curve.training_deg.is_empty() {
+        chart
+            .draw_series(training.iter().map(|&a| PathElement::new(vec![(a, y1), (a, y1 - tick)], TRAINING.mix(0.6))))
+            .map_err(|e| e.to_string())?
+            .label("training angles")
+            .legend(|(x, y)| PathElement::new(vec![(x + 6, y - 5), (x + 6, y + 5)], TRAINING));
+    }
+    chart
+        .draw_series(test.iter().map(|&a| PathElement::new(vec![(a, y0), (a, y0 + tick)], BLACK.mix(0.4))))
+        .map_err(|e| e.to_string())?
+        .label("test angles")
+        .legend(|(x, y)| PathElement::new(vec![(x + 6, y - 5), (x + 6, y + 5)], BLACK.mix(0.5)));
+    Ok(())
 }
 
 /// How a legend entry is drawn.

@@ -105,9 +105,8 @@ fn card(out: &mut String, key: &str, label: &str, value: f64, unit: &str, sub: &
     );
 }
 
-fn summary(out: &mut String, r: &Report) {
-    open(out, "summary");
-    out.push_str("<div class=\"cards\">");
+/// The summary's cards: the position errors after calibration, each with its value before.
+fn summary_cards(out: &mut String, r: &Report) {
     let after = &r.after_groups.all;
     let before_sub = |pick: fn(&ErrorStats) -> f64| {
         r.before.as_ref().map_or_else(
@@ -150,6 +149,12 @@ fn summary(out: &mut String, r: &Report) {
     if let Some(rotation) = after.summary.mean_rotation_error_mrad {
         card(out, "card.rotation", "Mean rotation error", rotation, "mrad", "full-pose data");
     }
+}
+
+fn summary(out: &mut String, r: &Report) {
+    open(out, "summary");
+    out.push_str("<div class=\"cards\">");
+    summary_cards(out, r);
     out.push_str("</div>\n");
     let _ = write!(
         out,
@@ -575,7 +580,18 @@ pub(crate) fn diagnosis_section(out: &mut String, d: &Diagnosis, plots: &[(Strin
     );
     card(out, "diagnosis.noise_floor_mm", "Noise floor", d.noise.floor_mm, "mm", "what no model can remove");
     out.push_str("</div>");
-    let left = match &d.remaining {
+    let left = what_is_left(d);
+    let _ = write!(out, "<p>{}</p><pre>{}</pre>", escape(&left), escape(&d.summary()));
+    candidate_table(out, d);
+    for (name, svg) in plots {
+        let _ = write!(out, "<figure>{svg}<figcaption>{}</figcaption></figure>", escape(name));
+    }
+    out.push_str("</section>\n");
+}
+
+/// What the diagnosis says is left after the selected effects: structure a GP finds, or not.
+fn what_is_left(d: &Diagnosis) -> String {
+    match &d.remaining {
         Some(gp) if gp.significant => format!(
             "What is left: a GP on what the selected effects leave still lowers the held-out error to {:.4} mm \
              (z = {:.1}, {:.0} % less): structure no listed effect explains.",
@@ -591,8 +607,11 @@ pub(crate) fn diagnosis_section(out: &mut String, d: &Diagnosis, plots: &[(Strin
             100.0 * gp.gain
         ),
         None => "What is left: not checked by a GP.".to_owned(),
-    };
-    let _ = write!(out, "<p>{}</p><pre>{}</pre>", escape(&left), escape(&d.summary()));
+    }
+}
+
+/// Each candidate effect alone: its parameters and held-out mean error.
+fn candidate_table(out: &mut String, d: &Diagnosis) {
     out.push_str("<table><tr><th class=\"l\">candidate alone</th><th>parameters</th><th>held-out mean (mm)</th></tr>");
     for c in &d.candidates {
         let joints: Vec<String> = c.joints.iter().map(ToString::to_string).collect();
@@ -607,10 +626,6 @@ pub(crate) fn diagnosis_section(out: &mut String, d: &Diagnosis, plots: &[(Strin
         );
     }
     out.push_str("</table>");
-    for (name, svg) in plots {
-        let _ = write!(out, "<figure>{svg}<figcaption>{}</figcaption></figure>", escape(name));
-    }
-    out.push_str("</section>\n");
 }
 
 /// The diagnosis alone as a page (`diagnosis.html` of `calib diagnose --report`).

@@ -121,82 +121,68 @@ impl RobotDescription {
         }
         crate::robot_check::check_values(self, text, file)?;
         crate::robot_check::check_chain(self, Some(text), file)?;
+        // The n-th `limits_deg` (or `limits_m`) in the file belongs to the n-th joint of its kind.
         let (mut deg_index, mut m_index) = (0, 0);
         for (i, joint) in self.joints.iter().enumerate() {
-            let norm = Vector3::from(joint.axis).norm();
-            if (norm - 1.0).abs() > UNIT_TOLERANCE {
-                return Err(at("axis", i, format!("joint {}: axis has norm {norm}, expected 1", i + 1)));
-            }
-            if !scale_in_bounds(joint.scale) {
-                let (lo, hi) = SCALE_BOUNDS;
-                let message =
-                    format!("joint {}: scale {:e} must be a finite number from {lo:e} to {hi:e}", i + 1, joint.scale);
-                let before = self.joints[..i].iter().filter(|j| j.scale != 1.0).count();
-                return Err(at("scale", before, message));
-            }
-            if let Some(pitch) = joint.pitch_mm {
-                let before = self.joints[..i].iter().filter(|j| j.pitch_mm.is_some()).count();
-                let (lo, hi) = crate::PITCH_BOUNDS_MM;
-                if joint.kind != JointKind::Prismatic {
-                    let message = format!(
-                        "joint {}: pitch_mm is a linear axis's screw lead, and joint {} is {:?}",
-                        i + 1,
-                        i + 1,
-                        joint.kind
-                    );
-                    return Err(at("pitch_mm", before, message));
-                }
-                if !(lo..=hi).contains(&pitch) {
-                    let message = format!("joint {}: pitch_mm {pitch:e} must be a number from {lo} to {hi} mm", i + 1);
-                    return Err(at("pitch_mm", before, message));
-                }
-            }
-            if !joint.axis.iter().chain(&joint.point).all(|v| v.is_finite()) {
-                return Err(at("axis", i, format!("joint {}: axis or point is not finite", i + 1)));
-            }
-            let limit = crate::MAX_TRANSLATION_M;
-            if let Some(v) = joint.point.iter().find(|v| v.abs() > limit) {
-                let message =
-                    format!("joint {}: point coordinate {v:e} m is beyond ±{limit:e} m, larger than any robot", i + 1);
-                return Err(at("point", i, message));
-            }
-            let (limits, field, index) = match joint.kind {
-                JointKind::Revolute => (joint.limits_deg, "limits_deg", &mut deg_index),
-                JointKind::Prismatic => (joint.limits_m, "limits_m", &mut m_index),
+            self.check_joint_geometry(i, &at)?;
+            let index = match joint.kind {
+                JointKind::Revolute => &mut deg_index,
+                JointKind::Prismatic => &mut m_index,
             };
-            let other = match joint.kind {
-                JointKind::Revolute => joint.limits_m.map(|_| "limits_m"),
-                JointKind::Prismatic => joint.limits_deg.map(|_| "limits_deg"),
-            };
-            if let Some(other) = other {
-                return Err(at("kind", i, format!("joint {}: {other} does not fit a {:?} joint", i + 1, joint.kind)));
+            check_joint_limits(i, joint, index, &at)?;
+        }
+        self.check_flange(&at)?;
+        if let Some(dynamics) = &self.dynamics {
+            check_dynamics(dynamics, self.joints.len(), &at)?;
+        }
+        Ok(())
+    }
+
+    /// Joint `i`'s axis, scale, screw pitch and point: a unit axis, numbers in their bounds.
+    fn check_joint_geometry(&self, i: usize, at: &impl Fn(&str, usize, String) -> Error) -> Result<(), Error> {
+        let joint = &self.joints[i];
+        let norm = Vector3::from(joint.axis).norm();
+        if (norm - 1.0).abs() > UNIT_TOLERANCE {
+            return Err(at("axis", i, format!("joint {}: axis has norm {norm}, expected 1", i + 1)));
+        }
+        if !scale_in_bounds(joint.scale) {
+            let (lo, hi) = SCALE_BOUNDS;
+            let message =
+                format!("joint {}: scale {:e} must be a finite number from {lo:e} to {hi:e}", i + 1, joint.scale);
+            let before = self.joints[..i].iter().filter(|j| j.scale != 1.0).count();
+            return Err(at("scale", before, message));
+        }
+        if let Some(pitch) = joint.pitch_mm {
+            let before = self.joints[..i].iter().filter(|j| j.pitch_mm.is_some()).count();
+            let (lo, hi) = crate::PITCH_BOUNDS_MM;
+            if joint.kind != JointKind::Prismatic {
+                let message = format!(
+                    "joint {}: pitch_mm is a linear axis's screw lead, and joint {} is {:?}",
+                    i + 1,
+                    i + 1,
+                    joint.kind
+                );
+                return Err(at("pitch_mm", before, message));
             }
-            match limits {
-                None => return Err(at("kind", i, format!("joint {}: {field} is required", i + 1))),
-                Some((lo, hi)) if !(lo.is_finite() && hi.is_finite() && lo < hi) => {
-                    return Err(at(
-                        field,
-                        *index,
-                        format!("joint {}: limits ({lo}, {hi}) must be finite and increasing", i + 1),
-                    ));
-                }
-                Some((lo, hi)) => {
-                    let (bound, unit) = limit_bound(joint.kind);
-                    let si = if joint.kind == JointKind::Revolute { 1f64.to_radians() } else { 1.0 };
-                    if lo.abs().max(hi.abs()) * si > bound {
-                        return Err(at(
-                            field,
-                            *index,
-                            format!(
-                                "joint {}: limits ({lo:e}, {hi:e}) reach beyond ±{bound:e} {unit}, further than any joint moves",
-                                i + 1
-                            ),
-                        ));
-                    }
-                    *index += 1;
-                }
+            if !(lo..=hi).contains(&pitch) {
+                let message = format!("joint {}: pitch_mm {pitch:e} must be a number from {lo} to {hi} mm", i + 1);
+                return Err(at("pitch_mm", before, message));
             }
         }
+        if !joint.axis.iter().chain(&joint.point).all(|v| v.is_finite()) {
+            return Err(at("axis", i, format!("joint {}: axis or point is not finite", i + 1)));
+        }
+        let limit = crate::MAX_TRANSLATION_M;
+        if let Some(v) = joint.point.iter().find(|v| v.abs() > limit) {
+            let message =
+                format!("joint {}: point coordinate {v:e} m is beyond ±{limit:e} m, larger than any robot", i + 1);
+            return Err(at("point", i, message));
+        }
+        Ok(())
+    }
+
+    /// The flange's axes: unit length and perpendicular.
+    fn check_flange(&self, at: &impl Fn(&str, usize, String) -> Error) -> Result<(), Error> {
         let x = Vector3::from(self.flange.x_axis);
         let z = Vector3::from(self.flange.z_axis);
         for (name, axis) in [("x_axis", x), ("z_axis", z)] {
@@ -207,26 +193,76 @@ impl RobotDescription {
         if x.dot(&z).abs() > UNIT_TOLERANCE {
             return Err(at("x_axis", 0, format!("flange x_axis and z_axis are not perpendicular (dot {})", x.dot(&z))));
         }
-        if let Some(dynamics) = &self.dynamics {
-            let n = self.joints.len();
-            if dynamics.links.len() != n {
-                return Err(at("links", 0, format!("{} links given, the robot has {n} joints", dynamics.links.len())));
-            }
-            // Left out (empty) where not known: compliance then cannot be simulated, nothing else needs it.
-            if !dynamics.stiffness_nm_per_rad.is_empty() && dynamics.stiffness_nm_per_rad.len() != n {
-                return Err(at(
-                    "stiffness_nm_per_rad",
-                    0,
-                    format!("{} stiffness values given, the robot has {n} joints", dynamics.stiffness_nm_per_rad.len()),
-                ));
-            }
-            if let Some(k) = dynamics.stiffness_nm_per_rad.iter().position(|k| !(k.is_finite() && *k > 0.0)) {
-                return Err(at("stiffness_nm_per_rad", 0, format!("joint {}: stiffness must be positive", k + 1)));
-            }
-            if let Some(k) = dynamics.links.iter().position(|l| !(l.mass_kg.is_finite() && l.mass_kg >= 0.0)) {
-                return Err(at("mass_kg", k, format!("link {}: mass must be finite and not negative", k + 1)));
-            }
-        }
         Ok(())
     }
+}
+
+/// Joint `i`'s limits: the field its kind takes (and not the other), finite, increasing and
+/// within reach; `index` counts the earlier joints whose limits sit in the same field.
+fn check_joint_limits(
+    i: usize,
+    joint: &JointDescription,
+    index: &mut usize,
+    at: &impl Fn(&str, usize, String) -> Error,
+) -> Result<(), Error> {
+    let (limits, field) = match joint.kind {
+        JointKind::Revolute => (joint.limits_deg, "limits_deg"),
+        JointKind::Prismatic => (joint.limits_m, "limits_m"),
+    };
+    let other = match joint.kind {
+        JointKind::Revolute => joint.limits_m.map(|_| "limits_m"),
+        JointKind::Prismatic => joint.limits_deg.map(|_| "limits_deg"),
+    };
+    if let Some(other) = other {
+        return Err(at("kind", i, format!("joint {}: {other} does not fit a {:?} joint", i + 1, joint.kind)));
+    }
+    match limits {
+        None => Err(at("kind", i, format!("joint {}: {field} is required", i + 1))),
+        Some((lo, hi)) if !(lo.is_finite() && hi.is_finite() && lo < hi) => {
+            Err(at(field, *index, format!("joint {}: limits ({lo}, {hi}) must be finite and increasing", i + 1)))
+        }
+        Some((lo, hi)) => {
+            let (bound, unit) = limit_bound(joint.kind);
+            let si = if joint.kind == JointKind::Revolute { 1f64.to_radians() } else { 1.0 };
+            if lo.abs().max(hi.abs()) * si > bound {
+                return Err(at(
+                    field,
+                    *index,
+                    format!(
+                        "joint {}: limits ({lo:e}, {hi:e}) reach beyond ±{bound:e} {unit}, further than any joint moves",
+                        i + 1
+                    ),
+                ));
+            }
+            *index += 1;
+            Ok(())
+        }
+    }
+}
+
+/// The dynamics section: one link per joint, stiffness (when given) one per joint and positive,
+/// masses finite and not negative.
+fn check_dynamics(
+    dynamics: &dynamics::RobotDynamics,
+    n: usize,
+    at: &impl Fn(&str, usize, String) -> Error,
+) -> Result<(), Error> {
+    if dynamics.links.len() != n {
+        return Err(at("links", 0, format!("{} links given, the robot has {n} joints", dynamics.links.len())));
+    }
+    // Left out (empty) where not known: compliance then cannot be simulated, nothing else needs it.
+    if !dynamics.stiffness_nm_per_rad.is_empty() && dynamics.stiffness_nm_per_rad.len() != n {
+        return Err(at(
+            "stiffness_nm_per_rad",
+            0,
+            format!("{} stiffness values given, the robot has {n} joints", dynamics.stiffness_nm_per_rad.len()),
+        ));
+    }
+    if let Some(k) = dynamics.stiffness_nm_per_rad.iter().position(|k| !(k.is_finite() && *k > 0.0)) {
+        return Err(at("stiffness_nm_per_rad", 0, format!("joint {}: stiffness must be positive", k + 1)));
+    }
+    if let Some(k) = dynamics.links.iter().position(|l| !(l.mass_kg.is_finite() && l.mass_kg >= 0.0)) {
+        return Err(at("mass_kg", k, format!("link {}: mass must be finite and not negative", k + 1)));
+    }
+    Ok(())
 }

@@ -216,51 +216,8 @@ impl UrdfDocument {
 
     /// The chain between the links `ends` names (or the only candidates).
     pub fn chain(&self, ends: &ChainEnds) -> Result<UrdfChain, Error> {
-        let base = match &ends.base_link {
-            Some(base) => {
-                self.link_exists(base, "--base-link")?;
-                base.clone()
-            }
-            None => self.root_link()?,
-        };
-        let tip = match &ends.tip_link {
-            Some(tip) => {
-                self.link_exists(tip, "--tip-link")?;
-                tip.clone()
-            }
-            None => self.deepest_leaf(&self.fixed_top(&base), &base)?,
-        };
-        // Ancestors of each end, nearest first, as (link, joint above it).
-        let up = |from: &str| {
-            let mut path = vec![from.to_owned()];
-            let mut on_path: HashSet<String> = path.iter().cloned().collect();
-            while let Some(joint) = self.parent_joint(path.last().map_or("", String::as_str)) {
-                if !on_path.insert(joint.parent.clone()) {
-                    break;
-                }
-                path.push(joint.parent.clone());
-            }
-            (path, on_path)
-        };
-        let ((from_base, _), (from_tip, tip_links)) = (up(&base), up(&tip));
-        let Some(meet) = from_base.iter().position(|l| tip_links.contains(l)) else {
-            return Err(self.error_at("link", &tip, format!("no chain joins base link '{base}' and tip link '{tip}'")));
-        };
-        let down = from_tip.iter().position(|l| *l == from_base[meet]).unwrap_or(0);
-        let mut steps = Vec::new();
-        for link in &from_base[..meet] {
-            steps.push(self.step(link, true, &base, &tip)?);
-        }
-        for link in from_tip[..down].iter().rev() {
-            steps.push(self.step(link, false, &base, &tip)?);
-        }
-        if steps.iter().all(|s| s.motion == StepMotion::Fixed) {
-            return Err(self.error_at(
-                "link",
-                &tip,
-                format!("no movable joint between base link '{base}' and tip link '{tip}'"),
-            ));
-        }
+        let (base, tip) = self.chain_ends(ends)?;
+        let (steps, from_base) = self.steps_between(&base, &tip)?;
         let frames = link_frames(&steps);
         let off_chain = self.off_chain_drivers(&steps, &from_base, &base, &tip)?;
         let joints = fold(&steps, &frames, &off_chain).map_err(|refusal| {
@@ -283,6 +240,63 @@ impl UrdfDocument {
             dynamics,
             joints_without_mass,
         })
+    }
+
+    /// The base and tip links: those `ends` names, checked, or the root and its deepest leaf.
+    fn chain_ends(&self, ends: &ChainEnds) -> Result<(String, String), Error> {
+        let base = match &ends.base_link {
+            Some(base) => {
+                self.link_exists(base, "--base-link")?;
+                base.clone()
+            }
+            None => self.root_link()?,
+        };
+        let tip = match &ends.tip_link {
+            Some(tip) => {
+                self.link_exists(tip, "--tip-link")?;
+                tip.clone()
+            }
+            None => self.deepest_leaf(&self.fixed_top(&base), &base)?,
+        };
+        Ok((base, tip))
+    }
+
+    /// `from` and its ancestors, nearest first, as a path and as a set (a loop ends the path).
+    fn ancestors(&self, from: &str) -> (Vec<String>, HashSet<String>) {
+        let mut path = vec![from.to_owned()];
+        let mut on_path: HashSet<String> = path.iter().cloned().collect();
+        while let Some(joint) = self.parent_joint(path.last().map_or("", String::as_str)) {
+            if !on_path.insert(joint.parent.clone()) {
+                break;
+            }
+            path.push(joint.parent.clone());
+        }
+        (path, on_path)
+    }
+
+    /// The steps from `base` up to where its ancestors meet the tip's, then down to `tip`, with
+    /// the base link and its ancestors; refused when no chain joins them or none of its joints moves.
+    fn steps_between(&self, base: &str, tip: &str) -> Result<(Vec<ChainStep>, Vec<String>), Error> {
+        let ((from_base, _), (from_tip, tip_links)) = (self.ancestors(base), self.ancestors(tip));
+        let Some(meet) = from_base.iter().position(|l| tip_links.contains(l)) else {
+            return Err(self.error_at("link", tip, format!("no chain joins base link '{base}' and tip link '{tip}'")));
+        };
+        let down = from_tip.iter().position(|l| *l == from_base[meet]).unwrap_or(0);
+        let mut steps = Vec::new();
+        for link in &from_base[..meet] {
+            steps.push(self.step(link, true, base, tip)?);
+        }
+        for link in from_tip[..down].iter().rev() {
+            steps.push(self.step(link, false, base, tip)?);
+        }
+        if steps.iter().all(|s| s.motion == StepMotion::Fixed) {
+            return Err(self.error_at(
+                "link",
+                tip,
+                format!("no movable joint between base link '{base}' and tip link '{tip}'"),
+            ));
+        }
+        Ok((steps, from_base))
     }
 
     /// The joints the chain's mimic joints follow that are defined but not on the chain, by name:
@@ -387,77 +401,21 @@ impl UrdfDocument {
         let joint = self
             .parent_joint(link)
             .ok_or_else(|| self.error_at("link", link, format!("link '{link}' has no parent joint")))?;
-        let refuse =
-            |message: String| self.error_at("joint", &joint.name, format!("joint '{}': {message}", joint.name));
         let numbers = joint.origin.xyz.iter().chain(joint.origin.rpy.iter());
         if !numbers.chain(joint.axis.iter()).all(|v| v.is_finite()) {
-            return Err(refuse("origin and axis must be finite".into()));
+            return Err(self.refuse_joint(joint, "origin and axis must be finite".into()));
         }
         let has_limit = self.element("joint", &joint.name).is_some_and(|e| e.child("limit").is_some());
-        let mimic = match (&joint.mimic, joint.joint_type == UrdfJointType::Fixed) {
-            (Some(m), false) => {
-                let (multiplier, offset) = (m.multiplier.unwrap_or(1.0), m.offset.unwrap_or(0.0));
-                if !(multiplier.is_finite() && offset.is_finite()) {
-                    let element = self.element("joint", &joint.name).and_then(|e| e.child("mimic"));
-                    return Err(self.at(
-                        element.map_or(self.outline.position, |e| e.position),
-                        format!(
-                            "joint '{}': mimic multiplier {multiplier} and offset {offset} must be finite",
-                            joint.name
-                        ),
-                    ));
-                }
-                Some(StepMimic { joint: m.joint.clone(), multiplier, offset })
-            }
-            _ => None,
-        };
-        // A mimic joint's limits are its motor's: where it has none, it takes the followed joint's.
-        let unlimited_mimic = mimic.is_some() && !has_limit;
-        let (lower, upper) = (joint.limit.lower, joint.limit.upper);
-        let limits = || -> Result<(f64, f64), String> {
-            if !has_limit {
-                return Err("a <limit lower=.. upper=..> is required".into());
-            }
-            if !(lower.is_finite() && upper.is_finite() && lower < upper) {
-                return Err(format!("limits lower {lower} upper {upper} must be finite and increasing"));
-            }
-            let kind =
-                if joint.joint_type == UrdfJointType::Prismatic { JointKind::Prismatic } else { JointKind::Revolute };
-            let (bound, unit) = crate::description::limit_bound(kind);
-            if lower.abs().max(upper.abs()) > bound {
-                return Err(format!(
-                    "limits lower {lower:e} upper {upper:e} reach beyond ±{bound:e} {unit}, further than any joint moves"
-                ));
-            }
-            Ok((lower, upper))
-        };
-        use UrdfJointType as T;
-        let motion = match joint.joint_type {
-            T::Fixed => StepMotion::Fixed,
-            T::Continuous => StepMotion::Revolute { limits_rad: None },
-            // URDF 1.2 leaves out limits to mean none: both infinite.
-            T::Revolute if has_limit && lower == f64::NEG_INFINITY && upper == f64::INFINITY => {
-                StepMotion::Revolute { limits_rad: None }
-            }
-            T::Revolute if unlimited_mimic => StepMotion::Revolute { limits_rad: None },
-            T::Revolute => StepMotion::Revolute { limits_rad: Some(limits().map_err(refuse)?) },
-            T::Prismatic if unlimited_mimic => StepMotion::Prismatic { limits_m: (f64::NEG_INFINITY, f64::INFINITY) },
-            T::Prismatic => StepMotion::Prismatic { limits_m: limits().map_err(refuse)? },
-            other => {
-                return Err(refuse(format!(
-                    "{} joints cannot be calibrated (only revolute, continuous, prismatic and fixed); choose the chain's ends with --base-link/--tip-link",
-                    other.name()
-                )));
-            }
-        };
+        let mimic = self.step_mimic(joint)?;
+        let motion = self.step_motion(joint, has_limit, mimic.is_some())?;
         if motion != StepMotion::Fixed && reversed {
-            return Err(refuse(format!(
+            return Err(self.refuse_joint(joint, format!(
                 "the chain from '{base}' to '{tip}' runs through this movable joint from child to parent; choose a base link above it"
             )));
         }
         let axis = Vector3::from(joint.axis);
         if motion != StepMotion::Fixed && axis.norm() < ZERO_AXIS {
-            return Err(refuse("the axis is zero".into()));
+            return Err(self.refuse_joint(joint, "the axis is zero".into()));
         }
         // Each angle brought into one turn first: the rotation is the same, and an angle such as
         // 1e308 no longer overflows the exponential map into NaN (found by `cargo xtask fuzz`).
@@ -481,6 +439,80 @@ impl UrdfDocument {
             mimic,
         })
     }
+
+    /// `joint`'s refusal, placed at its element.
+    fn refuse_joint(&self, joint: &UrdfJoint, message: String) -> Error {
+        self.error_at("joint", &joint.name, format!("joint '{}': {message}", joint.name))
+    }
+
+    /// The joint `joint` mimics, with a finite multiplier and offset; none for a fixed joint.
+    fn step_mimic(&self, joint: &UrdfJoint) -> Result<Option<StepMimic>, Error> {
+        match (&joint.mimic, joint.joint_type == UrdfJointType::Fixed) {
+            (Some(m), false) => {
+                let (multiplier, offset) = (m.multiplier.unwrap_or(1.0), m.offset.unwrap_or(0.0));
+                if !(multiplier.is_finite() && offset.is_finite()) {
+                    let element = self.element("joint", &joint.name).and_then(|e| e.child("mimic"));
+                    return Err(self.at(
+                        element.map_or(self.outline.position, |e| e.position),
+                        format!(
+                            "joint '{}': mimic multiplier {multiplier} and offset {offset} must be finite",
+                            joint.name
+                        ),
+                    ));
+                }
+                Ok(Some(StepMimic { joint: m.joint.clone(), multiplier, offset }))
+            }
+            _ => Ok(None),
+        }
+    }
+
+    /// How `joint` moves, with its limits; refused for a type that cannot be calibrated or
+    /// limits that are missing or out of bounds.
+    fn step_motion(&self, joint: &UrdfJoint, has_limit: bool, mimic: bool) -> Result<StepMotion, Error> {
+        let refuse = |message: String| self.refuse_joint(joint, message);
+        // A mimic joint's limits are its motor's: where it has none, it takes the followed joint's.
+        let unlimited_mimic = mimic && !has_limit;
+        let (lower, upper) = (joint.limit.lower, joint.limit.upper);
+        let limits = || checked_limits(joint, has_limit);
+        use UrdfJointType as T;
+        Ok(match joint.joint_type {
+            T::Fixed => StepMotion::Fixed,
+            T::Continuous => StepMotion::Revolute { limits_rad: None },
+            // URDF 1.2 leaves out limits to mean none: both infinite.
+            T::Revolute if has_limit && lower == f64::NEG_INFINITY && upper == f64::INFINITY => {
+                StepMotion::Revolute { limits_rad: None }
+            }
+            T::Revolute if unlimited_mimic => StepMotion::Revolute { limits_rad: None },
+            T::Revolute => StepMotion::Revolute { limits_rad: Some(limits().map_err(refuse)?) },
+            T::Prismatic if unlimited_mimic => StepMotion::Prismatic { limits_m: (f64::NEG_INFINITY, f64::INFINITY) },
+            T::Prismatic => StepMotion::Prismatic { limits_m: limits().map_err(refuse)? },
+            other => {
+                return Err(refuse(format!(
+                    "{} joints cannot be calibrated (only revolute, continuous, prismatic and fixed); choose the chain's ends with --base-link/--tip-link",
+                    other.name()
+                )));
+            }
+        })
+    }
+}
+
+/// `joint`'s limits: given, finite, increasing and within reach of any joint of its kind.
+fn checked_limits(joint: &UrdfJoint, has_limit: bool) -> Result<(f64, f64), String> {
+    let (lower, upper) = (joint.limit.lower, joint.limit.upper);
+    if !has_limit {
+        return Err("a <limit lower=.. upper=..> is required".into());
+    }
+    if !(lower.is_finite() && upper.is_finite() && lower < upper) {
+        return Err(format!("limits lower {lower} upper {upper} must be finite and increasing"));
+    }
+    let kind = if joint.joint_type == UrdfJointType::Prismatic { JointKind::Prismatic } else { JointKind::Revolute };
+    let (bound, unit) = crate::description::limit_bound(kind);
+    if lower.abs().max(upper.abs()) > bound {
+        return Err(format!(
+            "limits lower {lower:e} upper {upper:e} reach beyond ±{bound:e} {unit}, further than any joint moves"
+        ));
+    }
+    Ok((lower, upper))
 }
 
 impl LinkTree for UrdfDocument {

@@ -99,7 +99,6 @@ pub(crate) fn fold(
     frames: &[SE3],
     off_chain: &HashMap<String, OffChain>,
 ) -> Result<Vec<ChainJoint>, FoldRefusal> {
-    let axis = |k: usize| frames[k].rotation().act(&steps[k].axis);
     let mut joints: Vec<ChainJoint> = Vec::new();
     for (k, step) in steps.iter().enumerate() {
         if step.motion == StepMotion::Fixed {
@@ -110,7 +109,7 @@ pub(crate) fn fold(
                 first: k,
                 stages: Vec::new(),
                 driver_beside: None,
-                direction: axis(k),
+                direction: base_axis(steps, frames, k),
                 scale: 1.0,
             });
             continue;
@@ -120,72 +119,90 @@ pub(crate) fn fold(
             fold_beside(steps, frames, k, off_chain.get(&mimic.joint), &mut joints).map_err(refuse)?;
             continue;
         };
-        let actuated = &steps[a];
-        if actuated.motion == StepMotion::Fixed {
-            return Err(refuse(format!("follows joint '{}', a fixed joint", mimic.joint)));
-        }
-        if actuated.mimic.is_some() {
-            return Err(refuse(format!(
-                "follows joint '{}', itself a mimic joint: name the joint that drives both",
-                mimic.joint
-            )));
-        }
-        if a > k {
-            return Err(refuse(format!(
-                "follows joint '{}', further from the base: only stages after the joint that drives them are folded",
-                mimic.joint
-            )));
-        }
-        // Every movable joint between the actuated joint and this one must be another of its stages.
-        let between = steps[a + 1..k]
-            .iter()
-            .find(|s| s.motion != StepMotion::Fixed && s.mimic.as_ref().is_none_or(|m| m.joint != mimic.joint));
-        if let Some(other) = between {
-            return Err(refuse(format!(
-                "follows joint '{}', but joint '{}' moves between them: the stages' motions do not add into one \
-                 joint (only stages separated from the joint that drives them by fixed joints fold)",
-                mimic.joint, other.joint
-            )));
-        }
-        same_kind(step, actuated).map_err(refuse)?;
-        coaxial(steps, frames, a, k).map_err(refuse)?;
-        let Some(joint) = joints.iter_mut().find(|j| j.first == a && j.driver_beside.is_none()) else {
-            return Err(refuse(format!("follows joint '{}', which is not a joint of the chain", mimic.joint)));
-        };
-        joint.stages.push(k);
+        fold_on_chain(steps, frames, a, k, &mimic.joint, &mut joints).map_err(refuse)?;
     }
     for joint in &mut joints {
-        if joint.stages.is_empty() {
-            continue;
+        if !joint.stages.is_empty() {
+            sum_stages(joint, steps, frames)?;
         }
-        // A driver beside the chain moves nothing on it: only its stages' motions add.
-        let own = if joint.driver_beside.is_some() { Vector3::zeros() } else { axis(joint.first) };
-        let sum = joint
-            .stages
-            .iter()
-            .fold(own, |sum, &k| sum + axis(k) * steps[k].mimic.as_ref().map_or(0.0, |m| m.multiplier));
-        let scale = sum.norm();
-        let last = joint.stages.last().copied().unwrap_or(joint.first);
-        if !crate::description::scale_in_bounds(scale) {
-            let (lo, hi) = crate::description::SCALE_BOUNDS;
-            let name = &joint.actuated(steps).joint;
-            return Err(FoldRefusal {
-                step: last,
-                message: format!(
-                    "with joint '{name}' and its other stages it moves {scale:e} per unit of '{name}', outside {lo:e} \
-                     … {hi:e}: {}",
-                    if scale < lo {
-                        "the stages cancel, the motor moves nothing"
-                    } else {
-                        "no stage train gears so far"
-                    }
-                ),
-            });
-        }
-        joint.direction = sum / scale;
-        joint.scale = scale;
     }
     Ok(joints)
+}
+
+/// Step `k`'s axis in the base link's frame at the zero configuration.
+fn base_axis(steps: &[ChainStep], frames: &[SE3], k: usize) -> Vector3 {
+    frames[k].rotation().act(&steps[k].axis)
+}
+
+/// Folds the mimic step `k` into the joint of step `a`, the chain's joint `driver` it follows: a movable,
+/// actuated joint nearer the base, of the same kind and on the same line, with only fixed joints
+/// or its other stages between them. The message says why it does not fold.
+fn fold_on_chain(
+    steps: &[ChainStep],
+    frames: &[SE3],
+    a: usize,
+    k: usize,
+    driver: &str,
+    joints: &mut [ChainJoint],
+) -> Result<(), String> {
+    let (step, actuated) = (&steps[k], &steps[a]);
+    if actuated.motion == StepMotion::Fixed {
+        return Err(format!("follows joint '{driver}', a fixed joint"));
+    }
+    if actuated.mimic.is_some() {
+        return Err(format!("follows joint '{driver}', itself a mimic joint: name the joint that drives both"));
+    }
+    if a > k {
+        return Err(format!(
+            "follows joint '{driver}', further from the base: only stages after the joint that drives them are folded"
+        ));
+    }
+    // Every movable joint between the actuated joint and this one must be another of its stages.
+    let between = steps[a + 1..k]
+        .iter()
+        .find(|s| s.motion != StepMotion::Fixed && s.mimic.as_ref().is_none_or(|m| m.joint != driver));
+    if let Some(other) = between {
+        return Err(format!(
+            "follows joint '{driver}', but joint '{}' moves between them: the stages' motions do not add into one \
+             joint (only stages separated from the joint that drives them by fixed joints fold)",
+            other.joint
+        ));
+    }
+    same_kind(step, actuated)?;
+    coaxial(steps, frames, a, k)?;
+    let Some(joint) = joints.iter_mut().find(|j| j.first == a && j.driver_beside.is_none()) else {
+        return Err(format!("follows joint '{driver}', which is not a joint of the chain"));
+    };
+    joint.stages.push(k);
+    Ok(())
+}
+
+/// The joint's direction and scale from its actuated joint's twist and its stages' (each times
+/// its multiplier): refused, at its last stage, where the sum is outside the scale's bounds.
+fn sum_stages(joint: &mut ChainJoint, steps: &[ChainStep], frames: &[SE3]) -> Result<(), FoldRefusal> {
+    // A driver beside the chain moves nothing on it: only its stages' motions add.
+    let own = if joint.driver_beside.is_some() { Vector3::zeros() } else { base_axis(steps, frames, joint.first) };
+    let sum = joint
+        .stages
+        .iter()
+        .fold(own, |sum, &k| sum + base_axis(steps, frames, k) * steps[k].mimic.as_ref().map_or(0.0, |m| m.multiplier));
+    let scale = sum.norm();
+    let last = joint.stages.last().copied().unwrap_or(joint.first);
+    if !crate::description::scale_in_bounds(scale) {
+        let (lo, hi) = crate::description::SCALE_BOUNDS;
+        let name = &joint.actuated(steps).joint;
+        return Err(FoldRefusal {
+            step: last,
+            message: format!(
+                "with joint '{name}' and its other stages it moves {scale:e} per unit of '{name}', outside {lo:e} \
+                 … {hi:e}: {}",
+                if scale < lo { "the stages cancel, the motor moves nothing" } else { "no stage train gears so far" }
+            ),
+        });
+    }
+    joint.direction = sum / scale;
+    joint.scale = scale;
+    Ok(())
 }
 
 /// Folds the mimic step `k`, whose driver is not on the chain (`driver` as the chain's reader

@@ -205,9 +205,7 @@ fn start_tag(cursor: &mut Cursor<'_>, position: Position) -> Result<StartTag, Sy
 /// The document's root element, or the first syntax error.
 pub fn outline(text: &str) -> Result<Element, SyntaxError> {
     let mut cursor = Cursor { text, at: 0, line: 1, column: 1 };
-    // Elements still open, innermost last.
-    let mut open: Vec<Element> = Vec::new();
-    let mut root: Option<Element> = None;
+    let mut tree = Tree::default();
     while let Some(i) = cursor.rest().find('<') {
         cursor.advance(i);
         let rest = cursor.rest();
@@ -220,62 +218,93 @@ pub fn outline(text: &str) -> Result<Element, SyntaxError> {
         } else if rest.starts_with("<!") {
             cursor.skip_past(">", "a declaration")?;
         } else if rest.starts_with("</") {
-            let position = cursor.position();
-            cursor.advance(2);
-            let name = cursor.name();
-            cursor.skip_space();
-            if !cursor.rest().starts_with('>') {
-                return Err(SyntaxError { position, message: format!("end tag </{name}> is not closed with '>'") });
-            }
-            cursor.advance(1);
-            let Some(mut element) = open.pop() else {
-                return Err(SyntaxError { position, message: format!("end tag </{name}> has no start tag") });
-            };
-            if element.name != name {
-                return Err(SyntaxError {
-                    position,
-                    message: format!(
-                        "end tag </{name}> does not match <{}> opened at line {}, column {}",
-                        element.name, element.position.0, element.position.1
-                    ),
-                });
-            }
-            element.span.1 = cursor.at;
-            match open.last_mut() {
-                Some(parent) => parent.children.push(element),
-                None => root = Some(element),
-            }
+            tree.end_tag(&mut cursor)?;
         } else {
-            let (position, start) = (cursor.position(), cursor.at);
-            cursor.advance(1);
-            let StartTag { name, attributes, closed } = start_tag(&mut cursor, position)?;
-            if root.is_some() && open.is_empty() {
-                return Err(SyntaxError { position, message: format!("<{name}> follows the root element") });
-            }
-            if open.len() >= MAX_DEPTH {
-                return Err(SyntaxError {
-                    position,
-                    message: format!(
-                        "<{name}> is nested {} elements deep, at most {MAX_DEPTH} are read",
-                        open.len() + 1
-                    ),
-                });
-            }
-            let element = Element { name, attributes, position, span: (start, cursor.at), children: Vec::new() };
-            match (closed, open.last_mut()) {
-                (false, _) => open.push(element),
-                (true, Some(parent)) => parent.children.push(element),
-                (true, None) => root = Some(element),
-            }
+            tree.start_tag(&mut cursor)?;
         }
     }
-    if let Some(unclosed) = open.pop() {
-        return Err(SyntaxError {
-            position: unclosed.position,
-            message: format!("<{}> is never closed", unclosed.name),
-        });
+    tree.root()
+}
+
+/// The elements read so far: those still open, innermost last, and the root once it is closed.
+#[derive(Default)]
+struct Tree {
+    open: Vec<Element>,
+    root: Option<Element>,
+}
+
+impl Tree {
+    /// Puts a closed element into its parent, or makes it the root.
+    fn place_closed(&mut self, element: Element) {
+        match self.open.last_mut() {
+            Some(parent) => parent.children.push(element),
+            None => self.root = Some(element),
+        }
     }
-    root.ok_or_else(|| SyntaxError { position: (1, 1), message: "no root element".into() })
+
+    /// Reads the end tag at the cursor (at its `</`), which closes the innermost open element.
+    fn end_tag(&mut self, cursor: &mut Cursor<'_>) -> Result<(), SyntaxError> {
+        let position = cursor.position();
+        cursor.advance(2);
+        let name = cursor.name();
+        cursor.skip_space();
+        if !cursor.rest().starts_with('>') {
+            return Err(SyntaxError { position, message: format!("end tag </{name}> is not closed with '>'") });
+        }
+        cursor.advance(1);
+        let Some(mut element) = self.open.pop() else {
+            return Err(SyntaxError { position, message: format!("end tag </{name}> has no start tag") });
+        };
+        if element.name != name {
+            return Err(SyntaxError {
+                position,
+                message: format!(
+                    "end tag </{name}> does not match <{}> opened at line {}, column {}",
+                    element.name, element.position.0, element.position.1
+                ),
+            });
+        }
+        element.span.1 = cursor.at;
+        self.place_closed(element);
+        Ok(())
+    }
+
+    /// Reads the start tag at the cursor (at its `<`): one root, nested at most [`MAX_DEPTH`] deep.
+    fn start_tag(&mut self, cursor: &mut Cursor<'_>) -> Result<(), SyntaxError> {
+        let (position, start) = (cursor.position(), cursor.at);
+        cursor.advance(1);
+        let StartTag { name, attributes, closed } = start_tag(cursor, position)?;
+        if self.root.is_some() && self.open.is_empty() {
+            return Err(SyntaxError { position, message: format!("<{name}> follows the root element") });
+        }
+        if self.open.len() >= MAX_DEPTH {
+            return Err(SyntaxError {
+                position,
+                message: format!(
+                    "<{name}> is nested {} elements deep, at most {MAX_DEPTH} are read",
+                    self.open.len() + 1
+                ),
+            });
+        }
+        let element = Element { name, attributes, position, span: (start, cursor.at), children: Vec::new() };
+        if closed {
+            self.place_closed(element);
+        } else {
+            self.open.push(element);
+        }
+        Ok(())
+    }
+
+    /// The root, once the text is read: refused while an element is still open or without one.
+    fn root(mut self) -> Result<Element, SyntaxError> {
+        if let Some(unclosed) = self.open.pop() {
+            return Err(SyntaxError {
+                position: unclosed.position,
+                message: format!("<{}> is never closed", unclosed.name),
+            });
+        }
+        self.root.ok_or_else(|| SyntaxError { position: (1, 1), message: "no root element".into() })
+    }
 }
 
 #[cfg(test)]

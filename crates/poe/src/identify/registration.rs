@@ -44,13 +44,92 @@ pub fn register(nominal: &LocalPoe, observations: &[Observation]) -> Result<Loca
             Target::Point(point) => point,
         })
         .collect();
+    let closed = closed_form(observations, &flanges, &points, tool_count)?;
+    // The linear solve above splits its coefficients between the flange positions and the flange
+    // rotations, which are nearly dependent when few joints move (a point fixed to the flange
+    // moves with both): its rotation can then be far off. Alternating rigid fits from zero tool
+    // offsets do not share that weakness; the start with the smaller residual is kept.
+    let alternating = alternating_fit(observations, &flanges, &points, tool_count);
+    let residual = |(placement, offsets): &(SE3, Vec<Vector3>)| -> f64 {
+        observations
+            .iter()
+            .zip(&flanges)
+            .zip(&points)
+            .map(|((o, f), p)| (p - placement.transform_point(&f.transform_point(&offsets[o.tool]))).norm_squared())
+            .sum()
+    };
+    let (tracker_from_base, offsets) = if residual(&alternating) < residual(&closed) { alternating } else { closed };
+    let mut orientation_sums = vec![Matrix3::zeros(); tool_count];
+    for ((observation, flange), _) in observations.iter().zip(&flanges).zip(&points) {
+        if let Target::Pose(measured) = observation.target {
+            orientation_sums[observation.tool] +=
+                (tracker_from_base * *flange).rotation().inverse().matrix() * measured.rotation().matrix();
+        }
+    }
+    let flange_tool = nominal.tools()[0];
+    let tools = offsets
+        .iter()
+        .zip(&orientation_sums)
+        .map(|(offset, sum)| {
+            let orientation = if sum.norm() > 0.0 { nearest_rotation(sum) } else { SO3::identity() };
+            flange_tool * SE3::new(orientation, *offset)
+        })
+        .collect();
+    let mut model = nominal.clone();
+    model.set_tools(tools);
+    model.change_reference(tracker_from_base);
+    Ok(model)
+}
+
+/// The linear least-squares placement and tool offsets (the derivation on [`register`]): `R`
+/// nearest the fitted `p_f` coefficients, `u_k = ⅓ Σ_j (R e_j)·W_jk`, then `t` from the residual mean.
+fn closed_form(
+    observations: &[Observation],
+    flanges: &[SE3],
+    points: &[Vector3],
+    tool_count: usize,
+) -> Result<(SE3, Vec<Vector3>), Error> {
+    let count = observations.len() as f64;
+    let x = linear_coefficients(observations, flanges, points, tool_count)?;
+    let m = Matrix3::from_fn(|c, j| x[(j, c)]);
+    let rotation = nearest_rotation(&m);
+    let r = rotation.matrix();
+    let mut offsets = vec![Vector3::zeros(); tool_count];
+    for (tool, offset) in offsets.iter_mut().enumerate() {
+        for k in 0..3 {
+            offset[k] =
+                (0..3).map(|j| (0..3).map(|c| r[(c, j)] * x[(3 + 9 * tool + 3 * j + k, c)]).sum::<f64>()).sum::<f64>()
+                    / 3.0;
+        }
+    }
+    // The translation from the residual mean, now that R and the offsets are fixed.
+    let translation = observations
+        .iter()
+        .zip(flanges)
+        .zip(points)
+        .map(|((o, f), p)| p - rotation.act(&f.transform_point(&offsets[o.tool])))
+        .sum::<Vector3>()
+        / count;
+    Ok((SE3::new(rotation, translation), offsets))
+}
+
+/// The coefficients of `[p_f, vec(R_f) per tool, 1]` for each coordinate of the measured point
+/// (`unknowns × 3`), on centred data, by a truncated SVD solve; refused below the rank the
+/// tools' offsets need.
+fn linear_coefficients(
+    observations: &[Observation],
+    flanges: &[SE3],
+    points: &[Vector3],
+    tool_count: usize,
+) -> Result<faer::Mat<f64>, Error> {
+    let unknowns = 4 + 9 * tool_count;
     // Centre the data so that the columns are comparable in scale.
     let count = observations.len() as f64;
     let mean_flange = flanges.iter().map(|f| f.translation()).sum::<Vector3>() / count;
     let mean_point = points.iter().sum::<Vector3>() / count;
     let mut a = faer::Mat::<f64>::zeros(observations.len(), unknowns);
     let mut b = faer::Mat::<f64>::zeros(observations.len(), 3);
-    for (row, ((observation, flange), point)) in observations.iter().zip(&flanges).zip(&points).enumerate() {
+    for (row, ((observation, flange), point)) in observations.iter().zip(flanges).zip(points).enumerate() {
         let p = flange.translation() - mean_flange;
         let r = flange.rotation().matrix();
         for j in 0..3 {
@@ -87,60 +166,7 @@ pub fn register(nominal: &LocalPoe, observations: &[Observation]) -> Result<Loca
             }
         }
     }
-    let m = Matrix3::from_fn(|c, j| x[(j, c)]);
-    let rotation = nearest_rotation(&m);
-    let r = rotation.matrix();
-    let mut offsets = vec![Vector3::zeros(); tool_count];
-    for (tool, offset) in offsets.iter_mut().enumerate() {
-        for k in 0..3 {
-            offset[k] =
-                (0..3).map(|j| (0..3).map(|c| r[(c, j)] * x[(3 + 9 * tool + 3 * j + k, c)]).sum::<f64>()).sum::<f64>()
-                    / 3.0;
-        }
-    }
-    // The translation from the residual mean, now that R and the offsets are fixed.
-    let translation = observations
-        .iter()
-        .zip(&flanges)
-        .zip(&points)
-        .map(|((o, f), p)| p - rotation.act(&f.transform_point(&offsets[o.tool])))
-        .sum::<Vector3>()
-        / count;
-    let closed = (SE3::new(rotation, translation), offsets);
-    // The linear solve above splits its coefficients between the flange positions and the flange
-    // rotations, which are nearly dependent when few joints move (a point fixed to the flange
-    // moves with both): its rotation can then be far off. Alternating rigid fits from zero tool
-    // offsets do not share that weakness; the start with the smaller residual is kept.
-    let alternating = alternating_fit(observations, &flanges, &points, tool_count);
-    let residual = |(placement, offsets): &(SE3, Vec<Vector3>)| -> f64 {
-        observations
-            .iter()
-            .zip(&flanges)
-            .zip(&points)
-            .map(|((o, f), p)| (p - placement.transform_point(&f.transform_point(&offsets[o.tool]))).norm_squared())
-            .sum()
-    };
-    let (tracker_from_base, offsets) = if residual(&alternating) < residual(&closed) { alternating } else { closed };
-    let mut orientation_sums = vec![Matrix3::zeros(); tool_count];
-    for ((observation, flange), _) in observations.iter().zip(&flanges).zip(&points) {
-        if let Target::Pose(measured) = observation.target {
-            orientation_sums[observation.tool] +=
-                (tracker_from_base * *flange).rotation().inverse().matrix() * measured.rotation().matrix();
-        }
-    }
-    let flange_tool = nominal.tools()[0];
-    let tools = offsets
-        .iter()
-        .zip(&orientation_sums)
-        .map(|(offset, sum)| {
-            let orientation = if sum.norm() > 0.0 { nearest_rotation(sum) } else { SO3::identity() };
-            flange_tool * SE3::new(orientation, *offset)
-        })
-        .collect();
-    let mut model = nominal.clone();
-    model.set_tools(tools);
-    model.change_reference(tracker_from_base);
-    Ok(model)
+    Ok(x)
 }
 
 /// The rigid transform `(R, t)` minimising `Σ |R a_i + t − b_i|²` (Kabsch 1976, the SVD solution,
