@@ -142,7 +142,7 @@ mod tests {
     fn an_effects_file_with_a_typo_is_refused_at_its_line() {
         let good = parse_effects("(compliance: (payload_only: true), tracker_noise: ())", "e.ron").unwrap();
         assert_eq!(
-            good.compliance,
+            good.joint_compliance,
             Some(JointComplianceModel { payload_only: true, ..JointComplianceModel::default() })
         );
         assert_eq!(good.tracker_noise, Some(TrackerNoiseModel::default()));

@@ -227,7 +227,7 @@ pub fn joint_ranges(robot: &RobotDescription) -> Vec<JointRange> {
 /// compliance under the arm's weight and the payload) and tracker noise (Leica AT901 with T-Mac).
 pub fn paper_effects() -> Effects {
     Effects {
-        compliance: Some(JointComplianceModel::default()),
+        joint_compliance: Some(JointComplianceModel::default()),
         tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     }

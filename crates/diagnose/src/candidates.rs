@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 /// Generates [`Effect`] from the identified kinds of `loadsim::effect_kinds!`, and `None` and
 /// `Unknown`.
 macro_rules! verdict_effect {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident $(as $file:literal | $former:literal)?: $sim:ty)?, )* }
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident $(| $former:literal)?: $sim:ty)?, )* }
      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// An effect a verdict can name (the SPEC's `verdict.effect`): every kind the fit
         /// identifies, in the list's order, then `None` and `Unknown`.

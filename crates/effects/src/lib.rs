@@ -130,7 +130,7 @@ pub const CONSTANT_FEATURES: f64 = 1e-9;
 /// re-exports the kind's term type (`JointComplianceTerm`, …) from it: an effect's file is declared
 /// by its line in `loadsim::effect_kinds!`, nowhere else.
 macro_rules! effect_modules {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident $(as $file:literal | $former:literal)?: $sim:ty)?, )* }
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident $(| $former:literal)?: $sim:ty)?, )* }
      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         $( mod $name; pub use $name::$term; )*
     };
@@ -142,7 +142,7 @@ loadsim::effect_kinds!(effect_modules);
 /// per kind holding the kind's term type (`GearPeriodic(GearPeriodicTerm)`), every method
 /// delegated to its `EffectTerm` / `NewEffect` (module `term`).
 macro_rules! identified_effect {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident $(as $file:literal | $former:literal)?: $sim:ty)?, )* }
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident $(| $former:literal)?: $sim:ty)?, )* }
      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// An effect of a calibrated model, with its identified parameters: one variant per
         /// identified kind of `loadsim::effect_kinds!`, holding the kind's term type, written in

@@ -260,7 +260,7 @@ mod tests {
         let deflection =
             LinkDeflectionModel { links: vec![BentLink { joint_index: 0, flexibility_per_nm2: [2e-7, 2e-7] }] };
         let cell = SimulatedCell::new(model.clone(), Some(dynamics.clone()));
-        let effects = Effects { deflection: Some(deflection), ..Effects::default() };
+        let effects = Effects { link_deflection: Some(deflection), ..Effects::default() };
         let context = PoseContext { payload, ..PoseContext::default() };
         let sag = |lift: f64| {
             let q = [lift, 0.0, 0.0];
@@ -320,7 +320,7 @@ mod tests {
             let mut flexibility = [0.0; 2];
             flexibility[a] = h;
             let effects = Effects {
-                deflection: Some(LinkDeflectionModel {
+                link_deflection: Some(LinkDeflectionModel {
                     links: vec![BentLink { joint_index: 0, flexibility_per_nm2: flexibility }],
                 }),
                 ..Effects::default()

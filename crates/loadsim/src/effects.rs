@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 macro_rules! effects_struct {
     (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident
-                     $(=> $field:ident $(as $file:literal | $former:literal)?: $sim:ty)?, )* }
+                     $(=> $field:ident $(| $former:literal)?: $sim:ty)?, )* }
      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// Which effects act and with which parameters, a field per kind of
         /// [`effect_kinds!`](crate::effect_kinds) that the simulator models (named as its line
@@ -26,7 +26,7 @@ macro_rules! effects_struct {
         pub struct Effects {
             $( $(
                 #[doc = concat!("[`EffectKind::", stringify!($kind), "`] (`", stringify!($name), "`): its simulation, `None` when off.")]
-                $( #[serde(rename = $file, alias = $former)] )?
+                $( #[serde(alias = $former)] )?
                 pub $field: Option<$sim>,
             )? )*
             $( $(#[$sdoc])* pub $sfield: Option<$ssim>, )*
@@ -113,15 +113,15 @@ impl Effects {
             })
             .collect();
         Self {
-            compliance: Some(JointComplianceModel::default()),
+            joint_compliance: Some(JointComplianceModel::default()),
             backlash: Some(BacklashModel {
                 joints: (0..joint_count)
                     .map(|joint_index| JointBacklash { joint_index, half_band_rad: half_band })
                     .collect(),
             }),
-            periodic: Some(GearPeriodicModel { harmonics }),
+            gear_periodic: Some(GearPeriodicModel { harmonics }),
             thermal: Some(ThermalModel::default()),
-            drift: Some(TimeDriftModel::default()),
+            time_drift: Some(TimeDriftModel::default()),
             tracker_noise: Some(TrackerNoiseModel::default()),
             ..Effects::default()
         }

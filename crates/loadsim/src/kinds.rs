@@ -8,8 +8,8 @@
 /// Calls the macro `$callback` with the list of effect kinds, in a fixed order:
 ///
 /// ```text
-/// identified { $( #[doc] Kind spec_name: KindTerm $( => rust_field $(as "spec_name" | "former")?: KindModel )?, )* }
-/// simulated { $( #[doc] Kind spec_name => rust_field: KindModel, )* }
+/// identified { $( #[doc] Kind spec_name: KindTerm $( => spec_name $(| "former")?: KindModel )?, )* }
+/// simulated { $( #[doc] Kind spec_name => spec_name: KindModel, )* }
 /// ```
 ///
 /// `identified` kinds have a regressor in the `effects` crate: the type `KindTerm` in its module
@@ -18,18 +18,18 @@
 /// names keep the two sides apart: `effects::GearPeriodicTerm` is what the fit identifies and a
 /// model file holds, `loadsim::GearPeriodicModel` the simulator's ground truth.
 /// `simulated` kinds exist only in the simulator. `spec_name` is the SPEC's name (serde, the
-/// `--effects` item, the diagnosis JSON). Where a kind is simulated, `rust_field` is the field
-/// of [`crate::Effects`] that switches it on, and `KindModel` the type it holds there, which
+/// `--effects` item, the diagnosis JSON). Where a kind is simulated, the field of
+/// [`crate::Effects`] that switches it on has the same name (written twice because a macro cannot
+/// make a field from the kind's name), and `KindModel` is the type it holds there, which
 /// implements [`crate::SimulatedEffect`] (the effect's simulation: its checks and its place in the
-/// forward model). The effects file of `calib simulate` spells every field as the SPEC name: where
-/// the Rust field is spelt otherwise, `as "spec_name" | "former"` gives the file's spelling (serde
-/// needs it as a literal) and the spelling of files before SPEC version 5, which still reads. An
+/// forward model). `| "former"` gives the field's spelling in effects files before SPEC version 5,
+/// which still reads (serde needs it as a literal). An
 /// identified kind may have no simulation: it is then fitted, diagnosed and read from model files,
 /// and [`EffectKind::simulated_field`] is `None`.
 ///
 /// ```
 /// macro_rules! names {
-///     (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident $(as $file:literal | $former:literal)?: $sim:ty)?, )* }
+///     (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident $(| $former:literal)?: $sim:ty)?, )* }
 ///      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
 ///         [$(stringify!($name)),*]
 ///     };
@@ -44,20 +44,20 @@ macro_rules! effect_kinds {
             identified {
                 /// Joint compliance under gravity and payload.
                 JointCompliance joint_compliance: JointComplianceTerm
-                    => compliance as "joint_compliance" | "compliance": $crate::JointComplianceModel,
+                    => joint_compliance | "compliance": $crate::JointComplianceModel,
                 /// Backlash following the sign of the static torque.
                 Backlash backlash: BacklashTerm => backlash: $crate::BacklashModel,
                 /// A periodic error of a joint in its own angle (gear or encoder).
-                GearPeriodic gear_periodic: GearPeriodicTerm => periodic as "gear_periodic" | "periodic": $crate::GearPeriodicModel,
+                GearPeriodic gear_periodic: GearPeriodicTerm => gear_periodic | "periodic": $crate::GearPeriodicModel,
                 /// Thermal growth of the links with `temp_c`.
                 Thermal thermal: ThermalTerm => thermal: $crate::ThermalModel,
                 /// Drift of the robot's placement with `t_s`.
-                TimeDrift time_drift: TimeDriftTerm => drift as "time_drift" | "drift": $crate::TimeDriftModel,
+                TimeDrift time_drift: TimeDriftTerm => time_drift | "drift": $crate::TimeDriftModel,
                 /// A link bending under the gravity moment of everything beyond it.
                 LinkDeflection link_deflection: LinkDeflectionTerm
-                    => deflection as "link_deflection" | "deflection": $crate::LinkDeflectionModel,
+                    => link_deflection | "deflection": $crate::LinkDeflectionModel,
                 /// A periodic error of a linear axis in its own position, per screw or rack pitch.
-                ScrewPeriodic screw_periodic: ScrewPeriodicTerm => screw as "screw_periodic" | "screw": $crate::ScrewPeriodicModel,
+                ScrewPeriodic screw_periodic: ScrewPeriodicTerm => screw_periodic | "screw": $crate::ScrewPeriodicModel,
             }
             simulated {
                 /// Tracker measurement noise.
@@ -70,7 +70,7 @@ macro_rules! effect_kinds {
 }
 
 macro_rules! effect_kind_enum {
-    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident $(as $file:literal | $former:literal)?: $sim:ty)?, )* }
+    (identified { $( $(#[$doc:meta])* $kind:ident $name:ident: $term:ident $(=> $field:ident $(| $former:literal)?: $sim:ty)?, )* }
      simulated { $( $(#[$sdoc:meta])* $skind:ident $sname:ident => $sfield:ident: $ssim:ty, )* }) => {
         /// The kinds of effect, named as in the SPEC (`--effects`, the model file, the `calib
         /// diagnose` JSON), generated from [`effect_kinds!`](crate::effect_kinds).
@@ -112,8 +112,7 @@ macro_rules! effect_kind_enum {
             pub fn simulated_field(self) -> Option<&'static str> {
                 match self {
                     $( EffectKind::$kind => {
-                        // The list's literal where it gives one, before the Rust field's name.
-                        let field: &[&'static str] = &[$($($file,)? stringify!($field))?];
+                        let field: &[&'static str] = &[$(stringify!($field))?];
                         field.first().copied()
                     } )*
                     $( EffectKind::$skind => Some(stringify!($sfield)), )*
@@ -142,6 +141,7 @@ effect_kinds!(effect_kind_enum);
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Effects;
 
     #[test]
     fn the_serde_names_are_the_spec_names_and_read_back() {
@@ -156,5 +156,26 @@ mod tests {
         assert_eq!(EffectKind::GearPeriodic.simulated_field(), Some("gear_periodic"));
         assert_eq!(EffectKind::GearPeriodic.former_field(), Some("periodic"));
         assert_eq!(EffectKind::Backlash.former_field(), None);
+    }
+
+    /// One name per effect: the field of `Effects` that switches a kind on (and the effects
+    /// file's field) is the kind's SPEC name, for every kind the simulator models.
+    #[test]
+    fn every_simulated_kind_is_switched_on_by_a_field_of_its_own_name() {
+        let on = Effects {
+            joint_compliance: Some(Default::default()),
+            gear_periodic: Some(Default::default()),
+            time_drift: Some(Default::default()),
+            ..Effects::default()
+        };
+        for &kind in EffectKind::ALL {
+            if let Some(field) = kind.simulated_field() {
+                assert_eq!(field, kind.name(), "{kind:?}");
+            }
+        }
+        let text = ron::to_string(&on).unwrap();
+        for name in ["joint_compliance", "gear_periodic", "time_drift"] {
+            assert!(text.contains(&format!("{name}:")), "{text}");
+        }
     }
 }

@@ -26,7 +26,7 @@ fn blind(robot: &RobotDescription) -> RobotDescription {
 fn a_second_harmonic_on_joint_three_is_named_and_removed_position_only_and_full_pose() {
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
-        periodic: Some(GearPeriodicModel {
+        gear_periodic: Some(GearPeriodicModel {
             harmonics: vec![Harmonic { joint_index: 2, order: 2.0, amplitude_rad: 2e-4, phase_rad: 0.4 }],
         }),
         ..Effects::default()
@@ -59,7 +59,7 @@ fn a_second_harmonic_on_joint_three_is_named_and_removed_position_only_and_full_
 #[test]
 fn compliance_is_found_without_the_masses() {
     let robot = testkit::robot("irb4400.ron");
-    let effects = Effects { compliance: Some(loadsim::JointComplianceModel::default()), ..Effects::default() };
+    let effects = Effects { joint_compliance: Some(loadsim::JointComplianceModel::default()), ..Effects::default() };
     let data = simulated(&robot, &effects, false, 23);
     let d = diagnose(&blind(&robot), &data, &DiagnoseOptions::default()).unwrap();
     assert_eq!(d.verdict.effect, Effect::JointCompliance, "{}", d.summary());
@@ -128,7 +128,7 @@ fn the_seven_axis_two_moving_joint_campaign_names_compliance_on_joint_two() {
         }
     }
     let effects = Effects {
-        compliance: Some(loadsim::JointComplianceModel::default()),
+        joint_compliance: Some(loadsim::JointComplianceModel::default()),
         tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     };
@@ -188,7 +188,7 @@ fn a_lifting_column_is_reported_in_millimetres_and_offered_no_series_of_its_angl
     let periodic = GearPeriodicModel {
         harmonics: vec![Harmonic { joint_index: 2, order: 3.0, amplitude_rad: 4e-4, phase_rad: 0.3 }],
     };
-    let data = simulated(&robot, &Effects { periodic: Some(periodic), ..Effects::default() }, false, 5);
+    let data = simulated(&robot, &Effects { gear_periodic: Some(periodic), ..Effects::default() }, false, 5);
     let diagnosis = diagnose(&robot, &data, &DiagnoseOptions::default()).unwrap();
     assert_eq!(diagnosis.prismatic_joints, vec![1]);
     let column: Vec<_> = diagnosis.regions.iter().filter(|r| r.dimension == "joint 1").collect();

@@ -46,7 +46,7 @@ fn joint_2_gear_error() -> GearPeriodicModel {
 #[test]
 fn a_gear_error_of_high_order_is_identified_down_to_the_noise() {
     let robot = testkit::robot("irb4400.ron");
-    let effects = Effects { periodic: Some(joint_2_gear_error()), ..Effects::default() };
+    let effects = Effects { gear_periodic: Some(joint_2_gear_error()), ..Effects::default() };
     let (train, test) = split(&robot, &effects, 31);
     let poe = heldout(&robot, &train, &test, "");
     let gear = heldout(&robot, &train, &test, "gear_periodic:2:12");
@@ -80,7 +80,7 @@ fn backlash_thermal_growth_and_drift_are_each_identified_down_to_the_noise() {
         (
             "time_drift",
             Effects {
-                drift: Some(TimeDriftModel { twist_per_s: [4e-8, -3e-8, 2e-8, 0.0, 1e-8, 0.0] }),
+                time_drift: Some(TimeDriftModel { twist_per_s: [4e-8, -3e-8, 2e-8, 0.0, 1e-8, 0.0] }),
                 ..Effects::default()
             },
         ),
@@ -181,7 +181,7 @@ fn training_costs(seed: u64, mask: u32, extra: u32, options: &FitOptions) -> Tra
     let (subset, superset) = (pick(mask), pick(mask | extra));
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
-        periodic: Some(GearPeriodicModel {
+        gear_periodic: Some(GearPeriodicModel {
             harmonics: vec![Harmonic { joint_index: 1, order: 3.0, amplitude_rad: 2e-4, phase_rad: 0.5 }],
         }),
         tracker_noise: Some(TrackerNoiseModel::default()),
@@ -281,7 +281,7 @@ proptest::proptest! {
 fn a_model_is_its_parts_applied_in_order_and_export_reports_each_one() {
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
-        periodic: Some(GearPeriodicModel {
+        gear_periodic: Some(GearPeriodicModel {
             harmonics: vec![Harmonic { joint_index: 2, order: 2.0, amplitude_rad: 3e-4, phase_rad: 0.1 }],
         }),
         backlash: Some(loadsim::BacklashModel { joints: vec![JointBacklash { joint_index: 1, half_band_rad: 3e-4 }] }),
@@ -371,7 +371,7 @@ fn a_gear_series_warns_where_it_is_used_outside_the_angles_it_was_fitted_on() {
 fn joint_2_gear_campaign(seed: u64) -> (RobotDescription, MeasurementSet) {
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
-        periodic: Some(joint_2_gear_error()),
+        gear_periodic: Some(joint_2_gear_error()),
         tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     };
@@ -466,8 +466,11 @@ fn where_the_effects_fade_the_gp_falls_back_with_the_geometry() {
     let mut periodic = joint_2_gear_error();
     periodic.harmonics.push(Harmonic { joint_index: 2, order: 1.0, amplitude_rad: 4e-4, phase_rad: 0.7 });
     periodic.harmonics.push(Harmonic { joint_index: 2, order: 2.0, amplitude_rad: 2e-4, phase_rad: -0.4 });
-    let effects =
-        Effects { periodic: Some(periodic), tracker_noise: Some(TrackerNoiseModel::default()), ..Effects::default() };
+    let effects = Effects {
+        gear_periodic: Some(periodic),
+        tracker_noise: Some(TrackerNoiseModel::default()),
+        ..Effects::default()
+    };
     let cell = simulated_cell(&robot, &Perturbation::default(), 59).unwrap();
     let config = GeneratorConfig { sample_count: 1000, seed: 59, ..GeneratorConfig::default() };
     let all = simulate(&cell, &effects, &joint_ranges(&robot), &config, false).unwrap();
@@ -554,7 +557,7 @@ fn the_diagnosis_predicts_the_error_in_a_gap_and_past_the_end_from_arcs_of_the_j
 fn a_drift_fitted_in_one_session_is_not_carried_into_another_days_later() {
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
-        drift: Some(TimeDriftModel { twist_per_s: [4e-8, -3e-8, 2e-8, 0.0, 1e-8, 0.0] }),
+        time_drift: Some(TimeDriftModel { twist_per_s: [4e-8, -3e-8, 2e-8, 0.0, 1e-8, 0.0] }),
         tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     };
@@ -657,7 +660,7 @@ fn rows_that_excite_what_no_training_row_did_have_a_large_sigma_and_fall_back_to
 fn the_sigmas_columns_are_the_derivatives_of_the_prediction() {
     let robot = testkit::robot("irb4400.ron");
     let effects = Effects {
-        periodic: Some(joint_2_gear_error()),
+        gear_periodic: Some(joint_2_gear_error()),
         tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     };

@@ -39,7 +39,7 @@ fn coupled_campaign(seed: u64) -> (RobotDescription, MeasurementSet) {
         }],
     };
     let effects = Effects {
-        periodic: Some(periodic),
+        gear_periodic: Some(periodic),
         coupling: Some(coupling),
         tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()

@@ -58,7 +58,7 @@ fn noise_floor(robot: &RobotDescription, seed: u64) -> f64 {
 #[test]
 fn a_column_deflection_is_identified_down_to_the_noise_and_its_model_file_reads_back() {
     let robot = column_arm();
-    let effects = Effects { deflection: Some(column_bending()), ..Effects::default() };
+    let effects = Effects { link_deflection: Some(column_bending()), ..Effects::default() };
     let (train, test) = split(&robot, &effects, 41);
     let floor = noise_floor(&robot, 41);
     let poe = heldout(&fitted(&robot, &train, EffectSelection::None), &test);
@@ -108,7 +108,7 @@ fn the_diagnosis_names_the_column_deflection_beside_a_backlash_and_auto_reaches_
     let robot = column_arm();
     // A backlash of the shoulder (joint 3: the UR10's joint 2) of 0.1 mrad half band.
     let backlash = BacklashModel { joints: vec![JointBacklash { joint_index: 2, half_band_rad: 1e-4 }] };
-    let effects = Effects { deflection: Some(column_bending()), backlash: Some(backlash), ..Effects::default() };
+    let effects = Effects { link_deflection: Some(column_bending()), backlash: Some(backlash), ..Effects::default() };
     let (train, test) = split(&robot, &effects, 43);
     let floor = noise_floor(&robot, 43);
     let diagnosis = diagnose(&robot, &train, &DiagnoseOptions::default()).unwrap();

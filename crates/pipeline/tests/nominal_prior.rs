@@ -46,7 +46,7 @@ fn wrist(seed: u64, count: usize, flipped: bool) -> MeasurementSet {
     let wrist = if flipped { turn(-PI + 0.2, -0.2) } else { turn(0.2, PI - 0.2) };
     let ranges = [turn(-PI, PI), turn(-PI, 0.0), turn(-PI + 0.2, PI - 0.2), turn(-PI, PI), wrist, turn(-PI, PI)];
     let effects = Effects {
-        periodic: Some(gear_error()),
+        gear_periodic: Some(gear_error()),
         tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     };

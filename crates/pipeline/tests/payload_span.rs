@@ -86,7 +86,7 @@ fn a_deflection_that_stops_growing_within_the_trained_payloads_keeps_the_hold() 
     let payloads_kg = vec![1.0, 2.5, 3.5, 3.5 + 1e-7, 3.5 + 2e-7];
     let config = loadsim::GeneratorConfig { sample_count: 300, seed: 35, payloads_kg, ..Default::default() };
     let effects = campaign::Effects {
-        compliance: Some(loadsim::JointComplianceModel { payload_only: true, ..Default::default() }),
+        joint_compliance: Some(loadsim::JointComplianceModel { payload_only: true, ..Default::default() }),
         ..paper_effects()
     };
     let mut data = simulate(&cell, &effects, &joint_ranges(&soft), &config, false).unwrap();

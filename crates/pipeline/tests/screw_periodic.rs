@@ -53,7 +53,7 @@ fn heldout(model: &model::CalibratedModel, test: &MeasurementSet) -> f64 {
 fn a_screw_error_is_identified_down_to_the_noise_and_its_model_file_reads_back() {
     let robot = testkit::robot("column_ur10.ron");
     for seed in [51, 52] {
-        let (train, test) = split(&robot, &Effects { screw: Some(screw()), ..Effects::default() }, seed);
+        let (train, test) = split(&robot, &Effects { screw_periodic: Some(screw()), ..Effects::default() }, seed);
         let (quiet_train, quiet_test) = split(&robot, &Effects::default(), seed);
         let floor = heldout(&fit(&robot, &quiet_train, "").0, &quiet_test);
         let poe = heldout(&fit(&robot, &train, "").0, &test);
@@ -114,7 +114,7 @@ fn bad_screw_items_are_refused_with_what_is_wrong() {
 #[test]
 fn the_diagnosis_offers_the_screw_only_where_the_pitch_is_known_and_names_it() {
     let mut robot = testkit::robot("column_ur10.ron");
-    let (train, test) = split(&robot, &Effects { screw: Some(screw()), ..Effects::default() }, 54);
+    let (train, test) = split(&robot, &Effects { screw_periodic: Some(screw()), ..Effects::default() }, 54);
     let options = DiagnoseOptions::default();
     let unknown = diagnose(&robot, &train, &options).unwrap();
     assert!(!unknown.candidates.iter().any(|c| c.effect == Effect::ScrewPeriodic), "{}", unknown.summary());

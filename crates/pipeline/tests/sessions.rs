@@ -22,7 +22,7 @@ const DAYS: [f64; 4] = [0.0, 1.0, 3.0, 8.0];
 /// session `k`: the first three joined to train on, the last to evaluate.
 fn campaign(robot: &RobotDescription, offsets_mm: [[f64; 3]; 4], seed: u64) -> (MeasurementSet, MeasurementSet) {
     let effects = Effects {
-        drift: Some(TimeDriftModel { twist_per_s: [2e-8, -1.5e-8, 1e-8, 0.0, 0.0, 0.0] }),
+        time_drift: Some(TimeDriftModel { twist_per_s: [2e-8, -1.5e-8, 1e-8, 0.0, 0.0, 0.0] }),
         tracker_noise: Some(TrackerNoiseModel::default()),
         ..Effects::default()
     };

@@ -25,7 +25,7 @@ fn rendered() -> &'static Rendered {
     RENDERED.get_or_init(|| {
         let robot = testkit::robot("irb4400.ron");
         let effects = Effects {
-            periodic: Some(GearPeriodicModel {
+            gear_periodic: Some(GearPeriodicModel {
                 harmonics: vec![
                     Harmonic { joint_index: 1, order: 1.0, amplitude_rad: 2e-4, phase_rad: 0.3 },
                     Harmonic { joint_index: 1, order: 2.0, amplitude_rad: 1e-4, phase_rad: -1.0 },

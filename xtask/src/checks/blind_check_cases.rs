@@ -157,13 +157,13 @@ impl Hidden {
                         *k = if joints.contains(&j) { *k / scale } else { 1e15 };
                     }
                 }
-                effects.compliance = Some(JointComplianceModel::default());
+                effects.joint_compliance = Some(JointComplianceModel::default());
             }
             Hidden::ComplianceAll => {
                 if let Some(d) = dynamics.as_mut() {
                     d.stiffness_nm_per_rad.iter_mut().for_each(|k| *k /= scale);
                 }
-                effects.compliance = Some(JointComplianceModel::default());
+                effects.joint_compliance = Some(JointComplianceModel::default());
             }
             _ => self.add_model(scale, effects),
         }
@@ -183,7 +183,7 @@ impl Hidden {
                 });
             }
             Hidden::Gear(joint, harmonics) => {
-                effects.periodic = Some(GearPeriodicModel {
+                effects.gear_periodic = Some(GearPeriodicModel {
                     harmonics: harmonics
                         .iter()
                         .map(|&(order, weight, phase_rad)| Harmonic {
@@ -200,7 +200,7 @@ impl Hidden {
             }
             Hidden::Drift => {
                 let per_hour = scale * 1e-4 / 3600.0;
-                effects.drift = Some(TimeDriftModel {
+                effects.time_drift = Some(TimeDriftModel {
                     twist_per_s: [per_hour, -0.5 * per_hour, 0.7 * per_hour, 0.0, 0.0, 0.3 * per_hour],
                 });
             }
@@ -221,7 +221,7 @@ impl Hidden {
                 });
             }
             Hidden::Deflection(joint, weights) => {
-                effects.deflection = Some(LinkDeflectionModel {
+                effects.link_deflection = Some(LinkDeflectionModel {
                     links: vec![BentLink {
                         joint_index: *joint,
                         flexibility_per_nm2: weights.map(|w| 1e-7 * w * scale),

@@ -144,9 +144,9 @@ fn magnitudes(
 ) -> anyhow::Result<Magnitudes> {
     let run = |effects: &Effects| simulate(cell, effects, ranges, config, full_pose).map_err(anyhow::Error::from);
     let rigid = run(&Effects::default())?;
-    let bent = run(&Effects { compliance: effects.compliance, ..Effects::default() })?;
+    let bent = run(&Effects { joint_compliance: effects.joint_compliance, ..Effects::default() })?;
     let payload_only = JointComplianceModel { payload_only: true, ..JointComplianceModel::default() };
-    let payload = run(&Effects { compliance: Some(payload_only), ..Effects::default() })?;
+    let payload = run(&Effects { joint_compliance: Some(payload_only), ..Effects::default() })?;
     let noisy = run(&Effects { tracker_noise: effects.tracker_noise, ..Effects::default() })?;
     Ok(Magnitudes {
         compliance_mm: mean_distance_mm(&rigid, &bent),

@@ -273,7 +273,7 @@ fn effect_rows(out: &mut String, p: &Params) {
     row(
         out,
         "load model",
-        match p.effects.compliance {
+        match p.effects.joint_compliance {
             Some(c) if c.payload_only => "δq = C τ, payload weight only".into(),
             Some(_) => "δq = C τ(q, m): gravity of the arm, the balancer and the payload, first order".into(),
             None => "off".into(),
@@ -460,7 +460,7 @@ impl Preset {
     pub fn effects(self) -> Effects {
         let payload_only = self == Preset::PaperLike;
         Effects {
-            compliance: Some(JointComplianceModel { payload_only, ..JointComplianceModel::default() }),
+            joint_compliance: Some(JointComplianceModel { payload_only, ..JointComplianceModel::default() }),
             ..paper_effects()
         }
     }

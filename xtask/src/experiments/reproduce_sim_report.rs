@@ -304,7 +304,7 @@ fn cv_section(out: &mut String, params: &Params, outcome: &Outcome, svg_name: &s
 /// How far the compliance and the tracker noise move the tool.
 fn load_section(out: &mut String, params: &Params, outcome: &Outcome) {
     let m = &outcome.magnitudes;
-    let loaded_by = match params.effects.compliance {
+    let loaded_by = match params.effects.joint_compliance {
         Some(c) if c.payload_only => "under the payload alone, as simulated here".to_owned(),
         _ => format!(
             "under the arm's weight, the balancer and the payload together; the payload's share alone would be {:.3} mm",

@@ -101,7 +101,7 @@ fn measured_torques_are_the_drive_torques_holding_the_static_torque_within_the_s
         torque_sensor: Some(TorqueSensorNoise { sigma_nm: 0.0, ..Default::default() }),
         ..two_joint_runs()
     };
-    let effects = Effects { compliance: Some(JointComplianceModel::default()), ..Effects::default() };
+    let effects = Effects { joint_compliance: Some(JointComplianceModel::default()), ..Effects::default() };
     let samples = generate(&cell, &effects, &ranges, &exact).unwrap();
     let dynamics = cell.dynamics.clone().unwrap();
     for s in &samples {

@@ -90,7 +90,7 @@ fn a_coupling_reads_from_ron_under_its_own_field() {
                 (source_joint_index: 3, order: 1.0, phase_rad: -1.1)])])))";
     let effects: Effects = ron::from_str(text).unwrap();
     assert_eq!(effects.coupling, Some(joint3_by_q2_q4(1e-3)));
-    assert!(effects.compliance.is_none() && effects.periodic.is_none());
+    assert!(effects.joint_compliance.is_none() && effects.gear_periodic.is_none());
     let written = ron::to_string(&effects).unwrap();
     assert_eq!(ron::from_str::<Effects>(&written).unwrap(), effects);
 }
@@ -109,7 +109,8 @@ fn a_gear_error_of_order_forty_with_any_phase_on_joint_1_is_its_cos_sin_regresso
             phase_rad: rng.random_range(0.0..std::f64::consts::TAU),
         })
         .collect();
-    let effects = Effects { periodic: Some(GearPeriodicModel { harmonics: harmonics.clone() }), ..Effects::default() };
+    let effects =
+        Effects { gear_periodic: Some(GearPeriodicModel { harmonics: harmonics.clone() }), ..Effects::default() };
     for _ in 0..20 {
         let q = random_q(&robot.ranges, &mut rng);
         let offsets = effects.joint_offsets(&cell, &q, &PoseContext::default()).unwrap();

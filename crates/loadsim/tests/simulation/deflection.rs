@@ -14,7 +14,7 @@ const STIFFNESS: [f64; 6] = [3e5, 3e5, 3e5, 1e5, 1e5, 1e5];
 const PAYLOAD_KG: f64 = 7.5;
 
 fn tool_displacement(cell: &SimulatedCell, q: &[f64], settings: JointComplianceModel) -> Vector3 {
-    let effects = Effects { compliance: Some(settings), ..Effects::default() };
+    let effects = Effects { joint_compliance: Some(settings), ..Effects::default() };
     let context = PoseContext { payload: Payload::at_tool(PAYLOAD_KG), ..PoseContext::default() };
     effects.true_pose(cell, q, &context).unwrap().translation() - cell.robot.forward(q, 0).unwrap().translation()
 }

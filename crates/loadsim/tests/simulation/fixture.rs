@@ -36,7 +36,7 @@ fn iiwa7_joint_2_deflection_under_five_kilograms_is_reported() {
         }
     }
     let cell = SimulatedCell::new(with_tool(&robot.model, 0.1), Some(dynamics));
-    let effects = Effects { compliance: Some(JointComplianceModel::default()), ..Effects::default() };
+    let effects = Effects { joint_compliance: Some(JointComplianceModel::default()), ..Effects::default() };
     let context = PoseContext { payload: Payload::at_tool(5.0), ..PoseContext::default() };
     let q = [0.0, std::f64::consts::FRAC_PI_2, 0.0, 0.0, 0.0, 0.0, 0.0];
     let moved = effects.true_pose(&cell, &q, &context).unwrap().translation();
@@ -81,7 +81,7 @@ fn irb4400_compliance_deflection_magnitudes_are_reported() {
             (JointComplianceModel { payload_only: true, ..Default::default() }, &mut payload_only),
             (JointComplianceModel::default(), &mut everything),
         ] {
-            let effects = Effects { compliance: Some(settings), ..Effects::default() };
+            let effects = Effects { joint_compliance: Some(settings), ..Effects::default() };
             *sum += (effects.true_pose(&cell, &q, &context).unwrap().translation() - nominal).norm();
         }
     }
@@ -108,5 +108,5 @@ fn effects_round_trip_through_ron_and_missing_effects_read_as_off() {
     assert_eq!(ron::from_str::<Effects>(&text).unwrap(), typical);
     let sparse: Effects = ron::from_str("(thermal: Some((expansion_per_k: 2.3e-5)))").unwrap();
     assert_eq!(sparse.thermal.as_ref().unwrap().reference_temp_c, 20.0);
-    assert!(sparse.compliance.is_none() && sparse.tracker_noise.is_none());
+    assert!(sparse.joint_compliance.is_none() && sparse.tracker_noise.is_none());
 }

@@ -47,7 +47,7 @@ fn backlash_on_a_joint_the_robot_lacks_is_refused() {
 #[test]
 fn compliance_without_dynamics_is_refused() {
     let cell = SimulatedCell::new(irb4400().model, None);
-    let effects = Effects { compliance: Some(JointComplianceModel::default()), ..Effects::default() };
+    let effects = Effects { joint_compliance: Some(JointComplianceModel::default()), ..Effects::default() };
     let refused = effects.true_pose(&cell, &[0.0; 6], &PoseContext::default()).unwrap_err();
     assert_eq!(refused, Error::MissingDynamics { effect: "joint compliance" });
 }
@@ -57,7 +57,7 @@ fn compliance_on_masses_without_stiffness_is_refused_and_what_needs_masses_alone
     let robot = irb4400();
     let dynamics = loadsim::RobotDynamics { stiffness_nm_per_rad: Vec::new(), ..robot.dynamics.clone() };
     let cell = SimulatedCell::new(robot.model, Some(dynamics));
-    let effects = Effects { compliance: Some(JointComplianceModel::default()), ..Effects::default() };
+    let effects = Effects { joint_compliance: Some(JointComplianceModel::default()), ..Effects::default() };
     let q = [0.1, 0.3, -0.2, 0.0, 0.4, 0.0];
     let refused = effects.true_pose(&cell, &q, &PoseContext::default()).unwrap_err();
     assert_eq!(refused, Error::from(dynamics::Error::MissingStiffness { effect: "joint compliance" }));

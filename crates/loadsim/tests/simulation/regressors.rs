@@ -41,7 +41,7 @@ fn the_compliance_pose_error_is_its_joint_offsets_to_first_order() {
     // 100× stiffer than the fixture so that the second-order remainder is 1e-5 of the effect.
     let dynamics = stiff(&robot.dynamics, 100.0);
     let cell = SimulatedCell::new(model.clone(), Some(dynamics.clone()));
-    let effects = Effects { compliance: Some(JointComplianceModel::default()), ..Effects::default() };
+    let effects = Effects { joint_compliance: Some(JointComplianceModel::default()), ..Effects::default() };
     let mut rng = ChaCha8Rng::seed_from_u64(20);
     for _ in 0..20 {
         let q = random_q(&robot.ranges, &mut rng);
@@ -89,7 +89,8 @@ fn the_gear_error_pose_error_is_its_joint_offsets_to_first_order() {
         Harmonic { joint_index: 1, order: 3.0, amplitude_rad: 1e-5, phase_rad: -1.1 },
         Harmonic { joint_index: 4, order: 2.0, amplitude_rad: 3e-5, phase_rad: 2.0 },
     ];
-    let effects = Effects { periodic: Some(GearPeriodicModel { harmonics: harmonics.clone() }), ..Effects::default() };
+    let effects =
+        Effects { gear_periodic: Some(GearPeriodicModel { harmonics: harmonics.clone() }), ..Effects::default() };
     let mut rng = ChaCha8Rng::seed_from_u64(22);
     for _ in 0..20 {
         let q = random_q(&robot.ranges, &mut rng);
@@ -133,7 +134,7 @@ fn drift_is_the_twist_rate_times_the_time_exactly_in_the_tracker_frame() {
     let mut cell = SimulatedCell::new(robot.model.clone(), None);
     cell.tracker_from_base = SE3::new(SO3::from_rpy(0.1, -0.2, 2.5), Vector3::new(3.0, -1.0, 0.4));
     let drift = TimeDriftModel { twist_per_s: [3e-9, -1e-9, 2e-9, 1e-9, -2e-9, 4e-9] };
-    let effects = Effects { drift: Some(drift), ..Effects::default() };
+    let effects = Effects { time_drift: Some(drift), ..Effects::default() };
     let q = [0.2, 0.3, -0.1, 0.5, 0.6, -0.7];
     for t_s in [0.0, 600.0, 7200.0, 36000.0] {
         let predicted = Vector6::from(drift.twist_per_s) * t_s;
