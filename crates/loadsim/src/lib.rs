@@ -31,7 +31,7 @@
 //!     gravity_m_per_s2: loadsim::FLOOR_GRAVITY_M_PER_S2,
 //! };
 //! let cell = SimulatedCell::new(arm, Some(dynamics));
-//! let effects = Effects { compliance: Some(JointComplianceModel::default()), ..Effects::default() };
+//! let effects = Effects { joint_compliance: Some(JointComplianceModel::default()), ..Effects::default() };
 //! let context = PoseContext { payload: Payload::at_tool(10.0), ..PoseContext::default() };
 //! let pose = effects.true_pose(&cell, &[0.0], &context).unwrap();
 //! // 10 kg at 1 m: 98.1 N·m, 0.981 mrad, the tool sags by 0.981 mm.
