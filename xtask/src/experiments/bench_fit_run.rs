@@ -146,8 +146,10 @@ mod tests {
         command.args(["-c", "i=0; while [ $i -lt 200000 ]; do i=$((i+1)); done; echo done"]);
         let (cost, out) = measure(&mut command, &|_| {}).unwrap();
         assert_eq!(out.trim(), "done");
+        // Only a lower bound: the children's CPU time is the whole test process's, and other
+        // tests running beside this one reap their own children inside the same window.
         let cpu = cost.cpu_s.unwrap();
-        assert!(cpu > 0.0 && cpu <= cost.wall_s + 0.05, "{cost:?}");
+        assert!(cpu > 0.0, "{cost:?}");
         assert!(cost.peak_mib.is_some_and(|p| p > 0.0), "{cost:?}");
         let failed = measure(Command::new("sh").args(["-c", "echo why >&2; exit 3"]), &|_| {}).unwrap_err();
         assert!(failed.to_string().contains("why"), "{failed}");
