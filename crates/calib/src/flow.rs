@@ -364,6 +364,22 @@ pub fn simulate(
     out: impl std::io::Write,
     out_name: &str,
 ) -> Result<usize, Error> {
+    simulate_day(robot, robot_file, effects, config, &campaign::Day::default(), full_pose, out, out_name)
+}
+
+/// [`simulate`] on `day` of the campaign: the cell drawn from `config`'s seed as on the first
+/// day, then re-sighted, its clock and its draws moved to the day ([`campaign::Day::of`]).
+#[allow(clippy::too_many_arguments)] // `simulate`'s arguments and the day
+pub fn simulate_day(
+    robot: &RobotDescription,
+    robot_file: &str,
+    effects: &campaign::Effects,
+    config: &GeneratorConfig,
+    day: &campaign::Day,
+    full_pose: bool,
+    out: impl std::io::Write,
+    out_name: &str,
+) -> Result<usize, Error> {
     if config.moving_joints.is_empty()
         && let Some(direction) = robot.planar_direction()
     {
@@ -371,7 +387,8 @@ pub fn simulate(
         return Err(Error::in_file(robot_file.to_owned(), ErrorKind::PlanarChain { direction, joints }));
     }
     let cell = campaign::campaign_cell(robot, &Perturbation::default(), &Remount::default(), config)?;
-    campaign::simulate_to_csv(&cell, effects, &campaign::joint_ranges(robot), config, full_pose, out, out_name)
+    let (cell, config) = day.of(&cell, config);
+    campaign::simulate_to_csv(&cell, effects, &campaign::joint_ranges(robot), &config, full_pose, out, out_name)
 }
 
 /// `diagnose`: the diagnosis of `data` for `robot` and, where `report` names a folder, the

@@ -62,6 +62,15 @@ pub struct Args {
     /// TorqueSensorNoise].
     #[arg(long)]
     torque_sigma_nm: Option<f64>,
+    /// A later day of the same campaign: the same true robot, the tracker re-sighted (up to 5 mm
+    /// and 5 mrad per component off the first day's placement), the clock this many days on, the
+    /// poses and noise of a seed of the day's own [default: 0, the first day].
+    #[arg(long, default_value_t = 0)]
+    day: u64,
+    /// The cell's temperature at the campaign's start, °C (it then warms by 3 °C with a 2 h time
+    /// constant, loadsim's `TemperatureProfile`; on a later day it has warmed) [default: 20].
+    #[arg(long)]
+    temp_c: Option<f64>,
 }
 
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
@@ -85,13 +94,25 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     if args.rows == 0 {
         return Err("--rows: at least one pose is needed".into());
     }
-    let config = generator_config(args)?;
+    let mut config = generator_config(args)?;
+    if let Some(temp_c) = args.temp_c {
+        if !(temp_c.is_finite() && temp_c.abs() <= campaign::MAX_TEMPERATURE_C) {
+            return Err(format!(
+                "--temp-c: {temp_c} is not a temperature (°C, within ±{})",
+                campaign::MAX_TEMPERATURE_C
+            )
+            .into());
+        }
+        config.temperature.start_c = temp_c;
+    }
+    let day = campaign::Day { index: args.day, ..campaign::Day::default() };
     // Each row is written as it is drawn (memory of one row, whatever --rows), into the atomic
     // output: a failure or a kill leaves the old file, never a part.
     let mut out = measurements::OutputFile::create(&args.out)?;
     let robot_file = args.robot.robot.display().to_string();
     let out_name = args.out.display().to_string();
-    let rows = calib::flow::simulate(&robot, &robot_file, &effects, &config, args.full_pose, &mut out, &out_name)?;
+    let rows =
+        calib::flow::simulate_day(&robot, &robot_file, &effects, &config, &day, args.full_pose, &mut out, &out_name)?;
     out.finish()?;
 
     let on: Vec<&str> = effect_names(&effects);
@@ -103,6 +124,12 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         if on.is_empty() { "none".to_owned() } else { on.join(", ") },
         args.seed
     );
+    if args.day > 0 {
+        println!("  day {} of the campaign: the tracker re-sighted, the clock {} days on", args.day, args.day);
+    }
+    if let Some(temp_c) = args.temp_c {
+        println!("  the cell at {temp_c} °C at the campaign's start");
+    }
     for line in shape_lines(&config) {
         println!("  {line}");
     }
