@@ -159,6 +159,10 @@ impl EffectTerm for LinkDeflectionTerm {
         self.payload_span.as_ref()
     }
 
+    fn coverage_weight(&self, row: &Measurement) -> f64 {
+        self.payload_span.as_ref().map_or(1.0, |s| s.coverage(row.payload_kg))
+    }
+
     fn set_beyond_payload(&mut self, rule: BeyondSpan) {
         if let Some(span) = &mut self.payload_span {
             span.beyond = rule;

@@ -59,11 +59,17 @@ impl PayloadSpan {
         (!(low..=high).contains(&payload_kg)).then_some(self.beyond)
     }
 
+    /// How fully the model applies at a row of payload `payload_kg`
+    /// (`EffectTerm::coverage_weight`): 0 beyond the span where the term is dropped.
+    pub fn coverage(&self, payload_kg: f64) -> f64 {
+        self.beyond.coverage(Some(payload_kg), Some(self.kg))
+    }
+
     /// The payload the features are computed with under `rule` ([`PayloadSpan::rule_at`]): the
     /// nearer end of the span for a hold, the row's own otherwise.
     pub fn payload(&self, rule: Option<BeyondSpan>, payload_kg: f64) -> f64 {
         match rule {
-            Some(BeyondSpan::Hold) => payload_kg.clamp(self.kg[0], self.kg[1]),
+            Some(BeyondSpan::Hold | BeyondSpan::Drop) => payload_kg.clamp(self.kg[0], self.kg[1]),
             _ => payload_kg,
         }
     }
@@ -72,7 +78,7 @@ impl PayloadSpan {
     /// (as measured where no span was recorded for it).
     pub fn torque(&self, rule: Option<BeyondSpan>, joint: usize, torque_nm: f64) -> f64 {
         match (rule, self.torque_nm.get(joint)) {
-            (Some(BeyondSpan::Hold), Some(&[low, high])) => torque_nm.clamp(low, high),
+            (Some(BeyondSpan::Hold | BeyondSpan::Drop), Some(&[low, high])) => torque_nm.clamp(low, high),
             _ => torque_nm,
         }
     }

@@ -115,6 +115,10 @@ impl EffectTerm for ThermalTerm {
     fn set_beyond_span(&mut self, rule: BeyondSpan) {
         self.beyond_span = rule;
     }
+
+    fn coverage_weight(&self, row: &Measurement) -> f64 {
+        self.beyond_span.coverage(row.temp_c, self.fitted_span)
+    }
 }
 
 impl NewEffect for ThermalTerm {

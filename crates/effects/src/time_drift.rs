@@ -119,6 +119,10 @@ impl EffectTerm for TimeDriftTerm {
     fn set_beyond_span(&mut self, rule: BeyondSpan) {
         self.beyond_span = rule;
     }
+
+    fn coverage_weight(&self, row: &Measurement) -> f64 {
+        self.beyond_span.coverage(row.t_s, self.fitted_span)
+    }
 }
 
 impl NewEffect for TimeDriftTerm {

@@ -1,11 +1,14 @@
 //! Measuring sessions in the training rows, and what a term driven by time or temperature
 //! (`time_drift`, `thermal`) is beyond the span it was fitted on, chosen by leaving one session out
-//! at a time: held at its value at the span's end ([`BeyondSpan::Hold`]) or fallen back
-//! to the geometry ([`BeyondSpan::Zero`]). A robot re-measured days later starts from a placement
-//! of its own: whether the end of the last session or the geometry's average placement is nearer
-//! to it is a property of the cell (a foundation that settles one way, or a tracker re-sighted
-//! anywhere), which only other sessions of the same cell can tell. With one session nothing can,
-//! and each kind keeps the rule it had (drift: zero; growth: held).
+//! at a time: held at its value at the span's end ([`BeyondSpan::Hold`]), fallen back
+//! to the geometry it was fitted with ([`BeyondSpan::Zero`]), or dropped, the whole model fallen
+//! back to the geometry fitted alone and its GP ([`BeyondSpan::Drop`]). A robot re-measured days
+//! later starts from a placement of its own: whether the end of the last session or the
+//! geometry's average placement is nearer to it is a property of the cell (a foundation that
+//! settles one way, or a tracker re-sighted anywhere), which only other sessions of the same cell
+//! can tell. With one session nothing can: a drift is then dropped, the one rule that cannot make
+//! another day worse than the fit without it (every later day is beyond a drift's span), and a
+//! growth keeps its hold (a day at a temperature inside the span is inside it).
 
 use crate::fit_options::FitOptions;
 use crate::rule_choice::{Decision, FoldFailure, Target, held_out_errors, one_standard_error};
@@ -57,13 +60,15 @@ pub struct SpanChoice {
     pub reason: String,
 }
 
-/// The left-out sessions' mean position error under either rule.
+/// The left-out sessions' mean position error under each rule.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SpanErrors {
     /// Held at the span's end, mm.
     pub hold: f64,
     /// Zero beyond the span, mm.
     pub zero: f64,
+    /// Dropped beyond the span (the geometry fitted alone), mm.
+    pub drop: f64,
 }
 
 impl std::fmt::Display for SpanChoice {
@@ -75,9 +80,11 @@ impl std::fmt::Display for SpanChoice {
 /// Chooses the rule beyond the span for every effect of `effects` that has one (fitted with the
 /// items `specs` on `data`) and sets it: with several sessions, each left out in turn, the rest
 /// fitted (`poe` with the same items; no prior strength chosen, and no sessions or payloads chosen
-/// inside a fold), and the left-out rows predicted under either rule, the others' kept as fitted.
-/// The kind's own rule stays unless the other's mean error is lower by more than one standard
-/// error of the rows' paired differences (`rule_choice::one_standard_error`).
+/// inside a fold), and the left-out rows predicted under each of hold, zero and drop, the others'
+/// kept as fitted. The kind's own rule stays unless the best other's mean error is lower by more
+/// than one standard error of the rows' paired differences (`rule_choice::one_standard_error`).
+/// With one session, or none known, a drift is dropped and a growth keeps its hold
+/// ([`undecided_rule`]); with the choice switched off each keeps the rule it has.
 ///
 /// `fit` fits a fold (`crate::fit` with `poe`, passed in so that this module does not import the
 /// fit that calls it).
@@ -98,15 +105,13 @@ pub(crate) fn choose(
     if !settings.choose {
         return Ok(keep(effects, "its own rule (effects.sessions.choose is false)".into()));
     }
-    if found.is_empty() {
-        return Ok(keep(effects, "sessions unknown (a row has no t_s): its own rule".into()));
-    }
     if found.len() < 2 {
-        let reason = format!(
-            "one session (no gap in t_s longer than {} times the median spacing): nothing to leave out, its own rule",
-            settings.gap_ratio
-        );
-        return Ok(keep(effects, reason));
+        let why = if found.is_empty() {
+            "sessions unknown (a row has no t_s)".to_owned()
+        } else {
+            format!("one session (no gap in t_s longer than {} times the median spacing)", settings.gap_ratio)
+        };
+        return Ok(undecided(effects, &targets, found.len(), &why));
     }
     let fold_options = crate::rule_choice::fold_options(options, specs);
     // Per target, the left-out rows' errors under the kind's own rule and under the other.
@@ -114,7 +119,8 @@ pub(crate) fn choose(
         .iter()
         .map(|&k| {
             let rule = effects[k].beyond_span().unwrap_or(BeyondSpan::Zero);
-            Target { effect: k, rules: vec![rule, rule.other()] }
+            let others = RULES.into_iter().filter(|&r| r != rule);
+            Target { effect: k, rules: std::iter::once(rule).chain(others).collect() }
         })
         .collect();
     let errors = match held_out_errors(data, &found, &fold_options, &trials, IdentifiedEffect::set_beyond_span, fit) {
@@ -131,10 +137,12 @@ pub(crate) fn choose(
         let k = trial.effect;
         let rule = trial.rules[0];
         let decision = one_standard_error(&trial.rules, errors);
-        let (own_mm, other_mm) = (decision.means[0], decision.means[1]);
-        let errors = match rule {
-            BeyondSpan::Hold => SpanErrors { hold: own_mm, zero: other_mm },
-            BeyondSpan::Zero | BeyondSpan::Extend => SpanErrors { hold: other_mm, zero: own_mm },
+        let mean_of =
+            |wanted: BeyondSpan| trial.rules.iter().position(|&r| r == wanted).map_or(f64::NAN, |i| decision.means[i]);
+        let errors = SpanErrors {
+            hold: mean_of(BeyondSpan::Hold),
+            zero: mean_of(BeyondSpan::Zero),
+            drop: mean_of(BeyondSpan::Drop),
         };
         let reason = chosen_reason(&decision, rule, &errors, found.len());
         effects[k].set_beyond_span(decision.chosen);
@@ -147,6 +155,39 @@ pub(crate) fn choose(
         });
     }
     Ok(out)
+}
+
+/// The rules the sessions choose among for a drift or a growth (extend is a payload term's).
+const RULES: [BeyondSpan; 3] = [BeyondSpan::Hold, BeyondSpan::Zero, BeyondSpan::Drop];
+
+/// The rule of an effect that no left-out session can judge: a drift dropped (another day is
+/// always beyond its span, and the drop makes it the fit without effects there, so never worse
+/// than it), a growth its own (held: a day at a temperature inside its span is predicted as
+/// fitted, one beyond it at the nearer end).
+pub(crate) fn undecided_rule(effect: &IdentifiedEffect) -> BeyondSpan {
+    match effect {
+        IdentifiedEffect::TimeDrift(_) => BeyondSpan::Drop,
+        _ => effect.beyond_span().unwrap_or(BeyondSpan::Zero),
+    }
+}
+
+/// Each target effect set to its [`undecided_rule`], and why: `why` nothing could decide it.
+fn undecided(effects: &mut [IdentifiedEffect], targets: &[usize], sessions: usize, why: &str) -> Vec<SpanChoice> {
+    targets
+        .iter()
+        .map(|&k| {
+            let rule = undecided_rule(&effects[k]);
+            effects[k].set_beyond_span(rule);
+            let reason = match rule {
+                BeyondSpan::Drop => format!(
+                    "{why}: nothing to leave out, so nothing could decide the rule; dropped, the one rule that \
+                     cannot make a day beyond the span worse than the fit without effects"
+                ),
+                _ => format!("{why}: nothing to leave out, so nothing could decide the rule; its own rule"),
+            };
+            SpanChoice { effect: effects[k].label(), rule, sessions, heldout_mm: None, reason }
+        })
+        .collect()
 }
 
 /// Each target effect with the rule it has, and why it was not chosen.
@@ -168,10 +209,11 @@ fn own_rules(effects: &[IdentifiedEffect], targets: &[usize], sessions: usize, r
 fn chosen_reason(decision: &Decision, rule: BeyondSpan, errors: &SpanErrors, sessions: usize) -> String {
     let standard_error = decision.standard_error;
     format!(
-        "{} sessions, each left out in turn: {:.4} mm held, {:.4} mm zero beyond the span ({} rows; {})",
+        "{} sessions, each left out in turn: {:.4} mm held, {:.4} mm zero, {:.4} mm dropped beyond the span ({} rows; {})",
         sessions,
         errors.hold,
         errors.zero,
+        errors.drop,
         decision.rows,
         if decision.switched {
             format!("{} lower by more than one standard error, {standard_error:.4} mm", decision.chosen.name())

@@ -112,14 +112,30 @@ fn a_settling_cell_holds_the_drift_at_the_end_of_its_span() {
 }
 
 #[test]
-fn with_one_session_the_drift_keeps_its_own_rule_and_the_report_says_so() {
+fn with_one_session_the_drift_is_dropped_and_a_later_session_gets_the_fit_without_effects() {
     let robot = testkit::robot("irb4400.ron");
-    let (train, _) = campaign(&robot, [[0.0; 3]; 4], 73);
+    let (train, test) = campaign(&robot, [[0.0; 3]; 4], 73);
     let first: Vec<usize> = (0..120).collect();
-    let (_, report) = fit(&robot, &train.subset(&first), "time_drift");
+    let (drift, report) = fit(&robot, &train.subset(&first), "time_drift");
     let choice = &report.beyond_span[0];
-    assert_eq!((choice.rule, choice.sessions, choice.heldout_mm), (BeyondSpan::Zero, 1, None));
+    assert_eq!((choice.rule, choice.sessions, choice.heldout_mm), (BeyondSpan::Drop, 1, None));
     assert!(choice.reason.starts_with("one session"), "{}", choice.reason);
+    assert!(choice.reason.contains("nothing could decide"), "{}", choice.reason);
     let json = serde_json::to_value(&report).unwrap();
-    assert_eq!(json["beyond_span"][0]["rule"], "zero");
+    assert_eq!(json["beyond_span"][0]["rule"], "drop");
+    // On a later day the model is the geometry fitted alone, row for row (the rule's promise:
+    // never worse there than the fit without effects); on its own session it is not.
+    let alone = model::CalibratedModel {
+        kinematics: drift.fallback_kinematics.clone().expect("a fit with effects keeps the geometry fitted alone"),
+        ..drift.geometry_only()
+    };
+    let errors = |m: &model::CalibratedModel, set: &MeasurementSet| -> Vec<f64> {
+        model::evaluate(m, &m.bind(set).unwrap()).unwrap().errors.iter().map(|e| e.position_mm).collect()
+    };
+    let (later, later_alone) = (errors(&drift, &test), errors(&alone, &test));
+    for (a, b) in later.iter().zip(&later_alone) {
+        assert!((a - b).abs() < 1e-9, "{a} mm against {b} mm with the geometry fitted alone");
+    }
+    let own = train.subset(&first);
+    assert_ne!(errors(&drift, &own), errors(&alone, &own));
 }
