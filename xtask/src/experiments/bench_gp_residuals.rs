@@ -99,6 +99,27 @@ pub fn simulated_campaign(
     residuals(name, robot, &train_set, &test_set, true)
 }
 
+/// A simulated arm without payload as an input: `calib simulate --robot ROBOT --payloads 0
+/// --rows TRAIN+TEST --seed SEED` with the paper's effects (joint compliance under the arm's own
+/// weight, tracker noise), the first `train` poses to train on and the rest to test; the GP takes
+/// the joints alone, as `poe-gp` fits it. On the column arm (`column_arm.urdf`: a prismatic column
+/// in metres beside six revolute joints) these are the mixed-unit inputs of a construction robot.
+pub fn simulated_without_payload(
+    robot: &RobotDescription,
+    seed: u64,
+    train: usize,
+    test: usize,
+) -> anyhow::Result<Residuals> {
+    let config =
+        GeneratorConfig { sample_count: train + test, seed, payloads_kg: vec![0.0], ..GeneratorConfig::default() };
+    let (_, data) =
+        simulate_campaign(robot, &paper_effects(), &Perturbation::default(), &Remount::default(), &config, false)?;
+    let train_set = data.subset(&(0..train).collect::<Vec<_>>());
+    let test_set = data.subset(&(train..train + test).collect::<Vec<_>>());
+    let name = format!("simulated {}, seed {seed}, {train} poses", robot.name);
+    residuals(name, robot, &train_set, &test_set, false)
+}
+
 /// The shape of a real 7-axis campaign ([`payload_run_campaign`]: joints 1 and 2 moving, four
 /// payload runs with a tool each) with the paper's effects: `train + test` poses, every run in both
 /// sets (the training rows spread evenly over the campaign), so that no payload is seen only at
