@@ -41,6 +41,26 @@ pub enum TorqueSign {
     },
 }
 
+impl TorqueSign {
+    /// The torque `Σ_l coefficients_l · regressor_row[columns_l]` of [`TorqueSign::Learnt`],
+    /// given the joint's row of the gravity-torque regressors at one measurement
+    /// (`LoadFrame::regressors`); a column past the row's end counts as zero.
+    pub fn learnt_torque(regressor_row: &[f64], columns: &[usize], coefficients: &[f64]) -> f64 {
+        columns.iter().zip(coefficients).map(|(&c, k)| regressor_row.get(c).copied().unwrap_or(0.0) * k).sum()
+    }
+
+    /// Joint `joint`'s (0-based) row of the gravity-torque regressors of `load` at every row of
+    /// `data`, in its order: what [`TorqueSign::learnt_torque`] takes.
+    pub fn learnt_regressor_rows(load: &LoadFrame, joint: usize, data: &BoundSet<'_>) -> Result<Vec<Vec<f64>>, Error> {
+        data.iter()
+            .map(|(row, tool)| {
+                let missing = || Error::new(ErrorKind::EffectJoint { joint: joint + 1, joint_count: row.q.len() });
+                load.regressors(row, tool)?.into_iter().nth(joint).ok_or_else(missing)
+            })
+            .collect()
+    }
+}
+
 /// Backlash of one joint.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BacklashTerm {
@@ -67,6 +87,21 @@ impl BacklashTerm {
         Ok(model)
     }
 
+    /// [`BacklashTerm::new`] where `torques` holds what [`BacklashTerm::torque`] gives at each
+    /// training row: a caller that tries many learnt torques on the same rows computes the
+    /// regressors once ([`TorqueSign::learnt_torque`]) instead of once a torque.
+    pub fn with_torques(joint: usize, sign: TorqueSign, torques: &[f64]) -> Self {
+        let mut model = Self { joint, sign, scale: vec![1.0], theta: vec![0.0] };
+        let raw: Vec<Vec<f64>> = torques.iter().map(|&t| vec![model.feature_of(t)]).collect();
+        model.scale = rms_scales(&raw);
+        model
+    }
+
+    /// The feature at a row where the joint's torque is `torque`.
+    pub fn feature_of(&self, torque: f64) -> f64 {
+        sign(torque) / self.scale[0]
+    }
+
     /// The torque of the joint at one row, whose sign is the feature.
     pub fn torque(&self, row: &Measurement, tool: usize) -> Result<f64, Error> {
         let j = self.joint;
@@ -89,7 +124,7 @@ impl BacklashTerm {
             TorqueSign::Learnt { load, columns, coefficients } => {
                 let regressors = load.regressors(row, tool)?;
                 let row = regressors.get(j).ok_or_else(missing)?;
-                Ok(columns.iter().zip(coefficients).map(|(&c, k)| row.get(c).copied().unwrap_or(0.0) * k).sum())
+                Ok(TorqueSign::learnt_torque(row, columns, coefficients))
             }
         }
     }
@@ -101,7 +136,7 @@ impl Regressor for BacklashTerm {
     }
 
     fn features(&self, row: &Measurement, tool: usize) -> Result<Vec<f64>, Error> {
-        Ok(vec![sign(self.torque(row, tool)?) / self.scale[0]])
+        Ok(vec![self.feature_of(self.torque(row, tool)?)])
     }
 
     fn theta(&self) -> &[f64] {

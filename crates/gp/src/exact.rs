@@ -12,7 +12,8 @@ use crate::gram::training_covariance;
 use crate::kernel::{Bounds, KernelChoice};
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::lml::check_finite_outputs;
-use crate::optimise::{OptimisationReport, WarmStage, finish_from, fit_hyperparameters_from, refine, warm_stage_from};
+use crate::optimise::{OptimisationReport, WarmStage, finish_from, refine, warm_stage_from};
+use crate::optimise::{expect_one_thread_groups, one_thread_group};
 use crate::points::Points;
 use crate::scaling::{InputStandardiser, OutputNormaliser};
 
@@ -191,8 +192,9 @@ impl GroupFits<'_> {
     /// `start`, then `nested` (its own nested starts unless a fitted smaller model gives better ones).
     fn search(&self, start: &Kernel, nested: &[Kernel], g: Group<'_>) -> Result<(Kernel, OptimisationReport), Error> {
         start.validate(self.xs.dim())?;
-        let (bounds, config) = (self.bounds_of(start), self.config);
-        let o = fit_hyperparameters_from(start, nested, &bounds, self.xs, g.y, &config.optimiser, config.parallelism)?;
+        let (bounds, optimiser, par) = (self.bounds_of(start), &self.config.optimiser, self.config.parallelism);
+        let warm = warm_stage_from(start, nested, &bounds, self.xs, g.y, optimiser, par)?;
+        let o = finish_from(start, nested, &bounds, self.xs, g.y, optimiser, par, warm)?;
         Ok((o.kernel, o.report))
     }
 
@@ -494,7 +496,11 @@ impl ExactGp {
         let busy = config.parallelism == Parallelism::Rayon && groups.len() >= rayon::current_num_threads();
         let one_thread = GpConfig { parallelism: Parallelism::Sequential, ..config.clone() };
         let fits = GroupFits { xs: &xs, yn: &yn, config: if busy { &one_thread } else { config }, how: &how };
-        let fit_group = |(g, cols): (usize, &Vec<usize>)| fits.with_isotropic(fits.fit_searched(g, cols)?, cols);
+        expect_one_thread_groups(if busy { groups.len() } else { 0 });
+        let fit_group = |(g, cols): (usize, &Vec<usize>)| {
+            let fit = || fits.with_isotropic(fits.fit_searched(g, cols)?, cols);
+            if busy { one_thread_group(fit) } else { fit() }
+        };
         let fitted: Vec<_> = match config.parallelism {
             Parallelism::Sequential => groups.iter().enumerate().map(fit_group).collect(),
             Parallelism::Rayon => groups.par_iter().enumerate().map(fit_group).collect(),

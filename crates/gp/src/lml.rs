@@ -130,22 +130,10 @@ impl LmlWorkspace {
         kernel.validate(x.ncols())?;
         let points = Points::from_rows(x)?;
         check_finite_outputs(y)?;
-        evaluate(self, kernel, &points, y, with_gradient, parallelism)
+        let value = evaluate_value(self, kernel, &points, y, parallelism)?;
+        let gradient = if with_gradient { evaluate_gradient(self, points.dim(), parallelism) } else { Vec::new() };
+        Ok(LogMarginalLikelihood { value, gradient })
     }
-}
-
-/// The work horse of [`log_marginal_likelihood`] on validated points.
-pub(crate) fn evaluate(
-    workspace: &mut Workspace,
-    kernel: &Kernel,
-    x: &Points,
-    y: MatRef<'_, f64>,
-    with_gradient: bool,
-    parallelism: Parallelism,
-) -> Result<LogMarginalLikelihood, Error> {
-    let value = evaluate_value(workspace, kernel, x, y, parallelism)?;
-    let gradient = if with_gradient { evaluate_gradient(workspace, x.dim(), parallelism) } else { Vec::new() };
-    Ok(LogMarginalLikelihood { value, gradient })
 }
 
 /// The value stage: `K + σn² I = L Lᵀ` (`n³/3` flops) and `α = K⁻¹ Y`; the factor stays in the

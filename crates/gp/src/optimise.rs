@@ -7,6 +7,9 @@
 //! full data are searched once, from the subset's best optimum: the subset's optimum is the data's
 //! own first guess, a few full iterations away from the full optimum.
 
+use std::cell::Cell;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use faer::{Mat, MatRef};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -74,6 +77,31 @@ fn starting_points(
     points
 }
 
+/// Output groups [`crate::ExactGp`] fits one thread each, not yet finished, over the process: a
+/// group's evaluations stay on its thread (faer's parallel routines wait for threads busy with
+/// groups of their own) but for the last one, alone, which uses the pool. Results are the same.
+static UNFINISHED_GROUPS: AtomicUsize = AtomicUsize::new(0);
+thread_local!(static IN_GROUP: Cell<bool> = const { Cell::new(false) });
+
+/// Counts `groups` more in [`UNFINISHED_GROUPS`], before any of them runs.
+pub(crate) fn expect_one_thread_groups(groups: usize) {
+    UNFINISHED_GROUPS.fetch_add(groups, Ordering::SeqCst);
+}
+
+/// `f()` on this thread as one of the [`UNFINISHED_GROUPS`] (a panic leaves the count high).
+pub(crate) fn one_thread_group<T>(f: impl FnOnce() -> T) -> T {
+    let (outer, result) = (IN_GROUP.replace(true), f());
+    IN_GROUP.set(outer);
+    UNFINISHED_GROUPS.fetch_sub(1, Ordering::SeqCst);
+    result
+}
+
+/// `parallelism`, or the pool for the last of [`UNFINISHED_GROUPS`].
+fn tail_aware(parallelism: Parallelism) -> Parallelism {
+    let last = IN_GROUP.get() && UNFINISHED_GROUPS.load(Ordering::SeqCst) == 1;
+    if last { Parallelism::Rayon } else { parallelism }
+}
+
 /// The negative log marginal likelihood in log-parameters, in two stages (value, then gradient at
 /// the same point from the factor it left).
 struct NegativeLml<'a> {
@@ -100,10 +128,10 @@ impl<'a> NegativeLml<'a> {
 impl Objective for NegativeLml<'_> {
     fn value(&mut self, p: &[f64]) -> Option<f64> {
         let kernel = self.start.with_log_parameters(p).ok()?;
-        evaluate_value(&mut self.workspace, &kernel, self.x, self.y, self.parallelism).ok().map(|v| -v)
+        evaluate_value(&mut self.workspace, &kernel, self.x, self.y, tail_aware(self.parallelism)).ok().map(|v| -v)
     }
     fn gradient(&mut self) -> Option<Vec<f64>> {
-        let g = evaluate_gradient(&mut self.workspace, self.x.dim(), self.parallelism);
+        let g = evaluate_gradient(&mut self.workspace, self.x.dim(), tail_aware(self.parallelism));
         (!g.is_empty()).then(|| g.iter().map(|v| -v).collect())
     }
 }
@@ -244,22 +272,6 @@ pub(crate) fn warm_stage_from(
     };
     let evaluations = results.iter().flatten().map(|m| m.evaluations).sum();
     Ok(Some(WarmStage { results, indices: idx, evaluations, best }))
-}
-
-/// Maximises the log marginal likelihood of `y` (n × m, all columns sharing the kernel) from
-/// `start` and `nested` (usually [`Kernel::nested_starts`]) as [`warm_stage_from`] and
-/// [`finish_from`] search.
-pub(crate) fn fit_hyperparameters_from(
-    start: &Kernel,
-    nested: &[Kernel],
-    bounds: &Bounds,
-    x: &Points,
-    y: MatRef<'_, f64>,
-    config: &OptimiserConfig,
-    parallelism: Parallelism,
-) -> Result<Optimised, Error> {
-    let warm = warm_stage_from(start, nested, bounds, x, y, config, parallelism)?;
-    finish_from(start, nested, bounds, x, y, config, parallelism, warm)
 }
 
 /// The full-data search: from the warm stage's best optimum when there is one, else from
