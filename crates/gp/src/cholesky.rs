@@ -11,7 +11,7 @@ use dense::{solve_lower, solve_upper_transposed};
 
 /// `K + jitter·I = L Lᵀ` (the jitter is recorded by the caller in a [`JitterOutcome`]).
 #[derive(Debug, Clone)]
-pub(crate) struct Factor {
+pub struct Factor {
     /// Lower-triangular factor; the strict upper triangle is zero.
     l: Mat<f64>,
 }
@@ -39,7 +39,7 @@ pub(crate) fn factor_in_place(mut a: Mat<f64>, par: Par) -> Result<Mat<f64>, usi
 impl Factor {
     /// Factors `k` (lower triangle read) as it is, then with growing jitter on the diagonal until
     /// it succeeds or [`JitterConfig::max_attempts`] is exhausted.
-    pub(crate) fn with_jitter(k: &Mat<f64>, config: &JitterConfig, par: Par) -> Result<(Self, JitterOutcome), Error> {
+    pub fn with_jitter(k: &Mat<f64>, config: &JitterConfig, par: Par) -> Result<(Self, JitterOutcome), Error> {
         let n = k.nrows();
         let mut pivot = match factor_in_place(k.clone(), par) {
             Ok(l) => return Ok((Self { l }, JitterOutcome { added: 0.0, failed_attempts: 0 })),
@@ -62,7 +62,7 @@ impl Factor {
     }
 
     /// Factors `k + jitter·I` once (used to rebuild a stored model with its recorded jitter).
-    pub(crate) fn with_fixed_jitter(k: &Mat<f64>, jitter: f64, par: Par) -> Result<Self, Error> {
+    pub fn with_fixed_jitter(k: &Mat<f64>, jitter: f64, par: Par) -> Result<Self, Error> {
         let n = k.nrows();
         let mut a = k.clone();
         for i in 0..n {
@@ -77,7 +77,7 @@ impl Factor {
 
     /// A factor read back from storage: lower triangular (the upper triangle is ignored), every
     /// entry finite, a positive diagonal; otherwise the index of the first bad pivot.
-    pub(crate) fn from_lower(mut l: Mat<f64>) -> Result<Self, usize> {
+    pub fn from_lower(mut l: Mat<f64>) -> Result<Self, usize> {
         let n = l.nrows();
         for j in 0..n {
             if !(l[(j, j)] > 0.0 && l[(j, j)].is_finite()) || (j..n).any(|i| !l[(i, j)].is_finite()) {
@@ -89,7 +89,7 @@ impl Factor {
     }
 
     /// The lower-triangular factor.
-    pub(crate) fn lower(&self) -> &Mat<f64> {
+    pub fn lower(&self) -> &Mat<f64> {
         &self.l
     }
 
@@ -128,23 +128,23 @@ impl Factor {
     }
 
     /// `rhs ← L⁻¹ rhs`.
-    pub(crate) fn solve_lower_in_place(&self, rhs: MatMut<'_, f64>, par: Par) {
+    pub fn solve_lower_in_place(&self, rhs: MatMut<'_, f64>, par: Par) {
         solve_lower(self.l.as_ref(), rhs, par);
     }
 
     /// `rhs ← L⁻ᵀ rhs`.
-    pub(crate) fn solve_upper_transposed_in_place(&self, rhs: MatMut<'_, f64>, par: Par) {
+    pub fn solve_upper_transposed_in_place(&self, rhs: MatMut<'_, f64>, par: Par) {
         solve_upper_transposed(self.l.as_ref(), rhs, par);
     }
 
     /// `rhs ← (L Lᵀ)⁻¹ rhs` (R&W Algorithm 2.1, line 3).
-    pub(crate) fn solve_in_place(&self, mut rhs: MatMut<'_, f64>, par: Par) {
+    pub fn solve_in_place(&self, mut rhs: MatMut<'_, f64>, par: Par) {
         solve_lower(self.l.as_ref(), rhs.as_mut(), par);
         solve_upper_transposed(self.l.as_ref(), rhs, par);
     }
 
     /// `ln |L Lᵀ| = 2 Σ ln Lᵢᵢ`.
-    pub(crate) fn log_determinant(&self) -> f64 {
+    pub fn log_determinant(&self) -> f64 {
         2.0 * (0..self.l.nrows()).map(|i| self.l[(i, i)].ln()).sum::<f64>()
     }
 }

@@ -22,7 +22,7 @@ fn squared_norms(rows: MatRef<'_, f64>) -> Vec<f64> {
 
 /// The contraction, noise entry 0; `same` when `X` is `Z` (the diagonal then has `r² = 0` exactly,
 /// as in the kernel matrix the bound factored).
-pub(crate) fn contract_cross(
+pub fn contract_cross(
     kernel: &Evaluator,
     z: &Prepared,
     x: &Prepared,

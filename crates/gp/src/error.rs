@@ -96,13 +96,6 @@ pub enum Error {
         /// Number of starting points tried.
         starts: usize,
     },
-    /// More inducing points were asked for than there are training points.
-    TooManyInducingPoints {
-        /// Inducing points requested.
-        requested: usize,
-        /// Training points available.
-        available: usize,
-    },
     /// The diagonal of the inverse training covariance that leave-one-out prediction divides by
     /// is not finite and positive at a row (a covariance too ill-conditioned for it).
     LeaveOneOutFailed {
@@ -159,9 +152,6 @@ impl fmt::Display for Error {
             ),
             Self::OptimisationFailed { starts } => {
                 write!(f, "none of {starts} hyperparameter starts reached a finite log marginal likelihood")
-            }
-            Self::TooManyInducingPoints { requested, available } => {
-                write!(f, "{requested} inducing points requested but only {available} training points")
             }
             Self::LeaveOneOutFailed { size, row, value } => write!(
                 f,

@@ -568,7 +568,7 @@ impl ExactGp {
 }
 
 /// Rows agree, at least one point, one input and one output, everything finite.
-pub(crate) fn validate_training_data(x: MatRef<'_, f64>, y: MatRef<'_, f64>) -> Result<Points, Error> {
+pub fn validate_training_data(x: MatRef<'_, f64>, y: MatRef<'_, f64>) -> Result<Points, Error> {
     if x.nrows() != y.nrows() {
         return Err(Error::RowCountMismatch { input_rows: x.nrows(), output_rows: y.nrows() });
     }
@@ -587,7 +587,7 @@ pub(crate) fn validate_training_data(x: MatRef<'_, f64>, y: MatRef<'_, f64>) -> 
 
 /// Every output of `0..m` served by exactly one kernel (`outputs`, per kernel), or prediction
 /// would leave it empty.
-pub(crate) fn check_served<'a>(outputs: impl Iterator<Item = &'a Vec<usize>>, m: usize) -> Result<(), Error> {
+pub fn check_served<'a>(outputs: impl Iterator<Item = &'a Vec<usize>>, m: usize) -> Result<(), Error> {
     let mut served = vec![0usize; m];
     for &j in outputs.flatten() {
         if j >= m {

@@ -181,7 +181,7 @@ pub(crate) fn fill_training_lower(
 }
 
 /// Lower triangle of `K(X, X) + diagonal · I` in a new matrix (R&W Eq. 2.21's `K + σn² I`).
-pub(crate) fn training_covariance(kernel: &Evaluator, x: &Prepared, diagonal: f64, par: Parallelism) -> Mat<f64> {
+pub fn training_covariance(kernel: &Evaluator, x: &Prepared, diagonal: f64, par: Parallelism) -> Mat<f64> {
     let mut k = Mat::zeros(x.len(), x.len());
     fill_training_lower(k.as_mut(), kernel, x, diagonal, None, par);
     k
@@ -232,17 +232,17 @@ fn covariance(kernel: &Evaluator, x: &Prepared, z: &Prepared, same: bool, par: P
 }
 
 /// `K(X, Z)` without noise.
-pub(crate) fn cross_covariance(kernel: &Evaluator, x: &Prepared, z: &Prepared, par: Parallelism) -> Mat<f64> {
+pub fn cross_covariance(kernel: &Evaluator, x: &Prepared, z: &Prepared, par: Parallelism) -> Mat<f64> {
     covariance(kernel, x, z, false, par)
 }
 
 /// `K(Z, Z)` in full (both triangles), without noise.
-pub(crate) fn full_covariance(kernel: &Evaluator, z: &Prepared, par: Parallelism) -> Mat<f64> {
+pub fn full_covariance(kernel: &Evaluator, z: &Prepared, par: Parallelism) -> Mat<f64> {
     covariance(kernel, z, z, true, par)
 }
 
 /// `k(z, z)` for every point, without noise.
-pub(crate) fn prior_variances(kernel: &Evaluator, z: &Prepared) -> Vec<f64> {
+pub fn prior_variances(kernel: &Evaluator, z: &Prepared) -> Vec<f64> {
     let linear = z.linear.as_ref().map(squared_norms).unwrap_or_else(|| vec![0.0; z.len()]);
     linear.into_iter().map(|l| kernel.prior_variance(l)).collect()
 }

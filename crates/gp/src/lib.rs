@@ -1,6 +1,6 @@
 //! Gaussian process regression on plain matrices: kernels with analytic gradients, the log
-//! marginal likelihood, hyperparameter optimisation, prediction, and an inducing-point
-//! approximation for large training sets.
+//! marginal likelihood, hyperparameter optimisation and prediction; [`blocks`] holds what the
+//! inducing-point approximation for large training sets (the `gp-sparse` crate) builds on.
 //!
 //! This crate depends on no other crate of the workspace: matrices in, matrices out. Inputs are
 //! `n × d` faer matrices (one point per row), outputs `n × m` (one output per column, e.g. the six
@@ -29,15 +29,14 @@
 #![deny(missing_docs)]
 
 mod additive;
+pub mod blocks;
 mod cholesky;
 mod config;
 mod cross_gradient;
-mod elbo;
 mod error;
 mod exact;
 mod fixed_folds;
 mod gram;
-mod inducing;
 mod kernel;
 mod lml;
 mod loo;
@@ -45,16 +44,14 @@ mod optimise;
 mod points;
 mod predict;
 mod scaling;
-mod sparse;
+mod subset;
 
 pub use cholesky::JitterOutcome;
 pub use config::{GpConfig, JitterConfig, OptimiserConfig, OutputMode, Parallelism};
 pub use dense::FactorOptions;
-pub use elbo::sparse_evidence_lower_bound;
 pub use error::Error;
 pub use exact::{AdditiveChoice, ComponentReport, ExactFitReport, ExactGp, IsotropicChoice};
 pub use fixed_folds::FoldTargets;
-pub use inducing::InducingSelection;
 pub use kernel::{
     AdditiveTerm, Bounds, CompositeKernel, Kernel, KernelChoice, Matern52Ard, QuadraticKernel, SquaredExponentialArd,
     StationaryShape,
@@ -64,4 +61,3 @@ pub use loo::LeaveOneOut;
 pub use optimise::OptimisationReport;
 pub use predict::{PredictOptions, Prediction};
 pub use scaling::{InputStandardiser, OutputNormaliser};
-pub use sparse::{SparseComponentReport, SparseConfig, SparseFitReport, SparseGp};

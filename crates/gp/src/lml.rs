@@ -47,7 +47,8 @@ pub fn log_marginal_likelihood(
     LmlWorkspace::default().log_marginal_likelihood(kernel, x, y, with_gradient, parallelism)
 }
 
-pub(crate) fn check_finite_outputs(y: MatRef<'_, f64>) -> Result<(), Error> {
+/// Refuses a NaN or infinite output, naming its row and column.
+pub fn check_finite_outputs(y: MatRef<'_, f64>) -> Result<(), Error> {
     for j in 0..y.ncols() {
         for i in 0..y.nrows() {
             if !y[(i, j)].is_finite() {

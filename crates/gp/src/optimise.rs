@@ -18,10 +18,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::Error;
 use crate::config::{OptimiserConfig, Parallelism};
-use crate::inducing::random_indices;
 use crate::kernel::{Bounds, Kernel};
 use crate::lml::{Workspace, evaluate_gradient, evaluate_value};
 use crate::points::Points;
+use crate::subset::random_indices;
 use lbfgsb::{Objective, Settings, Termination};
 
 /// What the hyperparameter search did, for one kernel.

@@ -10,14 +10,14 @@ use crate::Error;
 
 /// `len` points of dimension `dim`, row-major.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub(crate) struct Points {
+pub struct Points {
     dim: usize,
     data: Vec<f64>,
 }
 
 impl Points {
     /// Copies the rows of `x`, refusing NaN and infinities.
-    pub(crate) fn from_rows(x: MatRef<'_, f64>) -> Result<Self, Error> {
+    pub fn from_rows(x: MatRef<'_, f64>) -> Result<Self, Error> {
         let (n, dim) = (x.nrows(), x.ncols());
         let mut data = Vec::with_capacity(n * dim);
         for i in 0..n {
@@ -33,29 +33,34 @@ impl Points {
     }
 
     /// Builds from row-major data; `data.len()` must be a multiple of `dim`.
-    pub(crate) fn from_row_major(dim: usize, data: Vec<f64>) -> Self {
+    pub fn from_row_major(dim: usize, data: Vec<f64>) -> Self {
         debug_assert!(dim > 0 && data.len().is_multiple_of(dim));
         Self { dim, data }
     }
 
     /// Number of points.
-    pub(crate) fn len(&self) -> usize {
+    pub fn len(&self) -> usize {
         self.data.len().checked_div(self.dim).unwrap_or(0)
     }
 
+    /// Whether there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
     /// Dimension of each point.
-    pub(crate) fn dim(&self) -> usize {
+    pub fn dim(&self) -> usize {
         self.dim
     }
 
     /// Point `i`.
     #[inline]
-    pub(crate) fn row(&self, i: usize) -> &[f64] {
+    pub fn row(&self, i: usize) -> &[f64] {
         &self.data[i * self.dim..(i + 1) * self.dim]
     }
 
     /// All coordinates, row-major.
-    pub(crate) fn as_slice(&self) -> &[f64] {
+    pub fn as_slice(&self) -> &[f64] {
         &self.data
     }
 
@@ -67,12 +72,12 @@ impl Points {
     }
 
     /// The points in `range`, in order.
-    pub(crate) fn rows(&self, range: std::ops::Range<usize>) -> Self {
+    pub fn rows(&self, range: std::ops::Range<usize>) -> Self {
         Self { dim: self.dim, data: self.data[range.start * self.dim..range.end * self.dim].to_vec() }
     }
 
     /// The points at `indices`, in that order.
-    pub(crate) fn select(&self, indices: &[usize]) -> Self {
+    pub fn select(&self, indices: &[usize]) -> Self {
         let mut data = Vec::with_capacity(indices.len() * self.dim);
         for &i in indices {
             data.extend_from_slice(self.row(i));

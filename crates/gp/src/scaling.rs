@@ -66,7 +66,7 @@ fn check_map(mean: &[f64], scale: &[f64], len: usize, field: &'static str) -> Re
 
 impl InputStandardiser {
     /// Refuses a map that does not have `dim` finite entries with positive scales.
-    pub(crate) fn check(&self, dim: usize) -> Result<(), Error> {
+    pub fn check(&self, dim: usize) -> Result<(), Error> {
         check_map(&self.mean, &self.scale, dim, "inputs")
     }
 
@@ -76,13 +76,13 @@ impl InputStandardiser {
     }
 
     /// Mean and standard deviation of each column of the training inputs.
-    pub(crate) fn fit(points: &Points) -> Self {
+    pub fn fit(points: &Points) -> Self {
         let (mean, scale) = column_moments(points.len(), points.dim(), |i, j| points.row(i)[j]);
         Self { mean, scale }
     }
 
     /// Applies the map to raw inputs, refusing a wrong column count or non-finite entries.
-    pub(crate) fn apply(&self, x: MatRef<'_, f64>) -> Result<Points, Error> {
+    pub fn apply(&self, x: MatRef<'_, f64>) -> Result<Points, Error> {
         if x.ncols() != self.mean.len() {
             return Err(Error::InputDimensionMismatch { expected: self.mean.len(), found: x.ncols() });
         }
@@ -91,7 +91,7 @@ impl InputStandardiser {
     }
 
     /// Applies the map to already validated points.
-    pub(crate) fn apply_points(&self, raw: &Points) -> Points {
+    pub fn apply_points(&self, raw: &Points) -> Points {
         let data = raw
             .as_slice()
             .chunks_exact(raw.dim().max(1))
@@ -103,7 +103,7 @@ impl InputStandardiser {
 
 impl OutputNormaliser {
     /// Refuses a map that does not have `outputs` finite entries with positive scales.
-    pub(crate) fn check(&self, outputs: usize) -> Result<(), Error> {
+    pub fn check(&self, outputs: usize) -> Result<(), Error> {
         check_map(&self.mean, &self.scale, outputs, "outputs")
     }
 
@@ -113,13 +113,13 @@ impl OutputNormaliser {
     }
 
     /// Mean and standard deviation of each output column.
-    pub(crate) fn fit(y: MatRef<'_, f64>) -> Self {
+    pub fn fit(y: MatRef<'_, f64>) -> Self {
         let (mean, scale) = column_moments(y.nrows(), y.ncols(), |i, j| y[(i, j)]);
         Self { mean, scale }
     }
 
     /// `(y − mean) / scale`, column by column.
-    pub(crate) fn normalise(&self, y: MatRef<'_, f64>) -> Mat<f64> {
+    pub fn normalise(&self, y: MatRef<'_, f64>) -> Mat<f64> {
         Mat::from_fn(y.nrows(), y.ncols(), |i, j| (y[(i, j)] - self.mean[j]) / self.scale[j])
     }
 }

@@ -2,24 +2,10 @@
 
 mod common;
 
-use common::{close, random_kernels, rng, uniform_points};
+use common::{central_difference, close, random_kernels, rng, uniform_points};
 use faer::Mat;
-use gp::{FactorOptions, Kernel, LmlWorkspace, Parallelism, log_marginal_likelihood, sparse_evidence_lower_bound};
+use gp::{FactorOptions, Kernel, LmlWorkspace, Parallelism, log_marginal_likelihood};
 use rand::Rng;
-
-const STEP: f64 = 1e-5;
-
-/// Central difference of `f` in log-parameter `j`.
-fn central_difference(kernel: &Kernel, j: usize, f: impl Fn(&Kernel) -> f64) -> f64 {
-    let p = kernel.log_parameters();
-    let mut plus = p.clone();
-    plus[j] += STEP;
-    let mut minus = p;
-    minus[j] -= STEP;
-    let kp = kernel.with_log_parameters(&plus).expect("finite parameters");
-    let km = kernel.with_log_parameters(&minus).expect("finite parameters");
-    (f(&kp) - f(&km)) / (2.0 * STEP)
-}
 
 #[test]
 fn kernel_gradients_match_central_differences_at_random_points() {
@@ -208,36 +194,5 @@ fn log_marginal_likelihood_matches_the_dense_gaussian_density() {
         let expected = -0.5 * quad - 0.5 * log_det - 0.5 * n as f64 * (2.0 * std::f64::consts::PI).ln();
         let lml = log_marginal_likelihood(&kernel, x.as_ref(), y.as_ref(), false, Parallelism::Rayon).expect("pd");
         assert!(close(lml.value, expected, 1e-9), "{} vs {}", lml.value, expected);
-    }
-}
-
-#[test]
-fn sparse_bound_gradient_matches_central_differences_at_random_points() {
-    // n = 30 rows, m = 7 inducing inputs off the data, one and two outputs, every kernel family.
-    let (n, d, m) = (30, 3, 7);
-    let mut r = rng(13);
-    for trial in 0..3 {
-        let x = uniform_points(&mut r, n, d, -2.0, 2.0);
-        let z = uniform_points(&mut r, m, d, -2.0, 2.0);
-        for outputs in [1, 2] {
-            let y = Mat::from_fn(n, outputs, |i, c| {
-                (x[(i, 0)] * (c + 1) as f64).sin() + 0.3 * x[(i, 1)] + 0.1 * r.random::<f64>()
-            });
-            for kernel in random_kernels(&mut r, d) {
-                let bound = |k: &Kernel, g: bool| {
-                    sparse_evidence_lower_bound(k, x.as_ref(), y.as_ref(), z.as_ref(), g, Parallelism::Sequential)
-                        .expect("positive definite")
-                };
-                let analytic = bound(&kernel, true);
-                assert_eq!(analytic.gradient.len(), kernel.parameter_count());
-                for (j, gj) in analytic.gradient.iter().enumerate() {
-                    let fd = central_difference(&kernel, j, |k| bound(k, false).value);
-                    assert!(
-                        close(*gj, fd, 1e-6),
-                        "trial {trial} outputs {outputs} {kernel:?} parameter {j}: analytic {gj} vs fd {fd}"
-                    );
-                }
-            }
-        }
     }
 }

@@ -96,7 +96,7 @@ pub struct ResidualGpOptions {
     /// The sparse GP (its `gp` field is replaced by [`ResidualGpOptions::gp`], but for the
     /// outputs and the kernel, which [`ResidualGpOptions::sparse_outputs`] and
     /// [`ResidualGpOptions::sparse_kernel`] set).
-    pub sparse: gp::SparseConfig,
+    pub sparse: gp_sparse::SparseConfig,
     /// One kernel for all outputs or one each, in the sparse GP.
     pub sparse_outputs: gp::OutputMode,
     /// The covariance family of the sparse GP.
@@ -143,7 +143,7 @@ impl Default for ResidualGpOptions {
             // search takes minutes); the sparse GP with 500 inducing points takes seconds there
             // and stays within a few percent of the exact error.
             sparse_above_rows: 4000,
-            sparse: gp::SparseConfig::default(),
+            sparse: gp_sparse::SparseConfig::default(),
             // A kernel per output: shared hyperparameters lose accuracy where the outputs' errors
             // vary on different scales.
             sparse_outputs: gp::OutputMode::Independent,
@@ -374,7 +374,7 @@ impl ResidualGpOptions {
 #[serde(untagged)]
 pub enum GpModel {
     /// The sparse variational GP.
-    Sparse(gp::SparseGp),
+    Sparse(gp_sparse::SparseGp),
     /// The exact GP.
     Exact(gp::ExactGp),
 }
@@ -436,14 +436,14 @@ pub enum GpFitReport {
     /// The exact GP's report.
     Exact(gp::ExactFitReport),
     /// The sparse GP's report.
-    Sparse(gp::SparseFitReport),
+    Sparse(gp_sparse::SparseFitReport),
 }
 
 impl GpFitReport {
     /// The output columns whose kernel's hyperparameter search stopped on its iteration limit or a
     /// failed line search rather than on a tolerance, with the iterations it ran. For the sparse GP
     /// that is the exact search on its subset: the bound's search that refines it runs a fixed
-    /// budget ([`gp::SparseConfig::bound_iterations`]) and its outcome stays in the report.
+    /// budget ([`gp_sparse::SparseConfig::bound_iterations`]) and its outcome stays in the report.
     pub fn unconverged(&self) -> Vec<(Vec<usize>, usize)> {
         let exact = |c: &gp::ComponentReport| match &c.optimisation {
             Some(o) if !o.converged => Some((c.outputs.clone(), o.iterations)),
@@ -780,8 +780,8 @@ impl ResidualGp {
                     kernel: options.sparse_kernel,
                     ..options.gp.clone()
                 };
-                let config = gp::SparseConfig { gp, inducing_points, ..options.sparse.clone() };
-                let model = timings::phase("search", || gp::SparseGp::fit(x.as_ref(), y.as_ref(), &config))
+                let config = gp_sparse::SparseConfig { gp, inducing_points, ..options.sparse.clone() };
+                let model = timings::phase("search", || gp_sparse::SparseGp::fit(x.as_ref(), y.as_ref(), &config))
                     .map_err(Error::gp)?;
                 let report = GpFitReport::Sparse(model.report().clone());
                 (GpModel::Sparse(model), report, None, None)

@@ -18,10 +18,8 @@ use std::time::Instant;
 
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
-use gp::{
-    ExactGp, GpConfig, Kernel, KernelChoice, OptimiserConfig, OutputMode, Parallelism, PredictOptions, SparseConfig,
-    SparseGp,
-};
+use gp::{ExactGp, GpConfig, Kernel, KernelChoice, OptimiserConfig, OutputMode, Parallelism, PredictOptions};
+use gp_sparse::{SparseConfig, SparseGp};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -21,7 +21,8 @@ pub use matern52::Matern52Ard;
 pub use quadratic::QuadraticKernel;
 pub use shape::StationaryShape;
 pub use squared_exponential::SquaredExponentialArd;
-pub(crate) use terms::{Evaluator, Expanded, Prepared, Terms};
+pub(crate) use terms::Terms;
+pub use terms::{Evaluator, Expanded, Prepared};
 
 use serde::{Deserialize, Serialize};
 
@@ -382,7 +383,7 @@ impl Kernel {
     }
 
     /// The evaluator and `points` prepared for it.
-    pub(crate) fn prepare(&self, points: &Points) -> (Evaluator, Prepared) {
+    pub fn prepare(&self, points: &Points) -> (Evaluator, Prepared) {
         let terms = self.terms(points.dim());
         let prepared = terms.prepare(points);
         (terms.evaluator, prepared)
@@ -390,7 +391,7 @@ impl Kernel {
 
     /// The gradient in this kernel's log-parameters from the gradient in the expanded ones (chain
     /// rule through the ties: Eq. 5's one length scale `ℓ = θ1^{−1/2}` and one slope weight).
-    pub(crate) fn fold_gradient(&self, expanded: &[f64], dim: usize) -> Vec<f64> {
+    pub fn fold_gradient(&self, expanded: &[f64], dim: usize) -> Vec<f64> {
         let layout = Expanded { dim };
         let lengths = (0..dim).map(|i| expanded[layout.length(i)]);
         let mut g = vec![expanded[Expanded::SIGNAL]];
@@ -449,7 +450,7 @@ impl Kernel {
 impl Bounds {
     /// Checks `0 < lower ≤ upper < ∞` and the length against `kernel`, and returns the bounds in
     /// log space.
-    pub(crate) fn to_log(&self, kernel: &Kernel) -> Result<(Vec<f64>, Vec<f64>), Error> {
+    pub fn to_log(&self, kernel: &Kernel) -> Result<(Vec<f64>, Vec<f64>), Error> {
         let expected = kernel.parameter_count();
         for found in [self.lower.len(), self.upper.len()] {
             if found != expected {
@@ -463,12 +464,6 @@ impl Bounds {
         }
         Ok((self.lower.iter().map(|v| v.ln()).collect(), self.upper.iter().map(|v| v.ln()).collect()))
     }
-}
-
-/// `‖a − b‖²`.
-#[inline]
-pub(crate) fn squared_distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
 }
 
 #[cfg(test)]

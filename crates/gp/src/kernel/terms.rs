@@ -11,13 +11,14 @@ use crate::points::Points;
 
 /// What the Gram-matrix loops need besides the prepared points.
 #[derive(Debug, Clone)]
-pub(crate) struct Evaluator {
+pub struct Evaluator {
     pub(crate) shape: StationaryShape,
-    pub(crate) signal_variance: f64,
+    /// `σf²`.
+    pub signal_variance: f64,
     /// `σc²`, 0 without a constant term.
-    pub(crate) constant: f64,
+    pub constant: f64,
     /// `aᵢ` of the additive term, empty without one.
-    pub(crate) additive_variances: Vec<f64>,
+    pub additive_variances: Vec<f64>,
     pub(crate) noise_variance: f64,
 }
 
@@ -32,19 +33,26 @@ impl Evaluator {
 /// multiplied by `√wᵢ` for the linear term (so that it is a plain inner product), and divided by
 /// the additive term's own length scales `bᵢ`.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Prepared {
+pub struct Prepared {
     pub(crate) stationary: Points,
-    pub(crate) linear: Option<Points>,
+    /// Inputs times `√wᵢ`, `None` without a linear term.
+    pub linear: Option<Points>,
     pub(crate) additive: Option<Points>,
 }
 
 impl Prepared {
-    pub(crate) fn len(&self) -> usize {
+    /// Number of points.
+    pub fn len(&self) -> usize {
         self.stationary.len()
     }
 
+    /// Whether there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
     /// The points in `range`, in order.
-    pub(crate) fn rows(&self, range: std::ops::Range<usize>) -> Self {
+    pub fn rows(&self, range: std::ops::Range<usize>) -> Self {
         Self {
             stationary: self.stationary.rows(range.clone()),
             linear: self.linear.as_ref().map(|l| l.rows(range.clone())),
@@ -66,30 +74,39 @@ pub(crate) struct Terms {
 
 /// Index of each block in the expanded log-parameters for `dim` inputs.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Expanded {
-    pub(crate) dim: usize,
+pub struct Expanded {
+    /// Number of inputs.
+    pub dim: usize,
 }
 
 impl Expanded {
-    pub(crate) const SIGNAL: usize = 0;
+    /// `ln σf²`.
+    pub const SIGNAL: usize = 0;
+    /// `ln ℓᵢ`.
     pub(crate) fn length(self, i: usize) -> usize {
         1 + i
     }
-    pub(crate) fn constant(self) -> usize {
+    /// `ln σc²`.
+    pub fn constant(self) -> usize {
         1 + self.dim
     }
-    pub(crate) fn linear(self, i: usize) -> usize {
+    /// `ln wᵢ`.
+    pub fn linear(self, i: usize) -> usize {
         2 + self.dim + i
     }
-    pub(crate) fn additive_variance(self, i: usize) -> usize {
+    /// `ln aᵢ`.
+    pub fn additive_variance(self, i: usize) -> usize {
         2 + 2 * self.dim + i
     }
+    /// `ln bᵢ`.
     pub(crate) fn additive_length(self, i: usize) -> usize {
         2 + 3 * self.dim + i
     }
-    pub(crate) fn noise(self) -> usize {
+    /// `ln σn²`.
+    pub fn noise(self) -> usize {
         2 + 4 * self.dim
     }
+    /// Number of expanded log-parameters, `4d + 3`.
     pub(crate) fn len(self) -> usize {
         3 + 4 * self.dim
     }

@@ -1,4 +1,5 @@
-//! Helpers shared by the integration tests: seeded data and GP samples.
+//! Helpers shared by the integration tests (gp's and gp-sparse's): seeded data, GP samples and
+//! central differences.
 #![allow(dead_code)]
 
 use faer::Mat;
@@ -88,4 +89,18 @@ pub fn sample_gp(rng: &mut ChaCha8Rng, kernel: &Kernel, x: &Mat<f64>, m: usize) 
 /// `|a − b| ≤ tol · max(1, |a|, |b|)`.
 pub fn close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol * 1f64.max(a.abs()).max(b.abs())
+}
+
+const STEP: f64 = 1e-5;
+
+/// Central difference of `f` in log-parameter `j`.
+pub fn central_difference(kernel: &Kernel, j: usize, f: impl Fn(&Kernel) -> f64) -> f64 {
+    let p = kernel.log_parameters();
+    let mut plus = p.clone();
+    plus[j] += STEP;
+    let mut minus = p;
+    minus[j] -= STEP;
+    let kp = kernel.with_log_parameters(&plus).expect("finite parameters");
+    let km = kernel.with_log_parameters(&minus).expect("finite parameters");
+    (f(&kp) - f(&km)) / (2.0 * STEP)
 }

@@ -17,16 +17,16 @@ use faer::{Accum, Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
 use crate::Error;
-use crate::cholesky::{Factor, JitterOutcome};
-use crate::config::{GpConfig, OutputMode, Parallelism};
 use crate::elbo::{CHUNK_ROWS, Posterior, evidence_lower_bound};
-use crate::exact::{ComponentReport, ExactGp, check_served, validate_training_data};
-use crate::gram::{cross_covariance, full_covariance, prior_variances, training_covariance};
-use crate::inducing::{InducingSelection, random_indices, select_inducing};
-use crate::kernel::Kernel;
-use crate::points::Points;
-use crate::predict::{PredictOptions, Prediction};
-use crate::scaling::{InputStandardiser, OutputNormaliser};
+use crate::inducing::{InducingSelection, select_inducing};
+use gp::blocks::{
+    Factor, Points, check_served, cross_covariance, full_covariance, prior_variances, random_indices,
+    training_covariance, validate_training_data,
+};
+use gp::{
+    ComponentReport, ExactGp, GpConfig, InputStandardiser, JitterOutcome, Kernel, OutputMode, OutputNormaliser,
+    Parallelism, PredictOptions, Prediction,
+};
 use lbfgsb::{Objective, Settings, Termination};
 
 /// Configuration of the sparse approximation.
@@ -73,7 +73,9 @@ impl SparseConfig {
         let (points, subset) = (self.inducing_points, self.hyperparameter_subset);
         let checks = [("inducing_points", points, 1, "at least 1"), ("hyperparameter_subset", subset, 2, "at least 2")];
         let refused = checks.into_iter().find(|&(_, value, least, _)| value < least);
-        refused.map_or(Ok(()), |(field, n, _, expected)| Err(Error::InvalidOption { field, value: n as f64, expected }))
+        refused.map_or(Ok(()), |(field, n, _, expected)| {
+            Err(gp::Error::InvalidOption { field, value: n as f64, expected }.into())
+        })
     }
 }
 
@@ -176,7 +178,7 @@ fn maximise_bound(
     };
     let mut objective = NegativeBound { start, x, y, z, config: gp, gradient: None };
     let minimum = lbfgsb::minimise(&mut objective, &start.log_parameters(), &lower, &upper, &settings)
-        .ok_or(Error::OptimisationFailed { starts: 1 })?;
+        .ok_or(gp::Error::OptimisationFailed { starts: 1 })?;
     let converged = matches!(minimum.termination, Termination::GradientTolerance | Termination::FunctionTolerance);
     Ok((start.with_log_parameters(&minimum.x)?, minimum.iterations, converged))
 }
@@ -202,7 +204,7 @@ impl SparseGp {
     ) -> Result<Self, Error> {
         let valid = kernels.len() == 1 || (config.gp.outputs == OutputMode::Independent && kernels.len() == y.ncols());
         if !valid {
-            return Err(Error::InvalidConfig { field: "kernels", value: kernels.len() as f64 });
+            return Err(gp::Error::InvalidConfig { field: "kernels", value: kernels.len() as f64 }.into());
         }
         Self::fit_impl(x, y, Some(kernels), config)
     }
@@ -315,13 +317,13 @@ impl SparseGp {
     }
 
     /// Posterior mean and variance (latent, no noise) at the rows of `x`.
-    pub fn predict(&self, x: MatRef<'_, f64>) -> Result<Prediction, Error> {
+    pub fn predict(&self, x: MatRef<'_, f64>) -> Result<Prediction, gp::Error> {
         self.predict_with(x, &PredictOptions::default())
     }
 
     /// Posterior at the rows of `x` with the quantities `options` asks for; the rows are taken in
     /// chunks, so memory stays `O(chunk · m)` besides the result.
-    pub fn predict_with(&self, x: MatRef<'_, f64>, options: &PredictOptions) -> Result<Prediction, Error> {
+    pub fn predict_with(&self, x: MatRef<'_, f64>, options: &PredictOptions) -> Result<Prediction, gp::Error> {
         let z = self.inputs.apply(x)?;
         let par = self.parallelism.faer();
         let (ns, m) = (z.len(), self.output_count());
@@ -431,24 +433,24 @@ impl From<SparseGp> for StoredSparseGp {
 }
 
 impl TryFrom<StoredSparseGp> for SparseGp {
-    type Error = Error;
+    type Error = gp::Error;
 
-    fn try_from(s: StoredSparseGp) -> Result<Self, Error> {
+    fn try_from(s: StoredSparseGp) -> Result<Self, gp::Error> {
         let (d, m) = (s.inputs.mean.len(), s.outputs.mean.len());
         s.inputs.check(d)?;
         s.outputs.check(m)?;
         let nu = s.inducing_inputs.len();
         if nu == 0 {
-            return Err(Error::TooFewPoints { rows: 0, required: 1 });
+            return Err(gp::Error::TooFewPoints { rows: 0, required: 1 });
         }
         if let Some(row) = s.inducing_inputs.iter().find(|r| r.len() != d) {
-            return Err(Error::InputDimensionMismatch { expected: d, found: row.len() });
+            return Err(gp::Error::InputDimensionMismatch { expected: d, found: row.len() });
         }
         let zm = Mat::from_fn(nu, d, |i, j| s.inducing_inputs[i][j]);
         let inducing = Points::from_rows(zm.as_ref())?;
         check_served(s.report.components.iter().map(|c| &c.outputs), m)?;
         if s.posteriors.len() != s.report.components.len() {
-            return Err(Error::InvalidConfig { field: "posteriors", value: s.posteriors.len() as f64 });
+            return Err(gp::Error::InvalidConfig { field: "posteriors", value: s.posteriors.len() as f64 });
         }
         let par = s.parallelism.faer();
         let mut components = Vec::with_capacity(s.posteriors.len());
@@ -457,15 +459,18 @@ impl TryFrom<StoredSparseGp> for SparseGp {
             let k = c.outputs.len();
             let w_ok = stored.w.len() == nu && stored.w.iter().all(|r| r.len() == k && r.iter().all(|v| v.is_finite()));
             if !w_ok {
-                return Err(Error::InvalidConfig { field: "posteriors.w", value: stored.w.len() as f64 });
+                return Err(gp::Error::InvalidConfig { field: "posteriors.w", value: stored.w.len() as f64 });
             }
             let l_ok = stored.l_b.len() == nu && stored.l_b.iter().enumerate().all(|(i, r)| r.len() == i + 1);
             if !l_ok {
-                return Err(Error::InvalidConfig { field: "posteriors.l_b", value: stored.l_b.len() as f64 });
+                return Err(gp::Error::InvalidConfig { field: "posteriors.l_b", value: stored.l_b.len() as f64 });
             }
             let l = Mat::from_fn(nu, nu, |i, j| if j <= i { stored.l_b[i][j] } else { 0.0 });
-            let l_b =
-                Factor::from_lower(l).map_err(|pivot| Error::CholeskyFailed { size: nu, pivot, jitter_tried: 0.0 })?;
+            let l_b = Factor::from_lower(l).map_err(|pivot| gp::Error::CholeskyFailed {
+                size: nu,
+                pivot,
+                jitter_tried: 0.0,
+            })?;
             let w = Mat::from_fn(nu, k, |i, j| stored.w[i][j]);
             let (evaluator, zp) = c.kernel.prepare(&inducing);
             let kuu = training_covariance(&evaluator, &zp, 0.0, s.parallelism);

@@ -18,14 +18,12 @@ use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::{Accum, Mat, MatRef};
 
-use crate::Error;
-use crate::cholesky::{Factor, JitterOutcome};
-use crate::config::{JitterConfig, Parallelism};
-use crate::cross_gradient::contract_cross;
-use crate::gram::{cross_covariance, prior_variances, training_covariance};
-use crate::kernel::{Evaluator, Expanded, Kernel, Prepared};
-use crate::points::Points;
 use dense::product;
+use gp::blocks::{
+    Evaluator, Expanded, Factor, Points, Prepared, check_finite_outputs, contract_cross, cross_covariance,
+    prior_variances, training_covariance,
+};
+use gp::{Error, JitterConfig, JitterOutcome, Kernel, LogMarginalLikelihood, Parallelism};
 
 /// Rows per chunk: a `m × 2048` block is 8 MB at `m = 500`, small beside `K_uu`'s factors yet
 /// wide enough for faer's products to run at full speed.
@@ -226,7 +224,7 @@ pub fn sparse_evidence_lower_bound(
     inducing: MatRef<'_, f64>,
     with_gradient: bool,
     parallelism: Parallelism,
-) -> Result<crate::LogMarginalLikelihood, Error> {
+) -> Result<LogMarginalLikelihood, Error> {
     if x.nrows() != y.nrows() {
         return Err(Error::RowCountMismatch { input_rows: x.nrows(), output_rows: y.nrows() });
     }
@@ -236,9 +234,9 @@ pub fn sparse_evidence_lower_bound(
     kernel.validate(x.ncols())?;
     let points = Points::from_rows(x)?;
     let z = Points::from_rows(inducing)?;
-    crate::lml::check_finite_outputs(y)?;
+    check_finite_outputs(y)?;
     let no_jitter = JitterConfig { max_attempts: 0, ..JitterConfig::default() };
     let (posterior, gradient) =
         evidence_lower_bound(kernel, &points, y, &z, (&no_jitter, None), with_gradient, parallelism)?;
-    Ok(crate::LogMarginalLikelihood { value: posterior.bound, gradient })
+    Ok(LogMarginalLikelihood { value: posterior.bound, gradient })
 }

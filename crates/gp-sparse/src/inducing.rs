@@ -1,15 +1,13 @@
 //! Choice of inducing inputs for the sparse approximation: a seeded random subset of the training
 //! inputs, or k-means centres (k-means++ seeding, Arthur & Vassilvitskii 2007, then Lloyd steps).
 
-use rand::seq::index::sample;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::config::Parallelism;
-use crate::kernel::squared_distance;
-use crate::points::Points;
+use gp::Parallelism;
+use gp::blocks::{Points, random_indices};
 
 /// How the inducing inputs are chosen (on standardised inputs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -29,12 +27,10 @@ impl Default for InducingSelection {
     }
 }
 
-/// `count` distinct indices out of `0..n`, sorted, from `seed`.
-pub(crate) fn random_indices(n: usize, count: usize, seed: u64) -> Vec<usize> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut indices = sample(&mut rng, n, count.min(n)).into_vec();
-    indices.sort_unstable();
-    indices
+/// `‖a − b‖²`.
+#[inline]
+fn squared_distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
 }
 
 /// `count` inducing inputs chosen from `x` by `selection`.

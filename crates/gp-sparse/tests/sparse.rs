@@ -1,13 +1,12 @@
 //! The inducing-point approximation against the exact GP.
 
+#[path = "../../gp/tests/common/mod.rs"]
 mod common;
 
 use common::{rng, uniform_points};
 use faer::Mat;
-use gp::{
-    Error, ExactGp, GpConfig, InducingSelection, Kernel, KernelChoice, Matern52Ard, OptimiserConfig, Parallelism,
-    PredictOptions, SparseConfig, SparseGp,
-};
+use gp::{ExactGp, GpConfig, Kernel, KernelChoice, Matern52Ard, OptimiserConfig, Parallelism, PredictOptions};
+use gp_sparse::{Error, InducingSelection, SparseConfig, SparseGp};
 use rand::Rng;
 use rand_distr::StandardNormal;
 
@@ -153,7 +152,7 @@ fn more_inducing_points_than_training_points_are_refused() {
     let config = SparseConfig { inducing_points: 0, ..SparseConfig::default() };
     assert_eq!(
         SparseGp::fit(x.as_ref(), y.as_ref(), &config).err(),
-        Some(Error::InvalidOption { field: "inducing_points", value: 0.0, expected: "at least 1" })
+        Some(Error::Gp(gp::Error::InvalidOption { field: "inducing_points", value: 0.0, expected: "at least 1" }))
     );
 }
 
