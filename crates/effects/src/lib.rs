@@ -28,7 +28,8 @@
 
 /// The default of the fit's `EffectOptions::hold_beyond_span`, also what the diagnosis uses: thermal
 /// growth and drift are applied as fitted up to this fraction of their fitted span beyond either
-/// end, held (growth) or faded to zero (drift) further out. 1: a linear term is trusted as far
+/// end; further out each follows its [`BeyondSpan`] rule (held, zero, or dropped to the geometry
+/// fitted alone), chosen from the sessions where they can decide it. 1: a linear term is trusted as far
 /// beyond its data as the data reaches (see `EffectOptions::hold_beyond_span`).
 pub const HOLD_BEYOND_SPAN: f64 = 1.0;
 
