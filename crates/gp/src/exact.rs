@@ -12,8 +12,8 @@ use crate::gram::training_covariance;
 use crate::kernel::{Bounds, KernelChoice};
 use crate::kernel::{Evaluator, Kernel, Prepared};
 use crate::lml::check_finite_outputs;
+use crate::optimise::ExpectedGroups;
 use crate::optimise::{OptimisationReport, WarmStage, finish_from, refine, warm_stage_from};
-use crate::optimise::{expect_one_thread_groups, one_thread_group};
 use crate::points::Points;
 use crate::scaling::{InputStandardiser, OutputNormaliser};
 
@@ -496,10 +496,10 @@ impl ExactGp {
         let busy = config.parallelism == Parallelism::Rayon && groups.len() >= rayon::current_num_threads();
         let one_thread = GpConfig { parallelism: Parallelism::Sequential, ..config.clone() };
         let fits = GroupFits { xs: &xs, yn: &yn, config: if busy { &one_thread } else { config }, how: &how };
-        expect_one_thread_groups(if busy { groups.len() } else { 0 });
+        let expected = ExpectedGroups::new(if busy { groups.len() } else { 0 });
         let fit_group = |(g, cols): (usize, &Vec<usize>)| {
             let fit = || fits.with_isotropic(fits.fit_searched(g, cols)?, cols);
-            if busy { one_thread_group(fit) } else { fit() }
+            if busy { expected.run(fit) } else { fit() }
         };
         let fitted: Vec<_> = match config.parallelism {
             Parallelism::Sequential => groups.iter().enumerate().map(fit_group).collect(),

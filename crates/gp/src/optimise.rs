@@ -83,17 +83,39 @@ fn starting_points(
 static UNFINISHED_GROUPS: AtomicUsize = AtomicUsize::new(0);
 thread_local!(static IN_GROUP: Cell<bool> = const { Cell::new(false) });
 
-/// Counts `groups` more in [`UNFINISHED_GROUPS`], before any of them runs.
-pub(crate) fn expect_one_thread_groups(groups: usize) {
-    UNFINISHED_GROUPS.fetch_add(groups, Ordering::SeqCst);
+/// The groups one fit counted in [`UNFINISHED_GROUPS`]. Each group run by [`Self::run`] takes
+/// itself back when it ends, a panic included; dropping this takes back the groups that never ran
+/// (a panic elsewhere ended the fit), so the count stays true for the process's later fits.
+pub(crate) struct ExpectedGroups {
+    left: AtomicUsize,
 }
 
-/// `f()` on this thread as one of the [`UNFINISHED_GROUPS`] (a panic leaves the count high).
-pub(crate) fn one_thread_group<T>(f: impl FnOnce() -> T) -> T {
-    let (outer, result) = (IN_GROUP.replace(true), f());
-    IN_GROUP.set(outer);
-    UNFINISHED_GROUPS.fetch_sub(1, Ordering::SeqCst);
-    result
+impl ExpectedGroups {
+    /// Counts `groups` more in [`UNFINISHED_GROUPS`], before any of them runs.
+    pub(crate) fn new(groups: usize) -> Self {
+        UNFINISHED_GROUPS.fetch_add(groups, Ordering::SeqCst);
+        Self { left: AtomicUsize::new(groups) }
+    }
+
+    /// `f()` on this thread as one of the counted groups.
+    pub(crate) fn run<T>(&self, f: impl FnOnce() -> T) -> T {
+        struct Finish<'a>(&'a AtomicUsize, bool);
+        impl Drop for Finish<'_> {
+            fn drop(&mut self) {
+                IN_GROUP.set(self.1);
+                self.0.fetch_sub(1, Ordering::SeqCst);
+                UNFINISHED_GROUPS.fetch_sub(1, Ordering::SeqCst);
+            }
+        }
+        let _finish = Finish(&self.left, IN_GROUP.replace(true));
+        f()
+    }
+}
+
+impl Drop for ExpectedGroups {
+    fn drop(&mut self) {
+        UNFINISHED_GROUPS.fetch_sub(*self.left.get_mut(), Ordering::SeqCst);
+    }
 }
 
 /// `parallelism`, or the pool for the last of [`UNFINISHED_GROUPS`].
